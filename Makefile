@@ -1,0 +1,78 @@
+# mcplay: the two commands a fresh machine needs are `make run` and `make test`.
+# Both install missing Debian packages first (`make deps`).
+
+SHELL := /bin/bash
+JOBS ?= $(shell nproc 2>/dev/null || echo 2)
+BUILD ?= build
+BUILD_WASM ?= build-wasm
+SCENE ?= scenes/exp_1d.json
+ARGS ?=
+
+# emcc's JavaScript optimiser needs Debian's acorn when node is not Debian's own.
+export NODE_PATH := /usr/share/nodejs
+
+APT_PACKAGES := cmake g++ make googletest libgtest-dev emscripten libglm-dev libstb-dev \
+	libtinygltf-dev nlohmann-json3-dev
+# One file or command per package that tells whether it is installed.
+DEP_PROBES := /usr/bin/cmake /usr/bin/g++ /usr/src/googletest/CMakeLists.txt \
+	/usr/include/gtest/gtest.h /usr/bin/em++ /usr/include/glm/glm.hpp /usr/include/stb/stb_image_write.h \
+	/usr/include/tiny_gltf.h /usr/include/nlohmann/json.hpp
+
+.PHONY: all deps build build-wasm test test-native test-wasm test-compare run bench format clean help
+
+all: build
+
+help:
+	@echo "make run    build the native CLI and run it on $(SCENE)"
+	@echo "make test   install what is missing, build native + wasm, run every test suite"
+	@echo "make bench  samples per second natively and in wasm under Node, and their ratio"
+	@echo "make format clang-format every C++ source"
+
+deps:
+	@missing=""; for p in $(DEP_PROBES); do [ -e $$p ] || missing="$$missing $$p"; done; \
+	command -v node >/dev/null || missing="$$missing node"; \
+	if [ -n "$$missing" ]; then \
+	  echo "deps: missing$$missing"; \
+	  if [ "$$(id -u)" = 0 ]; then \
+	    apt-get update -q && DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends $(APT_PACKAGES); \
+	  else \
+	    echo "deps: not root; run: sudo apt-get install -y --no-install-recommends $(APT_PACKAGES)"; exit 1; \
+	  fi; \
+	fi
+
+$(BUILD)/CMakeCache.txt:
+	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release
+
+$(BUILD_WASM)/CMakeCache.txt:
+	emcmake cmake -S . -B $(BUILD_WASM) -DCMAKE_BUILD_TYPE=Release
+
+build: deps $(BUILD)/CMakeCache.txt
+	cmake --build $(BUILD) -j $(JOBS)
+
+build-wasm: deps $(BUILD_WASM)/CMakeCache.txt
+	cmake --build $(BUILD_WASM) -j $(JOBS)
+
+test-native: build
+	ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS)
+
+test-wasm: build-wasm
+	ctest --test-dir $(BUILD_WASM) --output-on-failure -j $(JOBS)
+
+# The same study through the native CLI and the wasm CLI under Node must agree.
+test-compare: build build-wasm
+	bash tests/compare_native_wasm.sh $(BUILD)/mcplay "node $(BUILD_WASM)/mcplay.js"
+
+test: test-native test-wasm test-compare
+	@echo "make test: all suites passed"
+
+run: build
+	./$(BUILD)/mcplay run $(SCENE) $(ARGS)
+
+bench: build build-wasm
+	bash bench/run_bench.sh $(BUILD)/mcplay_bench "node $(BUILD_WASM)/mcplay_bench.js"
+
+format:
+	clang-format -i $$(git ls-files '*.cpp' '*.h')
+
+clean:
+	rm -rf $(BUILD) $(BUILD_WASM)

@@ -1,0 +1,1 @@
+extern "C" const char* mcp_version(void) { return MCPLAY_VERSION; }

@@ -1,0 +1,106 @@
+// One- and two-dimensional sampling distributions for importance sampling: analytic
+// densities sampled by their inverse CDF, and piecewise-constant densities tabulated from a
+// user-given shape. Each distribution is normalised on its interval, has an exact pdf and
+// an inverse (the CDF), and samples whole blocks at once (one dispatch per block).
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+namespace mcp {
+
+enum class Dist1DKind {
+    Uniform,            ///< p = 1/(b-a)
+    Power,              ///< p proportional to (x - a)^k, k > -1 (k = 1: linear ramp)
+    Exponential,        ///< p proportional to exp(-rate x); rate may be negative, not 0
+    TruncatedGaussian,  ///< p proportional to exp(-(x-mu)^2 / (2 sigma^2)) on [a, b]
+    Cosine,             ///< p proportional to cos(omega (x - x0)), |omega (x - x0)| <= pi/2
+    Tabulated,          ///< piecewise constant on equal bins of [a, b]
+};
+
+/// A normalised density on [a, b]. Construct with the make_* functions below, which
+/// validate their parameters and return an error message instead of an object on bad input.
+class Distribution1D {
+  public:
+    Distribution1D() = default;
+
+    Dist1DKind kind() const { return kind_; }
+    double lower() const { return a_; }
+    double upper() const { return b_; }
+
+    /// Inverse-CDF sample for u in (0,1); the result lies in [a, b].
+    double sample(double u) const;
+    /// Density at x (0 outside [a, b]).
+    double pdf(double x) const;
+    /// CDF at x, so that cdf(sample(u)) == u up to rounding: the inverse of sample.
+    double cdf(double x) const;
+
+    /// x[i] = sample(u[i]), pdf[i] = pdf(x[i]) for i < n: the batch form used in hot loops.
+    void sample_block(const double* u, double* x, double* pdf, size_t n) const;
+    /// pdf[i] *= pdf(x[i]): multiplies the densities of a product of 1D distributions.
+    void multiply_pdf_block(const double* x, double* pdf, size_t n) const;
+
+    /// A short description, e.g. "power(k=1) on [0, 1]".
+    std::string describe() const;
+
+  private:
+    friend struct Distribution1DFactory;
+    Dist1DKind kind_ = Dist1DKind::Uniform;
+    double a_ = 0.0, b_ = 1.0;
+    double p0_ = 0.0, p1_ = 0.0;    // kind-specific parameters (k; rate; mu, sigma; omega, x0)
+    double c0_ = 0.0, c1_ = 0.0;    // precomputed normalisation terms
+    std::vector<double> func_;      // tabulated: bin values (normalised density)
+    std::vector<double> cdf_;       // tabulated: cdf at bin edges, cdf_[0] = 0, back() = 1
+};
+
+/// Result of a factory: either a distribution or an error naming the bad parameter.
+template <class T> struct Made {
+    T value;
+    std::string error;  ///< empty on success
+    bool ok() const { return error.empty(); }
+};
+
+Made<Distribution1D> make_uniform(double a, double b);
+Made<Distribution1D> make_power(double a, double b, double k);
+Made<Distribution1D> make_exponential(double a, double b, double rate);
+Made<Distribution1D> make_truncated_gaussian(double a, double b, double mu, double sigma);
+Made<Distribution1D> make_cosine(double a, double b, double omega, double x0);
+/// Piecewise-constant density on equal bins of [a, b] proportional to |values[i]|.
+/// Errors when values is empty, has a negative, NaN or infinite entry, or sums to zero.
+Made<Distribution1D> make_tabulated(double a, double b, const std::vector<double>& values);
+
+/// Piecewise-constant density on an nx-by-ny grid over [x0,x1] x [y0,y1], proportional to
+/// |values[iy * nx + ix]|, sampled as marginal in y then conditional in x [PBR4, A.5.6].
+class TabulatedDistribution2D {
+  public:
+    /// Samples (x, y) from (u1, u2) and returns the density per unit area.
+    void sample(double u1, double u2, double* x, double* y, double* pdf) const;
+    double pdf(double x, double y) const;
+    /// The inverse of sample: (u1, u2) from a point.
+    void invert(double x, double y, double* u1, double* u2) const;
+    void sample_block(const double* u1, const double* u2, double* x, double* y, double* pdf,
+                      size_t n) const;
+
+    int nx() const { return nx_; }
+    int ny() const { return ny_; }
+    double x0() const { return x0_; }
+    double x1() const { return x1_; }
+    double y0() const { return y0_; }
+    double y1() const { return y1_; }
+
+  private:
+    friend Made<TabulatedDistribution2D> make_tabulated_2d(double, double, double, double, int,
+                                                           int, const std::vector<double>&);
+    int nx_ = 0, ny_ = 0;
+    double x0_ = 0, x1_ = 1, y0_ = 0, y1_ = 1;
+    std::vector<Distribution1D> conditional_;  // one per row y, over x
+    Distribution1D marginal_;                  // over y
+    double total_ = 0.0;                       // integral of the unnormalised table
+    std::vector<double> values_;               // |values|, row-major
+};
+
+Made<TabulatedDistribution2D> make_tabulated_2d(double x0, double x1, double y0, double y1,
+                                                int nx, int ny, const std::vector<double>& values);
+
+}  // namespace mcp

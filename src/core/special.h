@@ -1,0 +1,39 @@
+// Special functions for error bars and goodness-of-fit tests: the normal and Student t
+// quantiles, the regularised incomplete gamma function (chi-square tail probabilities),
+// and the trigamma function (the variance of a log sample variance).
+#pragma once
+
+namespace mcp {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kInvPi = 0.31830988618379067154;
+constexpr double kSqrt2 = 1.41421356237309504880;
+
+/// Standard normal CDF Phi(x), accurate in both tails.
+double normal_cdf(double x);
+
+/// Standard normal quantile Phi^-1(p) for p in (0, 1): the rational starting value of
+/// [AS64, 26.2.23] refined by Halley steps on erfc, good to a few ulps.
+double normal_quantile(double p);
+
+/// Quantile of Student's t with nu degrees of freedom: exact for nu = 1, 2; the
+/// Cornish-Fisher expansion [AS64, 26.7.5] otherwise (error < 1e-3 for nu >= 3).
+double student_t_quantile(double p, double nu);
+
+/// Regularised lower incomplete gamma P(a, x) = gamma(a, x) / Gamma(a), and Q = 1 - P
+/// computed without cancellation: series for x < a + 1, continued fraction otherwise
+/// [NR07, 6.2].
+double gamma_p(double a, double x);
+double gamma_q(double a, double x);
+
+/// Upper tail probability of the chi-square distribution with k degrees of freedom.
+double chi_square_sf(double x, double k);
+
+/// Quantile of the chi-square distribution: P(X <= x) = p.
+double chi_square_quantile(double p, double k);
+
+/// Trigamma psi'(x) for x > 0 (recurrence up to x >= 6, then the asymptotic series).
+/// Var[log s^2] = psi'((R - 1) / 2) for a sample variance of R normal values.
+double trigamma(double x);
+
+}  // namespace mcp

@@ -1,0 +1,72 @@
+// Numerically stable running statistics: compensated sums, Welford moments and a
+// least-squares line fit with its uncertainty.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+namespace mcp {
+
+/// Neumaier's improved Kahan summation [Neumaier74]: the running compensation also
+/// catches the case where the new term is larger than the running sum.
+class NeumaierSum {
+  public:
+    void add(double x) {
+        double t = sum_ + x;
+        if (std::fabs(sum_) >= std::fabs(x))
+            comp_ += (sum_ - t) + x;
+        else
+            comp_ += (x - t) + sum_;
+        sum_ = t;
+    }
+    double value() const { return sum_ + comp_; }
+
+  private:
+    double sum_ = 0.0;
+    double comp_ = 0.0;
+};
+
+/// Running mean and variance by Welford's update [Welford62]; the mean is also kept as a
+/// compensated sum so that 1e9 and more terms lose no digits. Never E[x^2] - E[x]^2.
+class RunningMoments {
+  public:
+    void add(double x) {
+        ++n_;
+        sum_.add(x);
+        double delta = x - mean_;
+        mean_ += delta / static_cast<double>(n_);
+        m2_ += delta * (x - mean_);
+    }
+    /// Parallel combination of two sets of moments [Chan79].
+    void merge(const RunningMoments& o);
+
+    uint64_t count() const { return n_; }
+    /// Compensated-sum mean (more accurate than the Welford running mean).
+    double mean() const { return n_ ? sum_.value() / static_cast<double>(n_) : 0.0; }
+    double sum() const { return sum_.value(); }
+    /// Unbiased sample variance, 1/(n-1) sum (x - mean)^2.
+    double variance() const { return n_ > 1 ? m2_ / static_cast<double>(n_ - 1) : 0.0; }
+    double sum_squared_deviations() const { return m2_; }
+
+  private:
+    uint64_t n_ = 0;
+    NeumaierSum sum_;
+    double mean_ = 0.0;
+    double m2_ = 0.0;
+};
+
+/// Ordinary least squares y = intercept + slope * x.
+struct LineFit {
+    double slope = 0.0;
+    double intercept = 0.0;
+    double slope_se = 0.0;        ///< from the residuals, s / sqrt(Sxx)
+    double residual_variance = 0.0;
+    double sxx = 0.0;             ///< sum (x - mean x)^2
+    int points = 0;
+};
+
+/// Fits a line through (x[i], y[i]); needs at least two distinct x.
+LineFit fit_line(const std::vector<double>& x, const std::vector<double>& y);
+
+}  // namespace mcp
