@@ -8,6 +8,9 @@ BUILD_WASM ?= build-wasm
 SCENE ?= scenes/exp_1d.json
 ARGS ?=
 
+# Node 20's fetch() cannot load the .wasm beside a non-ES6 Emscripten program from a file path.
+NODE_RUN := node --no-experimental-fetch
+
 # emcc's JavaScript optimiser needs Debian's acorn when node is not Debian's own.
 export NODE_PATH := /usr/share/nodejs
 
@@ -60,7 +63,7 @@ test-wasm: build-wasm
 
 # The same study through the native CLI and the wasm CLI under Node must agree.
 test-compare: build build-wasm
-	bash tests/compare_native_wasm.sh $(BUILD)/mcplay "node $(BUILD_WASM)/mcplay.js"
+	bash tests/compare_native_wasm.sh $(BUILD)/mcplay "$(NODE_RUN) $(BUILD_WASM)/mcplay.js"
 
 test: test-native test-wasm test-compare
 	@echo "make test: all suites passed"
@@ -69,7 +72,7 @@ run: build
 	./$(BUILD)/mcplay run $(SCENE) $(ARGS)
 
 bench: build build-wasm
-	bash bench/run_bench.sh $(BUILD)/mcplay_bench "node $(BUILD_WASM)/mcplay_bench.js"
+	bash bench/run_bench.sh $(BUILD)/mcplay_bench "$(NODE_RUN) $(BUILD_WASM)/mcplay_bench.js"
 
 format:
 	clang-format -i $$(git ls-files '*.cpp' '*.h')

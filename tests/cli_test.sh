@@ -1,2 +1,68 @@
 #!/usr/bin/env bash
-exit 0
+# The mcplay CLI through its real executable: exit codes, one-line errors, output formats.
+# Usage: cli_test.sh SOURCE_DIR MCPLAY_EXECUTABLE (a .js file is run with node)
+set -u
+src=${1:?source dir}
+exe=${2:?mcplay executable}
+cd "$src"
+case "$exe" in
+    *.js) mcplay="node --no-experimental-fetch $exe" ;;  # Node 20 fetch() cannot load file paths
+    *) mcplay="$exe" ;;
+esac
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+passed=0 failed=0
+
+check() {  # check NAME EXPECTED_EXIT PATTERN_IN_OUTPUT -- ARGS...
+    local name=$1 want=$2 pattern=$3
+    shift 4
+    $mcplay "$@" >"$tmp/out" 2>"$tmp/err"
+    local got=$?
+    if [ "$got" != "$want" ]; then
+        echo "FAIL $name: exit $got, expected $want"; cat "$tmp/err"; failed=$((failed + 1)); return
+    fi
+    if [ -n "$pattern" ] && ! grep -qE -- "$pattern" "$tmp/out" "$tmp/err"; then
+        echo "FAIL $name: output lacks /$pattern/"; head -5 "$tmp/out" "$tmp/err"; failed=$((failed + 1)); return
+    fi
+    passed=$((passed + 1))
+}
+
+small=(--n-min 16 --n-max 256 --reps 4)
+check help 0 'usage:' -- --help
+check version 0 '^mcplay [0-9]+\.[0-9]+' -- --version
+check no-args 2 'usage:' --
+check unknown-command 2 "unknown command 'frobnicate'" -- frobnicate
+check unknown-option 2 "unknown option '--fast'" -- run exp_1d --fast
+check bad-number 2 "--n-min: expected a whole number >= 0, got 'abc'" -- run exp_1d --n-min abc
+check negative-number 2 "--reps: expected a whole number >= 0, got '-3'" -- run exp_1d --reps -3
+check missing-value 2 '--seed needs a value' -- run exp_1d --seed
+check bad-format 2 "--format: expected table, json or csv, got 'xml'" -- run exp_1d --format xml
+check two-scenes 2 'run takes one scene' -- run exp_1d disk_quarter
+check no-scene 2 'run needs a scene' -- run
+check missing-scene 3 "no scene file 'nowhere'" -- run nowhere
+check bad-settings 3 'reps must be in 2' -- run exp_1d --reps 1
+check bad-range 3 'n_max \(8\) must be >= n_min \(64\)' -- run exp_1d --n-min 64 --n-max 8
+check unknown-estimator 3 "unknown estimator 'sobol'" -- run exp_1d --estimators sobol "${small[@]}"
+printf '{"integrand": {"type": "monomial", "powers": [1]}, "n_mx": 3}' >"$tmp/typo.json"
+check scene-typo 3 "unknown field 'n_mx'" -- run "$tmp/typo.json"
+printf '{"integrand": ' >"$tmp/broken.json"
+check scene-broken 3 'invalid JSON' -- run "$tmp/broken.json"
+check table 0 'fitted order: variance ~ N\^' -- run exp_1d "${small[@]}"
+check by-path 0 'scene exp_1d' -- run scenes/exp_1d.json "${small[@]}"
+check csv 0 '^scene,estimator,sampler,pdf,n,' -- run exp_1d "${small[@]}" --format csv
+check estimators 0 '^"exp_1d","importance"' -- run exp_1d "${small[@]}" --format csv --estimators importance
+check json 0 '"version": 1' -- run disk_quarter "${small[@]}" --format json
+check out-file 0 '' -- run exp_1d "${small[@]}" --format json --out "$tmp/result.json"
+if node -e 'const r = JSON.parse(require("fs").readFileSync(process.argv[1])); if (r.version !== 1 || r.estimators.length < 3) process.exit(1)' "$tmp/result.json"; then
+    passed=$((passed + 1))
+else
+    echo "FAIL out-file: $tmp/result.json is not the documented JSON"; failed=$((failed + 1))
+fi
+check out-unwritable 1 "cannot write" -- run exp_1d "${small[@]}" --out /nonexistent-dir/x.json
+check list 0 'disk_quarter' -- list
+check list-presets 0 'stratified_importance' -- list
+check list-bad-dir 1 'cannot open scenes directory' -- list --scenes /nonexistent-dir
+check threads 0 '1 thread' -- run exp_1d "${small[@]}" --threads 1
+
+echo "$passed passed, $failed failed"
+[ "$failed" = 0 ]

@@ -1,1 +1,136 @@
-extern "C" const char* mcp_version(void) { return MCPLAY_VERSION; }
+// The extern "C" boundary. The library is built without exceptions: every error is a value
+// returned up to here and turned into a status code plus a message (like sqlite3_errmsg).
+#include <cstdlib>
+#include <cstring>
+#include <string>
+
+#include "api/mcplay.h"
+#include "api/scene.h"
+
+namespace {
+
+thread_local std::string g_last_error;
+
+int fail(int status, const std::string& message) {
+    g_last_error = message;
+    return status;
+}
+
+char* copy_out(const std::string& s) {
+    char* p = static_cast<char*>(std::malloc(s.size() + 1));
+    if (p) std::memcpy(p, s.c_str(), s.size() + 1);
+    return p;
+}
+
+// JSON text out, never throwing on odd bytes in user strings.
+std::string dump(const mcp::Json& j, int indent = -1) {
+    return j.dump(indent, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
+}  // namespace
+
+extern "C" {
+
+const char* mcp_version(void) { return MCPLAY_VERSION; }
+
+const char* mcp_last_error(void) { return g_last_error.c_str(); }
+
+void mcp_free(char* p) { std::free(p); }
+
+int mcp_study_run(const char* scene_json, const char* options_json, mcp_progress_fn progress,
+                  void* user, char** result_json) {
+    if (!result_json) return fail(MCP_ERROR_ARGUMENT, "mcp_study_run: result_json is NULL");
+    *result_json = nullptr;
+    mcp::Made<mcp::Json> scene = mcp::parse_json(scene_json, "scene");
+    if (!scene.ok()) return fail(MCP_ERROR_SCENE, scene.error);
+    mcp::Json options;
+    if (options_json && *options_json) {
+        mcp::Made<mcp::Json> o = mcp::parse_json(options_json, "options");
+        if (!o.ok()) return fail(MCP_ERROR_ARGUMENT, o.error);
+        options = o.value;
+    }
+    mcp::Made<mcp::SceneRequest> req = mcp::build_request(scene.value, options);
+    if (!req.ok()) return fail(MCP_ERROR_SCENE, req.error);
+
+    mcp::StudyProgress on_level;
+    if (progress) {
+        on_level = [&](const mcp::StudyResult& partial, size_t level) {
+            std::string text = dump(mcp::progress_to_json(partial, level));
+            return progress(text.c_str(), user) == 0;
+        };
+    }
+    mcp::StudyResult result =
+        mcp::run_study(req.value.problem, req.value.estimators, req.value.settings, on_level);
+    *result_json = copy_out(dump(mcp::study_to_json(result)));
+    if (!*result_json) return fail(MCP_ERROR_INTERNAL, "out of memory writing the result");
+    if (result.cancelled) return fail(MCP_ERROR_CANCELLED, "study cancelled by the caller");
+    g_last_error.clear();
+    return MCP_OK;
+}
+
+int mcp_result_format(const char* result_json, const char* format, char** text) {
+    if (!text) return fail(MCP_ERROR_ARGUMENT, "mcp_result_format: text is NULL");
+    *text = nullptr;
+    if (!format) return fail(MCP_ERROR_ARGUMENT, "mcp_result_format: format is NULL");
+    mcp::Made<mcp::Json> r = mcp::parse_json(result_json, "result");
+    if (!r.ok()) return fail(MCP_ERROR_ARGUMENT, r.error);
+    if (!r.value.is_object() || !r.value.contains("estimators"))
+        return fail(MCP_ERROR_ARGUMENT, "result: not an mcplay study result (no \"estimators\")");
+    std::string out;
+    const std::string f = format;
+    if (f == "table") out = mcp::format_table(r.value);
+    else if (f == "csv") out = mcp::format_csv(r.value);
+    else if (f == "json") out = dump(r.value, 2) + "\n";
+    else return fail(MCP_ERROR_ARGUMENT, "unknown format '" + f + "' (known: table, json, csv)");
+    *text = copy_out(out);
+    g_last_error.clear();
+    return MCP_OK;
+}
+
+int mcp_scene_info(const char* scene_json, char** info_json) {
+    if (!info_json) return fail(MCP_ERROR_ARGUMENT, "mcp_scene_info: info_json is NULL");
+    *info_json = nullptr;
+    mcp::Made<mcp::Json> scene = mcp::parse_json(scene_json, "scene");
+    if (!scene.ok()) return fail(MCP_ERROR_SCENE, scene.error);
+    mcp::Made<mcp::SceneRequest> req = mcp::build_request(scene.value, mcp::Json());
+    if (!req.ok()) return fail(MCP_ERROR_SCENE, req.error);
+    const mcp::Problem& p = req.value.problem;
+    mcp::Json names = mcp::Json::array();
+    for (const mcp::EstimatorSpec& e : req.value.estimators) names.push_back(e.name);
+    mcp::Json info{{"name", p.name},
+                   {"description", p.description},
+                   {"domain", mcp::domain_kind_name(p.domain.kind)},
+                   {"dimension", p.domain.point_dim()},
+                   {"exact", p.exact ? mcp::Json(*p.exact) : mcp::Json(nullptr)},
+                   {"estimators", names},
+                   {"n_min", req.value.settings.n_min},
+                   {"n_max", req.value.settings.n_max},
+                   {"reps", req.value.settings.reps},
+                   {"seed", req.value.settings.seed}};
+    *info_json = copy_out(dump(info));
+    g_last_error.clear();
+    return MCP_OK;
+}
+
+int mcp_catalog(char** catalog_json) {
+    if (!catalog_json) return fail(MCP_ERROR_ARGUMENT, "mcp_catalog: catalog_json is NULL");
+    mcp::Json presets = mcp::Json::array();
+    for (const mcp::EstimatorPreset& p : mcp::estimator_presets())
+        presets.push_back({{"name", p.name},
+                           {"sampler", mcp::sampler_name(p.sampler)},
+                           {"needs_pdf", p.needs_pdf},
+                           {"summary", p.summary}});
+    mcp::Json catalog{
+        {"version", mcp::kResultSchemaVersion},
+        {"estimators", presets},
+        {"samplers", {"independent", "stratified", "latin_hypercube"}},
+        {"pdfs", {"uniform", "power", "exponential", "gaussian", "cosine", "tabulated", "product",
+                  "tabulated_2d", "cosine_hemisphere"}},
+        {"integrands", {"constant", "monomial", "exponential", "gaussian", "indicator_ball"}},
+        {"domains", {"box", "interval", "disk", "triangle", "sphere", "hemisphere"}}};
+    *catalog_json = copy_out(dump(catalog));
+    g_last_error.clear();
+    return MCP_OK;
+}
+
+}  // extern "C"

@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "core/made.h"
+
 namespace mcp {
 
 enum class Dist1DKind {
@@ -52,13 +54,6 @@ class Distribution1D {
     double c0_ = 0.0, c1_ = 0.0;    // precomputed normalisation terms
     std::vector<double> func_;      // tabulated: bin values (normalised density)
     std::vector<double> cdf_;       // tabulated: cdf at bin edges, cdf_[0] = 0, back() = 1
-};
-
-/// Result of a factory: either a distribution or an error naming the bad parameter.
-template <class T> struct Made {
-    T value;
-    std::string error;  ///< empty on success
-    bool ok() const { return error.empty(); }
 };
 
 Made<Distribution1D> make_uniform(double a, double b);

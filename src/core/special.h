@@ -32,7 +32,7 @@ double chi_square_sf(double x, double k);
 /// Quantile of the chi-square distribution: P(X <= x) = p.
 double chi_square_quantile(double p, double k);
 
-/// Trigamma psi'(x) for x > 0 (recurrence up to x >= 6, then the asymptotic series).
+/// Trigamma psi'(x) for x > 0 (recurrence up to x >= 10, then the asymptotic series).
 /// Var[log s^2] = psi'((R - 1) / 2) for a sample variance of R normal values.
 double trigamma(double x);
 

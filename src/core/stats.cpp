@@ -2,6 +2,30 @@
 
 namespace mcp {
 
+void RunningMoments::add_block(const double* x, size_t n) {
+    if (n == 0) return;
+    double block_sum = 0.0;
+    for (size_t i = 0; i < n; ++i) block_sum += x[i];
+    const double block_mean = block_sum / static_cast<double>(n);
+    double m2 = 0.0, correction = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+        const double d = x[i] - block_mean;
+        m2 += d * d;
+        correction += d;
+    }
+    // Corrected two-pass formula: removes the rounding error of block_mean [Chan79, eq. 1.7].
+    m2 -= correction * correction / static_cast<double>(n);
+    for (size_t i = 0; i < n; ++i) sum_.add(x[i]);
+    // Chan's merge of (n_, mean_, m2_) with the block (n, block_mean + correction/n, m2).
+    const double na = static_cast<double>(n_), nb = static_cast<double>(n);
+    const double mean_b = block_mean + correction / nb;
+    const double delta = mean_b - mean_;
+    const double total = na + nb;
+    m2_ += m2 + delta * delta * na * nb / total;
+    mean_ += delta * nb / total;
+    n_ += n;
+}
+
 void RunningMoments::merge(const RunningMoments& o) {
     if (o.n_ == 0) return;
     if (n_ == 0) {

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -38,6 +39,10 @@ class RunningMoments {
         mean_ += delta / static_cast<double>(n_);
         m2_ += delta * (x - mean_);
     }
+    /// Adds a block of values: a compensated sum for the mean, a two-pass sum of squared
+    /// deviations about the block mean, merged by Chan's formula (one division per block
+    /// instead of one per value, and loops the compiler can vectorise).
+    void add_block(const double* x, size_t n);
     /// Parallel combination of two sets of moments [Chan79].
     void merge(const RunningMoments& o);
 

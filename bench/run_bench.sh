@@ -1,0 +1,16 @@
+#!/usr/bin/env bash
+# Runs the throughput benchmark natively and in WebAssembly under Node and prints the
+# figures side by side with their ratio. Usage: run_bench.sh NATIVE_BENCH "WASM_COMMAND"
+set -eu
+native=${1:?native bench}
+wasm=${2:?wasm bench command}
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+echo "mcplay bench: samples per second of the estimator loop (best of 3 runs of 2^22 samples, one thread)"
+echo "machine: $(nproc) cores, $(uname -m), $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //')"
+$native scenes >"$tmp/native"
+$wasm scenes >"$tmp/wasm"
+printf '%-44s %14s %14s %8s\n' case native wasm native/wasm
+join <(grep ^BENCH "$tmp/native" | awk '{print $2, $3}' | sort) \
+     <(grep ^BENCH "$tmp/wasm" | awk '{print $2, $3}' | sort) |
+    awk '{ printf "%-44s %14.3e %14.3e %7.2fx\n", $1, $2, $3, $2 / $3 }'

@@ -1,0 +1,56 @@
+/* mcplay C API: the one boundary shared by the CLI, the tests and the WebAssembly exports.
+ *
+ * Requests and results are JSON strings (schemas in docs/scene-format.md and
+ * docs/result-schema.md). Every function returns a status code; on failure
+ * mcp_last_error() gives a one-line message naming what is wrong. No C++ exception crosses
+ * this boundary. Strings returned through `char** out` are owned by the caller and freed
+ * with mcp_free(). */
+#ifndef MCPLAY_H
+#define MCPLAY_H
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum mcp_status {
+    MCP_OK = 0,
+    MCP_ERROR_ARGUMENT = 1,  /* a NULL pointer or a malformed options/format argument */
+    MCP_ERROR_SCENE = 2,     /* the scene JSON is malformed or names something invalid */
+    MCP_ERROR_CANCELLED = 3, /* the progress callback asked to stop (partial result given) */
+    MCP_ERROR_INTERNAL = 4   /* a bug: please report the message */
+} mcp_status;
+
+/* Called after each completed N of a study with that level's results as JSON
+ * ({"level_index", "n", "estimators": [...]}). Return 0 to go on, non-zero to cancel. */
+typedef int (*mcp_progress_fn)(const char* level_json, void* user);
+
+/* Library version, e.g. "0.1.0". */
+const char* mcp_version(void);
+
+/* Message of the last failed call on this thread ("" if none). */
+const char* mcp_last_error(void);
+
+/* Runs a convergence study of the scene. options_json may be NULL or override the scene's
+ * settings: {"estimators": [names], "n_min", "n_max", "reps", "seed", "threads"}.
+ * progress may be NULL. On MCP_OK or MCP_ERROR_CANCELLED *result_json holds the result. */
+int mcp_study_run(const char* scene_json, const char* options_json, mcp_progress_fn progress,
+                  void* user, char** result_json);
+
+/* Formats a study result as "table" (human), "csv" or "json" (pretty-printed). */
+int mcp_result_format(const char* result_json, const char* format, char** text);
+
+/* Validates a scene and summarises it: {"name", "description", "domain", "dimension",
+ * "exact", "estimators": [names], settings}. */
+int mcp_scene_info(const char* scene_json, char** info_json);
+
+/* What the library offers: estimator presets, samplers, pdfs, integrands, domains. */
+int mcp_catalog(char** catalog_json);
+
+/* Frees a string returned by this API. */
+void mcp_free(char* p);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* MCPLAY_H */

@@ -1,0 +1,310 @@
+// Study results as JSON (docs/result-schema.md), as a human table and as CSV. The table
+// and CSV are rendered from the JSON, so any client holding a result can format it.
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "api/scene.h"
+
+namespace mcp {
+
+namespace {
+
+// NaN and infinities become null in the JSON.
+Json num(double x) { return std::isfinite(x) ? Json(x) : Json(nullptr); }
+
+Json diagnostics_to_json(const RunDiagnostics& d) {
+    return Json{{"nonfinite", d.nonfinite}, {"zero_pdf", d.zero_pdf},
+                {"max_weight_share", num(d.max_weight_share)}};
+}
+
+// Plain-language warnings for a level's diagnostics.
+std::vector<std::string> warnings_for(const LevelStats& l) {
+    std::vector<std::string> w;
+    const RunDiagnostics& d = l.diagnostics;
+    if (d.nonfinite)
+        w.push_back(std::to_string(d.nonfinite) + " sample(s) with NaN/Inf f/p dropped: the estimate is biased");
+    if (d.zero_pdf)
+        w.push_back(std::to_string(d.zero_pdf) +
+                    " sample(s) with f != 0 where p = 0: the pdf misses part of the integrand, the estimate is biased");
+    // One sample carrying a large share of a big sum: the variance estimate is dominated by
+    // rare large weights (heavy tail, possibly infinite variance).
+    if (l.n >= 1024 && d.max_weight_share > 0.05)
+        w.push_back("one sample carried " + std::to_string(static_cast<int>(100 * d.max_weight_share + 0.5)) +
+                    "% of a run's sum at N = " + std::to_string(l.n) +
+                    ": heavy-tailed weights, the error bar is not trustworthy");
+    return w;
+}
+
+std::string fmt(const char* f, double x) {
+    if (!std::isfinite(x)) return "-";
+    char buf[64];
+    std::snprintf(buf, sizeof buf, f, x);
+    return buf;
+}
+
+std::string padl(const std::string& s, size_t w) { return s.size() >= w ? s : std::string(w - s.size(), ' ') + s; }
+std::string padr(const std::string& s, size_t w) { return s.size() >= w ? s : s + std::string(w - s.size(), ' '); }
+
+// Accessors that never throw, whatever shape of JSON a client hands back to us.
+const Json& get(const Json& j, const char* key) {
+    static const Json null_json;
+    if (!j.is_object()) return null_json;
+    auto it = j.find(key);
+    return it == j.end() ? null_json : *it;
+}
+
+const Json& at_index(const Json& j, size_t i) {
+    static const Json null_json;
+    return j.is_array() && i < j.size() ? j[i] : null_json;
+}
+
+// Iterates arrays only (a number or string is not a list of levels).
+const Json& list(const Json& j, const char* key) {
+    static const Json empty = Json::array();
+    const Json& v = get(j, key);
+    return v.is_array() ? v : empty;
+}
+
+double jnum(const Json& j, const char* key) {
+    const Json& v = get(j, key);
+    return v.is_number() ? v.get<double>() : NAN;
+}
+
+std::string jstr(const Json& j, const char* key) {
+    const Json& v = get(j, key);
+    return v.is_string() ? v.get<std::string>() : "";
+}
+
+bool jbool(const Json& j, const char* key) {
+    const Json& v = get(j, key);
+    return v.is_boolean() && v.get<bool>();
+}
+
+}  // namespace
+
+Json level_to_json(const LevelStats& l) {
+    Json j{{"n", l.n},
+           {"reps", l.reps},
+           {"mean", num(l.mean)},
+           {"variance", num(l.variance)},
+           {"variance_ci95", {num(l.variance_lo), num(l.variance_hi)}},
+           {"std_error", num(l.std_error)},
+           {"ci95", {num(l.ci_lo), num(l.ci_hi)}},
+           {"mean_run_std_error", num(l.mean_run_se)},
+           {"time_mean_s", num(l.time_mean)},
+           {"time_total_s", num(l.time_total)},
+           {"efficiency", num(l.efficiency)},
+           {"error", num(l.error)},
+           {"diagnostics", diagnostics_to_json(l.diagnostics)},
+           {"warnings", warnings_for(l)}};
+    if (l.has_exact) {
+        j["bias"] = num(l.bias);
+        j["mse"] = num(l.mse);
+        j["rmse"] = num(l.rmse);
+        j["coverage95"] = num(l.coverage);
+    } else {
+        j["bias"] = j["mse"] = j["rmse"] = j["coverage95"] = nullptr;
+    }
+    Json est = Json::array(), se = Json::array();
+    for (double x : l.estimates) est.push_back(num(x));
+    for (double x : l.run_std_errors) se.push_back(num(x));
+    j["replicates"] = Json{{"estimate", est}, {"std_error", se}};
+    return j;
+}
+
+Json fit_to_json(const ConvergenceFit& f) {
+    return Json{{"valid", f.valid},
+                {"order", f.valid ? num(f.order) : Json(nullptr)},
+                {"order_se", f.valid ? num(f.order_se) : Json(nullptr)},
+                {"intercept", f.valid ? num(f.intercept) : Json(nullptr)},
+                {"levels_used", f.levels_used},
+                {"note", f.note}};
+}
+
+namespace {
+
+Json estimator_header(const EstimatorStudy& e) {
+    return Json{{"name", e.spec.name},
+                {"sampler", sampler_name(e.spec.sampler)},
+                {"pdf", e.spec.proposal.describe()},
+                {"importance", e.spec.proposal.importance},
+                {"error_method", error_method_name(e.error_method)}};
+}
+
+}  // namespace
+
+Json study_to_json(const StudyResult& r) {
+    const Problem& p = r.problem;
+    Json scene{{"name", p.name},
+               {"description", p.description},
+               {"domain", domain_kind_name(p.domain.kind)},
+               {"domain_text", p.domain.describe()},
+               {"dimension", p.domain.point_dim()},
+               {"integrand", describe_integrand(p.integrand)},
+               {"quantity", p.quantity == Quantity::Mean ? "mean" : "integral"},
+               {"exact", p.exact ? num(*p.exact) : Json(nullptr)}};
+    Json settings{{"n_min", r.settings.n_min}, {"n_max", r.settings.n_max}, {"reps", r.settings.reps},
+                  {"seed", r.settings.seed}, {"threads", r.threads_used}};
+    Json estimators = Json::array();
+    for (const EstimatorStudy& e : r.estimators) {
+        Json j = estimator_header(e);
+        Json levels = Json::array();
+        for (const LevelStats& l : e.levels) levels.push_back(level_to_json(l));
+        j["levels"] = levels;
+        j["fit"] = fit_to_json(e.fit);
+        estimators.push_back(j);
+    }
+    return Json{{"version", kResultSchemaVersion},
+                {"mcplay", MCPLAY_VERSION},
+                {"scene", scene},
+                {"settings", settings},
+                {"cancelled", r.cancelled},
+                {"wall_time_s", num(r.wall_seconds)},
+                {"estimators", estimators}};
+}
+
+Json progress_to_json(const StudyResult& partial, size_t level_index) {
+    Json estimators = Json::array();
+    uint64_t n = 0;
+    for (const EstimatorStudy& e : partial.estimators) {
+        Json j = estimator_header(e);
+        if (level_index < e.levels.size()) {
+            j["level"] = level_to_json(e.levels[level_index]);
+            n = e.levels[level_index].n;
+        }
+        j["fit"] = fit_to_json(e.fit);
+        estimators.push_back(j);
+    }
+    return Json{{"version", kResultSchemaVersion}, {"level_index", level_index}, {"n", n},
+                {"estimators", estimators}};
+}
+
+std::string format_table(const Json& r) {
+    std::ostringstream out;
+    const Json& scene = get(r, "scene");
+    const Json& settings = get(r, "settings");
+    const double exact = jnum(scene, "exact");
+    const bool has_exact = std::isfinite(exact);
+    out << "mcplay " << jstr(r, "mcplay") << "  scene " << jstr(scene, "name");
+    if (!jstr(scene, "description").empty()) out << ": " << jstr(scene, "description");
+    out << "\n  " << jstr(scene, "quantity") << " of f = " << jstr(scene, "integrand") << " over "
+        << jstr(scene, "domain_text");
+    out << "\n  exact " << (has_exact ? fmt("%.12g", exact) : std::string("unknown")) << "   N = "
+        << fmt("%.0f", jnum(settings, "n_min")) << " .. " << fmt("%.0f", jnum(settings, "n_max"))
+        << ", " << fmt("%.0f", jnum(settings, "reps")) << " replicates per N, seed "
+        << fmt("%.0f", jnum(settings, "seed")) << ", " << fmt("%.0f", jnum(settings, "threads"))
+        << " thread(s), " << fmt("%.2f", jnum(r, "wall_time_s")) << " s\n";
+    if (jbool(r, "cancelled")) out << "  (cancelled: partial result)\n";
+
+    const Json& ests = list(r, "estimators");
+    for (const Json& e : ests) {
+        out << "\n" << jstr(e, "name") << "  [sampler " << jstr(e, "sampler") << ", pdf " << jstr(e, "pdf")
+            << ", per-run error: " << jstr(e, "error_method") << "]\n";
+        out << padl("N", 9) << padl("mean", 15) << padl("variance", 13) << padl("rel.err", 10);
+        if (has_exact) out << padl("rmse", 11) << padl("bias/se", 9) << padl("cover", 7);
+        out << padl("time/est", 11) << padl("efficiency", 12) << "\n";
+        std::vector<std::string> warnings;
+        for (const Json& l : list(e, "levels")) {
+            const double mean = jnum(l, "mean"), var = jnum(l, "variance");
+            const double ref = has_exact ? exact : mean;
+            out << padl(fmt("%.0f", jnum(l, "n")), 9) << padl(fmt("%.9g", mean), 15)
+                << padl(fmt("%.4e", var), 13)
+                << padl(ref != 0.0 ? fmt("%.2e", std::sqrt(var) / std::fabs(ref)) : "-", 10);
+            if (has_exact) {
+                const double se = jnum(l, "std_error"), bias = jnum(l, "bias");
+                out << padl(fmt("%.3e", jnum(l, "rmse")), 11)
+                    << padl(se > 0 ? fmt("%+.2f", bias / se) : "-", 9)
+                    << padl(fmt("%.2f", jnum(l, "coverage95")), 7);
+            }
+            out << padl(fmt("%.2e", jnum(l, "time_mean_s")), 11)
+                << padl(fmt("%.3e", jnum(l, "efficiency")), 12) << "\n";
+            for (const Json& w : list(l, "warnings"))
+                if (w.is_string()) warnings.push_back(w.get<std::string>());
+        }
+        const Json& fit = get(e, "fit");
+        if (jbool(fit, "valid"))
+            out << "  fitted order: variance ~ N^(" << fmt("%.3f", jnum(fit, "order")) << " +/- "
+                << fmt("%.3f", jnum(fit, "order_se")) << ")";
+        else
+            out << "  fitted order: none";
+        if (!jstr(fit, "note").empty()) out << " (" << jstr(fit, "note") << ")";
+        out << "\n";
+        // Repeated warnings (one per level) are shown once, the last (largest N) kept.
+        std::vector<std::string> shown;
+        for (auto it = warnings.rbegin(); it != warnings.rend(); ++it) {
+            std::string key = it->substr(0, 20);
+            bool seen = false;
+            for (const std::string& s : shown) seen = seen || s.substr(0, 20) == key;
+            if (!seen) shown.push_back(*it);
+        }
+        for (const std::string& w : shown) out << "  WARNING: " << w << "\n";
+    }
+
+    // Equal-N and equal-time comparison at the largest N every estimator reached.
+    if (ests.size() > 1) {
+        out << "\ncomparison at the largest N (efficiency = 1 / (variance x time); higher is better)\n";
+        out << padr("  estimator", 26) << padl("N", 9) << padl("variance", 13) << padl("time/est", 11)
+            << padl("efficiency", 12) << padl("vs first", 10) << "\n";
+        double first_eff = NAN;
+        for (const Json& e : ests) {
+            const Json& levels = list(e, "levels");
+            if (levels.empty()) continue;
+            const Json& l = levels.back();
+            const double eff = jnum(l, "efficiency");
+            if (std::isnan(first_eff)) first_eff = eff;
+            out << padr("  " + jstr(e, "name"), 26) << padl(fmt("%.0f", jnum(l, "n")), 9)
+                << padl(fmt("%.4e", jnum(l, "variance")), 13) << padl(fmt("%.2e", jnum(l, "time_mean_s")), 11)
+                << padl(fmt("%.3e", eff), 12)
+                << padl(first_eff > 0 && std::isfinite(eff) ? fmt("%.2fx", eff / first_eff) : "-", 10) << "\n";
+        }
+    }
+    return out.str();
+}
+
+std::string format_csv(const Json& r) {
+    std::ostringstream out;
+    out.precision(17);
+    out << "scene,estimator,sampler,pdf,n,reps,mean,variance,variance_lo,variance_hi,std_error,ci_lo,"
+           "ci_hi,exact,bias,mse,rmse,coverage95,mean_run_std_error,time_mean_s,efficiency,"
+           "nonfinite,zero_pdf,max_weight_share\n";
+    const Json& scene = get(r, "scene");
+    auto cell = [](const Json& v) -> std::string {
+        if (v.is_number()) {
+            std::ostringstream s;
+            s.precision(17);
+            s << v.get<double>();
+            return s.str();
+        }
+        return "";
+    };
+    auto quoted = [](const std::string& s) {
+        std::string q = "\"";
+        for (char ch : s) q += ch == '"' ? std::string("\"\"") : std::string(1, ch);
+        return q + "\"";
+    };
+    const Json exact = get(scene, "exact");
+    for (const Json& e : list(r, "estimators")) {
+        for (const Json& l : list(e, "levels")) {
+            const Json& d = get(l, "diagnostics");
+            const Json& vci = get(l, "variance_ci95");
+            const Json& ci = get(l, "ci95");
+            out << quoted(jstr(scene, "name")) << "," << quoted(jstr(e, "name")) << ","
+                << jstr(e, "sampler") << "," << quoted(jstr(e, "pdf")) << ","
+                << cell(get(l, "n")) << "," << cell(get(l, "reps")) << ","
+                << cell(get(l, "mean")) << "," << cell(get(l, "variance")) << ","
+                << cell(at_index(vci, 0)) << "," << cell(at_index(vci, 1)) << ","
+                << cell(get(l, "std_error")) << "," << cell(at_index(ci, 0)) << ","
+                << cell(at_index(ci, 1)) << "," << cell(exact) << ","
+                << cell(get(l, "bias")) << "," << cell(get(l, "mse")) << ","
+                << cell(get(l, "rmse")) << "," << cell(get(l, "coverage95")) << ","
+                << cell(get(l, "mean_run_std_error")) << "," << cell(get(l, "time_mean_s"))
+                << "," << cell(get(l, "efficiency")) << "," << cell(get(d, "nonfinite"))
+                << "," << cell(get(d, "zero_pdf")) << "," << cell(get(d, "max_weight_share"))
+                << "\n";
+        }
+    }
+    return out.str();
+}
+
+}  // namespace mcp

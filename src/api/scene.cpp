@@ -1,0 +1,608 @@
+// Scene parsing. Every value is type-checked before use (the API is built without
+// exceptions, so no nlohmann accessor that could throw is called on unchecked data), and
+// every error names the JSON path of the offending field and what was expected.
+#include "api/scene.h"
+
+#include <cmath>
+#include <set>
+#include <sstream>
+
+namespace mcp {
+
+namespace {
+
+// Records the first error as "path: message".
+struct Ctx {
+    std::string error;
+    bool fail(const std::string& path, const std::string& msg) {
+        if (error.empty()) error = path + ": " + msg;
+        return false;
+    }
+};
+
+std::string type_of(const Json& j) {
+    if (j.is_null()) return "null";
+    if (j.is_boolean()) return "a boolean";
+    if (j.is_number()) return "a number";
+    if (j.is_string()) return "a string";
+    if (j.is_array()) return "an array";
+    return "an object";
+}
+
+std::string join(const std::vector<std::string>& items) {
+    std::string s;
+    for (size_t i = 0; i < items.size(); ++i) s += (i ? ", " : "") + items[i];
+    return s;
+}
+
+// Rejects keys outside `known`, so that a typo ("n_mx") is an error, not a silent default.
+bool check_keys(Ctx& c, const Json& obj, const std::string& path,
+                const std::vector<std::string>& known) {
+    if (!obj.is_object()) return c.fail(path, "expected an object, got " + type_of(obj));
+    for (auto it = obj.begin(); it != obj.end(); ++it) {
+        bool ok = false;
+        for (const std::string& k : known) ok = ok || k == it.key();
+        if (!ok) return c.fail(path, "unknown field '" + it.key() + "' (known: " + join(known) + ")");
+    }
+    return true;
+}
+
+const Json* find(const Json& obj, const char* key) {
+    if (!obj.is_object()) return nullptr;
+    auto it = obj.find(key);
+    return it == obj.end() ? nullptr : &*it;
+}
+
+std::string sub(const std::string& path, const char* key) { return path + "." + key; }
+
+// Optional number: leaves *out unchanged when absent.
+bool get_number(Ctx& c, const Json& obj, const char* key, const std::string& path, double* out) {
+    const Json* v = find(obj, key);
+    if (!v) return true;
+    if (!v->is_number()) return c.fail(sub(path, key), "expected a number, got " + type_of(*v));
+    double x = v->get<double>();
+    if (!std::isfinite(x)) return c.fail(sub(path, key), "must be finite");
+    *out = x;
+    return true;
+}
+
+bool get_count(Ctx& c, const Json& obj, const char* key, const std::string& path, uint64_t* out) {
+    const Json* v = find(obj, key);
+    if (!v) return true;
+    if (v->is_number_unsigned()) {
+        *out = v->get<uint64_t>();
+        return true;
+    }
+    if (v->is_number_integer() && v->get<int64_t>() >= 0) {
+        *out = static_cast<uint64_t>(v->get<int64_t>());
+        return true;
+    }
+    if (v->is_number_float()) {
+        double x = v->get<double>();
+        if (x >= 0.0 && x == std::floor(x) && x < 1.8e19) {
+            *out = static_cast<uint64_t>(x);
+            return true;
+        }
+    }
+    return c.fail(sub(path, key), "expected a non-negative whole number, got " +
+                                      (v->is_number() ? v->dump() : type_of(*v)));
+}
+
+bool get_string(Ctx& c, const Json& obj, const char* key, const std::string& path,
+                std::string* out) {
+    const Json* v = find(obj, key);
+    if (!v) return true;
+    if (!v->is_string()) return c.fail(sub(path, key), "expected a string, got " + type_of(*v));
+    *out = v->get<std::string>();
+    return true;
+}
+
+bool to_numbers(Ctx& c, const Json& v, const std::string& path, std::vector<double>* out) {
+    out->clear();
+    if (v.is_number()) {
+        out->push_back(v.get<double>());
+        return true;
+    }
+    if (!v.is_array()) return c.fail(path, "expected an array of numbers, got " + type_of(v));
+    for (size_t i = 0; i < v.size(); ++i) {
+        if (!v[i].is_number())
+            return c.fail(path + "[" + std::to_string(i) + "]", "expected a number, got " + type_of(v[i]));
+        double x = v[i].get<double>();
+        if (!std::isfinite(x)) return c.fail(path + "[" + std::to_string(i) + "]", "must be finite");
+        out->push_back(x);
+    }
+    return true;
+}
+
+bool get_numbers(Ctx& c, const Json& obj, const char* key, const std::string& path,
+                 std::vector<double>* out) {
+    const Json* v = find(obj, key);
+    if (!v) return true;
+    return to_numbers(c, *v, sub(path, key), out);
+}
+
+bool get_vec2(Ctx& c, const Json& v, const std::string& path, Vec2* out) {
+    std::vector<double> xs;
+    if (!to_numbers(c, v, path, &xs)) return false;
+    if (xs.size() != 2) return c.fail(path, "expected [x, y], got " + std::to_string(xs.size()) + " numbers");
+    *out = Vec2{xs[0], xs[1]};
+    return true;
+}
+
+// --- domain ------------------------------------------------------------------------------
+
+bool parse_domain(Ctx& c, const Json& j, const std::string& path, int default_dim, Domain* out) {
+    std::string type = "box";
+    if (!check_keys(c, j, path, {"type", "dim", "lower", "upper", "center", "radius", "vertices"}))
+        return false;
+    if (!get_string(c, j, "type", path, &type)) return false;
+    if (type == "box" || type == "interval") {
+        uint64_t dim = static_cast<uint64_t>(default_dim);
+        if (!get_count(c, j, "dim", path, &dim)) return false;
+        if (dim < 1 || dim > 64) return c.fail(sub(path, "dim"), "must be in 1..64, got " + std::to_string(dim));
+        std::vector<double> lo(dim, 0.0), hi(dim, 1.0);
+        if (!get_numbers(c, j, "lower", path, &lo) || !get_numbers(c, j, "upper", path, &hi)) return false;
+        if (find(j, "lower") && !find(j, "dim") && !find(j, "upper")) hi.assign(lo.size(), 1.0);
+        if (find(j, "upper") && !find(j, "dim") && !find(j, "lower")) lo.assign(hi.size(), 0.0);
+        if (lo.size() != hi.size())
+            return c.fail(path, "lower has " + std::to_string(lo.size()) + " entries, upper has " +
+                                    std::to_string(hi.size()));
+        if (type == "interval" && lo.size() != 1) return c.fail(path, "an interval has one dimension");
+        Made<Domain> d = make_box(lo, hi);
+        if (!d.ok()) return c.fail(path, d.error);
+        *out = d.value;
+        return true;
+    }
+    if (type == "disk") {
+        Vec2 center{0.0, 0.0};
+        double radius = 1.0;
+        if (const Json* v = find(j, "center"); v && !get_vec2(c, *v, sub(path, "center"), &center)) return false;
+        if (!get_number(c, j, "radius", path, &radius)) return false;
+        Made<Domain> d = make_disk(center, radius);
+        if (!d.ok()) return c.fail(path, d.error);
+        *out = d.value;
+        return true;
+    }
+    if (type == "triangle") {
+        const Json* v = find(j, "vertices");
+        if (!v) return c.fail(path, "a triangle needs \"vertices\": [[x, y], [x, y], [x, y]]");
+        if (!v->is_array() || v->size() != 3)
+            return c.fail(sub(path, "vertices"), "expected three [x, y] points");
+        Vec2 p[3];
+        for (size_t i = 0; i < 3; ++i)
+            if (!get_vec2(c, (*v)[i], sub(path, "vertices") + "[" + std::to_string(i) + "]", &p[i]))
+                return false;
+        Made<Domain> d = make_triangle(p[0], p[1], p[2]);
+        if (!d.ok()) return c.fail(path, d.error);
+        *out = d.value;
+        return true;
+    }
+    if (type == "sphere") {
+        *out = make_sphere();
+        return true;
+    }
+    if (type == "hemisphere") {
+        *out = make_hemisphere();
+        return true;
+    }
+    return c.fail(sub(path, "type"), "unknown domain '" + type +
+                                         "' (known: box, interval, disk, triangle, sphere, hemisphere)");
+}
+
+// --- integrand ---------------------------------------------------------------------------
+
+bool parse_integrand(Ctx& c, const Json& j, const std::string& path, int dim, Integrand* out) {
+    if (!check_keys(c, j, path, {"type", "scale", "powers", "rates", "center", "sigma", "radius"}))
+        return false;
+    std::string type;
+    if (!get_string(c, j, "type", path, &type)) return false;
+    if (type.empty()) return c.fail(path, "missing \"type\" (constant, monomial, exponential, gaussian, indicator_ball)");
+    IntegrandKind kind;
+    if (!parse_integrand_kind(type, &kind))
+        return c.fail(sub(path, "type"), "unknown integrand '" + type +
+                                             "' (known: constant, monomial, exponential, gaussian, indicator_ball)");
+    double scale = 1.0, width = 1.0;
+    std::vector<double> coeffs, center;
+    if (!get_number(c, j, "scale", path, &scale)) return false;
+    if (kind == IntegrandKind::Monomial && !get_numbers(c, j, "powers", path, &coeffs)) return false;
+    if (kind == IntegrandKind::Exponential && !get_numbers(c, j, "rates", path, &coeffs)) return false;
+    if ((kind == IntegrandKind::Monomial || kind == IntegrandKind::Exponential) && coeffs.size() == 1 && dim > 1)
+        coeffs.assign(static_cast<size_t>(dim), coeffs[0]);
+    if (kind == IntegrandKind::Gaussian || kind == IntegrandKind::IndicatorBall) {
+        if (!get_numbers(c, j, "center", path, &center)) return false;
+        if (!get_number(c, j, kind == IntegrandKind::Gaussian ? "sigma" : "radius", path, &width)) return false;
+    }
+    Made<Integrand> f = make_integrand(kind, dim, scale, coeffs, center, width);
+    if (!f.ok()) return c.fail(path, f.error);
+    *out = f.value;
+    return true;
+}
+
+// --- pdfs --------------------------------------------------------------------------------
+
+constexpr int kMaxBins = 1 << 20;
+constexpr int kSubSamples = 4;  // shape evaluations per bin and axis when tabulating
+
+// Tabulation values: explicit "values", or |shape| averaged over kSubSamples^d points per cell.
+bool table_values(Ctx& c, const Json& j, const std::string& path, const Problem& problem,
+                  const std::vector<int>& bins, const std::vector<double>& lo,
+                  const std::vector<double>& hi, std::vector<double>* values) {
+    size_t cells = 1;
+    for (int b : bins) cells *= static_cast<size_t>(b);
+    if (const Json* v = find(j, "values")) {
+        if (!to_numbers(c, *v, sub(path, "values"), values)) return false;
+        if (values->size() != cells)
+            return c.fail(sub(path, "values"), "has " + std::to_string(values->size()) +
+                                                   " entries, bins ask for " + std::to_string(cells));
+        return true;
+    }
+    const Json* shape = find(j, "shape");
+    if (!shape) return c.fail(path, "a tabulated pdf needs \"values\" or \"shape\"");
+    Integrand f;
+    const int dim = static_cast<int>(bins.size());
+    if (shape->is_string() && shape->get<std::string>() == "integrand") {
+        if (problem.integrand.dim != dim)
+            return c.fail(sub(path, "shape"), "the integrand has " + std::to_string(problem.integrand.dim) +
+                                                  " dimensions, the table " + std::to_string(dim));
+        f = problem.integrand;
+    } else if (!parse_integrand(c, *shape, sub(path, "shape"), dim, &f)) {
+        return false;
+    }
+    values->assign(cells, 0.0);
+    std::vector<double> point(static_cast<size_t>(dim));
+    const int sub_count = dim == 1 ? kSubSamples : kSubSamples * kSubSamples;
+    for (size_t cell = 0; cell < cells; ++cell) {
+        // cell index: x fastest (row-major over y), matching make_tabulated_2d.
+        size_t ix = cell % static_cast<size_t>(bins[0]);
+        size_t iy = dim == 2 ? cell / static_cast<size_t>(bins[0]) : 0;
+        double sum = 0.0;
+        for (int s = 0; s < sub_count; ++s) {
+            int sx = s % kSubSamples, sy = s / kSubSamples;
+            point[0] = lo[0] + (hi[0] - lo[0]) * (ix + (sx + 0.5) / kSubSamples) / bins[0];
+            if (dim == 2) point[1] = lo[1] + (hi[1] - lo[1]) * (iy + (sy + 0.5) / kSubSamples) / bins[1];
+            double v = std::fabs(evaluate_point(f, point.data()));
+            sum += std::isfinite(v) ? v : 0.0;
+        }
+        (*values)[cell] = sum / sub_count;
+    }
+    return true;
+}
+
+bool parse_pdf_1d(Ctx& c, const Json& j, const std::string& path, const Problem& problem,
+                  double a, double b, Distribution1D* out) {
+    if (!check_keys(c, j, path, {"type", "k", "rate", "mu", "sigma", "omega", "x0", "bins", "values", "shape"}))
+        return false;
+    std::string type;
+    if (!get_string(c, j, "type", path, &type)) return false;
+    Made<Distribution1D> d;
+    if (type == "uniform") {
+        d = make_uniform(a, b);
+    } else if (type == "power" || type == "linear") {
+        double k = 1.0;
+        if (!get_number(c, j, "k", path, &k)) return false;
+        d = make_power(a, b, k);
+    } else if (type == "exponential") {
+        double rate = 1.0;
+        if (!get_number(c, j, "rate", path, &rate)) return false;
+        d = make_exponential(a, b, rate);
+    } else if (type == "gaussian" || type == "truncated_gaussian") {
+        double mu = 0.5 * (a + b), sigma = 0.25 * (b - a);
+        if (!get_number(c, j, "mu", path, &mu) || !get_number(c, j, "sigma", path, &sigma)) return false;
+        d = make_truncated_gaussian(a, b, mu, sigma);
+    } else if (type == "cosine") {
+        double omega = 1.0, x0 = 0.0;
+        if (!get_number(c, j, "omega", path, &omega) || !get_number(c, j, "x0", path, &x0)) return false;
+        d = make_cosine(a, b, omega, x0);
+    } else if (type == "tabulated") {
+        uint64_t bins = 64;
+        if (!get_count(c, j, "bins", path, &bins)) return false;
+        if (bins < 1 || bins > static_cast<uint64_t>(kMaxBins))
+            return c.fail(sub(path, "bins"), "must be in 1.." + std::to_string(kMaxBins));
+        if (find(j, "values") && !find(j, "bins")) bins = find(j, "values")->size();
+        std::vector<double> values;
+        if (!table_values(c, j, path, problem, {static_cast<int>(bins)}, {a}, {b}, &values)) return false;
+        d = make_tabulated(a, b, values);
+    } else {
+        return c.fail(sub(path, "type"), "unknown 1D pdf '" + type +
+                                             "' (known: uniform, power, exponential, gaussian, cosine, tabulated)");
+    }
+    if (!d.ok()) return c.fail(path, d.error);
+    *out = d.value;
+    return true;
+}
+
+bool parse_pdf(Ctx& c, const Json& j, const std::string& path, const Problem& problem,
+               Proposal* out) {
+    const Domain& dom = problem.domain;
+    std::string type;
+    if (!j.is_object()) return c.fail(path, "expected an object, got " + type_of(j));
+    if (!get_string(c, j, "type", path, &type)) return false;
+    if (type.empty()) return c.fail(path, "missing \"type\"");
+    out->importance = true;
+    if (type == "cosine_hemisphere") {
+        if (!check_keys(c, j, path, {"type"})) return false;
+        out->kind = ProposalKind::CosineHemisphere;
+    } else if (type == "tabulated_2d") {
+        if (!check_keys(c, j, path, {"type", "bins", "values", "shape"})) return false;
+        if (dom.kind != DomainKind::Box || dom.lo.size() != 2)
+            return c.fail(path, "tabulated_2d needs a 2-dimensional box domain");
+        std::vector<double> bins{32, 32};
+        if (!get_numbers(c, j, "bins", path, &bins)) return false;
+        if (bins.size() == 1) bins.push_back(bins[0]);
+        if (bins.size() != 2) return c.fail(sub(path, "bins"), "expected [nx, ny]");
+        for (double b : bins)
+            if (!(b >= 1 && b <= 4096 && b == std::floor(b)))
+                return c.fail(sub(path, "bins"), "each count must be a whole number in 1..4096");
+        std::vector<int> nb{static_cast<int>(bins[0]), static_cast<int>(bins[1])};
+        std::vector<double> values;
+        if (!table_values(c, j, path, problem, nb, dom.lo, dom.hi, &values)) return false;
+        Made<TabulatedDistribution2D> t =
+            make_tabulated_2d(dom.lo[0], dom.hi[0], dom.lo[1], dom.hi[1], nb[0], nb[1], values);
+        if (!t.ok()) return c.fail(path, t.error);
+        out->kind = ProposalKind::Tabulated2D;
+        out->table = t.value;
+    } else {
+        if (dom.kind != DomainKind::Box)
+            return c.fail(path, "pdf '" + type + "' samples box axes, the domain is a " +
+                                    domain_kind_name(dom.kind) +
+                                    (dom.kind == DomainKind::Hemisphere ? " (use cosine_hemisphere)" : ""));
+        out->kind = ProposalKind::Product1D;
+        out->marginals.clear();
+        const size_t dim = dom.lo.size();
+        if (type == "product") {
+            if (!check_keys(c, j, path, {"type", "factors"})) return false;
+            const Json* f = find(j, "factors");
+            if (!f || !f->is_array())
+                return c.fail(sub(path, "factors"), "expected an array with one 1D pdf per axis");
+            if (f->size() != dim)
+                return c.fail(sub(path, "factors"), "has " + std::to_string(f->size()) +
+                                                        " entries, the box has " + std::to_string(dim) + " axes");
+            for (size_t a = 0; a < dim; ++a) {
+                Distribution1D d;
+                if (!parse_pdf_1d(c, (*f)[a], sub(path, "factors") + "[" + std::to_string(a) + "]",
+                                  problem, dom.lo[a], dom.hi[a], &d))
+                    return false;
+                out->marginals.push_back(d);
+            }
+        } else {
+            if (type == "tabulated" && dim != 1)
+                return c.fail(path, "tabulated is 1D: use tabulated_2d, or a product of 1D pdfs");
+            for (size_t a = 0; a < dim; ++a) {
+                Distribution1D d;
+                if (!parse_pdf_1d(c, j, path, problem, dom.lo[a], dom.hi[a], &d)) return false;
+                out->marginals.push_back(d);
+            }
+        }
+    }
+    std::string mismatch = check_proposal(*out, dom);
+    if (!mismatch.empty()) return c.fail(path, mismatch);
+    return true;
+}
+
+// --- estimators --------------------------------------------------------------------------
+
+const EstimatorPreset* find_preset(const std::string& name) {
+    for (const EstimatorPreset& p : estimator_presets())
+        if (name == p.name) return &p;
+    return nullptr;
+}
+
+std::vector<std::string> preset_names() {
+    std::vector<std::string> names;
+    for (const EstimatorPreset& p : estimator_presets()) names.push_back(p.name);
+    return names;
+}
+
+bool parse_estimator(Ctx& c, const Json& j, const std::string& path, const Problem& problem,
+                     EstimatorSpec* out) {
+    std::string name, sampler_name_str, warp;
+    const Json* pdf = nullptr;
+    if (j.is_string()) {
+        name = j.get<std::string>();
+    } else if (j.is_object()) {
+        if (!check_keys(c, j, path, {"name", "sampler", "pdf", "warp"})) return false;
+        if (!get_string(c, j, "name", path, &name) || !get_string(c, j, "sampler", path, &sampler_name_str) ||
+            !get_string(c, j, "warp", path, &warp))
+            return false;
+        pdf = find(j, "pdf");
+    } else {
+        return c.fail(path, "expected an estimator name or object, got " + type_of(j));
+    }
+    if (name.empty()) return c.fail(path, "an estimator needs a \"name\"");
+    const EstimatorPreset* preset = find_preset(name);
+    out->name = name;
+    out->sampler = preset ? preset->sampler : SamplerKind::Independent;
+    if (!sampler_name_str.empty() && !parse_sampler(sampler_name_str, &out->sampler))
+        return c.fail(sub(path, "sampler"), "unknown sampler '" + sampler_name_str +
+                                                "' (known: independent, stratified, latin_hypercube)");
+    if (!warp.empty() && warp != "polar" && warp != "concentric")
+        return c.fail(sub(path, "warp"), "unknown warp '" + warp + "' (known: polar, concentric)");
+    if (!warp.empty() && problem.domain.kind != DomainKind::Disk)
+        return c.fail(sub(path, "warp"), "only disk domains have a choice of warp");
+    out->proposal = uniform_proposal(problem.domain, warp == "polar");
+    if (pdf) {
+        if (!parse_pdf(c, *pdf, sub(path, "pdf"), problem, &out->proposal)) return false;
+    } else if (preset && preset->needs_pdf) {
+        return c.fail(path, "estimator '" + name + "' needs a pdf: give \"pdf\": {\"type\": ...}");
+    }
+    return true;
+}
+
+}  // namespace
+
+const std::vector<EstimatorPreset>& estimator_presets() {
+    static const std::vector<EstimatorPreset> presets = {
+        {"uniform", SamplerKind::Independent, false, "independent uniform points, f / p with p uniform"},
+        {"stratified", SamplerKind::Stratified, false, "one jittered point per cell of an N-cell grid"},
+        {"latin_hypercube", SamplerKind::LatinHypercube, false, "N-rooks: one point per slab of every axis"},
+        {"importance", SamplerKind::Independent, true, "independent points drawn from the given pdf"},
+        {"stratified_importance", SamplerKind::Stratified, true, "jittered unit-cube points warped by the pdf's inverse CDF"},
+    };
+    return presets;
+}
+
+Made<Json> parse_json(const char* text, const char* what) {
+    if (!text) return made_error<Json>(std::string(what) + ": no text (null pointer)");
+    Json j = Json::parse(text, nullptr, /*allow_exceptions=*/false);
+    if (!j.is_discarded()) return {j, {}};
+    // Parse again with a SAX handler that records the position and reason.
+    struct ErrorSax : nlohmann::json_sax<Json> {
+        std::string message;
+        bool null() override { return true; }
+        bool boolean(bool) override { return true; }
+        bool number_integer(number_integer_t) override { return true; }
+        bool number_unsigned(number_unsigned_t) override { return true; }
+        bool number_float(number_float_t, const string_t&) override { return true; }
+        bool string(string_t&) override { return true; }
+        bool binary(binary_t&) override { return true; }
+        bool start_object(std::size_t) override { return true; }
+        bool key(string_t&) override { return true; }
+        bool end_object() override { return true; }
+        bool start_array(std::size_t) override { return true; }
+        bool end_array() override { return true; }
+        bool parse_error(std::size_t position, const std::string& last_token,
+                         const nlohmann::detail::exception& ex) override {
+            std::string reason = ex.what();
+            // nlohmann's text: "[json.exception.parse_error.101] parse error at line 2, column 5: ..."
+            size_t at = reason.find("parse error");
+            if (at != std::string::npos) reason = reason.substr(at);
+            message = reason + " (near '" + last_token.substr(0, 20) + "', byte " + std::to_string(position) + ")";
+            return false;
+        }
+    } sax;
+    Json::sax_parse(text, &sax, nlohmann::detail::input_format_t::json, /*strict=*/true);
+    return made_error<Json>(std::string(what) + ": invalid JSON: " +
+                            (sax.message.empty() ? "could not parse" : sax.message));
+}
+
+Made<SceneRequest> build_request(const Json& scene, const Json& options) {
+    Ctx c;
+    SceneRequest req;
+    const std::string path = "scene";
+    if (!check_keys(c, scene, path,
+                    {"name", "description", "domain", "integrand", "quantity", "exact", "estimators",
+                     "n_min", "n_max", "reps", "seed", "threads", "notes"}))
+        return made_error<SceneRequest>(c.error);
+    Problem& pr = req.problem;
+    pr.name = "scene";
+    if (!get_string(c, scene, "name", path, &pr.name) ||
+        !get_string(c, scene, "description", path, &pr.description))
+        return made_error<SceneRequest>(c.error);
+
+    const Json* integrand = find(scene, "integrand");
+    if (!integrand) return made_error<SceneRequest>("scene: missing \"integrand\"");
+    // The integrand's own array lengths give a default box dimension.
+    int default_dim = 1;
+    for (const char* key : {"powers", "rates", "center"})
+        if (const Json* v = find(*integrand, key); v && v->is_array() && !v->empty())
+            default_dim = static_cast<int>(v->size());
+    if (const Json* d = find(scene, "domain")) {
+        if (!parse_domain(c, *d, "scene.domain", default_dim, &pr.domain))
+            return made_error<SceneRequest>(c.error);
+    } else {
+        pr.domain = make_box(std::vector<double>(static_cast<size_t>(default_dim), 0.0),
+                             std::vector<double>(static_cast<size_t>(default_dim), 1.0)).value;
+    }
+    if (!parse_integrand(c, *integrand, "scene.integrand", pr.domain.point_dim(), &pr.integrand))
+        return made_error<SceneRequest>(c.error);
+
+    std::string quantity = "integral";
+    if (!get_string(c, scene, "quantity", path, &quantity)) return made_error<SceneRequest>(c.error);
+    if (quantity == "integral") pr.quantity = Quantity::Integral;
+    else if (quantity == "mean") pr.quantity = Quantity::Mean;
+    else return made_error<SceneRequest>("scene.quantity: expected \"integral\" or \"mean\", got \"" + quantity + "\"");
+
+    if (const Json* e = find(scene, "exact"); e && !e->is_null()) {
+        double exact = 0.0;
+        if (!get_number(c, scene, "exact", path, &exact)) return made_error<SceneRequest>(c.error);
+        pr.exact = exact;
+    } else if (pr.domain.kind == DomainKind::Box) {
+        std::optional<double> v = exact_integral_over_box(pr.integrand, pr.domain.lo, pr.domain.hi);
+        if (v && pr.quantity == Quantity::Mean) *v /= pr.domain.measure();
+        pr.exact = v;
+    }
+
+    // Estimators: the scene's list, or the three uniform-density presets.
+    std::vector<EstimatorSpec> all;
+    std::set<std::string> names;
+    if (const Json* list = find(scene, "estimators")) {
+        if (!list->is_array() || list->empty())
+            return made_error<SceneRequest>("scene.estimators: expected a non-empty array");
+        for (size_t i = 0; i < list->size(); ++i) {
+            EstimatorSpec spec;
+            if (!parse_estimator(c, (*list)[i], "scene.estimators[" + std::to_string(i) + "]", pr, &spec))
+                return made_error<SceneRequest>(c.error);
+            if (!names.insert(spec.name).second)
+                return made_error<SceneRequest>("scene.estimators[" + std::to_string(i) +
+                                                "]: duplicate estimator name '" + spec.name + "'");
+            all.push_back(spec);
+        }
+    } else {
+        for (const char* n : {"uniform", "stratified", "latin_hypercube"}) {
+            EstimatorSpec spec;
+            parse_estimator(c, Json(n), "scene.estimators", pr, &spec);
+            all.push_back(spec);
+        }
+    }
+
+    // Settings: defaults, then the scene, then the options.
+    StudySettings& s = req.settings;
+    uint64_t reps = static_cast<uint64_t>(s.reps), threads = 0;
+    if (!get_count(c, scene, "n_min", path, &s.n_min) || !get_count(c, scene, "n_max", path, &s.n_max) ||
+        !get_count(c, scene, "reps", path, &reps) || !get_count(c, scene, "seed", path, &s.seed) ||
+        !get_count(c, scene, "threads", path, &threads))
+        return made_error<SceneRequest>(c.error);
+
+    req.estimators = all;
+    if (!options.is_null()) {
+        if (!check_keys(c, options, "options", {"estimators", "n_min", "n_max", "reps", "seed", "threads"}) ||
+            !get_count(c, options, "n_min", "options", &s.n_min) ||
+            !get_count(c, options, "n_max", "options", &s.n_max) ||
+            !get_count(c, options, "reps", "options", &reps) ||
+            !get_count(c, options, "seed", "options", &s.seed) ||
+            !get_count(c, options, "threads", "options", &threads))
+            return made_error<SceneRequest>(c.error);
+        if (const Json* sel = find(options, "estimators")) {
+            if (!sel->is_array() || sel->empty())
+                return made_error<SceneRequest>("options.estimators: expected a non-empty array of names");
+            req.estimators.clear();
+            std::set<std::string> chosen;
+            for (size_t i = 0; i < sel->size(); ++i) {
+                const Json& item = (*sel)[i];
+                if (!item.is_string())
+                    return made_error<SceneRequest>("options.estimators[" + std::to_string(i) + "]: expected a name");
+                const std::string name = item.get<std::string>();
+                if (!chosen.insert(name).second) continue;
+                bool found = false;
+                for (const EstimatorSpec& e : all)
+                    if (e.name == name) {
+                        req.estimators.push_back(e);
+                        found = true;
+                    }
+                if (found) continue;
+                const EstimatorPreset* preset = find_preset(name);
+                if (preset && !preset->needs_pdf) {
+                    EstimatorSpec spec;
+                    parse_estimator(c, item, "options.estimators", pr, &spec);
+                    req.estimators.push_back(spec);
+                    continue;
+                }
+                std::vector<std::string> have;
+                for (const EstimatorSpec& e : all) have.push_back(e.name);
+                return made_error<SceneRequest>(
+                    "unknown estimator '" + name + "' (this scene has: " + join(have) +
+                    (preset ? "; '" + name + "' needs a pdf, which only a scene can give)"
+                            : "; presets: " + join(preset_names()) + ")"));
+            }
+        }
+    }
+    if (reps > 100000) reps = 100001;  // reported by check_settings
+    if (threads > 1000) threads = 1001;
+    s.reps = static_cast<int>(reps);
+    s.threads = static_cast<int>(threads);
+    std::string bad = check_settings(s);
+    if (!bad.empty()) return made_error<SceneRequest>("settings: " + bad);
+    return {req, {}};
+}
+
+}  // namespace mcp

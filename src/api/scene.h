@@ -1,0 +1,48 @@
+// Scene JSON -> problem, estimators and study settings (docs/scene-format.md), and study
+// results -> JSON (docs/result-schema.md), table and CSV. Internal to the C API.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "core/made.h"
+#include "estimators/study.h"
+
+namespace mcp {
+
+using Json = nlohmann::json;
+
+struct SceneRequest {
+    Problem problem;
+    std::vector<EstimatorSpec> estimators;
+    StudySettings settings;
+};
+
+/// Parses JSON text without exceptions; on failure the message gives the byte position.
+Made<Json> parse_json(const char* text, const char* what);
+
+/// Builds a study request from a scene and optional overrides (either may be null JSON).
+Made<SceneRequest> build_request(const Json& scene, const Json& options);
+
+/// Estimator presets: name -> (sampler, needs a pdf).
+struct EstimatorPreset {
+    const char* name;
+    SamplerKind sampler;
+    bool needs_pdf;
+    const char* summary;
+};
+const std::vector<EstimatorPreset>& estimator_presets();
+
+constexpr int kResultSchemaVersion = 1;
+
+Json study_to_json(const StudyResult& result);
+Json level_to_json(const LevelStats& level);
+Json fit_to_json(const ConvergenceFit& fit);
+Json progress_to_json(const StudyResult& partial, size_t level_index);
+
+std::string format_table(const Json& result);
+std::string format_csv(const Json& result);
+
+}  // namespace mcp

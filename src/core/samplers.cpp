@@ -1,0 +1,149 @@
+#include "core/samplers.h"
+
+#include <cmath>
+
+namespace mcp {
+
+namespace {
+// (c + xi) / k rounds to 1 when k is large and xi close to 1; keep u inside [0, 1).
+constexpr double kOneMinusEpsilon = 0x1.fffffffffffffp-1;
+}  // namespace
+
+const char* sampler_name(SamplerKind kind) {
+    switch (kind) {
+    case SamplerKind::Independent: return "independent";
+    case SamplerKind::Stratified: return "stratified";
+    case SamplerKind::LatinHypercube: return "latin_hypercube";
+    }
+    return "?";
+}
+
+bool parse_sampler(const std::string& name, SamplerKind* kind) {
+    if (name == "independent") *kind = SamplerKind::Independent;
+    else if (name == "stratified") *kind = SamplerKind::Stratified;
+    else if (name == "latin_hypercube") *kind = SamplerKind::LatinHypercube;
+    else return false;
+    return true;
+}
+
+namespace {
+
+// Largest divisor of n that is <= limit (limit >= 1).
+uint64_t largest_divisor_at_most(uint64_t n, double limit) {
+    uint64_t best = 1;
+    for (uint64_t q = 1; q * q <= n; ++q) {
+        if (n % q) continue;
+        uint64_t p = n / q;
+        if (static_cast<double>(q) <= limit && q > best) best = q;
+        if (static_cast<double>(p) <= limit && p > best) best = p;
+    }
+    return best;
+}
+
+}  // namespace
+
+std::vector<uint64_t> stratification_grid(uint64_t n, int dim) {
+    std::vector<uint64_t> k(static_cast<size_t>(dim), 1);
+    uint64_t remaining = n;
+    for (int j = 0; j < dim - 1; ++j) {
+        // The tiny allowance keeps exact roots exact: 64^(1/3) may round to 3.9999999.
+        double root = std::pow(static_cast<double>(remaining), 1.0 / (dim - j)) * (1.0 + 1e-12);
+        k[j] = largest_divisor_at_most(remaining, root);
+        remaining /= k[j];
+    }
+    k[dim - 1] = remaining;
+    return k;
+}
+
+namespace {
+
+// One keyed bijection of [0, 2^bits): each step (xor with a constant, multiplication by an
+// odd number, xorshift to the right, addition) is invertible modulo 2^bits.
+inline uint64_t bijection(uint64_t x, uint64_t mask, int bits, uint64_t key) {
+    int shift = bits > 1 ? bits / 2 : 1;
+    for (int round = 0; round < 4; ++round) {
+        uint64_t rk = mix64(key + static_cast<uint64_t>(round));
+        x ^= rk & mask;
+        x = (x * (rk | 1u)) & mask;
+        x ^= x >> shift;
+        x = (x * 0x9e3779b97f4a7c15ULL) & mask;  // odd multiplier: a bijection mod 2^bits
+        x ^= x >> (shift > 1 ? shift - 1 : 1);
+        x = (x + (rk >> 32)) & mask;
+    }
+    return x;
+}
+
+}  // namespace
+
+uint64_t permute_index(uint64_t index, uint64_t n, uint64_t key) {
+    if (n <= 1) return 0;
+    int bits = 0;
+    while ((uint64_t(1) << bits) < n) ++bits;
+    uint64_t mask = bits >= 64 ? ~uint64_t(0) : (uint64_t(1) << bits) - 1;
+    // Cycle walking: apply the bijection until the value falls back inside [0, n). The
+    // orbit of an index < n returns to [0, n), so this is a permutation of [0, n).
+    uint64_t x = index;
+    do {
+        x = bijection(x, mask, bits, key);
+    } while (x >= n);
+    return x;
+}
+
+SamplerPlan make_sampler_plan(SamplerKind kind, int dim, uint64_t n, Pcg32& rng) {
+    SamplerPlan plan;
+    plan.kind = kind;
+    plan.dim = dim;
+    plan.total = n;
+    if (kind == SamplerKind::Stratified) plan.strata = stratification_grid(n, dim);
+    if (kind == SamplerKind::LatinHypercube) {
+        for (int j = 0; j < dim; ++j) {
+            uint64_t hi = rng.next_u32(), lo = rng.next_u32();
+            plan.perm_keys.push_back((hi << 32) | lo);
+        }
+    }
+    return plan;
+}
+
+void generate_block(const SamplerPlan& plan, uint64_t first, size_t count, Pcg32& rng,
+                    PointBlock& u) {
+    u.n = count;
+    const int d = plan.dim;
+    switch (plan.kind) {
+    case SamplerKind::Independent:
+        // Point-major draw order so that a point's coordinates come from consecutive draws.
+        for (size_t i = 0; i < count; ++i)
+            for (int j = 0; j < d; ++j) u.coord(j)[i] = rng.next_double();
+        break;
+    case SamplerKind::Stratified: {
+        // Cell index in mixed radix, last axis fastest: cell = ((c_0 k_1 + c_1) k_2 + c_2)...
+        // Consecutive indices are neighbouring cells, which the collapsed-strata variance
+        // estimate relies on (pairs 2m, 2m+1).
+        for (size_t i = 0; i < count; ++i) {
+            uint64_t cell = first + i;
+            for (int j = d - 1; j >= 0; --j) {
+                uint64_t k = plan.strata[static_cast<size_t>(j)];
+                uint64_t c = cell % k;
+                cell /= k;
+                u.coord(j)[i] = std::fmin(
+                    (static_cast<double>(c) + rng.next_double()) / static_cast<double>(k),
+                    kOneMinusEpsilon);
+            }
+        }
+        break;
+    }
+    case SamplerKind::LatinHypercube: {
+        const double inv_n = 1.0 / static_cast<double>(plan.total);
+        for (size_t i = 0; i < count; ++i) {
+            uint64_t index = first + i;
+            for (int j = 0; j < d; ++j) {
+                uint64_t slab = permute_index(index, plan.total, plan.perm_keys[static_cast<size_t>(j)]);
+                u.coord(j)[i] =
+                    std::fmin((static_cast<double>(slab) + rng.next_double()) * inv_n, kOneMinusEpsilon);
+            }
+        }
+        break;
+    }
+    }
+}
+
+}  // namespace mcp

@@ -1,0 +1,56 @@
+// Point sets in the unit cube [0,1)^d, generated block by block (structure of arrays) so
+// that a run of N samples needs O(1) memory whatever N is.
+//
+// - Independent: every coordinate an independent uniform.
+// - Stratified (jittered): the cube is cut into N cells, one jittered sample per cell.
+//   The grid rule for any N (not only perfect powers k^d) is stratification_grid().
+// - Latin hypercube (N-rooks) [McKay79]: each axis cut into N slabs, each slab of each axis
+//   holds exactly one sample; the slab orders are independent random permutations,
+//   evaluated by a keyed bijection instead of stored arrays [Kensler13].
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/made.h"
+#include "core/points.h"
+#include "core/rng.h"
+
+namespace mcp {
+
+enum class SamplerKind { Independent, Stratified, LatinHypercube };
+
+const char* sampler_name(SamplerKind kind);
+/// Parses "independent", "stratified", "latin_hypercube"; false if unknown.
+bool parse_sampler(const std::string& name, SamplerKind* kind);
+
+/// Strata counts k_0..k_{d-1} with k_0 k_1 ... k_{d-1} = n exactly, as even as the
+/// factors of n allow: k_j is the largest divisor of the remaining count not above its
+/// (d-j)-th root, so the counts never decrease with j. For n = 2^m the counts are powers
+/// of two within a factor 2 of each other (n = 8, d = 2: 2 x 4); for prime n the grid
+/// degenerates to n slabs along the last axis, which is still a valid stratification.
+std::vector<uint64_t> stratification_grid(uint64_t n, int dim);
+
+/// A keyed pseudo-random permutation of [0, n): cycle-walking over a bijection of the
+/// enclosing power-of-two range [Kensler13, Black02]; O(1) memory, any n >= 1.
+uint64_t permute_index(uint64_t index, uint64_t n, uint64_t key);
+
+/// Everything a run needs to generate its points; built once per run.
+struct SamplerPlan {
+    SamplerKind kind = SamplerKind::Independent;
+    int dim = 1;
+    uint64_t total = 0;               ///< N, the number of points of the whole run
+    std::vector<uint64_t> strata;     ///< stratified: counts per axis (product = total)
+    std::vector<uint64_t> perm_keys;  ///< Latin hypercube: one permutation key per axis
+};
+
+/// Plans a run of n points in dim dimensions. Latin hypercube keys are drawn from rng.
+SamplerPlan make_sampler_plan(SamplerKind kind, int dim, uint64_t n, Pcg32& rng);
+
+/// Writes points first .. first + count - 1 of the run into u (count <= u.capacity),
+/// drawing jitter from rng. Consecutive calls must cover the run in order.
+void generate_block(const SamplerPlan& plan, uint64_t first, size_t count, Pcg32& rng,
+                    PointBlock& u);
+
+}  // namespace mcp

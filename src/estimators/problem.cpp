@@ -1,0 +1,289 @@
+#include "estimators/problem.h"
+
+#include <cmath>
+#include <sstream>
+
+#include "core/special.h"
+
+namespace mcp {
+
+const char* domain_kind_name(DomainKind kind) {
+    switch (kind) {
+    case DomainKind::Box: return "box";
+    case DomainKind::Disk: return "disk";
+    case DomainKind::Triangle: return "triangle";
+    case DomainKind::Sphere: return "sphere";
+    case DomainKind::Hemisphere: return "hemisphere";
+    }
+    return "?";
+}
+
+int Domain::point_dim() const {
+    switch (kind) {
+    case DomainKind::Box: return static_cast<int>(lo.size());
+    case DomainKind::Disk:
+    case DomainKind::Triangle: return 2;
+    case DomainKind::Sphere:
+    case DomainKind::Hemisphere: return 3;
+    }
+    return 0;
+}
+
+int Domain::sample_dim() const { return kind == DomainKind::Box ? static_cast<int>(lo.size()) : 2; }
+
+double Domain::measure() const {
+    switch (kind) {
+    case DomainKind::Box: {
+        double v = 1.0;
+        for (size_t j = 0; j < lo.size(); ++j) v *= hi[j] - lo[j];
+        return v;
+    }
+    case DomainKind::Disk: return kPi * radius * radius;
+    case DomainKind::Triangle:
+        return 0.5 * std::fabs((v1.x - v0.x) * (v2.y - v0.y) - (v2.x - v0.x) * (v1.y - v0.y));
+    case DomainKind::Sphere: return 4.0 * kPi;
+    case DomainKind::Hemisphere: return 2.0 * kPi;
+    }
+    return 0.0;
+}
+
+std::string Domain::describe() const {
+    std::ostringstream s;
+    s.precision(6);
+    switch (kind) {
+    case DomainKind::Box:
+        for (size_t j = 0; j < lo.size(); ++j) s << (j ? " x " : "") << "[" << lo[j] << ", " << hi[j] << "]";
+        break;
+    case DomainKind::Disk:
+        s << "disk centre (" << center.x << ", " << center.y << ") radius " << radius;
+        break;
+    case DomainKind::Triangle:
+        s << "triangle (" << v0.x << ", " << v0.y << ") (" << v1.x << ", " << v1.y << ") (" << v2.x
+          << ", " << v2.y << ")";
+        break;
+    case DomainKind::Sphere: s << "unit sphere of directions"; break;
+    case DomainKind::Hemisphere: s << "hemisphere of directions z >= 0"; break;
+    }
+    return s.str();
+}
+
+Made<Domain> make_box(std::vector<double> lo, std::vector<double> hi) {
+    if (lo.empty() || lo.size() != hi.size())
+        return made_error<Domain>("box: lower and upper must be non-empty and of equal length");
+    if (lo.size() > 64) return made_error<Domain>("box: at most 64 dimensions, got " + std::to_string(lo.size()));
+    for (size_t j = 0; j < lo.size(); ++j) {
+        if (!std::isfinite(lo[j]) || !std::isfinite(hi[j]) || !(lo[j] < hi[j]))
+            return made_error<Domain>("box: axis " + std::to_string(j) +
+                                      " needs finite lower < upper");
+    }
+    Domain d;
+    d.kind = DomainKind::Box;
+    d.lo = std::move(lo);
+    d.hi = std::move(hi);
+    return {d, {}};
+}
+
+Made<Domain> make_disk(Vec2 center, double radius) {
+    if (!std::isfinite(center.x) || !std::isfinite(center.y))
+        return made_error<Domain>("disk: center must be finite");
+    if (!(radius > 0.0) || !std::isfinite(radius))
+        return made_error<Domain>("disk: radius must be a finite number > 0");
+    Domain d;
+    d.kind = DomainKind::Disk;
+    d.center = center;
+    d.radius = radius;
+    d.lo = {center.x - radius, center.y - radius};
+    d.hi = {center.x + radius, center.y + radius};
+    return {d, {}};
+}
+
+Made<Domain> make_triangle(Vec2 a, Vec2 b, Vec2 c) {
+    for (Vec2 v : {a, b, c})
+        if (!std::isfinite(v.x) || !std::isfinite(v.y))
+            return made_error<Domain>("triangle: vertices must be finite");
+    Domain d;
+    d.kind = DomainKind::Triangle;
+    d.v0 = a;
+    d.v1 = b;
+    d.v2 = c;
+    if (!(d.measure() > 0.0)) return made_error<Domain>("triangle: vertices are collinear (zero area)");
+    return {d, {}};
+}
+
+Domain make_sphere() {
+    Domain d;
+    d.kind = DomainKind::Sphere;
+    return d;
+}
+
+Domain make_hemisphere() {
+    Domain d;
+    d.kind = DomainKind::Hemisphere;
+    return d;
+}
+
+const char* proposal_kind_name(ProposalKind kind) {
+    switch (kind) {
+    case ProposalKind::UniformBox: return "uniform";
+    case ProposalKind::DiskPolar: return "uniform_polar";
+    case ProposalKind::DiskConcentric: return "uniform_concentric";
+    case ProposalKind::Triangle: return "uniform";
+    case ProposalKind::Sphere: return "uniform";
+    case ProposalKind::Hemisphere: return "uniform";
+    case ProposalKind::CosineHemisphere: return "cosine_hemisphere";
+    case ProposalKind::Product1D: return "product";
+    case ProposalKind::Tabulated2D: return "tabulated_2d";
+    }
+    return "?";
+}
+
+std::string Proposal::describe() const {
+    switch (kind) {
+    case ProposalKind::UniformBox: return "uniform";
+    case ProposalKind::DiskPolar: return "uniform (polar map r = sqrt(u1))";
+    case ProposalKind::DiskConcentric: return "uniform (concentric map)";
+    case ProposalKind::Triangle: return "uniform (barycentric sqrt map)";
+    case ProposalKind::Sphere:
+    case ProposalKind::Hemisphere: return "uniform";
+    case ProposalKind::CosineHemisphere: return "cos(theta)/pi";
+    case ProposalKind::Product1D: {
+        std::string s;
+        for (size_t j = 0; j < marginals.size(); ++j) s += (j ? " x " : "") + marginals[j].describe();
+        return s;
+    }
+    case ProposalKind::Tabulated2D:
+        return "tabulated_2d(" + std::to_string(table.nx()) + " x " + std::to_string(table.ny()) + ")";
+    }
+    return "?";
+}
+
+Proposal uniform_proposal(const Domain& domain, bool disk_polar) {
+    Proposal p;
+    switch (domain.kind) {
+    case DomainKind::Box: p.kind = ProposalKind::UniformBox; break;
+    case DomainKind::Disk: p.kind = disk_polar ? ProposalKind::DiskPolar : ProposalKind::DiskConcentric; break;
+    case DomainKind::Triangle: p.kind = ProposalKind::Triangle; break;
+    case DomainKind::Sphere: p.kind = ProposalKind::Sphere; break;
+    case DomainKind::Hemisphere: p.kind = ProposalKind::Hemisphere; break;
+    }
+    return p;
+}
+
+std::string check_proposal(const Proposal& p, const Domain& d) {
+    auto need = [&](DomainKind k) -> std::string {
+        if (d.kind == k) return "";
+        return std::string("pdf '") + proposal_kind_name(p.kind) + "' samples a " +
+               domain_kind_name(k) + ", the domain is a " + domain_kind_name(d.kind);
+    };
+    switch (p.kind) {
+    case ProposalKind::UniformBox: return need(DomainKind::Box);
+    case ProposalKind::DiskPolar:
+    case ProposalKind::DiskConcentric: return need(DomainKind::Disk);
+    case ProposalKind::Triangle: return need(DomainKind::Triangle);
+    case ProposalKind::Sphere: return need(DomainKind::Sphere);
+    case ProposalKind::Hemisphere:
+    case ProposalKind::CosineHemisphere: return need(DomainKind::Hemisphere);
+    case ProposalKind::Product1D: {
+        if (auto e = need(DomainKind::Box); !e.empty()) return e;
+        if (p.marginals.size() != d.lo.size())
+            return "pdf has " + std::to_string(p.marginals.size()) + " factors, the box has " +
+                   std::to_string(d.lo.size()) + " axes";
+        for (size_t j = 0; j < d.lo.size(); ++j)
+            if (p.marginals[j].lower() != d.lo[j] || p.marginals[j].upper() != d.hi[j])
+                return "pdf factor " + std::to_string(j) + " does not span the box axis";
+        return "";
+    }
+    case ProposalKind::Tabulated2D: {
+        if (auto e = need(DomainKind::Box); !e.empty()) return e;
+        if (d.lo.size() != 2) return "tabulated_2d needs a 2-dimensional box";
+        if (p.table.x0() != d.lo[0] || p.table.x1() != d.hi[0] || p.table.y0() != d.lo[1] ||
+            p.table.y1() != d.hi[1])
+            return "tabulated_2d table does not span the box";
+        return "";
+    }
+    }
+    return "unknown pdf";
+}
+
+void warp_block(const Proposal& p, const Domain& d, const PointBlock& u, PointBlock& x,
+                double* pdf) {
+    const size_t n = u.n;
+    x.n = n;
+    switch (p.kind) {
+    case ProposalKind::UniformBox: {
+        const double density = 1.0 / d.measure();
+        for (size_t j = 0; j < d.lo.size(); ++j) {
+            const double a = d.lo[j], w = d.hi[j] - d.lo[j];
+            const double* uj = u.coord(static_cast<int>(j));
+            double* xj = x.coord(static_cast<int>(j));
+            for (size_t i = 0; i < n; ++i) xj[i] = a + w * uj[i];
+        }
+        for (size_t i = 0; i < n; ++i) pdf[i] = density;
+        break;
+    }
+    case ProposalKind::DiskPolar:
+    case ProposalKind::DiskConcentric: {
+        const double density = 1.0 / d.measure();
+        const bool polar = p.kind == ProposalKind::DiskPolar;
+        for (size_t i = 0; i < n; ++i) {
+            Vec2 uv{u.coord(0)[i], u.coord(1)[i]};
+            Vec2 q = polar ? sample_disk_polar(uv) : sample_disk_concentric(uv);
+            x.coord(0)[i] = d.center.x + d.radius * q.x;
+            x.coord(1)[i] = d.center.y + d.radius * q.y;
+            pdf[i] = density;
+        }
+        break;
+    }
+    case ProposalKind::Triangle: {
+        const double density = 1.0 / d.measure();
+        for (size_t i = 0; i < n; ++i) {
+            Vec2 b = sample_triangle_barycentric(Vec2{u.coord(0)[i], u.coord(1)[i]});
+            Vec2 q = b.x * d.v0 + b.y * d.v1 + (1.0 - b.x - b.y) * d.v2;
+            x.coord(0)[i] = q.x;
+            x.coord(1)[i] = q.y;
+            pdf[i] = density;
+        }
+        break;
+    }
+    case ProposalKind::Sphere:
+    case ProposalKind::Hemisphere:
+    case ProposalKind::CosineHemisphere: {
+        for (size_t i = 0; i < n; ++i) {
+            Vec2 uv{u.coord(0)[i], u.coord(1)[i]};
+            Vec3 w = p.kind == ProposalKind::Sphere       ? sample_uniform_sphere(uv)
+                     : p.kind == ProposalKind::Hemisphere ? sample_uniform_hemisphere(uv)
+                                                          : sample_cosine_hemisphere(uv);
+            x.coord(0)[i] = w.x;
+            x.coord(1)[i] = w.y;
+            x.coord(2)[i] = w.z;
+            pdf[i] = p.kind == ProposalKind::Sphere       ? uniform_sphere_pdf()
+                     : p.kind == ProposalKind::Hemisphere ? uniform_hemisphere_pdf()
+                                                          : cosine_hemisphere_pdf(w.z);
+        }
+        break;
+    }
+    case ProposalKind::Product1D: {
+        // The first axis writes the density, the others multiply theirs in.
+        for (size_t j = 0; j < p.marginals.size(); ++j) {
+            const int jj = static_cast<int>(j);
+            if (j == 0) {
+                p.marginals[0].sample_block(u.coord(0), x.coord(0), pdf, n);
+            } else {
+                double density[kBlockSize];
+                for (size_t start = 0; start < n; start += kBlockSize) {
+                    const size_t m = n - start < kBlockSize ? n - start : kBlockSize;
+                    p.marginals[j].sample_block(u.coord(jj) + start, x.coord(jj) + start,
+                                                density, m);
+                    for (size_t i = 0; i < m; ++i) pdf[start + i] *= density[i];
+                }
+            }
+        }
+        break;
+    }
+    case ProposalKind::Tabulated2D:
+        p.table.sample_block(u.coord(0), u.coord(1), x.coord(0), x.coord(1), pdf, n);
+        break;
+    }
+}
+
+}  // namespace mcp

@@ -1,0 +1,101 @@
+// A problem (domain, integrand, quantity, exact value) and the proposals that sample its
+// domain: uniform warps of the unit square/cube, or importance distributions.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/distributions.h"
+#include "core/made.h"
+#include "core/points.h"
+#include "core/samplers.h"
+#include "core/warps.h"
+#include "integrands/integrand.h"
+
+namespace mcp {
+
+enum class DomainKind { Box, Disk, Triangle, Sphere, Hemisphere };
+
+const char* domain_kind_name(DomainKind kind);
+
+/// The integration domain. Points handed to integrands live in its embedding space:
+/// box: R^d; disk and triangle: R^2; sphere and hemisphere: unit directions in R^3 (z up).
+struct Domain {
+    DomainKind kind = DomainKind::Box;
+    std::vector<double> lo{0.0}, hi{1.0};  ///< box bounds
+    Vec2 center{0.0, 0.0};                 ///< disk centre
+    double radius = 1.0;                   ///< disk radius
+    Vec2 v0{0, 0}, v1{1, 0}, v2{0, 1};     ///< triangle vertices
+
+    /// Dimension of the points given to the integrand.
+    int point_dim() const;
+    /// Dimension of the unit cube the warps start from.
+    int sample_dim() const;
+    /// Lebesgue measure: volume, area, or solid angle.
+    double measure() const;
+    std::string describe() const;
+};
+
+Made<Domain> make_box(std::vector<double> lo, std::vector<double> hi);
+Made<Domain> make_disk(Vec2 center, double radius);
+Made<Domain> make_triangle(Vec2 a, Vec2 b, Vec2 c);
+Domain make_sphere();
+Domain make_hemisphere();
+
+/// What a run estimates: the integral of f over the domain, or its mean (the integral
+/// divided by the domain's measure, i.e. E[f(X)] for X uniform on the domain).
+enum class Quantity { Integral, Mean };
+
+struct Problem {
+    std::string name;
+    std::string description;
+    Domain domain;
+    Integrand integrand;
+    Quantity quantity = Quantity::Integral;
+    std::optional<double> exact;
+};
+
+enum class ProposalKind {
+    UniformBox,        ///< x = lo + (hi - lo) u
+    DiskPolar,         ///< course-notes polar map
+    DiskConcentric,    ///< Shirley-Chiu concentric map
+    Triangle,          ///< uniform barycentrics
+    Sphere,            ///< uniform on the sphere
+    Hemisphere,        ///< uniform on the hemisphere
+    CosineHemisphere,  ///< cos(theta)/pi on the hemisphere
+    Product1D,         ///< independent 1D distributions per box axis
+    Tabulated2D,       ///< piecewise-constant table over a 2D box
+};
+
+const char* proposal_kind_name(ProposalKind kind);
+
+/// The density the points are drawn from, with respect to the domain's measure.
+struct Proposal {
+    ProposalKind kind = ProposalKind::UniformBox;
+    std::vector<Distribution1D> marginals;  ///< Product1D: one per axis
+    TabulatedDistribution2D table;          ///< Tabulated2D
+    bool importance = false;                ///< true for a non-uniform density
+    std::string describe() const;
+};
+
+/// The uniform proposal of a domain; for disks, concentric unless polar is asked for.
+Proposal uniform_proposal(const Domain& domain, bool disk_polar = false);
+
+/// Checks that a proposal can sample a domain (kinds and dimensions match, the 1D
+/// distributions cover exactly the box axes). Returns an error message or "".
+std::string check_proposal(const Proposal& proposal, const Domain& domain);
+
+/// Warps a block of unit-cube points u (domain.sample_dim() coordinates) to domain points x
+/// (domain.point_dim() coordinates) and writes each point's density into pdf.
+void warp_block(const Proposal& proposal, const Domain& domain, const PointBlock& u,
+                PointBlock& x, double* pdf);
+
+/// An estimator: how the unit-cube points are placed, and which density warps them.
+struct EstimatorSpec {
+    std::string name;
+    SamplerKind sampler = SamplerKind::Independent;
+    Proposal proposal;
+};
+
+}  // namespace mcp

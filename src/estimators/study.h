@@ -1,0 +1,104 @@
+// Convergence study: every estimator at every N of a ladder of powers of two, R independent
+// replicates each, summarised by level (variance of the estimator, bias, RMSE, coverage,
+// time, efficiency) and by a fitted convergence order.
+//
+// Randomness: replicate r of estimator e at level N draws from its own PCG32 stream, a hash
+// of (seed, name of e, N, r). Results are therefore identical whatever the thread count,
+// and running a subset of the estimators does not change the ones that remain.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "core/stats.h"
+#include "estimators/estimator.h"
+
+namespace mcp {
+
+struct StudySettings {
+    uint64_t n_min = 16;
+    uint64_t n_max = 65536;
+    int reps = 32;
+    uint64_t seed = 1;
+    int threads = 0;  ///< 0: all hardware threads
+};
+
+/// Checks the settings; returns an error message naming the setting, or "".
+std::string check_settings(const StudySettings& s);
+
+/// The N ladder: powers of two from the first >= n_min up to n_max.
+std::vector<uint64_t> n_ladder(uint64_t n_min, uint64_t n_max);
+
+struct LevelStats {
+    uint64_t n = 0;
+    int reps = 0;
+    double mean = 0.0;            ///< mean of the R estimates
+    double variance = 0.0;        ///< unbiased variance of the estimator across replicates
+    double variance_lo = 0.0;     ///< 95% interval of the variance (chi-square, normal estimates)
+    double variance_hi = 0.0;
+    double std_error = 0.0;       ///< standard error of `mean`, sqrt(variance / R)
+    double ci_lo = 0.0, ci_hi = 0.0;  ///< 95% t interval of the mean over the R replicates
+    bool has_exact = false;
+    double bias = 0.0;            ///< mean - exact
+    double mse = 0.0;             ///< mean of (estimate - exact)^2
+    double rmse = 0.0;
+    double coverage = 0.0;        ///< share of replicates whose own 95% interval covers exact
+    double mean_run_se = 0.0;     ///< average per-run standard error reported by the runs
+    double time_mean = 0.0;       ///< seconds per estimate
+    double time_total = 0.0;
+    double efficiency = 0.0;      ///< 1 / (variance * time_mean)
+    double error = 0.0;           ///< rmse when exact is known, else sqrt(variance)
+    RunDiagnostics diagnostics;   ///< summed over replicates
+    std::vector<double> estimates, run_std_errors;  ///< per replicate
+};
+
+struct ConvergenceFit {
+    bool valid = false;
+    double order = 0.0;     ///< slope of log variance against log N
+    double order_se = 0.0;  ///< its standard error
+    double intercept = 0.0;
+    int levels_used = 0;
+    std::string note;       ///< why the fit is missing or partial
+};
+
+/// Least-squares fit of log variance against log N over the levels with a positive finite
+/// variance. The slope's standard error is the larger of the residual estimate and the
+/// sampling noise of log s^2 for R normal replicates, psi'((R-1)/2) [trigamma].
+ConvergenceFit fit_convergence(const std::vector<LevelStats>& levels);
+
+struct EstimatorStudy {
+    EstimatorSpec spec;
+    ErrorMethod error_method = ErrorMethod::Iid;
+    std::vector<LevelStats> levels;
+    ConvergenceFit fit;
+};
+
+struct StudyResult {
+    Problem problem;
+    StudySettings settings;
+    int threads_used = 1;
+    double wall_seconds = 0.0;
+    bool cancelled = false;
+    std::vector<EstimatorStudy> estimators;
+};
+
+/// Called after each completed level (all estimators at that N); returning false cancels
+/// the study after that level.
+using StudyProgress = std::function<bool(const StudyResult& partial, size_t level_index)>;
+
+/// Summarises the R runs of one level.
+LevelStats summarise_level(const std::vector<RunResult>& runs, const Problem& problem);
+
+/// The stream id of one replicate (see the header comment).
+uint64_t replicate_stream(uint64_t seed, const std::string& estimator, uint64_t n, int rep);
+
+StudyResult run_study(const Problem& problem, const std::vector<EstimatorSpec>& estimators,
+                      const StudySettings& settings, const StudyProgress& progress = {});
+
+/// Threads the study will use for a requested count (0 = hardware); 1 where the build
+/// has no threads (WebAssembly without pthreads).
+int resolve_threads(int requested);
+
+}  // namespace mcp

@@ -1,0 +1,17 @@
+#!/usr/bin/env bash
+# The same studies through the native CLI and the WebAssembly CLI under Node must give the
+# same numbers: integer work (RNG, samplers) is bit-identical; transcendental functions may
+# differ in the last bit between glibc and musl, so estimates are compared to 1e-12 relative.
+set -eu
+native=${1:?native mcplay}
+wasm=${2:?wasm mcplay command}
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+status=0
+for scene in scenes/*.json; do
+    name=$(basename "$scene" .json)
+    $native run "$scene" --n-min 16 --n-max 1024 --reps 4 --threads 2 --quiet --format json --out "$tmp/$name.native.json"
+    $wasm run "$scene" --n-min 16 --n-max 1024 --reps 4 --quiet --format json --out "$tmp/$name.wasm.json"
+    node tests/compare_results.mjs "$tmp/$name.native.json" "$tmp/$name.wasm.json" || status=1
+done
+exit $status

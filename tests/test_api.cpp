@@ -1,0 +1,204 @@
+// The C API: documented result JSON, error codes and messages for bad input, progress and
+// cancellation, formatting.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "api/mcplay.h"
+
+using nlohmann::json;
+
+namespace {
+
+struct Outcome {
+    int status;
+    std::string error;
+    json result;
+};
+
+Outcome run(const std::string& scene, const char* options = nullptr, mcp_progress_fn cb = nullptr,
+            void* user = nullptr) {
+    char* out = nullptr;
+    Outcome o;
+    o.status = mcp_study_run(scene.c_str(), options, cb, user, &out);
+    o.error = mcp_last_error();
+    if (out) {
+        o.result = json::parse(out);
+        mcp_free(out);
+    }
+    return o;
+}
+
+const char* kSmall = R"({"name": "small", "integrand": {"type": "monomial", "powers": [2]},
+  "estimators": ["uniform", "stratified"], "n_min": 16, "n_max": 64, "reps": 4})";
+
+}  // namespace
+
+TEST(Api, ResultFollowsTheDocumentedSchema) {
+    Outcome o = run(kSmall);
+    ASSERT_EQ(o.status, MCP_OK) << o.error;
+    const json& r = o.result;
+    EXPECT_EQ(r["version"], 1);
+    EXPECT_EQ(r["mcplay"], mcp_version());
+    EXPECT_EQ(r["scene"]["name"], "small");
+    EXPECT_NEAR(r["scene"]["exact"].get<double>(), 1.0 / 3.0, 1e-15);  // closed form
+    EXPECT_EQ(r["settings"]["reps"], 4);
+    ASSERT_EQ(r["estimators"].size(), 2u);
+    for (const json& e : r["estimators"]) {
+        for (const char* k : {"name", "sampler", "pdf", "error_method", "levels", "fit"}) EXPECT_TRUE(e.contains(k)) << k;
+        ASSERT_EQ(e["levels"].size(), 3u);  // 16, 32, 64
+        for (const json& l : e["levels"])
+            for (const char* k : {"n", "reps", "mean", "variance", "variance_ci95", "std_error", "ci95",
+                                  "bias", "mse", "rmse", "coverage95", "mean_run_std_error", "time_mean_s",
+                                  "efficiency", "error", "diagnostics", "warnings", "replicates"})
+                EXPECT_TRUE(l.contains(k)) << k;
+        EXPECT_EQ(e["levels"][2]["n"], 64);
+        EXPECT_EQ(e["levels"][0]["replicates"]["estimate"].size(), 4u);
+        EXPECT_TRUE(e["fit"]["valid"].get<bool>());
+    }
+}
+
+TEST(Api, BadScenesGiveScenesErrorsNamingTheField) {
+    struct Case {
+        const char* scene;
+        const char* expected;  // substring of the message
+    };
+    const Case cases[] = {
+        {"{", "invalid JSON"},
+        {"[1, 2]", "expected an object"},
+        {"{}", "missing \"integrand\""},
+        {R"({"integrand": {"type": "monomial", "powers": [1]}, "n_mx": 5})", "unknown field 'n_mx'"},
+        {R"({"integrand": {"type": "wobble"}})", "unknown integrand 'wobble'"},
+        {R"({"integrand": {"type": "monomial", "powers": [-1]}})", "powers[0] must be > -1"},
+        {R"({"integrand": {"type": "monomial", "powers": "x"}})", "scene.integrand.powers"},
+        {R"({"integrand": {"type": "gaussian", "sigma": 0}})", "sigma must be"},
+        {R"({"domain": {"type": "disk", "radius": -1}, "integrand": {"type": "constant"}})", "radius"},
+        {R"({"domain": {"type": "box", "lower": [0, 1], "upper": [1, 1]}, "integrand": {"type": "constant"}})", "axis 1"},
+        {R"({"domain": {"type": "torus"}, "integrand": {"type": "constant"}})", "unknown domain 'torus'"},
+        {R"({"domain": {"type": "triangle", "vertices": [[0,0],[1,1],[2,2]]}, "integrand": {"type": "constant"}})", "collinear"},
+        {R"({"integrand": {"type": "constant"}, "estimators": ["importance"]})", "needs a pdf"},
+        {R"({"integrand": {"type": "constant"}, "estimators": [{"name": "a", "sampler": "sobol"}]})", "unknown sampler 'sobol'"},
+        {R"({"integrand": {"type": "constant"}, "estimators": ["uniform", "uniform"]})", "duplicate estimator"},
+        {R"({"integrand": {"type": "constant"}, "estimators": [{"name": "i", "pdf": {"type": "power", "k": -2}}]})", "k"},
+        {R"({"integrand": {"type": "constant"}, "estimators": [{"name": "i", "pdf": {"type": "exponential", "rate": 0}}]})", "rate"},
+        {R"({"integrand": {"type": "constant"}, "estimators": [{"name": "i", "pdf": {"type": "tabulated", "values": [1, -1]}}]})", "values"},
+        {R"({"integrand": {"type": "constant"}, "estimators": [{"name": "i", "pdf": {"type": "cosine_hemisphere"}}]})", "hemisphere"},
+        {R"({"domain": {"type": "hemisphere"}, "integrand": {"type": "constant"}, "estimators": [{"name": "i", "pdf": {"type": "power"}}]})", "cosine_hemisphere"},
+        {R"({"integrand": {"type": "constant"}, "estimators": [{"name": "w", "warp": "polar"}]})", "only disk"},
+        {R"({"integrand": {"type": "constant"}, "n_min": 100, "n_max": 10})", "n_max (10) must be >= n_min (100)"},
+        {R"({"integrand": {"type": "constant"}, "reps": 1})", "reps must be in 2.."},
+        {R"({"integrand": {"type": "constant"}, "n_max": -5})", "scene.n_max: expected a non-negative whole number"},
+        {R"({"integrand": {"type": "constant"}, "n_min": 17, "n_max": 31})", "no power of two"},
+        {R"({"integrand": {"type": "constant"}, "quantity": "median"})", "scene.quantity"},
+    };
+    for (const Case& c : cases) {
+        Outcome o = run(c.scene);
+        EXPECT_EQ(o.status, MCP_ERROR_SCENE) << c.scene;
+        EXPECT_NE(o.error.find(c.expected), std::string::npos) << c.scene << "\n  got: " << o.error;
+        EXPECT_TRUE(o.result.is_null());
+    }
+}
+
+TEST(Api, BadOptions) {
+    Outcome o = run(kSmall, R"({"estimators": ["nope"]})");
+    EXPECT_EQ(o.status, MCP_ERROR_SCENE);
+    EXPECT_NE(o.error.find("unknown estimator 'nope'"), std::string::npos) << o.error;
+    o = run(kSmall, R"({"reps": "many"})");
+    EXPECT_NE(o.error.find("options.reps"), std::string::npos) << o.error;
+    o = run(kSmall, "{oops");
+    EXPECT_EQ(o.status, MCP_ERROR_ARGUMENT);
+    EXPECT_NE(o.error.find("options: invalid JSON"), std::string::npos) << o.error;
+    // A preset that needs no pdf can be added from the options.
+    o = run(kSmall, R"({"estimators": ["latin_hypercube"]})");
+    ASSERT_EQ(o.status, MCP_OK) << o.error;
+    EXPECT_EQ(o.result["estimators"][0]["sampler"], "latin_hypercube");
+}
+
+TEST(Api, NullPointersAreArgumentErrors) {
+    EXPECT_EQ(mcp_study_run(kSmall, nullptr, nullptr, nullptr, nullptr), MCP_ERROR_ARGUMENT);
+    char* out = nullptr;
+    EXPECT_EQ(mcp_study_run(nullptr, nullptr, nullptr, nullptr, &out), MCP_ERROR_SCENE);
+    EXPECT_EQ(mcp_result_format(nullptr, "table", &out), MCP_ERROR_ARGUMENT);
+    EXPECT_EQ(mcp_result_format("{}", nullptr, &out), MCP_ERROR_ARGUMENT);
+    EXPECT_EQ(mcp_scene_info(nullptr, &out), MCP_ERROR_SCENE);
+    EXPECT_EQ(out, nullptr);
+}
+
+namespace {
+struct ProgressLog {
+    std::vector<uint64_t> ns;
+    size_t cancel_after = 100;
+};
+int on_progress(const char* level_json, void* user) {
+    auto* log = static_cast<ProgressLog*>(user);
+    json j = json::parse(level_json);
+    log->ns.push_back(j["n"].get<uint64_t>());
+    EXPECT_EQ(j["estimators"].size(), 2u);
+    EXPECT_TRUE(j["estimators"][0]["level"].contains("variance"));
+    return log->ns.size() >= log->cancel_after ? 1 : 0;
+}
+}  // namespace
+
+TEST(Api, ProgressAfterEveryLevelAndCancel) {
+    ProgressLog log;
+    Outcome o = run(kSmall, nullptr, on_progress, &log);
+    ASSERT_EQ(o.status, MCP_OK);
+    EXPECT_EQ(log.ns, (std::vector<uint64_t>{16, 32, 64}));
+
+    ProgressLog cancel;
+    cancel.cancel_after = 2;
+    o = run(kSmall, nullptr, on_progress, &cancel);
+    EXPECT_EQ(o.status, MCP_ERROR_CANCELLED);
+    EXPECT_TRUE(o.result["cancelled"].get<bool>());
+    EXPECT_EQ(o.result["estimators"][0]["levels"].size(), 2u);
+}
+
+TEST(Api, FormatsTableCsvJson) {
+    char* out = nullptr;
+    ASSERT_EQ(mcp_study_run(kSmall, nullptr, nullptr, nullptr, &out), MCP_OK);
+    std::string result = out;
+    mcp_free(out);
+
+    char* text = nullptr;
+    ASSERT_EQ(mcp_result_format(result.c_str(), "table", &text), MCP_OK);
+    std::string table = text;
+    mcp_free(text);
+    EXPECT_NE(table.find("fitted order: variance ~ N^("), std::string::npos) << table;
+    EXPECT_NE(table.find("stratified"), std::string::npos);
+
+    ASSERT_EQ(mcp_result_format(result.c_str(), "csv", &text), MCP_OK);
+    std::string csv = text;
+    mcp_free(text);
+    size_t lines = 0;
+    for (char c : csv) lines += c == '\n';
+    EXPECT_EQ(lines, 1u + 2u * 3u);  // header + estimators x levels
+    EXPECT_EQ(csv.rfind("scene,estimator,sampler,pdf,n,", 0), 0u);
+
+    ASSERT_EQ(mcp_result_format(result.c_str(), "json", &text), MCP_OK);
+    EXPECT_EQ(json::parse(text), json::parse(result));
+    mcp_free(text);
+
+    EXPECT_EQ(mcp_result_format(result.c_str(), "xml", &text), MCP_ERROR_ARGUMENT);
+    EXPECT_NE(std::string(mcp_last_error()).find("unknown format 'xml'"), std::string::npos);
+    // Odd but valid JSON shapes are rejected or formatted, never a crash.
+    EXPECT_EQ(mcp_result_format("[1,2]", "table", &text), MCP_ERROR_ARGUMENT);
+    ASSERT_EQ(mcp_result_format(R"({"estimators": 5, "scene": [], "settings": "x"})", "table", &text), MCP_OK);
+    mcp_free(text);
+    ASSERT_EQ(mcp_result_format(R"({"estimators": [{"levels": [3, {"n": "x"}]}]})", "csv", &text), MCP_OK);
+    mcp_free(text);
+}
+
+TEST(Api, SceneInfoAndCatalog) {
+    char* out = nullptr;
+    ASSERT_EQ(mcp_scene_info(kSmall, &out), MCP_OK);
+    json info = json::parse(out);
+    mcp_free(out);
+    EXPECT_EQ(info["name"], "small");
+    EXPECT_EQ(info["estimators"], json({"uniform", "stratified"}));
+    ASSERT_EQ(mcp_catalog(&out), MCP_OK);
+    json cat = json::parse(out);
+    mcp_free(out);
+    EXPECT_GE(cat["estimators"].size(), 5u);
+}

@@ -1,0 +1,190 @@
+// Estimators and the study runner on the scenes in scenes/: unbiasedness within standard
+// errors, convergence orders, honest per-run error bars, determinism across threads.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "api/scene.h"
+
+using namespace mcp;
+
+namespace {
+
+SceneRequest load(const std::string& name, const Json& options = Json()) {
+    std::ifstream in(std::string(MCPLAY_SOURCE_DIR) + "/scenes/" + name + ".json");
+    std::stringstream ss;
+    ss << in.rdbuf();
+    Made<Json> j = parse_json(ss.str().c_str(), name.c_str());
+    EXPECT_TRUE(j.ok()) << j.error;
+    Made<SceneRequest> r = build_request(j.value, options);
+    EXPECT_TRUE(r.ok()) << r.error;
+    return r.value;
+}
+
+StudyResult run(const SceneRequest& r) { return run_study(r.problem, r.estimators, r.settings); }
+
+const EstimatorStudy& find(const StudyResult& s, const std::string& name) {
+    for (const EstimatorStudy& e : s.estimators)
+        if (e.spec.name == name) return e;
+    ADD_FAILURE() << "no estimator " << name;
+    return s.estimators.at(0);
+}
+
+}  // namespace
+
+// Every estimator of every scene: the mean of R replicates lies within 4 standard errors of
+// the exact value, at the three largest N.
+class SceneUnbiased : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(SceneUnbiased, MeanWithinFourStandardErrors) {
+    SceneRequest req = load(GetParam(), Json{{"n_min", 1024}, {"n_max", 16384}, {"reps", 32}, {"seed", 2024}});
+    ASSERT_TRUE(req.problem.exact.has_value()) << "scene without exact value";
+    const double exact = *req.problem.exact;
+    StudyResult s = run(req);
+    for (const EstimatorStudy& e : s.estimators) {
+        ASSERT_EQ(e.levels.size(), 5u);
+        for (size_t i = 2; i < e.levels.size(); ++i) {
+            const LevelStats& l = e.levels[i];
+            EXPECT_LE(std::fabs(l.mean - exact), 4.0 * l.std_error + 1e-12 * std::fabs(exact))
+                << GetParam() << " / " << e.spec.name << " N=" << l.n << " mean=" << l.mean
+                << " se=" << l.std_error;
+            EXPECT_EQ(l.diagnostics.nonfinite, 0u);
+            EXPECT_EQ(l.diagnostics.zero_pdf, 0u);
+        }
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(AllScenes, SceneUnbiased,
+                         ::testing::Values("disk_quarter", "expectation_4xy", "exp_1d",
+                                           "gaussian_peak_1d", "gaussian_2d", "hemisphere_cos2",
+                                           "triangle_moment"));
+
+TEST(Convergence, UniformVarianceFallsAsOneOverN) {
+    // Fitted order within 0.1 of -1 (the fit's own standard error is ~0.02 here).
+    for (const char* scene : {"exp_1d", "disk_quarter", "gaussian_2d"}) {
+        SceneRequest req = load(scene, Json{{"estimators", {"uniform"}}, {"n_min", 16}, {"n_max", 65536},
+                                            {"reps", 64}, {"seed", 7}});
+        StudyResult s = run(req);
+        const ConvergenceFit& f = s.estimators[0].fit;
+        ASSERT_TRUE(f.valid);
+        EXPECT_NEAR(f.order, -1.0, 0.1) << scene << " order_se=" << f.order_se;
+        EXPECT_LT(f.order_se, 0.05);
+    }
+}
+
+TEST(Convergence, JitteredOnSmooth1DFallsAtLeastAsNToMinus2_5) {
+    SceneRequest req = load("exp_1d", Json{{"estimators", {"stratified", "stratified_importance"}},
+                                           {"n_min", 16}, {"n_max", 65536}, {"reps", 64}, {"seed", 7}});
+    StudyResult s = run(req);
+    for (const EstimatorStudy& e : s.estimators) {
+        ASSERT_TRUE(e.fit.valid);
+        EXPECT_LE(e.fit.order, -2.5) << e.spec.name;
+        EXPECT_NEAR(e.fit.order, -3.0, 0.15) << e.spec.name;  // theory: N^-3 in 1D
+    }
+}
+
+TEST(Convergence, StratifiedNeverWorseThanUniform) {
+    // Jittered sampling with one point per equal cell cannot increase the variance.
+    SceneRequest req = load("gaussian_2d", Json{{"estimators", {"uniform", "stratified"}}, {"n_min", 256},
+                                                {"n_max", 16384}, {"reps", 64}});
+    StudyResult s = run(req);
+    const auto& u = find(s, "uniform");
+    const auto& st = find(s, "stratified");
+    for (size_t i = 0; i < u.levels.size(); ++i) EXPECT_LT(st.levels[i].variance, u.levels[i].variance);
+}
+
+TEST(Convergence, ImportanceSamplingBeatsUniformAndPerfectPdfHasZeroVariance) {
+    SceneRequest req = load("exp_1d", Json{{"estimators", {"uniform", "importance"}}, {"n_min", 1024},
+                                           {"n_max", 1024}, {"reps", 32}});
+    StudyResult s = run(req);
+    EXPECT_LT(find(s, "importance").levels[0].variance * 20.0, find(s, "uniform").levels[0].variance);
+
+    // f = 3x^2 sampled from p = 3x^2 (power k = 2): every weight is exactly 1.
+    Json scene = {{"integrand", {{"type", "monomial"}, {"scale", 3}, {"powers", {2}}}},
+                  {"estimators", {{{"name", "importance"}, {"pdf", {{"type", "power"}, {"k", 2}}}}}},
+                  {"n_min", 64}, {"n_max", 256}, {"reps", 8}};
+    Made<SceneRequest> r = build_request(scene, Json());
+    ASSERT_TRUE(r.ok()) << r.error;
+    StudyResult z = run(r.value);
+    for (const LevelStats& l : z.estimators[0].levels) {
+        EXPECT_NEAR(l.mean, 1.0, 1e-12);
+        EXPECT_LT(l.variance, 1e-28);
+    }
+}
+
+TEST(ErrorBars, IidStandardErrorMatchesReplicateSpread) {
+    // E[s^2/N] = Var[I_N]; with R = 128 the ratio of the two estimates lies well inside
+    // [0.7, 1.4] (its relative sd is about sqrt(2/127) = 0.13).
+    SceneRequest req = load("exp_1d", Json{{"estimators", {"uniform", "importance"}}, {"n_min", 4096},
+                                           {"n_max", 4096}, {"reps", 128}, {"seed", 3}});
+    StudyResult s = run(req);
+    for (const EstimatorStudy& e : s.estimators) {
+        const LevelStats& l = e.levels[0];
+        double ratio = l.mean_run_se * l.mean_run_se / l.variance;
+        EXPECT_GT(ratio, 0.7) << e.spec.name;
+        EXPECT_LT(ratio, 1.4) << e.spec.name;
+        EXPECT_GE(l.coverage, 0.88) << e.spec.name;
+        EXPECT_LE(l.coverage, 1.0) << e.spec.name;
+    }
+}
+
+TEST(ErrorBars, CollapsedStrataIsConservative) {
+    SceneRequest req = load("exp_1d", Json{{"estimators", {"stratified"}}, {"n_min", 64},
+                                           {"n_max", 4096}, {"reps", 64}, {"seed", 3}});
+    StudyResult s = run(req);
+    for (const LevelStats& l : s.estimators[0].levels) {
+        EXPECT_GT(l.mean_run_se * l.mean_run_se, 0.8 * l.variance) << "N=" << l.n;
+        EXPECT_GE(l.coverage, 0.9);
+    }
+}
+
+TEST(Study, IdenticalWithOneAndTwoThreads) {
+    Json opts{{"n_min", 16}, {"n_max", 4096}, {"reps", 8}, {"seed", 11}};
+    opts["threads"] = 1;
+    StudyResult one = run(load("expectation_4xy", opts));
+    opts["threads"] = 2;
+    StudyResult two = run(load("expectation_4xy", opts));
+    ASSERT_EQ(one.estimators.size(), two.estimators.size());
+    for (size_t e = 0; e < one.estimators.size(); ++e)
+        for (size_t i = 0; i < one.estimators[e].levels.size(); ++i) {
+            EXPECT_EQ(one.estimators[e].levels[i].estimates, two.estimators[e].levels[i].estimates);
+            EXPECT_EQ(one.estimators[e].levels[i].run_std_errors, two.estimators[e].levels[i].run_std_errors);
+        }
+}
+
+TEST(Study, SubsetOfEstimatorsGivesSameNumbers) {
+    StudyResult all = run(load("exp_1d", Json{{"n_max", 1024}, {"reps", 4}}));
+    StudyResult one = run(load("exp_1d", Json{{"n_max", 1024}, {"reps", 4}, {"estimators", {"importance"}}}));
+    EXPECT_EQ(find(all, "importance").levels.back().estimates, one.estimators[0].levels.back().estimates);
+}
+
+TEST(Study, DifferentSeedsGiveDifferentNumbers) {
+    StudyResult a = run(load("exp_1d", Json{{"n_max", 256}, {"reps", 4}, {"seed", 1}}));
+    StudyResult b = run(load("exp_1d", Json{{"n_max", 256}, {"reps", 4}, {"seed", 2}}));
+    EXPECT_NE(a.estimators[0].levels.back().estimates, b.estimators[0].levels.back().estimates);
+}
+
+TEST(Diagnostics, NonFiniteSamplesAreCountedAndDropped) {
+    // sqrt(x) on [-1, 1]: NaN for every x < 0 (about half the samples).
+    Json scene = {{"domain", {{"type", "interval"}, {"lower", -1}, {"upper", 1}}},
+                  {"integrand", {{"type", "monomial"}, {"powers", {0.5}}}},
+                  {"estimators", {"uniform"}}, {"n_min", 1000}, {"n_max", 1024}, {"reps", 4}};
+    Made<SceneRequest> r = build_request(scene, Json());
+    ASSERT_TRUE(r.ok()) << r.error;
+    StudyResult s = run(r.value);
+    const LevelStats& l = s.estimators[0].levels[0];
+    EXPECT_GT(l.diagnostics.nonfinite, 4 * 1024 / 2 - 200);
+    EXPECT_LT(l.diagnostics.nonfinite, 4 * 1024 / 2 + 200);
+    EXPECT_TRUE(std::isfinite(l.mean));
+    Json j = level_to_json(l);
+    ASSERT_FALSE(j["warnings"].empty());
+    EXPECT_NE(j["warnings"][0].get<std::string>().find("NaN/Inf"), std::string::npos);
+}
+
+TEST(Study, LadderIsPowersOfTwo) {
+    EXPECT_EQ(n_ladder(10, 100), (std::vector<uint64_t>{16, 32, 64}));
+    EXPECT_EQ(n_ladder(1, 4), (std::vector<uint64_t>{1, 2, 4}));
+    EXPECT_TRUE(n_ladder(17, 31).empty());
+}

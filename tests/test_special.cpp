@@ -1,0 +1,64 @@
+// Special functions against closed forms and identities (no values copied from a run).
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "core/special.h"
+
+using namespace mcp;
+
+TEST(Special, NormalQuantileInvertsCdf) {
+    for (double p : {1e-300, 1e-20, 1e-10, 1e-4, 0.01, 0.1, 0.3, 0.5, 0.7, 0.975, 0.999}) {
+        double x = normal_quantile(p);
+        EXPECT_NEAR(normal_cdf(x) / p, 1.0, 1e-12) << "p=" << p;
+    }
+    EXPECT_NEAR(normal_quantile(1.0 - 1e-10), -normal_quantile(1e-10), 1e-5);
+    EXPECT_NEAR(normal_quantile(0.5), 0.0, 1e-15);
+}
+
+TEST(Special, StudentTQuantileExactSmallDof) {
+    // nu = 1 is Cauchy: t = tan(pi (p - 1/2)); nu = 2 has a closed-form CDF.
+    EXPECT_NEAR(student_t_quantile(0.975, 1), std::tan(kPi * 0.475), 1e-12);
+    const double t2 = student_t_quantile(0.975, 2);
+    EXPECT_NEAR(0.5 + t2 / (2.0 * std::sqrt(2.0 + t2 * t2)), 0.975, 1e-12);
+    // Large nu tends to the normal quantile.
+    EXPECT_NEAR(student_t_quantile(0.975, 1e6), normal_quantile(0.975), 1e-5);
+}
+
+TEST(Special, StudentTQuantileMatchesCdfByQuadrature) {
+    // CDF of t with nu dof by Simpson integration of its density, at the quantile.
+    for (double nu : {3.0, 7.0, 31.0}) {
+        const double t = student_t_quantile(0.975, nu);
+        const double c = std::exp(std::lgamma(0.5 * (nu + 1)) - std::lgamma(0.5 * nu)) / std::sqrt(nu * kPi);
+        auto pdf = [&](double x) { return c * std::pow(1.0 + x * x / nu, -0.5 * (nu + 1)); };
+        const int m = 20000;
+        double h = t / m, s = pdf(0) + pdf(t);
+        for (int i = 1; i < m; ++i) s += (i % 2 ? 4.0 : 2.0) * pdf(i * h);
+        EXPECT_NEAR(0.5 + s * h / 3.0, 0.975, 1e-3) << "nu=" << nu;
+    }
+}
+
+TEST(Special, IncompleteGammaIdentities) {
+    // P(1, x) = 1 - e^-x; chi-square with 2 dof has survival e^(-x/2).
+    for (double x : {0.01, 0.5, 1.0, 3.0, 10.0, 50.0}) {
+        EXPECT_NEAR(gamma_p(1.0, x), -std::expm1(-x), 1e-14);
+        EXPECT_NEAR(chi_square_sf(x, 2.0) / std::exp(-0.5 * x), 1.0, 1e-12);
+        EXPECT_NEAR(gamma_p(3.5, x) + gamma_q(3.5, x), 1.0, 1e-14);
+    }
+    // P(1/2, x) = erf(sqrt(x)).
+    for (double x : {0.1, 1.0, 4.0}) EXPECT_NEAR(gamma_p(0.5, x), std::erf(std::sqrt(x)), 1e-13);
+}
+
+TEST(Special, ChiSquareQuantileInverts) {
+    for (double k : {1.0, 2.0, 5.0, 31.0, 200.0})
+        for (double p : {0.025, 0.5, 0.975}) {
+            double x = chi_square_quantile(p, k);
+            EXPECT_NEAR(1.0 - chi_square_sf(x, k), p, 1e-10) << "k=" << k << " p=" << p;
+        }
+}
+
+TEST(Special, TrigammaKnownValues) {
+    EXPECT_NEAR(trigamma(1.0), kPi * kPi / 6.0, 1e-12);
+    EXPECT_NEAR(trigamma(0.5), kPi * kPi / 2.0, 1e-12);
+    EXPECT_NEAR(trigamma(10.5) - trigamma(11.5), 1.0 / (10.5 * 10.5), 1e-14);
+}
