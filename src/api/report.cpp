@@ -256,7 +256,7 @@ std::string format_table(const Json& r) {
             out << padr("  " + jstr(e, "name"), 26) << padl(fmt("%.0f", jnum(l, "n")), 9)
                 << padl(fmt("%.4e", jnum(l, "variance")), 13) << padl(fmt("%.2e", jnum(l, "time_mean_s")), 11)
                 << padl(fmt("%.3e", eff), 12)
-                << padl(first_eff > 0 && std::isfinite(eff) ? fmt("%.2fx", eff / first_eff) : "-", 10) << "\n";
+                << padl(first_eff > 0 && std::isfinite(eff) ? fmt("%.3gx", eff / first_eff) : "-", 10) << "\n";
         }
     }
     return out.str();
