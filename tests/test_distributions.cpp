@@ -430,6 +430,27 @@ TEST(Power, SingularDensity) {
     }
 }
 
+// Where x = a + (b - a) u^(1/(k+1)) rounds to a (|a| large against the offset) or t underflows
+// (k near -1), samples must still have a positive, finite density, or f / pdf breaks.
+TEST(Power, SamplesNearAHavePositiveFiniteDensity) {
+    struct Setting {
+        double a, b, k;
+    };
+    for (Setting s : {Setting{1.0, 2.0, -0.5}, Setting{0.0, 1.0, -0.99}, Setting{1e9, 1e9 + 1.0, 1.0},
+                      Setting{-3.0, -2.0, 2.0}}) {
+        auto m = make_power(s.a, s.b, s.k);
+        ASSERT_TRUE(m.ok()) << m.error;
+        for (double u : {0x1p-54, 1e-20, 1e-12, 1e-6, 1e-4, 0.5}) {
+            double x = m.value.sample(u);
+            double p = m.value.pdf(x);
+            EXPECT_GT(x, s.a) << m.value.describe() << " u=" << u;
+            EXPECT_LE(x, s.b);
+            EXPECT_GT(p, 0.0) << m.value.describe() << " u=" << u << " x=" << x;
+            EXPECT_TRUE(std::isfinite(p)) << m.value.describe() << " u=" << u << " x=" << x;
+        }
+    }
+}
+
 TEST(Distribution1D, Describe) {
     EXPECT_EQ(make_uniform(0, 1).value.describe(), "uniform on [0, 1]");
     EXPECT_EQ(make_power(0, 1, 1).value.describe(), "power(k=1) on [0, 1]");

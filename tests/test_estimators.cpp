@@ -57,7 +57,7 @@ TEST_P(SceneUnbiased, MeanWithinFourStandardErrors) {
 }
 
 INSTANTIATE_TEST_SUITE_P(AllScenes, SceneUnbiased,
-                         ::testing::Values("disk_quarter", "expectation_4xy", "exp_1d",
+                         ::testing::Values("disk_quarter", "disk_third", "expectation_4xy", "exp_1d",
                                            "gaussian_peak_1d", "gaussian_2d", "hemisphere_cos2",
                                            "triangle_moment"));
 
@@ -82,6 +82,18 @@ TEST(Convergence, JitteredOnSmooth1DFallsAtLeastAsNToMinus2_5) {
         ASSERT_TRUE(e.fit.valid);
         EXPECT_LE(e.fit.order, -2.5) << e.spec.name;
         EXPECT_NEAR(e.fit.order, -3.0, 0.15) << e.spec.name;  // theory: N^-3 in 1D
+    }
+}
+
+TEST(Convergence, StratifiedOnA2DDiscontinuityFallsAsNToMinus1_5) {
+    // One point per cell: only the ~sqrt(N) cells cut by the edge contribute variance, each
+    // O(1/N^2), so Var ~ N^-1.5 in 2D. Needs an edge no power-of-two grid aligns with.
+    SceneRequest req = load("disk_third", Json{{"estimators", {"stratified_polar", "stratified_concentric"}},
+                                               {"n_min", 64}, {"n_max", 65536}, {"reps", 64}, {"seed", 5}});
+    StudyResult s = run(req);
+    for (const EstimatorStudy& e : s.estimators) {
+        ASSERT_TRUE(e.fit.valid);
+        EXPECT_NEAR(e.fit.order, -1.5, 0.15) << e.spec.name;
     }
 }
 

@@ -93,9 +93,17 @@ struct UniformK {
 };
 
 // p(x) = (k + 1) / L t^k with t = (x - a) / L; F = t^(k + 1); x = a + L u^(1/(k + 1)).
+// Near a the density is infinite (k < 0) or zero (k > 0), and a + L t rounds to a once L t
+// is below half an ulp of a (u < 1e-8 for k = -1/2 on [1, 2]); for k near -1, t itself
+// underflows (u^(1/(k+1)) < 1e-308 has probability 8e-4 at k = -0.99). Samples are therefore
+// raised to `lowest` = a + d0, the first point above a where the density is positive and
+// finite (found by the factory), so that f / pdf stays defined; that moves mass cdf(lowest),
+// e.g. 2e-162 for k = -1/2 on [0, 1].
 struct PowerK {
-    double a, b, len, k, kp1, inv_kp1;
-    double sample(double u) const { return clamp(a + len * std::pow(u, inv_kp1), a, b); }
+    double a, b, len, k, kp1, inv_kp1, lowest;
+    double sample(double u) const {
+        return clamp(std::max(a + len * std::pow(u, inv_kp1), lowest), a, b);
+    }
     double pdf(double x) const {
         if (!(x >= a && x <= b)) return 0.0;
         return kp1 / len * std::pow((x - a) / len, k);
@@ -338,13 +346,13 @@ struct Distribution1DFactory {
         d.cdf_ = std::move(cdf);
     }
 
-    // Kernels. Fields: power p0 = k, c0 = k + 1, c1 = 1 / (k + 1); exponential p0 = rate,
-    // p1 = expm1(s L) or e^{-s L}, c0 = expm1(-s L), c1 = s / -c0; Gaussian p0 = mu,
-    // p1 = sigma, c0 = z, c1 = 1 / (sqrt(2 pi) z); cosine p0 = omega, p1 = x0, c0 = d,
-    // c1 = omega / d; tabulated c0 = bin width, c1 = 1 / bin width.
+    // Kernels. Fields: power p0 = k, p1 = d0 (see PowerK), c0 = k + 1, c1 = 1 / (k + 1);
+    // exponential p0 = rate, p1 = expm1(s L) or e^{-s L}, c0 = expm1(-s L), c1 = s / -c0;
+    // Gaussian p0 = mu, p1 = sigma, c0 = z, c1 = 1 / (sqrt(2 pi) z); cosine p0 = omega,
+    // p1 = x0, c0 = d, c1 = omega / d; tabulated c0 = bin width, c1 = 1 / bin width.
     static UniformK uniform(const Distribution1D& d) { return {d.a_, d.b_, 1.0 / (d.b_ - d.a_)}; }
     static PowerK power(const Distribution1D& d) {
-        return {d.a_, d.b_, d.b_ - d.a_, d.p0_, d.c0_, d.c1_};
+        return {d.a_, d.b_, d.b_ - d.a_, d.p0_, d.c0_, d.c1_, d.a_ + d.p1_};
     }
     static ExponentialK exponential(const Distribution1D& d) {
         bool positive = d.p0_ > 0.0;
@@ -457,7 +465,18 @@ Made<Distribution1D> make_power(double a, double b, double k) {
     if (!(k > -1.0 && std::isfinite(k)))
         return made_error<Distribution1D>("power: k must be finite and > -1, got " + num(k));
     double kp1 = k + 1.0;
-    return {Distribution1DFactory::make(Dist1DKind::Power, a, b, k, 0, kp1, 1.0 / kp1), {}};
+    // p1 = d0, the smallest offset (to a factor 2) from a with a positive, finite density;
+    // 0 when the density at a itself is (k = 0). The doubling ends by b - a at the latest,
+    // where t = 1 and the density (k + 1) / L is positive and finite.
+    Distribution1D d = Distribution1DFactory::make(Dist1DKind::Power, a, b, k, 0, kp1, 1.0 / kp1);
+    double d0 = 0.0;
+    for (;;) {
+        double p = d.pdf(a + d0);
+        if ((p > 0.0 && std::isfinite(p)) || a + d0 >= b) break;
+        d0 = d0 == 0.0 ? std::nextafter(a, b) - a : 2.0 * d0;
+    }
+    d0 = std::min(d0, b - a);
+    return {Distribution1DFactory::make(Dist1DKind::Power, a, b, k, d0, kp1, 1.0 / kp1), {}};
 }
 
 Made<Distribution1D> make_exponential(double a, double b, double rate) {
