@@ -47,7 +47,7 @@ double samples_per_second(const SceneRequest& req, const EstimatorSpec& spec, ui
     return static_cast<double>(n) / best;
 }
 
-}  // namespace
+} // namespace
 
 int main(int argc, char** argv) {
     const std::string dir = argc > 1 ? argv[1] : "scenes";
@@ -62,13 +62,18 @@ int main(int argc, char** argv) {
         const uint64_t draws = uint64_t(1) << 26;
         for (uint64_t i = 0; i < draws; ++i) acc ^= rng.next_u32();
         double t = seconds_since(t0);
-        std::printf("BENCH pcg32_u32_draws %.6e  (checksum %u)\n", static_cast<double>(draws) / t, acc);
+        std::printf("BENCH pcg32_u32_draws %.6e  (checksum %u)\n", static_cast<double>(draws) / t,
+                    acc);
     }
     const char* cases[][2] = {
-        {"exp_1d", "uniform"},         {"exp_1d", "stratified"},
-        {"exp_1d", "importance"},      {"exp_1d", "latin_hypercube"},
-        {"gaussian_2d", "uniform"},    {"gaussian_2d", "stratified_table"},
-        {"disk_quarter", "stratified_concentric"}, {"hemisphere_cos2", "cosine"},
+        {"exp_1d", "uniform"},
+        {"exp_1d", "stratified"},
+        {"exp_1d", "importance"},
+        {"exp_1d", "latin_hypercube"},
+        {"gaussian_2d", "uniform"},
+        {"gaussian_2d", "stratified_table"},
+        {"disk_quarter", "stratified_concentric"},
+        {"hemisphere_cos2", "cosine"},
     };
     for (auto& c : cases) {
         SceneRequest req;

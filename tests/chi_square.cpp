@@ -35,6 +35,8 @@ ChiSquareResult chi_square(const std::vector<double>& observed, const std::vecto
     return r;
 }
 
-double sidak_level(double alpha, int k) { return 1.0 - std::pow(1.0 - alpha, 1.0 / k); }
+double sidak_level(double alpha, int k) {
+    return 1.0 - std::pow(1.0 - alpha, 1.0 / k);
+}
 
-}  // namespace mcp::test
+} // namespace mcp::test

@@ -9,7 +9,7 @@ struct ChiSquareResult {
     double statistic = 0.0;
     int dof = 0;
     double p_value = 1.0;
-    int cells = 0;  ///< cells after pooling
+    int cells = 0; ///< cells after pooling
 };
 
 /// Pearson chi-square of observed against expected counts. Cells with an expected count
@@ -22,4 +22,4 @@ ChiSquareResult chi_square(const std::vector<double>& observed, const std::vecto
 /// (Sidak correction).
 double sidak_level(double alpha, int k);
 
-}  // namespace mcp::test
+} // namespace mcp::test

@@ -34,7 +34,7 @@ Outcome run(const std::string& scene, const char* options = nullptr, mcp_progres
 const char* kSmall = R"({"name": "small", "integrand": {"type": "monomial", "powers": [2]},
   "estimators": ["uniform", "stratified"], "n_min": 16, "n_max": 64, "reps": 4})";
 
-}  // namespace
+} // namespace
 
 TEST(Api, ResultFollowsTheDocumentedSchema) {
     Outcome o = run(kSmall);
@@ -43,16 +43,18 @@ TEST(Api, ResultFollowsTheDocumentedSchema) {
     EXPECT_EQ(r["version"], 1);
     EXPECT_EQ(r["mcplay"], mcp_version());
     EXPECT_EQ(r["scene"]["name"], "small");
-    EXPECT_NEAR(r["scene"]["exact"].get<double>(), 1.0 / 3.0, 1e-15);  // closed form
+    EXPECT_NEAR(r["scene"]["exact"].get<double>(), 1.0 / 3.0, 1e-15); // closed form
     EXPECT_EQ(r["settings"]["reps"], 4);
     ASSERT_EQ(r["estimators"].size(), 2u);
     for (const json& e : r["estimators"]) {
-        for (const char* k : {"name", "sampler", "pdf", "error_method", "levels", "fit"}) EXPECT_TRUE(e.contains(k)) << k;
-        ASSERT_EQ(e["levels"].size(), 3u);  // 16, 32, 64
+        for (const char* k : {"name", "sampler", "pdf", "error_method", "levels", "fit"})
+            EXPECT_TRUE(e.contains(k)) << k;
+        ASSERT_EQ(e["levels"].size(), 3u); // 16, 32, 64
         for (const json& l : e["levels"])
-            for (const char* k : {"n", "reps", "mean", "variance", "variance_ci95", "std_error", "ci95",
-                                  "bias", "mse", "rmse", "coverage95", "mean_run_std_error", "time_mean_s",
-                                  "efficiency", "error", "diagnostics", "warnings", "replicates"})
+            for (const char* k :
+                 {"n", "reps", "mean", "variance", "variance_ci95", "std_error", "ci95", "bias",
+                  "mse", "rmse", "coverage95", "mean_run_std_error", "time_mean_s", "efficiency",
+                  "error", "diagnostics", "warnings", "replicates"})
                 EXPECT_TRUE(l.contains(k)) << k;
         EXPECT_EQ(e["levels"][2]["n"], 64);
         EXPECT_EQ(e["levels"][0]["replicates"]["estimate"].size(), 4u);
@@ -63,33 +65,48 @@ TEST(Api, ResultFollowsTheDocumentedSchema) {
 TEST(Api, BadScenesGiveScenesErrorsNamingTheField) {
     struct Case {
         const char* scene;
-        const char* expected;  // substring of the message
+        const char* expected; // substring of the message
     };
     const Case cases[] = {
         {"{", "invalid JSON"},
         {"[1, 2]", "expected an object"},
         {"{}", "missing \"integrand\""},
-        {R"({"integrand": {"type": "monomial", "powers": [1]}, "n_mx": 5})", "unknown field 'n_mx'"},
+        {R"({"integrand": {"type": "monomial", "powers": [1]}, "n_mx": 5})",
+         "unknown field 'n_mx'"},
         {R"({"integrand": {"type": "wobble"}})", "unknown integrand 'wobble'"},
         {R"({"integrand": {"type": "monomial", "powers": [-1]}})", "powers[0] must be > -1"},
         {R"({"integrand": {"type": "monomial", "powers": "x"}})", "scene.integrand.powers"},
         {R"({"integrand": {"type": "gaussian", "sigma": 0}})", "sigma must be"},
-        {R"({"domain": {"type": "disk", "radius": -1}, "integrand": {"type": "constant"}})", "radius"},
-        {R"({"domain": {"type": "box", "lower": [0, 1], "upper": [1, 1]}, "integrand": {"type": "constant"}})", "axis 1"},
-        {R"({"domain": {"type": "torus"}, "integrand": {"type": "constant"}})", "unknown domain 'torus'"},
-        {R"({"domain": {"type": "triangle", "vertices": [[0,0],[1,1],[2,2]]}, "integrand": {"type": "constant"}})", "collinear"},
+        {R"({"domain": {"type": "disk", "radius": -1}, "integrand": {"type": "constant"}})",
+         "radius"},
+        {R"({"domain": {"type": "box", "lower": [0, 1], "upper": [1, 1]}, "integrand": {"type": "constant"}})",
+         "axis 1"},
+        {R"({"domain": {"type": "torus"}, "integrand": {"type": "constant"}})",
+         "unknown domain 'torus'"},
+        {R"({"domain": {"type": "triangle", "vertices": [[0,0],[1,1],[2,2]]}, "integrand": {"type": "constant"}})",
+         "collinear"},
         {R"({"integrand": {"type": "constant"}, "estimators": ["importance"]})", "needs a pdf"},
-        {R"({"integrand": {"type": "constant"}, "estimators": [{"name": "a", "sampler": "sobol"}]})", "unknown sampler 'sobol'"},
-        {R"({"integrand": {"type": "constant"}, "estimators": ["uniform", "uniform"]})", "duplicate estimator"},
-        {R"({"integrand": {"type": "constant"}, "estimators": [{"name": "i", "pdf": {"type": "power", "k": -2}}]})", "k"},
-        {R"({"integrand": {"type": "constant"}, "estimators": [{"name": "i", "pdf": {"type": "exponential", "rate": 0}}]})", "rate"},
-        {R"({"integrand": {"type": "constant"}, "estimators": [{"name": "i", "pdf": {"type": "tabulated", "values": [1, -1]}}]})", "values"},
-        {R"({"integrand": {"type": "constant"}, "estimators": [{"name": "i", "pdf": {"type": "cosine_hemisphere"}}]})", "hemisphere"},
-        {R"({"domain": {"type": "hemisphere"}, "integrand": {"type": "constant"}, "estimators": [{"name": "i", "pdf": {"type": "power"}}]})", "cosine_hemisphere"},
-        {R"({"integrand": {"type": "constant"}, "estimators": [{"name": "w", "warp": "polar"}]})", "only disk"},
-        {R"({"integrand": {"type": "constant"}, "n_min": 100, "n_max": 10})", "n_max (10) must be >= n_min (100)"},
+        {R"({"integrand": {"type": "constant"}, "estimators": [{"name": "a", "sampler": "sobol"}]})",
+         "unknown sampler 'sobol'"},
+        {R"({"integrand": {"type": "constant"}, "estimators": ["uniform", "uniform"]})",
+         "duplicate estimator"},
+        {R"({"integrand": {"type": "constant"}, "estimators": [{"name": "i", "pdf": {"type": "power", "k": -2}}]})",
+         "k"},
+        {R"({"integrand": {"type": "constant"}, "estimators": [{"name": "i", "pdf": {"type": "exponential", "rate": 0}}]})",
+         "rate"},
+        {R"({"integrand": {"type": "constant"}, "estimators": [{"name": "i", "pdf": {"type": "tabulated", "values": [1, -1]}}]})",
+         "values"},
+        {R"({"integrand": {"type": "constant"}, "estimators": [{"name": "i", "pdf": {"type": "cosine_hemisphere"}}]})",
+         "hemisphere"},
+        {R"({"domain": {"type": "hemisphere"}, "integrand": {"type": "constant"}, "estimators": [{"name": "i", "pdf": {"type": "power"}}]})",
+         "cosine_hemisphere"},
+        {R"({"integrand": {"type": "constant"}, "estimators": [{"name": "w", "warp": "polar"}]})",
+         "only disk"},
+        {R"({"integrand": {"type": "constant"}, "n_min": 100, "n_max": 10})",
+         "n_max (10) must be >= n_min (100)"},
         {R"({"integrand": {"type": "constant"}, "reps": 1})", "reps must be in 2.."},
-        {R"({"integrand": {"type": "constant"}, "n_max": -5})", "scene.n_max: expected a non-negative whole number"},
+        {R"({"integrand": {"type": "constant"}, "n_max": -5})",
+         "scene.n_max: expected a non-negative whole number"},
         {R"({"integrand": {"type": "constant"}, "n_min": 17, "n_max": 31})", "no power of two"},
         {R"({"integrand": {"type": "constant"}, "quantity": "median"})", "scene.quantity"},
     };
@@ -139,7 +156,7 @@ int on_progress(const char* level_json, void* user) {
     EXPECT_TRUE(j["estimators"][0]["level"].contains("variance"));
     return log->ns.size() >= log->cancel_after ? 1 : 0;
 }
-}  // namespace
+} // namespace
 
 TEST(Api, ProgressAfterEveryLevelAndCancel) {
     ProgressLog log;
@@ -173,7 +190,7 @@ TEST(Api, FormatsTableCsvJson) {
     mcp_free(text);
     size_t lines = 0;
     for (char c : csv) lines += c == '\n';
-    EXPECT_EQ(lines, 1u + 2u * 3u);  // header + estimators x levels
+    EXPECT_EQ(lines, 1u + 2u * 3u); // header + estimators x levels
     EXPECT_EQ(csv.rfind("scene,estimator,sampler,pdf,n,", 0), 0u);
 
     ASSERT_EQ(mcp_result_format(result.c_str(), "json", &text), MCP_OK);
@@ -184,9 +201,12 @@ TEST(Api, FormatsTableCsvJson) {
     EXPECT_NE(std::string(mcp_last_error()).find("unknown format 'xml'"), std::string::npos);
     // Odd but valid JSON shapes are rejected or formatted, never a crash.
     EXPECT_EQ(mcp_result_format("[1,2]", "table", &text), MCP_ERROR_ARGUMENT);
-    ASSERT_EQ(mcp_result_format(R"({"estimators": 5, "scene": [], "settings": "x"})", "table", &text), MCP_OK);
+    ASSERT_EQ(
+        mcp_result_format(R"({"estimators": 5, "scene": [], "settings": "x"})", "table", &text),
+        MCP_OK);
     mcp_free(text);
-    ASSERT_EQ(mcp_result_format(R"({"estimators": [{"levels": [3, {"n": "x"}]}]})", "csv", &text), MCP_OK);
+    ASSERT_EQ(mcp_result_format(R"({"estimators": [{"levels": [3, {"n": "x"}]}]})", "csv", &text),
+              MCP_OK);
     mcp_free(text);
 }
 

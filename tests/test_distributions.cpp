@@ -7,8 +7,8 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
-#include <ostream>
 #include <limits>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -45,16 +45,18 @@ double gauss_legendre(const std::function<double(double)>& f, double lo, double 
 struct Case {
     std::string name;
     Made<Distribution1D> made;
-    double window_lo, window_hi;  ///< chi-square cells: `cells` equal ones on the window, plus
-    int cells;                    ///< [a, window_lo] and [window_hi, b] when not empty
-    bool singular_at_a = false;   ///< density ~ (x - a)^-1/2: integrate in s, x = a + L s^2
-    bool tail_relative = false;   ///< x - a is computed as an offset from a: check cdf(sample(u))
-                                  ///< = u to 1e-8 relative for u down to 1e-12
-    std::vector<double> table;    ///< tabulated values (empty for analytic kinds)
+    double window_lo, window_hi; ///< chi-square cells: `cells` equal ones on the window, plus
+    int cells;                   ///< [a, window_lo] and [window_hi, b] when not empty
+    bool singular_at_a = false;  ///< density ~ (x - a)^-1/2: integrate in s, x = a + L s^2
+    bool tail_relative = false;  ///< x - a is computed as an offset from a: check cdf(sample(u))
+                                 ///< = u to 1e-8 relative for u down to 1e-12
+    std::vector<double> table;   ///< tabulated values (empty for analytic kinds)
 };
 
 // gtest prints a parameter with this (instead of its bytes) when a test fails.
-void PrintTo(const Case& c, std::ostream* os) { *os << c.name; }
+void PrintTo(const Case& c, std::ostream* os) {
+    *os << c.name;
+}
 
 Case analytic(std::string name, Made<Distribution1D> made, bool tail_relative,
               double window_lo = NAN, double window_hi = NAN) {
@@ -76,7 +78,7 @@ Case tabulated(std::string name, double a, double b, std::vector<double> values,
     c.made = make_tabulated(a, b, values);
     c.window_lo = a;
     c.window_hi = b;
-    c.cells = 4 * int(values.size());  // four chi-square cells per table bin, edges aligned
+    c.cells = 4 * int(values.size()); // four chi-square cells per table bin, edges aligned
     c.tail_relative = tail_relative;
     c.table = std::move(values);
     return c;
@@ -105,17 +107,28 @@ const std::vector<Case>& cases() {
         c.push_back(analytic("exponential_rate_m3", make_exponential(0.0, 1.0, -3.0), true));
         c.push_back(analytic("exponential_rate_1em9", make_exponential(0.0, 1.0, 1e-9), true));
         c.push_back(analytic("exponential_rate_m1em9", make_exponential(0.0, 1.0, -1e-9), true));
-        c.push_back(analytic("exponential_rate_500", make_exponential(0.0, 1.0, 500.0), true, 0.0, 0.02));
-        c.push_back(analytic("exponential_rate_m500", make_exponential(0.0, 1.0, -500.0), true, 0.98, 1.0));
-        c.push_back(analytic("exponential_rate_m2000_on_1_3", make_exponential(1.0, 3.0, -2000.0), false, 2.995, 3.0));
-        c.push_back(analytic("gaussian_centred", make_truncated_gaussian(0.0, 1.0, 0.5, 0.1), true));
-        c.push_back(analytic("gaussian_off_centre", make_truncated_gaussian(0.0, 1.0, 0.2, 0.3), true));
-        c.push_back(analytic("gaussian_asymmetric", make_truncated_gaussian(-0.5, 3.0, 0.0, 1.0), false));
-        c.push_back(analytic("gaussian_far_tail_5_6", make_truncated_gaussian(5.0, 6.0, 0.0, 1.0), false));
-        c.push_back(analytic("gaussian_far_tail_m6_m5", make_truncated_gaussian(-6.0, -5.0, 0.0, 1.0), false));
-        c.push_back(analytic("gaussian_deep_tail_20_21", make_truncated_gaussian(20.0, 21.0, 0.0, 1.0), false, 20.0, 20.25));
-        c.push_back(analytic("gaussian_wide_sigma", make_truncated_gaussian(0.0, 1.0, 0.3, 1e3), true));
-        c.push_back(analytic("gaussian_sigma_1e6", make_truncated_gaussian(0.0, 1.0, 0.3, 1e6), true));
+        c.push_back(
+            analytic("exponential_rate_500", make_exponential(0.0, 1.0, 500.0), true, 0.0, 0.02));
+        c.push_back(
+            analytic("exponential_rate_m500", make_exponential(0.0, 1.0, -500.0), true, 0.98, 1.0));
+        c.push_back(analytic("exponential_rate_m2000_on_1_3", make_exponential(1.0, 3.0, -2000.0),
+                             false, 2.995, 3.0));
+        c.push_back(
+            analytic("gaussian_centred", make_truncated_gaussian(0.0, 1.0, 0.5, 0.1), true));
+        c.push_back(
+            analytic("gaussian_off_centre", make_truncated_gaussian(0.0, 1.0, 0.2, 0.3), true));
+        c.push_back(
+            analytic("gaussian_asymmetric", make_truncated_gaussian(-0.5, 3.0, 0.0, 1.0), false));
+        c.push_back(
+            analytic("gaussian_far_tail_5_6", make_truncated_gaussian(5.0, 6.0, 0.0, 1.0), false));
+        c.push_back(analytic("gaussian_far_tail_m6_m5",
+                             make_truncated_gaussian(-6.0, -5.0, 0.0, 1.0), false));
+        c.push_back(analytic("gaussian_deep_tail_20_21",
+                             make_truncated_gaussian(20.0, 21.0, 0.0, 1.0), false, 20.0, 20.25));
+        c.push_back(
+            analytic("gaussian_wide_sigma", make_truncated_gaussian(0.0, 1.0, 0.3, 1e3), true));
+        c.push_back(
+            analytic("gaussian_sigma_1e6", make_truncated_gaussian(0.0, 1.0, 0.3, 1e6), true));
         c.push_back(analytic("cosine_full_half_period", make_cosine(-h, h, 1.0, 0.0), true));
         c.push_back(analytic("cosine_omega2_sub_interval", make_cosine(0.0, 1.0, 2.0, 0.3), true));
         c.push_back(analytic("cosine_omega2_to_zero", make_cosine(0.0, 0.5 * h, 2.0, 0.0), true));
@@ -130,7 +143,9 @@ const std::vector<Case>& cases() {
 }
 
 /// Chi-square tests in this file: one per case, one for the 2D table.
-double chi_level() { return test::sidak_level(0.01, int(cases().size()) + 1); }
+double chi_level() {
+    return test::sidak_level(0.01, int(cases().size()) + 1);
+}
 
 /// Integral of the density over [lo, hi], computed without the distribution's cdf: Gauss-Legendre
 /// on about `panels` panels per unit of (b - a); across table bins for tabulated cases (exact
@@ -174,7 +189,7 @@ std::vector<double> chi_edges(const Case& c) {
 
 class Dist1D : public ::testing::TestWithParam<Case> {};
 
-}  // namespace
+} // namespace
 
 TEST_P(Dist1D, IsValid) {
     const Case& c = GetParam();
@@ -309,7 +324,8 @@ TEST_P(Dist1D, ChiSquare) {
     auto r = test::chi_square(observed, expected);
     EXPECT_GT(r.p_value, chi_level()) << "chi2=" << r.statistic << " dof=" << r.dof;
     // No pooling beyond the cells of negligible mass: 4 per nonzero table bin, or most of the 50.
-    int nonzero_bins = int(std::count_if(c.table.begin(), c.table.end(), [](double v) { return v > 0; }));
+    int nonzero_bins =
+        int(std::count_if(c.table.begin(), c.table.end(), [](double v) { return v > 0; }));
     EXPECT_GE(r.cells, c.table.empty() ? 20 : 4 * nonzero_bins);
 }
 
@@ -350,7 +366,7 @@ TEST(Tabulated, PdfMatchesValues) {
         const Distribution1D& d = c.made.value;
         const double a = d.lower(), b = d.upper(), n = double(c.table.size());
         double sum = 0.0;
-        for (double v : c.table) sum += v / 1e300;  // scaled: one case holds values near 1e300
+        for (double v : c.table) sum += v / 1e300; // scaled: one case holds values near 1e300
         for (size_t i = 0; i < c.table.size(); ++i) {
             double expect = c.table[i] / 1e300 / sum * n / (b - a);
             EXPECT_NEAR(d.pdf(a + (b - a) * (i + 0.5) / n), expect, 1e-13 * expect) << "bin " << i;
@@ -424,7 +440,7 @@ TEST(Power, SingularDensity) {
     ASSERT_TRUE(m.ok());
     for (double u : {0x1p-54, 1e-12, 1e-3}) {
         double x = m.value.sample(u);
-        EXPECT_NEAR(x, u * u, 1e-15 * u * u);  // x = u^(1/(k+1)) = u^2
+        EXPECT_NEAR(x, u * u, 1e-15 * u * u); // x = u^(1/(k+1)) = u^2
         EXPECT_TRUE(std::isfinite(m.value.pdf(x)));
         EXPECT_NEAR(m.value.pdf(x), 0.5 / u, 1e-13 / u);
     }
@@ -436,8 +452,8 @@ TEST(Power, SamplesNearAHavePositiveFiniteDensity) {
     struct Setting {
         double a, b, k;
     };
-    for (Setting s : {Setting{1.0, 2.0, -0.5}, Setting{0.0, 1.0, -0.99}, Setting{1e9, 1e9 + 1.0, 1.0},
-                      Setting{-3.0, -2.0, 2.0}}) {
+    for (Setting s : {Setting{1.0, 2.0, -0.5}, Setting{0.0, 1.0, -0.99},
+                      Setting{1e9, 1e9 + 1.0, 1.0}, Setting{-3.0, -2.0, 2.0}}) {
         auto m = make_power(s.a, s.b, s.k);
         ASSERT_TRUE(m.ok()) << m.error;
         for (double u : {0x1p-54, 1e-20, 1e-12, 1e-6, 1e-4, 0.5}) {
@@ -524,7 +540,7 @@ TEST(Tabulated, SingleNonzeroBin) {
         double x = m.value.sample(u);
         ASSERT_GE(x, lo - 1e-15);
         ASSERT_LE(x, hi + 1e-15);
-        ASSERT_NEAR(x, lo + u * (hi - lo), 1e-14);  // linear inside the bin
+        ASSERT_NEAR(x, lo + u * (hi - lo), 1e-14); // linear inside the bin
     }
     EXPECT_NEAR(m.value.pdf(0.0), 3.5, 1e-14);
     EXPECT_EQ(m.value.pdf(-0.9), 0.0);
@@ -535,7 +551,7 @@ TEST(Tabulated, SingleNonzeroBin) {
 TEST(Distribution1D, FactoriesRejectBadParameters) {
     struct Bad {
         Made<Distribution1D> made;
-        const char* expect;  // a substring naming the parameter (and where useful its value)
+        const char* expect; // a substring naming the parameter (and where useful its value)
     };
     const double nan = std::numeric_limits<double>::quiet_NaN();
     const double inf = std::numeric_limits<double>::infinity();
@@ -552,7 +568,7 @@ TEST(Distribution1D, FactoriesRejectBadParameters) {
         {make_exponential(0, 1, 0), "rate must be finite and != 0, got 0"},
         {make_exponential(0, 1, nan), "rate"},
         {make_exponential(0, 1, -inf), "rate"},
-        {make_exponential(0, 1e-10, 1e-320), "rate"},  // |rate| (b - a) underflows to 0
+        {make_exponential(0, 1e-10, 1e-320), "rate"}, // |rate| (b - a) underflows to 0
         {make_exponential(nan, 1, 1), "a=nan"},
         {make_truncated_gaussian(0, 1, 0.5, 0), "sigma must be finite and > 0, got 0"},
         {make_truncated_gaussian(0, 1, 0.5, -1), "sigma"},
@@ -585,7 +601,7 @@ TEST(Distribution1D, FactoriesRejectBadParameters) {
     }
     // Boundary values that are valid.
     EXPECT_TRUE(make_power(0, 1, -0.999).ok());
-    EXPECT_TRUE(make_cosine(-kPi / 6, kPi / 6, 3.0, 0.0).ok());  // pi/2 up to rounding
+    EXPECT_TRUE(make_cosine(-kPi / 6, kPi / 6, 3.0, 0.0).ok()); // pi/2 up to rounding
     EXPECT_TRUE(make_tabulated(0, 1, std::vector<double>(1u << 22, 1.0)).ok());
     EXPECT_TRUE(make_tabulated(0, 1, {0, 1e-310}).ok());
     EXPECT_TRUE(make_truncated_gaussian(29, 30, 0, 1).ok());
@@ -599,10 +615,10 @@ constexpr int kNx = 6, kNy = 5;
 constexpr double kX0 = -1.0, kX1 = 2.0, kY0 = 0.0, kY1 = 1.0;
 // Row 2 is all zero; rows 0, 1 and 4 have zero cells.
 const std::vector<double> kTable2D = {
-    1, 2, 0, 3, 1, 1,  //
-    0, 0, 5, 0, 0, 1,  //
-    0, 0, 0, 0, 0, 0,  //
-    2, 2, 2, 2, 2, 2,  //
+    1,   2, 0, 3, 1, 1, //
+    0,   0, 5, 0, 0, 1, //
+    0,   0, 0, 0, 0, 0, //
+    2,   2, 2, 2, 2, 2, //
     0.5, 0, 0, 0, 0, 4,
 };
 
@@ -625,7 +641,7 @@ TabulatedDistribution2D table_2d() {
     return m.value;
 }
 
-}  // namespace
+} // namespace
 
 TEST(Tabulated2D, PdfIntegratesToOneAndMatchesValues) {
     TabulatedDistribution2D t = table_2d();
@@ -669,7 +685,7 @@ TEST(Tabulated2D, ChiSquareAndZeroCellsNeverSampled) {
     }
     auto r = test::chi_square(observed, expected);
     EXPECT_GT(r.p_value, chi_level()) << "chi2=" << r.statistic << " dof=" << r.dof;
-    EXPECT_GE(r.cells, 15);  // the 15 nonzero cells; zero cells pool into their neighbours
+    EXPECT_GE(r.cells, 15); // the 15 nonzero cells; zero cells pool into their neighbours
 }
 
 // Convention (distributions.cpp): u2 selects the row through the marginal in y, u1 the point
@@ -753,7 +769,8 @@ TEST(Tabulated2D, FactoryRejectsBadInput) {
     const Bad bad[] = {
         {make_tabulated_2d(0, 1, 0, 1, 0, 2, {}), "nx and ny must be > 0, got nx=0"},
         {make_tabulated_2d(0, 1, 0, 1, 2, -1, {1, 1}), "ny=-1"},
-        {make_tabulated_2d(0, 1, 0, 1, 2, 2, {1, 1, 1}), "values.size() must equal nx * ny = 4, got 3"},
+        {make_tabulated_2d(0, 1, 0, 1, 2, 2, {1, 1, 1}),
+         "values.size() must equal nx * ny = 4, got 3"},
         {make_tabulated_2d(0, 1, 0, 1, 2, 1, {1, -2}), "values[1] must be finite and >= 0, got -2"},
         {make_tabulated_2d(0, 1, 0, 1, 2, 1, {nan, 1}), "values[0]"},
         {make_tabulated_2d(0, 1, 0, 1, 2, 1, {0, 0}), "values must not all be zero"},

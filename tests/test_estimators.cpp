@@ -23,7 +23,9 @@ SceneRequest load(const std::string& name, const Json& options = Json()) {
     return r.value;
 }
 
-StudyResult run(const SceneRequest& r) { return run_study(r.problem, r.estimators, r.settings); }
+StudyResult run(const SceneRequest& r) {
+    return run_study(r.problem, r.estimators, r.settings);
+}
 
 const EstimatorStudy& find(const StudyResult& s, const std::string& name) {
     for (const EstimatorStudy& e : s.estimators)
@@ -32,14 +34,15 @@ const EstimatorStudy& find(const StudyResult& s, const std::string& name) {
     return s.estimators.at(0);
 }
 
-}  // namespace
+} // namespace
 
 // Every estimator of every scene: the mean of R replicates lies within 4 standard errors of
 // the exact value, at the three largest N.
 class SceneUnbiased : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(SceneUnbiased, MeanWithinFourStandardErrors) {
-    SceneRequest req = load(GetParam(), Json{{"n_min", 1024}, {"n_max", 16384}, {"reps", 32}, {"seed", 2024}});
+    SceneRequest req =
+        load(GetParam(), Json{{"n_min", 1024}, {"n_max", 16384}, {"reps", 32}, {"seed", 2024}});
     ASSERT_TRUE(req.problem.exact.has_value()) << "scene without exact value";
     const double exact = *req.problem.exact;
     StudyResult s = run(req);
@@ -57,15 +60,18 @@ TEST_P(SceneUnbiased, MeanWithinFourStandardErrors) {
 }
 
 INSTANTIATE_TEST_SUITE_P(AllScenes, SceneUnbiased,
-                         ::testing::Values("disk_quarter", "disk_third", "expectation_4xy", "exp_1d",
-                                           "gaussian_peak_1d", "gaussian_2d", "hemisphere_cos2",
-                                           "triangle_moment"));
+                         ::testing::Values("disk_quarter", "disk_third", "expectation_4xy",
+                                           "exp_1d", "gaussian_peak_1d", "gaussian_2d",
+                                           "hemisphere_cos2", "triangle_moment"));
 
 TEST(Convergence, UniformVarianceFallsAsOneOverN) {
     // Fitted order within 0.1 of -1 (the fit's own standard error is ~0.02 here).
     for (const char* scene : {"exp_1d", "disk_quarter", "gaussian_2d"}) {
-        SceneRequest req = load(scene, Json{{"estimators", {"uniform"}}, {"n_min", 16}, {"n_max", 65536},
-                                            {"reps", 64}, {"seed", 7}});
+        SceneRequest req = load(scene, Json{{"estimators", {"uniform"}},
+                                            {"n_min", 16},
+                                            {"n_max", 65536},
+                                            {"reps", 64},
+                                            {"seed", 7}});
         StudyResult s = run(req);
         const ConvergenceFit& f = s.estimators[0].fit;
         ASSERT_TRUE(f.valid);
@@ -76,20 +82,27 @@ TEST(Convergence, UniformVarianceFallsAsOneOverN) {
 
 TEST(Convergence, JitteredOnSmooth1DFallsAtLeastAsNToMinus2_5) {
     SceneRequest req = load("exp_1d", Json{{"estimators", {"stratified", "stratified_importance"}},
-                                           {"n_min", 16}, {"n_max", 65536}, {"reps", 64}, {"seed", 7}});
+                                           {"n_min", 16},
+                                           {"n_max", 65536},
+                                           {"reps", 64},
+                                           {"seed", 7}});
     StudyResult s = run(req);
     for (const EstimatorStudy& e : s.estimators) {
         ASSERT_TRUE(e.fit.valid);
         EXPECT_LE(e.fit.order, -2.5) << e.spec.name;
-        EXPECT_NEAR(e.fit.order, -3.0, 0.15) << e.spec.name;  // theory: N^-3 in 1D
+        EXPECT_NEAR(e.fit.order, -3.0, 0.15) << e.spec.name; // theory: N^-3 in 1D
     }
 }
 
 TEST(Convergence, StratifiedOnA2DDiscontinuityFallsAsNToMinus1_5) {
     // One point per cell: only the ~sqrt(N) cells cut by the edge contribute variance, each
     // O(1/N^2), so Var ~ N^-1.5 in 2D. Needs an edge no power-of-two grid aligns with.
-    SceneRequest req = load("disk_third", Json{{"estimators", {"stratified_polar", "stratified_concentric"}},
-                                               {"n_min", 64}, {"n_max", 65536}, {"reps", 64}, {"seed", 5}});
+    SceneRequest req =
+        load("disk_third", Json{{"estimators", {"stratified_polar", "stratified_concentric"}},
+                                {"n_min", 64},
+                                {"n_max", 65536},
+                                {"reps", 64},
+                                {"seed", 5}});
     StudyResult s = run(req);
     for (const EstimatorStudy& e : s.estimators) {
         ASSERT_TRUE(e.fit.valid);
@@ -99,24 +112,33 @@ TEST(Convergence, StratifiedOnA2DDiscontinuityFallsAsNToMinus1_5) {
 
 TEST(Convergence, StratifiedNeverWorseThanUniform) {
     // Jittered sampling with one point per equal cell cannot increase the variance.
-    SceneRequest req = load("gaussian_2d", Json{{"estimators", {"uniform", "stratified"}}, {"n_min", 256},
-                                                {"n_max", 16384}, {"reps", 64}});
+    SceneRequest req = load("gaussian_2d", Json{{"estimators", {"uniform", "stratified"}},
+                                                {"n_min", 256},
+                                                {"n_max", 16384},
+                                                {"reps", 64}});
     StudyResult s = run(req);
     const auto& u = find(s, "uniform");
     const auto& st = find(s, "stratified");
-    for (size_t i = 0; i < u.levels.size(); ++i) EXPECT_LT(st.levels[i].variance, u.levels[i].variance);
+    for (size_t i = 0; i < u.levels.size(); ++i)
+        EXPECT_LT(st.levels[i].variance, u.levels[i].variance);
 }
 
 TEST(Convergence, ImportanceSamplingBeatsUniformAndPerfectPdfHasZeroVariance) {
-    SceneRequest req = load("exp_1d", Json{{"estimators", {"uniform", "importance"}}, {"n_min", 1024},
-                                           {"n_max", 1024}, {"reps", 32}});
+    SceneRequest req = load("exp_1d", Json{{"estimators", {"uniform", "importance"}},
+                                           {"n_min", 1024},
+                                           {"n_max", 1024},
+                                           {"reps", 32}});
     StudyResult s = run(req);
-    EXPECT_LT(find(s, "importance").levels[0].variance * 20.0, find(s, "uniform").levels[0].variance);
+    EXPECT_LT(find(s, "importance").levels[0].variance * 20.0,
+              find(s, "uniform").levels[0].variance);
 
     // f = 3x^2 sampled from p = 3x^2 (power k = 2): every weight is exactly 1.
-    Json scene = {{"integrand", {{"type", "monomial"}, {"scale", 3}, {"powers", {2}}}},
-                  {"estimators", {{{"name", "importance"}, {"pdf", {{"type", "power"}, {"k", 2}}}}}},
-                  {"n_min", 64}, {"n_max", 256}, {"reps", 8}};
+    Json scene = {
+        {"integrand", {{"type", "monomial"}, {"scale", 3}, {"powers", {2}}}},
+        {"estimators", {{{"name", "importance"}, {"pdf", {{"type", "power"}, {"k", 2}}}}}},
+        {"n_min", 64},
+        {"n_max", 256},
+        {"reps", 8}};
     Made<SceneRequest> r = build_request(scene, Json());
     ASSERT_TRUE(r.ok()) << r.error;
     StudyResult z = run(r.value);
@@ -129,8 +151,11 @@ TEST(Convergence, ImportanceSamplingBeatsUniformAndPerfectPdfHasZeroVariance) {
 TEST(ErrorBars, IidStandardErrorMatchesReplicateSpread) {
     // E[s^2/N] = Var[I_N]; with R = 128 the ratio of the two estimates lies well inside
     // [0.7, 1.4] (its relative sd is about sqrt(2/127) = 0.13).
-    SceneRequest req = load("exp_1d", Json{{"estimators", {"uniform", "importance"}}, {"n_min", 4096},
-                                           {"n_max", 4096}, {"reps", 128}, {"seed", 3}});
+    SceneRequest req = load("exp_1d", Json{{"estimators", {"uniform", "importance"}},
+                                           {"n_min", 4096},
+                                           {"n_max", 4096},
+                                           {"reps", 128},
+                                           {"seed", 3}});
     StudyResult s = run(req);
     for (const EstimatorStudy& e : s.estimators) {
         const LevelStats& l = e.levels[0];
@@ -143,8 +168,11 @@ TEST(ErrorBars, IidStandardErrorMatchesReplicateSpread) {
 }
 
 TEST(ErrorBars, CollapsedStrataIsConservative) {
-    SceneRequest req = load("exp_1d", Json{{"estimators", {"stratified"}}, {"n_min", 64},
-                                           {"n_max", 4096}, {"reps", 64}, {"seed", 3}});
+    SceneRequest req = load("exp_1d", Json{{"estimators", {"stratified"}},
+                                           {"n_min", 64},
+                                           {"n_max", 4096},
+                                           {"reps", 64},
+                                           {"seed", 3}});
     StudyResult s = run(req);
     for (const LevelStats& l : s.estimators[0].levels) {
         EXPECT_GT(l.mean_run_se * l.mean_run_se, 0.8 * l.variance) << "N=" << l.n;
@@ -162,14 +190,17 @@ TEST(Study, IdenticalWithOneAndTwoThreads) {
     for (size_t e = 0; e < one.estimators.size(); ++e)
         for (size_t i = 0; i < one.estimators[e].levels.size(); ++i) {
             EXPECT_EQ(one.estimators[e].levels[i].estimates, two.estimators[e].levels[i].estimates);
-            EXPECT_EQ(one.estimators[e].levels[i].run_std_errors, two.estimators[e].levels[i].run_std_errors);
+            EXPECT_EQ(one.estimators[e].levels[i].run_std_errors,
+                      two.estimators[e].levels[i].run_std_errors);
         }
 }
 
 TEST(Study, SubsetOfEstimatorsGivesSameNumbers) {
     StudyResult all = run(load("exp_1d", Json{{"n_max", 1024}, {"reps", 4}}));
-    StudyResult one = run(load("exp_1d", Json{{"n_max", 1024}, {"reps", 4}, {"estimators", {"importance"}}}));
-    EXPECT_EQ(find(all, "importance").levels.back().estimates, one.estimators[0].levels.back().estimates);
+    StudyResult one =
+        run(load("exp_1d", Json{{"n_max", 1024}, {"reps", 4}, {"estimators", {"importance"}}}));
+    EXPECT_EQ(find(all, "importance").levels.back().estimates,
+              one.estimators[0].levels.back().estimates);
 }
 
 TEST(Study, DifferentSeedsGiveDifferentNumbers) {
@@ -182,7 +213,10 @@ TEST(Diagnostics, NonFiniteSamplesAreCountedAndDropped) {
     // sqrt(x) on [-1, 1]: NaN for every x < 0 (about half the samples).
     Json scene = {{"domain", {{"type", "interval"}, {"lower", -1}, {"upper", 1}}},
                   {"integrand", {{"type", "monomial"}, {"powers", {0.5}}}},
-                  {"estimators", {"uniform"}}, {"n_min", 1000}, {"n_max", 1024}, {"reps", 4}};
+                  {"estimators", {"uniform"}},
+                  {"n_min", 1000},
+                  {"n_max", 1024},
+                  {"reps", 4}};
     Made<SceneRequest> r = build_request(scene, Json());
     ASSERT_TRUE(r.ok()) << r.error;
     StudyResult s = run(r.value);

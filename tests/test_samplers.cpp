@@ -32,11 +32,12 @@ std::vector<std::vector<double>> generate_all(SamplerKind kind, int dim, uint64_
     return pts;
 }
 
-}  // namespace
+} // namespace
 
 TEST(StratificationGrid, ProductIsNAndBalanced) {
     for (int dim = 1; dim <= 5; ++dim)
-        for (uint64_t n : {1ull, 2ull, 7ull, 12ull, 16ull, 64ull, 97ull, 100ull, 1000ull, 4096ull, 65536ull}) {
+        for (uint64_t n :
+             {1ull, 2ull, 7ull, 12ull, 16ull, 64ull, 97ull, 100ull, 1000ull, 4096ull, 65536ull}) {
             auto k = stratification_grid(n, dim);
             uint64_t prod = 1;
             for (uint64_t v : k) prod *= v;
@@ -46,15 +47,17 @@ TEST(StratificationGrid, ProductIsNAndBalanced) {
     for (int dim = 1; dim <= 4; ++dim)
         for (int m = 0; m <= 20; ++m) {
             auto k = stratification_grid(uint64_t(1) << m, dim);
-            uint64_t lo = *std::min_element(k.begin(), k.end()), hi = *std::max_element(k.begin(), k.end());
+            uint64_t lo = *std::min_element(k.begin(), k.end()),
+                     hi = *std::max_element(k.begin(), k.end());
             EXPECT_LE(hi, 2 * lo) << "m=" << m << " dim=" << dim;
         }
     EXPECT_EQ(stratification_grid(64, 3), (std::vector<uint64_t>{4, 4, 4}));
-    EXPECT_EQ(stratification_grid(97, 2), (std::vector<uint64_t>{1, 97}));  // prime: slabs
+    EXPECT_EQ(stratification_grid(97, 2), (std::vector<uint64_t>{1, 97})); // prime: slabs
 }
 
 TEST(Samplers, StratifiedPutsOnePointPerCell) {
-    for (auto [dim, n] : std::vector<std::pair<int, uint64_t>>{{1, 37}, {2, 64}, {2, 128}, {3, 100}}) {
+    for (auto [dim, n] :
+         std::vector<std::pair<int, uint64_t>>{{1, 37}, {2, 64}, {2, 128}, {3, 100}}) {
         auto k = stratification_grid(n, dim);
         auto pts = generate_all(SamplerKind::Stratified, dim, n, 3, 16);
         std::set<std::vector<uint64_t>> cells;
@@ -72,7 +75,8 @@ TEST(Samplers, StratifiedPutsOnePointPerCell) {
 }
 
 TEST(Samplers, LatinHypercubeOnePointPerSlab) {
-    for (auto [dim, n] : std::vector<std::pair<int, uint64_t>>{{1, 10}, {2, 100}, {3, 257}, {5, 1000}}) {
+    for (auto [dim, n] :
+         std::vector<std::pair<int, uint64_t>>{{1, 10}, {2, 100}, {3, 257}, {5, 1000}}) {
         auto pts = generate_all(SamplerKind::LatinHypercube, dim, n, 5, 64);
         for (int j = 0; j < dim; ++j) {
             std::set<uint64_t> slabs;
@@ -95,14 +99,16 @@ TEST(Samplers, PermuteIndexIsAPermutation) {
         }
     // Different keys give different orders.
     int same = 0;
-    for (uint64_t i = 0; i < 1000; ++i) same += permute_index(i, 1000, 1) == permute_index(i, 1000, 2);
+    for (uint64_t i = 0; i < 1000; ++i)
+        same += permute_index(i, 1000, 1) == permute_index(i, 1000, 2);
     EXPECT_LT(same, 20);
 }
 
 TEST(Samplers, MarginalsUniformChiSquare) {
     const uint64_t n = 20000;
     const int bins = 50;
-    const SamplerKind kinds[] = {SamplerKind::Independent, SamplerKind::Stratified, SamplerKind::LatinHypercube};
+    const SamplerKind kinds[] = {SamplerKind::Independent, SamplerKind::Stratified,
+                                 SamplerKind::LatinHypercube};
     const double level = test::sidak_level(0.01, 3 * 3);
     for (SamplerKind kind : kinds) {
         // Many short runs pooled, so that a stratified run's exact balance does not make the
@@ -121,7 +127,8 @@ TEST(Samplers, MarginalsUniformChiSquare) {
 }
 
 TEST(Samplers, BlockSizeDoesNotChangePoints) {
-    for (SamplerKind kind : {SamplerKind::Independent, SamplerKind::Stratified, SamplerKind::LatinHypercube}) {
+    for (SamplerKind kind :
+         {SamplerKind::Independent, SamplerKind::Stratified, SamplerKind::LatinHypercube}) {
         auto a = generate_all(kind, 3, 1000, 42, 1000);
         auto b = generate_all(kind, 3, 1000, 42, 7);
         EXPECT_EQ(a, b) << sampler_name(kind);

@@ -29,7 +29,8 @@ TEST(Special, StudentTQuantileMatchesCdfByQuadrature) {
     // CDF of t with nu dof by Simpson integration of its density, at the quantile.
     for (double nu : {3.0, 7.0, 31.0}) {
         const double t = student_t_quantile(0.975, nu);
-        const double c = std::exp(std::lgamma(0.5 * (nu + 1)) - std::lgamma(0.5 * nu)) / std::sqrt(nu * kPi);
+        const double c =
+            std::exp(std::lgamma(0.5 * (nu + 1)) - std::lgamma(0.5 * nu)) / std::sqrt(nu * kPi);
         auto pdf = [&](double x) { return c * std::pow(1.0 + x * x / nu, -0.5 * (nu + 1)); };
         const int m = 20000;
         double h = t / m, s = pdf(0) + pdf(t);

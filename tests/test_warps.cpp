@@ -21,7 +21,9 @@ constexpr double kHalfPi = 0.5 * kPi;
 // Six chi-square tests below (polar disk, concentric disk, triangle, sphere, hemisphere, cosine
 // hemisphere) share a 1% family-wise level.
 constexpr int kChiSquareTests = 6;
-double chi_level() { return test::sidak_level(0.01, kChiSquareTests); }
+double chi_level() {
+    return test::sidak_level(0.01, kChiSquareTests);
+}
 constexpr int kChiSamples = 200000;
 constexpr int kRoundTrips = 5000;
 
@@ -118,7 +120,7 @@ test::ChiSquareResult disk_chi_square(Vec2 (*sample)(Vec2), uint64_t seed) {
     return test::chi_square(observed, expected);
 }
 
-}  // namespace
+} // namespace
 
 // --- Exact values (from the formulas in warps.h) -------------------------------------------
 
@@ -340,23 +342,23 @@ TEST(Warps, TriangleChiSquare) {
 }
 
 TEST(Warps, UniformSphereChiSquare) {
-    auto r = direction_chi_square(sample_uniform_sphere,
-                                  [](double) { return uniform_sphere_pdf(); }, kPi, 16, 16, 24u);
+    auto r = direction_chi_square(
+        sample_uniform_sphere, [](double) { return uniform_sphere_pdf(); }, kPi, 16, 16, 24u);
     EXPECT_GT(r.p_value, chi_level()) << "chi2=" << r.statistic << " dof=" << r.dof;
     EXPECT_GT(r.cells, 200);
 }
 
 TEST(Warps, UniformHemisphereChiSquare) {
-    auto r = direction_chi_square(sample_uniform_hemisphere,
-                                  [](double) { return uniform_hemisphere_pdf(); }, kHalfPi, 12,
-                                  16, 25u);
+    auto r = direction_chi_square(
+        sample_uniform_hemisphere, [](double) { return uniform_hemisphere_pdf(); }, kHalfPi, 12, 16,
+        25u);
     EXPECT_GT(r.p_value, chi_level()) << "chi2=" << r.statistic << " dof=" << r.dof;
     EXPECT_GT(r.cells, 150);
 }
 
 TEST(Warps, CosineHemisphereChiSquare) {
-    auto r = direction_chi_square(sample_cosine_hemisphere, cosine_hemisphere_pdf, kHalfPi, 12,
-                                  16, 26u);
+    auto r =
+        direction_chi_square(sample_cosine_hemisphere, cosine_hemisphere_pdf, kHalfPi, 12, 16, 26u);
     EXPECT_GT(r.p_value, chi_level()) << "chi2=" << r.statistic << " dof=" << r.dof;
     EXPECT_GT(r.cells, 150);
 }
@@ -364,8 +366,8 @@ TEST(Warps, CosineHemisphereChiSquare) {
 // A warp into the wrong density must fail the same test: the uniform hemisphere's samples
 // judged against the cosine density.
 TEST(Warps, ChiSquareRejectsWrongDensity) {
-    auto r = direction_chi_square(sample_uniform_hemisphere, cosine_hemisphere_pdf, kHalfPi, 12,
-                                  16, 27u);
+    auto r = direction_chi_square(sample_uniform_hemisphere, cosine_hemisphere_pdf, kHalfPi, 12, 16,
+                                  27u);
     EXPECT_LT(r.p_value, 1e-12);
 }
 

@@ -27,15 +27,21 @@ std::string dump(const mcp::Json& j, int indent = -1) {
     return j.dump(indent, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
-}  // namespace
+} // namespace
 
 extern "C" {
 
-const char* mcp_version(void) { return MCPLAY_VERSION; }
+const char* mcp_version(void) {
+    return MCPLAY_VERSION;
+}
 
-const char* mcp_last_error(void) { return g_last_error.c_str(); }
+const char* mcp_last_error(void) {
+    return g_last_error.c_str();
+}
 
-void mcp_free(char* p) { std::free(p); }
+void mcp_free(char* p) {
+    std::free(p);
+}
 
 int mcp_study_run(const char* scene_json, const char* options_json, mcp_progress_fn progress,
                   void* user, char** result_json) {
@@ -78,10 +84,14 @@ int mcp_result_format(const char* result_json, const char* format, char** text) 
         return fail(MCP_ERROR_ARGUMENT, "result: not an mcplay study result (no \"estimators\")");
     std::string out;
     const std::string f = format;
-    if (f == "table") out = mcp::format_table(r.value);
-    else if (f == "csv") out = mcp::format_csv(r.value);
-    else if (f == "json") out = dump(r.value, 2) + "\n";
-    else return fail(MCP_ERROR_ARGUMENT, "unknown format '" + f + "' (known: table, json, csv)");
+    if (f == "table")
+        out = mcp::format_table(r.value);
+    else if (f == "csv")
+        out = mcp::format_csv(r.value);
+    else if (f == "json")
+        out = dump(r.value, 2) + "\n";
+    else
+        return fail(MCP_ERROR_ARGUMENT, "unknown format '" + f + "' (known: table, json, csv)");
     *text = copy_out(out);
     g_last_error.clear();
     return MCP_OK;
@@ -124,8 +134,9 @@ int mcp_catalog(char** catalog_json) {
         {"version", mcp::kResultSchemaVersion},
         {"estimators", presets},
         {"samplers", {"independent", "stratified", "latin_hypercube"}},
-        {"pdfs", {"uniform", "power", "exponential", "gaussian", "cosine", "tabulated", "product",
-                  "tabulated_2d", "cosine_hemisphere"}},
+        {"pdfs",
+         {"uniform", "power", "exponential", "gaussian", "cosine", "tabulated", "product",
+          "tabulated_2d", "cosine_hemisphere"}},
         {"integrands", {"constant", "monomial", "exponential", "gaussian", "indicator_ball"}},
         {"domains", {"box", "interval", "disk", "triangle", "sphere", "hemisphere"}}};
     *catalog_json = copy_out(dump(catalog));
@@ -133,4 +144,4 @@ int mcp_catalog(char** catalog_json) {
     return MCP_OK;
 }
 
-}  // extern "C"
+} // extern "C"

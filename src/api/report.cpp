@@ -11,10 +11,13 @@ namespace mcp {
 namespace {
 
 // NaN and infinities become null in the JSON.
-Json num(double x) { return std::isfinite(x) ? Json(x) : Json(nullptr); }
+Json num(double x) {
+    return std::isfinite(x) ? Json(x) : Json(nullptr);
+}
 
 Json diagnostics_to_json(const RunDiagnostics& d) {
-    return Json{{"nonfinite", d.nonfinite}, {"zero_pdf", d.zero_pdf},
+    return Json{{"nonfinite", d.nonfinite},
+                {"zero_pdf", d.zero_pdf},
                 {"max_weight_share", num(d.max_weight_share)}};
 }
 
@@ -23,14 +26,17 @@ std::vector<std::string> warnings_for(const LevelStats& l) {
     std::vector<std::string> w;
     const RunDiagnostics& d = l.diagnostics;
     if (d.nonfinite)
-        w.push_back(std::to_string(d.nonfinite) + " sample(s) with NaN/Inf f/p dropped: the estimate is biased");
+        w.push_back(std::to_string(d.nonfinite) +
+                    " sample(s) with NaN/Inf f/p dropped: the estimate is biased");
     if (d.zero_pdf)
         w.push_back(std::to_string(d.zero_pdf) +
-                    " sample(s) with f != 0 where p = 0: the pdf misses part of the integrand, the estimate is biased");
+                    " sample(s) with f != 0 where p = 0: the pdf misses part of the integrand, the "
+                    "estimate is biased");
     // One sample carrying a large share of a big sum: the variance estimate is dominated by
     // rare large weights (heavy tail, possibly infinite variance).
     if (l.n >= 1024 && d.max_weight_share > 0.05)
-        w.push_back("one sample carried " + std::to_string(static_cast<int>(100 * d.max_weight_share + 0.5)) +
+        w.push_back("one sample carried " +
+                    std::to_string(static_cast<int>(100 * d.max_weight_share + 0.5)) +
                     "% of a run's sum at N = " + std::to_string(l.n) +
                     ": heavy-tailed weights, the error bar is not trustworthy");
     return w;
@@ -43,8 +49,12 @@ std::string fmt(const char* f, double x) {
     return buf;
 }
 
-std::string padl(const std::string& s, size_t w) { return s.size() >= w ? s : std::string(w - s.size(), ' ') + s; }
-std::string padr(const std::string& s, size_t w) { return s.size() >= w ? s : s + std::string(w - s.size(), ' '); }
+std::string padl(const std::string& s, size_t w) {
+    return s.size() >= w ? s : std::string(w - s.size(), ' ') + s;
+}
+std::string padr(const std::string& s, size_t w) {
+    return s.size() >= w ? s : s + std::string(w - s.size(), ' ');
+}
 
 // Accessors that never throw, whatever shape of JSON a client hands back to us.
 const Json& get(const Json& j, const char* key) {
@@ -81,7 +91,7 @@ bool jbool(const Json& j, const char* key) {
     return v.is_boolean() && v.get<bool>();
 }
 
-}  // namespace
+} // namespace
 
 Json level_to_json(const LevelStats& l) {
     Json j{{"n", l.n},
@@ -132,7 +142,7 @@ Json estimator_header(const EstimatorStudy& e) {
                 {"error_method", error_method_name(e.error_method)}};
 }
 
-}  // namespace
+} // namespace
 
 Json study_to_json(const StudyResult& r) {
     const Problem& p = r.problem;
@@ -144,8 +154,11 @@ Json study_to_json(const StudyResult& r) {
                {"integrand", describe_integrand(p.integrand)},
                {"quantity", p.quantity == Quantity::Mean ? "mean" : "integral"},
                {"exact", p.exact ? num(*p.exact) : Json(nullptr)}};
-    Json settings{{"n_min", r.settings.n_min}, {"n_max", r.settings.n_max}, {"reps", r.settings.reps},
-                  {"seed", r.settings.seed}, {"threads", r.threads_used}};
+    Json settings{{"n_min", r.settings.n_min},
+                  {"n_max", r.settings.n_max},
+                  {"reps", r.settings.reps},
+                  {"seed", r.settings.seed},
+                  {"threads", r.threads_used}};
     Json estimators = Json::array();
     for (const EstimatorStudy& e : r.estimators) {
         Json j = estimator_header(e);
@@ -176,7 +189,9 @@ Json progress_to_json(const StudyResult& partial, size_t level_index) {
         j["fit"] = fit_to_json(e.fit);
         estimators.push_back(j);
     }
-    return Json{{"version", kResultSchemaVersion}, {"level_index", level_index}, {"n", n},
+    return Json{{"version", kResultSchemaVersion},
+                {"level_index", level_index},
+                {"n", n},
                 {"estimators", estimators}};
 }
 
@@ -190,16 +205,18 @@ std::string format_table(const Json& r) {
     if (!jstr(scene, "description").empty()) out << ": " << jstr(scene, "description");
     out << "\n  " << jstr(scene, "quantity") << " of f = " << jstr(scene, "integrand") << " over "
         << jstr(scene, "domain_text");
-    out << "\n  exact " << (has_exact ? fmt("%.12g", exact) : std::string("unknown")) << "   N = "
-        << fmt("%.0f", jnum(settings, "n_min")) << " .. " << fmt("%.0f", jnum(settings, "n_max"))
-        << ", " << fmt("%.0f", jnum(settings, "reps")) << " replicates per N, seed "
-        << fmt("%.0f", jnum(settings, "seed")) << ", " << fmt("%.0f", jnum(settings, "threads"))
-        << " thread(s), " << fmt("%.2f", jnum(r, "wall_time_s")) << " s\n";
+    out << "\n  exact " << (has_exact ? fmt("%.12g", exact) : std::string("unknown"))
+        << "   N = " << fmt("%.0f", jnum(settings, "n_min")) << " .. "
+        << fmt("%.0f", jnum(settings, "n_max")) << ", " << fmt("%.0f", jnum(settings, "reps"))
+        << " replicates per N, seed " << fmt("%.0f", jnum(settings, "seed")) << ", "
+        << fmt("%.0f", jnum(settings, "threads")) << " thread(s), "
+        << fmt("%.2f", jnum(r, "wall_time_s")) << " s\n";
     if (jbool(r, "cancelled")) out << "  (cancelled: partial result)\n";
 
     const Json& ests = list(r, "estimators");
     for (const Json& e : ests) {
-        out << "\n" << jstr(e, "name") << "  [sampler " << jstr(e, "sampler") << ", pdf " << jstr(e, "pdf")
+        out << "\n"
+            << jstr(e, "name") << "  [sampler " << jstr(e, "sampler") << ", pdf " << jstr(e, "pdf")
             << ", per-run error: " << jstr(e, "error_method") << "]\n";
         out << padl("N", 9) << padl("mean", 15) << padl("variance", 13) << padl("rel.err", 10);
         if (has_exact) out << padl("rmse", 11) << padl("bias/se", 9) << padl("cover", 7);
@@ -243,9 +260,10 @@ std::string format_table(const Json& r) {
 
     // Equal-N and equal-time comparison at the largest N every estimator reached.
     if (ests.size() > 1) {
-        out << "\ncomparison at the largest N (efficiency = 1 / (variance x time); higher is better)\n";
-        out << padr("  estimator", 26) << padl("N", 9) << padl("variance", 13) << padl("time/est", 11)
-            << padl("efficiency", 12) << padl("vs first", 10) << "\n";
+        out << "\ncomparison at the largest N (efficiency = 1 / (variance x time); higher is "
+               "better)\n";
+        out << padr("  estimator", 26) << padl("N", 9) << padl("variance", 13)
+            << padl("time/est", 11) << padl("efficiency", 12) << padl("vs first", 10) << "\n";
         double first_eff = NAN;
         for (const Json& e : ests) {
             const Json& levels = list(e, "levels");
@@ -254,9 +272,11 @@ std::string format_table(const Json& r) {
             const double eff = jnum(l, "efficiency");
             if (std::isnan(first_eff)) first_eff = eff;
             out << padr("  " + jstr(e, "name"), 26) << padl(fmt("%.0f", jnum(l, "n")), 9)
-                << padl(fmt("%.4e", jnum(l, "variance")), 13) << padl(fmt("%.2e", jnum(l, "time_mean_s")), 11)
-                << padl(fmt("%.3e", eff), 12)
-                << padl(first_eff > 0 && std::isfinite(eff) ? fmt("%.3gx", eff / first_eff) : "-", 10) << "\n";
+                << padl(fmt("%.4e", jnum(l, "variance")), 13)
+                << padl(fmt("%.2e", jnum(l, "time_mean_s")), 11) << padl(fmt("%.3e", eff), 12)
+                << padl(first_eff > 0 && std::isfinite(eff) ? fmt("%.3gx", eff / first_eff) : "-",
+                        10)
+                << "\n";
         }
     }
     return out.str();
@@ -265,7 +285,8 @@ std::string format_table(const Json& r) {
 std::string format_csv(const Json& r) {
     std::ostringstream out;
     out.precision(17);
-    out << "scene,estimator,sampler,pdf,n,reps,mean,variance,variance_lo,variance_hi,std_error,ci_lo,"
+    out << "scene,estimator,sampler,pdf,n,reps,mean,variance,variance_lo,variance_hi,std_error,ci_"
+           "lo,"
            "ci_hi,exact,bias,mse,rmse,coverage95,mean_run_std_error,time_mean_s,efficiency,"
            "nonfinite,zero_pdf,max_weight_share\n";
     const Json& scene = get(r, "scene");
@@ -290,21 +311,19 @@ std::string format_csv(const Json& r) {
             const Json& vci = get(l, "variance_ci95");
             const Json& ci = get(l, "ci95");
             out << quoted(jstr(scene, "name")) << "," << quoted(jstr(e, "name")) << ","
-                << jstr(e, "sampler") << "," << quoted(jstr(e, "pdf")) << ","
-                << cell(get(l, "n")) << "," << cell(get(l, "reps")) << ","
-                << cell(get(l, "mean")) << "," << cell(get(l, "variance")) << ","
-                << cell(at_index(vci, 0)) << "," << cell(at_index(vci, 1)) << ","
-                << cell(get(l, "std_error")) << "," << cell(at_index(ci, 0)) << ","
-                << cell(at_index(ci, 1)) << "," << cell(exact) << ","
-                << cell(get(l, "bias")) << "," << cell(get(l, "mse")) << ","
+                << jstr(e, "sampler") << "," << quoted(jstr(e, "pdf")) << "," << cell(get(l, "n"))
+                << "," << cell(get(l, "reps")) << "," << cell(get(l, "mean")) << ","
+                << cell(get(l, "variance")) << "," << cell(at_index(vci, 0)) << ","
+                << cell(at_index(vci, 1)) << "," << cell(get(l, "std_error")) << ","
+                << cell(at_index(ci, 0)) << "," << cell(at_index(ci, 1)) << "," << cell(exact)
+                << "," << cell(get(l, "bias")) << "," << cell(get(l, "mse")) << ","
                 << cell(get(l, "rmse")) << "," << cell(get(l, "coverage95")) << ","
-                << cell(get(l, "mean_run_std_error")) << "," << cell(get(l, "time_mean_s"))
-                << "," << cell(get(l, "efficiency")) << "," << cell(get(d, "nonfinite"))
-                << "," << cell(get(d, "zero_pdf")) << "," << cell(get(d, "max_weight_share"))
-                << "\n";
+                << cell(get(l, "mean_run_std_error")) << "," << cell(get(l, "time_mean_s")) << ","
+                << cell(get(l, "efficiency")) << "," << cell(get(d, "nonfinite")) << ","
+                << cell(get(d, "zero_pdf")) << "," << cell(get(d, "max_weight_share")) << "\n";
         }
     }
     return out.str();
 }
 
-}  // namespace mcp
+} // namespace mcp

@@ -42,7 +42,8 @@ bool check_keys(Ctx& c, const Json& obj, const std::string& path,
     for (auto it = obj.begin(); it != obj.end(); ++it) {
         bool ok = false;
         for (const std::string& k : known) ok = ok || k == it.key();
-        if (!ok) return c.fail(path, "unknown field '" + it.key() + "' (known: " + join(known) + ")");
+        if (!ok)
+            return c.fail(path, "unknown field '" + it.key() + "' (known: " + join(known) + ")");
     }
     return true;
 }
@@ -53,7 +54,9 @@ const Json* find(const Json& obj, const char* key) {
     return it == obj.end() ? nullptr : &*it;
 }
 
-std::string sub(const std::string& path, const char* key) { return path + "." + key; }
+std::string sub(const std::string& path, const char* key) {
+    return path + "." + key;
+}
 
 // Optional number: leaves *out unchanged when absent.
 bool get_number(Ctx& c, const Json& obj, const char* key, const std::string& path, double* out) {
@@ -106,9 +109,11 @@ bool to_numbers(Ctx& c, const Json& v, const std::string& path, std::vector<doub
     if (!v.is_array()) return c.fail(path, "expected an array of numbers, got " + type_of(v));
     for (size_t i = 0; i < v.size(); ++i) {
         if (!v[i].is_number())
-            return c.fail(path + "[" + std::to_string(i) + "]", "expected a number, got " + type_of(v[i]));
+            return c.fail(path + "[" + std::to_string(i) + "]",
+                          "expected a number, got " + type_of(v[i]));
         double x = v[i].get<double>();
-        if (!std::isfinite(x)) return c.fail(path + "[" + std::to_string(i) + "]", "must be finite");
+        if (!std::isfinite(x))
+            return c.fail(path + "[" + std::to_string(i) + "]", "must be finite");
         out->push_back(x);
     }
     return true;
@@ -124,7 +129,8 @@ bool get_numbers(Ctx& c, const Json& obj, const char* key, const std::string& pa
 bool get_vec2(Ctx& c, const Json& v, const std::string& path, Vec2* out) {
     std::vector<double> xs;
     if (!to_numbers(c, v, path, &xs)) return false;
-    if (xs.size() != 2) return c.fail(path, "expected [x, y], got " + std::to_string(xs.size()) + " numbers");
+    if (xs.size() != 2)
+        return c.fail(path, "expected [x, y], got " + std::to_string(xs.size()) + " numbers");
     *out = Vec2{xs[0], xs[1]};
     return true;
 }
@@ -139,15 +145,18 @@ bool parse_domain(Ctx& c, const Json& j, const std::string& path, int default_di
     if (type == "box" || type == "interval") {
         uint64_t dim = static_cast<uint64_t>(default_dim);
         if (!get_count(c, j, "dim", path, &dim)) return false;
-        if (dim < 1 || dim > 64) return c.fail(sub(path, "dim"), "must be in 1..64, got " + std::to_string(dim));
+        if (dim < 1 || dim > 64)
+            return c.fail(sub(path, "dim"), "must be in 1..64, got " + std::to_string(dim));
         std::vector<double> lo(dim, 0.0), hi(dim, 1.0);
-        if (!get_numbers(c, j, "lower", path, &lo) || !get_numbers(c, j, "upper", path, &hi)) return false;
+        if (!get_numbers(c, j, "lower", path, &lo) || !get_numbers(c, j, "upper", path, &hi))
+            return false;
         if (find(j, "lower") && !find(j, "dim") && !find(j, "upper")) hi.assign(lo.size(), 1.0);
         if (find(j, "upper") && !find(j, "dim") && !find(j, "lower")) lo.assign(hi.size(), 0.0);
         if (lo.size() != hi.size())
             return c.fail(path, "lower has " + std::to_string(lo.size()) + " entries, upper has " +
                                     std::to_string(hi.size()));
-        if (type == "interval" && lo.size() != 1) return c.fail(path, "an interval has one dimension");
+        if (type == "interval" && lo.size() != 1)
+            return c.fail(path, "an interval has one dimension");
         Made<Domain> d = make_box(lo, hi);
         if (!d.ok()) return c.fail(path, d.error);
         *out = d.value;
@@ -156,7 +165,8 @@ bool parse_domain(Ctx& c, const Json& j, const std::string& path, int default_di
     if (type == "disk") {
         Vec2 center{0.0, 0.0};
         double radius = 1.0;
-        if (const Json* v = find(j, "center"); v && !get_vec2(c, *v, sub(path, "center"), &center)) return false;
+        if (const Json* v = find(j, "center"); v && !get_vec2(c, *v, sub(path, "center"), &center))
+            return false;
         if (!get_number(c, j, "radius", path, &radius)) return false;
         Made<Domain> d = make_disk(center, radius);
         if (!d.ok()) return c.fail(path, d.error);
@@ -185,8 +195,9 @@ bool parse_domain(Ctx& c, const Json& j, const std::string& path, int default_di
         *out = make_hemisphere();
         return true;
     }
-    return c.fail(sub(path, "type"), "unknown domain '" + type +
-                                         "' (known: box, interval, disk, triangle, sphere, hemisphere)");
+    return c.fail(sub(path, "type"),
+                  "unknown domain '" + type +
+                      "' (known: box, interval, disk, triangle, sphere, hemisphere)");
 }
 
 // --- integrand ---------------------------------------------------------------------------
@@ -196,21 +207,28 @@ bool parse_integrand(Ctx& c, const Json& j, const std::string& path, int dim, In
         return false;
     std::string type;
     if (!get_string(c, j, "type", path, &type)) return false;
-    if (type.empty()) return c.fail(path, "missing \"type\" (constant, monomial, exponential, gaussian, indicator_ball)");
+    if (type.empty())
+        return c.fail(
+            path, "missing \"type\" (constant, monomial, exponential, gaussian, indicator_ball)");
     IntegrandKind kind;
     if (!parse_integrand_kind(type, &kind))
-        return c.fail(sub(path, "type"), "unknown integrand '" + type +
-                                             "' (known: constant, monomial, exponential, gaussian, indicator_ball)");
+        return c.fail(sub(path, "type"),
+                      "unknown integrand '" + type +
+                          "' (known: constant, monomial, exponential, gaussian, indicator_ball)");
     double scale = 1.0, width = 1.0;
     std::vector<double> coeffs, center;
     if (!get_number(c, j, "scale", path, &scale)) return false;
-    if (kind == IntegrandKind::Monomial && !get_numbers(c, j, "powers", path, &coeffs)) return false;
-    if (kind == IntegrandKind::Exponential && !get_numbers(c, j, "rates", path, &coeffs)) return false;
-    if ((kind == IntegrandKind::Monomial || kind == IntegrandKind::Exponential) && coeffs.size() == 1 && dim > 1)
+    if (kind == IntegrandKind::Monomial && !get_numbers(c, j, "powers", path, &coeffs))
+        return false;
+    if (kind == IntegrandKind::Exponential && !get_numbers(c, j, "rates", path, &coeffs))
+        return false;
+    if ((kind == IntegrandKind::Monomial || kind == IntegrandKind::Exponential) &&
+        coeffs.size() == 1 && dim > 1)
         coeffs.assign(static_cast<size_t>(dim), coeffs[0]);
     if (kind == IntegrandKind::Gaussian || kind == IntegrandKind::IndicatorBall) {
         if (!get_numbers(c, j, "center", path, &center)) return false;
-        if (!get_number(c, j, kind == IntegrandKind::Gaussian ? "sigma" : "radius", path, &width)) return false;
+        if (!get_number(c, j, kind == IntegrandKind::Gaussian ? "sigma" : "radius", path, &width))
+            return false;
     }
     Made<Integrand> f = make_integrand(kind, dim, scale, coeffs, center, width);
     if (!f.ok()) return c.fail(path, f.error);
@@ -221,7 +239,7 @@ bool parse_integrand(Ctx& c, const Json& j, const std::string& path, int dim, In
 // --- pdfs --------------------------------------------------------------------------------
 
 constexpr int kMaxBins = 1 << 20;
-constexpr int kSubSamples = 4;  // shape evaluations per bin and axis when tabulating
+constexpr int kSubSamples = 4; // shape evaluations per bin and axis when tabulating
 
 // Tabulation values: explicit "values", or |shape| averaged over kSubSamples^d points per cell.
 bool table_values(Ctx& c, const Json& j, const std::string& path, const Problem& problem,
@@ -233,7 +251,8 @@ bool table_values(Ctx& c, const Json& j, const std::string& path, const Problem&
         if (!to_numbers(c, *v, sub(path, "values"), values)) return false;
         if (values->size() != cells)
             return c.fail(sub(path, "values"), "has " + std::to_string(values->size()) +
-                                                   " entries, bins ask for " + std::to_string(cells));
+                                                   " entries, bins ask for " +
+                                                   std::to_string(cells));
         return true;
     }
     const Json* shape = find(j, "shape");
@@ -242,7 +261,8 @@ bool table_values(Ctx& c, const Json& j, const std::string& path, const Problem&
     const int dim = static_cast<int>(bins.size());
     if (shape->is_string() && shape->get<std::string>() == "integrand") {
         if (problem.integrand.dim != dim)
-            return c.fail(sub(path, "shape"), "the integrand has " + std::to_string(problem.integrand.dim) +
+            return c.fail(sub(path, "shape"), "the integrand has " +
+                                                  std::to_string(problem.integrand.dim) +
                                                   " dimensions, the table " + std::to_string(dim));
         f = problem.integrand;
     } else if (!parse_integrand(c, *shape, sub(path, "shape"), dim, &f)) {
@@ -259,7 +279,8 @@ bool table_values(Ctx& c, const Json& j, const std::string& path, const Problem&
         for (int s = 0; s < sub_count; ++s) {
             int sx = s % kSubSamples, sy = s / kSubSamples;
             point[0] = lo[0] + (hi[0] - lo[0]) * (ix + (sx + 0.5) / kSubSamples) / bins[0];
-            if (dim == 2) point[1] = lo[1] + (hi[1] - lo[1]) * (iy + (sy + 0.5) / kSubSamples) / bins[1];
+            if (dim == 2)
+                point[1] = lo[1] + (hi[1] - lo[1]) * (iy + (sy + 0.5) / kSubSamples) / bins[1];
             double v = std::fabs(evaluate_point(f, point.data()));
             sum += std::isfinite(v) ? v : 0.0;
         }
@@ -268,9 +289,10 @@ bool table_values(Ctx& c, const Json& j, const std::string& path, const Problem&
     return true;
 }
 
-bool parse_pdf_1d(Ctx& c, const Json& j, const std::string& path, const Problem& problem,
-                  double a, double b, Distribution1D* out) {
-    if (!check_keys(c, j, path, {"type", "k", "rate", "mu", "sigma", "omega", "x0", "bins", "values", "shape"}))
+bool parse_pdf_1d(Ctx& c, const Json& j, const std::string& path, const Problem& problem, double a,
+                  double b, Distribution1D* out) {
+    if (!check_keys(c, j, path,
+                    {"type", "k", "rate", "mu", "sigma", "omega", "x0", "bins", "values", "shape"}))
         return false;
     std::string type;
     if (!get_string(c, j, "type", path, &type)) return false;
@@ -287,11 +309,13 @@ bool parse_pdf_1d(Ctx& c, const Json& j, const std::string& path, const Problem&
         d = make_exponential(a, b, rate);
     } else if (type == "gaussian" || type == "truncated_gaussian") {
         double mu = 0.5 * (a + b), sigma = 0.25 * (b - a);
-        if (!get_number(c, j, "mu", path, &mu) || !get_number(c, j, "sigma", path, &sigma)) return false;
+        if (!get_number(c, j, "mu", path, &mu) || !get_number(c, j, "sigma", path, &sigma))
+            return false;
         d = make_truncated_gaussian(a, b, mu, sigma);
     } else if (type == "cosine") {
         double omega = 1.0, x0 = 0.0;
-        if (!get_number(c, j, "omega", path, &omega) || !get_number(c, j, "x0", path, &x0)) return false;
+        if (!get_number(c, j, "omega", path, &omega) || !get_number(c, j, "x0", path, &x0))
+            return false;
         d = make_cosine(a, b, omega, x0);
     } else if (type == "tabulated") {
         uint64_t bins = 64;
@@ -300,11 +324,13 @@ bool parse_pdf_1d(Ctx& c, const Json& j, const std::string& path, const Problem&
             return c.fail(sub(path, "bins"), "must be in 1.." + std::to_string(kMaxBins));
         if (find(j, "values") && !find(j, "bins")) bins = find(j, "values")->size();
         std::vector<double> values;
-        if (!table_values(c, j, path, problem, {static_cast<int>(bins)}, {a}, {b}, &values)) return false;
+        if (!table_values(c, j, path, problem, {static_cast<int>(bins)}, {a}, {b}, &values))
+            return false;
         d = make_tabulated(a, b, values);
     } else {
-        return c.fail(sub(path, "type"), "unknown 1D pdf '" + type +
-                                             "' (known: uniform, power, exponential, gaussian, cosine, tabulated)");
+        return c.fail(sub(path, "type"),
+                      "unknown 1D pdf '" + type +
+                          "' (known: uniform, power, exponential, gaussian, cosine, tabulated)");
     }
     if (!d.ok()) return c.fail(path, d.error);
     *out = d.value;
@@ -343,9 +369,10 @@ bool parse_pdf(Ctx& c, const Json& j, const std::string& path, const Problem& pr
         out->table = t.value;
     } else {
         if (dom.kind != DomainKind::Box)
-            return c.fail(path, "pdf '" + type + "' samples box axes, the domain is a " +
-                                    domain_kind_name(dom.kind) +
-                                    (dom.kind == DomainKind::Hemisphere ? " (use cosine_hemisphere)" : ""));
+            return c.fail(
+                path, "pdf '" + type + "' samples box axes, the domain is a " +
+                          domain_kind_name(dom.kind) +
+                          (dom.kind == DomainKind::Hemisphere ? " (use cosine_hemisphere)" : ""));
         out->kind = ProposalKind::Product1D;
         out->marginals.clear();
         const size_t dim = dom.lo.size();
@@ -356,7 +383,8 @@ bool parse_pdf(Ctx& c, const Json& j, const std::string& path, const Problem& pr
                 return c.fail(sub(path, "factors"), "expected an array with one 1D pdf per axis");
             if (f->size() != dim)
                 return c.fail(sub(path, "factors"), "has " + std::to_string(f->size()) +
-                                                        " entries, the box has " + std::to_string(dim) + " axes");
+                                                        " entries, the box has " +
+                                                        std::to_string(dim) + " axes");
             for (size_t a = 0; a < dim; ++a) {
                 Distribution1D d;
                 if (!parse_pdf_1d(c, (*f)[a], sub(path, "factors") + "[" + std::to_string(a) + "]",
@@ -401,7 +429,8 @@ bool parse_estimator(Ctx& c, const Json& j, const std::string& path, const Probl
         name = j.get<std::string>();
     } else if (j.is_object()) {
         if (!check_keys(c, j, path, {"name", "sampler", "pdf", "warp"})) return false;
-        if (!get_string(c, j, "name", path, &name) || !get_string(c, j, "sampler", path, &sampler_name_str) ||
+        if (!get_string(c, j, "name", path, &name) ||
+            !get_string(c, j, "sampler", path, &sampler_name_str) ||
             !get_string(c, j, "warp", path, &warp))
             return false;
         pdf = find(j, "pdf");
@@ -413,8 +442,9 @@ bool parse_estimator(Ctx& c, const Json& j, const std::string& path, const Probl
     out->name = name;
     out->sampler = preset ? preset->sampler : SamplerKind::Independent;
     if (!sampler_name_str.empty() && !parse_sampler(sampler_name_str, &out->sampler))
-        return c.fail(sub(path, "sampler"), "unknown sampler '" + sampler_name_str +
-                                                "' (known: independent, stratified, latin_hypercube)");
+        return c.fail(sub(path, "sampler"),
+                      "unknown sampler '" + sampler_name_str +
+                          "' (known: independent, stratified, latin_hypercube)");
     if (!warp.empty() && warp != "polar" && warp != "concentric")
         return c.fail(sub(path, "warp"), "unknown warp '" + warp + "' (known: polar, concentric)");
     if (!warp.empty() && problem.domain.kind != DomainKind::Disk)
@@ -428,15 +458,20 @@ bool parse_estimator(Ctx& c, const Json& j, const std::string& path, const Probl
     return true;
 }
 
-}  // namespace
+} // namespace
 
 const std::vector<EstimatorPreset>& estimator_presets() {
     static const std::vector<EstimatorPreset> presets = {
-        {"uniform", SamplerKind::Independent, false, "independent uniform points, f / p with p uniform"},
-        {"stratified", SamplerKind::Stratified, false, "one jittered point per cell of an N-cell grid"},
-        {"latin_hypercube", SamplerKind::LatinHypercube, false, "N-rooks: one point per slab of every axis"},
-        {"importance", SamplerKind::Independent, true, "independent points drawn from the given pdf"},
-        {"stratified_importance", SamplerKind::Stratified, true, "jittered unit-cube points warped by the pdf's inverse CDF"},
+        {"uniform", SamplerKind::Independent, false,
+         "independent uniform points, f / p with p uniform"},
+        {"stratified", SamplerKind::Stratified, false,
+         "one jittered point per cell of an N-cell grid"},
+        {"latin_hypercube", SamplerKind::LatinHypercube, false,
+         "N-rooks: one point per slab of every axis"},
+        {"importance", SamplerKind::Independent, true,
+         "independent points drawn from the given pdf"},
+        {"stratified_importance", SamplerKind::Stratified, true,
+         "jittered unit-cube points warped by the pdf's inverse CDF"},
     };
     return presets;
 }
@@ -463,10 +498,12 @@ Made<Json> parse_json(const char* text, const char* what) {
         bool parse_error(std::size_t position, const std::string& last_token,
                          const nlohmann::detail::exception& ex) override {
             std::string reason = ex.what();
-            // nlohmann's text: "[json.exception.parse_error.101] parse error at line 2, column 5: ..."
+            // nlohmann's text: "[json.exception.parse_error.101] parse error at line 2, column 5:
+            // ..."
             size_t at = reason.find("parse error");
             if (at != std::string::npos) reason = reason.substr(at);
-            message = reason + " (near '" + last_token.substr(0, 20) + "', byte " + std::to_string(position) + ")";
+            message = reason + " (near '" + last_token.substr(0, 20) + "', byte " +
+                      std::to_string(position) + ")";
             return false;
         }
     } sax;
@@ -480,8 +517,8 @@ Made<SceneRequest> build_request(const Json& scene, const Json& options) {
     SceneRequest req;
     const std::string path = "scene";
     if (!check_keys(c, scene, path,
-                    {"name", "description", "domain", "integrand", "quantity", "exact", "estimators",
-                     "n_min", "n_max", "reps", "seed", "threads", "notes"}))
+                    {"name", "description", "domain", "integrand", "quantity", "exact",
+                     "estimators", "n_min", "n_max", "reps", "seed", "threads", "notes"}))
         return made_error<SceneRequest>(c.error);
     Problem& pr = req.problem;
     pr.name = "scene";
@@ -501,16 +538,22 @@ Made<SceneRequest> build_request(const Json& scene, const Json& options) {
             return made_error<SceneRequest>(c.error);
     } else {
         pr.domain = make_box(std::vector<double>(static_cast<size_t>(default_dim), 0.0),
-                             std::vector<double>(static_cast<size_t>(default_dim), 1.0)).value;
+                             std::vector<double>(static_cast<size_t>(default_dim), 1.0))
+                        .value;
     }
     if (!parse_integrand(c, *integrand, "scene.integrand", pr.domain.point_dim(), &pr.integrand))
         return made_error<SceneRequest>(c.error);
 
     std::string quantity = "integral";
-    if (!get_string(c, scene, "quantity", path, &quantity)) return made_error<SceneRequest>(c.error);
-    if (quantity == "integral") pr.quantity = Quantity::Integral;
-    else if (quantity == "mean") pr.quantity = Quantity::Mean;
-    else return made_error<SceneRequest>("scene.quantity: expected \"integral\" or \"mean\", got \"" + quantity + "\"");
+    if (!get_string(c, scene, "quantity", path, &quantity))
+        return made_error<SceneRequest>(c.error);
+    if (quantity == "integral")
+        pr.quantity = Quantity::Integral;
+    else if (quantity == "mean")
+        pr.quantity = Quantity::Mean;
+    else
+        return made_error<SceneRequest>(
+            "scene.quantity: expected \"integral\" or \"mean\", got \"" + quantity + "\"");
 
     if (const Json* e = find(scene, "exact"); e && !e->is_null()) {
         double exact = 0.0;
@@ -530,7 +573,8 @@ Made<SceneRequest> build_request(const Json& scene, const Json& options) {
             return made_error<SceneRequest>("scene.estimators: expected a non-empty array");
         for (size_t i = 0; i < list->size(); ++i) {
             EstimatorSpec spec;
-            if (!parse_estimator(c, (*list)[i], "scene.estimators[" + std::to_string(i) + "]", pr, &spec))
+            if (!parse_estimator(c, (*list)[i], "scene.estimators[" + std::to_string(i) + "]", pr,
+                                 &spec))
                 return made_error<SceneRequest>(c.error);
             if (!names.insert(spec.name).second)
                 return made_error<SceneRequest>("scene.estimators[" + std::to_string(i) +
@@ -548,14 +592,16 @@ Made<SceneRequest> build_request(const Json& scene, const Json& options) {
     // Settings: defaults, then the scene, then the options.
     StudySettings& s = req.settings;
     uint64_t reps = static_cast<uint64_t>(s.reps), threads = 0;
-    if (!get_count(c, scene, "n_min", path, &s.n_min) || !get_count(c, scene, "n_max", path, &s.n_max) ||
+    if (!get_count(c, scene, "n_min", path, &s.n_min) ||
+        !get_count(c, scene, "n_max", path, &s.n_max) ||
         !get_count(c, scene, "reps", path, &reps) || !get_count(c, scene, "seed", path, &s.seed) ||
         !get_count(c, scene, "threads", path, &threads))
         return made_error<SceneRequest>(c.error);
 
     req.estimators = all;
     if (!options.is_null()) {
-        if (!check_keys(c, options, "options", {"estimators", "n_min", "n_max", "reps", "seed", "threads"}) ||
+        if (!check_keys(c, options, "options",
+                        {"estimators", "n_min", "n_max", "reps", "seed", "threads"}) ||
             !get_count(c, options, "n_min", "options", &s.n_min) ||
             !get_count(c, options, "n_max", "options", &s.n_max) ||
             !get_count(c, options, "reps", "options", &reps) ||
@@ -564,13 +610,15 @@ Made<SceneRequest> build_request(const Json& scene, const Json& options) {
             return made_error<SceneRequest>(c.error);
         if (const Json* sel = find(options, "estimators")) {
             if (!sel->is_array() || sel->empty())
-                return made_error<SceneRequest>("options.estimators: expected a non-empty array of names");
+                return made_error<SceneRequest>(
+                    "options.estimators: expected a non-empty array of names");
             req.estimators.clear();
             std::set<std::string> chosen;
             for (size_t i = 0; i < sel->size(); ++i) {
                 const Json& item = (*sel)[i];
                 if (!item.is_string())
-                    return made_error<SceneRequest>("options.estimators[" + std::to_string(i) + "]: expected a name");
+                    return made_error<SceneRequest>("options.estimators[" + std::to_string(i) +
+                                                    "]: expected a name");
                 const std::string name = item.get<std::string>();
                 if (!chosen.insert(name).second) continue;
                 bool found = false;
@@ -596,7 +644,7 @@ Made<SceneRequest> build_request(const Json& scene, const Json& options) {
             }
         }
     }
-    if (reps > 100000) reps = 100001;  // reported by check_settings
+    if (reps > 100000) reps = 100001; // reported by check_settings
     if (threads > 1000) threads = 1001;
     s.reps = static_cast<int>(reps);
     s.threads = static_cast<int>(threads);
@@ -605,4 +653,4 @@ Made<SceneRequest> build_request(const Json& scene, const Json& options) {
     return {req, {}};
 }
 
-}  // namespace mcp
+} // namespace mcp

@@ -45,4 +45,4 @@ Json progress_to_json(const StudyResult& partial, size_t level_index);
 std::string format_table(const Json& result);
 std::string format_csv(const Json& result);
 
-}  // namespace mcp
+} // namespace mcp

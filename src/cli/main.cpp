@@ -20,9 +20,9 @@ namespace {
 
 // Exit codes.
 constexpr int kExitOk = 0;
-constexpr int kExitRuntime = 1;   // I/O failure, cancelled study, internal error
-constexpr int kExitUsage = 2;     // bad command line
-constexpr int kExitScene = 3;     // bad scene file
+constexpr int kExitRuntime = 1; // I/O failure, cancelled study, internal error
+constexpr int kExitUsage = 2;   // bad command line
+constexpr int kExitScene = 3;   // bad scene file
 
 const char* kUsage =
     "mcplay - Monte Carlo estimator playground\n"
@@ -107,7 +107,8 @@ int cmd_list(const std::vector<std::string>& args) {
     if (DIR* d = opendir(dir.c_str())) {
         while (dirent* e = readdir(d)) {
             std::string name = e->d_name;
-            if (name.size() > 5 && name.compare(name.size() - 5, 5, ".json") == 0) files.push_back(name);
+            if (name.size() > 5 && name.compare(name.size() - 5, 5, ".json") == 0)
+                files.push_back(name);
         }
         closedir(d);
     } else {
@@ -134,8 +135,8 @@ int cmd_list(const std::vector<std::string>& args) {
         for (auto& e : j["estimators"]) ests += (ests.empty() ? "" : ", ") + e.get<std::string>();
         std::printf("  %-28s %s, %dD, exact %s\n  %-28s %s\n  %-28s estimators: %s\n",
                     f.substr(0, f.size() - 5).c_str(), j["domain"].get<std::string>().c_str(),
-                    j["dimension"].get<int>(), exact.c_str(), "", j["description"].get<std::string>().c_str(),
-                    "", ests.c_str());
+                    j["dimension"].get<int>(), exact.c_str(), "",
+                    j["description"].get<std::string>().c_str(), "", ests.c_str());
     }
     char* catalog = nullptr;
     if (mcp_catalog(&catalog) == MCP_OK) {
@@ -177,7 +178,8 @@ int cmd_run(const std::vector<std::string>& args) {
         };
         std::string v;
         if (a == "--estimators") {
-            if (!value(&v)) return usage_error("--estimators needs a comma-separated list of names");
+            if (!value(&v))
+                return usage_error("--estimators needs a comma-separated list of names");
             nlohmann::json list = nlohmann::json::array();
             std::stringstream ss(v);
             std::string item;
@@ -187,10 +189,12 @@ int cmd_run(const std::vector<std::string>& args) {
             }
             if (list.empty()) return usage_error("--estimators needs at least one name");
             options["estimators"] = list;
-        } else if (a == "--n-min" || a == "--n-max" || a == "--reps" || a == "--seed" || a == "--threads") {
+        } else if (a == "--n-min" || a == "--n-max" || a == "--reps" || a == "--seed" ||
+                   a == "--threads") {
             if (!value(&v)) return usage_error(a + " needs a value");
             unsigned long long x = 0;
-            if (!parse_count(v, &x)) return usage_error(a + ": expected a whole number >= 0, got '" + v + "'");
+            if (!parse_count(v, &x))
+                return usage_error(a + ": expected a whole number >= 0, got '" + v + "'");
             std::string key = a.substr(2);
             std::replace(key.begin(), key.end(), '-', '_');
             options[key] = x;
@@ -221,7 +225,8 @@ int cmd_run(const std::vector<std::string>& args) {
     if (!is_regular_file(path)) path = scenes_dir(dir_arg) + "/" + scene_arg + ".json";
     std::string text;
     if (!is_regular_file(path) || !read_file(path, &text)) {
-        std::fprintf(stderr, "mcplay: no scene file '%s' (nor '%s')\n", scene_arg.c_str(), path.c_str());
+        std::fprintf(stderr, "mcplay: no scene file '%s' (nor '%s')\n", scene_arg.c_str(),
+                     path.c_str());
         return kExitScene;
     }
 
@@ -256,7 +261,7 @@ int cmd_run(const std::vector<std::string>& args) {
     return status == MCP_ERROR_CANCELLED ? kExitRuntime : rc;
 }
 
-}  // namespace
+} // namespace
 
 int main(int argc, char** argv) {
     std::vector<std::string> args(argv + 1, argv + argc);

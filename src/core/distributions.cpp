@@ -26,7 +26,7 @@
 namespace mcp {
 namespace {
 
-constexpr double kOneMinusEpsilon = 0x1.fffffffffffffp-1;  // largest double below 1
+constexpr double kOneMinusEpsilon = 0x1.fffffffffffffp-1; // largest double below 1
 constexpr double kEpsilon = std::numeric_limits<double>::epsilon();
 constexpr double kHalfPi = 0.5 * kPi;
 constexpr double kQuarterPi = 0.25 * kPi;
@@ -40,7 +40,9 @@ constexpr double kExpFromLowerLimit = 40.0;
 // probabilities (Q(30) = 5e-198) and exp(t^2 / 2) inside normal_quantile stay in range.
 constexpr double kMaxTailSigmas = 30.0;
 
-double clamp(double x, double lo, double hi) { return x < lo ? lo : (x > hi ? hi : x); }
+double clamp(double x, double lo, double hi) {
+    return x < lo ? lo : (x > hi ? hi : x);
+}
 
 /// Shortest "%g" text that reads back as the same double.
 std::string num(double v) {
@@ -52,7 +54,9 @@ std::string num(double v) {
     return buf;
 }
 
-std::string interval_text(double a, double b) { return "[" + num(a) + ", " + num(b) + "]"; }
+std::string interval_text(double a, double b) {
+    return "[" + num(a) + ", " + num(b) + "]";
+}
 
 /// Empty if [a, b] is a usable interval; otherwise the message, naming a and b.
 std::string check_interval(const char* what, double a, double b, const char* na = "a",
@@ -63,8 +67,9 @@ std::string check_interval(const char* what, double a, double b, const char* na 
                nb + "=" + num(b);
     double len = b - a;
     if (!(std::isfinite(len) && std::isfinite(1.0 / len)))
-        return std::string(what) + ": " + nb + " - " + na + " must be finite and not subnormal, got " +
-               na + "=" + num(a) + ", " + nb + "=" + num(b);
+        return std::string(what) + ": " + nb + " - " + na +
+               " must be finite and not subnormal, got " + na + "=" + num(a) + ", " + nb + "=" +
+               num(b);
     return {};
 }
 
@@ -72,7 +77,9 @@ std::string check_interval(const char* what, double a, double b, const char* na 
 // One formula maps x to its bin everywhere (1D pdf and cdf, the placement of samples, the 2D
 // pdf), so a sample is always in the bin it was drawn from.
 
-double bin_scale(double a, double b, size_t n) { return static_cast<double>(n) / (b - a); }
+double bin_scale(double a, double b, size_t n) {
+    return static_cast<double>(n) / (b - a);
+}
 
 size_t bin_of(double x, double a, double scale, size_t n) {
     double r = (x - a) * scale;
@@ -124,7 +131,7 @@ struct PowerK {
 //             x = b + log(e^{-s L} - u m) / s.
 // log1p and expm1 keep the small-rate limit (nearly uniform) and the small-u tail exact.
 struct ExponentialK {
-    double a, b, s, m, norm, e;  // e: expm1(s L) or e^{-s L} (rate < 0), see above
+    double a, b, s, m, norm, e; // e: expm1(s L) or e^{-s L} (rate < 0), see above
     bool positive, from_lower;
     double sample(double u) const {
         double x;
@@ -149,7 +156,9 @@ struct ExponentialK {
     }
 };
 
-double exponential_span(double rate, double a, double b) { return std::fabs(rate) * (b - a); }
+double exponential_span(double rate, double a, double b) {
+    return std::fabs(rate) * (b - a);
+}
 
 // P(lo <= T <= hi) for a standard normal T, lo <= hi: a difference of upper tails when both
 // ends are >= 1/2, of lower tails when both are <= -1/2, of erf values otherwise (both
@@ -175,8 +184,8 @@ double normal_mass_from(double alpha, double delta) {
                          w2 = 0.23692688505618908751;
         const double h = 0.5 * delta;
         auto f = [alpha](double v) { return std::exp(-v * (alpha + 0.5 * v)); };
-        double sum = w0 * f(h) + w1 * (f(h - x1 * h) + f(h + x1 * h)) +
-                     w2 * (f(h - x2 * h) + f(h + x2 * h));
+        double sum =
+            w0 * f(h) + w1 * (f(h - x1 * h) + f(h + x1 * h)) + w2 * (f(h - x2 * h) + f(h + x2 * h));
         return kInvSqrt2Pi * std::exp(-0.5 * alpha * alpha) * h * sum;
     }
     return normal_mass(alpha, alpha + delta);
@@ -205,7 +214,7 @@ double normal_solve_from(double alpha, double m) {
 //   F(x) = normal_mass_from(alpha, (x - a) / sigma) / z
 //        = 1 - normal_mass_from(-beta, (b - x) / sigma) / z.
 struct GaussianK {
-    double a, b, mu, sigma, alpha, beta, z, norm;  // norm = 1 / (sqrt(2 pi) z)
+    double a, b, mu, sigma, alpha, beta, z, norm; // norm = 1 / (sqrt(2 pi) z)
     double sample(double u) const {
         const double span = (b - a) / sigma;
         double x = u <= 0.5 ? a + sigma * std::min(normal_solve_from(alpha, u * z), span)
@@ -229,7 +238,7 @@ struct GaussianK {
 // p proportional to cos(theta), theta = omega (x - x0) in [ta, tb] within [-pi/2, pi/2];
 // d = sin tb - sin ta. The pdf alone needs no edge values.
 struct CosinePdfK {
-    double a, b, omega, x0, norm;  // norm = omega / d
+    double a, b, omega, x0, norm; // norm = omega / d
     double pdf(double x) const {
         if (!(x >= a && x <= b)) return 0.0;
         return norm * std::max(0.0, std::cos(omega * (x - x0)));
@@ -293,14 +302,14 @@ struct CosineK : CosinePdfK {
 // edge. Sampling finds the bin by binary search, cdf[i] <= u < cdf[i + 1], which never selects a
 // bin of zero probability (its cdf entries are equal), then interpolates linearly inside it.
 struct TabulatedK {
-    double a, b, width, scale;  // width = (b - a) / n, scale = n / (b - a)
+    double a, b, width, scale; // width = (b - a) / n, scale = n / (b - a)
     const double* func;
     const double* cdf_edges;
     size_t n;
     double sample(double u) const {
         u = u > 0.0 ? std::min(u, kOneMinusEpsilon) : 0.0;
-        size_t i = static_cast<size_t>(std::upper_bound(cdf_edges, cdf_edges + n + 1, u) -
-                                       cdf_edges) - 1;
+        size_t i =
+            static_cast<size_t>(std::upper_bound(cdf_edges, cdf_edges + n + 1, u) - cdf_edges) - 1;
         double lo = cdf_edges[i];
         double t = (u - lo) / (cdf_edges[i + 1] - lo);
         double x = clamp(a + (static_cast<double>(i) + t) * width, a, b);
@@ -325,12 +334,12 @@ struct TabulatedK {
     }
 };
 
-}  // namespace
+} // namespace
 
 // The one friend of Distribution1D: builds distributions and their per-kind kernels.
 struct Distribution1DFactory {
-    static Distribution1D make(Dist1DKind kind, double a, double b, double p0, double p1,
-                               double c0, double c1) {
+    static Distribution1D make(Dist1DKind kind, double a, double b, double p0, double p1, double c0,
+                               double c1) {
         Distribution1D d;
         d.kind_ = kind;
         d.a_ = a;
@@ -360,7 +369,7 @@ struct Distribution1DFactory {
         return {d.a_, d.b_, std::fabs(d.p0_), d.c0_, d.c1_, d.p1_, positive, from_lower};
     }
     static GaussianK gaussian(const Distribution1D& d) {
-        return {d.a_, d.b_, d.p0_, d.p1_, (d.a_ - d.p0_) / d.p1_, (d.b_ - d.p0_) / d.p1_,
+        return {d.a_,  d.b_, d.p0_, d.p1_, (d.a_ - d.p0_) / d.p1_, (d.b_ - d.p0_) / d.p1_,
                 d.c0_, d.c1_};
     }
     static CosinePdfK cosine_pdf(const Distribution1D& d) {
@@ -391,16 +400,21 @@ struct Distribution1DFactory {
     template <bool kFull, class F>
     static auto visit(const Distribution1D& d, F&& f) -> decltype(f(UniformK{})) {
         switch (d.kind_) {
-            case Dist1DKind::Power: return f(power(d));
-            case Dist1DKind::Exponential: return f(exponential(d));
-            case Dist1DKind::TruncatedGaussian: return f(gaussian(d));
-            case Dist1DKind::Cosine:
-                if constexpr (kFull)
-                    return f(cosine(d));
-                else
-                    return f(cosine_pdf(d));
-            case Dist1DKind::Tabulated: return f(tabulated(d));
-            case Dist1DKind::Uniform: break;
+        case Dist1DKind::Power:
+            return f(power(d));
+        case Dist1DKind::Exponential:
+            return f(exponential(d));
+        case Dist1DKind::TruncatedGaussian:
+            return f(gaussian(d));
+        case Dist1DKind::Cosine:
+            if constexpr (kFull)
+                return f(cosine(d));
+            else
+                return f(cosine_pdf(d));
+        case Dist1DKind::Tabulated:
+            return f(tabulated(d));
+        case Dist1DKind::Uniform:
+            break;
         }
         return f(uniform(d));
     }
@@ -438,15 +452,18 @@ void Distribution1D::multiply_pdf_block(const double* x, double* pdf_out, size_t
 std::string Distribution1D::describe() const {
     std::string on = " on " + interval_text(a_, b_);
     switch (kind_) {
-        case Dist1DKind::Power: return "power(k=" + num(p0_) + ")" + on;
-        case Dist1DKind::Exponential: return "exponential(rate=" + num(p0_) + ")" + on;
-        case Dist1DKind::TruncatedGaussian:
-            return "truncated_gaussian(mu=" + num(p0_) + ", sigma=" + num(p1_) + ")" + on;
-        case Dist1DKind::Cosine:
-            return "cosine(omega=" + num(p0_) + ", x0=" + num(p1_) + ")" + on;
-        case Dist1DKind::Tabulated:
-            return "tabulated(" + std::to_string(func_.size()) + " bins)" + on;
-        case Dist1DKind::Uniform: break;
+    case Dist1DKind::Power:
+        return "power(k=" + num(p0_) + ")" + on;
+    case Dist1DKind::Exponential:
+        return "exponential(rate=" + num(p0_) + ")" + on;
+    case Dist1DKind::TruncatedGaussian:
+        return "truncated_gaussian(mu=" + num(p0_) + ", sigma=" + num(p1_) + ")" + on;
+    case Dist1DKind::Cosine:
+        return "cosine(omega=" + num(p0_) + ", x0=" + num(p1_) + ")" + on;
+    case Dist1DKind::Tabulated:
+        return "tabulated(" + std::to_string(func_.size()) + " bins)" + on;
+    case Dist1DKind::Uniform:
+        break;
     }
     return "uniform" + on;
 }
@@ -518,8 +535,8 @@ Made<Distribution1D> make_truncated_gaussian(double a, double b, double mu, doub
     double norm = kInvSqrt2Pi / z;
     if (!(z > 0.0 && std::isfinite(norm / sigma)))
         return made_error<Distribution1D>(
-            "truncated_gaussian: the probability of [a, b] underflows, got " +
-            interval_text(a, b) + " with mu=" + num(mu) + ", sigma=" + num(sigma));
+            "truncated_gaussian: the probability of [a, b] underflows, got " + interval_text(a, b) +
+            " with mu=" + num(mu) + ", sigma=" + num(sigma));
     return {Distribution1DFactory::make(Dist1DKind::TruncatedGaussian, a, b, mu, sigma, z, norm),
             {}};
 }
@@ -548,8 +565,8 @@ Made<Distribution1D> make_cosine(double a, double b, double omega, double x0) {
     double norm = omega / d;
     if (!(d > 0.0 && std::isfinite(norm)))
         return made_error<Distribution1D>("cosine: the integral of cos(omega (x - x0)) over " +
-                                          interval_text(a, b) + " underflows, got omega=" +
-                                          num(omega));
+                                          interval_text(a, b) +
+                                          " underflows, got omega=" + num(omega));
     return {Distribution1DFactory::make(Dist1DKind::Cosine, a, b, omega, x0, d, norm), {}};
 }
 
@@ -603,8 +620,8 @@ Made<Distribution1D> make_tabulated(double a, double b, const std::vector<double
                                           interval_text(a, b));
     for (size_t i = 0; i < n; ++i) func[i] = values[i] / vmax * density_scale;
 
-    Distribution1D d = Distribution1DFactory::make(Dist1DKind::Tabulated, a, b, 0, 0, width,
-                                                   bin_scale(a, b, n));
+    Distribution1D d =
+        Distribution1DFactory::make(Dist1DKind::Tabulated, a, b, 0, 0, width, bin_scale(a, b, n));
     Distribution1DFactory::set_table(d, std::move(func), std::move(cdf));
     return {std::move(d), {}};
 }
@@ -615,7 +632,7 @@ Made<Distribution1D> make_tabulated(double a, double b, const std::vector<double
 
 void TabulatedDistribution2D::sample(double u1, double u2, double* x, double* y,
                                      double* pdf_out) const {
-    if (conditional_.empty()) {  // default-constructed: no table
+    if (conditional_.empty()) { // default-constructed: no table
         *x = x0_;
         *y = y0_;
         *pdf_out = 0.0;
@@ -645,13 +662,13 @@ void TabulatedDistribution2D::invert(double x, double y, double* u1, double* u2)
     *u1 = conditional_[iy].cdf(x);
 }
 
-void TabulatedDistribution2D::sample_block(const double* u1, const double* u2, double* x,
-                                           double* y, double* pdf_out, size_t n) const {
+void TabulatedDistribution2D::sample_block(const double* u1, const double* u2, double* x, double* y,
+                                           double* pdf_out, size_t n) const {
     if (conditional_.empty()) {
         for (size_t i = 0; i < n; ++i) sample(u1[i], u2[i], x + i, y + i, pdf_out + i);
         return;
     }
-    marginal_.sample_block(u2, y, pdf_out, n);  // pdf_out holds the marginal density for now
+    marginal_.sample_block(u2, y, pdf_out, n); // pdf_out holds the marginal density for now
     const double y_scale = bin_scale(y0_, y1_, size_t(ny_));
     for (size_t i = 0; i < n; ++i) {
         size_t iy = bin_of(y[i], y0_, y_scale, size_t(ny_));
@@ -660,9 +677,8 @@ void TabulatedDistribution2D::sample_block(const double* u1, const double* u2, d
     }
 }
 
-Made<TabulatedDistribution2D> make_tabulated_2d(double x0, double x1, double y0, double y1,
-                                                int nx, int ny,
-                                                const std::vector<double>& values) {
+Made<TabulatedDistribution2D> make_tabulated_2d(double x0, double x1, double y0, double y1, int nx,
+                                                int ny, const std::vector<double>& values) {
     using R = TabulatedDistribution2D;
     std::string err = check_interval("tabulated_2d", x0, x1, "x0", "x1");
     if (err.empty()) err = check_interval("tabulated_2d", y0, y1, "y0", "y1");
@@ -685,8 +701,7 @@ Made<TabulatedDistribution2D> make_tabulated_2d(double x0, double x1, double y0,
                                  "] must be finite and >= 0, got " + num(v));
         vmax = std::max(vmax, v);
     }
-    if (!(vmax > 0.0))
-        return made_error<R>("tabulated_2d: values must not all be zero (sum is 0)");
+    if (!(vmax > 0.0)) return made_error<R>("tabulated_2d: values must not all be zero (sum is 0)");
 
     R r;
     r.nx_ = nx;
@@ -718,7 +733,8 @@ Made<TabulatedDistribution2D> make_tabulated_2d(double x0, double x1, double y0,
         std::vector<double> row(values.begin() + std::ptrdiff_t(iy * size_t(nx)),
                                 values.begin() + std::ptrdiff_t((iy + 1) * size_t(nx)));
         Made<Distribution1D> c = make_tabulated(x0, x1, rows[iy] > 0.0 ? row : uniform_row);
-        if (!c.ok()) return made_error<R>("tabulated_2d: row " + std::to_string(iy) + ": " + c.error);
+        if (!c.ok())
+            return made_error<R>("tabulated_2d: row " + std::to_string(iy) + ": " + c.error);
         r.conditional_.push_back(std::move(c.value));
     }
     const double cell_area = (x1 - x0) / nx * ((y1 - y0) / ny);
@@ -730,4 +746,4 @@ Made<TabulatedDistribution2D> make_tabulated_2d(double x0, double x1, double y0,
     return {std::move(r), {}};
 }
 
-}  // namespace mcp
+} // namespace mcp

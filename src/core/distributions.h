@@ -13,12 +13,12 @@
 namespace mcp {
 
 enum class Dist1DKind {
-    Uniform,            ///< p = 1/(b-a)
-    Power,              ///< p proportional to (x - a)^k, k > -1 (k = 1: linear ramp)
-    Exponential,        ///< p proportional to exp(-rate x); rate may be negative, not 0
-    TruncatedGaussian,  ///< p proportional to exp(-(x-mu)^2 / (2 sigma^2)) on [a, b]
-    Cosine,             ///< p proportional to cos(omega (x - x0)), |omega (x - x0)| <= pi/2
-    Tabulated,          ///< piecewise constant on equal bins of [a, b]
+    Uniform,           ///< p = 1/(b-a)
+    Power,             ///< p proportional to (x - a)^k, k > -1 (k = 1: linear ramp)
+    Exponential,       ///< p proportional to exp(-rate x); rate may be negative, not 0
+    TruncatedGaussian, ///< p proportional to exp(-(x-mu)^2 / (2 sigma^2)) on [a, b]
+    Cosine,            ///< p proportional to cos(omega (x - x0)), |omega (x - x0)| <= pi/2
+    Tabulated,         ///< piecewise constant on equal bins of [a, b]
 };
 
 /// A normalised density on [a, b]. Construct with the make_* functions below, which
@@ -50,10 +50,10 @@ class Distribution1D {
     friend struct Distribution1DFactory;
     Dist1DKind kind_ = Dist1DKind::Uniform;
     double a_ = 0.0, b_ = 1.0;
-    double p0_ = 0.0, p1_ = 0.0;    // kind-specific parameters (k; rate; mu, sigma; omega, x0)
-    double c0_ = 0.0, c1_ = 0.0;    // precomputed normalisation terms
-    std::vector<double> func_;      // tabulated: bin values (normalised density)
-    std::vector<double> cdf_;       // tabulated: cdf at bin edges, cdf_[0] = 0, back() = 1
+    double p0_ = 0.0, p1_ = 0.0; // kind-specific parameters and precomputed terms
+    double c0_ = 0.0, c1_ = 0.0; // (see the kernels in distributions.cpp)
+    std::vector<double> func_;   // tabulated: the normalised density of each bin
+    std::vector<double> cdf_;    // tabulated: cdf at bin edges, cdf_[0] = 0, back() = 1
 };
 
 Made<Distribution1D> make_uniform(double a, double b);
@@ -61,12 +61,13 @@ Made<Distribution1D> make_power(double a, double b, double k);
 Made<Distribution1D> make_exponential(double a, double b, double rate);
 Made<Distribution1D> make_truncated_gaussian(double a, double b, double mu, double sigma);
 Made<Distribution1D> make_cosine(double a, double b, double omega, double x0);
-/// Piecewise-constant density on equal bins of [a, b] proportional to |values[i]|.
+/// Piecewise-constant density on equal bins of [a, b] proportional to values[i] >= 0.
 /// Errors when values is empty, has a negative, NaN or infinite entry, or sums to zero.
 Made<Distribution1D> make_tabulated(double a, double b, const std::vector<double>& values);
 
 /// Piecewise-constant density on an nx-by-ny grid over [x0,x1] x [y0,y1], proportional to
-/// |values[iy * nx + ix]|, sampled as marginal in y then conditional in x [PBR4, A.5.6].
+/// values[iy * nx + ix] >= 0, sampled as marginal in y (from u2) then conditional in x (from
+/// u1) [PBR4, A.5.6].
 class TabulatedDistribution2D {
   public:
     /// Samples (x, y) from (u1, u2) and returns the density per unit area.
@@ -85,17 +86,17 @@ class TabulatedDistribution2D {
     double y1() const { return y1_; }
 
   private:
-    friend Made<TabulatedDistribution2D> make_tabulated_2d(double, double, double, double, int,
-                                                           int, const std::vector<double>&);
+    friend Made<TabulatedDistribution2D> make_tabulated_2d(double, double, double, double, int, int,
+                                                           const std::vector<double>&);
     int nx_ = 0, ny_ = 0;
     double x0_ = 0, x1_ = 1, y0_ = 0, y1_ = 1;
-    std::vector<Distribution1D> conditional_;  // one per row y, over x
-    Distribution1D marginal_;                  // over y
-    double total_ = 0.0;                       // integral of the unnormalised table
-    std::vector<double> values_;               // |values|, row-major
+    std::vector<Distribution1D> conditional_; // one per row y, over x
+    Distribution1D marginal_;                 // over y
+    double total_ = 0.0;                      // integral of the unnormalised table
+    std::vector<double> values_;              // |values|, row-major
 };
 
-Made<TabulatedDistribution2D> make_tabulated_2d(double x0, double x1, double y0, double y1,
-                                                int nx, int ny, const std::vector<double>& values);
+Made<TabulatedDistribution2D> make_tabulated_2d(double x0, double x1, double y0, double y1, int nx,
+                                                int ny, const std::vector<double>& values);
 
-}  // namespace mcp
+} // namespace mcp

@@ -27,4 +27,4 @@ struct PointBlock {
     const double* coord(int j) const { return data.data() + static_cast<size_t>(j) * capacity; }
 };
 
-}  // namespace mcp
+} // namespace mcp

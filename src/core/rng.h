@@ -40,8 +40,8 @@ class Pcg32 {
     /// singular at an end point (x^-0.9 at 0) are sampled down to 2^-54 without hitting
     /// the singularity itself, and log(u), 1/u are always finite.
     double next_double() {
-        uint64_t hi = next_u32() >> 5;  // 27 bits
-        uint64_t lo = next_u32() >> 6;  // 26 bits
+        uint64_t hi = next_u32() >> 5; // 27 bits
+        uint64_t lo = next_u32() >> 6; // 26 bits
         uint64_t k = (hi << 26) | lo;
         return (static_cast<double>(k) + 0.5) * 0x1p-53;
     }
@@ -96,7 +96,9 @@ inline uint64_t mix64(uint64_t z) {
 }
 
 /// Combines words into one 64-bit key, order-sensitive.
-inline uint64_t hash_combine(uint64_t h, uint64_t v) { return mix64(h ^ mix64(v)); }
+inline uint64_t hash_combine(uint64_t h, uint64_t v) {
+    return mix64(h ^ mix64(v));
+}
 
 /// FNV-1a of a string, for hashing estimator names into stream ids.
 inline uint64_t hash_string(const char* s) {
@@ -105,4 +107,4 @@ inline uint64_t hash_string(const char* s) {
     return h;
 }
 
-}  // namespace mcp
+} // namespace mcp

@@ -7,22 +7,29 @@ namespace mcp {
 namespace {
 // (c + xi) / k rounds to 1 when k is large and xi close to 1; keep u inside [0, 1).
 constexpr double kOneMinusEpsilon = 0x1.fffffffffffffp-1;
-}  // namespace
+} // namespace
 
 const char* sampler_name(SamplerKind kind) {
     switch (kind) {
-    case SamplerKind::Independent: return "independent";
-    case SamplerKind::Stratified: return "stratified";
-    case SamplerKind::LatinHypercube: return "latin_hypercube";
+    case SamplerKind::Independent:
+        return "independent";
+    case SamplerKind::Stratified:
+        return "stratified";
+    case SamplerKind::LatinHypercube:
+        return "latin_hypercube";
     }
     return "?";
 }
 
 bool parse_sampler(const std::string& name, SamplerKind* kind) {
-    if (name == "independent") *kind = SamplerKind::Independent;
-    else if (name == "stratified") *kind = SamplerKind::Stratified;
-    else if (name == "latin_hypercube") *kind = SamplerKind::LatinHypercube;
-    else return false;
+    if (name == "independent")
+        *kind = SamplerKind::Independent;
+    else if (name == "stratified")
+        *kind = SamplerKind::Stratified;
+    else if (name == "latin_hypercube")
+        *kind = SamplerKind::LatinHypercube;
+    else
+        return false;
     return true;
 }
 
@@ -40,7 +47,7 @@ uint64_t largest_divisor_at_most(uint64_t n, double limit) {
     return best;
 }
 
-}  // namespace
+} // namespace
 
 std::vector<uint64_t> stratification_grid(uint64_t n, int dim) {
     std::vector<uint64_t> k(static_cast<size_t>(dim), 1);
@@ -66,14 +73,14 @@ inline uint64_t bijection(uint64_t x, uint64_t mask, int bits, uint64_t key) {
         x ^= rk & mask;
         x = (x * (rk | 1u)) & mask;
         x ^= x >> shift;
-        x = (x * 0x9e3779b97f4a7c15ULL) & mask;  // odd multiplier: a bijection mod 2^bits
+        x = (x * 0x9e3779b97f4a7c15ULL) & mask; // odd multiplier: a bijection mod 2^bits
         x ^= x >> (shift > 1 ? shift - 1 : 1);
         x = (x + (rk >> 32)) & mask;
     }
     return x;
 }
 
-}  // namespace
+} // namespace
 
 uint64_t permute_index(uint64_t index, uint64_t n, uint64_t key) {
     if (n <= 1) return 0;
@@ -124,9 +131,9 @@ void generate_block(const SamplerPlan& plan, uint64_t first, size_t count, Pcg32
                 uint64_t k = plan.strata[static_cast<size_t>(j)];
                 uint64_t c = cell % k;
                 cell /= k;
-                u.coord(j)[i] = std::fmin(
-                    (static_cast<double>(c) + rng.next_double()) / static_cast<double>(k),
-                    kOneMinusEpsilon);
+                u.coord(j)[i] =
+                    std::fmin((static_cast<double>(c) + rng.next_double()) / static_cast<double>(k),
+                              kOneMinusEpsilon);
             }
         }
         break;
@@ -136,9 +143,10 @@ void generate_block(const SamplerPlan& plan, uint64_t first, size_t count, Pcg32
         for (size_t i = 0; i < count; ++i) {
             uint64_t index = first + i;
             for (int j = 0; j < d; ++j) {
-                uint64_t slab = permute_index(index, plan.total, plan.perm_keys[static_cast<size_t>(j)]);
-                u.coord(j)[i] =
-                    std::fmin((static_cast<double>(slab) + rng.next_double()) * inv_n, kOneMinusEpsilon);
+                uint64_t slab =
+                    permute_index(index, plan.total, plan.perm_keys[static_cast<size_t>(j)]);
+                u.coord(j)[i] = std::fmin((static_cast<double>(slab) + rng.next_double()) * inv_n,
+                                          kOneMinusEpsilon);
             }
         }
         break;
@@ -146,4 +154,4 @@ void generate_block(const SamplerPlan& plan, uint64_t first, size_t count, Pcg32
     }
 }
 
-}  // namespace mcp
+} // namespace mcp

@@ -40,9 +40,9 @@ uint64_t permute_index(uint64_t index, uint64_t n, uint64_t key);
 struct SamplerPlan {
     SamplerKind kind = SamplerKind::Independent;
     int dim = 1;
-    uint64_t total = 0;               ///< N, the number of points of the whole run
-    std::vector<uint64_t> strata;     ///< stratified: counts per axis (product = total)
-    std::vector<uint64_t> perm_keys;  ///< Latin hypercube: one permutation key per axis
+    uint64_t total = 0;              ///< N, the number of points of the whole run
+    std::vector<uint64_t> strata;    ///< stratified: counts per axis (product = total)
+    std::vector<uint64_t> perm_keys; ///< Latin hypercube: one permutation key per axis
 };
 
 /// Plans a run of n points in dim dimensions. Latin hypercube keys are drawn from rng.
@@ -53,4 +53,4 @@ SamplerPlan make_sampler_plan(SamplerKind kind, int dim, uint64_t n, Pcg32& rng)
 void generate_block(const SamplerPlan& plan, uint64_t first, size_t count, Pcg32& rng,
                     PointBlock& u);
 
-}  // namespace mcp
+} // namespace mcp

@@ -5,7 +5,9 @@
 
 namespace mcp {
 
-double normal_cdf(double x) { return 0.5 * std::erfc(-x / kSqrt2); }
+double normal_cdf(double x) {
+    return 0.5 * std::erfc(-x / kSqrt2);
+}
 
 namespace {
 
@@ -24,7 +26,7 @@ double normal_quantile_lower(double p) {
     return x;
 }
 
-}  // namespace
+} // namespace
 
 double normal_quantile(double p) {
     if (!(p > 0.0)) return -std::numeric_limits<double>::infinity();
@@ -83,7 +85,7 @@ double gamma_q_fraction(double a, double x) {
     return std::exp(-x + a * std::log(x) - std::lgamma(a)) * h;
 }
 
-}  // namespace
+} // namespace
 
 double gamma_p(double a, double x) {
     if (!(x > 0.0)) return 0.0;
@@ -97,7 +99,9 @@ double gamma_q(double a, double x) {
     return x < a + 1.0 ? 1.0 - gamma_p_series(a, x) : gamma_q_fraction(a, x);
 }
 
-double chi_square_sf(double x, double k) { return gamma_q(0.5 * k, 0.5 * x); }
+double chi_square_sf(double x, double k) {
+    return gamma_q(0.5 * k, 0.5 * x);
+}
 
 double chi_square_quantile(double p, double k) {
     if (!(p > 0.0)) return 0.0;
@@ -109,7 +113,10 @@ double chi_square_quantile(double p, double k) {
     double lo = 0.0, hi = std::numeric_limits<double>::infinity();
     for (int it = 0; it < 100; ++it) {
         double f = gamma_p(0.5 * k, 0.5 * x) - p;
-        if (f > 0) hi = x; else lo = x;
+        if (f > 0)
+            hi = x;
+        else
+            lo = x;
         double log_pdf = (0.5 * k - 1.0) * std::log(x) - 0.5 * x - 0.5 * k * std::log(2.0) -
                          std::lgamma(0.5 * k);
         double step = f / std::exp(log_pdf);
@@ -132,8 +139,10 @@ double trigamma(double x) {
     // omitted term, 691/2730 x^-13, is below 3e-14.
     double series =
         r + 0.5 * r2 +
-        r * r2 * (1.0 / 6.0 - r2 * (1.0 / 30.0 - r2 * (1.0 / 42.0 - r2 * (1.0 / 30.0 - r2 * 5.0 / 66.0))));
+        r * r2 *
+            (1.0 / 6.0 -
+             r2 * (1.0 / 30.0 - r2 * (1.0 / 42.0 - r2 * (1.0 / 30.0 - r2 * 5.0 / 66.0))));
     return acc + series;
 }
 
-}  // namespace mcp
+} // namespace mcp

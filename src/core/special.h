@@ -36,4 +36,4 @@ double chi_square_quantile(double p, double k);
 /// Var[log s^2] = psi'((R - 1) / 2) for a sample variance of R normal values.
 double trigamma(double x);
 
-}  // namespace mcp
+} // namespace mcp

@@ -74,4 +74,4 @@ LineFit fit_line(const std::vector<double>& x, const std::vector<double>& y) {
     return fit;
 }
 
-}  // namespace mcp
+} // namespace mcp

@@ -65,13 +65,13 @@ class RunningMoments {
 struct LineFit {
     double slope = 0.0;
     double intercept = 0.0;
-    double slope_se = 0.0;        ///< from the residuals, s / sqrt(Sxx)
+    double slope_se = 0.0; ///< from the residuals, s / sqrt(Sxx)
     double residual_variance = 0.0;
-    double sxx = 0.0;             ///< sum (x - mean x)^2
+    double sxx = 0.0; ///< sum (x - mean x)^2
     int points = 0;
 };
 
 /// Fits a line through (x[i], y[i]); needs at least two distinct x.
 LineFit fit_line(const std::vector<double>& x, const std::vector<double>& y);
 
-}  // namespace mcp
+} // namespace mcp

@@ -13,23 +13,25 @@
 namespace mcp {
 namespace {
 
-constexpr double kOneMinusEpsilon = 0x1.fffffffffffffp-1;  // largest double below 1
+constexpr double kOneMinusEpsilon = 0x1.fffffffffffffp-1; // largest double below 1
 constexpr double kTwoPi = 2.0 * kPi;
 constexpr double kHalfPi = 0.5 * kPi;
 constexpr double kQuarterPi = 0.25 * kPi;
 constexpr double kFourOverPi = 4.0 / kPi;
 
-double clamp_unit(double v) { return v > 0.0 ? std::min(v, kOneMinusEpsilon) : 0.0; }
+double clamp_unit(double v) {
+    return v > 0.0 ? std::min(v, kOneMinusEpsilon) : 0.0;
+}
 
 /// The azimuth of (x, y) as a fraction of a full turn, in [0, 1).
 double azimuth_unit(double y, double x) {
     double phi = std::atan2(y, x);
     if (phi < 0.0) phi += kTwoPi;
     double u = phi / kTwoPi;
-    return u > 0.0 && u < 1.0 ? u : 0.0;  // -0, and 2 pi after rounding, are angle 0
+    return u > 0.0 && u < 1.0 ? u : 0.0; // -0, and 2 pi after rounding, are angle 0
 }
 
-}  // namespace
+} // namespace
 
 // --- Unit disk -------------------------------------------------------------------------
 
@@ -90,7 +92,7 @@ Vec2 sample_triangle_barycentric(Vec2 u) {
 
 Vec2 invert_triangle_barycentric(Vec2 b) {
     double s = 1.0 - b.x;
-    if (!(s > 0.0)) return {0.0, 0.0};  // the vertex b0 = 1, where u2 is arbitrary
+    if (!(s > 0.0)) return {0.0, 0.0}; // the vertex b0 = 1, where u2 is arbitrary
     return {clamp_unit(s * s), clamp_unit(b.y / s)};
 }
 
@@ -116,7 +118,9 @@ Vec3 sample_uniform_hemisphere(Vec2 u) {
     return {r * std::cos(phi), r * std::sin(phi), z};
 }
 
-Vec2 invert_uniform_hemisphere(Vec3 w) { return {clamp_unit(w.z), azimuth_unit(w.y, w.x)}; }
+Vec2 invert_uniform_hemisphere(Vec3 w) {
+    return {clamp_unit(w.z), azimuth_unit(w.y, w.x)};
+}
 
 // Malley's method [PBR4, A.5]: the projection of a cosine-weighted direction onto the
 // disk is uniform, so lift a concentric disk sample and invert through the disk.
@@ -126,6 +130,8 @@ Vec3 sample_cosine_hemisphere(Vec2 u) {
     return {d.x, d.y, z};
 }
 
-Vec2 invert_cosine_hemisphere(Vec3 w) { return invert_disk_concentric({w.x, w.y}); }
+Vec2 invert_cosine_hemisphere(Vec3 w) {
+    return invert_disk_concentric({w.x, w.y});
+}
 
-}  // namespace mcp
+} // namespace mcp

@@ -24,12 +24,15 @@ Vec2 sample_disk_concentric(Vec2 u);
 Vec2 invert_disk_concentric(Vec2 p);
 
 /// Density of both disk warps per unit area of the unit disk.
-inline double disk_pdf() { return 0.31830988618379067154; }
+inline double disk_pdf() {
+    return 0.31830988618379067154;
+}
 
 // --- Triangle --------------------------------------------------------------------------
 
 /// Uniform barycentric coordinates (b0, b1) on the triangle, b2 = 1 - b0 - b1:
-/// b0 = 1 - sqrt(u1), b1 = u2 sqrt(u1) [PBR4, 4.4]. The point is b0 a + b1 b + b2 c.
+/// b0 = 1 - sqrt(u1), b1 = u2 sqrt(u1) [Turk90]. The point is b0 a + b1 b + b2 c; the
+/// density is 1/area (2 on the barycentric simplex).
 Vec2 sample_triangle_barycentric(Vec2 u);
 Vec2 invert_triangle_barycentric(Vec2 b);
 
@@ -38,12 +41,16 @@ Vec2 invert_triangle_barycentric(Vec2 b);
 /// Uniform direction: z = 1 - 2 u1, phi = 2 pi u2 (Archimedes' hat-box theorem).
 Vec3 sample_uniform_sphere(Vec2 u);
 Vec2 invert_uniform_sphere(Vec3 w);
-inline double uniform_sphere_pdf() { return 0.25 * 0.31830988618379067154; }
+inline double uniform_sphere_pdf() {
+    return 0.25 * 0.31830988618379067154;
+}
 
 /// Uniform direction on the hemisphere z >= 0: z = u1, phi = 2 pi u2.
 Vec3 sample_uniform_hemisphere(Vec2 u);
 Vec2 invert_uniform_hemisphere(Vec3 w);
-inline double uniform_hemisphere_pdf() { return 0.5 * 0.31830988618379067154; }
+inline double uniform_hemisphere_pdf() {
+    return 0.5 * 0.31830988618379067154;
+}
 
 /// Cosine-weighted hemisphere by Malley's method: a concentric disk sample lifted to the
 /// hemisphere. Density cos(theta)/pi per unit solid angle.
@@ -53,4 +60,4 @@ inline double cosine_hemisphere_pdf(double cos_theta) {
     return cos_theta > 0.0 ? cos_theta * 0.31830988618379067154 : 0.0;
 }
 
-}  // namespace mcp
+} // namespace mcp

@@ -16,18 +16,24 @@ void RunDiagnostics::merge(const RunDiagnostics& o) {
 
 const char* error_method_name(ErrorMethod m) {
     switch (m) {
-    case ErrorMethod::Iid: return "iid";
-    case ErrorMethod::CollapsedStrata: return "collapsed_strata";
-    case ErrorMethod::IidConservative: return "iid_conservative";
+    case ErrorMethod::Iid:
+        return "iid";
+    case ErrorMethod::CollapsedStrata:
+        return "collapsed_strata";
+    case ErrorMethod::IidConservative:
+        return "iid_conservative";
     }
     return "?";
 }
 
 ErrorMethod error_method_for(SamplerKind sampler) {
     switch (sampler) {
-    case SamplerKind::Independent: return ErrorMethod::Iid;
-    case SamplerKind::Stratified: return ErrorMethod::CollapsedStrata;
-    case SamplerKind::LatinHypercube: return ErrorMethod::IidConservative;
+    case SamplerKind::Independent:
+        return ErrorMethod::Iid;
+    case SamplerKind::Stratified:
+        return ErrorMethod::CollapsedStrata;
+    case SamplerKind::LatinHypercube:
+        return ErrorMethod::IidConservative;
     }
     return ErrorMethod::Iid;
 }
@@ -46,10 +52,10 @@ RunResult run_estimate(const Problem& problem, const EstimatorSpec& spec, uint64
     RunResult result;
     result.n = n;
     RunningMoments moments;
-    NeumaierSum abs_sum, pair_sq_sum;  // sum |w|; sum over strata pairs (2m, 2m+1) of (w_a - w_b)^2
+    NeumaierSum abs_sum, pair_sq_sum; // sum |w|; sum over strata pairs (2m, 2m+1) of (w_a - w_b)^2
     double max_abs = 0.0;
     uint64_t pairs = 0;
-    double* w = ws.pdf.data();  // the weights overwrite the densities
+    double* w = ws.pdf.data(); // the weights overwrite the densities
 
     for (uint64_t first = 0; first < n; first += kBlockSize) {
         const size_t count = static_cast<size_t>(n - first < kBlockSize ? n - first : kBlockSize);
@@ -61,10 +67,14 @@ RunResult run_estimate(const Problem& problem, const EstimatorSpec& spec, uint64
             double wi = f / p;
             if (!std::isfinite(wi) || !(p > 0.0)) {
                 // Rare path: classify, count, and drop (contribute 0).
-                if (p > 0.0 && std::isfinite(p)) ++result.diagnostics.nonfinite;    // f/p overflowed or f NaN/Inf
-                else if (f == 0.0) {}                                                // 0/0: no mass on either side
-                else if (std::isnan(f) || std::isnan(p)) ++result.diagnostics.nonfinite;
-                else ++result.diagnostics.zero_pdf;                                  // f != 0 where p = 0
+                if (p > 0.0 && std::isfinite(p))
+                    ++result.diagnostics.nonfinite; // f/p overflowed or f NaN/Inf
+                else if (f == 0.0) {
+                } // 0/0: no mass on either side
+                else if (std::isnan(f) || std::isnan(p))
+                    ++result.diagnostics.nonfinite;
+                else
+                    ++result.diagnostics.zero_pdf; // f != 0 where p = 0
                 wi = 0.0;
             }
             w[i] = wi;
@@ -78,7 +88,8 @@ RunResult run_estimate(const Problem& problem, const EstimatorSpec& spec, uint64
         abs_sum.add(block_abs);
         // Blocks start at multiples of kBlockSize (even), so pairs never straddle two blocks.
         double block_pairs = 0.0;
-        for (size_t i = 0; i + 1 < count; i += 2) block_pairs += (w[i] - w[i + 1]) * (w[i] - w[i + 1]);
+        for (size_t i = 0; i + 1 < count; i += 2)
+            block_pairs += (w[i] - w[i + 1]) * (w[i] - w[i + 1]);
         pair_sq_sum.add(block_pairs);
         pairs += count / 2;
     }
@@ -102,4 +113,4 @@ RunResult run_estimate(const Problem& problem, const EstimatorSpec& spec, uint64
     return result;
 }
 
-}  // namespace mcp
+} // namespace mcp

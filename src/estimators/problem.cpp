@@ -9,27 +9,37 @@ namespace mcp {
 
 const char* domain_kind_name(DomainKind kind) {
     switch (kind) {
-    case DomainKind::Box: return "box";
-    case DomainKind::Disk: return "disk";
-    case DomainKind::Triangle: return "triangle";
-    case DomainKind::Sphere: return "sphere";
-    case DomainKind::Hemisphere: return "hemisphere";
+    case DomainKind::Box:
+        return "box";
+    case DomainKind::Disk:
+        return "disk";
+    case DomainKind::Triangle:
+        return "triangle";
+    case DomainKind::Sphere:
+        return "sphere";
+    case DomainKind::Hemisphere:
+        return "hemisphere";
     }
     return "?";
 }
 
 int Domain::point_dim() const {
     switch (kind) {
-    case DomainKind::Box: return static_cast<int>(lo.size());
+    case DomainKind::Box:
+        return static_cast<int>(lo.size());
     case DomainKind::Disk:
-    case DomainKind::Triangle: return 2;
+    case DomainKind::Triangle:
+        return 2;
     case DomainKind::Sphere:
-    case DomainKind::Hemisphere: return 3;
+    case DomainKind::Hemisphere:
+        return 3;
     }
     return 0;
 }
 
-int Domain::sample_dim() const { return kind == DomainKind::Box ? static_cast<int>(lo.size()) : 2; }
+int Domain::sample_dim() const {
+    return kind == DomainKind::Box ? static_cast<int>(lo.size()) : 2;
+}
 
 double Domain::measure() const {
     switch (kind) {
@@ -38,11 +48,14 @@ double Domain::measure() const {
         for (size_t j = 0; j < lo.size(); ++j) v *= hi[j] - lo[j];
         return v;
     }
-    case DomainKind::Disk: return kPi * radius * radius;
+    case DomainKind::Disk:
+        return kPi * radius * radius;
     case DomainKind::Triangle:
         return 0.5 * std::fabs((v1.x - v0.x) * (v2.y - v0.y) - (v2.x - v0.x) * (v1.y - v0.y));
-    case DomainKind::Sphere: return 4.0 * kPi;
-    case DomainKind::Hemisphere: return 2.0 * kPi;
+    case DomainKind::Sphere:
+        return 4.0 * kPi;
+    case DomainKind::Hemisphere:
+        return 2.0 * kPi;
     }
     return 0.0;
 }
@@ -52,7 +65,8 @@ std::string Domain::describe() const {
     s.precision(6);
     switch (kind) {
     case DomainKind::Box:
-        for (size_t j = 0; j < lo.size(); ++j) s << (j ? " x " : "") << "[" << lo[j] << ", " << hi[j] << "]";
+        for (size_t j = 0; j < lo.size(); ++j)
+            s << (j ? " x " : "") << "[" << lo[j] << ", " << hi[j] << "]";
         break;
     case DomainKind::Disk:
         s << "disk centre (" << center.x << ", " << center.y << ") radius " << radius;
@@ -61,8 +75,12 @@ std::string Domain::describe() const {
         s << "triangle (" << v0.x << ", " << v0.y << ") (" << v1.x << ", " << v1.y << ") (" << v2.x
           << ", " << v2.y << ")";
         break;
-    case DomainKind::Sphere: s << "unit sphere of directions"; break;
-    case DomainKind::Hemisphere: s << "hemisphere of directions z >= 0"; break;
+    case DomainKind::Sphere:
+        s << "unit sphere of directions";
+        break;
+    case DomainKind::Hemisphere:
+        s << "hemisphere of directions z >= 0";
+        break;
     }
     return s.str();
 }
@@ -70,7 +88,8 @@ std::string Domain::describe() const {
 Made<Domain> make_box(std::vector<double> lo, std::vector<double> hi) {
     if (lo.empty() || lo.size() != hi.size())
         return made_error<Domain>("box: lower and upper must be non-empty and of equal length");
-    if (lo.size() > 64) return made_error<Domain>("box: at most 64 dimensions, got " + std::to_string(lo.size()));
+    if (lo.size() > 64)
+        return made_error<Domain>("box: at most 64 dimensions, got " + std::to_string(lo.size()));
     for (size_t j = 0; j < lo.size(); ++j) {
         if (!std::isfinite(lo[j]) || !std::isfinite(hi[j]) || !(lo[j] < hi[j]))
             return made_error<Domain>("box: axis " + std::to_string(j) +
@@ -106,7 +125,8 @@ Made<Domain> make_triangle(Vec2 a, Vec2 b, Vec2 c) {
     d.v0 = a;
     d.v1 = b;
     d.v2 = c;
-    if (!(d.measure() > 0.0)) return made_error<Domain>("triangle: vertices are collinear (zero area)");
+    if (!(d.measure() > 0.0))
+        return made_error<Domain>("triangle: vertices are collinear (zero area)");
     return {d, {}};
 }
 
@@ -124,35 +144,52 @@ Domain make_hemisphere() {
 
 const char* proposal_kind_name(ProposalKind kind) {
     switch (kind) {
-    case ProposalKind::UniformBox: return "uniform";
-    case ProposalKind::DiskPolar: return "uniform_polar";
-    case ProposalKind::DiskConcentric: return "uniform_concentric";
-    case ProposalKind::Triangle: return "uniform";
-    case ProposalKind::Sphere: return "uniform";
-    case ProposalKind::Hemisphere: return "uniform";
-    case ProposalKind::CosineHemisphere: return "cosine_hemisphere";
-    case ProposalKind::Product1D: return "product";
-    case ProposalKind::Tabulated2D: return "tabulated_2d";
+    case ProposalKind::UniformBox:
+        return "uniform";
+    case ProposalKind::DiskPolar:
+        return "uniform_polar";
+    case ProposalKind::DiskConcentric:
+        return "uniform_concentric";
+    case ProposalKind::Triangle:
+        return "uniform";
+    case ProposalKind::Sphere:
+        return "uniform";
+    case ProposalKind::Hemisphere:
+        return "uniform";
+    case ProposalKind::CosineHemisphere:
+        return "cosine_hemisphere";
+    case ProposalKind::Product1D:
+        return "product";
+    case ProposalKind::Tabulated2D:
+        return "tabulated_2d";
     }
     return "?";
 }
 
 std::string Proposal::describe() const {
     switch (kind) {
-    case ProposalKind::UniformBox: return "uniform";
-    case ProposalKind::DiskPolar: return "uniform (polar map r = sqrt(u1))";
-    case ProposalKind::DiskConcentric: return "uniform (concentric map)";
-    case ProposalKind::Triangle: return "uniform (barycentric sqrt map)";
+    case ProposalKind::UniformBox:
+        return "uniform";
+    case ProposalKind::DiskPolar:
+        return "uniform (polar map r = sqrt(u1))";
+    case ProposalKind::DiskConcentric:
+        return "uniform (concentric map)";
+    case ProposalKind::Triangle:
+        return "uniform (barycentric sqrt map)";
     case ProposalKind::Sphere:
-    case ProposalKind::Hemisphere: return "uniform";
-    case ProposalKind::CosineHemisphere: return "cos(theta)/pi";
+    case ProposalKind::Hemisphere:
+        return "uniform";
+    case ProposalKind::CosineHemisphere:
+        return "cos(theta)/pi";
     case ProposalKind::Product1D: {
         std::string s;
-        for (size_t j = 0; j < marginals.size(); ++j) s += (j ? " x " : "") + marginals[j].describe();
+        for (size_t j = 0; j < marginals.size(); ++j)
+            s += (j ? " x " : "") + marginals[j].describe();
         return s;
     }
     case ProposalKind::Tabulated2D:
-        return "tabulated_2d(" + std::to_string(table.nx()) + " x " + std::to_string(table.ny()) + ")";
+        return "tabulated_2d(" + std::to_string(table.nx()) + " x " + std::to_string(table.ny()) +
+               ")";
     }
     return "?";
 }
@@ -160,11 +197,21 @@ std::string Proposal::describe() const {
 Proposal uniform_proposal(const Domain& domain, bool disk_polar) {
     Proposal p;
     switch (domain.kind) {
-    case DomainKind::Box: p.kind = ProposalKind::UniformBox; break;
-    case DomainKind::Disk: p.kind = disk_polar ? ProposalKind::DiskPolar : ProposalKind::DiskConcentric; break;
-    case DomainKind::Triangle: p.kind = ProposalKind::Triangle; break;
-    case DomainKind::Sphere: p.kind = ProposalKind::Sphere; break;
-    case DomainKind::Hemisphere: p.kind = ProposalKind::Hemisphere; break;
+    case DomainKind::Box:
+        p.kind = ProposalKind::UniformBox;
+        break;
+    case DomainKind::Disk:
+        p.kind = disk_polar ? ProposalKind::DiskPolar : ProposalKind::DiskConcentric;
+        break;
+    case DomainKind::Triangle:
+        p.kind = ProposalKind::Triangle;
+        break;
+    case DomainKind::Sphere:
+        p.kind = ProposalKind::Sphere;
+        break;
+    case DomainKind::Hemisphere:
+        p.kind = ProposalKind::Hemisphere;
+        break;
     }
     return p;
 }
@@ -176,13 +223,18 @@ std::string check_proposal(const Proposal& p, const Domain& d) {
                domain_kind_name(k) + ", the domain is a " + domain_kind_name(d.kind);
     };
     switch (p.kind) {
-    case ProposalKind::UniformBox: return need(DomainKind::Box);
+    case ProposalKind::UniformBox:
+        return need(DomainKind::Box);
     case ProposalKind::DiskPolar:
-    case ProposalKind::DiskConcentric: return need(DomainKind::Disk);
-    case ProposalKind::Triangle: return need(DomainKind::Triangle);
-    case ProposalKind::Sphere: return need(DomainKind::Sphere);
+    case ProposalKind::DiskConcentric:
+        return need(DomainKind::Disk);
+    case ProposalKind::Triangle:
+        return need(DomainKind::Triangle);
+    case ProposalKind::Sphere:
+        return need(DomainKind::Sphere);
     case ProposalKind::Hemisphere:
-    case ProposalKind::CosineHemisphere: return need(DomainKind::Hemisphere);
+    case ProposalKind::CosineHemisphere:
+        return need(DomainKind::Hemisphere);
     case ProposalKind::Product1D: {
         if (auto e = need(DomainKind::Box); !e.empty()) return e;
         if (p.marginals.size() != d.lo.size())
@@ -272,8 +324,8 @@ void warp_block(const Proposal& p, const Domain& d, const PointBlock& u, PointBl
                 double density[kBlockSize];
                 for (size_t start = 0; start < n; start += kBlockSize) {
                     const size_t m = n - start < kBlockSize ? n - start : kBlockSize;
-                    p.marginals[j].sample_block(u.coord(jj) + start, x.coord(jj) + start,
-                                                density, m);
+                    p.marginals[j].sample_block(u.coord(jj) + start, x.coord(jj) + start, density,
+                                                m);
                     for (size_t i = 0; i < m; ++i) pdf[start + i] *= density[i];
                 }
             }
@@ -286,4 +338,4 @@ void warp_block(const Proposal& p, const Domain& d, const PointBlock& u, PointBl
     }
 }
 
-}  // namespace mcp
+} // namespace mcp

@@ -23,10 +23,10 @@ const char* domain_kind_name(DomainKind kind);
 /// box: R^d; disk and triangle: R^2; sphere and hemisphere: unit directions in R^3 (z up).
 struct Domain {
     DomainKind kind = DomainKind::Box;
-    std::vector<double> lo{0.0}, hi{1.0};  ///< box bounds
-    Vec2 center{0.0, 0.0};                 ///< disk centre
-    double radius = 1.0;                   ///< disk radius
-    Vec2 v0{0, 0}, v1{1, 0}, v2{0, 1};     ///< triangle vertices
+    std::vector<double> lo{0.0}, hi{1.0}; ///< box bounds
+    Vec2 center{0.0, 0.0};                ///< disk centre
+    double radius = 1.0;                  ///< disk radius
+    Vec2 v0{0, 0}, v1{1, 0}, v2{0, 1};    ///< triangle vertices
 
     /// Dimension of the points given to the integrand.
     int point_dim() const;
@@ -57,15 +57,15 @@ struct Problem {
 };
 
 enum class ProposalKind {
-    UniformBox,        ///< x = lo + (hi - lo) u
-    DiskPolar,         ///< course-notes polar map
-    DiskConcentric,    ///< Shirley-Chiu concentric map
-    Triangle,          ///< uniform barycentrics
-    Sphere,            ///< uniform on the sphere
-    Hemisphere,        ///< uniform on the hemisphere
-    CosineHemisphere,  ///< cos(theta)/pi on the hemisphere
-    Product1D,         ///< independent 1D distributions per box axis
-    Tabulated2D,       ///< piecewise-constant table over a 2D box
+    UniformBox,       ///< x = lo + (hi - lo) u
+    DiskPolar,        ///< course-notes polar map
+    DiskConcentric,   ///< Shirley-Chiu concentric map
+    Triangle,         ///< uniform barycentrics
+    Sphere,           ///< uniform on the sphere
+    Hemisphere,       ///< uniform on the hemisphere
+    CosineHemisphere, ///< cos(theta)/pi on the hemisphere
+    Product1D,        ///< independent 1D distributions per box axis
+    Tabulated2D,      ///< piecewise-constant table over a 2D box
 };
 
 const char* proposal_kind_name(ProposalKind kind);
@@ -73,9 +73,9 @@ const char* proposal_kind_name(ProposalKind kind);
 /// The density the points are drawn from, with respect to the domain's measure.
 struct Proposal {
     ProposalKind kind = ProposalKind::UniformBox;
-    std::vector<Distribution1D> marginals;  ///< Product1D: one per axis
-    TabulatedDistribution2D table;          ///< Tabulated2D
-    bool importance = false;                ///< true for a non-uniform density
+    std::vector<Distribution1D> marginals; ///< Product1D: one per axis
+    TabulatedDistribution2D table;         ///< Tabulated2D
+    bool importance = false;               ///< true for a non-uniform density
     std::string describe() const;
 };
 
@@ -88,8 +88,8 @@ std::string check_proposal(const Proposal& proposal, const Domain& domain);
 
 /// Warps a block of unit-cube points u (domain.sample_dim() coordinates) to domain points x
 /// (domain.point_dim() coordinates) and writes each point's density into pdf.
-void warp_block(const Proposal& proposal, const Domain& domain, const PointBlock& u,
-                PointBlock& x, double* pdf);
+void warp_block(const Proposal& proposal, const Domain& domain, const PointBlock& u, PointBlock& x,
+                double* pdf);
 
 /// An estimator: how the unit-cube points are placed, and which density warps them.
 struct EstimatorSpec {
@@ -98,4 +98,4 @@ struct EstimatorSpec {
     Proposal proposal;
 };
 
-}  // namespace mcp
+} // namespace mcp

@@ -21,12 +21,13 @@ namespace {
 constexpr uint64_t kMaxN = uint64_t(1) << 36;
 constexpr int kMaxReps = 100000;
 constexpr int kMaxThreads = 256;
-}  // namespace
+} // namespace
 
 std::string check_settings(const StudySettings& s) {
     if (s.n_min < 1) return "n_min must be >= 1, got " + std::to_string(s.n_min);
     if (s.n_max > kMaxN)
-        return "n_max must be <= 2^36 (" + std::to_string(kMaxN) + "), got " + std::to_string(s.n_max);
+        return "n_max must be <= 2^36 (" + std::to_string(kMaxN) + "), got " +
+               std::to_string(s.n_max);
     if (s.n_max < s.n_min)
         return "n_max (" + std::to_string(s.n_max) + ") must be >= n_min (" +
                std::to_string(s.n_min) + ")";
@@ -165,7 +166,7 @@ StudyResult run_study(const Problem& problem, const std::vector<EstimatorSpec>& 
     const std::vector<uint64_t> ladder = n_ladder(settings.n_min, settings.n_max);
     const size_t n_est = estimators.size();
     const size_t reps = static_cast<size_t>(settings.reps);
-    const uint64_t seed_state = mix64(settings.seed ^ 0x6d63706c6179ULL);  // "mcplay"
+    const uint64_t seed_state = mix64(settings.seed ^ 0x6d63706c6179ULL); // "mcplay"
 
     for (size_t level = 0; level < ladder.size(); ++level) {
         const uint64_t n = ladder[level];
@@ -181,7 +182,8 @@ StudyResult run_study(const Problem& problem, const std::vector<EstimatorSpec>& 
                 runs[t] = run_estimate(problem, estimators[e], n, rng, ws);
             }
         };
-        const int threads = static_cast<int>(std::min<size_t>(static_cast<size_t>(result.threads_used), tasks));
+        const int threads =
+            static_cast<int>(std::min<size_t>(static_cast<size_t>(result.threads_used), tasks));
 #if MCPLAY_HAS_THREADS
         if (threads > 1) {
             std::vector<std::thread> pool;
@@ -213,4 +215,4 @@ StudyResult run_study(const Problem& problem, const std::vector<EstimatorSpec>& 
     return result;
 }
 
-}  // namespace mcp
+} // namespace mcp

@@ -22,7 +22,7 @@ struct StudySettings {
     uint64_t n_max = 65536;
     int reps = 32;
     uint64_t seed = 1;
-    int threads = 0;  ///< 0: all hardware threads
+    int threads = 0; ///< 0: all hardware threads
 };
 
 /// Checks the settings; returns an error message naming the setting, or "".
@@ -34,33 +34,33 @@ std::vector<uint64_t> n_ladder(uint64_t n_min, uint64_t n_max);
 struct LevelStats {
     uint64_t n = 0;
     int reps = 0;
-    double mean = 0.0;            ///< mean of the R estimates
-    double variance = 0.0;        ///< unbiased variance of the estimator across replicates
-    double variance_lo = 0.0;     ///< 95% interval of the variance (chi-square, normal estimates)
+    double mean = 0.0;        ///< mean of the R estimates
+    double variance = 0.0;    ///< unbiased variance of the estimator across replicates
+    double variance_lo = 0.0; ///< 95% interval of the variance (chi-square, normal estimates)
     double variance_hi = 0.0;
-    double std_error = 0.0;       ///< standard error of `mean`, sqrt(variance / R)
-    double ci_lo = 0.0, ci_hi = 0.0;  ///< 95% t interval of the mean over the R replicates
+    double std_error = 0.0;          ///< standard error of `mean`, sqrt(variance / R)
+    double ci_lo = 0.0, ci_hi = 0.0; ///< 95% t interval of the mean over the R replicates
     bool has_exact = false;
-    double bias = 0.0;            ///< mean - exact
-    double mse = 0.0;             ///< mean of (estimate - exact)^2
+    double bias = 0.0; ///< mean - exact
+    double mse = 0.0;  ///< mean of (estimate - exact)^2
     double rmse = 0.0;
-    double coverage = 0.0;        ///< share of replicates whose own 95% interval covers exact
-    double mean_run_se = 0.0;     ///< average per-run standard error reported by the runs
-    double time_mean = 0.0;       ///< seconds per estimate
+    double coverage = 0.0;    ///< share of replicates whose own 95% interval covers exact
+    double mean_run_se = 0.0; ///< average per-run standard error reported by the runs
+    double time_mean = 0.0;   ///< seconds per estimate
     double time_total = 0.0;
-    double efficiency = 0.0;      ///< 1 / (variance * time_mean)
-    double error = 0.0;           ///< rmse when exact is known, else sqrt(variance)
-    RunDiagnostics diagnostics;   ///< summed over replicates
-    std::vector<double> estimates, run_std_errors;  ///< per replicate
+    double efficiency = 0.0;    ///< 1 / (variance * time_mean)
+    double error = 0.0;         ///< rmse when exact is known, else sqrt(variance)
+    RunDiagnostics diagnostics; ///< summed over replicates
+    std::vector<double> estimates, run_std_errors; ///< per replicate
 };
 
 struct ConvergenceFit {
     bool valid = false;
-    double order = 0.0;     ///< slope of log variance against log N
-    double order_se = 0.0;  ///< its standard error
+    double order = 0.0;    ///< slope of log variance against log N
+    double order_se = 0.0; ///< its standard error
     double intercept = 0.0;
     int levels_used = 0;
-    std::string note;       ///< why the fit is missing or partial
+    std::string note; ///< why the fit is missing or partial
 };
 
 /// Least-squares fit of log variance against log N over the levels with a positive finite
@@ -101,4 +101,4 @@ StudyResult run_study(const Problem& problem, const std::vector<EstimatorSpec>& 
 /// has no threads (WebAssembly without pthreads).
 int resolve_threads(int requested);
 
-}  // namespace mcp
+} // namespace mcp

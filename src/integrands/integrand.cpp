@@ -9,19 +9,24 @@ namespace mcp {
 
 const char* integrand_kind_name(IntegrandKind kind) {
     switch (kind) {
-    case IntegrandKind::Constant: return "constant";
-    case IntegrandKind::Monomial: return "monomial";
-    case IntegrandKind::Exponential: return "exponential";
-    case IntegrandKind::Gaussian: return "gaussian";
-    case IntegrandKind::IndicatorBall: return "indicator_ball";
+    case IntegrandKind::Constant:
+        return "constant";
+    case IntegrandKind::Monomial:
+        return "monomial";
+    case IntegrandKind::Exponential:
+        return "exponential";
+    case IntegrandKind::Gaussian:
+        return "gaussian";
+    case IntegrandKind::IndicatorBall:
+        return "indicator_ball";
     }
     return "?";
 }
 
 bool parse_integrand_kind(const std::string& name, IntegrandKind* kind) {
-    for (IntegrandKind k : {IntegrandKind::Constant, IntegrandKind::Monomial,
-                            IntegrandKind::Exponential, IntegrandKind::Gaussian,
-                            IntegrandKind::IndicatorBall}) {
+    for (IntegrandKind k :
+         {IntegrandKind::Constant, IntegrandKind::Monomial, IntegrandKind::Exponential,
+          IntegrandKind::Gaussian, IntegrandKind::IndicatorBall}) {
         if (name == integrand_kind_name(k)) {
             *kind = k;
             return true;
@@ -45,30 +50,32 @@ std::string fmt(double v) {
     return s.str();
 }
 
-}  // namespace
+} // namespace
 
 Made<Integrand> make_integrand(IntegrandKind kind, int dim, double scale,
                                std::vector<double> coeffs, std::vector<double> center,
                                double width) {
     const std::string name = integrand_kind_name(kind);
     if (dim < 1 || dim > 64)
-        return made_error<Integrand>(name + ": dimension must be in 1..64, got " + std::to_string(dim));
+        return made_error<Integrand>(name + ": dimension must be in 1..64, got " +
+                                     std::to_string(dim));
     if (!std::isfinite(scale)) return made_error<Integrand>(name + ": scale must be finite");
     bool needs_coeffs = kind == IntegrandKind::Monomial || kind == IntegrandKind::Exponential;
     bool needs_center = kind == IntegrandKind::Gaussian || kind == IntegrandKind::IndicatorBall;
     const char* coeff_name = kind == IntegrandKind::Monomial ? "powers" : "rates";
     if (needs_coeffs) {
         if (coeffs.size() != static_cast<size_t>(dim))
-            return made_error<Integrand>(name + ": " + coeff_name + " has " +
-                                         std::to_string(coeffs.size()) + " entries, the domain has " +
-                                         std::to_string(dim) + " dimensions");
+            return made_error<Integrand>(
+                name + ": " + coeff_name + " has " + std::to_string(coeffs.size()) +
+                " entries, the domain has " + std::to_string(dim) + " dimensions");
         if (!all_finite(coeffs))
             return made_error<Integrand>(name + ": " + coeff_name + " must be finite numbers");
         if (kind == IntegrandKind::Monomial)
             for (size_t j = 0; j < coeffs.size(); ++j)
                 if (!(coeffs[j] > -1.0))
                     return made_error<Integrand>("monomial: powers[" + std::to_string(j) +
-                                                 "] must be > -1 (integrable), got " + fmt(coeffs[j]));
+                                                 "] must be > -1 (integrable), got " +
+                                                 fmt(coeffs[j]));
     }
     if (needs_center) {
         if (center.empty()) center.assign(static_cast<size_t>(dim), 0.0);
@@ -162,7 +169,9 @@ std::optional<double> exact_integral_over_box(const Integrand& f, const std::vec
     for (int j = 0; j < f.dim; ++j) {
         const double a = lo[static_cast<size_t>(j)], b = hi[static_cast<size_t>(j)];
         switch (f.kind) {
-        case IntegrandKind::Constant: result *= b - a; break;
+        case IntegrandKind::Constant:
+            result *= b - a;
+            break;
         case IntegrandKind::Monomial: {
             const double p = f.coeffs[static_cast<size_t>(j)];
             // Negative x with a fractional power has no real value: no closed form here.
@@ -180,9 +189,9 @@ std::optional<double> exact_integral_over_box(const Integrand& f, const std::vec
             // sigma sqrt(pi/2) [erf((b-c)/(sigma sqrt2)) - erf((a-c)/(sigma sqrt2))]
             const double c = f.center[static_cast<size_t>(j)], s = f.width * kSqrt2;
             double hi_t = (b - c) / s, lo_t = (a - c) / s;
-            double diff = (lo_t > 0.0)    ? std::erfc(lo_t) - std::erfc(hi_t)
+            double diff = (lo_t > 0.0)   ? std::erfc(lo_t) - std::erfc(hi_t)
                           : (hi_t < 0.0) ? std::erfc(-hi_t) - std::erfc(-lo_t)
-                                          : std::erf(hi_t) - std::erf(lo_t);
+                                         : std::erf(hi_t) - std::erf(lo_t);
             result *= f.width * std::sqrt(0.5 * kPi) * diff;
             break;
         }
@@ -203,15 +212,19 @@ std::string describe_integrand(const Integrand& f) {
     s.precision(6);
     auto var = [&](int j) { return f.dim == 1 ? std::string("x") : "x" + std::to_string(j + 1); };
     switch (f.kind) {
-    case IntegrandKind::Constant: s << f.scale; break;
+    case IntegrandKind::Constant:
+        s << f.scale;
+        break;
     case IntegrandKind::Monomial:
         s << f.scale;
         for (int j = 0; j < f.dim; ++j)
-            if (f.coeffs[static_cast<size_t>(j)] != 0.0) s << " * " << var(j) << "^" << f.coeffs[static_cast<size_t>(j)];
+            if (f.coeffs[static_cast<size_t>(j)] != 0.0)
+                s << " * " << var(j) << "^" << f.coeffs[static_cast<size_t>(j)];
         break;
     case IntegrandKind::Exponential:
         s << f.scale << " * exp(";
-        for (int j = 0; j < f.dim; ++j) s << (j ? " + " : "") << f.coeffs[static_cast<size_t>(j)] << " " << var(j);
+        for (int j = 0; j < f.dim; ++j)
+            s << (j ? " + " : "") << f.coeffs[static_cast<size_t>(j)] << " " << var(j);
         s << ")";
         break;
     case IntegrandKind::Gaussian:
@@ -224,4 +237,4 @@ std::string describe_integrand(const Integrand& f) {
     return s.str();
 }
 
-}  // namespace mcp
+} // namespace mcp

@@ -12,20 +12,20 @@
 namespace mcp {
 
 enum class IntegrandKind {
-    Constant,       ///< f = scale
-    Monomial,       ///< f = scale * prod_j x_j^p_j (p_j > -1 for an integrable singularity)
-    Exponential,    ///< f = scale * exp(sum_j a_j x_j)
-    Gaussian,       ///< f = scale * exp(-|x - c|^2 / (2 sigma^2))
-    IndicatorBall,  ///< f = scale * [|x - c| < r]
+    Constant,      ///< f = scale
+    Monomial,      ///< f = scale * prod_j x_j^p_j (p_j > -1 for an integrable singularity)
+    Exponential,   ///< f = scale * exp(sum_j a_j x_j)
+    Gaussian,      ///< f = scale * exp(-|x - c|^2 / (2 sigma^2))
+    IndicatorBall, ///< f = scale * [|x - c| < r]
 };
 
 struct Integrand {
     IntegrandKind kind = IntegrandKind::Constant;
     int dim = 1;
     double scale = 1.0;
-    std::vector<double> coeffs;  ///< powers p_j (monomial) or rates a_j (exponential)
-    std::vector<double> center;  ///< Gaussian and ball centre
-    double width = 1.0;          ///< Gaussian sigma or ball radius
+    std::vector<double> coeffs; ///< powers p_j (monomial) or rates a_j (exponential)
+    std::vector<double> center; ///< Gaussian and ball centre
+    double width = 1.0;         ///< Gaussian sigma or ball radius
 };
 
 const char* integrand_kind_name(IntegrandKind kind);
@@ -52,4 +52,4 @@ double ball_volume(int dim, double r);
 /// Human-readable formula, e.g. "4 * x1^2 * x2^1".
 std::string describe_integrand(const Integrand& f);
 
-}  // namespace mcp
+} // namespace mcp
