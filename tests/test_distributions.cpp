@@ -12,10 +12,10 @@
 #include <string>
 #include <vector>
 
-#include "chi_square.h"
 #include "core/distributions.h"
 #include "core/rng.h"
 #include "core/special.h"
+#include "test_support.h"
 
 using namespace mcp;
 
@@ -23,23 +23,6 @@ namespace {
 
 constexpr double kEps = std::numeric_limits<double>::epsilon();
 constexpr int kChiSamples = 100000;
-
-/// Composite 5-point Gauss-Legendre rule on `panels` equal panels of [lo, hi].
-double gauss_legendre(const std::function<double(double)>& f, double lo, double hi, int panels) {
-    const double x1 = std::sqrt(5.0 - 2.0 * std::sqrt(10.0 / 7.0)) / 3.0;
-    const double x2 = std::sqrt(5.0 + 2.0 * std::sqrt(10.0 / 7.0)) / 3.0;
-    const double w0 = 128.0 / 225.0;
-    const double w1 = (322.0 + 13.0 * std::sqrt(70.0)) / 900.0;
-    const double w2 = (322.0 - 13.0 * std::sqrt(70.0)) / 900.0;
-    const double h = (hi - lo) / panels;
-    double sum = 0.0;
-    for (int p = 0; p < panels; ++p) {
-        double c = lo + (p + 0.5) * h, r = 0.5 * h;
-        sum += r * (w0 * f(c) + w1 * (f(c - x1 * r) + f(c + x1 * r)) +
-                    w2 * (f(c - x2 * r) + f(c + x2 * r)));
-    }
-    return sum;
-}
 
 /// One distribution under test, with what the generic tests need to know about it.
 struct Case {
@@ -156,8 +139,9 @@ double integrate_pdf(const Case& c, double lo, double hi, int panels) {
     const double a = d.lower(), b = d.upper(), len = b - a;
     auto pdf = [&d](double x) { return d.pdf(x); };
     if (c.singular_at_a) {
-        return gauss_legendre([&](double s) { return d.pdf(a + len * s * s) * 2.0 * len * s; },
-                              std::sqrt((lo - a) / len), std::sqrt((hi - a) / len), panels);
+        return test::gauss_legendre(
+            [&](double s) { return d.pdf(a + len * s * s) * 2.0 * len * s; },
+            std::sqrt((lo - a) / len), std::sqrt((hi - a) / len), panels);
     }
     if (!c.table.empty()) {
         const int n = int(c.table.size());
@@ -166,14 +150,14 @@ double integrate_pdf(const Case& c, double lo, double hi, int panels) {
             double edge = i == n ? b : a + len * i / n;
             if (edge <= left) continue;
             double right = std::min(edge, hi);
-            sum += gauss_legendre(pdf, left, right, 1);
+            sum += test::gauss_legendre(pdf, left, right, 1);
             left = right;
             if (left >= hi) break;
         }
         return sum;
     }
     int p = std::max(16, int(std::ceil(panels * (hi - lo) / len)));
-    return gauss_legendre(pdf, lo, hi, p);
+    return test::gauss_legendre(pdf, lo, hi, p);
 }
 
 std::vector<double> chi_edges(const Case& c) {

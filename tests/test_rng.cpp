@@ -4,8 +4,8 @@
 #include <cmath>
 #include <set>
 
-#include "chi_square.h"
 #include "core/rng.h"
+#include "test_support.h"
 
 using namespace mcp;
 

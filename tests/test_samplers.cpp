@@ -5,8 +5,8 @@
 #include <cmath>
 #include <set>
 
-#include "chi_square.h"
 #include "core/samplers.h"
+#include "test_support.h"
 
 using namespace mcp;
 

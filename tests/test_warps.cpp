@@ -6,10 +6,10 @@
 #include <functional>
 #include <vector>
 
-#include "chi_square.h"
 #include "core/rng.h"
 #include "core/special.h"
 #include "core/warps.h"
+#include "test_support.h"
 
 using namespace mcp;
 
@@ -43,24 +43,6 @@ double azimuth_distance(double a, double b) {
 double azimuth(double x, double y) {
     double phi = std::atan2(y, x);
     return phi < 0.0 ? phi + kTwoPi : phi;
-}
-
-/// Composite 5-point Gauss-Legendre rule on `panels` equal panels of [lo, hi]
-/// (exact for polynomials of degree 9 on each panel).
-double gauss_legendre(const std::function<double(double)>& f, double lo, double hi, int panels) {
-    const double x1 = std::sqrt(5.0 - 2.0 * std::sqrt(10.0 / 7.0)) / 3.0;
-    const double x2 = std::sqrt(5.0 + 2.0 * std::sqrt(10.0 / 7.0)) / 3.0;
-    const double w0 = 128.0 / 225.0;
-    const double w1 = (322.0 + 13.0 * std::sqrt(70.0)) / 900.0;
-    const double w2 = (322.0 - 13.0 * std::sqrt(70.0)) / 900.0;
-    const double h = (hi - lo) / panels;
-    double sum = 0.0;
-    for (int p = 0; p < panels; ++p) {
-        double c = lo + (p + 0.5) * h, r = 0.5 * h;
-        sum += r * (w0 * f(c) + w1 * (f(c - x1 * r) + f(c + x1 * r)) +
-                    w2 * (f(c - x2 * r) + f(c + x2 * r)));
-    }
-    return sum;
 }
 
 /// Composite Simpson rule with `intervals` (even) subintervals.
@@ -376,12 +358,14 @@ TEST(Warps, ChiSquareRejectsWrongDensity) {
 TEST(Warps, DensitiesIntegrateToOne) {
     const double tol = 1e-12;
     // Disk: integral over r of pdf * 2 pi r.
-    double disk = gauss_legendre([](double r) { return disk_pdf() * kTwoPi * r; }, 0.0, 1.0, 16);
+    double disk =
+        test::gauss_legendre([](double r) { return disk_pdf() * kTwoPi * r; }, 0.0, 1.0, 16);
     EXPECT_NEAR(disk, 1.0, tol);
     // Directions: integral over theta of pdf(cos theta) * 2 pi sin theta.
     auto over_theta = [](double (*pdf)(double), double theta_max) {
-        return gauss_legendre([pdf](double t) { return pdf(std::cos(t)) * kTwoPi * std::sin(t); },
-                              0.0, theta_max, 64);
+        return test::gauss_legendre(
+            [pdf](double t) { return pdf(std::cos(t)) * kTwoPi * std::sin(t); }, 0.0, theta_max,
+            64);
     };
     EXPECT_NEAR(over_theta([](double) { return uniform_sphere_pdf(); }, kPi), 1.0, tol);
     EXPECT_NEAR(over_theta([](double) { return uniform_hemisphere_pdf(); }, kHalfPi), 1.0, tol);

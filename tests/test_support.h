@@ -1,6 +1,8 @@
-// Pearson chi-square goodness-of-fit test shared by the sampling tests.
+// Helpers shared by the test suites: Pearson chi-square goodness of fit, Sidak levels,
+// and composite Gauss-Legendre quadrature.
 #pragma once
 
+#include <functional>
 #include <vector>
 
 namespace mcp::test {
@@ -21,5 +23,9 @@ ChiSquareResult chi_square(const std::vector<double>& observed, const std::vecto
 /// Per-test significance level that keeps the family-wise level alpha over k tests
 /// (Sidak correction).
 double sidak_level(double alpha, int k);
+
+/// Composite 5-point Gauss-Legendre rule on `panels` equal panels of [lo, hi] (exact for
+/// polynomials of degree 9 on each panel).
+double gauss_legendre(const std::function<double(double)>& f, double lo, double hi, int panels);
 
 } // namespace mcp::test

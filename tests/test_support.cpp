@@ -1,4 +1,4 @@
-#include "chi_square.h"
+#include "test_support.h"
 
 #include <cmath>
 
@@ -37,6 +37,22 @@ ChiSquareResult chi_square(const std::vector<double>& observed, const std::vecto
 
 double sidak_level(double alpha, int k) {
     return 1.0 - std::pow(1.0 - alpha, 1.0 / k);
+}
+
+double gauss_legendre(const std::function<double(double)>& f, double lo, double hi, int panels) {
+    const double x1 = std::sqrt(5.0 - 2.0 * std::sqrt(10.0 / 7.0)) / 3.0;
+    const double x2 = std::sqrt(5.0 + 2.0 * std::sqrt(10.0 / 7.0)) / 3.0;
+    const double w0 = 128.0 / 225.0;
+    const double w1 = (322.0 + 13.0 * std::sqrt(70.0)) / 900.0;
+    const double w2 = (322.0 - 13.0 * std::sqrt(70.0)) / 900.0;
+    const double h = (hi - lo) / panels;
+    double sum = 0.0;
+    for (int p = 0; p < panels; ++p) {
+        double c = lo + (p + 0.5) * h, r = 0.5 * h;
+        sum += r * (w0 * f(c) + w1 * (f(c - x1 * r) + f(c + x1 * r)) +
+                    w2 * (f(c - x2 * r) + f(c + x2 * r)));
+    }
+    return sum;
 }
 
 } // namespace mcp::test
