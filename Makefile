@@ -72,7 +72,7 @@ run: build
 	./$(BUILD)/mcplay run $(SCENE) $(ARGS)
 
 bench: build build-wasm
-	bash bench/run_bench.sh $(BUILD)/mcplay_bench "$(NODE_RUN) $(BUILD_WASM)/mcplay_bench.js"
+	bash bench/run_bench.sh $(BUILD)/mcplay_bench "$(NODE_RUN) --no-liftoff $(BUILD_WASM)/mcplay_bench.js"
 
 format:
 	clang-format -i $$(git ls-files '*.cpp' '*.h')

@@ -6,7 +6,8 @@ native=${1:?native bench}
 wasm=${2:?wasm bench command}
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-echo "mcplay bench: samples per second of the estimator loop (best of 3 runs of 2^22 samples, one thread)"
+echo "mcplay bench: samples per second of the estimator loop (best of 5 runs of 2^22 samples, one thread;"
+echo "  wasm under node --no-liftoff: steady-state optimised code, as a browser reaches after tier-up)"
 echo "machine: $(nproc) cores, $(uname -m), $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //')"
 $native scenes >"$tmp/native"
 $wasm scenes >"$tmp/wasm"
