@@ -18,10 +18,13 @@ Json num(double x) {
 Json diagnostics_to_json(const RunDiagnostics& d) {
     return Json{{"nonfinite", d.nonfinite},
                 {"zero_pdf", d.zero_pdf},
+                {"nonzero", d.nonzero},
                 {"max_weight_share", num(d.max_weight_share)}};
 }
 
 // Plain-language warnings for a level's diagnostics.
+std::string fmt(const char* f, double x);
+
 std::vector<std::string> warnings_for(const LevelStats& l) {
     std::vector<std::string> w;
     const RunDiagnostics& d = l.diagnostics;
@@ -39,6 +42,31 @@ std::vector<std::string> warnings_for(const LevelStats& l) {
                     std::to_string(static_cast<int>(100 * d.max_weight_share + 0.5)) +
                     "% of a run's sum at N = " + std::to_string(l.n) +
                     ": heavy-tailed weights, the error bar is not trustworthy");
+    // Hill's tail index of the weights: below 2 the variance of f/p is (probably) infinite
+    // and the standard error, however small it looks, does not measure the error.
+    if (std::isfinite(l.tail_index) && l.tail_index < 2.0)
+        w.push_back("the weights f/p are heavy-tailed (tail index " + fmt("%.2f", l.tail_index) +
+                    " < 2) at N = " + std::to_string(l.n) +
+                    ": the variance is probably infinite, the error bar is not trustworthy");
+    if (l.n >= 64 && l.nonzero_per_run < 10.0)
+        w.push_back(
+            "only " + fmt("%.1f", l.nonzero_per_run) + " of " + std::to_string(l.n) +
+            " samples per run hit the integrand (f != 0): a narrow peak or small support is "
+            "barely sampled, the estimate and its error bar are unreliable");
+    return w;
+}
+
+std::vector<std::string> estimator_warnings(const EstimatorStudy& e, const StudySettings& s) {
+    std::vector<std::string> w;
+    if (e.support.missed > 0)
+        w.push_back("the pdf is zero at " + std::to_string(e.support.missed) + " of " +
+                    std::to_string(e.support.f_nonzero) + " probe points where f != 0 (" +
+                    fmt("%.3g", 100.0 * e.support.missed_fraction) +
+                    "% of |f|): the estimator never samples there and is biased");
+    if (s.accumulator == Accumulator::Float32)
+        w.push_back(
+            "float32 accumulation (teaching mode): the estimates are naive single-precision "
+            "sums and stall or drift at large N");
     return w;
 }
 
@@ -107,6 +135,8 @@ Json level_to_json(const LevelStats& l) {
            {"efficiency", num(l.efficiency)},
            {"error", num(l.error)},
            {"diagnostics", diagnostics_to_json(l.diagnostics)},
+           {"tail_index", num(l.tail_index)},
+           {"nonzero_per_run", num(l.nonzero_per_run)},
            {"warnings", warnings_for(l)}};
     if (l.has_exact) {
         j["bias"] = num(l.bias);
@@ -134,12 +164,19 @@ Json fit_to_json(const ConvergenceFit& f) {
 
 namespace {
 
-Json estimator_header(const EstimatorStudy& e) {
+Json estimator_header(const EstimatorStudy& e, const StudySettings& s) {
     return Json{{"name", e.spec.name},
                 {"sampler", sampler_name(e.spec.sampler)},
+                {"samples_per_stratum", e.spec.per_stratum},
                 {"pdf", e.spec.proposal.describe()},
                 {"importance", e.spec.proposal.importance},
-                {"error_method", error_method_name(e.error_method)}};
+                {"error_method", error_method_name(e.error_method)},
+                {"support_check",
+                 {{"probes", e.support.probes},
+                  {"f_nonzero", e.support.f_nonzero},
+                  {"missed", e.support.missed},
+                  {"missed_fraction", num(e.support.missed_fraction)}}},
+                {"warnings", estimator_warnings(e, s)}};
 }
 
 } // namespace
@@ -154,14 +191,16 @@ Json study_to_json(const StudyResult& r) {
                {"integrand", describe_integrand(p.integrand)},
                {"quantity", p.quantity == Quantity::Mean ? "mean" : "integral"},
                {"exact", p.exact ? num(*p.exact) : Json(nullptr)}};
-    Json settings{{"n_min", r.settings.n_min},
-                  {"n_max", r.settings.n_max},
-                  {"reps", r.settings.reps},
-                  {"seed", r.settings.seed},
-                  {"threads", r.threads_used}};
+    Json settings{
+        {"n_min", r.settings.n_min},
+        {"n_max", r.settings.n_max},
+        {"reps", r.settings.reps},
+        {"seed", r.settings.seed},
+        {"accumulator", r.settings.accumulator == Accumulator::Float32 ? "float32" : "compensated"},
+        {"threads", r.threads_used}};
     Json estimators = Json::array();
     for (const EstimatorStudy& e : r.estimators) {
-        Json j = estimator_header(e);
+        Json j = estimator_header(e, r.settings);
         Json levels = Json::array();
         for (const LevelStats& l : e.levels) levels.push_back(level_to_json(l));
         j["levels"] = levels;
@@ -181,7 +220,7 @@ Json progress_to_json(const StudyResult& partial, size_t level_index) {
     Json estimators = Json::array();
     uint64_t n = 0;
     for (const EstimatorStudy& e : partial.estimators) {
-        Json j = estimator_header(e);
+        Json j = estimator_header(e, partial.settings);
         if (level_index < e.levels.size()) {
             j["level"] = level_to_json(e.levels[level_index]);
             n = e.levels[level_index].n;
@@ -222,6 +261,8 @@ std::string format_table(const Json& r) {
         if (has_exact) out << padl("rmse", 11) << padl("bias/se", 9) << padl("cover", 7);
         out << padl("time/est", 11) << padl("efficiency", 12) << "\n";
         std::vector<std::string> warnings;
+        for (const Json& w : list(e, "warnings"))
+            if (w.is_string()) out << "  WARNING: " << w.get<std::string>() << "\n";
         for (const Json& l : list(e, "levels")) {
             const double mean = jnum(l, "mean"), var = jnum(l, "variance");
             const double ref = has_exact ? exact : mean;

@@ -428,7 +428,16 @@ bool parse_estimator(Ctx& c, const Json& j, const std::string& path, const Probl
     if (j.is_string()) {
         name = j.get<std::string>();
     } else if (j.is_object()) {
-        if (!check_keys(c, j, path, {"name", "sampler", "pdf", "warp"})) return false;
+        if (!check_keys(c, j, path, {"name", "sampler", "pdf", "warp", "samples_per_stratum"}))
+            return false;
+        uint64_t m = 1;
+        if (!get_count(c, j, "samples_per_stratum", path, &m)) return false;
+        if (m != 1 && m != 2)
+            return c.fail(
+                sub(path, "samples_per_stratum"),
+                "must be 1 (one jittered point per cell) or 2 (unbiased error bars), got " +
+                    std::to_string(m));
+        out->per_stratum = m;
         if (!get_string(c, j, "name", path, &name) ||
             !get_string(c, j, "sampler", path, &sampler_name_str) ||
             !get_string(c, j, "warp", path, &warp))
@@ -445,6 +454,8 @@ bool parse_estimator(Ctx& c, const Json& j, const std::string& path, const Probl
         return c.fail(sub(path, "sampler"),
                       "unknown sampler '" + sampler_name_str +
                           "' (known: independent, stratified, latin_hypercube)");
+    if (out->per_stratum != 1 && out->sampler != SamplerKind::Stratified)
+        return c.fail(sub(path, "samples_per_stratum"), "applies to the stratified sampler only");
     if (!warp.empty() && warp != "polar" && warp != "concentric")
         return c.fail(sub(path, "warp"), "unknown warp '" + warp + "' (known: polar, concentric)");
     if (!warp.empty() && problem.domain.kind != DomainKind::Disk)
@@ -455,6 +466,20 @@ bool parse_estimator(Ctx& c, const Json& j, const std::string& path, const Probl
     } else if (preset && preset->needs_pdf) {
         return c.fail(path, "estimator '" + name + "' needs a pdf: give \"pdf\": {\"type\": ...}");
     }
+    return true;
+}
+
+bool parse_accumulator(Ctx& c, const Json& obj, const std::string& path, Accumulator* out) {
+    std::string name;
+    if (!get_string(c, obj, "accumulator", path, &name)) return false;
+    if (name.empty()) return true;
+    if (name == "compensated")
+        *out = Accumulator::Compensated;
+    else if (name == "float32")
+        *out = Accumulator::Float32;
+    else
+        return c.fail(sub(path, "accumulator"),
+                      "expected \"compensated\" or \"float32\", got \"" + name + "\"");
     return true;
 }
 
@@ -518,7 +543,8 @@ Made<SceneRequest> build_request(const Json& scene, const Json& options) {
     const std::string path = "scene";
     if (!check_keys(c, scene, path,
                     {"name", "description", "domain", "integrand", "quantity", "exact",
-                     "estimators", "n_min", "n_max", "reps", "seed", "threads", "notes"}))
+                     "estimators", "n_min", "n_max", "reps", "seed", "threads", "accumulator",
+                     "notes"}))
         return made_error<SceneRequest>(c.error);
     Problem& pr = req.problem;
     pr.name = "scene";
@@ -595,7 +621,8 @@ Made<SceneRequest> build_request(const Json& scene, const Json& options) {
     if (!get_count(c, scene, "n_min", path, &s.n_min) ||
         !get_count(c, scene, "n_max", path, &s.n_max) ||
         !get_count(c, scene, "reps", path, &reps) || !get_count(c, scene, "seed", path, &s.seed) ||
-        !get_count(c, scene, "threads", path, &threads))
+        !get_count(c, scene, "threads", path, &threads) ||
+        !parse_accumulator(c, scene, path, &s.accumulator))
         return made_error<SceneRequest>(c.error);
 
     req.estimators = all;
@@ -650,6 +677,11 @@ Made<SceneRequest> build_request(const Json& scene, const Json& options) {
     s.threads = static_cast<int>(threads);
     std::string bad = check_settings(s);
     if (!bad.empty()) return made_error<SceneRequest>("settings: " + bad);
+    for (const EstimatorSpec& e : req.estimators)
+        if (e.per_stratum > 1 && s.n_min < e.per_stratum)
+            return made_error<SceneRequest>("estimator '" + e.name + "': samples_per_stratum = " +
+                                            std::to_string(e.per_stratum) +
+                                            " needs n_min >= " + std::to_string(e.per_stratum));
     return {req, {}};
 }
 

@@ -96,12 +96,16 @@ uint64_t permute_index(uint64_t index, uint64_t n, uint64_t key) {
     return x;
 }
 
-SamplerPlan make_sampler_plan(SamplerKind kind, int dim, uint64_t n, Pcg32& rng) {
+SamplerPlan make_sampler_plan(SamplerKind kind, int dim, uint64_t n, Pcg32& rng,
+                              uint64_t per_stratum) {
     SamplerPlan plan;
     plan.kind = kind;
     plan.dim = dim;
     plan.total = n;
-    if (kind == SamplerKind::Stratified) plan.strata = stratification_grid(n, dim);
+    if (kind == SamplerKind::Stratified) {
+        plan.per_stratum = per_stratum >= 1 && n % per_stratum == 0 ? per_stratum : 1;
+        plan.strata = stratification_grid(n / plan.per_stratum, dim);
+    }
     if (kind == SamplerKind::LatinHypercube) {
         for (int j = 0; j < dim; ++j) {
             uint64_t hi = rng.next_u32(), lo = rng.next_u32();
@@ -126,7 +130,7 @@ void generate_block(const SamplerPlan& plan, uint64_t first, size_t count, Pcg32
         // Consecutive indices are neighbouring cells, which the collapsed-strata variance
         // estimate relies on (pairs 2m, 2m+1).
         for (size_t i = 0; i < count; ++i) {
-            uint64_t cell = first + i;
+            uint64_t cell = (first + i) / plan.per_stratum;
             for (int j = d - 1; j >= 0; --j) {
                 uint64_t k = plan.strata[static_cast<size_t>(j)];
                 uint64_t c = cell % k;

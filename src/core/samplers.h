@@ -40,13 +40,17 @@ uint64_t permute_index(uint64_t index, uint64_t n, uint64_t key);
 struct SamplerPlan {
     SamplerKind kind = SamplerKind::Independent;
     int dim = 1;
-    uint64_t total = 0;              ///< N, the number of points of the whole run
-    std::vector<uint64_t> strata;    ///< stratified: counts per axis (product = total)
+    uint64_t total = 0;           ///< N, the number of points of the whole run
+    std::vector<uint64_t> strata; ///< stratified: counts per axis (product = total / per_stratum)
+    uint64_t per_stratum = 1;     ///< stratified: points per cell (1 or 2)
     std::vector<uint64_t> perm_keys; ///< Latin hypercube: one permutation key per axis
 };
 
 /// Plans a run of n points in dim dimensions. Latin hypercube keys are drawn from rng.
-SamplerPlan make_sampler_plan(SamplerKind kind, int dim, uint64_t n, Pcg32& rng);
+/// Stratified runs put per_stratum points in each of n / per_stratum cells (n must be a
+/// multiple of per_stratum; points 2c and 2c+1 share cell c when per_stratum = 2).
+SamplerPlan make_sampler_plan(SamplerKind kind, int dim, uint64_t n, Pcg32& rng,
+                              uint64_t per_stratum = 1);
 
 /// Writes points first .. first + count - 1 of the run into u (count <= u.capacity),
 /// drawing jitter from rng. Consecutive calls must cover the run in order.

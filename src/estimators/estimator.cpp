@@ -1,7 +1,9 @@
 #include "estimators/estimator.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <limits>
 
 #include "core/stats.h"
@@ -11,7 +13,9 @@ namespace mcp {
 void RunDiagnostics::merge(const RunDiagnostics& o) {
     nonfinite += o.nonfinite;
     zero_pdf += o.zero_pdf;
+    nonzero += o.nonzero;
     max_weight_share = std::fmax(max_weight_share, o.max_weight_share);
+    // Tail indices do not add up; a level reports the median over its runs.
 }
 
 const char* error_method_name(ErrorMethod m) {
@@ -20,26 +24,45 @@ const char* error_method_name(ErrorMethod m) {
         return "iid";
     case ErrorMethod::CollapsedStrata:
         return "collapsed_strata";
+    case ErrorMethod::PairedStrata:
+        return "paired_strata";
     case ErrorMethod::IidConservative:
         return "iid_conservative";
     }
     return "?";
 }
 
-ErrorMethod error_method_for(SamplerKind sampler) {
-    switch (sampler) {
+ErrorMethod error_method_for(const EstimatorSpec& spec) {
+    switch (spec.sampler) {
     case SamplerKind::Independent:
         return ErrorMethod::Iid;
     case SamplerKind::Stratified:
-        return ErrorMethod::CollapsedStrata;
+        return spec.per_stratum == 2 ? ErrorMethod::PairedStrata : ErrorMethod::CollapsedStrata;
     case SamplerKind::LatinHypercube:
         return ErrorMethod::IidConservative;
     }
     return ErrorMethod::Iid;
 }
 
+int hill_order(uint64_t n) {
+    // k grows with N (k / N -> 0, k -> infinity, as Hill's estimator needs) but stays small
+    // enough for a fixed-size heap: k = min(64, N / 16); below 8 there is no estimate.
+    const uint64_t k = std::min<uint64_t>(64, n / 16);
+    return k < 8 ? 0 : static_cast<int>(k);
+}
+
+double hill_tail_index(const std::vector<double>& top, int k) {
+    if (k < 1 || static_cast<int>(top.size()) < k + 1)
+        return std::numeric_limits<double>::quiet_NaN();
+    const double xk = top[static_cast<size_t>(k)];
+    if (!(xk > 0.0)) return 0.0;
+    double sum = 0.0;
+    for (int i = 0; i < k; ++i) sum += std::log(top[static_cast<size_t>(i)] / xk);
+    return sum > 0.0 ? k / sum : std::numeric_limits<double>::infinity();
+}
+
 RunResult run_estimate(const Problem& problem, const EstimatorSpec& spec, uint64_t n, Pcg32& rng,
-                       Workspace& ws) {
+                       Workspace& ws, Accumulator accumulator) {
     const auto start = std::chrono::steady_clock::now();
     const Domain& domain = problem.domain;
     const int sdim = domain.sample_dim(), pdim = domain.point_dim();
@@ -48,13 +71,19 @@ RunResult run_estimate(const Problem& problem, const EstimatorSpec& spec, uint64
     ws.pdf.resize(kBlockSize);
     ws.f.resize(kBlockSize);
 
-    const SamplerPlan plan = make_sampler_plan(spec.sampler, sdim, n, rng);
+    const SamplerPlan plan = make_sampler_plan(spec.sampler, sdim, n, rng, spec.per_stratum);
     RunResult result;
     result.n = n;
     RunningMoments moments;
-    NeumaierSum abs_sum, pair_sq_sum; // sum |w|; sum over strata pairs (2m, 2m+1) of (w_a - w_b)^2
+    NeumaierSum abs_sum, pair_sq_sum; // sum |w|; sum over pairs (2m, 2m+1) of (w_a - w_b)^2
+    float float_sum = 0.0f;           // Accumulator::Float32 only
     double max_abs = 0.0;
-    uint64_t pairs = 0;
+    uint64_t pairs = 0, nonzero = 0;
+    // The k+1 largest |w| seen so far, as a min-heap (top.front() is the smallest kept).
+    const int k = hill_order(n);
+    const size_t keep = k > 0 ? static_cast<size_t>(k) + 1 : 0;
+    ws.top.clear();
+    ws.top.reserve(keep);
     double* w = ws.pdf.data(); // the weights overwrite the densities
 
     for (uint64_t first = 0; first < n; first += kBlockSize) {
@@ -68,9 +97,9 @@ RunResult run_estimate(const Problem& problem, const EstimatorSpec& spec, uint64
             if (!std::isfinite(wi) || !(p > 0.0)) {
                 // Rare path: classify, count, and drop (contribute 0).
                 if (p > 0.0 && std::isfinite(p))
-                    ++result.diagnostics.nonfinite; // f/p overflowed or f NaN/Inf
+                    ++result.diagnostics.nonfinite; // f/p overflow, f NaN/Inf
                 else if (f == 0.0) {
-                } // 0/0: no mass on either side
+                } // 0/0: no mass either side
                 else if (std::isnan(f) || std::isnan(p))
                     ++result.diagnostics.nonfinite;
                 else
@@ -80,10 +109,23 @@ RunResult run_estimate(const Problem& problem, const EstimatorSpec& spec, uint64
             w[i] = wi;
         }
         moments.add_block(w, count);
+        if (accumulator == Accumulator::Float32)
+            for (size_t i = 0; i < count; ++i) float_sum += static_cast<float>(w[i]);
         double block_abs = 0.0;
         for (size_t i = 0; i < count; ++i) {
-            block_abs += std::fabs(w[i]);
-            max_abs = std::fmax(max_abs, std::fabs(w[i]));
+            const double a = std::fabs(w[i]);
+            block_abs += a;
+            max_abs = std::fmax(max_abs, a);
+            nonzero += a != 0.0;
+            if (keep == 0) continue;
+            if (ws.top.size() < keep) {
+                ws.top.push_back(a);
+                std::push_heap(ws.top.begin(), ws.top.end(), std::greater<double>());
+            } else if (a > ws.top.front()) {
+                std::pop_heap(ws.top.begin(), ws.top.end(), std::greater<double>());
+                ws.top.back() = a;
+                std::push_heap(ws.top.begin(), ws.top.end(), std::greater<double>());
+            }
         }
         abs_sum.add(block_abs);
         // Blocks start at multiples of kBlockSize (even), so pairs never straddle two blocks.
@@ -95,19 +137,31 @@ RunResult run_estimate(const Problem& problem, const EstimatorSpec& spec, uint64
     }
 
     const double scale = problem.quantity == Quantity::Mean ? 1.0 / domain.measure() : 1.0;
-    result.estimate = moments.mean() * scale;
     const double nd = static_cast<double>(n);
+    const double mean =
+        accumulator == Accumulator::Float32 ? static_cast<double>(float_sum) / nd : moments.mean();
+    result.estimate = mean * scale;
     double variance_of_mean = std::numeric_limits<double>::quiet_NaN();
-    if (error_method_for(spec.sampler) == ErrorMethod::CollapsedStrata) {
-        // E[(w_a - w_b)^2] = s_a^2 + s_b^2 + (m_a - m_b)^2 >= s_a^2 + s_b^2, so
-        // sum (w_a - w_b)^2 / (2 pairs) bounds the mean within-stratum variance from above.
-        if (pairs > 0) variance_of_mean = pair_sq_sum.value() / (2.0 * pairs) / nd;
-    } else if (n > 1) {
-        variance_of_mean = moments.variance() / nd;
+    switch (error_method_for(spec)) {
+    case ErrorMethod::CollapsedStrata:
+    case ErrorMethod::PairedStrata:
+        // E[(w_a - w_b)^2] = s_a^2 + s_b^2 + (m_a - m_b)^2: an upper bound for neighbouring
+        // strata, exactly s_a^2 + s_b^2 when a and b share a stratum. Either way
+        // Var[I_N] ~ sum over pairs (w_a - w_b)^2 / (2 pairs N).
+        if (pairs > 0)
+            variance_of_mean = pair_sq_sum.value() / (2.0 * static_cast<double>(pairs)) / nd;
+        break;
+    case ErrorMethod::Iid:
+    case ErrorMethod::IidConservative:
+        if (n > 1) variance_of_mean = moments.variance() / nd;
+        break;
     }
     result.std_error = std::sqrt(variance_of_mean) * scale;
     const double total_abs = abs_sum.value();
     result.diagnostics.max_weight_share = total_abs > 0.0 ? max_abs / total_abs : 0.0;
+    result.diagnostics.nonzero = nonzero;
+    std::sort(ws.top.begin(), ws.top.end(), std::greater<double>());
+    result.diagnostics.tail_index = hill_tail_index(ws.top, k);
     result.seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return result;

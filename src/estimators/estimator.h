@@ -15,19 +15,26 @@ namespace mcp {
 /// (the estimate is then biased, and the count says by how many samples).
 struct RunDiagnostics {
     uint64_t nonfinite = 0;        ///< f/p was NaN or infinite (f itself NaN/Inf): dropped
-    uint64_t zero_pdf = 0;         ///< f != 0 where p = 0: unreachable mass, dropped
+    uint64_t zero_pdf = 0;         ///< f != 0 where p = 0 at a sampled point: dropped
+    uint64_t nonzero = 0;          ///< samples with f/p != 0 (few: a narrow peak was missed)
     double max_weight_share = 0.0; ///< max |w_i| / sum |w_i|: near 1 means one sample rules
+    double tail_index = 0.0;       ///< Hill estimate of the tail index of |w| (NaN: none)
     void merge(const RunDiagnostics& o);
 };
 
 /// How the per-run standard error is estimated.
 enum class ErrorMethod {
     Iid,             ///< s^2 / N from the sample variance (independent samples)
-    CollapsedStrata, ///< pairs of neighbouring strata [Cochran77, 5A.12]: conservative
+    CollapsedStrata, ///< neighbouring strata paired [Cochran77, 5A.12]: conservative
+    PairedStrata,    ///< two points per stratum: unbiased [Cochran77, 5.4]
     IidConservative, ///< s^2 / N for Latin hypercube: >= its variance up to N/(N-1) [Owen97]
 };
 const char* error_method_name(ErrorMethod m);
-ErrorMethod error_method_for(SamplerKind sampler);
+ErrorMethod error_method_for(const EstimatorSpec& spec);
+
+/// How the weights are summed. Float32 is a teaching mode: a naive single-precision running
+/// sum, to show where naive accumulation stalls (the error bar stays in double).
+enum class Accumulator { Compensated, Float32 };
 
 struct RunResult {
     uint64_t n = 0;
@@ -37,14 +44,24 @@ struct RunResult {
     RunDiagnostics diagnostics;
 };
 
+/// Number of largest weights the Hill estimator uses at N samples (0: too few samples).
+int hill_order(uint64_t n);
+
+/// Hill's estimator of the tail index alpha from the k+1 largest values, sorted in
+/// decreasing order: k / sum_{i<k} log(x_i / x_k) [Hill75]. P(|w| > t) ~ t^-alpha, so
+/// alpha < 2 means infinite variance. Infinite when the top values are all equal, 0 when
+/// x_k is 0 (fewer than k+1 non-zero weights).
+double hill_tail_index(const std::vector<double>& top_descending, int k);
+
 /// Buffers reused across runs so that a run allocates nothing per block.
 struct Workspace {
     PointBlock u, x;
     std::vector<double> pdf, f;
+    std::vector<double> top; ///< min-heap of the largest |w| for the tail index
 };
 
 /// Runs one estimate of the problem with n samples, all randomness drawn from rng.
 RunResult run_estimate(const Problem& problem, const EstimatorSpec& spec, uint64_t n, Pcg32& rng,
-                       Workspace& ws);
+                       Workspace& ws, Accumulator accumulator = Accumulator::Compensated);
 
 } // namespace mcp

@@ -338,4 +338,32 @@ void warp_block(const Proposal& p, const Domain& d, const PointBlock& u, PointBl
     }
 }
 
+void proposal_pdf_block(const Proposal& p, const Domain& d, const PointBlock& x, double* pdf) {
+    const size_t n = x.n;
+    switch (p.kind) {
+    case ProposalKind::UniformBox:
+    case ProposalKind::DiskPolar:
+    case ProposalKind::DiskConcentric:
+    case ProposalKind::Triangle:
+    case ProposalKind::Sphere:
+    case ProposalKind::Hemisphere: {
+        // Uniform proposals: 1/measure wherever the warp can land, which is the whole domain.
+        const double density = 1.0 / d.measure();
+        for (size_t i = 0; i < n; ++i) pdf[i] = density;
+        break;
+    }
+    case ProposalKind::CosineHemisphere:
+        for (size_t i = 0; i < n; ++i) pdf[i] = cosine_hemisphere_pdf(x.coord(2)[i]);
+        break;
+    case ProposalKind::Product1D:
+        for (size_t i = 0; i < n; ++i) pdf[i] = 1.0;
+        for (size_t j = 0; j < p.marginals.size(); ++j)
+            p.marginals[j].multiply_pdf_block(x.coord(static_cast<int>(j)), pdf, n);
+        break;
+    case ProposalKind::Tabulated2D:
+        for (size_t i = 0; i < n; ++i) pdf[i] = p.table.pdf(x.coord(0)[i], x.coord(1)[i]);
+        break;
+    }
+}
+
 } // namespace mcp

@@ -91,10 +91,16 @@ std::string check_proposal(const Proposal& proposal, const Domain& domain);
 void warp_block(const Proposal& proposal, const Domain& domain, const PointBlock& u, PointBlock& x,
                 double* pdf);
 
+/// pdf[i] = density of the proposal at the domain points x (0 outside its support): the
+/// scalar-free form of the densities warp_block returns, for points from anywhere.
+void proposal_pdf_block(const Proposal& proposal, const Domain& domain, const PointBlock& x,
+                        double* pdf);
+
 /// An estimator: how the unit-cube points are placed, and which density warps them.
 struct EstimatorSpec {
     std::string name;
     SamplerKind sampler = SamplerKind::Independent;
+    uint64_t per_stratum = 1; ///< stratified: points per cell; 2 gives an unbiased error bar
     Proposal proposal;
 };
 

@@ -21,7 +21,44 @@ namespace {
 constexpr uint64_t kMaxN = uint64_t(1) << 36;
 constexpr int kMaxReps = 100000;
 constexpr int kMaxThreads = 256;
+constexpr uint64_t kSupportProbes = 1 << 16;
 } // namespace
+
+SupportCheck check_support(const Problem& problem, const EstimatorSpec& spec, uint64_t probes,
+                           uint64_t seed) {
+    SupportCheck check;
+    check.probes = probes;
+    if (!spec.proposal.importance) return check; // uniform proposals cover the whole domain
+    const Domain& d = problem.domain;
+    Pcg32 rng(mix64(seed ^ 0x737570706f7274ULL), hash_string(spec.name.c_str())); // "support"
+    const Proposal uniform = uniform_proposal(d);
+    const SamplerPlan plan =
+        make_sampler_plan(SamplerKind::Independent, d.sample_dim(), probes, rng);
+    PointBlock u, x;
+    u.reset(d.sample_dim(), kBlockSize);
+    x.reset(d.point_dim(), kBlockSize);
+    std::vector<double> f(kBlockSize), p(kBlockSize);
+    NeumaierSum all, missed;
+    for (uint64_t first = 0; first < probes; first += kBlockSize) {
+        const size_t count = static_cast<size_t>(std::min<uint64_t>(kBlockSize, probes - first));
+        generate_block(plan, first, count, rng, u);
+        warp_block(uniform, d, u, x, p.data());
+        evaluate_block(problem.integrand, x, f.data());
+        proposal_pdf_block(spec.proposal, d, x, p.data());
+        for (size_t i = 0; i < count; ++i) {
+            const double a = std::fabs(f[i]);
+            if (!(a > 0.0) || !std::isfinite(a)) continue;
+            ++check.f_nonzero;
+            all.add(a);
+            if (!(p[i] > 0.0)) {
+                ++check.missed;
+                missed.add(a);
+            }
+        }
+    }
+    check.missed_fraction = all.value() > 0.0 ? missed.value() / all.value() : 0.0;
+    return check;
+}
 
 std::string check_settings(const StudySettings& s) {
     if (s.n_min < 1) return "n_min must be >= 1, got " + std::to_string(s.n_min);
@@ -66,7 +103,11 @@ LevelStats summarise_level(const std::vector<RunResult>& runs, const Problem& pr
     int covered = 0, se_count = 0;
     s.has_exact = problem.exact.has_value();
     const double exact = s.has_exact ? *problem.exact : 0.0;
+    std::vector<double> tails;
+    double nonzero = 0.0;
     for (const RunResult& r : runs) {
+        if (!std::isnan(r.diagnostics.tail_index)) tails.push_back(r.diagnostics.tail_index);
+        nonzero += static_cast<double>(r.diagnostics.nonzero);
         est.add(r.estimate);
         time.add(r.seconds);
         s.diagnostics.merge(r.diagnostics);
@@ -84,6 +125,13 @@ LevelStats summarise_level(const std::vector<RunResult>& runs, const Problem& pr
         }
     }
     const double R = static_cast<double>(s.reps);
+    s.nonzero_per_run = nonzero / R;
+    s.tail_index = std::numeric_limits<double>::quiet_NaN();
+    if (!tails.empty()) {
+        std::sort(tails.begin(), tails.end());
+        const size_t m = tails.size();
+        s.tail_index = m % 2 ? tails[m / 2] : 0.5 * (tails[m / 2 - 1] + tails[m / 2]);
+    }
     s.mean = est.mean();
     s.variance = est.variance();
     // s^2 / sigma^2 ~ chi^2_{R-1} for normal estimates.
@@ -160,7 +208,8 @@ StudyResult run_study(const Problem& problem, const std::vector<EstimatorSpec>& 
     for (const EstimatorSpec& spec : estimators) {
         EstimatorStudy es;
         es.spec = spec;
-        es.error_method = error_method_for(spec.sampler);
+        es.error_method = error_method_for(spec);
+        es.support = check_support(problem, spec, kSupportProbes, settings.seed);
         result.estimators.push_back(es);
     }
     const std::vector<uint64_t> ladder = n_ladder(settings.n_min, settings.n_max);
@@ -179,7 +228,7 @@ StudyResult run_study(const Problem& problem, const std::vector<EstimatorSpec>& 
                 const size_t e = t / reps;
                 const int r = static_cast<int>(t % reps);
                 Pcg32 rng(seed_state, replicate_stream(settings.seed, estimators[e].name, n, r));
-                runs[t] = run_estimate(problem, estimators[e], n, rng, ws);
+                runs[t] = run_estimate(problem, estimators[e], n, rng, ws, settings.accumulator);
             }
         };
         const int threads =

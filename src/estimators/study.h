@@ -23,6 +23,7 @@ struct StudySettings {
     int reps = 32;
     uint64_t seed = 1;
     int threads = 0; ///< 0: all hardware threads
+    Accumulator accumulator = Accumulator::Compensated;
 };
 
 /// Checks the settings; returns an error message naming the setting, or "".
@@ -48,9 +49,11 @@ struct LevelStats {
     double mean_run_se = 0.0; ///< average per-run standard error reported by the runs
     double time_mean = 0.0;   ///< seconds per estimate
     double time_total = 0.0;
-    double efficiency = 0.0;    ///< 1 / (variance * time_mean)
-    double error = 0.0;         ///< rmse when exact is known, else sqrt(variance)
-    RunDiagnostics diagnostics; ///< summed over replicates
+    double efficiency = 0.0;      ///< 1 / (variance * time_mean)
+    double error = 0.0;           ///< rmse when exact is known, else sqrt(variance)
+    RunDiagnostics diagnostics;   ///< summed over replicates
+    double tail_index = 0.0;      ///< median over replicates of the Hill tail index (NaN: none)
+    double nonzero_per_run = 0.0; ///< mean number of non-zero weights per run
     std::vector<double> estimates, run_std_errors; ///< per replicate
 };
 
@@ -68,9 +71,24 @@ struct ConvergenceFit {
 /// sampling noise of log s^2 for R normal replicates, psi'((R-1)/2) [trigamma].
 ConvergenceFit fit_convergence(const std::vector<LevelStats>& levels);
 
+/// Does the proposal cover the integrand's support? Checked once per estimator with
+/// uniform points of the domain: where f != 0 but p = 0 the estimator cannot sample, and is
+/// biased by the integral over that region, which no run's own samples can reveal.
+struct SupportCheck {
+    uint64_t probes = 0;
+    uint64_t f_nonzero = 0;       ///< probes with f != 0
+    uint64_t missed = 0;          ///< probes with f != 0 and p = 0
+    double missed_fraction = 0.0; ///< share of sum |f| over the probes that lies where p = 0
+};
+
+/// Runs the support check with `probes` uniform points (its own random stream).
+SupportCheck check_support(const Problem& problem, const EstimatorSpec& spec, uint64_t probes,
+                           uint64_t seed);
+
 struct EstimatorStudy {
     EstimatorSpec spec;
     ErrorMethod error_method = ErrorMethod::Iid;
+    SupportCheck support;
     std::vector<LevelStats> levels;
     ConvergenceFit fit;
 };
