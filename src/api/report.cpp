@@ -25,48 +25,103 @@ Json diagnostics_to_json(const RunDiagnostics& d) {
 // Plain-language warnings for a level's diagnostics.
 std::string fmt(const char* f, double x);
 
-std::vector<std::string> warnings_for(const LevelStats& l) {
-    std::vector<std::string> w;
+// A warning: a stable code (for clients that filter or group) and a sentence for people.
+Json warning(const char* code, const std::string& message) {
+    return Json{{"code", code}, {"message", message}};
+}
+
+Json warnings_for(const LevelStats& l) {
+    Json w = Json::array();
     const RunDiagnostics& d = l.diagnostics;
     if (d.nonfinite)
-        w.push_back(std::to_string(d.nonfinite) +
-                    " sample(s) with NaN/Inf f/p dropped: the estimate is biased");
+        w.push_back(warning("nonfinite", std::to_string(d.nonfinite) +
+                                             " sample(s) with NaN/Inf f/p dropped: the estimate is "
+                                             "biased"));
     if (d.zero_pdf)
-        w.push_back(std::to_string(d.zero_pdf) +
-                    " sample(s) with f != 0 where p = 0: the pdf misses part of the integrand, the "
-                    "estimate is biased");
+        w.push_back(warning("zero_pdf_samples",
+                            std::to_string(d.zero_pdf) +
+                                " sample(s) with f != 0 where p = 0: the pdf misses part of the "
+                                "integrand, the estimate is biased"));
     // One sample carrying a large share of a big sum: the variance estimate is dominated by
     // rare large weights (heavy tail, possibly infinite variance).
     if (l.n >= 1024 && d.max_weight_share > 0.05)
-        w.push_back("one sample carried " +
-                    std::to_string(static_cast<int>(100 * d.max_weight_share + 0.5)) +
-                    "% of a run's sum at N = " + std::to_string(l.n) +
-                    ": heavy-tailed weights, the error bar is not trustworthy");
-    // Hill's tail index of the weights: below 2 the variance of f/p is (probably) infinite
-    // and the standard error, however small it looks, does not measure the error.
-    if (std::isfinite(l.tail_index) && l.tail_index < 2.0)
-        w.push_back("the weights f/p are heavy-tailed (tail index " + fmt("%.2f", l.tail_index) +
-                    " < 2) at N = " + std::to_string(l.n) +
-                    ": the variance is probably infinite, the error bar is not trustworthy");
-    if (l.n >= 64 && l.nonzero_per_run < 10.0)
-        w.push_back(
-            "only " + fmt("%.1f", l.nonzero_per_run) + " of " + std::to_string(l.n) +
-            " samples per run hit the integrand (f != 0): a narrow peak or small support is "
-            "barely sampled, the estimate and its error bar are unreliable");
+        w.push_back(warning("dominant_sample",
+                            "one sample carried " +
+                                std::to_string(static_cast<int>(100 * d.max_weight_share + 0.5)) +
+                                "% of a run's sum at N = " + std::to_string(l.n) +
+                                ": the error bar is not trustworthy"));
+    // Kish's effective sample size: when a handful of samples carry the sum (a narrow peak
+    // barely hit, a few huge weights), the estimate and its error bar rest on those few.
+    if (l.ess_mean < 10.0 && l.ess_mean < 0.25 * static_cast<double>(l.n))
+        w.push_back(warning("low_ess", "effective sample size " + fmt("%.1f", l.ess_mean) + " of " +
+                                           std::to_string(l.n) + " at N = " + std::to_string(l.n) +
+                                           ": the estimate rests on a few samples (narrow peak, "
+                                           "small support or huge weights), its error bar is "
+                                           "unreliable"));
+    // With the exact value known: the replicates' mean must lie within a few of its own
+    // standard errors of it, or the estimator is biased or its variance infinite.
+    if (l.has_exact) {
+        const double tolerance = 5.0 * l.std_error + 1e-12 * std::fabs(l.mean - l.bias);
+        if (std::fabs(l.bias) > tolerance)
+            w.push_back(warning(
+                "exact_outside_ci",
+                "the mean of " + std::to_string(l.reps) + " replicates misses the exact value by " +
+                    (l.std_error > 0.0
+                         ? fmt("%.1f", std::fabs(l.bias) / l.std_error) + " standard errors"
+                         : std::string("a margin with zero spread")) +
+                    " at N = " + std::to_string(l.n) +
+                    ": the estimator is biased or its error bars are wrong"));
+    }
     return w;
 }
 
-std::vector<std::string> estimator_warnings(const EstimatorStudy& e, const StudySettings& s) {
-    std::vector<std::string> w;
+Json estimator_warnings(const EstimatorStudy& e, const StudySettings& s) {
+    Json w = Json::array();
+    // Hill's tail index alpha of the weights, P(|w| > t) ~ t^-alpha, a property of the
+    // estimator: it is read at the largest N, whose pooled sample reaches deepest into the
+    // tail. Below 2 the variance is infinite; below 4 the variance of the sample variance is,
+    // and error bars are unreliable at any practical N. Flag when alpha = 2 is within two
+    // standard errors (alpha / sqrt(k)) [Hill75].
+    const LevelStats* deepest = e.levels.empty() ? nullptr : &e.levels.back();
+    if (deepest && std::isfinite(deepest->tail_index) && deepest->tail_k > 0) {
+        const double a = deepest->tail_index;
+        const double se = a / std::sqrt(static_cast<double>(deepest->tail_k));
+        const std::string where = " (from the " + std::to_string(deepest->tail_k) + " largest of " +
+                                  std::to_string(deepest->n * deepest->reps) +
+                                  " weights at N = " + std::to_string(deepest->n) + ")";
+        if (a < 2.0 + 2.0 * se)
+            w.push_back(warning("heavy_tail", "the weights f/p are heavy-tailed: tail index " +
+                                                  fmt("%.2f", a) + " +/- " + fmt("%.2f", se) +
+                                                  where +
+                                                  ", and below 2 the variance is infinite: the "
+                                                  "error bars are not trustworthy"));
+        else if (a < 4.0)
+            w.push_back(warning("heavy_tail_4",
+                                "the weights f/p have a heavy tail: tail index " + fmt("%.2f", a) +
+                                    where +
+                                    " is below 4, so the variance is finite but its estimate is "
+                                    "unreliable and the error bars may be too small"));
+    }
+
     if (e.support.missed > 0)
-        w.push_back("the pdf is zero at " + std::to_string(e.support.missed) + " of " +
-                    std::to_string(e.support.f_nonzero) + " probe points where f != 0 (" +
-                    fmt("%.3g", 100.0 * e.support.missed_fraction) +
-                    "% of |f|): the estimator never samples there and is biased");
+        w.push_back(warning("pdf_support",
+                            "the pdf is zero at " + std::to_string(e.support.missed) + " of " +
+                                std::to_string(e.support.f_nonzero) +
+                                " probe points where f != 0 (" +
+                                fmt("%.3g", 100.0 * e.support.missed_fraction) +
+                                "% of |f|): the estimator never samples there and is biased"));
+    if (e.consistency.dof > 0 && e.consistency.p_value < 1e-3)
+        w.push_back(warning("level_drift",
+                            "the means at different N disagree beyond their error bars (chi2 = " +
+                                fmt("%.1f", e.consistency.chi2) + " for " +
+                                std::to_string(e.consistency.dof) +
+                                " degrees of freedom, p = " + fmt("%.2g", e.consistency.p_value) +
+                                "): the error bars understate the error (heavy tails, too few "
+                                "samples, or bias)"));
     if (s.accumulator == Accumulator::Float32)
-        w.push_back(
-            "float32 accumulation (teaching mode): the estimates are naive single-precision "
-            "sums and stall or drift at large N");
+        w.push_back(warning("float32_accumulator",
+                            "float32 accumulation (teaching mode): the estimates are naive "
+                            "single-precision sums and stall or drift at large N"));
     return w;
 }
 
@@ -136,7 +191,9 @@ Json level_to_json(const LevelStats& l) {
            {"error", num(l.error)},
            {"diagnostics", diagnostics_to_json(l.diagnostics)},
            {"tail_index", num(l.tail_index)},
+           {"tail_k", l.tail_k},
            {"nonzero_per_run", num(l.nonzero_per_run)},
+           {"ess", num(l.ess_mean)},
            {"warnings", warnings_for(l)}};
     if (l.has_exact) {
         j["bias"] = num(l.bias);
@@ -176,6 +233,10 @@ Json estimator_header(const EstimatorStudy& e, const StudySettings& s) {
                   {"f_nonzero", e.support.f_nonzero},
                   {"missed", e.support.missed},
                   {"missed_fraction", num(e.support.missed_fraction)}}},
+                {"consistency",
+                 {{"chi2", num(e.consistency.chi2)},
+                  {"dof", e.consistency.dof},
+                  {"p_value", num(e.consistency.p_value)}}},
                 {"warnings", estimator_warnings(e, s)}};
 }
 
@@ -260,9 +321,10 @@ std::string format_table(const Json& r) {
         out << padl("N", 9) << padl("mean", 15) << padl("variance", 13) << padl("rel.err", 10);
         if (has_exact) out << padl("rmse", 11) << padl("bias/se", 9) << padl("cover", 7);
         out << padl("time/est", 11) << padl("efficiency", 12) << "\n";
-        std::vector<std::string> warnings;
         for (const Json& w : list(e, "warnings"))
-            if (w.is_string()) out << "  WARNING: " << w.get<std::string>() << "\n";
+            out << "  WARNING: " << jstr(w, "message") << "\n";
+        // Level warnings repeat from N to N: the table shows each code once, at the largest N.
+        std::vector<std::string> codes, messages;
         for (const Json& l : list(e, "levels")) {
             const double mean = jnum(l, "mean"), var = jnum(l, "variance");
             const double ref = has_exact ? exact : mean;
@@ -277,8 +339,16 @@ std::string format_table(const Json& r) {
             }
             out << padl(fmt("%.2e", jnum(l, "time_mean_s")), 11)
                 << padl(fmt("%.3e", jnum(l, "efficiency")), 12) << "\n";
-            for (const Json& w : list(l, "warnings"))
-                if (w.is_string()) warnings.push_back(w.get<std::string>());
+            for (const Json& w : list(l, "warnings")) {
+                const std::string code = jstr(w, "code");
+                size_t at = 0;
+                while (at < codes.size() && codes[at] != code) ++at;
+                if (at == codes.size()) {
+                    codes.push_back(code);
+                    messages.push_back("");
+                }
+                messages[at] = jstr(w, "message");
+            }
         }
         const Json& fit = get(e, "fit");
         if (jbool(fit, "valid"))
@@ -288,15 +358,7 @@ std::string format_table(const Json& r) {
             out << "  fitted order: none";
         if (!jstr(fit, "note").empty()) out << " (" << jstr(fit, "note") << ")";
         out << "\n";
-        // Repeated warnings (one per level) are shown once, the last (largest N) kept.
-        std::vector<std::string> shown;
-        for (auto it = warnings.rbegin(); it != warnings.rend(); ++it) {
-            std::string key = it->substr(0, 20);
-            bool seen = false;
-            for (const std::string& s : shown) seen = seen || s.substr(0, 20) == key;
-            if (!seen) shown.push_back(*it);
-        }
-        for (const std::string& w : shown) out << "  WARNING: " << w << "\n";
+        for (const std::string& m : messages) out << "  WARNING: " << m << "\n";
     }
 
     // Equal-N and equal-time comparison at the largest N every estimator reached.

@@ -15,7 +15,6 @@ void RunDiagnostics::merge(const RunDiagnostics& o) {
     zero_pdf += o.zero_pdf;
     nonzero += o.nonzero;
     max_weight_share = std::fmax(max_weight_share, o.max_weight_share);
-    // Tail indices do not add up; a level reports the median over its runs.
 }
 
 const char* error_method_name(ErrorMethod m) {
@@ -44,10 +43,10 @@ ErrorMethod error_method_for(const EstimatorSpec& spec) {
     return ErrorMethod::Iid;
 }
 
-int hill_order(uint64_t n) {
-    // k grows with N (k / N -> 0, k -> infinity, as Hill's estimator needs) but stays small
-    // enough for a fixed-size heap: k = min(64, N / 16); below 8 there is no estimate.
-    const uint64_t k = std::min<uint64_t>(64, n / 16);
+int hill_order(uint64_t samples) {
+    // k grows with the sample (k / n -> 0, k -> infinity, as Hill's estimator needs) but stays
+    // small enough for a fixed-size heap: k = min(64, n / 16); below 8 there is no estimate.
+    const uint64_t k = std::min<uint64_t>(64, samples / 16);
     return k < 8 ? 0 : static_cast<int>(k);
 }
 
@@ -75,13 +74,14 @@ RunResult run_estimate(const Problem& problem, const EstimatorSpec& spec, uint64
     RunResult result;
     result.n = n;
     RunningMoments moments;
-    NeumaierSum abs_sum, pair_sq_sum; // sum |w|; sum over pairs (2m, 2m+1) of (w_a - w_b)^2
+    NeumaierSum abs_sum, diff_sq_sum; // sum |w|; sum of squared differences (see below)
     float float_sum = 0.0f;           // Accumulator::Float32 only
     double max_abs = 0.0;
-    uint64_t pairs = 0, nonzero = 0;
-    // The k+1 largest |w| seen so far, as a min-heap (top.front() is the smallest kept).
-    const int k = hill_order(n);
-    const size_t keep = k > 0 ? static_cast<size_t>(k) + 1 : 0;
+    uint64_t diffs = 0, nonzero = 0;
+    double previous = 0.0;
+    const bool paired = error_method_for(spec) == ErrorMethod::PairedStrata;
+    // The kTopWeights largest |w| seen so far, as a min-heap (top.front() is the smallest).
+    const size_t keep = kTopWeights;
     ws.top.clear();
     ws.top.reserve(keep);
     double* w = ws.pdf.data(); // the weights overwrite the densities
@@ -117,7 +117,6 @@ RunResult run_estimate(const Problem& problem, const EstimatorSpec& spec, uint64
             block_abs += a;
             max_abs = std::fmax(max_abs, a);
             nonzero += a != 0.0;
-            if (keep == 0) continue;
             if (ws.top.size() < keep) {
                 ws.top.push_back(a);
                 std::push_heap(ws.top.begin(), ws.top.end(), std::greater<double>());
@@ -128,12 +127,24 @@ RunResult run_estimate(const Problem& problem, const EstimatorSpec& spec, uint64
             }
         }
         abs_sum.add(block_abs);
-        // Blocks start at multiples of kBlockSize (even), so pairs never straddle two blocks.
-        double block_pairs = 0.0;
-        for (size_t i = 0; i + 1 < count; i += 2)
-            block_pairs += (w[i] - w[i + 1]) * (w[i] - w[i + 1]);
-        pair_sq_sum.add(block_pairs);
-        pairs += count / 2;
+        if (paired) {
+            // Two points per cell: pairs (2m, 2m+1) share a cell. Blocks start at multiples of
+            // kBlockSize (even), so a pair never straddles two blocks.
+            double block_pairs = 0.0;
+            for (size_t i = 0; i + 1 < count; i += 2)
+                block_pairs += (w[i] - w[i + 1]) * (w[i] - w[i + 1]);
+            diff_sq_sum.add(block_pairs);
+            diffs += count / 2;
+        } else {
+            // Successive differences of neighbouring cells, across block boundaries too.
+            double block_diffs = 0.0;
+            for (size_t i = 0; i < count; ++i) {
+                if (first + i > 0) block_diffs += (w[i] - previous) * (w[i] - previous);
+                previous = w[i];
+            }
+            diff_sq_sum.add(block_diffs);
+            diffs += first == 0 ? count - 1 : count;
+        }
     }
 
     const double scale = problem.quantity == Quantity::Mean ? 1.0 / domain.measure() : 1.0;
@@ -145,11 +156,13 @@ RunResult run_estimate(const Problem& problem, const EstimatorSpec& spec, uint64
     switch (error_method_for(spec)) {
     case ErrorMethod::CollapsedStrata:
     case ErrorMethod::PairedStrata:
-        // E[(w_a - w_b)^2] = s_a^2 + s_b^2 + (m_a - m_b)^2: an upper bound for neighbouring
-        // strata, exactly s_a^2 + s_b^2 when a and b share a stratum. Either way
-        // Var[I_N] ~ sum over pairs (w_a - w_b)^2 / (2 pairs N).
-        if (pairs > 0)
-            variance_of_mean = pair_sq_sum.value() / (2.0 * static_cast<double>(pairs)) / nd;
+        // E[(w_a - w_b)^2] = s_a^2 + s_b^2 + (m_a - m_b)^2: exactly s_a^2 + s_b^2 when a and b
+        // share a cell (paired strata, unbiased), an upper bound for neighbouring cells
+        // (collapsed strata, conservative; all N-1 successive differences are used, so one
+        // unlucky pair cannot make the error bar 0 [Cochran77, 5A.12; vonNeumann41]).
+        // Either way Var[I_N] ~ sum d^2 / (2 count N).
+        if (diffs > 0)
+            variance_of_mean = diff_sq_sum.value() / (2.0 * static_cast<double>(diffs)) / nd;
         break;
     case ErrorMethod::Iid:
     case ErrorMethod::IidConservative:
@@ -160,8 +173,11 @@ RunResult run_estimate(const Problem& problem, const EstimatorSpec& spec, uint64
     const double total_abs = abs_sum.value();
     result.diagnostics.max_weight_share = total_abs > 0.0 ? max_abs / total_abs : 0.0;
     result.diagnostics.nonzero = nonzero;
+    // Effective sample size [Kish65]: how many equal weights would carry the same information.
+    const double sum_sq = moments.sum_squared_deviations() + nd * moments.mean() * moments.mean();
+    result.diagnostics.ess = sum_sq > 0.0 ? total_abs * total_abs / sum_sq : 0.0;
     std::sort(ws.top.begin(), ws.top.end(), std::greater<double>());
-    result.diagnostics.tail_index = hill_tail_index(ws.top, k);
+    result.top = ws.top;
     result.seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return result;

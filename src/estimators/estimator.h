@@ -18,7 +18,7 @@ struct RunDiagnostics {
     uint64_t zero_pdf = 0;         ///< f != 0 where p = 0 at a sampled point: dropped
     uint64_t nonzero = 0;          ///< samples with f/p != 0 (few: a narrow peak was missed)
     double max_weight_share = 0.0; ///< max |w_i| / sum |w_i|: near 1 means one sample rules
-    double tail_index = 0.0;       ///< Hill estimate of the tail index of |w| (NaN: none)
+    double ess = 0.0;              ///< Kish's effective sample size (sum |w|)^2 / sum w^2
     void merge(const RunDiagnostics& o);
 };
 
@@ -42,15 +42,19 @@ struct RunResult {
     double std_error = 0.0; ///< NaN when it cannot be estimated (N = 1)
     double seconds = 0.0;
     RunDiagnostics diagnostics;
+    std::vector<double> top; ///< the kTopWeights largest |w|, decreasing (for the tail index)
 };
 
-/// Number of largest weights the Hill estimator uses at N samples (0: too few samples).
-int hill_order(uint64_t n);
+/// Largest weights each run keeps for the tail index (enough for Hill's k = 64).
+constexpr size_t kTopWeights = 65;
+
+/// Hill order for a pool of `samples` weights: k = min(64, samples / 16), 0 below 8.
+int hill_order(uint64_t samples);
 
 /// Hill's estimator of the tail index alpha from the k+1 largest values, sorted in
-/// decreasing order: k / sum_{i<k} log(x_i / x_k) [Hill75]. P(|w| > t) ~ t^-alpha, so
-/// alpha < 2 means infinite variance. Infinite when the top values are all equal, 0 when
-/// x_k is 0 (fewer than k+1 non-zero weights).
+/// decreasing order (standard error about alpha / sqrt(k)): k / sum_{i<k} log(x_i / x_k) [Hill75].
+/// P(|w| > t) ~ t^-alpha, so alpha < 2 means infinite variance. Infinite when the top values are
+/// all equal, 0 when x_k is 0 (fewer than k+1 non-zero weights).
 double hill_tail_index(const std::vector<double>& top_descending, int k);
 
 /// Buffers reused across runs so that a run allocates nothing per block.

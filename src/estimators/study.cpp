@@ -103,10 +103,13 @@ LevelStats summarise_level(const std::vector<RunResult>& runs, const Problem& pr
     int covered = 0, se_count = 0;
     s.has_exact = problem.exact.has_value();
     const double exact = s.has_exact ? *problem.exact : 0.0;
-    std::vector<double> tails;
-    double nonzero = 0.0;
+    // Every run keeps its kTopWeights largest |w|, so the largest of the pooled tops are the
+    // largest weights of all R N samples: the tail index uses them all.
+    std::vector<double> pooled;
+    double nonzero = 0.0, ess = 0.0;
     for (const RunResult& r : runs) {
-        if (!std::isnan(r.diagnostics.tail_index)) tails.push_back(r.diagnostics.tail_index);
+        ess += r.diagnostics.ess;
+        pooled.insert(pooled.end(), r.top.begin(), r.top.end());
         nonzero += static_cast<double>(r.diagnostics.nonzero);
         est.add(r.estimate);
         time.add(r.seconds);
@@ -126,12 +129,10 @@ LevelStats summarise_level(const std::vector<RunResult>& runs, const Problem& pr
     }
     const double R = static_cast<double>(s.reps);
     s.nonzero_per_run = nonzero / R;
-    s.tail_index = std::numeric_limits<double>::quiet_NaN();
-    if (!tails.empty()) {
-        std::sort(tails.begin(), tails.end());
-        const size_t m = tails.size();
-        s.tail_index = m % 2 ? tails[m / 2] : 0.5 * (tails[m / 2 - 1] + tails[m / 2]);
-    }
+    s.ess_mean = ess / R;
+    std::sort(pooled.begin(), pooled.end(), std::greater<double>());
+    s.tail_k = hill_order(s.n * static_cast<uint64_t>(s.reps));
+    s.tail_index = hill_tail_index(pooled, s.tail_k);
     s.mean = est.mean();
     s.variance = est.variance();
     // s^2 / sigma^2 ~ chi^2_{R-1} for normal estimates.
@@ -164,7 +165,10 @@ ConvergenceFit fit_convergence(const std::vector<LevelStats>& levels) {
     std::vector<double> x, y;
     int reps = 0, skipped = 0;
     for (const LevelStats& l : levels) {
-        if (l.variance > 0.0 && std::isfinite(l.variance)) {
+        // A variance at the round-off level of the mean (an exact estimator such as a pdf
+        // proportional to f) carries no convergence information.
+        const double roundoff = 64.0 * 2.220446049250313e-16 * std::fabs(l.mean);
+        if (l.variance > roundoff * roundoff && std::isfinite(l.variance)) {
             x.push_back(std::log(static_cast<double>(l.n)));
             y.push_back(std::log(l.variance));
             reps = l.reps;
@@ -173,8 +177,12 @@ ConvergenceFit fit_convergence(const std::vector<LevelStats>& levels) {
         }
     }
     fit.levels_used = static_cast<int>(x.size());
-    if (x.size() < 2) {
-        fit.note = skipped ? "variance is zero at every N (exact estimator?)" : "needs two levels";
+    if (skipped)
+        fit.note = std::to_string(skipped) + " level(s) with zero (round-off) variance left out";
+    if (x.size() < 3) {
+        fit.note = x.empty() && skipped ? "variance is zero at every N (an exact estimator?)"
+                                        : "fewer than 3 levels with a variance: no fit" +
+                                              (fit.note.empty() ? "" : "; " + fit.note);
         return fit;
     }
     LineFit line = fit_line(x, y);
@@ -183,8 +191,30 @@ ConvergenceFit fit_convergence(const std::vector<LevelStats>& levels) {
     fit.intercept = line.intercept;
     const double noise = reps > 1 ? trigamma(0.5 * (reps - 1)) : 0.0;
     fit.order_se = std::sqrt(std::fmax(line.residual_variance, noise) / line.sxx);
-    if (skipped) fit.note = std::to_string(skipped) + " level(s) with zero variance left out";
     return fit;
+}
+
+LevelConsistency level_consistency(const std::vector<LevelStats>& levels) {
+    LevelConsistency c;
+    double wsum = 0.0, wmean = 0.0;
+    for (const LevelStats& l : levels)
+        if (l.std_error > 0.0 && std::isfinite(l.std_error) && std::isfinite(l.mean)) {
+            const double w = 1.0 / (l.std_error * l.std_error);
+            wsum += w;
+            wmean += w * l.mean;
+        }
+    if (wsum == 0.0) return c;
+    wmean /= wsum;
+    int used = 0;
+    for (const LevelStats& l : levels)
+        if (l.std_error > 0.0 && std::isfinite(l.std_error) && std::isfinite(l.mean)) {
+            const double z = (l.mean - wmean) / l.std_error;
+            c.chi2 += z * z;
+            ++used;
+        }
+    c.dof = used - 1;
+    c.p_value = c.dof > 0 ? chi_square_sf(c.chi2, c.dof) : 1.0;
+    return c;
 }
 
 int resolve_threads(int requested) {
@@ -251,6 +281,7 @@ StudyResult run_study(const Problem& problem, const std::vector<EstimatorSpec>& 
             EstimatorStudy& es = result.estimators[e];
             es.levels.push_back(summarise_level(level_runs, problem));
             es.fit = fit_convergence(es.levels);
+            es.consistency = level_consistency(es.levels);
         }
         result.wall_seconds =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

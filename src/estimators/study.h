@@ -52,8 +52,10 @@ struct LevelStats {
     double efficiency = 0.0;      ///< 1 / (variance * time_mean)
     double error = 0.0;           ///< rmse when exact is known, else sqrt(variance)
     RunDiagnostics diagnostics;   ///< summed over replicates
-    double tail_index = 0.0;      ///< median over replicates of the Hill tail index (NaN: none)
+    double tail_index = 0.0;      ///< Hill tail index of |w| pooled over the replicates (NaN: none)
+    int tail_k = 0;               ///< its order k (standard error ~ tail_index / sqrt(k))
     double nonzero_per_run = 0.0; ///< mean number of non-zero weights per run
+    double ess_mean = 0.0;        ///< mean effective sample size per run
     std::vector<double> estimates, run_std_errors; ///< per replicate
 };
 
@@ -85,8 +87,20 @@ struct SupportCheck {
 SupportCheck check_support(const Problem& problem, const EstimatorSpec& spec, uint64_t probes,
                            uint64_t seed);
 
+/// Do the level means agree with each other? Every level estimates the same number, so
+/// chi2 = sum_l (mean_l - m)^2 / se_l^2 about their weighted mean m is chi-square with L-1
+/// degrees of freedom when the error bars are right. A tiny p-value says they are not
+/// (heavy tails, too few samples at small N), even when the exact value is unknown.
+struct LevelConsistency {
+    double chi2 = 0.0;
+    int dof = 0;
+    double p_value = 1.0;
+};
+LevelConsistency level_consistency(const std::vector<LevelStats>& levels);
+
 struct EstimatorStudy {
     EstimatorSpec spec;
+    LevelConsistency consistency;
     ErrorMethod error_method = ErrorMethod::Iid;
     SupportCheck support;
     std::vector<LevelStats> levels;
