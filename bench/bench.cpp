@@ -2,6 +2,7 @@
 // raw PCG32 draws per second. Prints "BENCH <case> <samples/s>" lines that run_bench.sh
 // sets side by side for the native and the WebAssembly builds.
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -59,6 +60,52 @@ double pcg32_draws_per_second() {
     return static_cast<double>(draws) / t;
 }
 
+// Integrand evaluations per second over blocks of kBlockSize points (best of five calls).
+double evaluations_per_second(const Integrand& f, uint64_t total) {
+    PointBlock x;
+    x.reset(f.dim, kBlockSize);
+    x.n = kBlockSize;
+    Pcg32 rng(3, 4);
+    for (int j = 0; j < f.dim; ++j)
+        for (size_t i = 0; i < kBlockSize; ++i) x.coord(j)[i] = rng.next_double();
+    std::vector<double> out(kBlockSize);
+    double best = 1e300, checksum = 0.0;
+    for (int rep = 0; rep < 6; ++rep) { // the first call is the warm-up
+        auto t0 = std::chrono::steady_clock::now();
+        for (uint64_t done = 0; done < total; done += kBlockSize) {
+            evaluate_block(f, x, out.data());
+            checksum += out[0];
+        }
+        const double t = seconds_since(t0);
+        if (rep > 0 && t < best) best = t;
+    }
+    if (checksum == 0.123) std::fprintf(stderr, "(checksum)\n");
+    return static_cast<double>(total) / best;
+}
+
+// Summing 2^30 copies of 0.1: a naive double sum, a naive float sum and mcplay's compensated
+// sum, against the exact 2^30 * fl(0.1).
+void accumulation_accuracy() {
+    const uint64_t n = uint64_t(1) << 30;
+    const double term = 0.1;
+    double naive = 0.0;
+    float naive_float = 0.0f;
+    NeumaierSum compensated;
+    auto t0 = std::chrono::steady_clock::now();
+    for (uint64_t i = 0; i < n; ++i) {
+        naive += term;
+        naive_float += static_cast<float>(term);
+        compensated.add(term);
+    }
+    const double t = seconds_since(t0);
+    const double exact = term * static_cast<double>(n); // exact: a power-of-two multiple
+    std::printf("ACCUM sum of 2^30 x 0.1 (%.1f s): relative error naive double %.2e, naive float "
+                "%.2e, compensated %.2e\n",
+                t, std::fabs(naive - exact) / exact,
+                std::fabs(static_cast<double>(naive_float) - exact) / exact,
+                std::fabs(compensated.value() - exact) / exact);
+}
+
 } // namespace
 
 int main(int argc, char** argv) {
@@ -88,5 +135,18 @@ int main(int argc, char** argv) {
             if (spec.name == c[1])
                 std::printf("BENCH %s/%s %.6e\n", c[0], c[1], samples_per_second(req, spec, n));
     }
+
+    // An expression against the same integrand compiled in C++: exp(-(x-0.5)^2/0.01) is the
+    // built-in Gaussian with 2 sigma^2 = 0.01.
+    Made<Integrand> expr = make_expression_integrand("exp(-(x-0.5)^2/0.01)", 1);
+    Made<Integrand> gauss =
+        make_integrand(IntegrandKind::Gaussian, 1, 1.0, {}, {0.5}, std::sqrt(0.005));
+    if (!expr.ok() || !gauss.ok()) return 1;
+    const double e = evaluations_per_second(expr.value, n),
+                 g = evaluations_per_second(gauss.value, n);
+    std::printf("BENCH eval/expression_gaussian %.6e\n", e);
+    std::printf("BENCH eval/compiled_gaussian %.6e\n", g);
+    std::printf("RATIO compiled/expression %.2f\n", g / e);
+    if (argc > 3 && std::string(argv[3]) == "--accumulation") accumulation_accuracy();
     return 0;
 }

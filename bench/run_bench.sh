@@ -9,9 +9,15 @@ trap 'rm -rf "$tmp"' EXIT
 echo "mcplay bench: samples per second of the estimator loop (best of 5 runs of 2^22 samples, one thread;"
 echo "  wasm under node --no-liftoff: steady-state optimised code, as a browser reaches after tier-up)"
 echo "machine: $(nproc) cores, $(uname -m), $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //')"
-$native scenes >"$tmp/native"
-$wasm scenes >"$tmp/wasm"
+$native scenes $((1 << 22)) --accumulation >"$tmp/native"
+$wasm scenes $((1 << 22)) --accumulation >"$tmp/wasm"
 printf '%-44s %14s %14s %8s\n' case native wasm native/wasm
 join <(grep ^BENCH "$tmp/native" | awk '{print $2, $3}' | sort) \
      <(grep ^BENCH "$tmp/wasm" | awk '{print $2, $3}' | sort) |
     awk '{ printf "%-44s %14.3e %14.3e %7.2fx\n", $1, $2, $3, $2 / $3 }'
+echo
+echo "expression vs the same integrand compiled in C++ (evaluations per second; target ratio <= 3):"
+echo "  native: $(grep ^RATIO "$tmp/native" | cut -d' ' -f2-)    wasm: $(grep ^RATIO "$tmp/wasm" | cut -d' ' -f2-)"
+echo "accumulation over 2^30 terms:"
+echo "  native: $(grep ^ACCUM "$tmp/native" | cut -d' ' -f2-)"
+echo "  wasm:   $(grep ^ACCUM "$tmp/wasm" | cut -d' ' -f2-)"

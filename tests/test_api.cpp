@@ -2,6 +2,7 @@
 // cancellation, formatting.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -109,6 +110,24 @@ TEST(Api, BadScenesGiveScenesErrorsNamingTheField) {
          "scene.n_max: expected a non-negative whole number"},
         {R"({"integrand": {"type": "constant"}, "n_min": 17, "n_max": 31})", "no power of two"},
         {R"({"integrand": {"type": "constant"}, "quantity": "median"})", "scene.quantity"},
+        {R"J({"f": "x*y + sinn(pi*x)"})J", "scene.f: at position 7: unknown function 'sinn'"},
+        {R"J({"f": "exp(-(x-0.5)^2/0.01"})J",
+         "scene.f: at position 20: expected ')' to close the '(' at position 4"},
+        {R"J({"f": "1 +", "integrand": {"type": "constant"}})J", "not both"},
+        {R"J({"domain": {"type": "box", "dim": 2}, "f": "x3"})J", "beyond the domain's dimension"},
+        {R"({"integrand": {"type": "expression"}})", "needs \"f\""},
+        {R"J({"f": "x", "estimators": [{"name": "i", "pdf": "x^"}]})J", "pdf.shape: at position 3"},
+        {R"J({"f": "x", "domain": {"type": "box", "dim": 3}, "estimators": [{"name": "i", "pdf": "x"}]})J",
+         "1- or 2-dimensional"},
+        {R"J({"integrand": {"type": "genz_gaussian", "a": [1, -1], "u": [0.5, 0.5]}})J", "a[1]"},
+        {R"J({"integrand": {"type": "genz_wobbly", "dim": 2}})J",
+         "unknown integrand 'genz_wobbly'"},
+        {R"J({"integrand": {"type": "genz_product_peak", "dim": 64, "seed": 1}})J",
+         "outside double precision"},
+        {R"J({"integrand": {"type": "genz_gaussian", "dim": 2, "difficulty": -1}})J", "difficulty"},
+        {R"J({"integrand": {"type": "constant"}, "estimators": [{"name": "s", "sampler": "stratified", "samples_per_stratum": 3}]})J",
+         "samples_per_stratum"},
+        {R"J({"integrand": {"type": "constant"}, "accumulator": "float16"})J", "scene.accumulator"},
     };
     for (const Case& c : cases) {
         Outcome o = run(c.scene);
@@ -208,6 +227,31 @@ TEST(Api, FormatsTableCsvJson) {
     ASSERT_EQ(mcp_result_format(R"({"estimators": [{"levels": [3, {"n": "x"}]}]})", "csv", &text),
               MCP_OK);
     mcp_free(text);
+}
+
+TEST(Api, ExpressionAndGenzScenesRun) {
+    // Expression integrand and pdf: the integral of 3x^2 is 1; sampling p = 3x^2 is exact.
+    Outcome o =
+        run(R"J({"f": "3*x^2", "exact": 1, "estimators": ["uniform", {"name": "is", "pdf": "x^2"}],
+                        "n_min": 1024, "n_max": 1024, "reps": 8})J");
+    ASSERT_EQ(o.status, MCP_OK) << o.error;
+    EXPECT_EQ(o.result["scene"]["dimension"], 1);
+    for (const json& e : o.result["estimators"]) {
+        const json& l = e["levels"][0];
+        EXPECT_LT(std::fabs(l["mean"].get<double>() - 1.0), 5 * l["std_error"].get<double>() + 1e-3)
+            << e["name"];
+    }
+    // Without a domain the highest variable sets the dimension.
+    o = run(R"J({"f": "x1 * x3", "n_max": 64, "reps": 2})J");
+    ASSERT_EQ(o.status, MCP_OK) << o.error;
+    EXPECT_EQ(o.result["scene"]["dimension"], 3);
+    // Genz: the exact value comes from the closed form.
+    o = run(
+        R"J({"integrand": {"type": "genz_continuous", "a": [2, 3], "u": [0.25, 0.5]}, "n_max": 64, "reps": 2})J");
+    ASSERT_EQ(o.status, MCP_OK) << o.error;
+    const double i1 = (-std::expm1(-2 * 0.25) - std::expm1(-2 * 0.75)) / 2;
+    const double i2 = (-std::expm1(-3 * 0.5) - std::expm1(-3 * 0.5)) / 3;
+    EXPECT_NEAR(o.result["scene"]["exact"].get<double>(), i1 * i2, 1e-14);
 }
 
 TEST(Api, SceneInfoAndCatalog) {

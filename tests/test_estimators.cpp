@@ -288,7 +288,9 @@ TEST_P(StiffScene, NoConfidentWrongAnswer) {
 INSTANTIATE_TEST_SUITE_P(StiffScenes, StiffScene,
                          ::testing::Values("stiff_peak_1e-8", "singular_power_0.3",
                                            "singular_power_0.5", "singular_power_0.9", "step_1d",
-                                           "is_near_zero_pdf", "is_zero_pdf"));
+                                           "is_near_zero_pdf", "is_zero_pdf", "oscillatory_cos1000",
+                                           "offset_1e8_sin", "heavy_tail_abs", "genz_gaussian_32d",
+                                           "genz_oscillatory_64d", "genz_corner_peak_12d"));
 
 TEST(Diagnostics, MissedPeakIsFlaggedNotReportedAsExact) {
     SceneRequest req =

@@ -318,7 +318,7 @@ std::string format_table(const Json& r) {
         out << "\n"
             << jstr(e, "name") << "  [sampler " << jstr(e, "sampler") << ", pdf " << jstr(e, "pdf")
             << ", per-run error: " << jstr(e, "error_method") << "]\n";
-        out << padl("N", 9) << padl("mean", 15) << padl("variance", 13) << padl("rel.err", 10);
+        out << padl("N", 9) << padl("mean", 17) << padl("variance", 13) << padl("rel.err", 10);
         if (has_exact) out << padl("rmse", 11) << padl("bias/se", 9) << padl("cover", 7);
         out << padl("time/est", 11) << padl("efficiency", 12) << "\n";
         for (const Json& w : list(e, "warnings"))
@@ -328,7 +328,7 @@ std::string format_table(const Json& r) {
         for (const Json& l : list(e, "levels")) {
             const double mean = jnum(l, "mean"), var = jnum(l, "variance");
             const double ref = has_exact ? exact : mean;
-            out << padl(fmt("%.0f", jnum(l, "n")), 9) << padl(fmt("%.9g", mean), 15)
+            out << padl(fmt("%.0f", jnum(l, "n")), 9) << padl(fmt("%.9g", mean), 17)
                 << padl(fmt("%.4e", var), 13)
                 << padl(ref != 0.0 ? fmt("%.2e", std::sqrt(var) / std::fabs(ref)) : "-", 10);
             if (has_exact) {

@@ -202,19 +202,84 @@ bool parse_domain(Ctx& c, const Json& j, const std::string& path, int default_di
 
 // --- integrand ---------------------------------------------------------------------------
 
+constexpr const char* kIntegrandTypes =
+    "constant, monomial, exponential, gaussian, indicator_ball, expression, genz_oscillatory, "
+    "genz_product_peak, genz_corner_peak, genz_gaussian, genz_continuous, genz_discontinuous";
+
+bool parse_expression(Ctx& c, const Json& text, const std::string& path, int dim, Integrand* out) {
+    if (!text.is_string())
+        return c.fail(path, "expected an expression string, got " + type_of(text));
+    Made<Integrand> f = make_expression_integrand(text.get<std::string>(), dim);
+    if (!f.ok()) return c.fail(path, f.error);
+    *out = f.value;
+    return true;
+}
+
+// Genz families: explicit "a" and "u", or Genz's random normalisation from "seed" and
+// "difficulty" (dimension from "dim" or the domain).
+bool parse_genz(Ctx& c, const Json& j, const std::string& path, GenzFamily family, int dim,
+                Integrand* out) {
+    if (!check_keys(c, j, path, {"type", "a", "u", "dim", "seed", "difficulty"})) return false;
+    std::vector<double> a, u;
+    if (!get_numbers(c, j, "a", path, &a) || !get_numbers(c, j, "u", path, &u)) return false;
+    GenzParams params;
+    if (find(j, "a")) {
+        if (!find(j, "u")) u.assign(a.size(), 0.5);
+        Made<GenzParams> g = make_genz(family, a, u);
+        if (!g.ok()) return c.fail(path, g.error);
+        params = g.value;
+    } else {
+        if (find(j, "u"))
+            return c.fail(sub(path, "u"), "give \"a\" with \"u\", or neither (random)");
+        uint64_t seed = 1;
+        double difficulty = 1.0;
+        if (!get_count(c, j, "seed", path, &seed) ||
+            !get_number(c, j, "difficulty", path, &difficulty))
+            return false;
+        if (!(difficulty > 0.0))
+            return c.fail(sub(path, "difficulty"), "must be > 0 (1 = Genz's standard difficulty)");
+        params = genz_random(family, dim, seed, difficulty);
+    }
+    // Genz's normalisation can push an integral (and every value of f) below the double range
+    // (product_peak at d = 64 is ~1e-340): refuse it rather than estimate 0 against 0.
+    int sign = 0;
+    const double log_exact = genz_log_exact(params, &sign);
+    if (sign != 0 && log_exact < std::log(1e-280))
+        return c.fail(
+            path, std::string(genz_family_name(family)) +
+                      " in d = " + std::to_string(params.dim()) + " has an integral of about 1e" +
+                      std::to_string(static_cast<int>(std::floor(log_exact / std::log(10.0)))) +
+                      ", outside double precision: lower the difficulty or the dimension");
+    if (params.dim() != dim)
+        return c.fail(path, std::string(genz_family_name(family)) + " has " +
+                                std::to_string(params.dim()) + " dimensions, the domain " +
+                                std::to_string(dim));
+    *out = make_genz_integrand(params);
+    return true;
+}
+
 bool parse_integrand(Ctx& c, const Json& j, const std::string& path, int dim, Integrand* out) {
-    if (!check_keys(c, j, path, {"type", "scale", "powers", "rates", "center", "sigma", "radius"}))
-        return false;
+    if (j.is_string()) return parse_expression(c, j, path, dim, out);
+    if (!j.is_object())
+        return c.fail(path, "expected an integrand object or expression string, got " + type_of(j));
     std::string type;
     if (!get_string(c, j, "type", path, &type)) return false;
     if (type.empty())
-        return c.fail(
-            path, "missing \"type\" (constant, monomial, exponential, gaussian, indicator_ball)");
+        return c.fail(path, std::string("missing \"type\" (") + kIntegrandTypes + ")");
+    if (type == "expression") {
+        if (!check_keys(c, j, path, {"type", "f"})) return false;
+        const Json* text = find(j, "f");
+        if (!text) return c.fail(path, "an expression integrand needs \"f\": \"...\"");
+        return parse_expression(c, *text, sub(path, "f"), dim, out);
+    }
+    GenzFamily family;
+    if (parse_genz_family(type, &family)) return parse_genz(c, j, path, family, dim, out);
     IntegrandKind kind;
     if (!parse_integrand_kind(type, &kind))
         return c.fail(sub(path, "type"),
-                      "unknown integrand '" + type +
-                          "' (known: constant, monomial, exponential, gaussian, indicator_ball)");
+                      "unknown integrand '" + type + "' (known: " + kIntegrandTypes + ")");
+    if (!check_keys(c, j, path, {"type", "scale", "powers", "rates", "center", "sigma", "radius"}))
+        return false;
     double scale = 1.0, width = 1.0;
     std::vector<double> coeffs, center;
     if (!get_number(c, j, "scale", path, &scale)) return false;
@@ -236,10 +301,32 @@ bool parse_integrand(Ctx& c, const Json& j, const std::string& path, int dim, In
     return true;
 }
 
+// The dimension an integrand asks for when the scene gives no domain: the length of its
+// parameter arrays, a Genz "dim", or the highest variable an expression uses.
+int integrand_dimension(const Json& j) {
+    if (j.is_string() || (j.is_object() && find(j, "f") && find(j, "f")->is_string())) {
+        const std::string text =
+            j.is_string() ? j.get<std::string>() : find(j, "f")->get<std::string>();
+        for (int d = 1; d <= 64; ++d)
+            if (compile_expression(text, d).ok()) return d;
+        return 64; // not an expression in any dimension: the full one reports the real error
+    }
+    int dim = 1;
+    for (const char* key : {"powers", "rates", "center", "a", "u"})
+        if (const Json* v = find(j, key); v && v->is_array() && !v->empty())
+            dim = static_cast<int>(v->size());
+    if (const Json* v = find(j, "dim");
+        v && v->is_number_integer() && v->get<int64_t>() >= 1 && v->get<int64_t>() <= 64)
+        dim = static_cast<int>(v->get<int64_t>());
+    return dim;
+}
+
 // --- pdfs --------------------------------------------------------------------------------
 
 constexpr int kMaxBins = 1 << 20;
 constexpr int kSubSamples = 4; // shape evaluations per bin and axis when tabulating
+constexpr int kExpressionBins1D = 1024;
+constexpr int kExpressionBins2D = 64;
 
 // Tabulation values: explicit "values", or |shape| averaged over kSubSamples^d points per cell.
 bool table_values(Ctx& c, const Json& j, const std::string& path, const Problem& problem,
@@ -340,8 +427,33 @@ bool parse_pdf_1d(Ctx& c, const Json& j, const std::string& path, const Problem&
 bool parse_pdf(Ctx& c, const Json& j, const std::string& path, const Problem& problem,
                Proposal* out) {
     const Domain& dom = problem.domain;
+    // A pdf expression is an unnormalised shape, tabulated into a piecewise-constant density:
+    // "pdf": "x^2" or {"type": "expression", "p": "x^2", "bins": 256}.
+    if (j.is_string() || (j.is_object() && find(j, "type") && *find(j, "type") == "expression")) {
+        if (dom.kind != DomainKind::Box || dom.lo.size() > 2)
+            return c.fail(path, "pdf expressions are tabulated on 1- or 2-dimensional boxes; the "
+                                "domain is a " +
+                                    dom.describe());
+        Json table = {{"shape", j.is_string() ? j : Json(nullptr)}};
+        if (j.is_object()) {
+            if (!check_keys(c, j, path, {"type", "p", "bins"})) return false;
+            const Json* p = find(j, "p");
+            if (!p) return c.fail(path, "an expression pdf needs \"p\": \"...\"");
+            table["shape"] = *p;
+            if (const Json* b = find(j, "bins")) table["bins"] = *b;
+        }
+        if (!table["shape"].is_string())
+            return c.fail(sub(path, "p"),
+                          "expected an expression string, got " + type_of(table["shape"]));
+        const bool one_d = dom.lo.size() == 1;
+        table["type"] = one_d ? "tabulated" : "tabulated_2d";
+        if (!table.contains("bins"))
+            table["bins"] = one_d ? Json(kExpressionBins1D) : Json(kExpressionBins2D);
+        return parse_pdf(c, table, path, problem, out);
+    }
     std::string type;
-    if (!j.is_object()) return c.fail(path, "expected an object, got " + type_of(j));
+    if (!j.is_object())
+        return c.fail(path, "expected a pdf object or expression string, got " + type_of(j));
     if (!get_string(c, j, "type", path, &type)) return false;
     if (type.empty()) return c.fail(path, "missing \"type\"");
     out->importance = true;
@@ -542,7 +654,7 @@ Made<SceneRequest> build_request(const Json& scene, const Json& options) {
     SceneRequest req;
     const std::string path = "scene";
     if (!check_keys(c, scene, path,
-                    {"name", "description", "domain", "integrand", "quantity", "exact",
+                    {"name", "description", "domain", "integrand", "f", "quantity", "exact",
                      "estimators", "n_min", "n_max", "reps", "seed", "threads", "accumulator",
                      "notes"}))
         return made_error<SceneRequest>(c.error);
@@ -552,13 +664,18 @@ Made<SceneRequest> build_request(const Json& scene, const Json& options) {
         !get_string(c, scene, "description", path, &pr.description))
         return made_error<SceneRequest>(c.error);
 
+    // "f": "expression" is shorthand for "integrand": "expression".
     const Json* integrand = find(scene, "integrand");
-    if (!integrand) return made_error<SceneRequest>("scene: missing \"integrand\"");
-    // The integrand's own array lengths give a default box dimension.
-    int default_dim = 1;
-    for (const char* key : {"powers", "rates", "center"})
-        if (const Json* v = find(*integrand, key); v && v->is_array() && !v->empty())
-            default_dim = static_cast<int>(v->size());
+    const char* integrand_path = "scene.integrand";
+    if (const Json* f = find(scene, "f")) {
+        if (integrand)
+            return made_error<SceneRequest>("scene: give \"integrand\" or \"f\", not both");
+        integrand = f;
+        integrand_path = "scene.f";
+    }
+    if (!integrand)
+        return made_error<SceneRequest>("scene: missing \"integrand\" (or \"f\": an expression)");
+    const int default_dim = integrand_dimension(*integrand);
     if (const Json* d = find(scene, "domain")) {
         if (!parse_domain(c, *d, "scene.domain", default_dim, &pr.domain))
             return made_error<SceneRequest>(c.error);
@@ -567,7 +684,7 @@ Made<SceneRequest> build_request(const Json& scene, const Json& options) {
                              std::vector<double>(static_cast<size_t>(default_dim), 1.0))
                         .value;
     }
-    if (!parse_integrand(c, *integrand, "scene.integrand", pr.domain.point_dim(), &pr.integrand))
+    if (!parse_integrand(c, *integrand, integrand_path, pr.domain.point_dim(), &pr.integrand))
         return made_error<SceneRequest>(c.error);
 
     std::string quantity = "integral";

@@ -400,21 +400,16 @@ struct Distribution1DFactory {
     template <bool kFull, class F>
     static auto visit(const Distribution1D& d, F&& f) -> decltype(f(UniformK{})) {
         switch (d.kind_) {
-        case Dist1DKind::Power:
-            return f(power(d));
-        case Dist1DKind::Exponential:
-            return f(exponential(d));
-        case Dist1DKind::TruncatedGaussian:
-            return f(gaussian(d));
+        case Dist1DKind::Power: return f(power(d));
+        case Dist1DKind::Exponential: return f(exponential(d));
+        case Dist1DKind::TruncatedGaussian: return f(gaussian(d));
         case Dist1DKind::Cosine:
             if constexpr (kFull)
                 return f(cosine(d));
             else
                 return f(cosine_pdf(d));
-        case Dist1DKind::Tabulated:
-            return f(tabulated(d));
-        case Dist1DKind::Uniform:
-            break;
+        case Dist1DKind::Tabulated: return f(tabulated(d));
+        case Dist1DKind::Uniform: break;
         }
         return f(uniform(d));
     }
@@ -452,18 +447,13 @@ void Distribution1D::multiply_pdf_block(const double* x, double* pdf_out, size_t
 std::string Distribution1D::describe() const {
     std::string on = " on " + interval_text(a_, b_);
     switch (kind_) {
-    case Dist1DKind::Power:
-        return "power(k=" + num(p0_) + ")" + on;
-    case Dist1DKind::Exponential:
-        return "exponential(rate=" + num(p0_) + ")" + on;
+    case Dist1DKind::Power: return "power(k=" + num(p0_) + ")" + on;
+    case Dist1DKind::Exponential: return "exponential(rate=" + num(p0_) + ")" + on;
     case Dist1DKind::TruncatedGaussian:
         return "truncated_gaussian(mu=" + num(p0_) + ", sigma=" + num(p1_) + ")" + on;
-    case Dist1DKind::Cosine:
-        return "cosine(omega=" + num(p0_) + ", x0=" + num(p1_) + ")" + on;
-    case Dist1DKind::Tabulated:
-        return "tabulated(" + std::to_string(func_.size()) + " bins)" + on;
-    case Dist1DKind::Uniform:
-        break;
+    case Dist1DKind::Cosine: return "cosine(omega=" + num(p0_) + ", x0=" + num(p1_) + ")" + on;
+    case Dist1DKind::Tabulated: return "tabulated(" + std::to_string(func_.size()) + " bins)" + on;
+    case Dist1DKind::Uniform: break;
     }
     return "uniform" + on;
 }

@@ -11,12 +11,9 @@ constexpr double kOneMinusEpsilon = 0x1.fffffffffffffp-1;
 
 const char* sampler_name(SamplerKind kind) {
     switch (kind) {
-    case SamplerKind::Independent:
-        return "independent";
-    case SamplerKind::Stratified:
-        return "stratified";
-    case SamplerKind::LatinHypercube:
-        return "latin_hypercube";
+    case SamplerKind::Independent: return "independent";
+    case SamplerKind::Stratified: return "stratified";
+    case SamplerKind::LatinHypercube: return "latin_hypercube";
     }
     return "?";
 }

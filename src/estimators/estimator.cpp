@@ -19,26 +19,20 @@ void RunDiagnostics::merge(const RunDiagnostics& o) {
 
 const char* error_method_name(ErrorMethod m) {
     switch (m) {
-    case ErrorMethod::Iid:
-        return "iid";
-    case ErrorMethod::CollapsedStrata:
-        return "collapsed_strata";
-    case ErrorMethod::PairedStrata:
-        return "paired_strata";
-    case ErrorMethod::IidConservative:
-        return "iid_conservative";
+    case ErrorMethod::Iid: return "iid";
+    case ErrorMethod::CollapsedStrata: return "collapsed_strata";
+    case ErrorMethod::PairedStrata: return "paired_strata";
+    case ErrorMethod::IidConservative: return "iid_conservative";
     }
     return "?";
 }
 
 ErrorMethod error_method_for(const EstimatorSpec& spec) {
     switch (spec.sampler) {
-    case SamplerKind::Independent:
-        return ErrorMethod::Iid;
+    case SamplerKind::Independent: return ErrorMethod::Iid;
     case SamplerKind::Stratified:
         return spec.per_stratum == 2 ? ErrorMethod::PairedStrata : ErrorMethod::CollapsedStrata;
-    case SamplerKind::LatinHypercube:
-        return ErrorMethod::IidConservative;
+    case SamplerKind::LatinHypercube: return ErrorMethod::IidConservative;
     }
     return ErrorMethod::Iid;
 }

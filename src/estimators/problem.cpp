@@ -9,30 +9,22 @@ namespace mcp {
 
 const char* domain_kind_name(DomainKind kind) {
     switch (kind) {
-    case DomainKind::Box:
-        return "box";
-    case DomainKind::Disk:
-        return "disk";
-    case DomainKind::Triangle:
-        return "triangle";
-    case DomainKind::Sphere:
-        return "sphere";
-    case DomainKind::Hemisphere:
-        return "hemisphere";
+    case DomainKind::Box: return "box";
+    case DomainKind::Disk: return "disk";
+    case DomainKind::Triangle: return "triangle";
+    case DomainKind::Sphere: return "sphere";
+    case DomainKind::Hemisphere: return "hemisphere";
     }
     return "?";
 }
 
 int Domain::point_dim() const {
     switch (kind) {
-    case DomainKind::Box:
-        return static_cast<int>(lo.size());
+    case DomainKind::Box: return static_cast<int>(lo.size());
     case DomainKind::Disk:
-    case DomainKind::Triangle:
-        return 2;
+    case DomainKind::Triangle: return 2;
     case DomainKind::Sphere:
-    case DomainKind::Hemisphere:
-        return 3;
+    case DomainKind::Hemisphere: return 3;
     }
     return 0;
 }
@@ -48,14 +40,11 @@ double Domain::measure() const {
         for (size_t j = 0; j < lo.size(); ++j) v *= hi[j] - lo[j];
         return v;
     }
-    case DomainKind::Disk:
-        return kPi * radius * radius;
+    case DomainKind::Disk: return kPi * radius * radius;
     case DomainKind::Triangle:
         return 0.5 * std::fabs((v1.x - v0.x) * (v2.y - v0.y) - (v2.x - v0.x) * (v1.y - v0.y));
-    case DomainKind::Sphere:
-        return 4.0 * kPi;
-    case DomainKind::Hemisphere:
-        return 2.0 * kPi;
+    case DomainKind::Sphere: return 4.0 * kPi;
+    case DomainKind::Hemisphere: return 2.0 * kPi;
     }
     return 0.0;
 }
@@ -75,12 +64,8 @@ std::string Domain::describe() const {
         s << "triangle (" << v0.x << ", " << v0.y << ") (" << v1.x << ", " << v1.y << ") (" << v2.x
           << ", " << v2.y << ")";
         break;
-    case DomainKind::Sphere:
-        s << "unit sphere of directions";
-        break;
-    case DomainKind::Hemisphere:
-        s << "hemisphere of directions z >= 0";
-        break;
+    case DomainKind::Sphere: s << "unit sphere of directions"; break;
+    case DomainKind::Hemisphere: s << "hemisphere of directions z >= 0"; break;
     }
     return s.str();
 }
@@ -144,43 +129,28 @@ Domain make_hemisphere() {
 
 const char* proposal_kind_name(ProposalKind kind) {
     switch (kind) {
-    case ProposalKind::UniformBox:
-        return "uniform";
-    case ProposalKind::DiskPolar:
-        return "uniform_polar";
-    case ProposalKind::DiskConcentric:
-        return "uniform_concentric";
-    case ProposalKind::Triangle:
-        return "uniform";
-    case ProposalKind::Sphere:
-        return "uniform";
-    case ProposalKind::Hemisphere:
-        return "uniform";
-    case ProposalKind::CosineHemisphere:
-        return "cosine_hemisphere";
-    case ProposalKind::Product1D:
-        return "product";
-    case ProposalKind::Tabulated2D:
-        return "tabulated_2d";
+    case ProposalKind::UniformBox: return "uniform";
+    case ProposalKind::DiskPolar: return "uniform_polar";
+    case ProposalKind::DiskConcentric: return "uniform_concentric";
+    case ProposalKind::Triangle: return "uniform";
+    case ProposalKind::Sphere: return "uniform";
+    case ProposalKind::Hemisphere: return "uniform";
+    case ProposalKind::CosineHemisphere: return "cosine_hemisphere";
+    case ProposalKind::Product1D: return "product";
+    case ProposalKind::Tabulated2D: return "tabulated_2d";
     }
     return "?";
 }
 
 std::string Proposal::describe() const {
     switch (kind) {
-    case ProposalKind::UniformBox:
-        return "uniform";
-    case ProposalKind::DiskPolar:
-        return "uniform (polar map r = sqrt(u1))";
-    case ProposalKind::DiskConcentric:
-        return "uniform (concentric map)";
-    case ProposalKind::Triangle:
-        return "uniform (barycentric sqrt map)";
+    case ProposalKind::UniformBox: return "uniform";
+    case ProposalKind::DiskPolar: return "uniform (polar map r = sqrt(u1))";
+    case ProposalKind::DiskConcentric: return "uniform (concentric map)";
+    case ProposalKind::Triangle: return "uniform (barycentric sqrt map)";
     case ProposalKind::Sphere:
-    case ProposalKind::Hemisphere:
-        return "uniform";
-    case ProposalKind::CosineHemisphere:
-        return "cos(theta)/pi";
+    case ProposalKind::Hemisphere: return "uniform";
+    case ProposalKind::CosineHemisphere: return "cos(theta)/pi";
     case ProposalKind::Product1D: {
         std::string s;
         for (size_t j = 0; j < marginals.size(); ++j)
@@ -197,21 +167,13 @@ std::string Proposal::describe() const {
 Proposal uniform_proposal(const Domain& domain, bool disk_polar) {
     Proposal p;
     switch (domain.kind) {
-    case DomainKind::Box:
-        p.kind = ProposalKind::UniformBox;
-        break;
+    case DomainKind::Box: p.kind = ProposalKind::UniformBox; break;
     case DomainKind::Disk:
         p.kind = disk_polar ? ProposalKind::DiskPolar : ProposalKind::DiskConcentric;
         break;
-    case DomainKind::Triangle:
-        p.kind = ProposalKind::Triangle;
-        break;
-    case DomainKind::Sphere:
-        p.kind = ProposalKind::Sphere;
-        break;
-    case DomainKind::Hemisphere:
-        p.kind = ProposalKind::Hemisphere;
-        break;
+    case DomainKind::Triangle: p.kind = ProposalKind::Triangle; break;
+    case DomainKind::Sphere: p.kind = ProposalKind::Sphere; break;
+    case DomainKind::Hemisphere: p.kind = ProposalKind::Hemisphere; break;
     }
     return p;
 }
@@ -223,18 +185,13 @@ std::string check_proposal(const Proposal& p, const Domain& d) {
                domain_kind_name(k) + ", the domain is a " + domain_kind_name(d.kind);
     };
     switch (p.kind) {
-    case ProposalKind::UniformBox:
-        return need(DomainKind::Box);
+    case ProposalKind::UniformBox: return need(DomainKind::Box);
     case ProposalKind::DiskPolar:
-    case ProposalKind::DiskConcentric:
-        return need(DomainKind::Disk);
-    case ProposalKind::Triangle:
-        return need(DomainKind::Triangle);
-    case ProposalKind::Sphere:
-        return need(DomainKind::Sphere);
+    case ProposalKind::DiskConcentric: return need(DomainKind::Disk);
+    case ProposalKind::Triangle: return need(DomainKind::Triangle);
+    case ProposalKind::Sphere: return need(DomainKind::Sphere);
     case ProposalKind::Hemisphere:
-    case ProposalKind::CosineHemisphere:
-        return need(DomainKind::Hemisphere);
+    case ProposalKind::CosineHemisphere: return need(DomainKind::Hemisphere);
     case ProposalKind::Product1D: {
         if (auto e = need(DomainKind::Box); !e.empty()) return e;
         if (p.marginals.size() != d.lo.size())

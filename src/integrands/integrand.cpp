@@ -9,16 +9,13 @@ namespace mcp {
 
 const char* integrand_kind_name(IntegrandKind kind) {
     switch (kind) {
-    case IntegrandKind::Constant:
-        return "constant";
-    case IntegrandKind::Monomial:
-        return "monomial";
-    case IntegrandKind::Exponential:
-        return "exponential";
-    case IntegrandKind::Gaussian:
-        return "gaussian";
-    case IntegrandKind::IndicatorBall:
-        return "indicator_ball";
+    case IntegrandKind::Constant: return "constant";
+    case IntegrandKind::Monomial: return "monomial";
+    case IntegrandKind::Exponential: return "exponential";
+    case IntegrandKind::Gaussian: return "gaussian";
+    case IntegrandKind::IndicatorBall: return "indicator_ball";
+    case IntegrandKind::Expression: return "expression";
+    case IntegrandKind::Genz: return "genz";
     }
     return "?";
 }
@@ -99,10 +96,35 @@ Made<Integrand> make_integrand(IntegrandKind kind, int dim, double scale,
     return {f, {}};
 }
 
+Made<Integrand> make_expression_integrand(const std::string& text, int dim) {
+    Made<std::shared_ptr<const ExprProgram>> program = compile_expression(text, dim);
+    if (!program.ok()) return made_error<Integrand>(program.error);
+    Integrand f;
+    f.kind = IntegrandKind::Expression;
+    f.dim = dim;
+    f.expr = program.value;
+    return {f, {}};
+}
+
+Integrand make_genz_integrand(const GenzParams& params) {
+    Integrand f;
+    f.kind = IntegrandKind::Genz;
+    f.dim = params.dim();
+    f.genz = params;
+    return f;
+}
+
 void evaluate_block(const Integrand& f, const PointBlock& x, double* out) {
     const size_t n = x.n;
     const int d = f.dim;
     switch (f.kind) {
+    case IntegrandKind::Expression: {
+        const double* vars[64];
+        for (int j = 0; j < d; ++j) vars[j] = x.coord(j);
+        f.expr->evaluate(vars, n, out);
+        break;
+    }
+    case IntegrandKind::Genz: genz_evaluate_block(f.genz, x, out); break;
     case IntegrandKind::Constant:
         for (size_t i = 0; i < n; ++i) out[i] = f.scale;
         break;
@@ -165,13 +187,20 @@ double ball_volume(int dim, double r) {
 
 std::optional<double> exact_integral_over_box(const Integrand& f, const std::vector<double>& lo,
                                               const std::vector<double>& hi) {
+    if (f.kind == IntegrandKind::Expression) return std::nullopt;
+    if (f.kind == IntegrandKind::Genz) {
+        for (int j = 0; j < f.dim; ++j)
+            if (lo[static_cast<size_t>(j)] != 0.0 || hi[static_cast<size_t>(j)] != 1.0)
+                return std::nullopt;
+        return genz_exact(f.genz);
+    }
     double result = f.scale;
     for (int j = 0; j < f.dim; ++j) {
         const double a = lo[static_cast<size_t>(j)], b = hi[static_cast<size_t>(j)];
         switch (f.kind) {
-        case IntegrandKind::Constant:
-            result *= b - a;
-            break;
+        case IntegrandKind::Expression:
+        case IntegrandKind::Genz: return std::nullopt; // handled above
+        case IntegrandKind::Constant: result *= b - a; break;
         case IntegrandKind::Monomial: {
             const double p = f.coeffs[static_cast<size_t>(j)];
             // Negative x with a fractional power has no real value: no closed form here.
@@ -212,9 +241,7 @@ std::string describe_integrand(const Integrand& f) {
     s.precision(6);
     auto var = [&](int j) { return f.dim == 1 ? std::string("x") : "x" + std::to_string(j + 1); };
     switch (f.kind) {
-    case IntegrandKind::Constant:
-        s << f.scale;
-        break;
+    case IntegrandKind::Constant: s << f.scale; break;
     case IntegrandKind::Monomial:
         s << f.scale;
         for (int j = 0; j < f.dim; ++j)
@@ -230,8 +257,15 @@ std::string describe_integrand(const Integrand& f) {
     case IntegrandKind::Gaussian:
         s << f.scale << " * exp(-|x - c|^2 / (2 * " << f.width << "^2))";
         break;
-    case IntegrandKind::IndicatorBall:
-        s << f.scale << " * [|x - c| < " << f.width << "]";
+    case IntegrandKind::IndicatorBall: s << f.scale << " * [|x - c| < " << f.width << "]"; break;
+    case IntegrandKind::Expression: s << f.expr->source(); break;
+    case IntegrandKind::Genz:
+        s << genz_family_name(f.genz.family) << " (d = " << f.dim << ", sum a = ";
+        {
+            double sum = 0.0;
+            for (double a : f.genz.a) sum += a;
+            s << sum << ")";
+        }
         break;
     }
     return s.str();

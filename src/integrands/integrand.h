@@ -8,6 +8,8 @@
 
 #include "core/made.h"
 #include "core/points.h"
+#include "integrands/expression.h"
+#include "integrands/genz.h"
 
 namespace mcp {
 
@@ -17,15 +19,19 @@ enum class IntegrandKind {
     Exponential,   ///< f = scale * exp(sum_j a_j x_j)
     Gaussian,      ///< f = scale * exp(-|x - c|^2 / (2 sigma^2))
     IndicatorBall, ///< f = scale * [|x - c| < r]
+    Expression,    ///< a user-typed expression, compiled (integrands/expression.h)
+    Genz,          ///< one of Genz's six test families on [0,1]^d (integrands/genz.h)
 };
 
 struct Integrand {
     IntegrandKind kind = IntegrandKind::Constant;
     int dim = 1;
     double scale = 1.0;
-    std::vector<double> coeffs; ///< powers p_j (monomial) or rates a_j (exponential)
-    std::vector<double> center; ///< Gaussian and ball centre
-    double width = 1.0;         ///< Gaussian sigma or ball radius
+    std::vector<double> coeffs;              ///< powers p_j (monomial) or rates a_j (exponential)
+    std::vector<double> center;              ///< Gaussian and ball centre
+    double width = 1.0;                      ///< Gaussian sigma or ball radius
+    std::shared_ptr<const ExprProgram> expr; ///< Expression: shared, immutable
+    GenzParams genz;                         ///< Genz: family, a, u
 };
 
 const char* integrand_kind_name(IntegrandKind kind);
@@ -35,6 +41,12 @@ bool parse_integrand_kind(const std::string& name, IntegrandKind* kind);
 Made<Integrand> make_integrand(IntegrandKind kind, int dim, double scale,
                                std::vector<double> coeffs, std::vector<double> center,
                                double width);
+
+/// An integrand from an expression compiled for `dim` dimensions (error: "at position P: ...").
+Made<Integrand> make_expression_integrand(const std::string& text, int dim);
+
+/// An integrand from validated Genz parameters.
+Integrand make_genz_integrand(const GenzParams& params);
 
 /// out[i] = f(x_i) for the x.n points of the block.
 void evaluate_block(const Integrand& f, const PointBlock& x, double* out);
