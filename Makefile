@@ -21,7 +21,7 @@ DEP_PROBES := /usr/bin/cmake /usr/bin/g++ /usr/src/googletest/CMakeLists.txt \
 	/usr/include/gtest/gtest.h /usr/bin/em++ /usr/include/glm/glm.hpp /usr/include/stb/stb_image_write.h \
 	/usr/include/tiny_gltf.h /usr/include/nlohmann/json.hpp
 
-.PHONY: all deps build build-wasm test test-native test-wasm test-compare run bench format clean help
+.PHONY: all deps build build-wasm test test-native test-wasm test-compare test-web-core run bench format clean help
 
 all: build
 
@@ -65,7 +65,12 @@ test-wasm: build-wasm
 test-compare: build build-wasm
 	bash tests/compare_native_wasm.sh $(BUILD)/mcplay "$(NODE_RUN) $(BUILD_WASM)/mcplay.js"
 
-test: test-native test-wasm test-compare
+# web/core.js (the only caller of the browser wasm module build-wasm/mcplay_web.mjs) under
+# Node's test runner, compared with the native CLI.
+test-web-core: build build-wasm
+	MCPLAY_WASM_DIR=$(BUILD_WASM) MCPLAY_NATIVE=$(BUILD)/mcplay node --test web/test/
+
+test: test-native test-wasm test-compare test-web-core
 	@echo "make test: all suites passed"
 
 run: build

@@ -130,15 +130,17 @@ int mcp_catalog(char** catalog_json) {
                            {"sampler", mcp::sampler_name(p.sampler)},
                            {"needs_pdf", p.needs_pdf},
                            {"summary", p.summary}});
-    mcp::Json catalog{
-        {"version", mcp::kResultSchemaVersion},
-        {"estimators", presets},
-        {"samplers", {"independent", "stratified", "latin_hypercube"}},
-        {"pdfs",
-         {"uniform", "power", "exponential", "gaussian", "cosine", "tabulated", "product",
-          "tabulated_2d", "cosine_hemisphere"}},
-        {"integrands", {"constant", "monomial", "exponential", "gaussian", "indicator_ball"}},
-        {"domains", {"box", "interval", "disk", "triangle", "sphere", "hemisphere"}}};
+    mcp::Json catalog{{"version", mcp::kResultSchemaVersion},
+                      {"estimators", presets},
+                      {"samplers", {"independent", "stratified", "latin_hypercube"}},
+                      {"pdfs",
+                       {"uniform", "power", "exponential", "gaussian", "cosine", "tabulated",
+                        "product", "tabulated_2d", "cosine_hemisphere", "expression"}},
+                      {"integrands",
+                       {"constant", "monomial", "exponential", "gaussian", "indicator_ball",
+                        "expression", "genz_oscillatory", "genz_product_peak", "genz_corner_peak",
+                        "genz_gaussian", "genz_continuous", "genz_discontinuous"}},
+                      {"domains", {"box", "interval", "disk", "triangle", "sphere", "hemisphere"}}};
     *catalog_json = copy_out(dump(catalog));
     g_last_error.clear();
     return MCP_OK;

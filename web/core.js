@@ -1,0 +1,275 @@
+// The only module that talks to the wasm core (build-wasm/mcplay_web.mjs, the C API of
+// src/api/mcplay.h). Plain ES module: no bundler, no DOM, no Node APIs, so it runs in a page,
+// in a (module) Web Worker and in Node.
+//
+//   import createMcplay from './mcplay_web.mjs';
+//   const core = await loadCore(createMcplay);              // Node: loadCore(createMcplay, {wasmBinary})
+//   const result = core.runStudy(scene, {n_max: 4096}, (level) => { draw(level); });
+//
+// Every call is synchronous once the core is loaded (a long study blocks its thread: run it
+// in a Worker). Strings go in through malloc + stringToUTF8 and come out through the C API's
+// char** out-parameters, which are freed with mcp_free on every path.
+
+/** Status codes of src/api/mcplay.h (enum mcp_status). */
+export const Status = Object.freeze({ OK: 0, ARGUMENT: 1, SCENE: 2, CANCELLED: 3, INTERNAL: 4 });
+
+const STATUS_NAMES = Object.freeze(['OK', 'ARGUMENT', 'SCENE', 'CANCELLED', 'INTERNAL']);
+
+/** A failed C call: `status` is the C status code, `message` the C API's mcp_last_error(). */
+export class McplayError extends Error {
+  constructor(status, message) {
+    super(message);
+    this.name = 'McplayError';
+    this.status = status;
+    this.statusName = STATUS_NAMES[status] ?? `status ${status}`;
+  }
+}
+
+/** The module's exported functions this wrapper needs: exactly src/wasm/exported_functions.txt
+ *  (web/test/core.test.mjs checks that the two lists agree). */
+export const WASM_FUNCTIONS = Object.freeze([
+  '_malloc', '_free',
+  '_mcp_version', '_mcp_last_error', '_mcp_study_run', '_mcp_result_format', '_mcp_scene_info',
+  '_mcp_catalog', '_mcp_free',
+  '_mallinfo',
+]);
+
+/** The Emscripten runtime helpers this wrapper uses (all listed in
+ *  src/wasm/exported_runtime_methods.txt). */
+export const WASM_RUNTIME_METHODS = Object.freeze([
+  'UTF8ToString', 'stringToUTF8', 'lengthBytesUTF8', 'addFunction', 'removeFunction',
+  'getValue', 'setValue', 'HEAPU8',
+]);
+
+const FORMATS = Object.freeze(['table', 'csv', 'json']);
+
+/**
+ * Instantiates the wasm module and returns the core.
+ * @param {Function} createMcplay the default export of mcplay_web.mjs
+ * @param {object} moduleOptions Emscripten module options, e.g. {wasmBinary} in Node or
+ *        {locateFile} when the .wasm is not beside the .mjs
+ */
+export async function loadCore(createMcplay, moduleOptions = {}) {
+  if (typeof createMcplay !== 'function') {
+    throw new TypeError('loadCore: createMcplay must be the default export of mcplay_web.mjs');
+  }
+  const M = await createMcplay(moduleOptions);
+  const missing = [
+    ...WASM_FUNCTIONS.filter((name) => typeof M[name] !== 'function'),
+    ...WASM_RUNTIME_METHODS.filter((name) => M[name] === undefined),
+  ];
+  if (missing.length) {
+    throw new Error(`loadCore: the wasm module does not export ${missing.join(', ')} ` +
+      '(stale build? rebuild target mcplay_web)');
+  }
+  return makeCore(M);
+}
+
+function makeCore(M) {
+  // The study in progress ({onLevel, error}); the single progress trampoline routes to it.
+  let active = null;
+  // Set when the wasm itself failed (a trap or an abort): its state is unknown from then on.
+  let broken = null;
+  let disposed = false;
+
+  const trampoline = (levelPtr, _user) => {
+    const call = active;
+    if (!call || call.error) return 1;
+    try {
+      const level = JSON.parse(M.UTF8ToString(levelPtr));
+      return call.onLevel(level) === true ? 1 : 0;
+    } catch (e) {
+      // Never let a JS exception unwind through the C++ frames: remember it, ask the study to
+      // stop, and rethrow once mcp_study_run has returned and everything is freed.
+      call.error = { value: e };
+      return 1;
+    }
+  };
+  const progressPtr = M.addFunction(trampoline, 'iii');
+
+  function usable(what) {
+    if (disposed) throw new McplayError(Status.ARGUMENT, `${what}: the core was disposed`);
+    if (broken) {
+      throw new McplayError(Status.INTERNAL,
+        `${what}: the wasm core failed earlier and cannot be used (${broken.message ?? broken})`);
+    }
+  }
+
+  // Runs a C call; an exception out of it is a wasm trap/abort (JS exceptions from onLevel
+  // are caught in the trampoline), after which the module is not used again.
+  function callC(fn, ...args) {
+    try {
+      return fn(...args);
+    } catch (e) {
+      broken = e;
+      throw e;
+    }
+  }
+
+  function lastError(status) {
+    const message = M.UTF8ToString(M._mcp_last_error());
+    return message || `mcplay: status ${STATUS_NAMES[status] ?? status} without a message`;
+  }
+
+  function malloc(bytes) {
+    const p = M._malloc(bytes);
+    if (!p) throw new McplayError(Status.INTERNAL, `out of wasm memory (allocating ${bytes} bytes)`);
+    return p;
+  }
+
+  // A JS string as a NUL-terminated UTF-8 copy on the C heap; the caller frees it.
+  function cString(text) {
+    const bytes = M.lengthBytesUTF8(text) + 1;
+    const p = malloc(bytes);
+    M.stringToUTF8(text, p, bytes);
+    return p;
+  }
+
+  // Object or JSON text -> JSON text for the C API.
+  function jsonText(value, what) {
+    let text = value;
+    if (typeof value !== 'string') {
+      if (value === null || typeof value !== 'object') {
+        throw new McplayError(Status.ARGUMENT, `${what}: expected an object or JSON text, got ` +
+          (value === null ? 'null' : typeof value));
+      }
+      try {
+        text = JSON.stringify(value);
+      } catch (e) {
+        throw new McplayError(Status.ARGUMENT, `${what}: cannot be written as JSON (${e.message})`);
+      }
+    }
+    if (text.includes('\0')) {
+      throw new McplayError(Status.ARGUMENT, `${what}: contains a NUL character`);
+    }
+    return text;
+  }
+
+  /**
+   * Calls a C function whose last argument is a `char** out`, with `inputs` (JS strings or
+   * null) as its leading char* arguments and `extra` between them and the out slot. Returns
+   * {status, text} where text is the out string (null if none); frees everything.
+   */
+  function callOut(fn, inputs, extra = []) {
+    const ptrs = [];
+    let slot = 0;
+    try {
+      for (const s of inputs) ptrs.push(s === null ? 0 : cString(s));
+      slot = malloc(4);
+      M.setValue(slot, 0, 'i32');
+      const status = callC(fn, ...ptrs, ...extra, slot);
+      const out = M.getValue(slot, 'i32') >>> 0;
+      let text = null;
+      if (out) {
+        try {
+          text = M.UTF8ToString(out);
+        } finally {
+          M._mcp_free(out);
+        }
+      }
+      // Read the message before anything else can touch mcp_last_error.
+      const message = status === Status.OK ? '' : lastError(status);
+      return { status, text, message };
+    } finally {
+      if (!broken) {
+        if (slot) M._free(slot);
+        for (const p of ptrs) if (p) M._free(p);
+      }
+    }
+  }
+
+  // The out string of a call that must succeed, or the McplayError it failed with.
+  function textOf(r, fnName) {
+    if (r.status === Status.OK && r.text !== null) return r.text;
+    if (r.status === Status.OK) throw new McplayError(Status.INTERNAL, `${fnName}: OK but no output`);
+    throw new McplayError(r.status, r.message);
+  }
+
+  function version() {
+    usable('version');
+    return M.UTF8ToString(M._mcp_version());
+  }
+
+  function catalog() {
+    usable('catalog');
+    return JSON.parse(textOf(callOut(M._mcp_catalog, []), 'mcp_catalog'));
+  }
+
+  function sceneInfo(scene) {
+    usable('sceneInfo');
+    return JSON.parse(textOf(callOut(M._mcp_scene_info, [jsonText(scene, 'scene')]), 'mcp_scene_info'));
+  }
+
+  /**
+   * Runs a convergence study. `scene`: object or JSON text; `options`: object, JSON text or
+   * null ({estimators, n_min, n_max, reps, seed, threads}); `onLevel(level)` (optional) is
+   * called after each N with the progress object of docs/result-schema.md; returning exactly
+   * `true` cancels the study, whose result then has `cancelled: true` (after the last N there
+   * is nothing left to cancel: the result is complete and `cancelled` stays false). onLevel
+   * must be synchronous (a returned promise is ignored). An exception thrown by onLevel
+   * cancels the study and is rethrown from here. Failures throw McplayError.
+   */
+  function runStudy(scene, options = null, onLevel = null) {
+    usable('runStudy');
+    if (active) {
+      throw new McplayError(Status.ARGUMENT, 'runStudy: a study is already running on this core ' +
+        '(called from inside onLevel?)');
+    }
+    if (onLevel !== null && onLevel !== undefined && typeof onLevel !== 'function') {
+      throw new McplayError(Status.ARGUMENT, 'runStudy: onLevel must be a function or null');
+    }
+    const sceneText = jsonText(scene, 'scene');
+    const optionsText = options === null || options === undefined ? null : jsonText(options, 'options');
+    const call = { onLevel, error: null };
+    let r;
+    active = onLevel ? call : null;
+    try {
+      r = callOut(M._mcp_study_run, [sceneText, optionsText], [onLevel ? progressPtr : 0, 0]);
+    } finally {
+      active = null;
+    }
+    if (call.error) throw call.error.value;
+    if ((r.status === Status.OK || r.status === Status.CANCELLED) && r.text !== null) {
+      return JSON.parse(r.text);
+    }
+    throw new McplayError(r.status === Status.OK ? Status.INTERNAL : r.status,
+      r.message || 'mcp_study_run: no result');
+  }
+
+  /** A study result (object or JSON text) as 'table', 'csv' or 'json' (pretty-printed) text. */
+  function format(result, fmt = 'table') {
+    usable('format');
+    if (typeof fmt !== 'string') {
+      throw new McplayError(Status.ARGUMENT, `format: expected one of ${FORMATS.join(', ')}`);
+    }
+    return textOf(callOut(M._mcp_result_format, [jsonText(result, 'result'), fmt]), 'mcp_result_format');
+  }
+
+  /** Heap figures for leak checks: the wasm memory size and malloc's own accounting. */
+  function heapStats() {
+    usable('heapStats');
+    const info = malloc(40); // struct mallinfo: ten 32-bit fields (wasm32)
+    try {
+      callC(M._mallinfo, info);
+      const field = (i) => M.getValue(info + 4 * i, 'i32') >>> 0;
+      return {
+        memoryBytes: M.HEAPU8.length, // the wasm memory (grows, never shrinks)
+        arenaBytes: field(0),         // obtained from the system by malloc (sbrk)
+        allocatedBytes: field(7),     // in use, including this call's 40 bytes
+        freeBytes: field(8),
+      };
+    } finally {
+      M._free(info);
+    }
+  }
+
+  /** Releases the progress trampoline; the core cannot be used afterwards. */
+  function dispose() {
+    if (disposed) return;
+    if (active) throw new McplayError(Status.ARGUMENT, 'dispose: a study is running');
+    disposed = true;
+    M.removeFunction(progressPtr);
+  }
+
+  return Object.freeze({ version, catalog, sceneInfo, runStudy, format, heapStats, dispose });
+}
