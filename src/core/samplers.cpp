@@ -126,15 +126,27 @@ void generate_block(const SamplerPlan& plan, uint64_t first, size_t count, Pcg32
         // Cell index in mixed radix, last axis fastest: cell = ((c_0 k_1 + c_1) k_2 + c_2)...
         // Consecutive indices are neighbouring cells, which the collapsed-strata variance
         // estimate relies on (pairs 2m, 2m+1).
+        // An odometer over the cells: the digits of the block's first cell once (divisions),
+        // then one increment per cell (no division per sample).
+        uint64_t digits[64];
+        uint64_t cell = first / plan.per_stratum, within = first % plan.per_stratum;
+        for (int j = d - 1; j >= 0; --j) {
+            const uint64_t k = plan.strata[static_cast<size_t>(j)];
+            digits[j] = cell % k;
+            cell /= k;
+        }
         for (size_t i = 0; i < count; ++i) {
-            uint64_t cell = (first + i) / plan.per_stratum;
             for (int j = d - 1; j >= 0; --j) {
-                uint64_t k = plan.strata[static_cast<size_t>(j)];
-                uint64_t c = cell % k;
-                cell /= k;
-                u.coord(j)[i] =
-                    std::fmin((static_cast<double>(c) + rng.next_double()) / static_cast<double>(k),
-                              kOneMinusEpsilon);
+                const double k = static_cast<double>(plan.strata[static_cast<size_t>(j)]);
+                u.coord(j)[i] = std::fmin((static_cast<double>(digits[j]) + rng.next_double()) / k,
+                                          kOneMinusEpsilon);
+            }
+            if (++within == plan.per_stratum) {
+                within = 0;
+                for (int j = d - 1; j >= 0; --j) {
+                    if (++digits[j] < plan.strata[static_cast<size_t>(j)]) break;
+                    digits[j] = 0;
+                }
             }
         }
         break;
