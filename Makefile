@@ -7,6 +7,8 @@ BUILD ?= build
 BUILD_WASM ?= build-wasm
 SCENE ?= scenes/exp_1d.json
 ARGS ?=
+PORT ?= 8000
+SITE := $(BUILD)/site
 
 # Node 20's fetch() cannot load the .wasm beside a non-ES6 Emscripten program from a file path.
 NODE_RUN := node --no-experimental-fetch
@@ -15,18 +17,20 @@ NODE_RUN := node --no-experimental-fetch
 export NODE_PATH := /usr/share/nodejs
 
 APT_PACKAGES := cmake g++ make googletest libgtest-dev emscripten libglm-dev libstb-dev \
-	libtinygltf-dev nlohmann-json3-dev
+	libtinygltf-dev nlohmann-json3-dev chromium
 # One file or command per package that tells whether it is installed.
 DEP_PROBES := /usr/bin/cmake /usr/bin/g++ /usr/src/googletest/CMakeLists.txt \
 	/usr/include/gtest/gtest.h /usr/bin/em++ /usr/include/glm/glm.hpp /usr/include/stb/stb_image_write.h \
-	/usr/include/tiny_gltf.h /usr/include/nlohmann/json.hpp
+	/usr/include/tiny_gltf.h /usr/include/nlohmann/json.hpp /usr/bin/chromium
 
-.PHONY: all deps build build-wasm test test-native test-wasm test-compare test-web-core run bench format clean help
+.PHONY: all deps deps-web build build-wasm site test test-native test-wasm test-compare test-web-core \
+	test-e2e run cli bench format clean help
 
 all: build
 
 help:
-	@echo "make run    build the native CLI and run it on $(SCENE)"
+	@echo "make run    build everything and serve the playground on http://localhost:$(PORT)/"
+	@echo "make cli    build the native CLI and run it on $(SCENE)"
 	@echo "make test   install what is missing, build native + wasm, run every test suite"
 	@echo "make bench  samples per second natively and in wasm under Node, and their ratio"
 	@echo "make format clang-format every C++ source"
@@ -42,6 +46,13 @@ deps:
 	    echo "deps: not root; run: sudo apt-get install -y --no-install-recommends $(APT_PACKAGES)"; exit 1; \
 	  fi; \
 	fi
+
+# npm packages of the page (uPlot; playwright-core for the browser tests), from the lock file.
+deps-web: web/node_modules/.package-lock.json
+
+web/node_modules/.package-lock.json: web/package.json web/package-lock.json
+	cd web && npm ci --no-audit --no-fund
+	@touch $@
 
 $(BUILD)/CMakeCache.txt:
 	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release
@@ -67,13 +78,24 @@ test-compare: build build-wasm
 
 # web/core.js (the only caller of the browser wasm module build-wasm/mcplay_web.mjs) under
 # Node's test runner, compared with the native CLI.
-test-web-core: build build-wasm
+test-web-core: build build-wasm deps-web
 	MCPLAY_WASM_DIR=$(BUILD_WASM) MCPLAY_NATIVE=$(BUILD)/mcplay node --test web/test/
 
-test: test-native test-wasm test-compare test-web-core
+# The playground: page, wasm module, uPlot and the scenes with their manifest.
+site: build-wasm deps-web
+	node web/tools/build-site.mjs $(SITE) $(BUILD_WASM)
+
+# The page in headless Chromium, checked against the native CLI; screenshots in build/e2e.
+test-e2e: build site
+	MCPLAY_SITE=$(SITE) MCPLAY_NATIVE=$(BUILD)/mcplay MCPLAY_SHOTS=$(BUILD)/e2e node --test web/e2e/playground.e2e.mjs
+
+test: test-native test-wasm test-compare test-web-core test-e2e
 	@echo "make test: all suites passed"
 
-run: build
+run: build site
+	PORT=$(PORT) node web/tools/serve.mjs $(SITE)
+
+cli: build
 	./$(BUILD)/mcplay run $(SCENE) $(ARGS)
 
 bench: build build-wasm

@@ -1,0 +1,140 @@
+// End-to-end test of the playground in headless Chromium (Debian's chromium, driven by
+// playwright-core). Usage: node web/e2e/playground.e2e.mjs SITE_DIR NATIVE_MCPLAY SHOT_DIR
+// Serves SITE_DIR on a loopback port, runs a study in the page and checks it against the
+// native CLI, checks the inline expression error and Cancel, and saves screenshots.
+import { spawn, execFileSync } from 'node:child_process';
+import { mkdtempSync, mkdirSync, rmSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join, resolve, dirname } from 'node:path';
+import { fileURLToPath } from 'node:url';
+import { test, after, before } from 'node:test';
+import assert from 'node:assert/strict';
+import { chromium } from 'playwright-core';
+
+const here = dirname(fileURLToPath(import.meta.url));
+const site = resolve(process.env.MCPLAY_SITE ?? 'build/site');
+const native = resolve(process.env.MCPLAY_NATIVE ?? 'build/mcplay');
+const shots = resolve(process.env.MCPLAY_SHOTS ?? 'build/e2e');
+const chromiumPath = process.env.CHROMIUM ?? '/usr/bin/chromium';
+const port = 20000 + Math.floor(Math.random() * 20000);
+const url = `http://127.0.0.1:${port}/`;
+
+let server, context, page, profile;
+
+async function waitForServer() {
+  for (let i = 0; i < 100; ++i) {
+    try {
+      const r = await fetch(url);
+      if (r.ok) return;
+    } catch { /* not up yet */ }
+    await new Promise((r) => setTimeout(r, 100));
+  }
+  throw new Error(`the playground server did not answer at ${url}`);
+}
+
+before(async () => {
+  mkdirSync(shots, { recursive: true });
+  server = spawn(process.execPath, [join(here, '..', 'tools', 'serve.mjs'), site], {
+    env: { ...process.env, PORT: String(port), HOST: '127.0.0.1' },
+    stdio: ['ignore', 'pipe', 'inherit'],
+  });
+  await waitForServer();
+  profile = mkdtempSync(join(tmpdir(), 'mcplay-chromium-'));
+  context = await chromium.launchPersistentContext(profile, {
+    executablePath: chromiumPath,
+    headless: true,
+    args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
+      '--disable-background-networking', '--disable-component-update', '--disable-sync'],
+    viewport: { width: 1400, height: 1000 },
+  });
+  page = context.pages()[0] ?? (await context.newPage());
+  page.on('pageerror', (e) => console.error('page error:', e.message));
+  await page.goto(url);
+  await page.waitForFunction(() => window.mcplayDebug !== undefined, null, { timeout: 20000 });
+  await page.evaluate(() => window.mcplayDebug.ready);
+});
+
+after(async () => {
+  await context?.close();
+  server?.kill();
+  if (profile) rmSync(profile, { recursive: true, force: true });
+});
+
+// The native CLI's fitted orders for the same scene and settings.
+function cliFits(scene, estimators, settings) {
+  const out = execFileSync(native, ['run', join('scenes', `${scene}.json`), '--estimators', estimators.join(','),
+    '--n-min', String(settings.nMin), '--n-max', String(settings.nMax), '--reps', String(settings.reps),
+    '--seed', String(settings.seed), '--format', 'json', '--quiet'], { encoding: 'utf8' });
+  const result = JSON.parse(out);
+  return Object.fromEntries(result.estimators.map((e) => [e.name, e.fit]));
+}
+
+async function configure(scene, estimators, settings) {
+  await page.selectOption('#scene', scene); // option values are scene names
+  await page.waitForSelector(`input[data-estimator="${estimators[0]}"]`, { state: 'attached' });
+  for (const box of await page.$$('input[type=checkbox][data-estimator]')) {
+    const name = await box.getAttribute('data-estimator');
+    if ((await box.isChecked()) !== estimators.includes(name)) await box.click();
+  }
+  await page.fill('#n-min', String(settings.nMin));
+  await page.fill('#n-max', String(settings.nMax));
+  await page.fill('#reps', String(settings.reps));
+  await page.fill('#seed', String(settings.seed));
+}
+
+test('a study in the page plots every level and agrees with the CLI', async () => {
+  const settings = { nMin: 16, nMax: 4096, reps: 32, seed: 1 };
+  const estimators = ['uniform', 'stratified_polar'];
+  await configure('disk_third', estimators, settings);
+  const t0 = Date.now();
+  await page.click('#run');
+  await page.waitForFunction(() => document.querySelector('#status')?.textContent.startsWith('done'), null,
+    { timeout: 60000 });
+  console.log(`# study finished in the page in ${Date.now() - t0} ms`);
+  await page.screenshot({ path: join(shots, 'disk_third.png'), fullPage: true });
+
+  const state = await page.evaluate(() => window.mcplayDebug.state());
+  const levels = 9; // 16 .. 4096
+  const fits = cliFits('disk_third', estimators, settings);
+  for (const name of estimators) {
+    const est = Array.isArray(state.estimators) ? state.estimators.find((e) => e.name === name)
+      : state.estimators?.[name];
+    assert.ok(est, `no series for ${name} in the page state`);
+    assert.equal(est.levels.length, levels, `${name}: ${est.levels.length} points, expected ${levels}`);
+    const text = await page.textContent(`[data-fit="${name}"]`);
+    const shown = Number(text.match(/-?\d+\.\d{3}/)?.[0]);
+    assert.ok(Number.isFinite(shown), `${name}: no fitted order in "${text}"`);
+    assert.equal(shown.toFixed(3), fits[name].order.toFixed(3), `${name}: page ${shown} vs CLI ${fits[name].order}`);
+  }
+  const uniform = fits.uniform.order;
+  assert.ok(Math.abs(uniform + 1) < 0.2, `uniform order ${uniform} is not near -1`);
+  assert.ok(fits.stratified_polar.order < -1.3, `stratified order ${fits.stratified_polar.order} is not below -1.3`);
+});
+
+test('a malformed expression is reported inline at its position', async () => {
+  await page.fill('#custom-f', 'sin(');
+  await page.click('#custom-apply');
+  await page.waitForFunction(() => (document.querySelector('#custom-error')?.textContent ?? '').length > 0, null,
+    { timeout: 10000 });
+  const message = await page.textContent('#custom-error');
+  assert.match(message, /position \d+/);
+  await page.screenshot({ path: join(shots, 'expression_error.png') });
+  await page.fill('#custom-f', 'exp(-(x-0.5)^2/0.01)');
+  await page.click('#custom-apply');
+  await page.waitForFunction(() => (document.querySelector('#custom-error')?.textContent ?? '') === '', null,
+    { timeout: 10000 });
+});
+
+test('Cancel stops a long run promptly', async () => {
+  await configure('exp_1d', ['uniform', 'stratified'], { nMin: 16, nMax: 1 << 26, reps: 64, seed: 1 });
+  await page.click('#run');
+  await page.waitForFunction(() => document.querySelector('#status')?.textContent.startsWith('running'), null,
+    { timeout: 10000 });
+  await new Promise((r) => setTimeout(r, 500));
+  const t0 = Date.now();
+  await page.click('#cancel');
+  await page.waitForFunction(() => document.querySelector('#status')?.textContent.startsWith('cancelled'), null,
+    { timeout: 5000 });
+  console.log(`# cancel took effect after ${Date.now() - t0} ms`);
+  await page.screenshot({ path: join(shots, 'cancelled.png') });
+});

@@ -1,0 +1,370 @@
+// Wiring: the store, the workers and the views. Effects (loading scenes, validating custom
+// problems, running studies, exporting) react to the actions the UI dispatches; the views
+// re-render from the state (plots and tables once per animation frame).
+//
+// Workers: one "service" worker validates scenes and formats results (so it answers during a
+// run), and up to navigator.hardwareConcurrency run workers each study a subset of the selected
+// estimators (options.estimators); every estimator has its own random streams, so the split
+// changes no number, and the parts are merged (series.mergeResults). Cancel terminates the run
+// workers and starts new ones.
+import {
+  createStore, reducer, initialState, queryToState, stateToQuery, sceneDefaults, runBlocker,
+  debugSnapshot, buildCustomScene, customError, CUSTOM,
+} from './state.js';
+import { splitEstimators, partialResult } from './series.js';
+import { CoreWorker } from './client.js';
+import { MSG } from './protocol.js';
+import { initPlots, renderPlots, plotPng } from './plot.js';
+import { renderReport } from './report.js';
+import { mountControls, syncControls } from './ui/controls.js';
+import { mountCustom, syncCustom } from './ui/custom.js';
+import { mountExports, syncExports } from './ui/exports.js';
+
+const WORKER_URL = new URL('./worker.js', import.meta.url);
+const MAX_WORKERS = 16;
+const CORES = Math.max(1, Math.min(MAX_WORKERS, navigator.hardwareConcurrency || 2));
+
+const $ = (id) => document.getElementById(id);
+const store = createStore(reducer, initialState());
+const { dispatch } = store;
+
+let service = null;   // validation and formatting
+const runners = [];   // run workers, reused between runs
+let activeRun = null; // id of the run in progress
+let sceneToken = 0;   // the latest scene request (older answers are dropped)
+let urlReady = false; // the URL is written only once the first scene is in
+
+// ---------------------------------------------------------------------------------------------
+// Views
+
+const reportDom = { diagnostics: $('diagnostics'), diagnosticsEmpty: $('diagnostics-empty'), levels: $('levels') };
+initPlots({
+  variance: $('plot-variance'), time: $('plot-time'), calibration: $('plot-calibration'), coverage: $('plot-coverage'),
+  'legend-variance': $('legend-variance'), 'legend-time': $('legend-time'),
+  'legend-calibration': $('legend-calibration'), 'legend-coverage': $('legend-coverage'),
+});
+mountControls(store);
+mountCustom(store);
+mountExports(store);
+
+// Plots and tables are drawn in an animation frame, and at most every RUNNING_RENDER_MS while
+// a study runs: on a machine whose cores all run workers, the page's drawing takes time from
+// them, and so from the timings they measure.
+const RUNNING_RENDER_MS = 100;
+let pending = false;
+let lastRender = -Infinity;
+function renderHeavy() {
+  pending = false;
+  lastRender = performance.now();
+  const s = store.getState();
+  try {
+    renderPlots(s);
+    renderReport(s, reportDom);
+  } catch (e) {
+    console.error('render failed', e);
+  }
+}
+function scheduleHeavy() {
+  if (pending) return;
+  pending = true;
+  const running = store.getState().run.status === 'running';
+  const wait = running ? Math.max(0, lastRender + RUNNING_RENDER_MS - performance.now()) : 0;
+  setTimeout(() => requestAnimationFrame(renderHeavy), wait);
+}
+
+/** The comparison into the address bar (replaceState: no history entry per keystroke). */
+function writeUrl(state) {
+  if (!urlReady || !state.sceneId) return;
+  const q = stateToQuery(state);
+  if (q !== window.location.search) window.history.replaceState(null, '', `${window.location.pathname}${q}`);
+}
+
+let lastStatus = null;
+store.subscribe((state) => {
+  syncControls(state);
+  syncCustom(state);
+  syncExports(state);
+  // When a run ends, its final plots and fitted orders are drawn before anything else happens,
+  // so that whatever reads "done" in #status also finds the final numbers; otherwise later.
+  const ended = lastStatus === 'running' && state.run.status !== 'running';
+  lastStatus = state.run.status;
+  if (ended) renderHeavy();
+  else scheduleHeavy();
+  writeUrl(state);
+  if (state.run.status !== 'running') activeRun = null;
+});
+
+// ---------------------------------------------------------------------------------------------
+// Effects
+
+store.subscribe((state, action) => {
+  const p = action.payload || {};
+  switch (action.type) {
+    case 'scene/request':
+      if (p.sceneId !== CUSTOM) stopRunners(); // the plots of the previous problem are gone
+      if (p.sceneId === CUSTOM) {
+        dispatch({ type: 'custom/apply' });
+      } else {
+        loadScene(p.sceneId);
+      }
+      break;
+    case 'custom/apply':
+      applyCustom();
+      break;
+    case 'scene/loaded':
+      if (state.run.status !== 'running') stopRunners(); // a run of the previous problem, if any
+      break;
+    case 'run/request':
+      startRun();
+      break;
+    case 'run/cancel':
+      stopRunners();
+      break;
+    case 'export/request':
+      exportResult(p).catch((e) => dispatch({ type: 'notice', payload: { message: `export failed: ${e.message}` } }));
+      break;
+    case 'link/copy':
+      copyLink();
+      break;
+    default:
+  }
+});
+
+function runnersFor(k) {
+  while (runners.length < k) runners.push(new CoreWorker(WORKER_URL));
+  return runners.slice(0, k);
+}
+
+/** Terminates the run workers that are busy (a study cannot be interrupted otherwise). */
+function stopRunners() {
+  activeRun = null;
+  for (const w of runners) if (w.busy) w.restart();
+}
+
+async function fetchScene(entry) {
+  const res = await fetch(`scenes/${encodeURIComponent(entry.file)}`);
+  if (!res.ok) throw new Error(`scenes/${entry.file}: HTTP ${res.status}`);
+  return res.json();
+}
+
+/** Loads a scene of the manifest; `fromUrl` (first load) gives its estimators and settings. */
+async function loadScene(sceneId, fromUrl = null) {
+  const token = ++sceneToken;
+  const { scenes } = store.getState();
+  const entry = scenes.find((s) => s.name === sceneId) || scenes[0];
+  if (!entry) {
+    dispatch({ type: 'scene/failed', payload: { message: 'scenes/manifest.json lists no scene' } });
+    return false;
+  }
+  try {
+    const scene = await fetchScene(entry);
+    const { info } = await service.request(MSG.VALIDATE, { scene });
+    if (token !== sceneToken) return false;
+    dispatch({
+      type: 'scene/loaded',
+      payload: { sceneId: entry.name, scene, info, ...(fromUrl ? paramsFromUrl(fromUrl, info) : {}) },
+    });
+    return true;
+  } catch (e) {
+    if (token === sceneToken) dispatch({ type: 'scene/failed', payload: { message: `scene ${entry.name}: ${e.message}` } });
+    return false;
+  }
+}
+
+function paramsFromUrl(fromUrl, info) {
+  // The URL's values where it had them, else the scene's own (capped) range.
+  const base = sceneDefaults(info);
+  const q = queryToState(fromUrl.search, { ...base, estimators: null });
+  return {
+    selected: q.estimators,
+    params: { n_min: q.n_min, n_max: q.n_max, reps: q.reps, seed: q.seed },
+  };
+}
+
+/** Builds the custom scene from f and p and has the core validate it (in the worker). */
+async function applyCustom(fromUrl = null) {
+  const token = ++sceneToken;
+  const { f, p } = store.getState().custom;
+  if (!f.trim()) {
+    dispatch({ type: 'custom/error', payload: { field: 'f', message: 'scene.f: type an expression for f (then press "Use this problem")', position: null } });
+    $('custom-f').focus();
+    return false;
+  }
+  try {
+    // The dimension f implies (the unit cube of its highest variable), then the whole scene.
+    const first = await service.request(MSG.VALIDATE, { scene: { f } });
+    const scene = buildCustomScene(f, p, first.info.dimension);
+    const { info } = await service.request(MSG.VALIDATE, { scene });
+    if (token !== sceneToken) return false;
+    dispatch({
+      type: 'scene/loaded',
+      payload: { sceneId: CUSTOM, scene, info, custom: { f, p }, ...(fromUrl ? paramsFromUrl(fromUrl, info) : {}) },
+    });
+    return true;
+  } catch (e) {
+    if (token === sceneToken) dispatch({ type: 'custom/error', payload: customError(e) });
+    return false;
+  }
+}
+
+function startRun() {
+  const s = store.getState();
+  const blocker = runBlocker(s);
+  if (blocker) {
+    dispatch({ type: 'notice', payload: { message: blocker } });
+    return;
+  }
+  if (activeRun !== null) stopRunners();
+  const names = s.selected.slice();
+  const groups = splitEstimators(names, CORES);
+  const workers = runnersFor(groups.length);
+  const id = s.run.id + 1;
+  const settings = { ...s.params };
+  dispatch({
+    type: 'run/start',
+    payload: {
+      id,
+      workers: groups.length,
+      settings,
+      order: names,
+      exact: s.sceneInfo.exact ?? null,
+      sceneName: s.sceneInfo.name,
+      colors: Object.fromEntries(s.sceneInfo.estimators.map((n, i) => [n, i])),
+      startedAt: performance.now(),
+    },
+  });
+  activeRun = id;
+  // Draw the run's empty plots before the workers start, so that creating the charts does not
+  // compete with the first, shortest levels, whose timings are the most fragile.
+  renderHeavy();
+  groups.forEach((group, i) => {
+    workers[i].request(MSG.RUN, { scene: s.scene, options: { ...settings, estimators: group }, warmup: true }, (type, payload) => {
+      if (type === MSG.LEVEL) dispatch({ type: 'run/level', payload: { id, level: payload.level } });
+    }).then(({ result }) => {
+      dispatch({ type: 'run/partial', payload: { id, result, now: performance.now() } });
+    }).catch((e) => {
+      if (e && e.cancelled) return;
+      if (activeRun === id) stopRunners();
+      dispatch({ type: 'run/error', payload: { id, message: e && e.message ? e.message : String(e) } });
+    });
+  });
+}
+
+function download(name, href) {
+  const a = document.createElement('a');
+  a.href = href;
+  a.download = name;
+  document.body.append(a);
+  a.click();
+  a.remove();
+}
+
+function downloadText(name, text, type) {
+  const url = URL.createObjectURL(new Blob([text], { type }));
+  download(name, url);
+  setTimeout(() => URL.revokeObjectURL(url), 10000);
+}
+
+function fileStem(s) {
+  const r = s.run;
+  const st = r.settings || s.params;
+  const scene = String(r.sceneName || s.sceneId || 'scene').replace(/[^\w.-]+/g, '_');
+  return `mcplay-${scene}-N${st.n_min}-${st.n_max}-R${st.reps}-seed${st.seed}`;
+}
+
+async function exportResult({ format, plot }) {
+  const s = store.getState();
+  if (format === 'png') {
+    const url = plotPng(plot);
+    if (!url) throw new Error(`the ${plot} plot is empty`);
+    download(`${fileStem(s)}-${plot}.png`, url);
+    return;
+  }
+  const result = s.run.result || partialResult(s.run, s.sceneInfo, s.version);
+  if (!result.estimators.length) throw new Error('no results yet');
+  if (format === 'json') {
+    downloadText(`${fileStem(s)}.json`, `${JSON.stringify(result, null, 2)}\n`, 'application/json');
+  } else {
+    const { text } = await service.request(MSG.FORMAT, { result, format });
+    downloadText(`${fileStem(s)}.${format}`, text, format === 'csv' ? 'text/csv' : 'text/plain');
+  }
+  dispatch({ type: 'notice', payload: { message: `exported ${format.toUpperCase()}${result.cancelled ? ' (partial: the run did not finish)' : ''}` } });
+}
+
+async function copyLink() {
+  const url = window.location.href;
+  try {
+    await navigator.clipboard.writeText(url);
+    dispatch({ type: 'notice', payload: { message: 'link copied' } });
+  } catch {
+    dispatch({ type: 'notice', payload: { message: `link: ${url}` } });
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Start-up: the core, the manifest, then the scene the URL names (or the first one).
+
+async function start() {
+  service = new CoreWorker(WORKER_URL);
+  const manifest = fetch('scenes/manifest.json').then((r) => {
+    if (!r.ok) throw new Error(`scenes/manifest.json: HTTP ${r.status}`);
+    return r.json();
+  });
+  let version;
+  try {
+    ({ version } = await service.loaded);
+  } catch (e) {
+    dispatch({ type: 'core/failed', payload: { message: `the wasm core did not load: ${e.message}` } });
+    return;
+  }
+  dispatch({ type: 'core/ready', payload: { version } });
+  runnersFor(1); // warm one run worker while the scene loads
+
+  let scenes;
+  try {
+    scenes = await manifest;
+  } catch (e) {
+    dispatch({ type: 'core/failed', payload: { message: e.message } });
+    return;
+  }
+  dispatch({ type: 'scenes/loaded', payload: { scenes } });
+
+  const search = window.location.search;
+  const q = queryToState(search, { scene: scenes.length ? scenes[0].name : null });
+  let ok = false;
+  if (q.scene === CUSTOM) {
+    dispatch({ type: 'custom/edit', payload: { field: 'f', value: q.f } });
+    dispatch({ type: 'custom/edit', payload: { field: 'p', value: q.p } });
+    ok = await applyCustom({ search });
+  }
+  if (!ok) {
+    const known = scenes.some((s) => s.name === q.scene);
+    const customFailed = q.scene === CUSTOM;
+    // A broken custom link keeps its error shown and falls back to the first scene.
+    const err = store.getState().custom.error;
+    ok = await loadScene(known ? q.scene : (scenes[0] && scenes[0].name), customFailed ? null : { search });
+    if (customFailed && err) dispatch({ type: 'custom/error', payload: err });
+    if (ok && !customFailed && q.scene && !known) {
+      dispatch({ type: 'notice', payload: { message: `unknown scene '${q.scene}' in the link: showing ${scenes[0].name}` } });
+    }
+  }
+  urlReady = true;
+  writeUrl(store.getState());
+  runnersFor(Math.min(CORES, (store.getState().sceneInfo?.estimators || []).length || 1));
+  return ok;
+}
+
+// Resolves once the core is loaded and the first scene is shown; rejects with the reason if not.
+const ready = start().then((ok) => {
+  const s = store.getState();
+  if (s.run.status === 'error') throw new Error(s.run.message);
+  if (!ok) throw new Error(s.notice || 'no scene could be loaded');
+  return true;
+});
+ready.catch(() => {});
+
+// Read-only hook for tests: a structured-cloneable snapshot and a promise of the first scene.
+window.mcplayDebug = Object.freeze({
+  state: () => structuredClone(debugSnapshot(store.getState())),
+  ready,
+});

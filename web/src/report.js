@@ -1,0 +1,115 @@
+// Renders the numbers and the diagnostics of state.run: the #diagnostics list (every warning
+// with its code and message, estimator-level and per N) and one table per estimator whose
+// flagged cells sit next to the warning that concerns them (low_ess by the effective sample
+// size, heavy_tail by the tail index, level_drift by the consistency test, ...). A pure render
+// of the state, text only (never HTML from data).
+import { collectWarnings, fitText, fmt } from './series.js';
+import { colorAt } from './palette.js';
+
+/** Which column (level codes) or summary item (estimator codes) a warning concerns. */
+const LEVEL_COLUMN = {
+  low_ess: 'ess', dominant_sample: 'share', nonfinite: 'mean', zero_pdf_samples: 'mean',
+  exact_outside_ci: 'mean',
+};
+const ESTIMATOR_ITEM = {
+  heavy_tail: 'tail', heavy_tail_4: 'tail', level_drift: 'consistency', pdf_support: 'support',
+};
+
+const COLUMNS = [
+  ['n', 'N', (l) => String(l.n)],
+  ['mean', 'mean', (l) => fmt(l.mean, 8)],
+  ['se', 'std. error', (l) => fmt(l.std_error)],
+  ['variance', 'variance', (l) => fmt(l.variance)],
+  ['vci', 'variance 95% CI', (l) => (l.variance_ci95 ? `${fmt(l.variance_ci95[0], 3)} – ${fmt(l.variance_ci95[1], 3)}` : '—')],
+  ['error', 'RMSE / error', (l) => fmt(l.error)],
+  ['coverage', 'coverage95', (l) => fmt(l.coverage95, 3)],
+  ['time', 'time/est [s]', (l) => fmt(l.time_mean_s, 3)],
+  ['efficiency', 'efficiency', (l) => fmt(l.efficiency, 3)],
+  ['ess', 'ESS', (l) => fmt(l.ess, 3)],
+  ['share', 'max weight share', (l) => fmt(l.diagnostics ? l.diagnostics.max_weight_share : null, 3)],
+  ['tail', 'tail index', (l) => (l.tail_index === null || l.tail_index === undefined ? '—' : `${fmt(l.tail_index, 3)} (k=${l.tail_k})`)],
+];
+
+function el(tag, props = {}, ...children) {
+  const e = document.createElement(tag);
+  for (const [k, v] of Object.entries(props)) {
+    if (k === 'dataset') Object.assign(e.dataset, v);
+    else if (k === 'style') e.style.cssText = v;
+    else e[k] = v;
+  }
+  for (const c of children) if (c !== null && c !== undefined && c !== false) e.append(c);
+  return e;
+}
+
+function badge(w) {
+  return el('span', { className: 'badge', title: w.message }, w.code);
+}
+
+let lastSig = null;
+
+/** Draws the diagnostics list and the tables of state.run into `dom`. */
+export function renderReport(state, dom) {
+  const run = state.run;
+  const sig = JSON.stringify([run.id, run.status, run.order,
+    run.order.map((n) => (run.records[n] ? [run.records[n].levels.length, run.records[n].fit] : 0))]);
+  if (sig === lastSig) return;
+  lastSig = sig;
+
+  const warnings = collectWarnings(run.records, run.order);
+  dom.diagnostics.replaceChildren(...warnings.map((w) => el('li', {
+    dataset: { estimator: w.estimator, code: w.code, scope: w.scope },
+  },
+  el('strong', {}, w.estimator), ' ',
+  el('code', {}, w.code), ' ',
+  w.message,
+  w.scope === 'level' && w.n.length ? el('span', { className: 'muted' }, ` (at N = ${w.n.join(', ')})`) : null)));
+  const hasRecords = run.order.some((n) => run.records[n]);
+  dom.diagnosticsEmpty.textContent = !hasRecords ? 'Run a study to see its diagnostics.' : 'No warnings.';
+  dom.diagnosticsEmpty.hidden = warnings.length > 0;
+
+  // Keep the tables the reader opened open.
+  const open = new Set([...dom.levels.querySelectorAll('details[open]')].map((d) => d.dataset.for));
+  dom.levels.replaceChildren(...run.order.filter((n) => run.records[n]).map((name) => {
+    const r = run.records[name];
+    return estimatorTable(r, run, open.has(name));
+  }));
+}
+
+function estimatorTable(r, run, isOpen) {
+  const last = r.levels[r.levels.length - 1] || null;
+  const byItem = {};
+  for (const w of r.warnings || []) (byItem[ESTIMATOR_ITEM[w.code] || 'name'] ??= []).push(w);
+  const flags = (item) => (byItem[item] || []).map(badge);
+  const color = colorAt(run.colors && r.name in run.colors ? run.colors[r.name] : run.order.indexOf(r.name));
+
+  const summary = el('summary', {},
+    el('span', { className: 'swatch', style: `background: ${color}` }),
+    el('strong', {}, r.name), ...flags('name'),
+    el('span', { className: 'muted' }, `${r.sampler || ''}${r.pdf ? `, pdf ${r.pdf}` : ''}`),
+    el('span', {}, 'order ', el('span', { className: 'mono' }, fitText(r.fit))),
+    r.consistency ? el('span', {}, `level consistency p = ${fmt(r.consistency.p_value, 3)}`, ...flags('consistency')) : null,
+    r.support_check && r.importance ? el('span', {}, `pdf support: ${r.support_check.missed} of ${r.support_check.probes} probes missed`, ...flags('support')) : flags('support').length ? el('span', {}, ...flags('support')) : null,
+    last ? el('span', {}, `tail index at N=${last.n}: ${fmt(last.tail_index, 3)}`, ...flags('tail')) : null,
+    last ? el('span', {}, `ESS at N=${last.n}: ${fmt(last.ess, 3)}`) : null,
+  );
+  const head = el('tr', {}, ...COLUMNS.map(([, label]) => el('th', { scope: 'col' }, label)));
+  const rows = [];
+  for (const l of r.levels) {
+    const flagged = {};
+    for (const w of l.warnings || []) (flagged[LEVEL_COLUMN[w.code] || 'n'] ??= []).push(w);
+    rows.push(el('tr', { dataset: { n: String(l.n) } }, ...COLUMNS.map(([key, , get]) => {
+      const ws = flagged[key];
+      return el('td', ws ? { className: 'flag', title: ws.map((w) => `${w.code}: ${w.message}`).join('\n') } : {},
+        ws ? `⚠ ${get(l)}` : get(l));
+    })));
+    for (const w of l.warnings || []) {
+      rows.push(el('tr', { className: 'warn-row' }, el('td', { colSpan: COLUMNS.length },
+        el('code', {}, w.code), ` N = ${l.n}: ${w.message}`)));
+    }
+  }
+  const details = el('details', { dataset: { for: r.name } }, summary,
+    el('div', { className: 'table-wrap' },
+      el('table', { className: 'levels' }, el('thead', {}, head), el('tbody', {}, ...rows))));
+  details.open = isOpen;
+  return details;
+}

@@ -1,0 +1,425 @@
+// Pure functions from the core's result / level JSON (docs/result-schema.md) to what the plots
+// draw: aligned x/y arrays for uPlot (null where a series has no point), confidence bands,
+// reference slopes, z-scores and their histogram, and the merge of the per-worker results.
+// No DOM and no uPlot: web/test/series.test.mjs runs this under Node.
+
+/** The core's N ladder: every power of two in [nMin, nMax]. */
+export function ladder(nMin, nMax) {
+  const out = [];
+  if (!(nMin >= 1) || !(nMax >= nMin)) return out;
+  for (let n = 1; n <= nMax; n *= 2) if (n >= nMin) out.push(n);
+  return out;
+}
+
+/** v when it can sit on a log axis (a finite number > 0), else null. */
+export function positive(v) {
+  return typeof v === 'number' && Number.isFinite(v) && v > 0 ? v : null;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Streaming and merging
+
+/**
+ * Folds one progress object of the core's level callback ({level_index, n, estimators: [{name,
+ * ...estimator fields, level, fit}]}) into `records` (name -> {name, ...estimator fields,
+ * levels: [...]}, the shape of result.estimators[k]); returns a new object, `records` unchanged.
+ */
+export function applyLevel(records, progress) {
+  const out = { ...records };
+  for (const e of progress.estimators || []) {
+    const { level, ...meta } = e;
+    const prev = out[e.name];
+    const levels = prev ? prev.levels.filter((l) => l.n !== level.n) : [];
+    levels.push(level);
+    levels.sort((a, b) => a.n - b.n);
+    out[e.name] = { ...meta, levels };
+  }
+  return out;
+}
+
+/** Share of the run's work done: levels finished weighted by their N (the cost of a level). */
+export function progressOf(records, order, nLadder) {
+  const perEstimator = nLadder.reduce((s, n) => s + n, 0);
+  if (!order.length || !perEstimator) return 0;
+  const inLadder = new Set(nLadder);
+  let done = 0;
+  for (const name of order) {
+    const r = records[name];
+    if (r) for (const l of r.levels) if (inLadder.has(l.n)) done += l.n;
+  }
+  return Math.min(1, done / (perEstimator * order.length));
+}
+
+function studyKey(r) {
+  const s = r.settings || {};
+  return JSON.stringify([r.version, r.scene, s.n_min, s.n_max, s.reps, s.seed, s.accumulator]);
+}
+
+/**
+ * One result from the results of several workers, each run with options.estimators = a subset
+ * (every estimator has its own random streams, so the split does not change any number).
+ * The estimators come in `order` (names; any others after them); settings.threads is the sum
+ * of the workers' threads, wall_time_s the longest worker's (they ran side by side), and the
+ * merge is cancelled if any part was. Throws if the parts are not of one study.
+ */
+export function mergeResults(partials, order = null) {
+  if (!Array.isArray(partials) || !partials.length) throw new Error('mergeResults: no results to merge');
+  const first = partials[0];
+  const key = studyKey(first);
+  const byName = new Map();
+  for (const r of partials) {
+    if (studyKey(r) !== key) {
+      throw new Error('mergeResults: the parts are results of different studies (scene or settings differ)');
+    }
+    for (const e of r.estimators) {
+      if (byName.has(e.name)) throw new Error(`mergeResults: estimator '${e.name}' is in two parts`);
+      byName.set(e.name, e);
+    }
+  }
+  const names = (order || []).filter((n) => byName.has(n));
+  for (const n of byName.keys()) if (!names.includes(n)) names.push(n);
+  return {
+    ...first,
+    cancelled: partials.some((r) => r.cancelled),
+    settings: {
+      ...first.settings,
+      threads: partials.reduce((s, r) => s + ((r.settings && r.settings.threads) || 1), 0),
+    },
+    wall_time_s: Math.max(...partials.map((r) => r.wall_time_s || 0)),
+    estimators: names.map((n) => byName.get(n)),
+  };
+}
+
+// ---------------------------------------------------------------------------------------------
+// Variance (or MSE) against N
+
+function unionSorted(values) {
+  return [...new Set(values)].sort((a, b) => a - b);
+}
+
+/**
+ * The variance plot: x = every N any estimator has reached; per estimator y = its MSE when
+ * the exact value is known (`exact` not null), else its variance, and the band lo/hi = the
+ * core's variance_ci95 (chi-square interval of the variance). For the MSE the band is the same
+ * interval scaled by mse / variance: the same relative uncertainty, centred on the plotted
+ * value. Values that cannot sit on a log axis (0, null) are null. `xs` (optional) fixes the x
+ * values, e.g. the whole N ladder of a run that is still going.
+ */
+export function varianceSeries(records, order, exact = null, xs = null) {
+  const useMse = exact !== null && exact !== undefined && Number.isFinite(exact);
+  const named = order.filter((n) => records[n]);
+  const x = xs ? xs.slice() : unionSorted(named.flatMap((n) => records[n].levels.map((l) => l.n)));
+  const series = named.map((name) => {
+    const byN = new Map(records[name].levels.map((l) => [l.n, l]));
+    const y = [];
+    const lo = [];
+    const hi = [];
+    for (const n of x) {
+      const l = byN.get(n);
+      if (!l) {
+        y.push(null); lo.push(null); hi.push(null);
+        continue;
+      }
+      const variance = l.variance;
+      const v = useMse && l.mse !== null && l.mse !== undefined ? l.mse : variance;
+      y.push(positive(v));
+      const ci = l.variance_ci95;
+      const scale = v === variance ? 1 : (positive(variance) ? v / variance : NaN);
+      lo.push(ci ? positive(ci[0] * scale) : null);
+      hi.push(ci ? positive(ci[1] * scale) : null);
+    }
+    return { name, y, lo, hi, fit: records[name].fit || null };
+  });
+  return { quantity: useMse ? 'mse' : 'variance', x, series };
+}
+
+/** Where reference slopes start: the smallest N with a point, at the largest y there. */
+export function anchorOf(x, series) {
+  for (let i = 0; i < x.length; i++) {
+    let y = null;
+    for (const s of series) if (s.y[i] !== null && (y === null || s.y[i] > y)) y = s.y[i];
+    if (y !== null) return { x: x[i], y };
+  }
+  return null;
+}
+
+/** Lines y = anchor.y (x / anchor.x)^-k for k in `orders` (N^-1, N^-2, N^-3 by default). */
+export function referenceLines(x, anchor, orders = [1, 2, 3]) {
+  if (!anchor) return [];
+  return orders.map((k) => ({
+    order: -k,
+    label: `N^-${k}`,
+    y: x.map((v) => anchor.y * (v / anchor.x) ** -k),
+  }));
+}
+
+/**
+ * Least-squares slope of log y on log x over the pairs where both are > 0 and finite:
+ * {slope, intercept (of ln y at ln x = 0), n}, or null with fewer than two distinct x.
+ * (The fitted order in the legend is the core's fit.order; this is for the plots' own lines.)
+ */
+export function fitSlope(xs, ys) {
+  const px = [];
+  const py = [];
+  for (let i = 0; i < Math.min(xs.length, ys.length); i++) {
+    if (positive(xs[i]) !== null && positive(ys[i]) !== null) {
+      px.push(Math.log(xs[i]));
+      py.push(Math.log(ys[i]));
+    }
+  }
+  const n = px.length;
+  if (n < 2) return null;
+  const mx = px.reduce((s, v) => s + v, 0) / n;
+  const my = py.reduce((s, v) => s + v, 0) / n;
+  let sxx = 0;
+  let sxy = 0;
+  for (let i = 0; i < n; i++) {
+    sxx += (px[i] - mx) ** 2;
+    sxy += (px[i] - mx) * (py[i] - my);
+  }
+  if (!(sxx > 0)) return null;
+  const slope = sxy / sxx;
+  return { slope, intercept: my - slope * mx, n };
+}
+
+// ---------------------------------------------------------------------------------------------
+// Error against time
+
+/**
+ * The equal-time plot: per estimator the points (time_mean_s, error) of its levels (error =
+ * RMSE when the exact value is known, else sqrt(variance)), on the sorted union of all times
+ * (uPlot's aligned data; null where a series has no point), the points in the order of N
+ * (`points`: [time, error] pairs, for joining them), and the least-squares slope of log error on
+ * log time.
+ */
+export function timeSeries(records, order) {
+  const named = order.filter((n) => records[n]);
+  const pts = named.map((name) => records[name].levels
+    .map((l) => [positive(l.time_mean_s), positive(l.error)])
+    .filter(([t, e]) => t !== null && e !== null));
+  const x = unionSorted(pts.flat().map(([t]) => t));
+  const index = new Map(x.map((t, i) => [t, i]));
+  const series = named.map((name, k) => {
+    const y = new Array(x.length).fill(null);
+    for (const [t, e] of pts[k]) y[index.get(t)] = e;
+    const fit = fitSlope(pts[k].map((p) => p[0]), pts[k].map((p) => p[1]));
+    return { name, y, points: pts[k], slope: fit ? fit.slope : null };
+  });
+  return { x, series };
+}
+
+// ---------------------------------------------------------------------------------------------
+// Calibration of the error bars
+
+/**
+ * z = (estimate - reference) / std_error of every replicate of `levels` (all of them, or the
+ * one with n === which). The reference is the exact value, or when it is unknown each level's
+ * mean of its replicates. Replicates with a zero or missing error bar are counted in zeroSe
+ * (a zero error bar with a wrong estimate is the confident wrong answer), not in z.
+ */
+export function zScores(levels, exact = null, which = 'all') {
+  const useExact = exact !== null && exact !== undefined && Number.isFinite(exact);
+  const z = [];
+  let zeroSe = 0;
+  for (const l of levels) {
+    if (which !== 'all' && l.n !== which) continue;
+    const rep = l.replicates;
+    if (!rep) continue;
+    const ref = useExact ? exact : l.mean;
+    for (let i = 0; i < rep.estimate.length; i++) {
+      const est = rep.estimate[i];
+      const se = rep.std_error[i];
+      if (typeof est !== 'number' || !Number.isFinite(est) || typeof ref !== 'number') continue;
+      if (typeof se === 'number' && se > 0 && Number.isFinite(se)) z.push((est - ref) / se);
+      else zeroSe++;
+    }
+  }
+  return { z, zeroSe, reference: useExact ? 'exact' : 'mean' };
+}
+
+/**
+ * Histogram of `values` over [lo, hi) in bins of `width`: counts, and density = counts /
+ * (all values x width) so that it compares with a density; values outside go to below/above.
+ */
+export function histogram(values, { lo = -5, hi = 5, width = 0.5 } = {}) {
+  const bins = Math.round((hi - lo) / width);
+  const edges = Array.from({ length: bins + 1 }, (_, i) => round9(lo + i * width));
+  const counts = new Array(bins).fill(0);
+  let below = 0;
+  let above = 0;
+  let total = 0;
+  for (const v of values) {
+    if (typeof v !== 'number' || Number.isNaN(v)) continue;
+    total++;
+    if (v < lo) below++;
+    else if (v >= hi) above++;
+    else counts[Math.min(bins - 1, Math.floor((v - lo) / width))]++;
+  }
+  const density = counts.map((c) => (total ? c / (total * width) : 0));
+  return { edges, counts, density, below, above, total };
+}
+
+function round9(v) {
+  return Math.round(v * 1e9) / 1e9;
+}
+
+export function normalDensity(x) {
+  return Math.exp(-0.5 * x * x) / Math.sqrt(2 * Math.PI);
+}
+
+/**
+ * The calibration plot: x a grid over [lo, hi] (step 0.1, a multiple of the bin width), the
+ * standard normal density on it, and per estimator its z-score histogram as a step function
+ * (y at grid point x = the density of the bin starting at or before x).
+ */
+export function calibrationSeries(records, order, exact = null, which = 'all',
+  { lo = -5, hi = 5, width = 0.5, step = 0.1 } = {}) {
+  const count = Math.round((hi - lo) / step);
+  const x = Array.from({ length: count + 1 }, (_, i) => round9(lo + i * step));
+  const normal = x.map(normalDensity);
+  const series = order.filter((n) => records[n]).map((name) => {
+    const zs = zScores(records[name].levels, exact, which);
+    const h = histogram(zs.z, { lo, hi, width });
+    const bins = h.counts.length;
+    const y = x.map((v) => (h.total ? h.density[Math.min(bins - 1, Math.floor((v - lo) / width + 1e-9))] : null));
+    return {
+      name, y, total: h.total, below: h.below, above: h.above, zeroSe: zs.zeroSe,
+      reference: zs.reference, within2: zs.z.filter((v) => Math.abs(v) <= 1.96).length,
+    };
+  });
+  return { x, normal, series };
+}
+
+/** coverage95 against N per estimator (null where unknown: no exact value). */
+export function coverageSeries(records, order, xs = null) {
+  const named = order.filter((n) => records[n]);
+  const x = xs ? xs.slice() : unionSorted(named.flatMap((n) => records[n].levels.map((l) => l.n)));
+  const series = named.map((name) => {
+    const byN = new Map(records[name].levels.map((l) => [l.n, l]));
+    return {
+      name,
+      y: x.map((n) => {
+        const l = byN.get(n);
+        return l && typeof l.coverage95 === 'number' ? l.coverage95 : null;
+      }),
+    };
+  });
+  return { x, series };
+}
+
+// ---------------------------------------------------------------------------------------------
+// Diagnostics and text
+
+/**
+ * Every warning of the records, grouped by (estimator, scope, code): estimator-level flags
+ * once, level flags with the list of N where they were raised and the message of the first.
+ */
+export function collectWarnings(records, order) {
+  const out = [];
+  for (const name of order) {
+    const r = records[name];
+    if (!r) continue;
+    for (const w of r.warnings || []) out.push({ estimator: name, scope: 'estimator', code: w.code, message: w.message, n: [] });
+    const byCode = new Map();
+    for (const l of r.levels) {
+      for (const w of l.warnings || []) {
+        if (!byCode.has(w.code)) {
+          const item = { estimator: name, scope: 'level', code: w.code, message: w.message, n: [] };
+          byCode.set(w.code, item);
+          out.push(item);
+        }
+        byCode.get(w.code).n.push(l.n);
+      }
+    }
+  }
+  return out;
+}
+
+/** x with 3 decimals exactly as C's printf("%.3f") writes it (ties to even, -0.000 kept). */
+export function fixed3(x) {
+  if (!Number.isFinite(x)) return String(x);
+  // toFixed rounds an exact tie (a binary value ending in exactly 5 at the 4th decimal, such as
+  // 1.0625) away from zero; glibc's printf rounds it to even. Other values round alike.
+  const digits = Math.abs(x).toFixed(20);
+  let s;
+  if (/^\d+\.\d{3}50*$/.test(digits)) {
+    const [int, frac] = digits.split('.');
+    let k = BigInt(int + frac.slice(0, 3));
+    if (k % 2n === 1n) k += 1n;
+    const t = k.toString().padStart(4, '0');
+    s = `${t.slice(0, -3)}.${t.slice(-3)}`;
+  } else {
+    s = Math.abs(x).toFixed(3);
+  }
+  return x < 0 || Object.is(x, -0) ? `-${s}` : s;
+}
+
+/** The core's fitted order as the CLI prints it: "-1.040 ± 0.028", or why there is none. */
+export function fitText(fit) {
+  if (!fit || !fit.valid || typeof fit.order !== 'number') {
+    return fit && fit.note ? `no fit (${fit.note})` : 'no fit yet';
+  }
+  const se = typeof fit.order_se === 'number' ? ` ± ${fixed3(fit.order_se)}` : '';
+  return `${fixed3(fit.order)}${se}`;
+}
+
+/** A number for tables: 4 significant digits, exponent form when very small or large. */
+export function fmt(v, digits = 4) {
+  if (v === null || v === undefined) return '—';
+  if (typeof v !== 'number') return String(v);
+  if (!Number.isFinite(v)) return String(v);
+  if (v === 0) return '0';
+  const a = Math.abs(v);
+  if (a < 1e-3 || a >= 1e6) return v.toExponential(digits - 1);
+  return Number(v.toPrecision(digits)).toString();
+}
+
+/** [lo, hi] in whole decades around the positive finite values (for log axes). */
+export function decadeRange(values, fallback = [1e-6, 1]) {
+  let min = Infinity;
+  let max = -Infinity;
+  for (const v of values) {
+    if (positive(v) === null) continue;
+    if (v < min) min = v;
+    if (v > max) max = v;
+  }
+  if (!(min <= max)) return fallback.slice();
+  // Number('1e-5') is the double nearest 10^-5; 10 ** -5 is not always.
+  let lo = Math.floor(Math.log10(min) + 1e-9);
+  let hi = Math.ceil(Math.log10(max) - 1e-9);
+  if (hi <= lo) {
+    lo -= 1;
+    hi += 1;
+  }
+  return [Number(`1e${lo}`), Number(`1e${hi}`)];
+}
+
+// ---------------------------------------------------------------------------------------------
+// Splitting a run over workers, and the result of a run cut short
+
+/** Deals `names` round-robin into at most k non-empty groups (one per worker), order kept. */
+export function splitEstimators(names, k) {
+  const groups = Array.from({ length: Math.max(1, Math.min(k, names.length)) }, () => []);
+  names.forEach((n, i) => groups[i % groups.length].push(n));
+  return groups.filter((g) => g.length);
+}
+
+/**
+ * A result object (docs/result-schema.md) from the levels streamed so far, for exporting a
+ * run that was cancelled (its workers were terminated, so they returned no result): the
+ * estimators are the streamed records, the scene block what core.sceneInfo said of the scene.
+ */
+export function partialResult(run, info, version = null) {
+  const scene = info
+    ? { name: info.name, description: info.description, domain: info.domain, dimension: info.dimension, exact: info.exact }
+    : { name: run.sceneName };
+  return {
+    version: 1,
+    mcplay: version,
+    scene,
+    settings: { ...(run.settings || {}), threads: run.workers },
+    cancelled: run.status !== 'done',
+    wall_time_s: run.elapsed !== null && run.elapsed !== undefined ? run.elapsed / 1000 : null,
+    estimators: run.order.filter((n) => run.records[n]).map((n) => run.records[n]),
+  };
+}

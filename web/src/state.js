@@ -1,0 +1,477 @@
+// The playground's one state object: a store (getState, subscribe, dispatch), the reducer that
+// is the only code changing the state, and the pure helpers that put the comparison in the URL
+// and read it back. No DOM, no workers: web/test/state.test.mjs runs it under Node.
+import { applyLevel, ladder, mergeResults, progressOf } from './series.js';
+
+/** Bounds of the core (docs/scene-format.md) and of the page's first run. */
+export const LIMITS = Object.freeze({
+  nMin: 1,
+  nMax: 2 ** 36,
+  repsMin: 2,
+  repsMax: 100000,
+  firstRunNMax: 65536, // the scene's own n_max, capped for a fast first run
+  exprLength: 2000,
+});
+
+/** Defaults of the comparison when neither the URL nor the scene says otherwise. */
+export const DEFAULTS = Object.freeze({
+  scene: null,       // the first scene of the manifest
+  estimators: null,  // null = all of the scene's estimators
+  n_min: 16,
+  n_max: 65536,
+  reps: 32,
+  seed: 1,
+  f: '',
+  p: '',
+});
+
+export const CUSTOM = 'custom';
+
+/** The URL keys, in the order stateToQuery writes them. */
+export const QUERY_KEYS = Object.freeze(['scene', 'estimators', 'n_min', 'n_max', 'reps', 'seed', 'f', 'p']);
+
+const NAME_RE = /^[A-Za-z0-9_.-]{1,100}$/;
+
+/** Parses a whole decimal number in [lo, hi]; anything else (1.5, 1e3, -2, '') gives null. */
+export function parseWhole(text, lo, hi) {
+  if (typeof text === 'number') text = String(text);
+  if (typeof text !== 'string' || !/^\s*\d{1,16}\s*$/.test(text)) return null;
+  const v = Number(text.trim());
+  return Number.isSafeInteger(v) && v >= lo && v <= hi ? v : null;
+}
+
+const PARAM_RULES = Object.freeze({
+  n_min: [LIMITS.nMin, LIMITS.nMax],
+  n_max: [LIMITS.nMin, LIMITS.nMax],
+  reps: [LIMITS.repsMin, LIMITS.repsMax],
+  seed: [0, Number.MAX_SAFE_INTEGER],
+});
+
+/** The message for an invalid value of a numeric setting, or '' when it is valid. */
+export function paramError(key, value) {
+  const [lo, hi] = PARAM_RULES[key];
+  if (parseWhole(value, lo, hi) !== null) return '';
+  return `${key} must be a whole number in ${lo}..${hi}`;
+}
+
+/** True when at least one power of two lies in [nMin, nMax] (the core's N ladder). */
+export function hasLadder(nMin, nMax) {
+  return ladder(nMin, nMax).length > 0;
+}
+
+// encodeURIComponent, leaving the characters that are safe in a query value readable.
+function enc(value) {
+  return encodeURIComponent(value).replace(/%2C/g, ',').replace(/%5E/g, '^').replace(/%2F/g, '/');
+}
+
+/**
+ * The comparison of a state as a query string ('?scene=...&estimators=a,b&n_min=...').
+ * `state` is either the store's state or a plain {scene, estimators, n_min, n_max, reps, seed,
+ * f, p}; the custom problem's f (and p) are written only for the custom scene.
+ */
+export function stateToQuery(state) {
+  const c = comparisonOf(state);
+  const parts = [];
+  const add = (k, v) => { if (v !== null && v !== undefined && v !== '') parts.push(`${k}=${enc(String(v))}`); };
+  add('scene', c.scene);
+  if (Array.isArray(c.estimators)) add('estimators', c.estimators.join(','));
+  for (const k of ['n_min', 'n_max', 'reps', 'seed']) add(k, c[k]);
+  if (c.scene === CUSTOM) {
+    add('f', c.f);
+    add('p', c.p);
+  }
+  return parts.length ? `?${parts.join('&')}` : '';
+}
+
+// {scene, estimators, n_min, ...} of the store's state or of a plain comparison object.
+function comparisonOf(state) {
+  if (state && state.params && 'sceneId' in state) {
+    return {
+      scene: state.sceneId,
+      estimators: state.selected,
+      ...state.params,
+      f: state.custom.applied ? state.custom.applied.f : state.custom.f,
+      p: state.custom.applied ? state.custom.applied.p : state.custom.p,
+    };
+  }
+  return { ...DEFAULTS, ...state };
+}
+
+/**
+ * Reads a comparison from a query string. Every value that is missing, malformed or out of the
+ * core's range is replaced by its default, so any URL gives a usable comparison:
+ * `defaults` is {scene, estimators, n_min, n_max, reps, seed, f, p} (missing keys from
+ * DEFAULTS). An f in the URL selects the custom scene; n_min > n_max, or a range holding no
+ * power of two, falls back to the default range. Estimator names are only checked for their
+ * spelling here: the scene decides which exist.
+ */
+export function queryToState(search, defaults = {}) {
+  const d = { ...DEFAULTS, ...defaults };
+  const out = { ...d };
+  let q;
+  try {
+    q = new URLSearchParams(typeof search === 'string' ? search : '');
+  } catch {
+    return out;
+  }
+  const get = (k) => {
+    const v = q.get(k);
+    return v === null ? null : v;
+  };
+
+  const scene = get('scene');
+  if (scene !== null && NAME_RE.test(scene)) out.scene = scene;
+
+  const est = get('estimators');
+  if (est !== null) {
+    const names = [...new Set(est.split(',').map((s) => s.trim()).filter((s) => NAME_RE.test(s)))];
+    if (names.length) out.estimators = names;
+  }
+
+  for (const k of ['n_min', 'n_max', 'reps', 'seed']) {
+    const raw = get(k);
+    if (raw === null) continue;
+    const [lo, hi] = PARAM_RULES[k];
+    const v = parseWhole(raw, lo, hi);
+    if (v !== null) out[k] = v;
+  }
+  if (out.n_min > out.n_max || !hasLadder(out.n_min, out.n_max)) {
+    out.n_min = d.n_min;
+    out.n_max = d.n_max;
+  }
+
+  for (const k of ['f', 'p']) {
+    const raw = get(k);
+    if (raw !== null && raw.length <= LIMITS.exprLength && !raw.includes('\0')) out[k] = raw.trim();
+  }
+  if (out.f) out.scene = CUSTOM;
+  else if (out.scene === CUSTOM) out.scene = d.scene === CUSTOM ? null : d.scene;
+  return out;
+}
+
+/** The scene's own N range, n_max capped for a fast first run (the issue's defaults). */
+export function sceneDefaults(info) {
+  const nMin = info && Number.isSafeInteger(info.n_min) ? info.n_min : DEFAULTS.n_min;
+  let nMax = info && Number.isSafeInteger(info.n_max) ? info.n_max : DEFAULTS.n_max;
+  nMax = Math.min(nMax, LIMITS.firstRunNMax);
+  const ok = nMin <= nMax && hasLadder(nMin, nMax);
+  return {
+    n_min: ok ? nMin : DEFAULTS.n_min,
+    n_max: ok ? nMax : DEFAULTS.n_max,
+    reps: DEFAULTS.reps,
+    seed: DEFAULTS.seed,
+  };
+}
+
+// ---------------------------------------------------------------------------------------------
+// Custom problems
+
+/**
+ * The scene of a typed problem: f over the unit interval (dimension 1) or the unit cube of
+ * `dimension` (what the core infers from f's highest variable), compared by uniform,
+ * stratified and Latin hypercube sampling, plus importance sampling (plain and stratified)
+ * from a density proportional to p when p is given. Nothing is evaluated here: the core parses
+ * both expressions when it validates the scene.
+ */
+export function buildCustomScene(f, p = '', dimension = 1) {
+  const d = Number.isSafeInteger(dimension) && dimension >= 1 ? dimension : 1;
+  const fx = String(f).trim();
+  const px = String(p || '').trim();
+  const scene = {
+    name: CUSTOM,
+    description: px ? `f = ${fx}, importance sampling from p proportional to ${px}` : `f = ${fx}`,
+    f: fx,
+    domain: d === 1 ? { type: 'interval', lower: 0, upper: 1 } : { type: 'box', dim: d },
+    estimators: ['uniform', 'stratified', 'latin_hypercube'],
+  };
+  if (px) scene.estimators.push({ name: 'importance', pdf: px }, { name: 'stratified_importance', pdf: px });
+  return scene;
+}
+
+/**
+ * Which input a core error about a custom scene concerns: 'p' for a pdf
+ * ("scene.estimators[3].pdf.shape: at position 2: ..."), else 'f'; with the 1-based position.
+ */
+export function customError(payload) {
+  const message = payload && payload.message ? payload.message : String(payload);
+  const path = payload && payload.field ? payload.field : (/^([\w.[\]]+):/.exec(message) || [])[1] || '';
+  let position = payload && Number.isSafeInteger(payload.position) ? payload.position : null;
+  if (position === null) {
+    const m = /: at position (\d+): /.exec(message);
+    if (m) position = Number(m[1]);
+  }
+  return { field: /^scene\.estimators\[\d+\]\.pdf/.test(path) ? 'p' : 'f', message, position };
+}
+
+// ---------------------------------------------------------------------------------------------
+// Store
+
+/** A store around `reducer`. Actions dispatched while subscribers run are queued, so every
+ *  subscriber sees every action once, in order, with the state right after it. */
+export function createStore(reducer, initial) {
+  let state = initial;
+  const subscribers = new Set();
+  const queue = [];
+  let busy = false;
+  return {
+    getState: () => state,
+    subscribe(fn) {
+      subscribers.add(fn);
+      return () => subscribers.delete(fn);
+    },
+    dispatch(action) {
+      queue.push(action);
+      if (busy) return;
+      busy = true;
+      try {
+        while (queue.length) {
+          const a = queue.shift();
+          state = reducer(state, a);
+          for (const fn of [...subscribers]) fn(state, a);
+        }
+      } finally {
+        busy = false;
+      }
+    },
+  };
+}
+
+export function initialState() {
+  return {
+    version: null,          // the core's version once a worker has loaded it
+    scenes: [],             // scenes/manifest.json
+    sceneId: null,          // a manifest name or CUSTOM
+    scene: null,            // the scene object that is run (file content or the built custom scene)
+    sceneInfo: null,        // core.sceneInfo(scene): name, description, dimension, exact, estimators, ...
+    selected: [],           // selected estimator names, in the scene's order
+    params: { n_min: DEFAULTS.n_min, n_max: DEFAULTS.n_max, reps: DEFAULTS.reps, seed: DEFAULTS.seed },
+    paramErrors: {},        // key -> message for an input that holds no valid value
+    custom: { f: '', p: '', error: null, pending: false, applied: null },
+    calibration: 'all',     // the histogram's level: 'all' (pooled) or an N
+    notice: '',             // last export / scene-loading message
+    run: emptyRun('loading'),
+  };
+}
+
+function emptyRun(status) {
+  return {
+    id: 0,
+    status,                 // loading | ready | running | done | cancelled | error
+    message: '',
+    progress: 0,
+    workers: 0,
+    startedAt: null,
+    elapsed: null,
+    settings: null,         // {n_min, n_max, reps, seed}
+    exact: null,            // the scene's exact value (MSE instead of variance when known)
+    sceneName: null,
+    colors: null,           // name -> palette index (its position in the scene)
+    order: [],              // estimator names of the run, in the scene's order
+    ladder: [],
+    records: {},            // name -> estimator record (levels streamed so far, fit, warnings)
+    partials: [],           // complete results of the workers done so far
+    result: null,           // the merged result once every worker is done
+  };
+}
+
+function orderedSelection(available, names) {
+  const want = new Set(names);
+  return available.filter((n) => want.has(n));
+}
+
+/** The reducer: (state, action) -> new state, never mutating its input. */
+export function reducer(state, action) {
+  const p = action.payload || {};
+  switch (action.type) {
+    case 'core/ready':
+      return {
+        ...state,
+        version: p.version,
+        run: state.run.status === 'loading' ? { ...state.run, status: 'ready' } : state.run,
+      };
+    case 'core/failed':
+      return { ...state, run: { ...state.run, status: 'error', message: p.message } };
+    case 'scenes/loaded':
+      return { ...state, scenes: p.scenes };
+    case 'scene/request': {
+      // A scene of the manifest is shown at once (its estimators all selected, its own capped
+      // range), from what the manifest says of it; core.sceneInfo completes it (scene/loaded)
+      // and Run waits for that. Edits made meanwhile are kept.
+      const entry = p.sceneId === CUSTOM ? null : state.scenes.find((sc) => sc.name === p.sceneId);
+      if (!entry) return { ...state, notice: '' };
+      const info = {
+        name: entry.name, description: entry.description, dimension: entry.dimension,
+        estimators: entry.estimators.slice(), n_min: entry.n_min, n_max: entry.n_max, provisional: true,
+      };
+      return {
+        ...state,
+        sceneId: entry.name,
+        scene: null,
+        sceneInfo: info,
+        selected: info.estimators.slice(),
+        params: { ...state.params, ...sceneDefaults(info) },
+        paramErrors: {},
+        custom: { ...state.custom, error: null, pending: false },
+        notice: '',
+        run: state.version ? { ...emptyRun('ready'), id: state.run.id } : state.run,
+      };
+    }
+    case 'scene/loaded': {
+      // {sceneId, scene, info, selected?, params?}: selected/params come from the URL, else all
+      // estimators and the scene's own (capped) range.
+      const available = p.info.estimators || [];
+      // the answer to a scene/request keeps what was chosen since
+      const keep = !p.selected && !p.params && state.sceneId === p.sceneId && state.sceneInfo && state.sceneInfo.provisional;
+      let selected = keep ? state.selected : p.selected ? p.selected : available;
+      selected = orderedSelection(available, selected);
+      if (!selected.length && !keep) selected = available.slice();
+      let params;
+      if (keep) params = state.params;
+      else if (p.params) params = { ...state.params, ...p.params };
+      else params = { ...state.params, ...sceneDefaults(p.info) };
+      const custom = p.sceneId === CUSTOM
+        ? { ...state.custom, error: null, pending: false, applied: p.custom || state.custom.applied }
+        : { ...state.custom, error: null, pending: false };
+      return {
+        ...state,
+        sceneId: p.sceneId,
+        scene: p.scene,
+        sceneInfo: p.info,
+        selected,
+        params,
+        paramErrors: keep ? state.paramErrors : {},
+        custom,
+        notice: '',
+        // a new problem clears the plots of the previous one (and stops its run)
+        run: state.version && !keep ? { ...emptyRun('ready'), id: state.run.id } : state.run,
+      };
+    }
+    case 'scene/failed':
+      return { ...state, notice: p.message, custom: { ...state.custom, pending: false } };
+    case 'estimator/set': {
+      const available = state.sceneInfo ? state.sceneInfo.estimators : [];
+      const set = new Set(state.selected);
+      if (p.checked) set.add(p.name);
+      else set.delete(p.name);
+      return { ...state, selected: orderedSelection(available, [...set]) };
+    }
+    case 'estimators/all': {
+      const available = state.sceneInfo ? state.sceneInfo.estimators : [];
+      return { ...state, selected: p.checked ? available.slice() : [] };
+    }
+    case 'param/set': {
+      // {key, value: the input's text}
+      const err = paramError(p.key, p.value);
+      const paramErrors = { ...state.paramErrors };
+      if (err) {
+        paramErrors[p.key] = err;
+        return { ...state, paramErrors };
+      }
+      delete paramErrors[p.key];
+      const [lo, hi] = PARAM_RULES[p.key];
+      return { ...state, params: { ...state.params, [p.key]: parseWhole(p.value, lo, hi) }, paramErrors };
+    }
+    case 'custom/edit':
+      return { ...state, custom: { ...state.custom, [p.field]: p.value } };
+    case 'custom/apply':
+      return { ...state, custom: { ...state.custom, pending: true, error: null } };
+    case 'custom/error':
+      // {field: 'f' | 'p', message, position}
+      return { ...state, custom: { ...state.custom, pending: false, error: { ...p } } };
+    case 'calibration/set':
+      return { ...state, calibration: p.value === 'all' ? 'all' : Number(p.value) };
+    case 'notice':
+      return { ...state, notice: p.message };
+
+    case 'run/request':
+      return state;
+    case 'run/start':
+      // {id, workers, settings, order, exact, sceneName, startedAt}
+      return {
+        ...state,
+        calibration: 'all',
+        run: {
+          ...emptyRun('running'),
+          id: p.id,
+          workers: p.workers,
+          startedAt: p.startedAt,
+          settings: p.settings,
+          exact: p.exact,
+          sceneName: p.sceneName,
+          colors: p.colors || null,
+          order: p.order,
+          ladder: ladder(p.settings.n_min, p.settings.n_max),
+        },
+      };
+    case 'run/level': {
+      if (p.id !== state.run.id || state.run.status !== 'running') return state;
+      const records = applyLevel(state.run.records, p.level);
+      return {
+        ...state,
+        run: { ...state.run, records, progress: progressOf(records, state.run.order, state.run.ladder) },
+      };
+    }
+    case 'run/partial': {
+      // one worker's complete result: its records become the result's estimators
+      if (p.id !== state.run.id || state.run.status !== 'running') return state;
+      const records = { ...state.run.records };
+      for (const e of p.result.estimators) records[e.name] = e;
+      const partials = [...state.run.partials, p.result];
+      const run = { ...state.run, records, partials, progress: progressOf(records, state.run.order, state.run.ladder) };
+      if (partials.length === state.run.workers) {
+        run.result = mergeResults(partials, state.run.order);
+        run.status = run.result.cancelled ? 'cancelled' : 'done';
+        run.progress = 1;
+        run.elapsed = p.now - state.run.startedAt;
+      }
+      return { ...state, run };
+    }
+    case 'run/cancel':
+      if (state.run.status !== 'running') return state;
+      return { ...state, run: { ...state.run, status: 'cancelled', elapsed: p.now - state.run.startedAt } };
+    case 'run/error':
+      if (p.id !== undefined && p.id !== state.run.id) return state;
+      return { ...state, run: { ...state.run, status: 'error', message: p.message } };
+    default:
+      return state;
+  }
+}
+
+/** The #status text of a state. */
+export function statusText(state) {
+  const r = state.run;
+  if (r.status === 'error') return `error: ${r.message}`;
+  return r.status;
+}
+
+/** True when the inputs make a runnable comparison; otherwise the reason. */
+export function runBlocker(state) {
+  if (!state.version) return 'the core is loading';
+  if (!state.scene) return state.sceneInfo ? 'loading the scene' : 'no scene';
+  if (!state.selected.length) return 'select at least one estimator';
+  const keys = Object.keys(state.paramErrors);
+  if (keys.length) return state.paramErrors[keys[0]];
+  const { n_min: a, n_max: b } = state.params;
+  if (a > b) return `n_max (${b}) must be >= n_min (${a})`;
+  if (!hasLadder(a, b)) return `no power of two lies between n_min = ${a} and n_max = ${b}`;
+  return '';
+}
+
+/** A structured-cloneable snapshot for window.mcplayDebug.state(). */
+export function debugSnapshot(state) {
+  const r = state.run;
+  return {
+    status: statusText(state),
+    version: state.version,
+    scene: state.sceneId,
+    sceneInfo: state.sceneInfo,
+    selected: state.selected.slice(),
+    params: { ...state.params },
+    query: stateToQuery(state),
+    custom: { f: state.custom.f, p: state.custom.p, error: state.custom.error },
+    run: { id: r.id, status: r.status, progress: r.progress, workers: r.workers, settings: r.settings, exact: r.exact },
+    // per estimator of the run: its levels so far ({n, variance, mse, error, ...}), fit, warnings
+    estimators: r.order.filter((n) => r.records[n]).map((n) => r.records[n]),
+    result: r.result,
+  };
+}

@@ -1,0 +1,308 @@
+// Tests of web/src/series.js: plot series from result / level JSON, bands, MSE, slopes,
+// z-score histograms, merging the workers' parts. Pure functions under Node's test runner.
+import { test } from 'node:test';
+import assert from 'node:assert/strict';
+
+import {
+  ladder, applyLevel, progressOf, mergeResults, varianceSeries, anchorOf, referenceLines, fitSlope,
+  timeSeries, zScores, histogram, normalDensity, calibrationSeries, coverageSeries, collectWarnings,
+  fixed3, fitText, fmt, decadeRange, splitEstimators, partialResult,
+} from '../src/series.js';
+
+// A level as the core reports it (docs/result-schema.md), with the fields the plots use.
+function lvl(n, over = {}) {
+  const variance = 1 / n;
+  return {
+    n, reps: 4, mean: 1, variance, variance_ci95: [variance / 2, variance * 3], std_error: Math.sqrt(variance / 4),
+    mse: variance * 1.5, rmse: Math.sqrt(variance * 1.5), error: Math.sqrt(variance * 1.5), coverage95: 0.75,
+    time_mean_s: n * 1e-8, warnings: [], replicates: { estimate: [1, 1, 1, 1], std_error: [1, 1, 1, 1] }, ...over,
+  };
+}
+function record(name, ns, over = {}) {
+  return { name, sampler: 'independent', warnings: [], fit: { valid: true, order: -1, order_se: 0.01 }, levels: ns.map((n) => lvl(n)), ...over };
+}
+
+test('ladder: the powers of two in [n_min, n_max]', () => {
+  assert.deepEqual(ladder(16, 256), [16, 32, 64, 128, 256]);
+  assert.deepEqual(ladder(17, 100), [32, 64]);
+  assert.deepEqual(ladder(1, 1), [1]);
+  assert.deepEqual(ladder(17, 31), []);
+  assert.deepEqual(ladder(64, 16), []);
+  assert.equal(ladder(16, 2 ** 36).length, 33);
+});
+
+test('variance against N: one series per estimator, nulls where it has no level', () => {
+  const records = { a: record('a', [16, 32, 64]), b: record('b', [16, 32]) };
+  const vs = varianceSeries(records, ['a', 'b', 'missing']);
+  assert.equal(vs.quantity, 'variance');
+  assert.deepEqual(vs.x, [16, 32, 64]);
+  assert.deepEqual(vs.series.map((s) => s.name), ['a', 'b']);
+  assert.deepEqual(vs.series[0].y, [1 / 16, 1 / 32, 1 / 64]);
+  assert.deepEqual(vs.series[1].y, [1 / 16, 1 / 32, null]);
+  // the band is the core's variance_ci95
+  assert.deepEqual(vs.series[0].lo, [1 / 32, 1 / 64, 1 / 128]);
+  assert.deepEqual(vs.series[0].hi, [3 / 16, 3 / 32, 3 / 64]);
+  assert.deepEqual(vs.series[1].hi[2], null);
+  // a fixed x (the run's whole ladder) leaves room for the levels still to come
+  const wide = varianceSeries(records, ['a'], null, [16, 32, 64, 128]);
+  assert.deepEqual(wide.series[0].y, [1 / 16, 1 / 32, 1 / 64, null]);
+});
+
+test('MSE instead of variance when the exact value is known; its band scaled alike', () => {
+  const records = { a: record('a', [16, 32]) };
+  const vs = varianceSeries(records, ['a'], 2.5);
+  assert.equal(vs.quantity, 'mse');
+  assert.deepEqual(vs.series[0].y, [1.5 / 16, 1.5 / 32]);
+  assert.ok(Math.abs(vs.series[0].lo[0] - 1.5 / 32) < 1e-15);
+  assert.ok(Math.abs(vs.series[0].hi[0] - 4.5 / 16) < 1e-15);
+  assert.equal(varianceSeries(records, ['a'], null).quantity, 'variance');
+});
+
+test('values that cannot sit on a log axis become null', () => {
+  const r = record('a', [16, 32, 64]);
+  r.levels[0] = lvl(16, { variance: 0, mse: 0, variance_ci95: [0, 0] });
+  r.levels[1] = lvl(32, { variance: null, variance_ci95: null, mse: null });
+  r.levels[2] = lvl(64, { variance: Infinity, variance_ci95: [1, Infinity] });
+  const vs = varianceSeries({ a: r }, ['a']);
+  assert.deepEqual(vs.series[0].y, [null, null, null]);
+  assert.deepEqual(vs.series[0].lo, [null, null, 1]);
+  assert.deepEqual(vs.series[0].hi, [null, null, null]);
+  // a zero variance with a nonzero MSE (all replicates equal and wrong): no band
+  const z = record('z', [16]);
+  z.levels[0] = lvl(16, { variance: 0, mse: 0.25, variance_ci95: [0, 0] });
+  const ms = varianceSeries({ z }, ['z'], 1);
+  assert.deepEqual([ms.series[0].y[0], ms.series[0].lo[0], ms.series[0].hi[0]], [0.25, null, null]);
+});
+
+test('fitSlope is exact on power laws and ignores what a log cannot take', () => {
+  const xs = [16, 32, 64, 128, 256, 512];
+  for (const order of [-1, -1.5, -2, -3, 0.5]) {
+    const fit = fitSlope(xs, xs.map((x) => 3.7 * x ** order));
+    assert.ok(Math.abs(fit.slope - order) < 1e-12, `slope ${fit.slope} for ${order}`);
+    assert.ok(Math.abs(fit.intercept - Math.log(3.7)) < 1e-10);
+    assert.equal(fit.n, 6);
+  }
+  const fit = fitSlope([1, 2, 4, 8, 16], [1, 0, null, 1 / 64, -1]);
+  assert.equal(fit.n, 2);
+  assert.ok(Math.abs(fit.slope + 2) < 1e-12);
+  assert.equal(fitSlope([4, 4, 4], [1, 2, 3]), null, 'one distinct x');
+  assert.equal(fitSlope([1], [1]), null);
+  // least squares, not two-point: y = x^-1 with one point off
+  const noisy = fitSlope([1, 2, 4], [1, 0.5 * Math.E, 0.25]);
+  const lx = [0, Math.LN2, 2 * Math.LN2];
+  const ly = [0, Math.log(0.5 * Math.E), Math.log(0.25)];
+  const mx = (lx[0] + lx[1] + lx[2]) / 3;
+  const my = (ly[0] + ly[1] + ly[2]) / 3;
+  const slope = lx.reduce((s, x, i) => s + (x - mx) * (ly[i] - my), 0) / lx.reduce((s, x) => s + (x - mx) ** 2, 0);
+  assert.ok(Math.abs(noisy.slope - slope) < 1e-12);
+});
+
+test('reference slopes start at the first point with the largest y there', () => {
+  const x = [16, 32, 64];
+  const series = [{ y: [null, 2, 1] }, { y: [null, 8, 4] }];
+  const anchor = anchorOf(x, series);
+  assert.deepEqual(anchor, { x: 32, y: 8 });
+  const refs = referenceLines(x, anchor);
+  assert.deepEqual(refs.map((r) => r.order), [-1, -2, -3]);
+  assert.deepEqual(refs[0].y, [16, 8, 4]);
+  assert.deepEqual(refs[1].y, [32, 8, 2]);
+  assert.deepEqual(refs[2].y, [64, 8, 1]);
+  for (const r of refs) assert.ok(Math.abs(fitSlope(x, r.y).slope - r.order) < 1e-12);
+  assert.equal(anchorOf(x, [{ y: [null, null, null] }]), null);
+  assert.deepEqual(referenceLines(x, null), []);
+});
+
+test('error against time: aligned on the union of times, points kept in the order of N', () => {
+  const a = record('a', [16, 32, 64]);
+  a.levels[0].time_mean_s = 5e-6; // slower than the next level (warm-up): not monotone
+  a.levels[1].time_mean_s = 2e-6;
+  a.levels[2].time_mean_s = 8e-6;
+  const b = record('b', [16]);
+  b.levels[0].time_mean_s = 2e-6; // same time as a's second point
+  b.levels[0].error = 0.5;
+  const ts = timeSeries({ a, b }, ['a', 'b']);
+  assert.deepEqual(ts.x, [2e-6, 5e-6, 8e-6]);
+  assert.deepEqual(ts.series[0].y, [a.levels[1].error, a.levels[0].error, a.levels[2].error]);
+  assert.deepEqual(ts.series[1].y, [0.5, null, null]);
+  assert.deepEqual(ts.series[0].points.map((p) => p[0]), [5e-6, 2e-6, 8e-6]);
+  assert.equal(ts.series[1].slope, null);
+  // error ~ t^-1/2 exactly
+  const c = record('c', [16, 32, 64, 128]);
+  c.levels.forEach((l) => { l.time_mean_s = l.n * 1e-7; l.error = 3 / Math.sqrt(l.n); });
+  assert.ok(Math.abs(timeSeries({ c }, ['c']).series[0].slope + 0.5) < 1e-12);
+});
+
+test('z-scores against the exact value, or each level\'s mean when it is unknown', () => {
+  const levels = [
+    lvl(16, { mean: 1.5, replicates: { estimate: [1, 2, 3, 2], std_error: [0.5, 0.5, 1, 0] } }),
+    lvl(32, { mean: 2, replicates: { estimate: [2.5, 1.5], std_error: [0.25, 0.25] } }),
+  ];
+  const all = zScores(levels, 2);
+  assert.deepEqual(all.z, [-2, 0, 1, 2, -2]);
+  assert.equal(all.zeroSe, 1, 'a zero error bar is counted, not divided by');
+  assert.equal(all.reference, 'exact');
+  assert.deepEqual(zScores(levels, 2, 32).z, [2, -2]);
+  const mean = zScores(levels, null, 16);
+  assert.deepEqual(mean.z, [-1, 1, 1.5]);
+  assert.equal(mean.reference, 'mean');
+});
+
+test('histogram: counts per bin, a density that integrates to the share inside, outliers apart', () => {
+  const h = histogram([-5, -0.25, 0, 0.1, 0.49, 0.5, 4.99, 5, -7, NaN], { lo: -5, hi: 5, width: 0.5 });
+  assert.equal(h.edges.length, 21);
+  assert.equal(h.edges[0], -5);
+  assert.equal(h.edges[10], 0);
+  assert.equal(h.total, 9, 'NaN is dropped');
+  assert.equal(h.below, 1);
+  assert.equal(h.above, 1);
+  assert.equal(h.counts[0], 1);  // -5
+  assert.equal(h.counts[9], 1);  // -0.25
+  assert.equal(h.counts[10], 3); // 0, 0.1, 0.49
+  assert.equal(h.counts[11], 1); // 0.5
+  assert.equal(h.counts[19], 1); // 4.99
+  const area = h.density.reduce((s, d) => s + d * 0.5, 0);
+  assert.ok(Math.abs(area - 7 / 9) < 1e-12);
+  assert.deepEqual(histogram([]).density.every((d) => d === 0), true);
+});
+
+test('the calibration plot: a step histogram per estimator against N(0, 1)', () => {
+  assert.ok(Math.abs(normalDensity(0) - 1 / Math.sqrt(2 * Math.PI)) < 1e-15);
+  const r = record('a', [16]);
+  r.levels[0].replicates = { estimate: [1.25, 0.75, 1.1, 1.0], std_error: [1, 1, 1, 1] }; // z = 0.25, -0.25, 0.1, 0
+  const cs = calibrationSeries({ a: r }, ['a'], 1);
+  assert.equal(cs.x.length, 101);
+  assert.equal(cs.x[50], 0);
+  assert.equal(cs.normal[50], normalDensity(0));
+  const s = cs.series[0];
+  assert.equal(s.total, 4);
+  assert.equal(s.within2, 4);
+  // bin [-0.5, 0) holds one of 4, bin [0, 0.5) three: densities 0.5 and 1.5
+  assert.equal(s.y[cs.x.indexOf(-0.5)], 0.5);
+  assert.equal(s.y[cs.x.indexOf(-0.1)], 0.5);
+  assert.equal(s.y[cs.x.indexOf(0)], 1.5);
+  assert.equal(s.y[cs.x.indexOf(0.4)], 1.5);
+  assert.equal(s.y[cs.x.indexOf(0.5)], 0);
+});
+
+test('coverage against N', () => {
+  const r = record('a', [16, 32]);
+  r.levels[1].coverage95 = null;
+  const cs = coverageSeries({ a: r }, ['a'], [16, 32, 64]);
+  assert.deepEqual(cs.series[0].y, [0.75, null, null]);
+});
+
+test('levels stream into records; progress is weighted by N', () => {
+  const meta = (name, n) => ({ name, sampler: 'stratified', warnings: [], fit: { valid: n > 16, order: -2 }, level: lvl(n) });
+  let rec = applyLevel({}, { level_index: 0, n: 16, estimators: [meta('a', 16), meta('b', 16)] });
+  assert.deepEqual(Object.keys(rec), ['a', 'b']);
+  assert.deepEqual(rec.a.levels.map((l) => l.n), [16]);
+  assert.equal(rec.a.level, undefined);
+  const before = rec;
+  rec = applyLevel(rec, { level_index: 1, n: 32, estimators: [meta('a', 32)] });
+  assert.deepEqual(before.a.levels.map((l) => l.n), [16], 'the old records are not changed');
+  assert.deepEqual(rec.a.levels.map((l) => l.n), [16, 32]);
+  assert.equal(rec.a.fit.valid, true, 'the latest fit');
+  rec = applyLevel(rec, { level_index: 1, n: 32, estimators: [meta('a', 32)] });
+  assert.equal(rec.a.levels.length, 2, 'a repeated level replaces');
+  const lad = ladder(16, 64);
+  assert.ok(Math.abs(progressOf(rec, ['a', 'b'], lad) - (48 + 16) / (2 * 112)) < 1e-12);
+  assert.equal(progressOf({}, [], lad), 0);
+});
+
+function part(names, over = {}) {
+  return {
+    cancelled: false,
+    estimators: names.map((n) => record(n, [16, 32])),
+    mcplay: '0.1.0',
+    scene: { name: 'disk_third', exact: 1 / 9 },
+    settings: { accumulator: 'compensated', n_max: 32, n_min: 16, reps: 4, seed: 1, threads: 1 },
+    version: 1,
+    wall_time_s: 0.5,
+    ...over,
+  };
+}
+
+test('merging the workers\' results: the scene\'s order, threads summed, the longest wall time', () => {
+  const merged = mergeResults([part(['b', 'd']), part(['a', 'c'], { wall_time_s: 0.75 })], ['a', 'b', 'c', 'd']);
+  assert.deepEqual(merged.estimators.map((e) => e.name), ['a', 'b', 'c', 'd']);
+  assert.equal(merged.settings.threads, 2);
+  assert.equal(merged.wall_time_s, 0.75);
+  assert.equal(merged.cancelled, false);
+  assert.deepEqual(merged.scene, part([]).scene);
+  assert.deepEqual(Object.keys(merged), Object.keys(part([])), 'the same fields as a result');
+  // one part: the result itself (but for threads)
+  assert.deepEqual(mergeResults([part(['a'])]), part(['a']));
+  // names missing from `order` come last; a cancelled part cancels the whole
+  const m2 = mergeResults([part(['x']), part(['a'], { cancelled: true })], ['a']);
+  assert.deepEqual(m2.estimators.map((e) => e.name), ['a', 'x']);
+  assert.equal(m2.cancelled, true);
+});
+
+test('merging refuses parts of different studies and duplicate estimators', () => {
+  assert.throws(() => mergeResults([]), /no results/);
+  assert.throws(() => mergeResults([part(['a']), part(['b'], { settings: { ...part([]).settings, seed: 2 } })]), /different studies/);
+  assert.throws(() => mergeResults([part(['a']), part(['b'], { scene: { name: 'other' } })]), /different studies/);
+  assert.throws(() => mergeResults([part(['a']), part(['a'])]), /'a' is in two parts/);
+});
+
+test('splitting the estimators over workers: round robin, never an empty group', () => {
+  assert.deepEqual(splitEstimators(['a', 'b', 'c', 'd', 'e'], 2), [['a', 'c', 'e'], ['b', 'd']]);
+  assert.deepEqual(splitEstimators(['a', 'b'], 8), [['a'], ['b']]);
+  assert.deepEqual(splitEstimators(['a'], 0), [['a']]);
+  assert.deepEqual(splitEstimators([], 4), []);
+  const names = ['u', 'v', 'w', 'x', 'y', 'z', 'q'];
+  for (let k = 1; k <= 8; k++) assert.deepEqual(splitEstimators(names, k).flat().sort(), [...names].sort());
+});
+
+test('a cancelled run exports the streamed levels as a result', () => {
+  const run = {
+    status: 'cancelled', settings: { n_min: 16, n_max: 64, reps: 4, seed: 1 }, workers: 2, elapsed: 250,
+    order: ['a', 'b', 'c'], records: { a: record('a', [16]), c: record('c', [16, 32]) }, sceneName: 'x',
+  };
+  const r = partialResult(run, { name: 'x', description: 'd', domain: 'box', dimension: 1, exact: null, estimators: ['a'] }, '0.1.0');
+  assert.equal(r.cancelled, true);
+  assert.equal(r.wall_time_s, 0.25);
+  assert.equal(r.settings.threads, 2);
+  assert.deepEqual(r.estimators.map((e) => e.name), ['a', 'c']);
+  assert.deepEqual(r.scene, { name: 'x', description: 'd', domain: 'box', dimension: 1, exact: null });
+});
+
+test('warnings grouped per estimator and code, level flags with their N', () => {
+  const a = record('a', [16, 32, 64], { warnings: [{ code: 'heavy_tail', message: 'tail index 1.4' }] });
+  a.levels[0].warnings = [{ code: 'low_ess', message: 'ess 2 at N = 16' }];
+  a.levels[1].warnings = [{ code: 'low_ess', message: 'ess 3 at N = 32' }, { code: 'dominant_sample', message: 'one sample' }];
+  const w = collectWarnings({ a, b: record('b', [16]) }, ['a', 'b']);
+  assert.deepEqual(w, [
+    { estimator: 'a', scope: 'estimator', code: 'heavy_tail', message: 'tail index 1.4', n: [] },
+    { estimator: 'a', scope: 'level', code: 'low_ess', message: 'ess 2 at N = 16', n: [16, 32] },
+    { estimator: 'a', scope: 'level', code: 'dominant_sample', message: 'one sample', n: [32] },
+  ]);
+});
+
+test('the fitted order is printed as the CLI prints it (%.3f)', () => {
+  assert.equal(fitText({ valid: true, order: -1.04049, order_se: 0.02751 }), '-1.040 ± 0.028');
+  assert.equal(fitText({ valid: true, order: -0.978, order_se: null }), '-0.978');
+  assert.equal(fitText({ valid: false, order: null, note: 'fewer than 3 levels with a variance: no fit' }),
+    'no fit (fewer than 3 levels with a variance: no fit)');
+  assert.equal(fitText(null), 'no fit yet');
+  // printf rounds exact binary ties to even, toFixed away from zero
+  assert.equal(fixed3(1.0625), '1.062');
+  assert.equal(fixed3(-1.0625), '-1.062');
+  assert.equal(fixed3(0.1875), '0.188');
+  assert.equal(fixed3(2.0015625), '2.002');
+  assert.equal(fixed3(0.0005), '0.001', '0.0005 is a little above the tie in binary');
+  assert.equal(fixed3(-0.0001), '-0.000');
+  assert.equal(fixed3(-0), '-0.000');
+  assert.equal(fixed3(12.3456), '12.346');
+});
+
+test('fmt and decadeRange', () => {
+  assert.equal(fmt(null), '—');
+  assert.equal(fmt(0), '0');
+  assert.equal(fmt(0.123456), '0.1235');
+  assert.equal(fmt(1.5e-7), '1.500e-7');
+  assert.equal(fmt(123456789), '1.235e+8');
+  assert.deepEqual(decadeRange([3e-5, 0.02, null, 0, -1]), [1e-5, 0.1]);
+  assert.deepEqual(decadeRange([1e-3]), [1e-4, 1e-2]);
+  assert.deepEqual(decadeRange([]), [1e-6, 1]);
+});

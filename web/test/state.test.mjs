@@ -1,0 +1,237 @@
+// Tests of web/src/state.js: the comparison in the URL and back, defaults, bad values, the
+// reducer, custom scenes. Pure functions under Node's test runner: node --test web/test/
+import { test } from 'node:test';
+import assert from 'node:assert/strict';
+
+import {
+  stateToQuery, queryToState, sceneDefaults, parseWhole, paramError, reducer, initialState,
+  createStore, runBlocker, statusText, buildCustomScene, customError, debugSnapshot, DEFAULTS, CUSTOM,
+} from '../src/state.js';
+
+const SCENE_DEFAULTS = { scene: 'disk_quarter', estimators: null, n_min: 16, n_max: 65536, reps: 32, seed: 1 };
+
+test('a comparison survives the round trip through the URL', () => {
+  const c = {
+    scene: 'disk_third', estimators: ['uniform', 'stratified_polar'], n_min: 32, n_max: 4096, reps: 64,
+    seed: 12345678901, f: '', p: '',
+  };
+  const q = stateToQuery(c);
+  assert.equal(q, '?scene=disk_third&estimators=uniform,stratified_polar&n_min=32&n_max=4096&reps=64&seed=12345678901');
+  assert.deepEqual(queryToState(q, SCENE_DEFAULTS), c);
+});
+
+test('custom f and p survive the round trip, whatever characters they hold', () => {
+  const c = {
+    scene: CUSTOM, estimators: ['uniform', 'importance'], n_min: 16, n_max: 1024, reps: 8, seed: 0,
+    f: 'exp(-(x-0.5)^2/0.01) + pow(x, 2)*1e-3 & #?=%', p: 'abs(x - 1/2)^-0.5 + 0.05',
+  };
+  const q = stateToQuery(c);
+  assert.doesNotMatch(q, /[ #]/, 'spaces and # are escaped');
+  assert.match(q, /\^/, 'the caret stays readable');
+  assert.deepEqual(queryToState(q, SCENE_DEFAULTS), c);
+  // f and p are written for the custom scene only
+  assert.doesNotMatch(stateToQuery({ ...c, scene: 'exp_1d' }), /[&?]f=/);
+});
+
+test('the store state maps to the same query as its comparison', () => {
+  let s = initialState();
+  s = reducer(s, { type: 'core/ready', payload: { version: '0.1.0' } });
+  s = reducer(s, {
+    type: 'scene/loaded',
+    payload: { sceneId: 'exp_1d', scene: {}, info: { estimators: ['uniform', 'stratified', 'importance'], n_min: 16, n_max: 1 << 20 } },
+  });
+  s = reducer(s, { type: 'estimator/set', payload: { name: 'stratified', checked: false } });
+  s = reducer(s, { type: 'param/set', payload: { key: 'seed', value: '7' } });
+  assert.equal(stateToQuery(s), '?scene=exp_1d&estimators=uniform,importance&n_min=16&n_max=65536&reps=32&seed=7');
+});
+
+test('an empty or foreign query gives the defaults', () => {
+  assert.deepEqual(queryToState('', SCENE_DEFAULTS), { ...DEFAULTS, ...SCENE_DEFAULTS });
+  assert.deepEqual(queryToState('?utm_source=x&foo=bar', SCENE_DEFAULTS), { ...DEFAULTS, ...SCENE_DEFAULTS });
+  assert.deepEqual(queryToState(undefined, SCENE_DEFAULTS), { ...DEFAULTS, ...SCENE_DEFAULTS });
+  assert.equal(queryToState('').n_max, 65536);
+});
+
+test('bad values are ignored one by one, the good ones kept', () => {
+  const q = queryToState('?scene=exp_1d&n_min=abc&n_max=4096&reps=1&seed=-3', SCENE_DEFAULTS);
+  assert.deepEqual(q, { ...DEFAULTS, ...SCENE_DEFAULTS, scene: 'exp_1d', n_max: 4096 });
+  for (const [key, bad] of [
+    ['n_min', '0'], ['n_min', '1.5'], ['n_min', '1e3'], ['n_min', ''], ['n_max', String(2 ** 36 + 1)],
+    ['reps', '100001'], ['reps', '2.0'], ['seed', '9007199254740993'], ['seed', '0x10'], ['reps', ' 4 4'],
+  ]) {
+    assert.equal(queryToState(`?${key}=${encodeURIComponent(bad)}`, SCENE_DEFAULTS)[key], SCENE_DEFAULTS[key], `${key}=${bad}`);
+  }
+  // the extremes that are allowed
+  assert.equal(queryToState(`?n_max=${2 ** 36}`, SCENE_DEFAULTS).n_max, 2 ** 36);
+  assert.equal(queryToState('?reps=100000&seed=0', SCENE_DEFAULTS).reps, 100000);
+  assert.equal(queryToState('?seed=0', SCENE_DEFAULTS).seed, 0);
+});
+
+test('an N range that is reversed or holds no power of two falls back to the default range', () => {
+  assert.deepEqual(pick(queryToState('?n_min=4096&n_max=64', SCENE_DEFAULTS)), [16, 65536]);
+  assert.deepEqual(pick(queryToState('?n_min=17&n_max=31', SCENE_DEFAULTS)), [16, 65536]);
+  // n_max alone below the default n_min
+  assert.deepEqual(pick(queryToState('?n_max=8', SCENE_DEFAULTS)), [16, 65536]);
+  assert.deepEqual(pick(queryToState('?n_min=1&n_max=8', SCENE_DEFAULTS)), [1, 8]);
+  function pick(q) {
+    return [q.n_min, q.n_max];
+  }
+});
+
+test('scene and estimator names are checked for their spelling, f selects the custom scene', () => {
+  assert.equal(queryToState('?scene=../../etc/passwd', SCENE_DEFAULTS).scene, 'disk_quarter');
+  assert.equal(queryToState('?scene=<script>', SCENE_DEFAULTS).scene, 'disk_quarter');
+  assert.equal(queryToState('?scene=singular_power_0.5', SCENE_DEFAULTS).scene, 'singular_power_0.5');
+  assert.deepEqual(queryToState('?estimators=uniform,,a b,uniform,stratified', SCENE_DEFAULTS).estimators, ['uniform', 'stratified']);
+  assert.equal(queryToState('?estimators=,,', SCENE_DEFAULTS).estimators, null);
+  assert.equal(queryToState('?scene=exp_1d&f=x%5E2', SCENE_DEFAULTS).scene, CUSTOM);
+  assert.equal(queryToState('?scene=custom', SCENE_DEFAULTS).scene, 'disk_quarter', 'custom without f');
+  assert.equal(queryToState(`?f=${'x+'.repeat(1001)}x`, SCENE_DEFAULTS).scene, 'disk_quarter', 'too long an f');
+});
+
+test('parseWhole and paramError accept whole numbers in range only', () => {
+  assert.equal(parseWhole('42', 1, 100), 42);
+  assert.equal(parseWhole(' 42 ', 1, 100), 42);
+  assert.equal(parseWhole(42, 1, 100), 42);
+  for (const bad of ['', '4.2', '-1', '1e2', 'abc', '101', null, undefined, {}]) assert.equal(parseWhole(bad, 1, 100), null, String(bad));
+  assert.equal(paramError('reps', '32'), '');
+  assert.match(paramError('reps', '1'), /reps must be a whole number in 2\.\.100000/);
+});
+
+test('sceneDefaults: the scene\'s own range with n_max capped at 65536, reps 32, seed 1', () => {
+  assert.deepEqual(sceneDefaults({ n_min: 16, n_max: 1 << 20, reps: 64, seed: 9 }), { n_min: 16, n_max: 65536, reps: 32, seed: 1 });
+  assert.deepEqual(sceneDefaults({ n_min: 4, n_max: 16384 }), { n_min: 4, n_max: 16384, reps: 32, seed: 1 });
+  assert.deepEqual(sceneDefaults({ n_min: 1 << 17, n_max: 1 << 20 }), { n_min: 16, n_max: 65536, reps: 32, seed: 1 });
+  assert.deepEqual(sceneDefaults(null), { n_min: 16, n_max: 65536, reps: 32, seed: 1 });
+});
+
+test('loading a scene selects all its estimators unless the URL named some', () => {
+  let s = reducer(initialState(), { type: 'core/ready', payload: { version: '0.1.0' } });
+  const info = { estimators: ['uniform', 'stratified_polar', 'latin_hypercube'], n_min: 16, n_max: 65536, exact: 0.25 };
+  const all = reducer(s, { type: 'scene/loaded', payload: { sceneId: 'disk_quarter', scene: {}, info } });
+  assert.deepEqual(all.selected, info.estimators);
+  const some = reducer(s, {
+    type: 'scene/loaded',
+    payload: { sceneId: 'disk_quarter', scene: {}, info, selected: ['latin_hypercube', 'nope', 'uniform'], params: { n_max: 1024 } },
+  });
+  assert.deepEqual(some.selected, ['uniform', 'latin_hypercube'], 'scene order, unknown names dropped');
+  assert.equal(some.params.n_max, 1024);
+  const none = reducer(s, { type: 'scene/loaded', payload: { sceneId: 'disk_quarter', scene: {}, info, selected: ['nope'] } });
+  assert.deepEqual(none.selected, info.estimators, 'no known name: all of them');
+  s = reducer(all, { type: 'estimators/all', payload: { checked: false } });
+  assert.deepEqual(s.selected, []);
+  assert.equal(runBlocker(s), 'select at least one estimator');
+});
+
+test('choosing a scene shows its estimators at once; the core\'s answer keeps the edits made meanwhile', () => {
+  let s = reducer(initialState(), { type: 'core/ready', payload: { version: '0.1.0' } });
+  s = reducer(s, {
+    type: 'scenes/loaded',
+    payload: { scenes: [{ file: 'exp_1d.json', name: 'exp_1d', description: 'd', dimension: 1, estimators: ['uniform', 'stratified', 'importance'], n_min: 16, n_max: 1 << 20 }] },
+  });
+  s = reducer(s, { type: 'run/start', payload: { id: 1, workers: 1, settings: { n_min: 16, n_max: 32, reps: 2, seed: 1 }, order: ['x'], startedAt: 0 } });
+  s = reducer(s, { type: 'scene/request', payload: { sceneId: 'exp_1d' } });
+  assert.equal(s.sceneId, 'exp_1d');
+  assert.deepEqual(s.selected, ['uniform', 'stratified', 'importance']);
+  assert.equal(s.params.n_max, 65536);
+  assert.equal(s.run.status, 'ready', 'the previous run is gone');
+  assert.equal(runBlocker(s), 'loading the scene');
+  s = reducer(s, { type: 'estimator/set', payload: { name: 'importance', checked: false } });
+  s = reducer(s, { type: 'param/set', payload: { key: 'n_max', value: '1024' } });
+  const info = { name: 'exp_1d', estimators: ['uniform', 'stratified', 'importance'], n_min: 16, n_max: 1 << 20, exact: Math.E - 1 };
+  s = reducer(s, { type: 'scene/loaded', payload: { sceneId: 'exp_1d', scene: { name: 'exp_1d' }, info } });
+  assert.deepEqual(s.selected, ['uniform', 'stratified']);
+  assert.equal(s.params.n_max, 1024);
+  assert.equal(s.sceneInfo.exact, Math.E - 1);
+  assert.equal(runBlocker(s), '');
+  // an unknown scene name changes nothing but the notice
+  assert.equal(reducer(s, { type: 'scene/request', payload: { sceneId: 'nope' } }).sceneId, 'exp_1d');
+});
+
+test('an invalid input is remembered as an error and blocks Run, the last good value kept', () => {
+  let s = reducer(initialState(), { type: 'core/ready', payload: { version: '0.1.0' } });
+  s = reducer(s, { type: 'scene/loaded', payload: { sceneId: 'x', scene: {}, info: { estimators: ['uniform'] } } });
+  assert.equal(runBlocker(s), '');
+  s = reducer(s, { type: 'param/set', payload: { key: 'reps', value: '1' } });
+  assert.equal(s.params.reps, 32);
+  assert.match(runBlocker(s), /reps/);
+  s = reducer(s, { type: 'param/set', payload: { key: 'reps', value: '8' } });
+  assert.equal(s.params.reps, 8);
+  assert.equal(runBlocker(s), '');
+  s = reducer(s, { type: 'param/set', payload: { key: 'n_min', value: '100000' } });
+  assert.match(runBlocker(s), /n_max \(65536\) must be >= n_min \(100000\)/);
+  s = reducer(s, { type: 'param/set', payload: { key: 'n_min', value: '40000' } });
+  s = reducer(s, { type: 'param/set', payload: { key: 'n_max', value: '60000' } });
+  assert.match(runBlocker(s), /no power of two/);
+});
+
+test('a run streams levels, merges the workers\' parts and ends done; stale messages are ignored', () => {
+  let s = reducer(initialState(), { type: 'core/ready', payload: { version: '0.1.0' } });
+  assert.equal(statusText(s), 'ready');
+  const settings = { n_min: 16, n_max: 32, reps: 2, seed: 1 };
+  s = reducer(s, { type: 'run/start', payload: { id: 1, workers: 2, settings, order: ['a', 'b'], exact: 1, sceneName: 'x', startedAt: 0 } });
+  assert.equal(statusText(s), 'running');
+  const level = (name, n) => ({ name, sampler: 'independent', warnings: [], fit: { valid: false }, level: { n, variance: 1 / n } });
+  s = reducer(s, { type: 'run/level', payload: { id: 1, level: { n: 16, estimators: [level('a', 16)] } } });
+  s = reducer(s, { type: 'run/level', payload: { id: 0, level: { n: 16, estimators: [level('b', 16)] } } });
+  assert.deepEqual(Object.keys(s.run.records), ['a']);
+  assert.ok(Math.abs(s.run.progress - 16 / 96) < 1e-12);
+  const part = (names) => ({
+    version: 1, mcplay: '0.1.0', scene: { name: 'x' }, settings: { ...settings, threads: 1 }, cancelled: false, wall_time_s: 0.1,
+    estimators: names.map((name) => ({ name, levels: [{ n: 16 }, { n: 32 }], fit: { valid: true, order: -1 } })),
+  });
+  s = reducer(s, { type: 'run/partial', payload: { id: 1, result: part(['b']), now: 5 } });
+  assert.equal(s.run.status, 'running');
+  s = reducer(s, { type: 'run/partial', payload: { id: 1, result: part(['a']), now: 10 } });
+  assert.equal(statusText(s), 'done');
+  assert.equal(s.run.progress, 1);
+  assert.equal(s.run.elapsed, 10);
+  assert.deepEqual(s.run.result.estimators.map((e) => e.name), ['a', 'b']);
+  const snap = debugSnapshot(s);
+  assert.deepEqual(structuredClone(snap), snap);
+  assert.deepEqual(snap.estimators.map((e) => e.name), ['a', 'b']);
+  assert.equal(snap.estimators[0].fit.order, -1);
+});
+
+test('cancel and errors set the status', () => {
+  let s = reducer(initialState(), { type: 'core/ready', payload: { version: '0.1.0' } });
+  s = reducer(s, { type: 'run/start', payload: { id: 3, workers: 1, settings: { n_min: 16, n_max: 64, reps: 2, seed: 1 }, order: ['a'], startedAt: 100 } });
+  const c = reducer(s, { type: 'run/cancel', payload: { now: 150 } });
+  assert.equal(statusText(c), 'cancelled');
+  assert.equal(c.run.elapsed, 50);
+  assert.equal(reducer(c, { type: 'run/cancel', payload: { now: 200 } }), c, 'nothing to cancel');
+  const e = reducer(s, { type: 'run/error', payload: { id: 3, message: 'settings: bad' } });
+  assert.equal(statusText(e), 'error: settings: bad');
+  assert.equal(reducer(s, { type: 'run/error', payload: { id: 2, message: 'old' } }), s, 'an old run\'s error');
+});
+
+test('the store queues actions dispatched by subscribers', () => {
+  const store = createStore((st, a) => [...st, a.type], []);
+  const seen = [];
+  store.subscribe((st, a) => {
+    seen.push([a.type, st.length]);
+    if (a.type === 'first') store.dispatch({ type: 'second' });
+  });
+  store.dispatch({ type: 'first' });
+  assert.deepEqual(seen, [['first', 1], ['second', 2]]);
+  assert.deepEqual(store.getState(), ['first', 'second']);
+});
+
+test('custom scenes: interval in 1D, box beyond, importance only with p', () => {
+  assert.deepEqual(buildCustomScene(' x^2 ', '', 1), {
+    name: 'custom', description: 'f = x^2', f: 'x^2',
+    domain: { type: 'interval', lower: 0, upper: 1 }, estimators: ['uniform', 'stratified', 'latin_hypercube'],
+  });
+  const s = buildCustomScene('x*y', 'x + y', 2);
+  assert.deepEqual(s.domain, { type: 'box', dim: 2 });
+  assert.deepEqual(s.estimators.slice(3), [{ name: 'importance', pdf: 'x + y' }, { name: 'stratified_importance', pdf: 'x + y' }]);
+  assert.deepEqual(buildCustomScene('x', '', 0).domain, { type: 'interval', lower: 0, upper: 1 });
+});
+
+test('customError names the field and position of the core\'s message', () => {
+  assert.deepEqual(customError({ message: "scene.f: at position 7: unknown function 'sinn'", field: 'scene.f', position: 7 }),
+    { field: 'f', message: "scene.f: at position 7: unknown function 'sinn'", position: 7 });
+  assert.deepEqual(customError({ message: 'scene.estimators[3].pdf.shape: at position 2: expected an expression' }),
+    { field: 'p', message: 'scene.estimators[3].pdf.shape: at position 2: expected an expression', position: 2 });
+  assert.deepEqual(customError(new Error('scene: something else')), { field: 'f', message: 'scene: something else', position: null });
+});
