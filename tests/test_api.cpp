@@ -254,6 +254,41 @@ TEST(Api, ExpressionAndGenzScenesRun) {
     EXPECT_NEAR(o.result["scene"]["exact"].get<double>(), i1 * i2, 1e-14);
 }
 
+TEST(Api, SamplesAreTheStudysFirstReplicate) {
+    // The dumped points are replicate 0 at N = n: their mean weight is that replicate's estimate.
+    const char* scene = R"J({"f": "exp(x)", "estimators": ["uniform", "stratified",
+        {"name": "is", "pdf": {"type": "exponential", "rate": -1}}], "n_min": 64, "n_max": 64, "reps": 2, "seed": 5})J";
+    Outcome o = run(scene);
+    ASSERT_EQ(o.status, MCP_OK) << o.error;
+    char* out = nullptr;
+    ASSERT_EQ(mcp_study_samples(scene, R"({"n": 64, "grid": 32})", &out), MCP_OK)
+        << mcp_last_error();
+    json dump = json::parse(out);
+    mcp_free(out);
+    ASSERT_EQ(dump["estimators"].size(), 3u);
+    for (size_t e = 0; e < 3; ++e) {
+        const json& d = dump["estimators"][e];
+        ASSERT_EQ(d["weight"].size(), 64u);
+        double sum = 0.0;
+        for (const json& w : d["weight"]) sum += w.get<double>();
+        const double estimate = o.result["estimators"][e]["levels"][0]["replicates"]["estimate"][0];
+        EXPECT_NEAR(sum / 64, estimate, 1e-13) << d["name"];
+    }
+    // Stratified: one point per cell of the reported grid.
+    const json& st = dump["estimators"][1];
+    EXPECT_EQ(st["strata"], json({64}));
+    std::vector<int> cells(64, 0);
+    for (const json& u : st["u"][0]) ++cells[static_cast<size_t>(u.get<double>() * 64)];
+    for (int c : cells) EXPECT_EQ(c, 1);
+    // 1D: the curve carries f and each density on the grid; the densities integrate to ~1.
+    ASSERT_EQ(dump["curve"]["x"].size(), 32u);
+    double mass = 0.0;
+    for (const json& p : dump["curve"]["pdf"]["is"]) mass += p.get<double>() / 32;
+    EXPECT_NEAR(mass, 1.0, 1e-3);
+    EXPECT_EQ(mcp_study_samples(scene, R"({"n": 0})", &out), MCP_ERROR_ARGUMENT);
+    EXPECT_NE(std::string(mcp_last_error()).find("options.n"), std::string::npos);
+}
+
 TEST(Api, SceneInfoAndCatalog) {
     char* out = nullptr;
     ASSERT_EQ(mcp_scene_info(kSmall, &out), MCP_OK);

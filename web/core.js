@@ -30,7 +30,7 @@ export class McplayError extends Error {
 export const WASM_FUNCTIONS = Object.freeze([
   '_malloc', '_free',
   '_mcp_version', '_mcp_last_error', '_mcp_study_run', '_mcp_result_format', '_mcp_scene_info',
-  '_mcp_catalog', '_mcp_free',
+  '_mcp_catalog', '_mcp_study_samples', '_mcp_free',
   '_mallinfo',
 ]);
 
@@ -201,6 +201,18 @@ function makeCore(M) {
   }
 
   /**
+   * The points behind a small run of each estimator (replicate 0 of a study at N = n), for
+   * scatter plots, f/p overlays and weight histograms: see mcp_study_samples in
+   * src/api/mcplay.h. `options`: {estimators, n (<= 4096), seed, grid}. Throws McplayError.
+   */
+  function samples(scene, options = null) {
+    usable('samples');
+    const optionsText = options === null || options === undefined ? null : jsonText(options, 'options');
+    return JSON.parse(textOf(callOut(M._mcp_study_samples, [jsonText(scene, 'scene'), optionsText]),
+      'mcp_study_samples'));
+  }
+
+  /**
    * Runs a convergence study. `scene`: object or JSON text; `options`: object, JSON text or
    * null ({estimators, n_min, n_max, reps, seed, threads}); `onLevel(level)` (optional) is
    * called after each N with the progress object of docs/result-schema.md; returning exactly
@@ -271,5 +283,5 @@ function makeCore(M) {
     M.removeFunction(progressPtr);
   }
 
-  return Object.freeze({ version, catalog, sceneInfo, runStudy, format, heapStats, dispose });
+  return Object.freeze({ version, catalog, sceneInfo, samples, runStudy, format, heapStats, dispose });
 }

@@ -1,5 +1,6 @@
 // The extern "C" boundary. The library is built without exceptions: every error is a value
 // returned up to here and turned into a status code plus a message (like sqlite3_errmsg).
+#include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <string>
@@ -70,6 +71,95 @@ int mcp_study_run(const char* scene_json, const char* options_json, mcp_progress
     *result_json = copy_out(dump(mcp::study_to_json(result)));
     if (!*result_json) return fail(MCP_ERROR_INTERNAL, "out of memory writing the result");
     if (result.cancelled) return fail(MCP_ERROR_CANCELLED, "study cancelled by the caller");
+    g_last_error.clear();
+    return MCP_OK;
+}
+
+int mcp_study_samples(const char* scene_json, const char* options_json, char** samples_json) {
+    if (!samples_json) return fail(MCP_ERROR_ARGUMENT, "mcp_study_samples: samples_json is NULL");
+    *samples_json = nullptr;
+    mcp::Made<mcp::Json> scene = mcp::parse_json(scene_json, "scene");
+    if (!scene.ok()) return fail(MCP_ERROR_SCENE, scene.error);
+    mcp::Json options = mcp::Json::object();
+    if (options_json && *options_json) {
+        mcp::Made<mcp::Json> o = mcp::parse_json(options_json, "options");
+        if (!o.ok()) return fail(MCP_ERROR_ARGUMENT, o.error);
+        options = o.value;
+    }
+    if (!options.is_object()) return fail(MCP_ERROR_ARGUMENT, "options: expected an object");
+    // "n" and "grid" belong to this call; the rest selects estimators and the seed.
+    uint64_t n = 256, grid = 256;
+    for (auto [key, target] : {std::pair<const char*, uint64_t*>{"n", &n}, {"grid", &grid}}) {
+        auto it = options.find(key);
+        if (it == options.end()) continue;
+        if (!it->is_number_integer() || it->get<int64_t>() < 1 || it->get<int64_t>() > 4096)
+            return fail(MCP_ERROR_ARGUMENT,
+                        std::string("options.") + key + ": expected a whole number in 1..4096");
+        *target = static_cast<uint64_t>(it->get<int64_t>());
+        options.erase(key);
+    }
+    mcp::Made<mcp::SceneRequest> req = mcp::build_request(scene.value, options);
+    if (!req.ok()) return fail(MCP_ERROR_SCENE, req.error);
+    const mcp::Problem& problem = req.value.problem;
+    const mcp::Domain& domain = problem.domain;
+    mcp::Json estimators = mcp::Json::array();
+    for (const mcp::EstimatorSpec& spec : req.value.estimators) {
+        mcp::SampleDump d = mcp::dump_samples(problem, spec, n, req.value.settings.seed);
+        auto axes = [&](const std::vector<double>& flat, int dim) {
+            mcp::Json out = mcp::Json::array();
+            for (int j = 0; j < dim; ++j) {
+                mcp::Json axis = mcp::Json::array();
+                for (size_t i = static_cast<size_t>(j); i < flat.size();
+                     i += static_cast<size_t>(dim))
+                    axis.push_back(flat[i]);
+                out.push_back(axis);
+            }
+            return out;
+        };
+        auto values = [](const std::vector<double>& v) {
+            mcp::Json out = mcp::Json::array();
+            for (double x : v) out.push_back(std::isfinite(x) ? mcp::Json(x) : mcp::Json(nullptr));
+            return out;
+        };
+        estimators.push_back({{"name", spec.name},
+                              {"sampler", mcp::sampler_name(spec.sampler)},
+                              {"pdf", spec.proposal.describe()},
+                              {"strata", d.strata},
+                              {"samples_per_stratum", d.per_stratum},
+                              {"u", axes(d.u, d.sample_dim)},
+                              {"x", axes(d.x, d.point_dim)},
+                              {"f", values(d.f)},
+                              {"density", values(d.pdf)},
+                              {"weight", values(d.weight)}});
+    }
+    mcp::Json result{{"version", mcp::kResultSchemaVersion},
+                     {"n", n},
+                     {"seed", req.value.settings.seed},
+                     {"domain", mcp::domain_kind_name(domain.kind)},
+                     {"dimension", domain.point_dim()},
+                     {"sample_dimension", domain.sample_dim()},
+                     {"estimators", estimators}};
+    // 1D boxes: f and every estimator's density on a grid of cell midpoints.
+    if (domain.kind == mcp::DomainKind::Box && domain.lo.size() == 1) {
+        mcp::PointBlock xs;
+        xs.reset(1, grid);
+        xs.n = grid;
+        for (uint64_t i = 0; i < grid; ++i)
+            xs.coord(0)[i] = domain.lo[0] + (domain.hi[0] - domain.lo[0]) * (i + 0.5) / grid;
+        std::vector<double> fv(grid), pv(grid);
+        mcp::evaluate_block(problem.integrand, xs, fv.data());
+        mcp::Json pdfs = mcp::Json::object(), xj = mcp::Json::array(), fj = mcp::Json::array();
+        for (uint64_t i = 0; i < grid; ++i) {
+            xj.push_back(xs.coord(0)[i]);
+            fj.push_back(std::isfinite(fv[i]) ? mcp::Json(fv[i]) : mcp::Json(nullptr));
+        }
+        for (const mcp::EstimatorSpec& spec : req.value.estimators) {
+            mcp::proposal_pdf_block(spec.proposal, domain, xs, pv.data());
+            pdfs[spec.name] = std::vector<double>(pv.begin(), pv.end());
+        }
+        result["curve"] = {{"x", xj}, {"f", fj}, {"pdf", pdfs}};
+    }
+    *samples_json = copy_out(dump(result));
     g_last_error.clear();
     return MCP_OK;
 }

@@ -296,3 +296,39 @@ StudyResult run_study(const Problem& problem, const std::vector<EstimatorSpec>& 
 }
 
 } // namespace mcp
+
+namespace mcp {
+
+SampleDump dump_samples(const Problem& problem, const EstimatorSpec& spec, uint64_t n,
+                        uint64_t seed) {
+    SampleDump dump;
+    const Domain& d = problem.domain;
+    dump.sample_dim = d.sample_dim();
+    dump.point_dim = d.point_dim();
+    // The same stream and seeding as replicate 0 of the study at this N.
+    Pcg32 rng(mix64(seed ^ 0x6d63706c6179ULL), replicate_stream(seed, spec.name, n, 0));
+    const SamplerPlan plan =
+        make_sampler_plan(spec.sampler, dump.sample_dim, n, rng, spec.per_stratum);
+    dump.strata = plan.strata;
+    dump.per_stratum = plan.per_stratum;
+    PointBlock u, x;
+    u.reset(dump.sample_dim, kBlockSize);
+    x.reset(dump.point_dim, kBlockSize);
+    std::vector<double> p(kBlockSize), f(kBlockSize);
+    for (uint64_t first = 0; first < n; first += kBlockSize) {
+        const size_t count = static_cast<size_t>(std::min<uint64_t>(kBlockSize, n - first));
+        generate_block(plan, first, count, rng, u);
+        warp_block(spec.proposal, d, u, x, p.data());
+        evaluate_block(problem.integrand, x, f.data());
+        for (size_t i = 0; i < count; ++i) {
+            for (int j = 0; j < dump.sample_dim; ++j) dump.u.push_back(u.coord(j)[i]);
+            for (int j = 0; j < dump.point_dim; ++j) dump.x.push_back(x.coord(j)[i]);
+            dump.pdf.push_back(p[i]);
+            dump.f.push_back(f[i]);
+            dump.weight.push_back(p[i] > 0.0 ? f[i] / p[i] : (f[i] == 0.0 ? 0.0 : NAN));
+        }
+    }
+    return dump;
+}
+
+} // namespace mcp

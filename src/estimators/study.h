@@ -134,3 +134,22 @@ StudyResult run_study(const Problem& problem, const std::vector<EstimatorSpec>& 
 int resolve_threads(int requested);
 
 } // namespace mcp
+
+namespace mcp {
+
+/// The points behind one small run, for looking at them: unit-cube points u (where strata
+/// are drawn), domain points x, densities p and values f, and the weights f/p.
+struct SampleDump {
+    int sample_dim = 0, point_dim = 0;
+    std::vector<double> u, x; ///< point-major: u[i * sample_dim + j], x[i * point_dim + j]
+    std::vector<double> pdf, f, weight;
+    std::vector<uint64_t> strata; ///< stratified: cells per axis of the unit cube
+    uint64_t per_stratum = 1;
+};
+
+/// Runs n samples of replicate 0's stream of the given N level (so the points are those of
+/// the study's first replicate at N = n) and records them.
+SampleDump dump_samples(const Problem& problem, const EstimatorSpec& spec, uint64_t n,
+                        uint64_t seed);
+
+} // namespace mcp

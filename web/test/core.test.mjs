@@ -183,6 +183,23 @@ test('runStudy gives the native CLI\'s numbers bit for bit', async () => {
   assert.equal(compared, 2 * 5 * 4 * 2);
 });
 
+test('samples returns the points of the study\'s first replicate', async () => {
+  const core = await getCore();
+  const options = { ...SMALL, n_min: 64, n_max: 64 };
+  const result = core.runStudy(EXP_1D, options);
+  const dump = core.samples(EXP_1D, { estimators: SMALL.estimators, n: 64, grid: 16 });
+  assert.equal(dump.estimators.length, 2);
+  for (const [e, d] of dump.estimators.entries()) {
+    assert.equal(d.weight.length, 64);
+    const mean = d.weight.reduce((a, b) => a + b, 0) / 64;
+    const estimate = result.estimators[e].levels[0].replicates.estimate[0];
+    assert.ok(Math.abs(mean - estimate) <= 1e-13 * Math.abs(estimate), `${d.name}: ${mean} vs ${estimate}`);
+  }
+  assert.deepEqual(dump.estimators[1].strata, [64]);
+  assert.equal(dump.curve.x.length, 16);
+  assertMcplayError(() => core.samples(EXP_1D, { n: 100000 }), Status.ARGUMENT, /options\.n/);
+});
+
 test('onLevel returning true cancels the study after that level', async () => {
   const core = await getCore();
   let calls = 0;
