@@ -98,8 +98,9 @@ run: build site
 cli: build
 	./$(BUILD)/mcplay run $(SCENE) $(ARGS)
 
-bench: build build-wasm
+bench: build build-wasm site
 	bash bench/run_bench.sh $(BUILD)/mcplay_bench "$(NODE_RUN) --no-liftoff $(BUILD_WASM)/mcplay_bench.js"
+	node web/e2e/first_plot.bench.mjs $(SITE) exp_1d 5
 
 format:
 	clang-format -i $$(git ls-files '*.cpp' '*.h')

@@ -1,0 +1,63 @@
+// Benchmark (not a test): time from pressing Run to the first plotted point on a 1D scene,
+// in headless Chromium. Usage: node web/e2e/first_plot.bench.mjs SITE_DIR [scene] [runs]
+import { spawn } from 'node:child_process';
+import { mkdtempSync, rmSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join, resolve, dirname } from 'node:path';
+import { fileURLToPath } from 'node:url';
+import { chromium } from 'playwright-core';
+
+const here = dirname(fileURLToPath(import.meta.url));
+const site = resolve(process.argv[2] ?? 'build/site');
+const scene = process.argv[3] ?? 'exp_1d';
+const runs = Number(process.argv[4] ?? 5);
+const port = 20000 + Math.floor(Math.random() * 20000);
+const url = `http://127.0.0.1:${port}/`;
+
+const server = spawn(process.execPath, [join(here, '..', 'tools', 'serve.mjs'), site], {
+  env: { ...process.env, PORT: String(port) }, stdio: 'ignore' });
+const profile = mkdtempSync(join(tmpdir(), 'mcplay-bench-'));
+try {
+  for (let i = 0; i < 100; ++i) {
+    try { if ((await fetch(url)).ok) break; } catch { /* starting */ }
+    await new Promise((r) => setTimeout(r, 100));
+  }
+  const context = await chromium.launchPersistentContext(profile, {
+    executablePath: process.env.CHROMIUM ?? '/usr/bin/chromium', headless: true,
+    args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
+      '--disable-background-networking', '--disable-component-update', '--disable-sync'] });
+  const page = context.pages()[0] ?? (await context.newPage());
+  const times = [];
+  for (let r = 0; r < runs; ++r) {
+    await page.goto(`${url}?scene=${scene}`);
+    await page.waitForFunction(() => window.mcplayDebug !== undefined);
+    await page.evaluate(() => window.mcplayDebug.ready);
+    await page.selectOption('#scene', scene);
+    await page.waitForFunction(() => !document.querySelector('#run').disabled);
+    // Measured inside the page: click, then the first animation frame after a level arrived.
+    const ms = await page.evaluate(() => new Promise((done) => {
+      const t0 = performance.now();
+      document.querySelector('#run').click();
+      const poll = () => {
+        const s = window.mcplayDebug.state();
+        const est = Array.isArray(s.estimators) ? s.estimators : Object.values(s.estimators ?? {});
+        if (est.some((e) => (e.levels ?? []).length > 0)) {
+          requestAnimationFrame(() => done(performance.now() - t0));
+        } else {
+          requestAnimationFrame(poll);
+        }
+      };
+      poll();
+    }));
+    times.push(ms);
+    await page.waitForFunction(() => /^(done|cancelled|error)/.test(document.querySelector('#status').textContent),
+      null, { timeout: 120000 });
+  }
+  await context.close();
+  times.sort((a, b) => a - b);
+  console.log(`first plot after Run (${scene}, ${runs} page loads): median ${times[Math.floor(runs / 2)].toFixed(0)} ms, ` +
+    `min ${times[0].toFixed(0)} ms, max ${times[runs - 1].toFixed(0)} ms (target: under 1000 ms)`);
+} finally {
+  server.kill();
+  rmSync(profile, { recursive: true, force: true });
+}
