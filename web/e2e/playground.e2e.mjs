@@ -111,6 +111,33 @@ test('a study in the page plots every level and agrees with the CLI', async () =
   assert.ok(fits.stratified_polar.order < -1.3, `stratified order ${fits.stratified_polar.order} is not below -1.3`);
 });
 
+test('the sample points, the 1D overlay and the weights are drawn', async () => {
+  await configure('disk_third', ['stratified_polar'], { nMin: 16, nMax: 1024, reps: 16, seed: 1 });
+  await page.click('#run');
+  await page.waitForFunction(() => document.querySelector('#status')?.textContent.startsWith('done'), null,
+    { timeout: 60000 });
+  await page.waitForFunction(() => {
+    const s = window.mcplayDebug.state().samples;
+    return s.status === 'ready' && s.points.stratified_polar === 256 && s.weights !== null;
+  }, null, { timeout: 20000 });
+  const state = await page.evaluate(() => window.mcplayDebug.state());
+  assert.equal(state.samples.points.stratified_polar, 256);
+  assert.equal(state.samples.seed, 1);
+  assert.ok(await page.$('#plot-samples canvas, #plot-samples svg'), 'no canvas in #plot-samples');
+  assert.ok(await page.$('#plot-weights canvas'), 'no weight histogram');
+  assert.match(await page.textContent('#plot-overlay'), /1D problems only/);
+  await page.screenshot({ path: join(shots, 'samples_disk_third.png'), fullPage: true });
+
+  await configure('gaussian_peak_1d', ['uniform', 'importance_gaussian'], { nMin: 16, nMax: 1024, reps: 16, seed: 1 });
+  await page.click('#run');
+  await page.waitForFunction(() => document.querySelector('#status')?.textContent.startsWith('done'), null,
+    { timeout: 60000 });
+  await page.waitForFunction(() => document.querySelector('#plot-overlay')?.dataset.drawn === 'true'
+    && window.mcplayDebug.state().samples.curve === true, null, { timeout: 20000 });
+  assert.ok(await page.$('#plot-overlay canvas'), 'no overlay chart');
+  await page.screenshot({ path: join(shots, 'samples_gaussian_peak_1d.png'), fullPage: true });
+});
+
 test('a malformed expression is reported inline at its position', async () => {
   await page.fill('#custom-f', 'sin(');
   await page.click('#custom-apply');

@@ -9,7 +9,7 @@
 // workers and starts new ones.
 import {
   createStore, reducer, initialState, queryToState, stateToQuery, sceneDefaults, runBlocker,
-  debugSnapshot, buildCustomScene, customError, CUSTOM,
+  debugSnapshot, buildCustomScene, customError, CUSTOM, WEIGHT_SAMPLES,
 } from './state.js';
 import { splitEstimators, partialResult } from './series.js';
 import { CoreWorker } from './client.js';
@@ -42,6 +42,9 @@ initPlots({
   variance: $('plot-variance'), time: $('plot-time'), calibration: $('plot-calibration'), coverage: $('plot-coverage'),
   'legend-variance': $('legend-variance'), 'legend-time': $('legend-time'),
   'legend-calibration': $('legend-calibration'), 'legend-coverage': $('legend-coverage'),
+  samples: $('plot-samples'), overlay: $('plot-overlay'), weights: $('plot-weights'),
+  'legend-overlay': $('legend-overlay'), 'legend-weights': $('legend-weights'),
+  samplesNote: $('samples-note'), overlayNote: $('overlay-note'), weightsNote: $('weights-note'),
 });
 mountControls(store);
 mountCustom(store);
@@ -128,6 +131,60 @@ store.subscribe((state, action) => {
       break;
     default:
   }
+});
+
+// ---------------------------------------------------------------------------------------------
+// Sample points: core.samples in the service worker (a study's replicate 0 at N = n, same seed),
+// asked for SAMPLES_DEBOUNCE_MS after the scene, the estimators, the seed or n last changed, and
+// at once when Run is pressed; the weight histograms get a second call with n = WEIGHT_SAMPLES.
+
+const SAMPLES_DEBOUNCE_MS = 250;
+let sceneSerial = 0;     // counts scenes loaded (a key of the samples)
+let samplesTimer = null;
+
+function samplesKeys(state) {
+  if (!state.scene || !state.selected.length || state.paramErrors.seed) return null;
+  const base = [sceneSerial, state.selected, state.params.seed];
+  return { key: JSON.stringify([...base, state.samples.n]), weightsKey: JSON.stringify(base) };
+}
+
+function requestSamples() {
+  clearTimeout(samplesTimer);
+  samplesTimer = null;
+  const s = store.getState();
+  const keys = samplesKeys(s);
+  if (!keys || !service) return;
+  const wantPoints = keys.key !== s.samples.key;
+  const wantWeights = keys.weightsKey !== s.samples.weightsKey;
+  if (!wantPoints && !wantWeights) return;
+  const scene = s.scene;
+  const estimators = s.selected.slice();
+  const seed = s.params.seed;
+  dispatch({ type: 'samples/request', payload: { key: keys.key, weightsKey: wantWeights ? keys.weightsKey : null, points: wantPoints || s.samples.status === 'error' } });
+  const fail = (key) => (e) => dispatch({ type: 'samples/failed', payload: { key, message: e && e.message ? e.message : String(e) } });
+  if (wantPoints || s.samples.status === 'error') {
+    service.request(MSG.SAMPLES, { scene, options: { estimators, n: s.samples.n, seed } })
+      .then(({ samples }) => dispatch({ type: 'samples/loaded', payload: { key: keys.key, samples } }))
+      .catch(fail(keys.key));
+  }
+  if (wantWeights) {
+    service.request(MSG.SAMPLES, { scene, options: { estimators, n: WEIGHT_SAMPLES, seed }, fields: ['weight'] })
+      .then(({ samples }) => dispatch({ type: 'samples/weights', payload: { key: keys.weightsKey, samples } }))
+      .catch(fail(keys.weightsKey));
+  }
+}
+
+store.subscribe((state, action) => {
+  if (action.type === 'scene/loaded') sceneSerial++;
+  if (action.type.startsWith('samples/') && action.type !== 'samples/n') return;
+  if (action.type === 'run/request') {
+    requestSamples();
+    return;
+  }
+  const keys = samplesKeys(state);
+  if (!keys || (keys.key === state.samples.key && keys.weightsKey === state.samples.weightsKey)) return;
+  clearTimeout(samplesTimer);
+  samplesTimer = setTimeout(requestSamples, SAMPLES_DEBOUNCE_MS);
 });
 
 function runnersFor(k) {

@@ -5,7 +5,7 @@
 import uPlot from '../vendor/uPlot.esm.js';
 import {
   varianceSeries, anchorOf, referenceLines, timeSeries, calibrationSeries, coverageSeries,
-  decadeRange, fitText, fmt,
+  decadeRange, fitText, fmt, curveOverlay, weightBins, weightHistogram, domainView, mapFor, mappedGrid,
 } from './series.js';
 import { colorAt, withAlpha } from './palette.js';
 
@@ -210,7 +210,7 @@ export function initPlots(elements) {
         if (size.width !== c.u.width || size.height !== c.u.height) c.u.setSize(size);
       }
     });
-    for (const k of ['variance', 'time', 'calibration', 'coverage']) ro.observe(dom[k]);
+    for (const k of ['variance', 'time', 'calibration', 'coverage', 'overlay', 'weights']) if (dom[k]) ro.observe(dom[k]);
   }
 }
 
@@ -221,6 +221,7 @@ function colorOf(run, name) {
 /** Draws everything of state.run. */
 export function renderPlots(state) {
   if (!dom) return;
+  renderSampleViews(state);
   const run = state.run;
   if (!run.order.length) {
     for (const k of ['variance', 'time', 'calibration', 'coverage']) {
@@ -442,6 +443,298 @@ function renderCoverage(state, run, records) {
       color: colorOf(run, s.name),
       parts: [{ text: last === undefined ? '—' : `${fmt(last, 3)} at the largest N`, className: 'fit' }],
     };
+  }));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Sample points, the 1D f/p overlay and the weight histograms (state.samples)
+
+let samplesDrawn = null; // [data, weights, status, sceneInfo] last drawn
+
+function sceneColor(state, name) {
+  const names = state.sceneInfo && state.sceneInfo.estimators ? state.sceneInfo.estimators : [];
+  const i = names.indexOf(name);
+  return colorAt(i < 0 ? 0 : i);
+}
+
+function renderSampleViews(state) {
+  if (!dom.samples) return;
+  const smp = state.samples;
+  const sig = [smp.data, smp.weights, smp.status, state.sceneInfo, smp.message];
+  if (samplesDrawn && sig.every((v, i) => v === samplesDrawn[i])) return;
+  samplesDrawn = sig;
+  dom.samples.classList.toggle('loading', smp.status === 'loading');
+  if (smp.status === 'error') {
+    empty(dom.samples, `No sample points: ${smp.message}`);
+  } else if (!smp.data) {
+    empty(dom.samples, smp.status === 'loading' ? 'Drawing the points…' : 'Select an estimator to see its points.');
+  } else {
+    renderScatter(state, smp.data);
+  }
+  renderOverlay(state, smp.data);
+  renderWeights(state, smp.weights);
+}
+
+const PANEL = 240; // logical size of a scatter panel (CSS scales it to the card)
+const PAD = { l: 38, r: 6, t: 6, b: 18 };
+
+/** A canvas of w x h logical pixels with a plot area mapping [xr] x [yr]; returns helpers. */
+function panel(w, h, xr, yr) {
+  const px = window.devicePixelRatio || 1;
+  const c = document.createElement('canvas');
+  c.width = Math.round(w * px);
+  c.height = Math.round(h * px);
+  const ctx = c.getContext('2d');
+  ctx.scale(px, px);
+  ctx.fillStyle = '#fff';
+  ctx.fillRect(0, 0, w, h);
+  const iw = w - PAD.l - PAD.r;
+  const ih = h - PAD.t - PAD.b;
+  const X = (v) => PAD.l + ((v - xr[0]) / (xr[1] - xr[0] || 1)) * iw;
+  const Y = (v) => PAD.t + ih - ((v - yr[0]) / (yr[1] - yr[0] || 1)) * ih;
+  const frame = () => {
+    ctx.strokeStyle = '#b8c0c8';
+    ctx.lineWidth = 1;
+    ctx.strokeRect(PAD.l + 0.5, PAD.t + 0.5, iw - 1, ih - 1);
+    ctx.fillStyle = '#5a6470';
+    ctx.font = '10px "DejaVu Sans", sans-serif';
+    ctx.textBaseline = 'top';
+    ctx.textAlign = 'left';
+    ctx.fillText(fmt(xr[0], 3), PAD.l, PAD.t + ih + 3);
+    ctx.textAlign = 'right';
+    ctx.fillText(fmt(xr[1], 3), PAD.l + iw, PAD.t + ih + 3);
+    ctx.textBaseline = 'bottom';
+    ctx.fillText(fmt(yr[0], 3), PAD.l - 3, PAD.t + ih);
+    ctx.textBaseline = 'top';
+    ctx.fillText(fmt(yr[1], 3), PAD.l - 3, PAD.t);
+  };
+  const clip = () => {
+    ctx.beginPath();
+    ctx.rect(PAD.l, PAD.t, iw, ih);
+    ctx.clip();
+  };
+  return { c, ctx, X, Y, frame, clip, iw, ih };
+}
+
+function dots(ctx, xs, ys, X, Y, color, n) {
+  const r = n <= 64 ? 2.6 : n <= 256 ? 1.9 : 1.3;
+  ctx.fillStyle = color;
+  ctx.beginPath();
+  for (let i = 0; i < xs.length; i++) {
+    const cx = X(xs[i]);
+    const cy = Y(ys[i]);
+    if (!Number.isFinite(cx) || !Number.isFinite(cy)) continue;
+    ctx.moveTo(cx + r, cy);
+    ctx.arc(cx, cy, r, 0, 2 * Math.PI);
+  }
+  ctx.fill();
+}
+
+const GRID_MAX = 64; // more cells per axis than this: the grid is not drawn (it would be a grey fill)
+
+/** Strata lines at k / cells on the horizontal (axis 'x') or vertical axis. */
+function strataLines(p, cells, axis) {
+  if (!(cells > 1) || cells > GRID_MAX) return;
+  const { ctx, X, Y } = p;
+  ctx.strokeStyle = cells > 64 ? 'rgba(90, 100, 112, 0.18)' : 'rgba(90, 100, 112, 0.45)';
+  ctx.lineWidth = 1;
+  ctx.beginPath();
+  for (let k = 1; k < cells; k++) {
+    const v = k / cells;
+    if (axis === 'x') {
+      const x = Math.round(X(v)) + 0.5;
+      ctx.moveTo(x, Y(0));
+      ctx.lineTo(x, Y(1));
+    } else {
+      const y = Math.round(Y(v)) + 0.5;
+      ctx.moveTo(X(0), y);
+      ctx.lineTo(X(1), y);
+    }
+  }
+  ctx.stroke();
+}
+
+function strataText(e, d) {
+  const s = e.strata || [];
+  if (!s.length) return e.sampler === 'latin_hypercube' ? 'Latin hypercube: one point per row and column' : 'no strata';
+  const shown = d > 2 ? `${s.slice(0, 2).join(' × ')} (of ${s.join(' × ')})` : s.join(' × ');
+  const per = e.samples_per_stratum > 1 ? `, ${e.samples_per_stratum} points per stratum` : '';
+  const fine = s.slice(0, 2).some((c) => c > GRID_MAX) ? ' (too fine to draw)' : '';
+  return `strata ${shown} cells${per}${fine}`;
+}
+
+function renderScatter(state, data) {
+  const d = data.dimension;
+  const view = domainView(data, state.scene && state.scene.domain);
+  const mapped = {};
+  const cards = data.estimators.map((e) => {
+    const color = sceneColor(state, e.name);
+    const n = e.u[0] ? e.u[0].length : 0;
+    // u space: the sampler's unit square (1D: u against the point's index)
+    const pu = panel(PANEL, PANEL, [0, 1], [0, 1]);
+    strataLines(pu, e.strata[0], 'x');
+    if (d >= 2) strataLines(pu, e.strata[1], 'y');
+    pu.frame();
+    pu.ctx.save();
+    pu.clip();
+    const uy = d >= 2 ? e.u[1] : e.u[0].map((_, i) => (i + 0.5) / n);
+    dots(pu.ctx, e.u[0], uy, pu.X, pu.Y, color, n);
+    pu.ctx.restore();
+    // x space: the domain (1D: f at the points, with the curve of f)
+    let px;
+    if (d === 1) {
+      const curve = data.curve;
+      // the y range of f on the grid (or at the points), cut as in the overlay for a singular f
+      const all = (curve ? curve.f : e.f).filter(Number.isFinite);
+      const lo = Math.min(0, ...all);
+      let hi = Math.max(...all);
+      // a maximum at an end of the grid is an endpoint singularity: cut it as the overlay does
+      const atEnd = curve && (curve.f[0] === hi || curve.f[curve.f.length - 1] === hi);
+      const sorted = all.slice().sort((a, b) => a - b);
+      const q = sorted[Math.floor(0.75 * (sorted.length - 1))];
+      if (atEnd && hi > 20 * q && q > 0) hi = 20 * q;
+      if (!(hi > lo)) hi = lo + 1;
+      px = panel(PANEL, PANEL, view.xRange, [lo, hi]);
+      px.frame();
+      px.ctx.save();
+      px.clip();
+      if (curve) {
+        px.ctx.strokeStyle = '#8a8f96';
+        px.ctx.lineWidth = 1;
+        px.ctx.beginPath();
+        curve.x.forEach((x, i) => (i ? px.ctx.lineTo(px.X(x), px.Y(curve.f[i])) : px.ctx.moveTo(px.X(x), px.Y(curve.f[i]))));
+        px.ctx.stroke();
+      }
+      dots(px.ctx, e.x[0], e.f, px.X, px.Y, color, n);
+      // rug
+      px.ctx.strokeStyle = color;
+      px.ctx.beginPath();
+      const yb = px.Y(lo);
+      for (const x of e.x[0]) {
+        const cx = Math.round(px.X(x)) + 0.5;
+        px.ctx.moveTo(cx, yb);
+        px.ctx.lineTo(cx, yb - 5);
+      }
+      px.ctx.stroke();
+      px.ctx.restore();
+    } else {
+      px = panel(PANEL, PANEL, view.xRange, view.yRange);
+      px.ctx.save();
+      px.clip();
+      const o = view.outline;
+      px.ctx.strokeStyle = '#5a6470';
+      px.ctx.lineWidth = 1;
+      px.ctx.beginPath();
+      if (o.type === 'circle') {
+        const r = Math.abs(px.X(o.cx + o.r) - px.X(o.cx));
+        px.ctx.ellipse(px.X(o.cx), px.Y(o.cy), r, Math.abs(px.Y(o.cy + o.r) - px.Y(o.cy)), 0, 0, 2 * Math.PI);
+      } else if (o.type === 'polygon') {
+        o.points.forEach(([x, y], i) => (i ? px.ctx.lineTo(px.X(x), px.Y(y)) : px.ctx.moveTo(px.X(x), px.Y(y))));
+        px.ctx.closePath();
+      }
+      px.ctx.stroke();
+      // the strata cells in the domain, when the sampler's map is known (checked on its points)
+      const known = e.strata.length === 2 && e.strata[0] <= 64 && e.strata[1] <= 64 && data.domain === 'disk'
+        ? mapFor(e, state.scene && state.scene.domain) : null;
+      if (known) {
+        px.ctx.strokeStyle = 'rgba(90, 100, 112, 0.4)';
+        px.ctx.beginPath();
+        for (const line of mappedGrid(known.map, e.strata)) {
+          line.forEach(([x, y], i) => (i ? px.ctx.lineTo(px.X(x), px.Y(y)) : px.ctx.moveTo(px.X(x), px.Y(y))));
+        }
+        px.ctx.stroke();
+        mapped[e.name] = known.name;
+      }
+      dots(px.ctx, e.x[view.axes[0]], e.x[view.axes[1]], px.X, px.Y, color, n);
+      px.ctx.restore();
+      px.frame();
+    }
+    const facts = `${e.sampler}; p: ${e.pdf}; ${strataText(e, d)}`;
+    return el('div', { className: 'sample-card', dataset: { estimator: e.name, points: String(n) } },
+      el('h3', {}, swatch(color), e.name, el('span', { className: 'muted small' }, `${n} points`)),
+      el('p', { className: 'facts' }, facts),
+      el('div', { className: 'pair' },
+        el('div', {}, pu.c, el('p', { className: 'cap' }, d === 1 ? 'u (across) by point index (up)' : d > 2 ? 'u: first two axes' : 'u (unit square)')),
+        el('div', {}, px.c, el('p', { className: 'cap' }, d === 1 ? 'x (across), f(x) (up); grey: f' : `x: ${view.labels.join(', ')}${view.note ? ` (${view.note})` : ''}${mapped[e.name] ? `; strata through the ${mapped[e.name]} map` : ''}`))));
+  });
+  dom.samples.replaceChildren(...cards);
+  if (dom.samplesNote) {
+    dom.samplesNote.textContent = `The first ${data.n} points of each selected estimator (replicate 0 of the study at N = ${data.n}, seed ${data.seed}):`
+      + ' left in the unit square of its sampler (u) with its strata grid, right in the domain (x)'
+      + `${view.note ? `, ${view.note}` : ''}. A polar map squeezes the cells of u near r = 0; the concentric map keeps them even.`;
+  }
+}
+
+function renderOverlay(state, data) {
+  const exact = state.sceneInfo && typeof state.sceneInfo.exact === 'number' ? state.sceneInfo.exact : null;
+  const ov = data && data.curve ? curveOverlay(data.curve, data.estimators.map((e) => e.name), { exact }) : null;
+  if (!ov) {
+    drop('overlay');
+    empty(dom.overlay, data && data.dimension !== 1 ? `1D problems only (this one is ${data.dimension}D).` : data ? '1D problems only.' : '1D problems only; no points yet.');
+    dom.overlay.dataset.drawn = 'false';
+    setLegend('overlay', dom['legend-overlay'], []);
+    return;
+  }
+  const data2 = [ov.x, ov.f, ...ov.pdfs.map((p) => p.y)];
+  const series = [{}, { label: 'f / ∫|f|', stroke: '#000', width: 2.5, points: { show: false } },
+    ...ov.pdfs.map((p) => ({ label: p.name, stroke: sceneColor(state, p.name), width: 1.5, points: { show: false } }))];
+  const sig = JSON.stringify(['overlay', ov.pdfs.map((p) => p.name)]);
+  draw('overlay', dom.overlay, sig, (c) => ({
+    scales: { x: { time: false, range: () => c.xRange }, y: { range: () => c.yRange } },
+    axes: [{ ...AXIS, label: 'x', space: 40 },
+      { ...AXIS, label: 'density', size: 52, values: (u, splits) => splits.map((v) => fmt(v, 3)) }],
+    series,
+    cursor: { drag: { x: false, y: false } },
+  }), data2, { xRange: [ov.x[0], ov.x[ov.x.length - 1]], yRange: ov.yRange });
+  dom.overlay.dataset.drawn = 'true';
+  setLegend('overlay', dom['legend-overlay'], [
+    { name: 'f / ∫|f|', color: '#000', parts: [{ text: ov.areaFrom === 'exact' ? `∫f = ${fmt(ov.area, 4)} (exact; the grid gives ${fmt(ov.trapezoid, 4)})` : `∫|f| ≈ ${fmt(ov.area, 4)}`, className: 'fit' }] },
+    ...ov.pdfs.map((p) => ({ name: p.name, color: sceneColor(state, p.name), parts: [] })),
+  ]);
+  if (dom.overlayNote) {
+    dom.overlayNote.textContent = 'f divided by ∫|f| (black, unit area; trapezoid rule on the grid) against each estimator\'s'
+      + ' sampling density p(x): where p is much smaller than |f|, the weights f/p are large.'
+      + (ov.areaFrom === 'exact' ? ' Here f is divided by its exact integral: the grid misses the mass of its singularity.' : '')
+      + (ov.clipped ? ` The y axis is cut at ${fmt(ov.yRange[1], 3)}: a spike goes above it.` : '');
+  }
+}
+
+function renderWeights(state, weights) {
+  if (!weights || !weights.estimators.length) {
+    drop('weights');
+    empty(dom.weights, 'No weights yet.');
+    setLegend('weights', dom['legend-weights'], []);
+    return;
+  }
+  const bins = weightBins(weights.estimators.map((e) => e.weight));
+  const hs = weights.estimators.map((e) => ({ name: e.name, h: weightHistogram(e.weight, bins) }));
+  if (!bins) {
+    drop('weights');
+    empty(dom.weights, 'Every weight is 0 (or not finite).');
+  } else {
+    const x = bins.logEdges;
+    const data = [x, ...hs.map(({ h }) => [...h.fraction, h.fraction[h.fraction.length - 1]].map((v) => (v > 0 ? Math.log10(v) : null)))];
+    const stepped = uPlot.paths.stepped({ align: 1 });
+    const series = [{}, ...hs.map(({ name }) => {
+      const color = sceneColor(state, name);
+      return { label: name, stroke: color, width: 2, paths: stepped, points: { show: false } };
+    })];
+    const lowest = Math.floor(Math.log10(1 / Math.max(...hs.map(({ h }) => h.total || 1))));
+    draw('weights', dom.weights, JSON.stringify(['weights', hs.map((h) => h.name)]), (c) => ({
+      scales: { x: { time: false, range: () => c.xRange }, y: { range: () => c.yRange } },
+      axes: [{ ...AXIS, values: log10Ticks, incrs: LOG10_AXIS.incrs, label: '|w| = |f / p|', space: 30 },
+        { ...AXIS, ...LOG10_AXIS, label: 'fraction of the points' }],
+      series,
+      cursor: { drag: { x: false, y: false } },
+    }), data, { xRange: [x[0], x[x.length - 1]], yRange: [lowest, 0.15] });
+  }
+  setLegend('weights', dom['legend-weights'], hs.map(({ name, h }) => {
+    const parts = [{ text: h.tail === null ? 'max|w| / mean|w| = —' : `max|w| / mean|w| = ${fmt(h.tail, 3)}`, className: 'fit' }];
+    if (h.zeros) parts.push({ text: `${h.zeros} zero weights`, className: 'fit' });
+    if (h.below) parts.push({ text: `${h.below} below ${fmt(Number(`1e${bins.logEdges[0]}`), 2)}`, className: 'fit' });
+    if (h.negative) parts.push({ text: `${h.negative} negative`, className: 'fit' });
+    if (h.nonFinite) parts.push({ text: `${h.nonFinite} not finite`, className: 'badge' });
+    return { name, color: sceneColor(state, name), data: { weights: name, zeros: String(h.zeros) }, parts };
   }));
 }
 

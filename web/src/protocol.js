@@ -8,6 +8,8 @@
 //   run      {scene, options, warmup?}      level     {level}  x N    (after each N)
 //                                           result    {result}        (core.runStudy)
 //   format   {result, format}               formatted {text}          (core.format)
+//   samples  {scene, options, fields?}      sampled   {samples}       (core.samples; `fields`
+//                                                     keeps only those per-estimator arrays)
 //   any request                             error     {status, statusName, message, field?, position?}
 //
 // Cancelling a run is not a message: the page terminates the worker (a study is synchronous, so
@@ -23,6 +25,8 @@ export const MSG = Object.freeze({
   RESULT: 'result',
   FORMAT: 'format',
   FORMATTED: 'formatted',
+  SAMPLES: 'samples',
+  SAMPLED: 'sampled',
   ERROR: 'error',
 });
 
@@ -32,6 +36,7 @@ export const FINAL_REPLY = Object.freeze({
   [MSG.VALIDATE]: MSG.VALIDATED,
   [MSG.RUN]: MSG.RESULT,
   [MSG.FORMAT]: MSG.FORMATTED,
+  [MSG.SAMPLES]: MSG.SAMPLED,
 });
 
 export function message(id, type, payload = {}) {

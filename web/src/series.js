@@ -423,3 +423,248 @@ export function partialResult(run, info, version = null) {
     estimators: run.order.filter((n) => run.records[n]).map((n) => run.records[n]),
   };
 }
+
+// ---------------------------------------------------------------------------------------------
+// Sample points (core.samples): the f/p overlay of 1D problems, weight histograms, summaries
+
+/** ∫|f| over the grid x by the trapezoid rule (0 when there is no interval). */
+export function trapezoidAbs(x, f) {
+  let s = 0;
+  for (let i = 1; i < x.length; i++) {
+    const a = Math.abs(f[i - 1]);
+    const b = Math.abs(f[i]);
+    if (Number.isFinite(a) && Number.isFinite(b)) s += 0.5 * (a + b) * (x[i] - x[i - 1]);
+  }
+  return s;
+}
+
+/** f on the grid divided by ∫|f| (trapezoid), so that it compares with a density; area = ∫|f|
+ *  (y is null when that area is zero or not finite). */
+export function normalizeCurve(x, f) {
+  const area = trapezoidAbs(x, f);
+  if (!(area > 0) || !Number.isFinite(area)) return { y: f.map(() => null), area };
+  return { y: f.map((v) => (Number.isFinite(v) ? v / area : null)), area };
+}
+
+/**
+ * The 1D overlay of a samples answer: x, f normalised to unit area, and each estimator's
+ * density p(x) on the same grid (in `order`). The y range is capped when a spike (a singular
+ * f or p) would flatten everything else: at 20 x the 75th percentile of the values (at least
+ * 1.5); `clipped` tells whether anything lies above it.
+ */
+export function curveOverlay(curve, order, { exact = null } = {}) {
+  if (!curve || !Array.isArray(curve.x) || !curve.x.length) return null;
+  let { y: f, area } = normalizeCurve(curve.x, curve.f);
+  // The grid misses the mass of an integrable singularity (x^-0.9: most of it lies before the
+  // first grid point): when f >= 0 and the exact integral is known, divide by that instead.
+  const trapezoid = area;
+  let areaFrom = 'trapezoid';
+  if (typeof exact === 'number' && exact > 0 && Number.isFinite(exact) && curve.f.every((v) => !(v < 0))
+    && Math.abs(trapezoid - exact) > 0.01 * exact) {
+    area = exact;
+    areaFrom = 'exact';
+    f = curve.f.map((v) => (Number.isFinite(v) ? v / exact : null));
+  }
+  const pdfs = order.filter((n) => curve.pdf && Array.isArray(curve.pdf[n]))
+    .map((name) => ({ name, y: curve.pdf[name].map((v) => (Number.isFinite(v) ? v : null)) }));
+  const all = [...f, ...pdfs.flatMap((p) => p.y)].filter((v) => v !== null && Number.isFinite(v));
+  let lo = 0;
+  let hi = 1;
+  if (all.length) {
+    const sorted = all.slice().sort((a, b) => a - b);
+    const max = sorted[sorted.length - 1];
+    lo = Math.min(0, sorted[0]);
+    const q75 = sorted[Math.floor(0.75 * (sorted.length - 1))];
+    const cap = Math.max(20 * q75, 1.5);
+    hi = max > cap ? cap : max * 1.05;
+    if (!(hi > lo)) hi = lo + 1;
+  }
+  const clipped = all.some((v) => v > hi);
+  return { x: curve.x.slice(), f, area, areaFrom, trapezoid, pdfs, yRange: [lo * 1.05, hi], clipped };
+}
+
+/**
+ * Common log-spaced bins of |w| for the weight histograms of several estimators: edges are
+ * powers of 10^(1/binsPerDecade) covering the largest |w| and at most maxDecades below it
+ * (smaller non-zero |w| go to the first bin's "below" count).
+ */
+export function weightBins(weightArrays, { binsPerDecade = 4, maxDecades = 12 } = {}) {
+  let min = Infinity;
+  let max = -Infinity;
+  for (const ws of weightArrays) {
+    for (const w of ws) {
+      const a = Math.abs(w);
+      if (!(a > 0) || !Number.isFinite(a)) continue;
+      if (a < min) min = a;
+      if (a > max) max = a;
+    }
+  }
+  if (!(min <= max)) return null;
+  const top = Math.ceil(Math.log10(max) * binsPerDecade + 1e-9) / binsPerDecade;
+  let bottom = Math.floor(Math.log10(min) * binsPerDecade - 1e-9) / binsPerDecade;
+  bottom = Math.max(bottom, top - maxDecades);
+  if (top - bottom < 1) bottom = top - 1;
+  const bins = Math.round((top - bottom) * binsPerDecade);
+  const logEdges = Array.from({ length: bins + 1 }, (_, i) => round9(bottom + i / binsPerDecade));
+  return { logEdges, binsPerDecade };
+}
+
+/**
+ * Histogram of |w| on the bins of weightBins: counts per bin, `zeros` (w = 0, e.g. f = 0 there)
+ * and `nonFinite` counted apart, `below` (0 < |w| under the first edge), `negative` (w < 0),
+ * fraction = counts / total, and the heavy-tail figure max|w| / mean|w|.
+ */
+export function weightHistogram(weights, bins) {
+  const nb = bins ? bins.logEdges.length - 1 : 0;
+  const counts = new Array(nb).fill(0);
+  let zeros = 0;
+  let nonFinite = 0;
+  let below = 0;
+  let negative = 0;
+  let sumAbs = 0;
+  let maxAbs = 0;
+  let total = 0;
+  for (const w of weights) {
+    total++;
+    if (typeof w !== 'number' || !Number.isFinite(w)) {
+      nonFinite++;
+      continue;
+    }
+    if (w < 0) negative++;
+    const a = Math.abs(w);
+    sumAbs += a;
+    if (a > maxAbs) maxAbs = a;
+    if (a === 0) {
+      zeros++;
+      continue;
+    }
+    if (!bins) continue;
+    const k = Math.floor((Math.log10(a) - bins.logEdges[0]) * bins.binsPerDecade + 1e-9);
+    if (k < 0) below++;
+    else counts[Math.min(nb - 1, k)]++;
+  }
+  const finite = total - nonFinite;
+  const meanAbs = finite ? sumAbs / finite : 0;
+  return {
+    counts, fraction: counts.map((c) => (total ? c / total : 0)), zeros, nonFinite, below, negative, total,
+    maxAbs, meanAbs, tail: meanAbs > 0 ? maxAbs / meanAbs : null,
+  };
+}
+
+/** What the scatter shows of each estimator of a samples answer (for mcplayDebug and the notes). */
+export function samplesSummary(samples) {
+  if (!samples) return null;
+  return {
+    n: samples.n, seed: samples.seed, domain: samples.domain, dimension: samples.dimension,
+    curve: Boolean(samples.curve),
+    estimators: samples.estimators.map((e) => ({
+      name: e.name, sampler: e.sampler, points: e.u && e.u[0] ? e.u[0].length : 0,
+      strata: (e.strata || []).slice(), samplesPerStratum: e.samples_per_stratum,
+    })),
+  };
+}
+
+/**
+ * How the points are drawn in the domain: which coordinates (axes), their ranges and the outline
+ * of the domain ({type: 'circle', cx, cy, r} | {type: 'polygon', points} | {type: 'rect'}), and
+ * a note when it is a projection. `domain` is the scene's domain object, when known.
+ */
+export function domainView(samples, domain = null) {
+  const type = samples.domain;
+  const d = samples.dimension;
+  const xs = samples.estimators.length ? samples.estimators[0].x : [];
+  const extent = (k) => {
+    let lo = Infinity;
+    let hi = -Infinity;
+    for (const e of samples.estimators) for (const v of e.x[k] || []) {
+      if (v < lo) lo = v;
+      if (v > hi) hi = v;
+    }
+    if (!(lo <= hi)) return [0, 1];
+    if (lo >= 0 && hi <= 1) return [0, 1];
+    const pad = 0.02 * (hi - lo || 1);
+    return [lo - pad, hi + pad];
+  };
+  if (type === 'disk') {
+    const [cx, cy] = domain && Array.isArray(domain.center) ? domain.center : [0, 0];
+    const r = domain && typeof domain.radius === 'number' ? domain.radius : 1;
+    return { axes: [0, 1], labels: ['x', 'y'], xRange: [cx - r, cx + r], yRange: [cy - r, cy + r],
+      outline: { type: 'circle', cx, cy, r }, note: '' };
+  }
+  if (type === 'triangle') {
+    const v = domain && Array.isArray(domain.vertices) ? domain.vertices : [[0, 0], [1, 0], [0, 1]];
+    const xr = [Math.min(...v.map((p) => p[0])), Math.max(...v.map((p) => p[0]))];
+    const yr = [Math.min(...v.map((p) => p[1])), Math.max(...v.map((p) => p[1]))];
+    return { axes: [0, 1], labels: ['x', 'y'], xRange: xr, yRange: yr, outline: { type: 'polygon', points: v }, note: '' };
+  }
+  if (type === 'sphere' || type === 'hemisphere' || (xs.length === 3 && d === 3 && type !== 'box')) {
+    return { axes: [0, 1], labels: ['x', 'y'], xRange: [-1, 1], yRange: [-1, 1], outline: { type: 'circle', cx: 0, cy: 0, r: 1 },
+      note: `directions on the ${type} projected to (x, y)` };
+  }
+  if (d === 1) {
+    const interval = domain && domain.type === 'interval' && Number.isFinite(domain.lower) && Number.isFinite(domain.upper);
+    const r = interval ? [domain.lower, domain.upper]
+      : samples.curve && samples.curve.x.length ? [samples.curve.x[0], samples.curve.x[samples.curve.x.length - 1]] : extent(0);
+    return { axes: [0], labels: ['x', 'f(x)'], xRange: r, yRange: null, outline: { type: 'rect' }, note: '' };
+  }
+  return { axes: [0, 1], labels: ['x1', 'x2'], xRange: extent(0), yRange: extent(1), outline: { type: 'rect' },
+    note: d > 2 ? `the first two of ${d} axes` : '' };
+}
+
+/**
+ * Maps from the unit square to a disk (center c, radius R) that the core's disk samplers use:
+ * polar (r = R sqrt(u1), θ = 2π u2) and concentric (Shirley–Chiu). Used only to draw the images
+ * of the strata cells in the domain, and only when the map reproduces the estimator's own
+ * points (mapFor), so a sampler the page does not know simply gets no mapped grid.
+ */
+export const DISK_MAPS = Object.freeze({
+  polar: ([u0, u1]) => {
+    const r = Math.sqrt(u0);
+    return [r * Math.cos(2 * Math.PI * u1), r * Math.sin(2 * Math.PI * u1)];
+  },
+  concentric: ([u0, u1]) => {
+    const a = 2 * u0 - 1;
+    const b = 2 * u1 - 1;
+    if (a === 0 && b === 0) return [0, 0];
+    let r;
+    let phi;
+    if (Math.abs(a) > Math.abs(b)) {
+      r = a;
+      phi = (Math.PI / 4) * (b / a);
+    } else {
+      r = b;
+      phi = Math.PI / 2 - (Math.PI / 4) * (a / b);
+    }
+    return [r * Math.cos(phi), r * Math.sin(phi)];
+  },
+});
+
+/** The disk map (of DISK_MAPS, scaled to the disk) that gives estimator e's x from its u, or null. */
+export function mapFor(e, domain = null) {
+  if (!e || !e.u || e.u.length !== 2 || !e.x || e.x.length < 2 || !e.u[0].length) return null;
+  const [cx, cy] = domain && Array.isArray(domain.center) ? domain.center : [0, 0];
+  const R = domain && typeof domain.radius === 'number' ? domain.radius : 1;
+  for (const [name, m] of Object.entries(DISK_MAPS)) {
+    const f = (u) => {
+      const [x, y] = m(u);
+      return [cx + R * x, cy + R * y];
+    };
+    let ok = true;
+    for (let i = 0; i < e.u[0].length && ok; i++) {
+      const [x, y] = f([e.u[0][i], e.u[1][i]]);
+      ok = Math.abs(x - e.x[0][i]) <= 1e-7 * R && Math.abs(y - e.x[1][i]) <= 1e-7 * R;
+    }
+    if (ok) return { name, map: f };
+  }
+  return null;
+}
+
+/** The images of the strata lines u_k = j / cells_k under `map`, as polylines of [x, y]. */
+export function mappedGrid(map, strata, steps = 64) {
+  const lines = [];
+  const [c0, c1] = strata;
+  const line = (fixed, axis) => Array.from({ length: steps + 1 }, (_, i) => map(axis === 0 ? [fixed, i / steps] : [i / steps, fixed]));
+  for (let j = 0; j <= c0; j++) lines.push(line(j / c0, 0));
+  for (let j = 0; j <= c1; j++) lines.push(line(j / c1, 1));
+  return lines;
+}

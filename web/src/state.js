@@ -1,7 +1,7 @@
 // The playground's one state object: a store (getState, subscribe, dispatch), the reducer that
 // is the only code changing the state, and the pure helpers that put the comparison in the URL
 // and read it back. No DOM, no workers: web/test/state.test.mjs runs it under Node.
-import { applyLevel, ladder, mergeResults, progressOf } from './series.js';
+import { applyLevel, ladder, mergeResults, progressOf, samplesSummary } from './series.js';
 
 /** Bounds of the core (docs/scene-format.md) and of the page's first run. */
 export const LIMITS = Object.freeze({
@@ -250,7 +250,18 @@ export function initialState() {
     calibration: 'all',     // the histogram's level: 'all' (pooled) or an N
     notice: '',             // last export / scene-loading message
     run: emptyRun('loading'),
+    samples: emptySamples(256),
   };
+}
+
+/** Points drawn of the selected estimators (core.samples): `data` the scatter's n points,
+ *  `weights` the n = 4096 weights of the histograms; each answer is kept only when its key is
+ *  the latest requested one (scene, estimators, seed, n). */
+export const SAMPLE_SIZES = Object.freeze([64, 256, 1024]);
+export const WEIGHT_SAMPLES = 4096;
+
+function emptySamples(n) {
+  return { n, status: 'idle', key: null, weightsKey: null, data: null, weights: null, message: '' };
 }
 
 function emptyRun(status) {
@@ -314,6 +325,7 @@ export function reducer(state, action) {
         custom: { ...state.custom, error: null, pending: false },
         notice: '',
         run: state.version ? { ...emptyRun('ready'), id: state.run.id } : state.run,
+        samples: emptySamples(state.samples.n),
       };
     }
     case 'scene/loaded': {
@@ -344,6 +356,7 @@ export function reducer(state, action) {
         notice: '',
         // a new problem clears the plots of the previous one (and stops its run)
         run: state.version && !keep ? { ...emptyRun('ready'), id: state.run.id } : state.run,
+        samples: keep ? state.samples : emptySamples(state.samples.n),
       };
     }
     case 'scene/failed':
@@ -382,6 +395,28 @@ export function reducer(state, action) {
       return { ...state, calibration: p.value === 'all' ? 'all' : Number(p.value) };
     case 'notice':
       return { ...state, notice: p.message };
+
+    case 'samples/n':
+      if (!SAMPLE_SIZES.includes(Number(p.n))) return state;
+      return { ...state, samples: { ...state.samples, n: Number(p.n) } };
+    case 'samples/request':
+      // {key, weightsKey?}: weightsKey only when the weights are asked for again
+      return {
+        ...state,
+        samples: {
+          ...state.samples, status: p.points === false ? state.samples.status : 'loading', key: p.key, message: '',
+          ...(p.weightsKey ? { weightsKey: p.weightsKey } : {}),
+        },
+      };
+    case 'samples/loaded':
+      if (p.key !== state.samples.key) return state;
+      return { ...state, samples: { ...state.samples, status: 'ready', data: p.samples, message: '' } };
+    case 'samples/weights':
+      if (p.key !== state.samples.weightsKey) return state;
+      return { ...state, samples: { ...state.samples, weights: p.samples } };
+    case 'samples/failed':
+      if (p.key !== state.samples.key && p.key !== state.samples.weightsKey) return state;
+      return { ...state, samples: { ...state.samples, status: 'error', message: p.message } };
 
     case 'run/request':
       return state;
@@ -473,5 +508,21 @@ export function debugSnapshot(state) {
     // per estimator of the run: its levels so far ({n, variance, mse, error, ...}), fit, warnings
     estimators: r.order.filter((n) => r.records[n]).map((n) => r.records[n]),
     result: r.result,
+    // the sample points drawn: per estimator the number of points, its strata; weights: n, zeros
+    samples: samplesDebug(state.samples),
+  };
+}
+
+function samplesDebug(smp) {
+  const summary = samplesSummary(smp.data);
+  return {
+    status: smp.status,
+    n: smp.n,
+    message: smp.message,
+    ...(summary || { estimators: [] }),
+    points: Object.fromEntries((summary ? summary.estimators : []).map((e) => [e.name, e.points])),
+    weights: smp.weights ? Object.fromEntries(smp.weights.estimators.map((e) => [e.name, {
+      n: e.weight.length, zeros: e.weight.filter((w) => w === 0).length,
+    }])) : null,
   };
 }

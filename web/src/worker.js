@@ -44,6 +44,18 @@ const handlers = {
   [MSG.FORMAT](core, id, { result, format }) {
     reply(id, MSG.FORMATTED, { text: core.format(result, format) });
   },
+  [MSG.SAMPLES](core, id, { scene, options, fields = null }) {
+    // The points of replicate 0 of a study at N = options.n. `fields` (e.g. ['weight']) drops
+    // the other per-point arrays before the answer is copied to the page.
+    const samples = core.samples(scene, options);
+    if (Array.isArray(fields)) {
+      const per = new Set(['u', 'x', 'f', 'density', 'weight']);
+      samples.estimators = samples.estimators.map((e) => Object.fromEntries(
+        Object.entries(e).filter(([k]) => !per.has(k) || fields.includes(k))));
+      if (!fields.includes('curve')) delete samples.curve;
+    }
+    reply(id, MSG.SAMPLED, { samples });
+  },
 };
 
 self.onmessage = async (e) => {

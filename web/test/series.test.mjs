@@ -306,3 +306,77 @@ test('fmt and decadeRange', () => {
   assert.deepEqual(decadeRange([1e-3]), [1e-4, 1e-2]);
   assert.deepEqual(decadeRange([]), [1e-6, 1]);
 });
+
+// ---------------------------------------------------------------------------------------------
+// Sample points: overlay normalisation, weight histograms, summaries, disk maps
+
+import {
+  trapezoidAbs, normalizeCurve, curveOverlay, weightBins, weightHistogram, samplesSummary, domainView,
+  mapFor, DISK_MAPS,
+} from '../src/series.js';
+
+test('normalizeCurve: f divided by the trapezoid integral of |f|', () => {
+  const x = [0, 0.5, 1];
+  assert.equal(trapezoidAbs(x, [1, 1, 1]), 1);
+  assert.equal(trapezoidAbs(x, [-2, -2, -2]), 2);
+  const { y, area } = normalizeCurve(x, [0, 2, 0]);
+  assert.equal(area, 1);
+  assert.deepEqual(y, [0, 2, 0]);
+  assert.deepEqual(normalizeCurve(x, [0, 0, 0]).y, [null, null, null]);
+});
+
+test('curveOverlay: pdfs in order, exact integral for a singular f >= 0, clipped range', () => {
+  const x = Array.from({ length: 11 }, (_, i) => i / 10);
+  const curve = { x, f: x.map(() => 3), pdf: { b: x.map(() => 1), a: x.map(() => 1) } };
+  const ov = curveOverlay(curve, ['a', 'b', 'missing']);
+  assert.deepEqual(ov.pdfs.map((p) => p.name), ['a', 'b']);
+  assert.ok(ov.f.every((v) => Math.abs(v - 1) < 1e-12));
+  assert.equal(ov.areaFrom, 'trapezoid');
+  assert.equal(ov.clipped, false);
+  const spike = { x, f: x.map((v, i) => (i === 0 ? 1000 : 1)), pdf: {} };
+  const s = curveOverlay(spike, [], { exact: 50 });
+  assert.equal(s.areaFrom, 'exact');
+  assert.equal(s.area, 50);
+  assert.equal(s.clipped, true);
+  assert.ok(s.yRange[1] < 1000 / 50);
+  assert.equal(curveOverlay(null, []), null);
+});
+
+test('weight histograms: log bins of |w|, zeros and non-finite apart, tail ratio', () => {
+  const w = [0, 0, 1, 1.5, 10, -100, 1e-20, Infinity];
+  const bins = weightBins([w], { binsPerDecade: 1, maxDecades: 5 });
+  assert.deepEqual(bins.logEdges, [-2, -1, 0, 1, 2, 3]); // 100 lies in [10^2, 10^3)
+  const h = weightHistogram(w, bins);
+  assert.equal(h.zeros, 2);
+  assert.equal(h.nonFinite, 1);
+  assert.equal(h.below, 1);
+  assert.equal(h.negative, 1);
+  assert.deepEqual(h.counts, [0, 0, 2, 1, 1]);
+  assert.equal(h.counts.reduce((a, b) => a + b) + h.zeros + h.nonFinite + h.below, w.length);
+  assert.equal(h.total, 8);
+  assert.equal(h.maxAbs, 100);
+  assert.ok(Math.abs(h.tail - 100 / ((1 + 1.5 + 10 + 100 + 1e-20) / 7)) < 1e-9);
+  assert.equal(weightBins([[0, 0]]), null);
+  assert.equal(weightHistogram([0, 0], null).zeros, 2);
+});
+
+test('samplesSummary and domainView', () => {
+  const e = { name: 'a', sampler: 'stratified', strata: [2, 2], samples_per_stratum: 1, u: [[0.1, 0.9], [0.2, 0.7]], x: [[0.1, 0.9], [0.2, 0.7]] };
+  const smp = { n: 2, seed: 3, domain: 'box', dimension: 2, estimators: [e] };
+  assert.deepEqual(samplesSummary(smp).estimators[0], { name: 'a', sampler: 'stratified', points: 2, strata: [2, 2], samplesPerStratum: 1 });
+  assert.deepEqual(domainView(smp).xRange, [0, 1]);
+  assert.match(domainView({ ...smp, dimension: 5 }).note, /first two of 5/);
+  assert.equal(domainView({ ...smp, domain: 'disk' }, { center: [1, 0], radius: 2 }).outline.r, 2);
+  assert.match(domainView({ ...smp, domain: 'hemisphere', dimension: 3 }).note, /projected/);
+  assert.deepEqual(domainView({ ...smp, dimension: 1, curve: { x: [0.1, 0.9] } }, { type: 'interval', lower: -1, upper: 2 }).xRange, [-1, 2]);
+});
+
+test('mapFor: recognises the disk map that produced the points, and only that', () => {
+  const u = [[0.1, 0.6, 0.95], [0.3, 0.5, 0.05]];
+  for (const name of ['polar', 'concentric']) {
+    const pts = u[0].map((_, i) => DISK_MAPS[name]([u[0][i], u[1][i]]));
+    const e = { u, x: [pts.map((p) => 2 * p[0] + 1), pts.map((p) => 2 * p[1])] };
+    assert.equal(mapFor(e, { center: [1, 0], radius: 2 }).name, name);
+  }
+  assert.equal(mapFor({ u, x: [[0, 0, 0], [0, 0, 0]] }), null);
+});

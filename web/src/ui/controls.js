@@ -30,6 +30,9 @@ export function mountControls(store) {
     dispatch({ type: 'run/request' });
   });
   $('cancel').addEventListener('click', () => dispatch({ type: 'run/cancel', payload: { now: performance.now() } }));
+  $('samples-n').addEventListener('change', (e) => {
+    dispatch({ type: 'samples/n', payload: { n: Number(e.target.value) } });
+  });
   $('calibration-level').addEventListener('change', (e) => {
     dispatch({ type: 'calibration/set', payload: { value: e.target.value } });
   });
@@ -47,6 +50,8 @@ function option(value, text) {
 }
 
 export function syncControls(state) {
+  const sn = $('samples-n');
+  if (sn && Number(sn.value) !== state.samples.n) sn.value = String(state.samples.n);
   // Scenes
   const sSig = JSON.stringify(state.scenes.map((s) => s.name));
   const select = $('scene');
