@@ -8,6 +8,7 @@ import {
   decadeRange, fitText, fmt, curveOverlay, weightBins, weightHistogram, domainView, mapFor, mappedGrid,
 } from './series.js';
 import { colorAt, withAlpha } from './palette.js';
+import { el } from './dom.js';
 
 const FONT = '12px "DejaVu Sans", system-ui, sans-serif';
 const LABEL_FONT = 'bold 12px "DejaVu Sans", system-ui, sans-serif';
@@ -161,16 +162,6 @@ function labelHook(items) {
 // ---------------------------------------------------------------------------------------------
 // Legends (plain DOM; text only, never HTML from data)
 
-function el(tag, props = {}, ...children) {
-  const e = document.createElement(tag);
-  for (const [k, v] of Object.entries(props)) {
-    if (k === 'dataset') Object.assign(e.dataset, v);
-    else if (k === 'style') e.style.cssText = v;
-    else e[k] = v;
-  }
-  for (const c of children) if (c !== null && c !== undefined) e.append(c);
-  return e;
-}
 
 function swatch(color, dashed = false) {
   return el('span', {

@@ -5,6 +5,7 @@
 // of the state, text only (never HTML from data).
 import { collectWarnings, fitText, fmt } from './series.js';
 import { colorAt } from './palette.js';
+import { el } from './dom.js';
 
 /** Which column (level codes) or summary item (estimator codes) a warning concerns. */
 const LEVEL_COLUMN = {
@@ -30,16 +31,6 @@ const COLUMNS = [
   ['tail', 'tail index', (l) => (l.tail_index === null || l.tail_index === undefined ? '—' : `${fmt(l.tail_index, 3)} (k=${l.tail_k})`)],
 ];
 
-function el(tag, props = {}, ...children) {
-  const e = document.createElement(tag);
-  for (const [k, v] of Object.entries(props)) {
-    if (k === 'dataset') Object.assign(e.dataset, v);
-    else if (k === 'style') e.style.cssText = v;
-    else e[k] = v;
-  }
-  for (const c of children) if (c !== null && c !== undefined && c !== false) e.append(c);
-  return e;
-}
 
 function badge(w) {
   return el('span', { className: 'badge', title: w.message }, w.code);
