@@ -3,6 +3,7 @@
 // every error names the JSON path of the offending field and what was expected.
 #include "api/scene.h"
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 #include <sstream>
@@ -356,23 +357,32 @@ bool table_values(Ctx& c, const Json& j, const std::string& path, const Problem&
         return false;
     }
     values->assign(cells, 0.0);
-    std::vector<double> point(static_cast<size_t>(dim));
-    const int sub_count = dim == 1 ? kSubSamples : kSubSamples * kSubSamples;
-    for (size_t cell = 0; cell < cells; ++cell) {
-        // cell index: x fastest (row-major over y), matching make_tabulated_2d.
-        size_t ix = cell % static_cast<size_t>(bins[0]);
-        size_t iy = dim == 2 ? cell / static_cast<size_t>(bins[0]) : 0;
-        double sum = 0.0;
-        for (int s = 0; s < sub_count; ++s) {
-            int sx = s % kSubSamples, sy = s / kSubSamples;
-            point[0] = lo[0] + (hi[0] - lo[0]) * (ix + (sx + 0.5) / kSubSamples) / bins[0];
+    // kSubSamples^d points per cell, evaluated a block at a time (cell-major, so each cell's
+    // points are summed in order); x fastest over the cells, matching make_tabulated_2d.
+    const size_t sub_count = dim == 1 ? kSubSamples : kSubSamples * kSubSamples;
+    const size_t total = cells * sub_count;
+    PointBlock block;
+    block.reset(dim, kBlockSize);
+    std::vector<double> v(kBlockSize);
+    for (size_t first = 0; first < total; first += kBlockSize) {
+        block.n = std::min(kBlockSize, total - first);
+        for (size_t i = 0; i < block.n; ++i) {
+            const size_t cell = (first + i) / sub_count, sub = (first + i) % sub_count;
+            const size_t ix = cell % static_cast<size_t>(bins[0]);
+            const size_t iy = dim == 2 ? cell / static_cast<size_t>(bins[0]) : 0;
+            const size_t sx = sub % kSubSamples, sy = sub / kSubSamples;
+            block.coord(0)[i] = lo[0] + (hi[0] - lo[0]) * (ix + (sx + 0.5) / kSubSamples) / bins[0];
             if (dim == 2)
-                point[1] = lo[1] + (hi[1] - lo[1]) * (iy + (sy + 0.5) / kSubSamples) / bins[1];
-            double v = std::fabs(evaluate_point(f, point.data()));
-            sum += std::isfinite(v) ? v : 0.0;
+                block.coord(1)[i] =
+                    lo[1] + (hi[1] - lo[1]) * (iy + (sy + 0.5) / kSubSamples) / bins[1];
         }
-        (*values)[cell] = sum / sub_count;
+        evaluate_block(f, block, v.data());
+        for (size_t i = 0; i < block.n; ++i) {
+            const double a = std::fabs(v[i]);
+            (*values)[(first + i) / sub_count] += std::isfinite(a) ? a : 0.0;
+        }
     }
+    for (double& value : *values) value /= static_cast<double>(sub_count);
     return true;
 }
 
