@@ -1,6 +1,7 @@
 // Throughput benchmark: samples per second of the estimator hot loop on several scenes, and
 // raw PCG32 draws per second. Prints "BENCH <case> <samples/s>" lines that run_bench.sh
 // sets side by side for the native and the WebAssembly builds.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -9,6 +10,7 @@
 #include <string>
 
 #include "api/scene.h"
+#include "render_api/render_request.h"
 
 using namespace mcp;
 
@@ -106,6 +108,38 @@ void accumulation_accuracy() {
                 std::fabs(compensated.value() - exact) / exact);
 }
 
+// Rays per second of one thread rendering a render scene with an estimator (camera, shadow
+// and bounce rays alike), best of three renders after a warm-up render.
+void render_rays_per_second(const std::string& dir, const char* scene, const char* estimator) {
+    std::ifstream in(dir + "/" + scene + ".json");
+    std::stringstream ss;
+    ss << in.rdbuf();
+    Made<Json> j = parse_json(ss.str().c_str(), scene);
+    if (!j.ok()) return;
+    Made<std::shared_ptr<RenderRequest>> r = build_render_request(j.value, Json{{"base_dir", dir}});
+    if (!r.ok()) {
+        std::fprintf(stderr, "bench: %s: %s\n", scene, r.error.c_str());
+        return;
+    }
+    RenderScene rs;
+    rs.build(*r.value->scene, r.value->accel);
+    for (const RenderEstimator& e : r.value->estimators) {
+        if (e.name != estimator) continue;
+        RenderSettings st;
+        st.width = st.height = 64;
+        st.spp = 4;
+        st.threads = 1;
+        render_image(rs, e, st);
+        st.spp = 16;
+        double best = 0.0;
+        for (int rep = 0; rep < 3; ++rep) {
+            RenderImage im = render_image(rs, e, st);
+            best = std::max(best, double(im.diagnostics.rays) / im.seconds);
+        }
+        std::printf("BENCH render/%s/%s_rays %.6e\n", scene, estimator, best);
+    }
+}
+
 } // namespace
 
 int main(int argc, char** argv) {
@@ -147,6 +181,10 @@ int main(int argc, char** argv) {
     std::printf("BENCH eval/expression_gaussian %.6e\n", e);
     std::printf("BENCH eval/compiled_gaussian %.6e\n", g);
     std::printf("RATIO compiled/expression %.2f\n", g / e);
+    render_rays_per_second(dir, "cornell_box", "mis_power");
+    render_rays_per_second(dir, "cornell_box", "light_area");
+    render_rays_per_second(dir, "cornell_box_path", "path_mis");
+    render_rays_per_second(dir, "veach_mis", "mis_power");
     if (argc > 3 && std::string(argv[3]) == "--accumulation") accumulation_accuracy();
     return 0;
 }

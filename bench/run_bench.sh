@@ -7,6 +7,7 @@ wasm=${2:?wasm bench command}
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 echo "mcplay bench: samples per second of the estimator loop (best of 5 runs of 2^22 samples, one thread;"
+echo "  render/*_rays: rays per second per core (camera, shadow and bounce rays), 64x64 at 16 spp, best of 3;"
 echo "  wasm under node --no-liftoff: steady-state optimised code, as a browser reaches after tier-up)"
 echo "machine: $(nproc) cores, $(uname -m), $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //')"
 $native scenes $((1 << 22)) --accumulation >"$tmp/native"

@@ -10,6 +10,14 @@ trap 'rm -rf "$tmp"' EXIT
 status=0
 for scene in scenes/*.json; do
     name=$(basename "$scene" .json)
+    if grep -q '"render"' "$scene"; then
+        # Render studies: tiny images, the reference rendered (not cached) on both sides.
+        small=(--n-min 1 --n-max 4 --reps 2 --width 12 --height 10 --no-cache --quiet --format json)
+        $native run "$scene" "${small[@]}" --threads 2 --out "$tmp/$name.native.json"
+        $wasm run "$scene" "${small[@]}" --out "$tmp/$name.wasm.json"
+        node tests/compare_results.mjs "$tmp/$name.native.json" "$tmp/$name.wasm.json" || status=1
+        continue
+    fi
     $native run "$scene" --n-min 16 --n-max 1024 --reps 4 --threads 2 --quiet --format json --out "$tmp/$name.native.json"
     $wasm run "$scene" --n-min 16 --n-max 1024 --reps 4 --quiet --format json --out "$tmp/$name.wasm.json"
     node tests/compare_results.mjs "$tmp/$name.native.json" "$tmp/$name.wasm.json" || status=1

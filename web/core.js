@@ -8,7 +8,8 @@
 //
 // Every call is synchronous once the core is loaded (a long study blocks its thread: run it
 // in a Worker). Strings go in through malloc + stringToUTF8 and come out through the C API's
-// char** out-parameters, which are freed with mcp_free on every path.
+// char** out-parameters, which are freed with mcp_free on every path. That machinery
+// (wasmBridge, instantiate) is shared with render_core.js, the wrapper of the render module.
 
 /** Status codes of src/api/mcplay.h (enum mcp_status). */
 export const Status = Object.freeze({ OK: 0, ARGUMENT: 1, SCENE: 2, CANCELLED: 3, INTERNAL: 4 });
@@ -50,22 +51,18 @@ const FORMATS = Object.freeze(['table', 'csv', 'json']);
  *        {locateFile} when the .wasm is not beside the .mjs
  */
 export async function loadCore(createMcplay, moduleOptions = {}) {
-  if (typeof createMcplay !== 'function') {
-    throw new TypeError('loadCore: createMcplay must be the default export of mcplay_web.mjs');
-  }
-  const M = await createMcplay(moduleOptions);
-  const missing = [
-    ...WASM_FUNCTIONS.filter((name) => typeof M[name] !== 'function'),
-    ...WASM_RUNTIME_METHODS.filter((name) => M[name] === undefined),
-  ];
-  if (missing.length) {
-    throw new Error(`loadCore: the wasm module does not export ${missing.join(', ')} ` +
-      '(stale build? rebuild target mcplay_web)');
-  }
-  return makeCore(M);
+  return makeCore(await instantiate(createMcplay, moduleOptions, WASM_FUNCTIONS, 'loadCore', 'mcplay_web'));
 }
 
-function makeCore(M) {
+/**
+ * The calling machinery shared by the wasm modules' wrappers (this file and render_core.js):
+ * strings in through malloc, `char** out` results out and freed with mcp_free, errors as
+ * McplayError with mcp_last_error's message, one progress trampoline routed to the study in
+ * progress, and a module that trapped never used again. `M` is an instantiated Emscripten
+ * module exporting _malloc, _free, _mcp_last_error, _mcp_free, _mallinfo and the runtime
+ * methods of WASM_RUNTIME_METHODS. Not part of the public API.
+ */
+export function wasmBridge(M) {
   // The study in progress ({onLevel, error}); the single progress trampoline routes to it.
   let active = null;
   // Set when the wasm itself failed (a trap or an abort): its state is unknown from then on.
@@ -80,7 +77,7 @@ function makeCore(M) {
       return call.onLevel(level) === true ? 1 : 0;
     } catch (e) {
       // Never let a JS exception unwind through the C++ frames: remember it, ask the study to
-      // stop, and rethrow once mcp_study_run has returned and everything is freed.
+      // stop, and rethrow once the study has returned and everything is freed.
       call.error = { value: e };
       return 1;
     }
@@ -145,6 +142,11 @@ function makeCore(M) {
     return text;
   }
 
+  // null/undefined -> null (the C API's NULL), else JSON text.
+  function optionalJson(value, what) {
+    return value === null || value === undefined ? null : jsonText(value, what);
+  }
+
   /**
    * Calls a C function whose last argument is a `char** out`, with `inputs` (JS strings or
    * null) as its leading char* arguments and `extra` between them and the out slot. Returns
@@ -185,58 +187,33 @@ function makeCore(M) {
     throw new McplayError(r.status, r.message);
   }
 
-  function version() {
-    usable('version');
-    return M.UTF8ToString(M._mcp_version());
-  }
-
-  function catalog() {
-    usable('catalog');
-    return JSON.parse(textOf(callOut(M._mcp_catalog, []), 'mcp_catalog'));
-  }
-
-  function sceneInfo(scene) {
-    usable('sceneInfo');
-    return JSON.parse(textOf(callOut(M._mcp_scene_info, [jsonText(scene, 'scene')]), 'mcp_scene_info'));
+  /** Calls fn(inputs..., out) and returns its output parsed as JSON; failures throw. */
+  function callJson(what, fn, fnName, inputs) {
+    usable(what);
+    return JSON.parse(textOf(callOut(fn, inputs), fnName));
   }
 
   /**
-   * The points behind a small run of each estimator (replicate 0 of a study at N = n), for
-   * scatter plots, f/p overlays and weight histograms: see mcp_study_samples in
-   * src/api/mcplay.h. `options`: {estimators, n (<= 4096), seed, grid}. Throws McplayError.
+   * A study through fn(scene, options, progress, user, out) (mcp_study_run, mcp_render_study_run):
+   * see runStudy below for the contract of onLevel. Returns the parsed result (also when
+   * cancelled); failures throw McplayError, an exception of onLevel is rethrown.
    */
-  function samples(scene, options = null) {
-    usable('samples');
-    const optionsText = options === null || options === undefined ? null : jsonText(options, 'options');
-    return JSON.parse(textOf(callOut(M._mcp_study_samples, [jsonText(scene, 'scene'), optionsText]),
-      'mcp_study_samples'));
-  }
-
-  /**
-   * Runs a convergence study. `scene`: object or JSON text; `options`: object, JSON text or
-   * null ({estimators, n_min, n_max, reps, seed, threads}); `onLevel(level)` (optional) is
-   * called after each N with the progress object of docs/result-schema.md; returning exactly
-   * `true` cancels the study, whose result then has `cancelled: true` (after the last N there
-   * is nothing left to cancel: the result is complete and `cancelled` stays false). onLevel
-   * must be synchronous (a returned promise is ignored). An exception thrown by onLevel
-   * cancels the study and is rethrown from here. Failures throw McplayError.
-   */
-  function runStudy(scene, options = null, onLevel = null) {
-    usable('runStudy');
+  function study(what, fn, fnName, scene, options, onLevel) {
+    usable(what);
     if (active) {
-      throw new McplayError(Status.ARGUMENT, 'runStudy: a study is already running on this core ' +
+      throw new McplayError(Status.ARGUMENT, `${what}: a study is already running on this core ` +
         '(called from inside onLevel?)');
     }
     if (onLevel !== null && onLevel !== undefined && typeof onLevel !== 'function') {
-      throw new McplayError(Status.ARGUMENT, 'runStudy: onLevel must be a function or null');
+      throw new McplayError(Status.ARGUMENT, `${what}: onLevel must be a function or null`);
     }
     const sceneText = jsonText(scene, 'scene');
-    const optionsText = options === null || options === undefined ? null : jsonText(options, 'options');
+    const optionsText = optionalJson(options, 'options');
     const call = { onLevel, error: null };
     let r;
     active = onLevel ? call : null;
     try {
-      r = callOut(M._mcp_study_run, [sceneText, optionsText], [onLevel ? progressPtr : 0, 0]);
+      r = callOut(fn, [sceneText, optionsText], [onLevel ? progressPtr : 0, 0]);
     } finally {
       active = null;
     }
@@ -245,16 +222,12 @@ function makeCore(M) {
       return JSON.parse(r.text);
     }
     throw new McplayError(r.status === Status.OK ? Status.INTERNAL : r.status,
-      r.message || 'mcp_study_run: no result');
+      r.message || `${fnName}: no result`);
   }
 
-  /** A study result (object or JSON text) as 'table', 'csv' or 'json' (pretty-printed) text. */
-  function format(result, fmt = 'table') {
-    usable('format');
-    if (typeof fmt !== 'string') {
-      throw new McplayError(Status.ARGUMENT, `format: expected one of ${FORMATS.join(', ')}`);
-    }
-    return textOf(callOut(M._mcp_result_format, [jsonText(result, 'result'), fmt]), 'mcp_result_format');
+  function version() {
+    usable('version');
+    return M.UTF8ToString(M._mcp_version());
   }
 
   /** Heap figures for leak checks: the wasm memory size and malloc's own accounting. */
@@ -283,5 +256,77 @@ function makeCore(M) {
     M.removeFunction(progressPtr);
   }
 
-  return Object.freeze({ version, catalog, sceneInfo, samples, runStudy, format, heapStats, dispose });
+  return {
+    usable, callOut, textOf, jsonText, optionalJson, callJson, study, version, heapStats, dispose,
+  };
+}
+
+/**
+ * Instantiates an Emscripten module factory and checks that it exports `functions` and the
+ * runtime methods; `what` names the function and target in the messages.
+ */
+export async function instantiate(factory, moduleOptions, functions, what, target) {
+  if (typeof factory !== 'function') {
+    throw new TypeError(`${what}: the first argument must be the default export of ${target}.mjs`);
+  }
+  const M = await factory(moduleOptions);
+  const missing = [
+    ...functions.filter((name) => typeof M[name] !== 'function'),
+    ...WASM_RUNTIME_METHODS.filter((name) => M[name] === undefined),
+  ];
+  if (missing.length) {
+    throw new Error(`${what}: the wasm module does not export ${missing.join(', ')} ` +
+      `(stale build? rebuild target ${target})`);
+  }
+  return M;
+}
+
+function makeCore(M) {
+  const b = wasmBridge(M);
+
+  function catalog() {
+    return b.callJson('catalog', M._mcp_catalog, 'mcp_catalog', []);
+  }
+
+  function sceneInfo(scene) {
+    b.usable('sceneInfo');
+    return b.callJson('sceneInfo', M._mcp_scene_info, 'mcp_scene_info', [b.jsonText(scene, 'scene')]);
+  }
+
+  /**
+   * The points behind a small run of each estimator (replicate 0 of a study at N = n), for
+   * scatter plots, f/p overlays and weight histograms: see mcp_study_samples in
+   * src/api/mcplay.h. `options`: {estimators, n (<= 4096), seed, grid}. Throws McplayError.
+   */
+  function samples(scene, options = null) {
+    b.usable('samples');
+    return b.callJson('samples', M._mcp_study_samples, 'mcp_study_samples',
+      [b.jsonText(scene, 'scene'), b.optionalJson(options, 'options')]);
+  }
+
+  /**
+   * Runs a convergence study. `scene`: object or JSON text; `options`: object, JSON text or
+   * null ({estimators, n_min, n_max, reps, seed, threads}); `onLevel(level)` (optional) is
+   * called after each N with the progress object of docs/result-schema.md; returning exactly
+   * `true` cancels the study, whose result then has `cancelled: true` (after the last N there
+   * is nothing left to cancel: the result is complete and `cancelled` stays false). onLevel
+   * must be synchronous (a returned promise is ignored). An exception thrown by onLevel
+   * cancels the study and is rethrown from here. Failures throw McplayError.
+   */
+  function runStudy(scene, options = null, onLevel = null) {
+    return b.study('runStudy', M._mcp_study_run, 'mcp_study_run', scene, options, onLevel);
+  }
+
+  /** A study result (object or JSON text) as 'table', 'csv' or 'json' (pretty-printed) text. */
+  function format(result, fmt = 'table') {
+    b.usable('format');
+    if (typeof fmt !== 'string') {
+      throw new McplayError(Status.ARGUMENT, `format: expected one of ${FORMATS.join(', ')}`);
+    }
+    return b.textOf(b.callOut(M._mcp_result_format, [b.jsonText(result, 'result'), fmt]), 'mcp_result_format');
+  }
+
+  return Object.freeze({
+    version: b.version, catalog, sceneInfo, samples, runStudy, format, heapStats: b.heapStats, dispose: b.dispose,
+  });
 }

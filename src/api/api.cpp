@@ -6,29 +6,13 @@
 #include <string>
 
 #include "api/mcplay.h"
+#include "api/boundary.h"
 #include "api/scene.h"
 
-namespace {
-
-thread_local std::string g_last_error;
-
-int fail(int status, const std::string& message) {
-    g_last_error = message;
-    return status;
-}
-
-char* copy_out(const std::string& s) {
-    char* p = static_cast<char*>(std::malloc(s.size() + 1));
-    if (p) std::memcpy(p, s.c_str(), s.size() + 1);
-    return p;
-}
-
-// JSON text out, never throwing on odd bytes in user strings.
-std::string dump(const mcp::Json& j, int indent = -1) {
-    return j.dump(indent, ' ', false, nlohmann::json::error_handler_t::replace);
-}
-
-} // namespace
+using mcp::boundary::copy_out;
+using mcp::boundary::dump;
+using mcp::boundary::fail;
+using mcp::boundary::g_last_error;
 
 extern "C" {
 

@@ -295,7 +295,61 @@ Json progress_to_json(const StudyResult& partial, size_t level_index) {
                 {"estimators", estimators}};
 }
 
+// Render studies: relative MSE against spp, with the image's mean luminance for the bias.
+std::string format_render_table(const Json& r) {
+    std::ostringstream out;
+    const Json& scene = get(r, "scene");
+    const Json& settings = get(r, "settings");
+    const Json& ref = get(scene, "reference");
+    out << "mcplay " << jstr(r, "mcplay") << "  render scene " << jstr(scene, "name");
+    if (!jstr(scene, "description").empty()) out << ": " << jstr(scene, "description");
+    out << "\n  " << fmt("%.0f", jnum(scene, "width")) << "x" << fmt("%.0f", jnum(scene, "height"))
+        << ", " << fmt("%.0f", jnum(scene, "triangles")) << " triangles, "
+        << fmt("%.0f", jnum(scene, "lights")) << " light triangle(s), reference "
+        << jstr(ref, "source");
+    if (get(ref, "spp").is_number()) out << " at " << fmt("%.0f", jnum(ref, "spp")) << " spp";
+    out << "\n  spp = " << fmt("%.0f", jnum(settings, "n_min")) << " .. "
+        << fmt("%.0f", jnum(settings, "n_max")) << ", " << fmt("%.0f", jnum(settings, "reps"))
+        << " images per spp, seed " << fmt("%.0f", jnum(settings, "seed")) << ", "
+        << fmt("%.0f", jnum(settings, "threads")) << " thread(s), "
+        << fmt("%.2f", jnum(r, "wall_time_s")) << " s\n";
+    for (const Json& w : list(scene, "warnings")) out << "  NOTE: " << jstr(w, "message") << "\n";
+    if (jbool(r, "cancelled")) out << "  (cancelled: partial result)\n";
+    for (const Json& e : list(r, "estimators")) {
+        out << "\n" << jstr(e, "name") << "  [" << jstr(e, "strategy") << ", lights by "
+            << jstr(e, "light_selection") << ", " << jstr(e, "pixel_sampler") << " pixels]\n";
+        out << padl("spp", 7) << padl("rel.MSE", 12) << padl("mean lum.", 13) << padl("bias/se", 9)
+            << padl("px cover", 9) << padl("s/image", 10) << padl("efficiency", 12)
+            << padl("discarded", 10) << "\n";
+        for (const Json& l : list(e, "levels")) {
+            const double se = jnum(l, "std_error"), bias = jnum(l, "bias");
+            out << padl(fmt("%.0f", jnum(l, "n")), 7) << padl(fmt("%.4e", jnum(l, "variance")), 12)
+                << padl(fmt("%.6g", jnum(l, "mean")), 13)
+                << padl(se > 0 ? fmt("%+.2f", bias / se) : "-", 9)
+                << padl(fmt("%.3f", jnum(l, "coverage95")), 9)
+                << padl(fmt("%.2e", jnum(l, "time_mean_s")), 10)
+                << padl(fmt("%.3e", jnum(l, "efficiency")), 12)
+                << padl(fmt("%.0f", jnum(get(l, "diagnostics"), "nonfinite")), 10) << "\n";
+        }
+        const Json& fit = get(e, "fit");
+        if (jbool(fit, "valid"))
+            out << "  fitted order: relative MSE ~ spp^(" << fmt("%.3f", jnum(fit, "order"))
+                << " +/- " << fmt("%.3f", jnum(fit, "order_se")) << ")";
+        else
+            out << "  fitted order: none";
+        if (!jstr(fit, "note").empty()) out << " (" << jstr(fit, "note") << ")";
+        out << ";  " << fmt("%.3g", jnum(e, "rays_per_second")) << " rays/s\n";
+        for (const Json& w : list(e, "warnings")) out << "  WARNING: " << jstr(w, "message") << "\n";
+        const Json& levels = list(e, "levels");
+        if (!levels.empty())
+            for (const Json& w : list(levels.back(), "warnings"))
+                out << "  WARNING: " << jstr(w, "message") << "\n";
+    }
+    return out.str();
+}
+
 std::string format_table(const Json& r) {
+    if (jstr(r, "kind") == "render") return format_render_table(r);
     std::ostringstream out;
     const Json& scene = get(r, "scene");
     const Json& settings = get(r, "settings");

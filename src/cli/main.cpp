@@ -1,5 +1,6 @@
 // mcplay command line: argument parsing and file I/O only; all work goes through the C API.
 #include <dirent.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -15,6 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "api/mcplay.h"
+#include "render_api/mcplay_render.h"
 
 namespace {
 
@@ -30,6 +32,7 @@ const char* kUsage =
     "usage:\n"
     "  mcplay list [--scenes DIR]\n"
     "  mcplay run SCENE [options]\n"
+    "  mcplay render SCENE [--estimator NAME] [--spp N] --out FILE [render options]\n"
     "  mcplay --help | --version\n"
     "\n"
     "SCENE is a scene JSON file, or the name of one in the scenes directory\n"
@@ -45,6 +48,16 @@ const char* kUsage =
     "  --format F           table (default), json or csv\n"
     "  --out FILE           write the result to FILE instead of standard output\n"
     "  --quiet              no progress lines on standard error\n"
+    "\n"
+    "render scenes (a scene JSON with a \"render\" object and a glTF file):\n"
+    "  run studies relative MSE against spp (--n-min/--n-max are spp) against a reference\n"
+    "  image, cached in --cache DIR (default $MCPLAY_CACHE, else ~/.cache/mcplay).\n"
+    "  --width W, --height H  image size (default from the scene)\n"
+    "  --cache DIR | --no-cache  where high-spp references are kept\n"
+    "  render writes one image: --out FILE (.png tone-mapped sRGB, .hdr linear Radiance),\n"
+    "  --error-out FILE (false-colour relative error against the reference, PNG),\n"
+    "  --estimator NAME (default the scene's first), --spp N (default the scene's spp_max),\n"
+    "  --seed S, --threads T, --format json (print the result JSON instead of a summary)\n"
     "\n"
     "exit codes: 0 ok, 1 runtime error, 2 bad arguments, 3 bad scene\n";
 
@@ -77,6 +90,73 @@ std::string scenes_dir(const std::string& given) {
     if (!given.empty()) return given;
     if (const char* env = std::getenv("MCPLAY_SCENES"); env && *env) return env;
     return "scenes";
+}
+
+std::string dirname_of(const std::string& path) {
+    size_t slash = path.find_last_of('/');
+    return slash == std::string::npos ? std::string(".") : path.substr(0, slash);
+}
+
+// The reference cache folder: --cache, else $MCPLAY_CACHE, else $HOME/.cache/mcplay
+// (created on demand); "" when none can be made.
+std::string cache_dir(const std::string& given) {
+    std::string dir = given;
+    if (dir.empty()) {
+        if (const char* env = std::getenv("MCPLAY_CACHE"); env && *env) dir = env;
+        else if (const char* home = std::getenv("HOME"); home && *home)
+            dir = std::string(home) + "/.cache/mcplay";
+        else
+            return "";
+    }
+    std::string partial;
+    std::stringstream ss(dir);
+    std::string part;
+    if (!dir.empty() && dir[0] == '/') partial = "";
+    while (std::getline(ss, part, '/')) {
+        if (part.empty()) continue;
+        partial += (partial.empty() && dir[0] != '/' ? "" : "/") + part;
+        mkdir(partial.c_str(), 0755);
+    }
+    return dir;
+}
+
+bool is_render_scene_text(const std::string& text) {
+    nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
+    return !j.is_discarded() && j.is_object() && j.contains("render");
+}
+
+std::string base64_decode(const std::string& in) {
+    std::string out;
+    uint32_t buf = 0;
+    int bits = 0;
+    for (char c : in) {
+        int v = c >= 'A' && c <= 'Z'   ? c - 'A'
+                : c >= 'a' && c <= 'z' ? c - 'a' + 26
+                : c >= '0' && c <= '9' ? c - '0' + 52
+                : c == '+'             ? 62
+                : c == '/'             ? 63
+                                       : -1;
+        if (v < 0) continue;
+        buf = (buf << 6) | uint32_t(v);
+        bits += 6;
+        if (bits >= 8) {
+            bits -= 8;
+            out += char((buf >> bits) & 0xff);
+        }
+    }
+    return out;
+}
+
+bool write_file(const std::string& path, const std::string& bytes) {
+    std::ofstream out(path, std::ios::binary);
+    out << bytes;
+    return bool(out);
+}
+
+// Finds a scene: a path, or a name in the scenes directory.
+std::string scene_path(const std::string& arg, const std::string& dir_arg) {
+    if (is_regular_file(arg)) return arg;
+    return scenes_dir(dir_arg) + "/" + arg + ".json";
 }
 
 // Strict whole-number parsing: digits only, no sign, no trailing text, no overflow.
@@ -124,6 +204,24 @@ int cmd_list(const std::vector<std::string>& args) {
             std::printf("  %-28s (unreadable)\n", f.c_str());
             continue;
         }
+        if (is_render_scene_text(text)) {
+            nlohmann::json o{{"base_dir", dir}};
+            if (mcp_render_scene_info(text.c_str(), o.dump().c_str(), &info) != MCP_OK) {
+                std::printf("  %-28s INVALID: %s\n", f.c_str(), mcp_last_error());
+                continue;
+            }
+            nlohmann::json j = nlohmann::json::parse(info);
+            mcp_free(info);
+            std::string ests;
+            for (auto& e : j["estimators"])
+                ests += (ests.empty() ? "" : ", ") + e["name"].get<std::string>();
+            std::printf("  %-28s render, %d triangles, %d light triangle(s)\n  %-28s %s\n"
+                        "  %-28s estimators: %s\n",
+                        f.substr(0, f.size() - 5).c_str(), j["triangles"].get<int>(),
+                        j["lights"].get<int>(), "", j["description"].get<std::string>().c_str(),
+                        "", ests.c_str());
+            continue;
+        }
         if (mcp_scene_info(text.c_str(), &info) != MCP_OK) {
             std::printf("  %-28s INVALID: %s\n", f.c_str(), mcp_last_error());
             continue;
@@ -166,8 +264,8 @@ int progress_line(const char* level_json, void*) {
 }
 
 int cmd_run(const std::vector<std::string>& args) {
-    std::string scene_arg, format = "table", out_path, dir_arg;
-    bool quiet = false;
+    std::string scene_arg, format = "table", out_path, dir_arg, cache_arg;
+    bool quiet = false, no_cache = false;
     nlohmann::json options = nlohmann::json::object();
     for (size_t i = 0; i < args.size(); ++i) {
         const std::string& a = args[i];
@@ -198,6 +296,15 @@ int cmd_run(const std::vector<std::string>& args) {
             std::string key = a.substr(2);
             std::replace(key.begin(), key.end(), '-', '_');
             options[key] = x;
+        } else if (a == "--width" || a == "--height") {
+            if (!value(&v)) return usage_error(a + " needs a value");
+            unsigned long long x = 0;
+            if (!parse_count(v, &x)) return usage_error(a + ": expected a whole number, got '" + v + "'");
+            options[a.substr(2)] = x;
+        } else if (a == "--cache") {
+            if (!value(&cache_arg)) return usage_error("--cache needs a directory");
+        } else if (a == "--no-cache") {
+            no_cache = true;
         } else if (a == "--format") {
             if (!value(&v)) return usage_error("--format needs table, json or csv");
             if (v != "table" && v != "json" && v != "csv")
@@ -221,8 +328,7 @@ int cmd_run(const std::vector<std::string>& args) {
     }
     if (scene_arg.empty()) return usage_error("run needs a scene file or name");
 
-    std::string path = scene_arg;
-    if (!is_regular_file(path)) path = scenes_dir(dir_arg) + "/" + scene_arg + ".json";
+    std::string path = scene_path(scene_arg, dir_arg);
     std::string text;
     if (!is_regular_file(path) || !read_file(path, &text)) {
         std::fprintf(stderr, "mcplay: no scene file '%s' (nor '%s')\n", scene_arg.c_str(),
@@ -232,9 +338,29 @@ int cmd_run(const std::vector<std::string>& args) {
 
     const bool show_progress = !quiet && isatty(fileno(stderr));
     char* result = nullptr;
-    const std::string opts = options.dump();
-    int status = mcp_study_run(text.c_str(), opts.c_str(), show_progress ? progress_line : nullptr,
+    int status;
+    if (is_render_scene_text(text)) {
+        // Render studies: N is samples per pixel.
+        for (const char* k : {"n_min", "n_max"})
+            if (options.contains(k)) {
+                options[std::string("spp_") + (k + 2)] = options[k];
+                options.erase(k);
+            }
+        options["base_dir"] = dirname_of(path);
+        if (!no_cache) {
+            std::string dir = cache_dir(cache_arg);
+            if (!dir.empty()) options["cache_dir"] = dir;
+        }
+        const std::string opts = options.dump();
+        status = mcp_render_study_run(text.c_str(), opts.c_str(),
+                                      show_progress ? progress_line : nullptr, nullptr, &result);
+    } else {
+        if (options.contains("width") || options.contains("height") || !cache_arg.empty())
+            return usage_error("--width, --height and --cache are for render scenes");
+        const std::string opts = options.dump();
+        status = mcp_study_run(text.c_str(), opts.c_str(), show_progress ? progress_line : nullptr,
                                nullptr, &result);
+    }
     if (status != MCP_OK && status != MCP_ERROR_CANCELLED) {
         std::fprintf(stderr, "mcplay: %s: %s\n", path.c_str(), mcp_last_error());
         return status == MCP_ERROR_SCENE ? kExitScene : kExitUsage;
@@ -259,6 +385,123 @@ int cmd_run(const std::vector<std::string>& args) {
     }
     mcp_free(formatted);
     return status == MCP_ERROR_CANCELLED ? kExitRuntime : rc;
+}
+
+int cmd_render(const std::vector<std::string>& args) {
+    std::string scene_arg, out_path, error_path, dir_arg, cache_arg, format = "summary";
+    bool no_cache = false;
+    nlohmann::json options = nlohmann::json::object();
+    for (size_t i = 0; i < args.size(); ++i) {
+        const std::string& a = args[i];
+        std::string v;
+        auto value = [&](std::string* out) {
+            if (i + 1 >= args.size() || args[i + 1].rfind("--", 0) == 0) return false;
+            *out = args[++i];
+            return true;
+        };
+        if (a == "--spp" || a == "--width" || a == "--height" || a == "--seed" ||
+            a == "--threads") {
+            if (!value(&v)) return usage_error(a + " needs a value");
+            unsigned long long x = 0;
+            if (!parse_count(v, &x)) return usage_error(a + ": expected a whole number, got '" + v + "'");
+            options[a.substr(2)] = x;
+        } else if (a == "--estimator") {
+            if (!value(&v)) return usage_error("--estimator needs a name");
+            options["estimator"] = v;
+        } else if (a == "--out") {
+            if (!value(&out_path)) return usage_error("--out needs a file name");
+        } else if (a == "--error-out") {
+            if (!value(&error_path)) return usage_error("--error-out needs a file name");
+        } else if (a == "--scenes") {
+            if (!value(&dir_arg)) return usage_error("--scenes needs a directory");
+        } else if (a == "--cache") {
+            if (!value(&cache_arg)) return usage_error("--cache needs a directory");
+        } else if (a == "--no-cache") {
+            no_cache = true;
+        } else if (a == "--format") {
+            if (!value(&format) || (format != "json" && format != "summary"))
+                return usage_error("--format: expected json or summary");
+        } else if (a.rfind("-", 0) == 0) {
+            return usage_error("unknown option '" + a + "'");
+        } else if (scene_arg.empty()) {
+            scene_arg = a;
+        } else {
+            return usage_error("render takes one scene, got '" + scene_arg + "' and '" + a + "'");
+        }
+    }
+    if (scene_arg.empty()) return usage_error("render needs a scene file or name");
+    if (out_path.empty() && error_path.empty() && format != "json")
+        return usage_error("render needs --out FILE (.png or .hdr) or --error-out FILE");
+    auto ends_with = [](const std::string& s, const char* suffix) {
+        size_t n = std::strlen(suffix);
+        return s.size() >= n && s.compare(s.size() - n, n, suffix) == 0;
+    };
+    nlohmann::json outputs = nlohmann::json::array();
+    if (!out_path.empty()) {
+        if (ends_with(out_path, ".png")) outputs.push_back("png");
+        else if (ends_with(out_path, ".hdr")) outputs.push_back("hdr");
+        else return usage_error("--out: the file name must end in .png or .hdr");
+    }
+    if (!error_path.empty()) {
+        if (!ends_with(error_path, ".png")) return usage_error("--error-out: must be a .png file");
+        outputs.push_back("error_png");
+    }
+    options["outputs"] = outputs;
+    std::string path = scene_path(scene_arg, dir_arg), text;
+    if (!is_regular_file(path) || !read_file(path, &text)) {
+        std::fprintf(stderr, "mcplay: no scene file '%s' (nor '%s')\n", scene_arg.c_str(),
+                     path.c_str());
+        return kExitScene;
+    }
+    options["base_dir"] = dirname_of(path);
+    if (!no_cache) {
+        std::string dir = cache_dir(cache_arg);
+        if (!dir.empty()) options["cache_dir"] = dir;
+    }
+    char* result = nullptr;
+    int status = mcp_render_image(text.c_str(), options.dump().c_str(), &result);
+    if (status != MCP_OK) {
+        std::fprintf(stderr, "mcplay: %s: %s\n", path.c_str(), mcp_last_error());
+        return status == MCP_ERROR_SCENE ? kExitScene : kExitUsage;
+    }
+    nlohmann::json j = nlohmann::json::parse(result, nullptr, false);
+    mcp_free(result);
+    if (j.is_discarded()) return kExitRuntime;
+    const nlohmann::json& images = j["images"];
+    if (!out_path.empty()) {
+        const char* key = ends_with(out_path, ".png") ? "png" : "hdr";
+        if (!write_file(out_path, base64_decode(images[key].get<std::string>()))) {
+            std::fprintf(stderr, "mcplay: cannot write '%s'\n", out_path.c_str());
+            return kExitRuntime;
+        }
+    }
+    if (!error_path.empty() &&
+        !write_file(error_path, base64_decode(images["error_png"].get<std::string>()))) {
+        std::fprintf(stderr, "mcplay: cannot write '%s'\n", error_path.c_str());
+        return kExitRuntime;
+    }
+    if (format == "json") {
+        j.erase("images");
+        std::printf("%s\n", j.dump(2).c_str());
+        return kExitOk;
+    }
+    std::printf("%s: %s at %s spp, %dx%d, %.3f s, %.3g rays/s\n",
+                j["scene"]["name"].get<std::string>().c_str(),
+                j["estimator"]["name"].get<std::string>().c_str(), j["spp"].dump().c_str(),
+                j["scene"]["width"].get<int>(), j["scene"]["height"].get<int>(),
+                j["seconds"].is_number() ? j["seconds"].get<double>() : 0.0,
+                j["rays_per_second"].is_number() ? j["rays_per_second"].get<double>() : 0.0);
+    if (j.contains("relative_mse"))
+        std::printf("relative MSE against the reference: %s, pixel 95%% coverage %s\n",
+                    j["relative_mse"].dump().c_str(), j["pixel_coverage95"].dump().c_str());
+    const auto& d = j["diagnostics"];
+    std::printf("samples %s, discarded (NaN/Inf) %s, rays %s\n", d["samples"].dump().c_str(),
+                d["discarded_nonfinite"].dump().c_str(), d["rays"].dump().c_str());
+    for (const auto& w : j["warnings"])
+        std::printf("WARNING: %s\n", w["message"].get<std::string>().c_str());
+    for (const auto& w : j["scene"]["warnings"])
+        std::printf("NOTE: %s\n", w["message"].get<std::string>().c_str());
+    return kExitOk;
 }
 
 } // namespace
@@ -286,5 +529,6 @@ int main(int argc, char** argv) {
         }
     if (cmd == "list") return cmd_list(rest);
     if (cmd == "run") return cmd_run(rest);
+    if (cmd == "render") return cmd_render(rest);
     return usage_error("unknown command '" + cmd + "'");
 }

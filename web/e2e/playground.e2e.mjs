@@ -1,7 +1,9 @@
 // End-to-end test of the playground in headless Chromium (Debian's chromium, driven by
 // playwright-core). Usage: node web/e2e/playground.e2e.mjs SITE_DIR NATIVE_MCPLAY SHOT_DIR
 // Serves SITE_DIR on a loopback port, runs a study in the page and checks it against the
-// native CLI, checks the inline expression error and Cancel, and saves screenshots.
+// native CLI, checks the inline expression error and Cancel, checks that none of that
+// downloads the render module, then runs a small render study (quad_light_floor) and checks its
+// fitted orders against the CLI and its images; saves screenshots.
 import { spawn, execFileSync } from 'node:child_process';
 import { mkdtempSync, mkdirSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
@@ -20,6 +22,7 @@ const port = 20000 + Math.floor(Math.random() * 20000);
 const url = `http://127.0.0.1:${port}/`;
 
 let server, context, page, profile;
+const requested = []; // every URL the page and its workers asked for
 
 async function waitForServer() {
   for (let i = 0; i < 100; ++i) {
@@ -47,6 +50,8 @@ before(async () => {
       '--disable-background-networking', '--disable-component-update', '--disable-sync'],
     viewport: { width: 1400, height: 1000 },
   });
+  // The context sees the requests of the page and of its workers (the wasm glue runs there).
+  context.on('request', (r) => requested.push(r.url()));
   page = context.pages()[0] ?? (await context.newPage());
   page.on('pageerror', (e) => console.error('page error:', e.message));
   await page.goto(url);
@@ -70,8 +75,16 @@ function cliFits(scene, estimators, settings) {
 }
 
 async function configure(scene, estimators, settings) {
+  const before = await page.evaluate(() => window.mcplayDebug.state().sceneInfo?.name);
   await page.selectOption('#scene', scene); // option values are scene names
   await page.waitForSelector(`input[data-estimator="${estimators[0]}"]`, { state: 'attached' });
+  if (before !== scene) {
+    // the core's answer about the scene (it may bring the scene's own image size)
+    await page.waitForFunction((name) => {
+      const s = window.mcplayDebug.state();
+      return s.sceneInfo?.name === name && !s.sceneInfo.provisional;
+    }, scene, { timeout: 20000 });
+  }
   for (const box of await page.$$('input[type=checkbox][data-estimator]')) {
     const name = await box.getAttribute('data-estimator');
     if ((await box.isChecked()) !== estimators.includes(name)) await box.click();
@@ -80,6 +93,8 @@ async function configure(scene, estimators, settings) {
   await page.fill('#n-max', String(settings.nMax));
   await page.fill('#reps', String(settings.reps));
   await page.fill('#seed', String(settings.seed));
+  if (settings.width) await page.fill('#width', String(settings.width));
+  if (settings.height) await page.fill('#height', String(settings.height));
 }
 
 test('a study in the page plots every level and agrees with the CLI', async () => {
@@ -164,4 +179,66 @@ test('Cancel stops a long run promptly', async () => {
     { timeout: 5000 });
   console.log(`# cancel took effect after ${Date.now() - t0} ms`);
   await page.screenshot({ path: join(shots, 'cancelled.png') });
+});
+
+test('the integration page never downloads the render module', () => {
+  // A control that the list holds the workers' requests: the integration module itself.
+  assert.ok(requested.some((u) => u.endsWith('/mcplay_web.wasm')), `mcplay_web.wasm not among ${requested.length} requests`);
+  const render = requested.filter((u) => /mcplay_render_web|render_core\.js/.test(u));
+  assert.deepEqual(render, [], 'integration scenes must not load the renderer');
+});
+
+// The native CLI's result of a render study (no reference cache: it renders the reference).
+function cliRender(scene, estimators, s) {
+  const out = execFileSync(native, ['run', join('scenes', `${scene}.json`), '--estimators', estimators.join(','),
+    '--n-min', String(s.nMin), '--n-max', String(s.nMax), '--reps', String(s.reps), '--seed', String(s.seed),
+    '--width', String(s.width), '--height', String(s.height), '--no-cache', '--format', 'json', '--quiet'],
+  { encoding: 'utf8', maxBuffer: 64 << 20 });
+  return JSON.parse(out);
+}
+
+test('a render scene: relative MSE against spp, fitted orders as the CLI, and the images', async () => {
+  const settings = { nMin: 1, nMax: 8, reps: 4, seed: 1, width: 16, height: 16 };
+  const estimators = ['bsdf', 'light_area', 'mis_power'];
+  await configure('quad_light_floor', estimators, settings);
+  // render scenes hide the integration-only panels
+  assert.equal(await page.isVisible('#custom'), false, 'the custom problem is shown for a render scene');
+  assert.equal(await page.isVisible('#samples-section'), false, 'sample points are shown for a render scene');
+  assert.equal(await page.isVisible('#render-images-section'), true);
+  const t0 = Date.now();
+  await page.click('#run');
+  await page.waitForFunction(() => document.querySelector('#status')?.textContent.startsWith('done'), null,
+    { timeout: 60000 });
+  console.log(`# render study finished in the page in ${Date.now() - t0} ms`);
+  assert.ok(requested.some((u) => u.endsWith('/mcplay_render_web.wasm')), 'the render module was not loaded');
+
+  const state = await page.evaluate(() => window.mcplayDebug.state());
+  assert.equal(state.kind, 'render');
+  assert.equal(state.run.nName, 'spp');
+  assert.equal(state.run.errorName, 'relative_mse');
+  assert.deepEqual(state.run.settings, { n_min: 1, n_max: 8, reps: 4, seed: 1, width: 16, height: 16 });
+  assert.match(state.query, /scene=quad_light_floor&estimators=bsdf,light_area,mis_power&n_min=1&n_max=8&reps=4&seed=1&width=16&height=16/);
+  assert.match(await page.textContent('#variance-title'), /Relative MSE against spp/);
+  const cli = cliRender('quad_light_floor', estimators, settings);
+  for (const name of estimators) {
+    const est = state.estimators.find((e) => e.name === name);
+    assert.ok(est, `no series for ${name}`);
+    assert.deepEqual(est.levels.map((l) => l.n), [1, 2, 4, 8]);
+    const text = await page.textContent(`[data-fit="${name}"]`);
+    const shown = Number(text.match(/-?\d+\.\d{3}/)?.[0]);
+    assert.ok(Number.isFinite(shown), `${name}: no fitted order in "${text}"`);
+    const native = cli.estimators.find((e) => e.name === name);
+    // wasm and native share the code; their libm may differ in the last bit of a sin or cos
+    assert.ok(Math.abs(shown - native.fit.order) <= 0.0015, `${name}: page ${shown} vs CLI ${native.fit.order}`);
+    const images = state.images.estimators[name];
+    assert.deepEqual(images, { preview: true, error: true, n: 8 });
+  }
+  // every image decoded at the study's size, the reference too
+  const sizes = await page.$$eval('#render-images img', (imgs) => imgs.map((i) => ({
+    role: i.dataset.role, name: i.dataset.estimator, w: i.naturalWidth, h: i.naturalHeight, drawn: i.dataset.drawn,
+  })));
+  assert.equal(sizes.length, 1 + 2 * estimators.length);
+  for (const im of sizes) assert.deepEqual([im.drawn, im.w, im.h], ['true', 16, 16], JSON.stringify(im));
+  assert.equal(state.images.reference, true);
+  await page.screenshot({ path: join(shots, 'render_quad_light_floor.png'), fullPage: true });
 });

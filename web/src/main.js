@@ -7,15 +7,22 @@
 // estimators (options.estimators); every estimator has its own random streams, so the split
 // changes no number, and the parts are merged (series.mergeResults). Cancel terminates the run
 // workers and starts new ones.
+//
+// Render scenes (a "render" object; state.kindOf) go the same way: the workers hand them to the
+// render core, which they import only then (so a page showing integrals never downloads
+// mcplay_render_web.wasm); each run worker renders the same reference, its estimators' images
+// and their PNGs (options.previews), shown by images.js as the levels come in.
 import {
   createStore, reducer, initialState, queryToState, stateToQuery, sceneDefaults, runBlocker,
-  debugSnapshot, buildCustomScene, customError, CUSTOM, WEIGHT_SAMPLES,
+  debugSnapshot, buildCustomScene, customError, CUSTOM, WEIGHT_SAMPLES, KIND, kindOf, normalizeInfo,
+  runSettings, studyOptions,
 } from './state.js';
 import { splitEstimators, partialResult } from './series.js';
 import { CoreWorker } from './client.js';
 import { MSG } from './protocol.js';
 import { initPlots, renderPlots, plotPng } from './plot.js';
 import { renderReport } from './report.js';
+import { renderImages } from './images.js';
 import { mountControls, syncControls } from './ui/controls.js';
 import { mountCustom, syncCustom } from './ui/custom.js';
 import { mountExports, syncExports } from './ui/exports.js';
@@ -38,6 +45,7 @@ let urlReady = false; // the URL is written only once the first scene is in
 // Views
 
 const reportDom = { diagnostics: $('diagnostics'), diagnosticsEmpty: $('diagnostics-empty'), levels: $('levels') };
+const imagesDom = { images: $('render-images') };
 initPlots({
   variance: $('plot-variance'), time: $('plot-time'), calibration: $('plot-calibration'), coverage: $('plot-coverage'),
   'legend-variance': $('legend-variance'), 'legend-time': $('legend-time'),
@@ -63,6 +71,7 @@ function renderHeavy() {
   try {
     renderPlots(s);
     renderReport(s, reportDom);
+    renderImages(s, imagesDom);
   } catch (e) {
     console.error('render failed', e);
   }
@@ -144,6 +153,7 @@ let samplesTimer = null;
 
 function samplesKeys(state) {
   if (!state.scene || !state.selected.length || state.paramErrors.seed) return null;
+  if (kindOf(state.sceneInfo) === KIND.RENDER) return null; // no sample points of a render
   const base = [sceneSerial, state.selected, state.params.seed];
   return { key: JSON.stringify([...base, state.samples.n]), weightsKey: JSON.stringify(base) };
 }
@@ -215,7 +225,7 @@ async function loadScene(sceneId, fromUrl = null) {
   }
   try {
     const scene = await fetchScene(entry);
-    const { info } = await service.request(MSG.VALIDATE, { scene });
+    const info = normalizeInfo((await service.request(MSG.VALIDATE, { scene })).info);
     if (token !== sceneToken) return false;
     dispatch({
       type: 'scene/loaded',
@@ -231,12 +241,46 @@ async function loadScene(sceneId, fromUrl = null) {
 function paramsFromUrl(fromUrl, info) {
   // The URL's values where it had them, else the scene's own (capped) range.
   const base = sceneDefaults(info);
-  const q = queryToState(fromUrl.search, { ...base, estimators: null });
+  const kind = kindOf(info);
+  const q = queryToState(fromUrl.search, { ...base, estimators: null }, kind);
   return {
     selected: q.estimators,
-    params: { n_min: q.n_min, n_max: q.n_max, reps: q.reps, seed: q.seed },
+    params: {
+      n_min: q.n_min, n_max: q.n_max, reps: q.reps, seed: q.seed,
+      ...(kind === KIND.RENDER ? { width: q.width, height: q.height } : {}),
+    },
   };
 }
+
+// ---------------------------------------------------------------------------------------------
+// Render scenes: a quick image of the scene once it is loaded (the service worker, the first
+// estimator at a few spp and the chosen size), and the run workers import the render module
+// while the reader looks at it.
+
+const PREVIEW_SPP = 16;
+let previewSerial = 0;
+
+function requestScenePreview(state) {
+  if (kindOf(state.sceneInfo) !== KIND.RENDER || !state.scene || !service) return;
+  const key = ++previewSerial;
+  // The estimator the scene's reference is rendered with (the least noisy of its kind).
+  const ref = state.sceneInfo.reference && state.sceneInfo.reference.estimator;
+  const estimator = ref && typeof ref === 'object' ? ref : state.sceneInfo.estimators[0];
+  const label = ref && typeof ref === 'object' ? `${ref.strategy} (the reference's estimator)` : String(estimator || '');
+  const { width, height } = state.params;
+  const options = { spp: PREVIEW_SPP, outputs: ['png'], ...(estimator ? { estimator } : {}),
+    ...(Number.isSafeInteger(width) ? { width } : {}), ...(Number.isSafeInteger(height) ? { height } : {}) };
+  dispatch({ type: 'preview/request', payload: { key } });
+  service.request(MSG.IMAGE, { scene: state.scene, options })
+    .then(({ image }) => dispatch({ type: 'preview/loaded', payload: { key, png: image.images.png, spp: PREVIEW_SPP, estimator: label, seconds: image.seconds } }))
+    .catch((e) => dispatch({ type: 'preview/failed', payload: { key, message: e && e.message ? e.message : String(e) } }));
+  const k = Math.min(CORES, state.sceneInfo.estimators.length || 1);
+  for (const w of runnersFor(k)) w.request(MSG.VALIDATE, { scene: state.scene }).catch(() => {});
+}
+
+store.subscribe((state, action) => {
+  if (action.type === 'scene/loaded') requestScenePreview(state);
+});
 
 /** Builds the custom scene from f and p and has the core validate it (in the worker). */
 async function applyCustom(fromUrl = null) {
@@ -276,15 +320,17 @@ function startRun() {
   const groups = splitEstimators(names, CORES);
   const workers = runnersFor(groups.length);
   const id = s.run.id + 1;
-  const settings = { ...s.params };
+  const kind = kindOf(s.sceneInfo);
+  const settings = runSettings(s);
   dispatch({
     type: 'run/start',
     payload: {
       id,
+      kind,
       workers: groups.length,
       settings,
       order: names,
-      exact: s.sceneInfo.exact ?? null,
+      exact: kind === KIND.RENDER ? null : s.sceneInfo.exact ?? null,
       sceneName: s.sceneInfo.name,
       colors: Object.fromEntries(s.sceneInfo.estimators.map((n, i) => [n, i])),
       startedAt: performance.now(),
@@ -295,7 +341,7 @@ function startRun() {
   // compete with the first, shortest levels, whose timings are the most fragile.
   renderHeavy();
   groups.forEach((group, i) => {
-    workers[i].request(MSG.RUN, { scene: s.scene, options: { ...settings, estimators: group }, warmup: true }, (type, payload) => {
+    workers[i].request(MSG.RUN, { scene: s.scene, options: studyOptions(kind, settings, group), warmup: true }, (type, payload) => {
       if (type === MSG.LEVEL) dispatch({ type: 'run/level', payload: { id, level: payload.level } });
     }).then(({ result }) => {
       dispatch({ type: 'run/partial', payload: { id, result, now: performance.now() } });
@@ -326,6 +372,9 @@ function fileStem(s) {
   const r = s.run;
   const st = r.settings || s.params;
   const scene = String(r.sceneName || s.sceneId || 'scene').replace(/[^\w.-]+/g, '_');
+  if (r.kind === KIND.RENDER) {
+    return `mcplay-${scene}-spp${st.n_min}-${st.n_max}-R${st.reps}-seed${st.seed}-${st.width}x${st.height}`;
+  }
   return `mcplay-${scene}-N${st.n_min}-${st.n_max}-R${st.reps}-seed${st.seed}`;
 }
 

@@ -209,12 +209,54 @@ function colorOf(run, name) {
   return colorAt(run.colors && name in run.colors ? run.colors[name] : run.order.indexOf(name));
 }
 
+const isRender = (run) => run.kind === 'render';
+
+const VARIANCE_NOTE = {
+  integral: 'Shaded: 95% interval of the variance (chi-square); dashed grey: reference slopes N⁻¹, N⁻², N⁻³ from the first point. Order = the core\'s least-squares fit of log variance on log N.',
+  render: 'Relative MSE of each estimator\'s images against the reference (mean over the replicates; shaded: its 95% interval from their spread); dashed grey: the reference slope spp⁻¹ of an unbiased estimator, from the first point. Order = the core\'s least-squares fit of log relative MSE on log spp.',
+};
+const COVERAGE_NOTE = {
+  integral: 'Share of replicates whose own 95% interval holds the exact value; grey: 0.95 and its binomial 95% band for the number of replicates.',
+  render: 'Share of the pixels (and colour channels) whose own 95% error bar covers the reference pixel, averaged over the replicates; grey: 0.95. At 1 spp a pixel has no error bar.',
+};
+
+function setText(id, text) {
+  const e = document.getElementById(id);
+  if (e && e.textContent !== text) e.textContent = text;
+}
+
+/** The titles and notes of the plots before a run, for the kind of scene shown. */
+function emptyTexts(render) {
+  setText('variance-title', render ? 'Relative MSE against spp' : 'Variance against N');
+  setText('variance-note', VARIANCE_NOTE[render ? 'render' : 'integral']);
+  setText('time-title', render ? 'Error against time per image' : 'Error against run time');
+  setText('coverage-note', COVERAGE_NOTE[render ? 'render' : 'integral']);
+}
+
+/** Axis and text names of a run: what N is (settings.n_name) and what the error is
+ *  (settings.error_name), e.g. spp and relative MSE for render studies. */
+export function runLabels(run) {
+  const nName = run.nName || 'N';
+  const spp = nName === 'spp';
+  const error = run.errorName || 'variance';
+  const readable = { relative_mse: 'relative MSE', mse: 'MSE', variance: 'variance' }[error] || error.replace(/_/g, ' ');
+  return {
+    n: nName,
+    nAxis: spp ? 'spp [samples per pixel]' : `${nName} [samples]`,
+    error: readable,
+    errorAxis: error === 'relative_mse' ? 'relative MSE against the reference' : null,
+    rootAxis: error === 'relative_mse' ? 'relative RMSE (√ relative MSE)' : null,
+    timeAxis: spp ? 'wall time per image [seconds]' : 'wall time per estimate [seconds]',
+  };
+}
+
 /** Draws everything of state.run. */
 export function renderPlots(state) {
   if (!dom) return;
   renderSampleViews(state);
   const run = state.run;
   if (!run.order.length) {
+    emptyTexts(state.sceneInfo && state.sceneInfo.kind === 'render');
     for (const k of ['variance', 'time', 'calibration', 'coverage']) {
       drop(k);
       if (!dom[k].querySelector('.empty')) empty(dom[k], 'Press Run to start a study.');
@@ -232,9 +274,13 @@ export function renderPlots(state) {
 }
 
 function renderVariance(state, run, records) {
-  const vs = varianceSeries(records, run.order, run.exact, run.ladder);
+  const render = isRender(run);
+  const names = runLabels(run);
+  // A render level's variance is its relative MSE against the reference (mse is the same number).
+  const vs = varianceSeries(records, run.order, render ? null : run.exact, run.ladder);
   const anchor = anchorOf(vs.x, vs.series);
-  const refs = referenceLines(vs.x, anchor);
+  const orders = render ? [1] : [1, 2, 3];
+  const refs = referenceLines(vs.x, anchor, orders);
   const data = [vs.x];
   const series = [{}];
   const bands = [];
@@ -252,7 +298,7 @@ function renderVariance(state, run, records) {
   // Three reference series always (all null until there is a first point), so the chart keeps
   // its series while the levels stream in.
   const refItems = [];
-  ['N⁻¹', 'N⁻²', 'N⁻³'].forEach((label, i) => {
+  orders.map((k) => `${render ? 'spp' : 'N'}${sup(-k)}`).forEach((label, i) => {
     refItems.push({ idx: data.length, label });
     data.push(refs[i] ? lgAll(refs[i].y) : vs.x.map(() => null));
     series.push({ label, stroke: '#8a8f96', width: 1, dash: [6, 5], points: { show: false } });
@@ -260,14 +306,19 @@ function renderVariance(state, run, records) {
   const values = vs.series.flatMap((s) => [...s.y, ...s.lo, ...s.hi]);
   const yRange = log10Range(values);
   const xRange = vs.x.length > 1 ? [vs.x[0], vs.x[vs.x.length - 1]] : [vs.x[0] / 2, vs.x[0] * 2];
-  const quantity = vs.quantity === 'mse' ? 'MSE of the estimate' : 'variance of the estimate';
+  const quantity = render ? names.errorAxis || names.error
+    : vs.quantity === 'mse' ? 'MSE of the estimate' : 'variance of the estimate';
   const title = document.getElementById('variance-title');
-  if (title) title.textContent = vs.quantity === 'mse' ? 'MSE against N (exact value known)' : 'Variance against N';
-  const sig = JSON.stringify([vs.quantity, run.order, run.colors]);
+  if (title) {
+    title.textContent = render ? `${names.error[0].toUpperCase()}${names.error.slice(1)} against ${names.n}`
+      : vs.quantity === 'mse' ? 'MSE against N (exact value known)' : 'Variance against N';
+  }
+  setText('variance-note', VARIANCE_NOTE[render ? 'render' : 'integral']);
+  const sig = JSON.stringify([vs.quantity, run.order, run.colors, run.kind, names.nAxis, quantity]);
   draw('variance', dom.variance, sig, (c) => ({
     scales: { x: logX(c, 2), y: log10Y(c) },
     axes: [
-      { ...AXIS, label: 'N [samples]', values: nTicks, space: 30 },
+      { ...AXIS, label: names.nAxis, values: nTicks, space: 30 },
       { ...AXIS, ...LOG10_AXIS, label: quantity },
     ],
     series,
@@ -282,7 +333,7 @@ function renderVariance(state, run, records) {
       name: s.name,
       color: colorOf(run, s.name),
       parts: [
-        vs.quantity === 'mse' ? 'order of variance' : 'order',
+        render ? `order of ${names.error}` : vs.quantity === 'mse' ? 'order of variance' : 'order',
         { fit: fitText(r.fit), name: s.name },
         ...(r.warnings || []).map((w) => ({ warning: w })),
       ],
@@ -325,10 +376,15 @@ function renderTime(state, run, records) {
     return { label: s.name, stroke: color, width: 2, paths: noLine, points: { show: true, size: 7, fill: color } };
   })];
   const lines = ts.series.map((s) => ({ color: colorOf(run, s.name), points: s.points.map(([t, e]) => [t, lg(e)]) }));
-  const known = run.exact !== null && run.exact !== undefined;
+  const render = isRender(run);
+  const names = runLabels(run);
+  const known = render || (run.exact !== null && run.exact !== undefined);
   const xRange = decadeRange(ts.x, [1e-6, 1]);
   const yRange = log10Range(ts.series.flatMap((s) => s.y));
-  const sig = JSON.stringify([run.order, run.colors, known]);
+  const yLabel = render ? names.rootAxis || names.error : known ? 'RMSE (error against the exact value)' : 'error = sqrt(variance)';
+  const sig = JSON.stringify([run.order, run.colors, known, yLabel, names.timeAxis]);
+  const title = document.getElementById('time-title');
+  if (title) title.textContent = render ? 'Error against time per image' : 'Error against run time';
   if (!ts.x.length) {
     drop('time');
     empty(dom.time, run.status === 'running' ? 'Waiting for the first N…' : 'No timings.');
@@ -336,8 +392,8 @@ function renderTime(state, run, records) {
     draw('time', dom.time, sig, (c) => ({
       scales: { x: logX(c, 10), y: log10Y(c) },
       axes: [
-        { ...AXIS, label: 'wall time per estimate [seconds]', values: (u, splits) => splits.map(decadeLabel), space: 20 },
-        { ...AXIS, ...LOG10_AXIS, label: known ? 'RMSE (error against the exact value)' : 'error = sqrt(variance)' },
+        { ...AXIS, label: names.timeAxis, values: (u, splits) => splits.map(decadeLabel), space: 20 },
+        { ...AXIS, ...LOG10_AXIS, label: yLabel },
       ],
       series,
       cursor: { drag: { x: false, y: false } },
@@ -363,12 +419,15 @@ function renderCalibration(state, run, records) {
     })];
   let ymax = 0.45;
   for (const s of cs.series) for (const v of s.y) if (v !== null && v > ymax) ymax = v;
-  const sig = JSON.stringify([run.order, run.colors]);
+  const render = isRender(run);
   const known = run.exact !== null && run.exact !== undefined;
+  const sig = JSON.stringify([run.order, run.colors, render, known]);
+  const zLabel = render ? 'z = (image mean luminance − mean of replicates) / std. error'
+    : known ? 'z = (estimate − exact) / std. error' : 'z = (estimate − mean of replicates) / std. error';
   draw('calibration', dom.calibration, sig, (c) => ({
     scales: { x: { time: false, range: () => c.xRange }, y: { range: () => c.yRange } },
     axes: [
-      { ...AXIS, label: known ? 'z = (estimate − exact) / std. error' : 'z = (estimate − mean of replicates) / std. error', space: 40 },
+      { ...AXIS, label: zLabel, space: 40 },
       { ...AXIS, label: 'density', size: 52, values: (u, splits) => splits.map((v) => fmt(v, 2)) },
     ],
     series,
@@ -377,7 +436,9 @@ function renderCalibration(state, run, records) {
 
   const note = document.getElementById('calibration-note');
   if (note) {
-    note.textContent = known
+    note.textContent = render
+      ? 'Render studies: z of each image\'s mean luminance against the mean of the level\'s replicates, over its own error bar (from the pixels\' variances; 1 spp gives none). A check of the size of the error bars, not of a bias.'
+      : known
       ? 'Histogram of z = (estimate − exact) / std. error over the replicates, against the standard normal density (black): calibrated error bars follow it; about 95% of z lie within ±1.96.'
       : 'No exact value: z is taken against each N\'s mean of the replicates, which checks the size of the error bars but not a bias.';
   }
@@ -395,9 +456,13 @@ function renderCalibration(state, run, records) {
 }
 
 function renderCoverage(state, run, records) {
+  const render = isRender(run);
+  const names = runLabels(run);
   const cs = coverageSeries(records, run.order, run.ladder);
   const reps = run.settings ? run.settings.reps : 32;
-  const half = 1.96 * Math.sqrt(0.95 * 0.05 / reps);
+  // Render studies: coverage is a share of pixels (not independent of each other): no band.
+  const half = render ? 0 : 1.96 * Math.sqrt(0.95 * 0.05 / reps);
+  setText('coverage-note', COVERAGE_NOTE[render ? 'render' : 'integral']);
   const data = [cs.x, cs.x.map(() => 0.95), cs.x.map(() => Math.min(1, 0.95 + half)), cs.x.map(() => 0.95 - half),
     ...cs.series.map((s) => s.y)];
   const series = [{}, { label: '0.95', stroke: '#8a8f96', width: 1, dash: [6, 5], points: { show: false } },
@@ -410,17 +475,17 @@ function renderCoverage(state, run, records) {
   let ymin = 0.8;
   for (const s of cs.series) for (const v of s.y) if (v !== null && v < ymin) ymin = v;
   ymin = Math.max(0, Math.floor((Math.min(ymin, 0.95 - half) - 0.02) * 10) / 10);
-  const known = run.exact !== null && run.exact !== undefined;
+  const known = render || (run.exact !== null && run.exact !== undefined);
   if (!known) {
     drop('coverage');
     empty(dom.coverage, 'Coverage needs the exact value, which this scene does not know.');
   } else {
     const xRange = cs.x.length > 1 ? [cs.x[0], cs.x[cs.x.length - 1]] : [cs.x[0] / 2, cs.x[0] * 2];
-    draw('coverage', dom.coverage, JSON.stringify([run.order, run.colors, reps]), (c) => ({
+    draw('coverage', dom.coverage, JSON.stringify([run.order, run.colors, reps, render, names.nAxis]), (c) => ({
       scales: { x: logX(c, 2), y: { range: () => c.yRange } },
       axes: [
-        { ...AXIS, label: 'N [samples]', values: nTicks, space: 30 },
-        { ...AXIS, label: 'coverage of the 95% intervals', size: 52, values: (u, splits) => splits.map((v) => fmt(v, 2)) },
+        { ...AXIS, label: names.nAxis, values: nTicks, space: 30 },
+        { ...AXIS, label: render ? 'pixels covered by their 95% error bars' : 'coverage of the 95% intervals', size: 52, values: (u, splits) => splits.map((v) => fmt(v, 2)) },
       ],
       series,
       bands: [{ series: [2, 3], fill: 'rgba(120, 128, 136, 0.15)' }],
@@ -432,7 +497,7 @@ function renderCoverage(state, run, records) {
     return {
       name: s.name,
       color: colorOf(run, s.name),
-      parts: [{ text: last === undefined ? '—' : `${fmt(last, 3)} at the largest N`, className: 'fit' }],
+      parts: [{ text: last === undefined ? '—' : `${fmt(last, 3)} at the largest ${names.n}`, className: 'fit' }],
     };
   }));
 }

@@ -7,10 +7,16 @@
 //   validate {scene}                        validated {info}          (core.sceneInfo)
 //   run      {scene, options, warmup?}      level     {level}  x N    (after each N)
 //                                           result    {result}        (core.runStudy)
+//   image    {scene, options}               imaged    {image}         (render scenes only:
+//                                                                      renderCore.renderImage)
 //   format   {result, format}               formatted {text}          (core.format)
 //   samples  {scene, options, fields?}      sampled   {samples}       (core.samples; `fields`
 //                                                     keeps only those per-estimator arrays)
 //   any request                             error     {status, statusName, message, field?, position?}
+//
+// A render scene (one with a "render" object: isRenderScene) goes to the render core
+// (render_core.js + mcplay_render_web.wasm), which the worker imports on the first such request
+// only; validate and run answer in the same shapes (info and result of the render C API).
 //
 // Cancelling a run is not a message: the page terminates the worker (a study is synchronous, so
 // the worker reads no message until it ends) and starts a new one.
@@ -27,6 +33,8 @@ export const MSG = Object.freeze({
   FORMATTED: 'formatted',
   SAMPLES: 'samples',
   SAMPLED: 'sampled',
+  IMAGE: 'image',
+  IMAGED: 'imaged',
   ERROR: 'error',
 });
 
@@ -37,7 +45,23 @@ export const FINAL_REPLY = Object.freeze({
   [MSG.RUN]: MSG.RESULT,
   [MSG.FORMAT]: MSG.FORMATTED,
   [MSG.SAMPLES]: MSG.SAMPLED,
+  [MSG.IMAGE]: MSG.IMAGED,
 });
+
+/** True for a render scene (an object, or JSON text of one, with a "render" key), the test
+ *  the C API applies (is_render_scene); anything else goes to the integration core. */
+export function isRenderScene(scene) {
+  let s = scene;
+  if (typeof s === 'string') {
+    if (!s.includes('"render"')) return false;
+    try {
+      s = JSON.parse(s);
+    } catch {
+      return false;
+    }
+  }
+  return s !== null && typeof s === 'object' && !Array.isArray(s) && Object.prototype.hasOwnProperty.call(s, 'render');
+}
 
 export function message(id, type, payload = {}) {
   return { id, type, payload };

@@ -31,6 +31,19 @@ const COLUMNS = [
   ['tail', 'tail index', (l) => (l.tail_index === null || l.tail_index === undefined ? '—' : `${fmt(l.tail_index, 3)} (k=${l.tail_k})`)],
 ];
 
+// Render studies: N is spp, the variance a relative MSE against the reference, the mean the
+// image's mean luminance, coverage a share of pixels; no ESS (meaningless pooled over an image).
+const RENDER_LABELS = {
+  n: 'spp', mean: 'mean luminance', variance: 'relative MSE', vci: 'relative MSE 95% CI',
+  error: 'relative RMSE', coverage: 'pixel coverage95', time: 'time/image [s]', share: 'max sample share',
+};
+const RENDER_COLUMNS = COLUMNS.filter(([key]) => key !== 'ess')
+  .map(([key, label, get]) => [key, RENDER_LABELS[key] || label, get]);
+
+function columnsOf(run) {
+  return run.kind === 'render' ? RENDER_COLUMNS : COLUMNS;
+}
+
 
 function badge(w) {
   return el('span', { className: 'badge', title: w.message }, w.code);
@@ -66,6 +79,16 @@ export function renderReport(state, dom) {
   }));
 }
 
+/** A render estimator's strategy and samplers, in a few words. */
+export function renderFacts(r) {
+  const parts = [`strategy ${r.strategy || '?'}`];
+  if (r.light_selection) parts.push(`lights chosen by ${r.light_selection}`);
+  if (r.light_sampling) parts.push(`sampled by ${r.light_sampling.replace('_', ' ')}`);
+  if (r.pixel_sampler) parts.push(`${r.pixel_sampler} pixel samples`);
+  if (r.max_depth) parts.push(`up to ${r.max_depth} bounces`);
+  return parts.join(', ');
+}
+
 function estimatorTable(r, run, isOpen) {
   const last = r.levels[r.levels.length - 1] || null;
   const byItem = {};
@@ -76,26 +99,28 @@ function estimatorTable(r, run, isOpen) {
   const summary = el('summary', {},
     el('span', { className: 'swatch', style: `background: ${color}` }),
     el('strong', {}, r.name), ...flags('name'),
-    el('span', { className: 'muted' }, `${r.sampler || ''}${r.pdf ? `, pdf ${r.pdf}` : ''}`),
+    el('span', { className: 'muted' }, run.kind === 'render' ? renderFacts(r) : `${r.sampler || ''}${r.pdf ? `, pdf ${r.pdf}` : ''}`),
     el('span', {}, 'order ', el('span', { className: 'mono' }, fitText(r.fit))),
     r.consistency ? el('span', {}, `level consistency p = ${fmt(r.consistency.p_value, 3)}`, ...flags('consistency')) : null,
     r.support_check && r.importance ? el('span', {}, `pdf support: ${r.support_check.missed} of ${r.support_check.probes} probes missed`, ...flags('support')) : flags('support').length ? el('span', {}, ...flags('support')) : null,
-    last ? el('span', {}, `tail index at N=${last.n}: ${fmt(last.tail_index, 3)}`, ...flags('tail')) : null,
-    last ? el('span', {}, `ESS at N=${last.n}: ${fmt(last.ess, 3)}`) : null,
+    last ? el('span', {}, `tail index at ${run.kind === 'render' ? 'spp' : 'N'}=${last.n}: ${fmt(last.tail_index, 3)}`, ...flags('tail')) : null,
+    last && run.kind !== 'render' ? el('span', {}, `ESS at N=${last.n}: ${fmt(last.ess, 3)}`) : null,
+    run.kind === 'render' && typeof r.rays_per_second === 'number' ? el('span', {}, `${fmt(r.rays_per_second, 3)} rays/s`) : null,
   );
-  const head = el('tr', {}, ...COLUMNS.map(([, label]) => el('th', { scope: 'col' }, label)));
+  const columns = columnsOf(run);
+  const head = el('tr', {}, ...columns.map(([, label]) => el('th', { scope: 'col' }, label)));
   const rows = [];
   for (const l of r.levels) {
     const flagged = {};
     for (const w of l.warnings || []) (flagged[LEVEL_COLUMN[w.code] || 'n'] ??= []).push(w);
-    rows.push(el('tr', { dataset: { n: String(l.n) } }, ...COLUMNS.map(([key, , get]) => {
+    rows.push(el('tr', { dataset: { n: String(l.n) } }, ...columns.map(([key, , get]) => {
       const ws = flagged[key];
       return el('td', ws ? { className: 'flag', title: ws.map((w) => `${w.code}: ${w.message}`).join('\n') } : {},
         ws ? `⚠ ${get(l)}` : get(l));
     })));
     for (const w of l.warnings || []) {
-      rows.push(el('tr', { className: 'warn-row' }, el('td', { colSpan: COLUMNS.length },
-        el('code', {}, w.code), ` N = ${l.n}: ${w.message}`)));
+      rows.push(el('tr', { className: 'warn-row' }, el('td', { colSpan: columns.length },
+        el('code', {}, w.code), ` ${run.kind === 'render' ? 'spp' : 'N'} = ${l.n}: ${w.message}`)));
     }
   }
   const details = el('details', { dataset: { for: r.name } }, summary,

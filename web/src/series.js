@@ -50,14 +50,25 @@ export function progressOf(records, order, nLadder) {
   return Math.min(1, done / (perEstimator * order.length));
 }
 
+// What makes two results parts of one study. A render study's scene block carries the time its
+// worker took to render the reference (each worker renders the same reference, from the same
+// random stream): that is not part of the key.
 function studyKey(r) {
   const s = r.settings || {};
-  return JSON.stringify([r.version, r.scene, s.n_min, s.n_max, s.reps, s.seed, s.accumulator]);
+  let scene = r.scene;
+  if (r.kind === 'render' && scene && scene.reference) {
+    const { seconds: _seconds, ...reference } = scene.reference;
+    scene = { ...scene, reference };
+  }
+  return JSON.stringify([r.version, r.kind, scene, s.n_min, s.n_max, s.reps, s.seed, s.accumulator,
+    s.width, s.height]);
 }
 
 /**
  * One result from the results of several workers, each run with options.estimators = a subset
- * (every estimator has its own random streams, so the split does not change any number).
+ * (every estimator has its own random streams, so the split does not change any number; in a
+ * render study every worker also renders the same reference, and the first part's scene block
+ * and reference image are kept).
  * The estimators come in `order` (names; any others after them); settings.threads is the sum
  * of the workers' threads, wall_time_s the longest worker's (they ran side by side), and the
  * merge is cancelled if any part was. Throws if the parts are not of one study.
@@ -410,17 +421,33 @@ export function splitEstimators(names, k) {
  * estimators are the streamed records, the scene block what core.sceneInfo said of the scene.
  */
 export function partialResult(run, info, version = null) {
-  const scene = info
-    ? { name: info.name, description: info.description, domain: info.domain, dimension: info.dimension, exact: info.exact }
-    : { name: run.sceneName };
+  const render = run.kind === 'render';
+  let scene;
+  if (!info) {
+    scene = { name: run.sceneName };
+  } else if (render) {
+    scene = {
+      name: info.name, description: info.description, kind: 'render', width: run.settings ? run.settings.width : info.width,
+      height: run.settings ? run.settings.height : info.height, triangles: info.triangles, lights: info.lights,
+      accel: info.accel, warnings: info.warnings, exact: null,
+    };
+  } else {
+    scene = { name: info.name, description: info.description, domain: info.domain, dimension: info.dimension, exact: info.exact };
+  }
   return {
     version: 1,
+    ...(render ? { kind: 'render' } : {}),
     mcplay: version,
     scene,
-    settings: { ...(run.settings || {}), threads: run.workers },
+    settings: {
+      ...(run.settings || {}),
+      threads: run.workers,
+      ...(render ? { n_name: run.nName, error_name: run.errorName } : {}),
+    },
     cancelled: run.status !== 'done',
     wall_time_s: run.elapsed !== null && run.elapsed !== undefined ? run.elapsed / 1000 : null,
     estimators: run.order.filter((n) => run.records[n]).map((n) => run.records[n]),
+    ...(render && run.referencePng ? { reference_png: run.referencePng } : {}),
   };
 }
 

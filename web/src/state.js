@@ -13,6 +13,24 @@ export const LIMITS = Object.freeze({
   exprLength: 2000,
 });
 
+/** Bounds of render studies: the render C API's spp and replicates (src/render_api), and the
+ *  resolution the page allows (small images: the study renders every one reps x levels times). */
+export const RENDER_LIMITS = Object.freeze({
+  sppMax: 2 ** 20,
+  repsMax: 1024,
+  sizeMin: 16,
+  sizeMax: 256,
+  firstRunSppMax: 1024, // the scene's own spp_max, capped for a fast first run
+});
+
+/** The two kinds of problem: integrals (src/api) and render scenes (src/render_api). */
+export const KIND = Object.freeze({ INTEGRAL: 'integral', RENDER: 'render' });
+
+/** The kind of a scene summary (a sceneInfo, a manifest entry): 'render' or 'integral'. */
+export function kindOf(info) {
+  return info && info.kind === KIND.RENDER ? KIND.RENDER : KIND.INTEGRAL;
+}
+
 /** Defaults of the comparison when neither the URL nor the scene says otherwise. */
 export const DEFAULTS = Object.freeze({
   scene: null,       // the first scene of the manifest
@@ -27,8 +45,8 @@ export const DEFAULTS = Object.freeze({
 
 export const CUSTOM = 'custom';
 
-/** The URL keys, in the order stateToQuery writes them. */
-export const QUERY_KEYS = Object.freeze(['scene', 'estimators', 'n_min', 'n_max', 'reps', 'seed', 'f', 'p']);
+/** The URL keys, in the order stateToQuery writes them (width and height: render scenes). */
+export const QUERY_KEYS = Object.freeze(['scene', 'estimators', 'n_min', 'n_max', 'reps', 'seed', 'width', 'height', 'f', 'p']);
 
 const NAME_RE = /^[A-Za-z0-9_.-]{1,100}$/;
 
@@ -47,11 +65,33 @@ const PARAM_RULES = Object.freeze({
   seed: [0, Number.MAX_SAFE_INTEGER],
 });
 
+const RENDER_PARAM_RULES = Object.freeze({
+  n_min: [1, RENDER_LIMITS.sppMax],
+  n_max: [1, RENDER_LIMITS.sppMax],
+  reps: [LIMITS.repsMin, RENDER_LIMITS.repsMax],
+  seed: [0, Number.MAX_SAFE_INTEGER],
+  width: [RENDER_LIMITS.sizeMin, RENDER_LIMITS.sizeMax],
+  height: [RENDER_LIMITS.sizeMin, RENDER_LIMITS.sizeMax],
+});
+
+/** The numeric settings of a kind of problem and their ranges: {key: [lo, hi]}. */
+export function paramRules(kind = KIND.INTEGRAL) {
+  return kind === KIND.RENDER ? RENDER_PARAM_RULES : PARAM_RULES;
+}
+
+/** The name a setting has in messages: render scenes call N spp. */
+function paramLabel(key, kind) {
+  if (kind !== KIND.RENDER) return key;
+  return { n_min: 'spp_min', n_max: 'spp_max' }[key] || key;
+}
+
 /** The message for an invalid value of a numeric setting, or '' when it is valid. */
-export function paramError(key, value) {
-  const [lo, hi] = PARAM_RULES[key];
+export function paramError(key, value, kind = KIND.INTEGRAL) {
+  const rule = paramRules(kind)[key];
+  if (!rule) return `${key} is not a setting of ${kind === KIND.RENDER ? 'render scenes' : 'integrals'}`;
+  const [lo, hi] = rule;
   if (parseWhole(value, lo, hi) !== null) return '';
-  return `${key} must be a whole number in ${lo}..${hi}`;
+  return `${paramLabel(key, kind)} must be a whole number in ${lo}..${hi}`;
 }
 
 /** True when at least one power of two lies in [nMin, nMax] (the core's N ladder). */
@@ -67,7 +107,8 @@ function enc(value) {
 /**
  * The comparison of a state as a query string ('?scene=...&estimators=a,b&n_min=...').
  * `state` is either the store's state or a plain {scene, estimators, n_min, n_max, reps, seed,
- * f, p}; the custom problem's f (and p) are written only for the custom scene.
+ * width?, height?, f, p}; the custom problem's f (and p) are written only for the custom scene,
+ * the image's width and height only for render scenes (for a plain object: when given).
  */
 export function stateToQuery(state) {
   const c = comparisonOf(state);
@@ -75,7 +116,7 @@ export function stateToQuery(state) {
   const add = (k, v) => { if (v !== null && v !== undefined && v !== '') parts.push(`${k}=${enc(String(v))}`); };
   add('scene', c.scene);
   if (Array.isArray(c.estimators)) add('estimators', c.estimators.join(','));
-  for (const k of ['n_min', 'n_max', 'reps', 'seed']) add(k, c[k]);
+  for (const k of ['n_min', 'n_max', 'reps', 'seed', 'width', 'height']) add(k, c[k]);
   if (c.scene === CUSTOM) {
     add('f', c.f);
     add('p', c.p);
@@ -86,10 +127,13 @@ export function stateToQuery(state) {
 // {scene, estimators, n_min, ...} of the store's state or of a plain comparison object.
 function comparisonOf(state) {
   if (state && state.params && 'sceneId' in state) {
+    const render = kindOf(state.sceneInfo) === KIND.RENDER;
     return {
       scene: state.sceneId,
       estimators: state.selected,
       ...state.params,
+      width: render ? state.params.width : null,
+      height: render ? state.params.height : null,
       f: state.custom.applied ? state.custom.applied.f : state.custom.f,
       p: state.custom.applied ? state.custom.applied.p : state.custom.p,
     };
@@ -101,11 +145,13 @@ function comparisonOf(state) {
  * Reads a comparison from a query string. Every value that is missing, malformed or out of the
  * core's range is replaced by its default, so any URL gives a usable comparison:
  * `defaults` is {scene, estimators, n_min, n_max, reps, seed, f, p} (missing keys from
- * DEFAULTS). An f in the URL selects the custom scene; n_min > n_max, or a range holding no
- * power of two, falls back to the default range. Estimator names are only checked for their
- * spelling here: the scene decides which exist.
+ * DEFAULTS; for render scenes also width and height). An f in the URL selects the custom
+ * scene; n_min > n_max, or a range holding no power of two, falls back to the default range.
+ * Estimator names are only checked for their spelling here: the scene decides which exist.
+ * `kind` gives the ranges (paramRules): a render scene's spp, replicates and image size; width
+ * and height are read for render scenes only.
  */
-export function queryToState(search, defaults = {}) {
+export function queryToState(search, defaults = {}, kind = KIND.INTEGRAL) {
   const d = { ...DEFAULTS, ...defaults };
   const out = { ...d };
   let q;
@@ -128,10 +174,11 @@ export function queryToState(search, defaults = {}) {
     if (names.length) out.estimators = names;
   }
 
-  for (const k of ['n_min', 'n_max', 'reps', 'seed']) {
+  const rules = paramRules(kind);
+  for (const k of ['n_min', 'n_max', 'reps', 'seed', ...(kind === KIND.RENDER ? ['width', 'height'] : [])]) {
     const raw = get(k);
     if (raw === null) continue;
-    const [lo, hi] = PARAM_RULES[k];
+    const [lo, hi] = rules[k];
     const v = parseWhole(raw, lo, hi);
     if (v !== null) out[k] = v;
   }
@@ -149,8 +196,11 @@ export function queryToState(search, defaults = {}) {
   return out;
 }
 
-/** The scene's own N range, n_max capped for a fast first run (the issue's defaults). */
+/** The scene's own N range, n_max capped for a fast first run (the issue's defaults); for a
+ *  render scene its spp range (spp_max capped), replicates and image size (clamped to the
+ *  page's limits). */
 export function sceneDefaults(info) {
+  if (kindOf(info) === KIND.RENDER) return renderDefaults(info);
   const nMin = info && Number.isSafeInteger(info.n_min) ? info.n_min : DEFAULTS.n_min;
   let nMax = info && Number.isSafeInteger(info.n_max) ? info.n_max : DEFAULTS.n_max;
   nMax = Math.min(nMax, LIMITS.firstRunNMax);
@@ -161,6 +211,87 @@ export function sceneDefaults(info) {
     reps: DEFAULTS.reps,
     seed: DEFAULTS.seed,
   };
+}
+
+function renderDefaults(info) {
+  const whole = (v, lo, hi, fallback) => (Number.isSafeInteger(v) && v >= lo && v <= hi ? v : fallback);
+  const clamp = (v, fallback) => (Number.isSafeInteger(v)
+    ? Math.min(RENDER_LIMITS.sizeMax, Math.max(RENDER_LIMITS.sizeMin, v)) : fallback);
+  const nMin = whole(info.n_min, 1, RENDER_LIMITS.sppMax, 1);
+  const nMax = Math.min(whole(info.n_max, 1, RENDER_LIMITS.sppMax, 64), RENDER_LIMITS.firstRunSppMax);
+  const ok = nMin <= nMax;
+  return {
+    n_min: ok ? nMin : 1,
+    n_max: ok ? nMax : 64,
+    reps: whole(info.reps, LIMITS.repsMin, RENDER_LIMITS.repsMax, 4),
+    seed: DEFAULTS.seed,
+    width: clamp(info.width, 64),
+    height: clamp(info.height, 64),
+  };
+}
+
+/**
+ * The page's summary of a render scene from the render core's sceneInfo (mcp_render_scene_info):
+ * estimators as names (the objects kept in estimatorDetails), the spp range, replicates and
+ * seed as n_min, n_max, reps, seed (what the controls show), the names of N and of the error
+ * (settings.n_name, settings.error_name). An integration scene's info is returned unchanged.
+ */
+export function normalizeInfo(info) {
+  if (!info || info.kind !== KIND.RENDER) return info;
+  const details = Array.isArray(info.estimators) ? info.estimators : [];
+  const st = info.settings || {};
+  return {
+    ...info,
+    kind: KIND.RENDER,
+    dimension: null,
+    exact: null,
+    estimators: details.map((e) => (typeof e === 'string' ? e : e.name)),
+    estimatorDetails: details,
+    n_min: st.n_min,
+    n_max: st.n_max,
+    reps: st.reps,
+    seed: st.seed,
+    n_name: st.n_name || 'spp',
+    error_name: st.error_name || 'relative_mse',
+  };
+}
+
+/**
+ * The settings of a run from the state: {n_min, n_max, reps, seed}, and for a render scene
+ * also {width, height}.
+ */
+export function runSettings(state) {
+  const { n_min, n_max, reps, seed, width, height } = state.params;
+  return kindOf(state.sceneInfo) === KIND.RENDER ? { n_min, n_max, reps, seed, width, height } : { n_min, n_max, reps, seed };
+}
+
+/**
+ * The options of one worker's study: the settings of runSettings and its estimators. A render
+ * study takes spp_min / spp_max for N, the image size, and previews (the PNGs of each level's
+ * image and its error, and of the reference).
+ */
+export function studyOptions(kind, settings, estimators) {
+  if (kind !== KIND.RENDER) {
+    const { n_min, n_max, reps, seed } = settings;
+    return { n_min, n_max, reps, seed, estimators };
+  }
+  return {
+    estimators,
+    spp_min: settings.n_min,
+    spp_max: settings.n_max,
+    reps: settings.reps,
+    seed: settings.seed,
+    width: settings.width,
+    height: settings.height,
+    previews: true,
+  };
+}
+
+/** What N and the error are called in a kind's plots and tables. */
+export function studyNames(kind, exactKnown = false) {
+  return kind === KIND.RENDER
+    ? { nName: 'spp', errorName: 'relative_mse' }
+    : { nName: 'N', errorName: exactKnown ? 'mse' : 'variance' };
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -244,13 +375,16 @@ export function initialState() {
     scene: null,            // the scene object that is run (file content or the built custom scene)
     sceneInfo: null,        // core.sceneInfo(scene): name, description, dimension, exact, estimators, ...
     selected: [],           // selected estimator names, in the scene's order
-    params: { n_min: DEFAULTS.n_min, n_max: DEFAULTS.n_max, reps: DEFAULTS.reps, seed: DEFAULTS.seed },
+    // width, height: the image of a render scene (null until one is chosen)
+    params: { n_min: DEFAULTS.n_min, n_max: DEFAULTS.n_max, reps: DEFAULTS.reps, seed: DEFAULTS.seed, width: null, height: null },
     paramErrors: {},        // key -> message for an input that holds no valid value
     custom: { f: '', p: '', error: null, pending: false, applied: null },
     calibration: 'all',     // the histogram's level: 'all' (pooled) or an N
     notice: '',             // last export / scene-loading message
     run: emptyRun('loading'),
     samples: emptySamples(256),
+    // render scenes: a quick image of the scene ({key, status, png, spp, estimator, message})
+    scenePreview: null,
   };
 }
 
@@ -273,7 +407,11 @@ function emptyRun(status) {
     workers: 0,
     startedAt: null,
     elapsed: null,
-    settings: null,         // {n_min, n_max, reps, seed}
+    settings: null,         // {n_min, n_max, reps, seed} (+ {width, height} for render scenes)
+    kind: KIND.INTEGRAL,    // of the scene studied: 'integral' or 'render'
+    nName: 'N',             // what N is called (settings.n_name: 'spp' for render studies)
+    errorName: 'variance',  // what the plotted error is (settings.error_name: 'relative_mse')
+    referencePng: null,     // render studies: the reference image (base64 PNG), once known
     exact: null,            // the scene's exact value (MSE instead of variance when known)
     sceneName: null,
     colors: null,           // name -> palette index (its position in the scene)
@@ -313,6 +451,8 @@ export function reducer(state, action) {
       const info = {
         name: entry.name, description: entry.description, dimension: entry.dimension,
         estimators: entry.estimators.slice(), n_min: entry.n_min, n_max: entry.n_max, provisional: true,
+        ...(kindOf(entry) === KIND.RENDER
+          ? { kind: KIND.RENDER, reps: entry.reps, width: entry.width, height: entry.height } : {}),
       };
       return {
         ...state,
@@ -326,6 +466,7 @@ export function reducer(state, action) {
         notice: '',
         run: state.version ? { ...emptyRun('ready'), id: state.run.id } : state.run,
         samples: emptySamples(state.samples.n),
+        scenePreview: null,
       };
     }
     case 'scene/loaded': {
@@ -357,6 +498,7 @@ export function reducer(state, action) {
         // a new problem clears the plots of the previous one (and stops its run)
         run: state.version && !keep ? { ...emptyRun('ready'), id: state.run.id } : state.run,
         samples: keep ? state.samples : emptySamples(state.samples.n),
+        scenePreview: null,
       };
     }
     case 'scene/failed':
@@ -374,14 +516,15 @@ export function reducer(state, action) {
     }
     case 'param/set': {
       // {key, value: the input's text}
-      const err = paramError(p.key, p.value);
+      const kind = kindOf(state.sceneInfo);
+      const err = paramError(p.key, p.value, kind);
       const paramErrors = { ...state.paramErrors };
       if (err) {
         paramErrors[p.key] = err;
         return { ...state, paramErrors };
       }
       delete paramErrors[p.key];
-      const [lo, hi] = PARAM_RULES[p.key];
+      const [lo, hi] = paramRules(kind)[p.key];
       return { ...state, params: { ...state.params, [p.key]: parseWhole(p.value, lo, hi) }, paramErrors };
     }
     case 'custom/edit':
@@ -418,10 +561,21 @@ export function reducer(state, action) {
       if (p.key !== state.samples.key && p.key !== state.samples.weightsKey) return state;
       return { ...state, samples: { ...state.samples, status: 'error', message: p.message } };
 
+    case 'preview/request':
+      return { ...state, scenePreview: { key: p.key, status: 'loading', png: null, message: '' } };
+    case 'preview/loaded':
+      if (!state.scenePreview || p.key !== state.scenePreview.key) return state;
+      return { ...state, scenePreview: { ...state.scenePreview, status: 'ready', png: p.png, spp: p.spp, estimator: p.estimator, seconds: p.seconds } };
+    case 'preview/failed':
+      if (!state.scenePreview || p.key !== state.scenePreview.key) return state;
+      return { ...state, scenePreview: { ...state.scenePreview, status: 'error', message: p.message } };
+
     case 'run/request':
       return state;
-    case 'run/start':
-      // {id, workers, settings, order, exact, sceneName, startedAt}
+    case 'run/start': {
+      // {id, workers, settings, order, exact, sceneName, startedAt, kind?}
+      const kind = p.kind === KIND.RENDER ? KIND.RENDER : KIND.INTEGRAL;
+      const names = studyNames(kind, p.exact !== null && p.exact !== undefined);
       return {
         ...state,
         calibration: 'all',
@@ -436,14 +590,23 @@ export function reducer(state, action) {
           colors: p.colors || null,
           order: p.order,
           ladder: ladder(p.settings.n_min, p.settings.n_max),
+          kind,
+          nName: names.nName,
+          errorName: names.errorName,
         },
       };
+    }
     case 'run/level': {
       if (p.id !== state.run.id || state.run.status !== 'running') return state;
       const records = applyLevel(state.run.records, p.level);
       return {
         ...state,
-        run: { ...state.run, records, progress: progressOf(records, state.run.order, state.run.ladder) },
+        run: {
+          ...state.run,
+          records,
+          progress: progressOf(records, state.run.order, state.run.ladder),
+          referencePng: (p.level && p.level.reference_png) || state.run.referencePng,
+        },
       };
     }
     case 'run/partial': {
@@ -452,7 +615,16 @@ export function reducer(state, action) {
       const records = { ...state.run.records };
       for (const e of p.result.estimators) records[e.name] = e;
       const partials = [...state.run.partials, p.result];
-      const run = { ...state.run, records, partials, progress: progressOf(records, state.run.order, state.run.ladder) };
+      const st = p.result.settings || {};
+      const run = {
+        ...state.run,
+        records,
+        partials,
+        progress: progressOf(records, state.run.order, state.run.ladder),
+        referencePng: state.run.referencePng || p.result.reference_png || null,
+        nName: st.n_name || state.run.nName,
+        errorName: st.error_name || state.run.errorName,
+      };
       if (partials.length === state.run.workers) {
         run.result = mergeResults(partials, state.run.order);
         run.status = run.result.cancelled ? 'cancelled' : 'done';
@@ -486,9 +658,18 @@ export function runBlocker(state) {
   if (!state.selected.length) return 'select at least one estimator';
   const keys = Object.keys(state.paramErrors);
   if (keys.length) return state.paramErrors[keys[0]];
+  const kind = kindOf(state.sceneInfo);
+  const [lo, hi] = [paramLabel('n_min', kind), paramLabel('n_max', kind)];
   const { n_min: a, n_max: b } = state.params;
-  if (a > b) return `n_max (${b}) must be >= n_min (${a})`;
-  if (!hasLadder(a, b)) return `no power of two lies between n_min = ${a} and n_max = ${b}`;
+  if (a > b) return `${hi} (${b}) must be >= ${lo} (${a})`;
+  if (!hasLadder(a, b)) return `no power of two lies between ${lo} = ${a} and ${hi} = ${b}`;
+  if (kind === KIND.RENDER) {
+    const rules = paramRules(kind);
+    for (const k of ['n_min', 'n_max', 'reps', 'width', 'height']) {
+      const v = state.params[k];
+      if (!(Number.isSafeInteger(v) && v >= rules[k][0] && v <= rules[k][1])) return paramError(k, String(v), kind);
+    }
+  }
   return '';
 }
 
@@ -504,9 +685,26 @@ export function debugSnapshot(state) {
     params: { ...state.params },
     query: stateToQuery(state),
     custom: { f: state.custom.f, p: state.custom.p, error: state.custom.error },
-    run: { id: r.id, status: r.status, progress: r.progress, workers: r.workers, settings: r.settings, exact: r.exact },
+    kind: kindOf(state.sceneInfo),
+    scenePreview: state.scenePreview ? { status: state.scenePreview.status, spp: state.scenePreview.spp, message: state.scenePreview.message } : null,
+    run: {
+      id: r.id, status: r.status, progress: r.progress, workers: r.workers, settings: r.settings, exact: r.exact,
+      kind: r.kind, nName: r.nName, errorName: r.errorName,
+    },
+    // render runs: which images the page has (the reference; per estimator its preview and error image)
+    images: r.kind === KIND.RENDER ? {
+      reference: Boolean(r.referencePng),
+      estimators: Object.fromEntries(r.order.filter((n) => r.records[n]).map((n) => [n, {
+        preview: Boolean(r.records[n].preview_png), error: Boolean(r.records[n].error_png),
+        n: r.records[n].levels.length ? r.records[n].levels[r.records[n].levels.length - 1].n : null,
+      }])),
+    } : null,
     // per estimator of the run: its levels so far ({n, variance, mse, error, ...}), fit, warnings
-    estimators: r.order.filter((n) => r.records[n]).map((n) => r.records[n]),
+    // (render runs: without their PNGs, which `images` summarises)
+    estimators: r.order.filter((n) => r.records[n]).map((n) => {
+      const { preview_png: _p, error_png: _e, ...rest } = r.records[n];
+      return rest;
+    }),
     result: r.result,
     // the sample points drawn: per estimator the number of points, its strata; weights: n, zeros
     samples: samplesDebug(state.samples),

@@ -1,30 +1,73 @@
-// The Web Worker that owns one wasm core: the only module that imports web/core.js and the
-// Emscripten glue (paths are those of the built site: site/src/worker.js, site/core.js,
-// site/mcplay_web.mjs + .wasm). Started as new Worker('src/worker.js', {type: 'module'}).
+// The Web Worker that owns the wasm cores: the only module that imports web/core.js,
+// web/render_core.js and the Emscripten glue (paths are those of the built site:
+// site/src/worker.js, site/core.js, site/render_core.js, site/mcplay_web.mjs + .wasm,
+// site/mcplay_render_web.mjs + .wasm). Started as new Worker('src/worker.js', {type: 'module'}).
 //
-// Requests and replies are the messages of protocol.js. The core is loaded at start-up and
-// every handler awaits the same promise: a top-level await before self.onmessage would lose
-// the messages that arrive while the wasm compiles. Every failure goes back as an ERROR
+// Requests and replies are the messages of protocol.js. The integration core is loaded at
+// start-up and every handler awaits the same promise: a top-level await before self.onmessage
+// would lose the messages that arrive while the wasm compiles. The render core is imported
+// (dynamic import) on the first request about a render scene only, so a page that shows
+// integrals never downloads mcplay_render_web.wasm. Every failure goes back as an ERROR
 // message; nothing is thrown out of a handler.
 import createMcplay from '../mcplay_web.mjs';
 import { loadCore } from '../core.js';
-import { MSG, message, errorPayload } from './protocol.js';
+import { MSG, message, errorPayload, isRenderScene } from './protocol.js';
 
 const ready = loadCore(createMcplay);
 ready.catch(() => {}); // reported to each request below, not as an unhandled rejection
 
+let renderReady = null;
+/** The render core, imported and instantiated on first use (a failure is retried next time). */
+function renderCore() {
+  renderReady ??= Promise.all([import('../mcplay_render_web.mjs'), import('../render_core.js')])
+    .then(([glue, wrapper]) => wrapper.loadRenderCore(glue.default))
+    .catch((e) => {
+      renderReady = null;
+      throw new Error(`the render module did not load: ${e && e.message ? e.message : e}`);
+    });
+  return renderReady;
+}
+
 function reply(id, type, payload) {
   self.postMessage(message(id, type, payload));
+}
+
+// A small image of each estimator before a render study, for the same reason as the
+// integration warm-up below: V8 runs a wasm function's first calls in its baseline compiler.
+// Its own random stream (seed + 1), a few pixels: it costs little and changes no number.
+function warmRender(render, scene, options) {
+  for (const estimator of options.estimators || []) {
+    try {
+      render.renderImage(scene, { estimator, spp: 2, width: 16, height: 16, seed: (options.seed || 0) + 1, outputs: [] });
+    } catch {
+      // the real study reports the error
+    }
+  }
 }
 
 const handlers = {
   [MSG.LOAD](core, id) {
     reply(id, MSG.READY, { version: core.version() });
   },
-  [MSG.VALIDATE](core, id, { scene }) {
+  async [MSG.VALIDATE](core, id, { scene }) {
+    if (isRenderScene(scene)) {
+      const render = await renderCore();
+      reply(id, MSG.VALIDATED, { info: render.sceneInfo(scene) });
+      return;
+    }
     reply(id, MSG.VALIDATED, { info: core.sceneInfo(scene) });
   },
-  [MSG.RUN](core, id, { scene, options, warmup = false }) {
+  async [MSG.RUN](core, id, { scene, options, warmup = false }) {
+    // Each finished N goes to the page at once; cancelling is done by terminating this worker.
+    const onLevel = (level) => {
+      reply(id, MSG.LEVEL, { level });
+    };
+    if (isRenderScene(scene)) {
+      const render = await renderCore();
+      if (warmup) warmRender(render, scene, options || {});
+      reply(id, MSG.RESULT, { result: render.runStudy(scene, options, onLevel) });
+      return;
+    }
     if (warmup) {
       // A small study of the same scene and estimators first, so that the timed levels do not
       // include V8's lazy compilation of the wasm functions they use (the first call of a
@@ -35,11 +78,13 @@ const handlers = {
         // the real study reports the error
       }
     }
-    // Each finished N goes to the page at once; cancelling is done by terminating this worker.
-    const result = core.runStudy(scene, options, (level) => {
-      reply(id, MSG.LEVEL, { level });
-    });
+    const result = core.runStudy(scene, options, onLevel);
     reply(id, MSG.RESULT, { result });
+  },
+  async [MSG.IMAGE](core, id, { scene, options }) {
+    if (!isRenderScene(scene)) throw new Error('image: not a render scene (no "render" object)');
+    const render = await renderCore();
+    reply(id, MSG.IMAGED, { image: render.renderImage(scene, options) });
   },
   [MSG.FORMAT](core, id, { result, format }) {
     reply(id, MSG.FORMATTED, { text: core.format(result, format) });
@@ -64,7 +109,7 @@ self.onmessage = async (e) => {
     const core = await ready;
     const handler = handlers[type];
     if (!handler) throw new Error(`worker: unknown message type '${type}'`);
-    handler(core, id, payload || {});
+    await handler(core, id, payload || {});
   } catch (err) {
     reply(id, MSG.ERROR, errorPayload(err));
   }

@@ -380,3 +380,63 @@ test('mapFor: recognises the disk map that produced the points, and only that', 
   }
   assert.equal(mapFor({ u, x: [[0, 0, 0], [0, 0, 0]] }), null);
 });
+
+// ---------------------------------------------------------------------------------------------
+// Render results (kind "render": N is spp, a level's variance its relative MSE)
+
+function renderPart(names, { seconds = 0.3, luminance = 0.5, threads = 1, cancelled = false } = {}) {
+  return {
+    version: 1, kind: 'render', mcplay: '0.1.0', reference_png: 'REF',
+    scene: { name: 'q', kind: 'render', width: 16, height: 16, exact: luminance, reference: { spp: 256, seconds, mean_luminance: luminance, source: 'rendered' } },
+    settings: { n_min: 1, n_max: 4, reps: 2, seed: 1, threads, n_name: 'spp', error_name: 'relative_mse' },
+    cancelled, wall_time_s: seconds + 0.1,
+    estimators: names.map((name) => record(name, [1, 2, 4])),
+  };
+}
+
+test('render parts merge although each worker timed its own reference; other references do not', () => {
+  const m = mergeResults([renderPart(['b'], { seconds: 0.2 }), renderPart(['a'], { seconds: 0.4 })], ['a', 'b']);
+  assert.equal(m.kind, 'render');
+  assert.deepEqual(m.estimators.map((e) => e.name), ['a', 'b']);
+  assert.equal(m.reference_png, 'REF');
+  assert.equal(m.settings.threads, 2);
+  assert.equal(m.settings.n_name, 'spp');
+  assert.ok(Math.abs(m.wall_time_s - 0.5) < 1e-12);
+  assert.throws(() => mergeResults([renderPart(['a']), renderPart(['b'], { luminance: 0.6 })]), /different studies/);
+  const other = renderPart(['b']);
+  other.settings.n_max = 8;
+  assert.throws(() => mergeResults([renderPart(['a']), other]), /different studies/);
+});
+
+test('render series: relative MSE against spp with one reference slope, error against time per image', () => {
+  const records = { a: record('a', [1, 2, 4]), b: record('b', [1, 2]) };
+  const vs = varianceSeries(records, ['a', 'b'], null, ladder(1, 4));
+  assert.equal(vs.quantity, 'variance');
+  assert.deepEqual(vs.x, [1, 2, 4]);
+  assert.deepEqual(vs.series[0].y, [1, 0.5, 0.25]);
+  assert.deepEqual(vs.series[1].y, [1, 0.5, null]);
+  const refs = referenceLines(vs.x, anchorOf(vs.x, vs.series), [1]);
+  assert.equal(refs.length, 1);
+  assert.deepEqual(refs[0].y, [1, 0.5, 0.25]);
+  const ts = timeSeries(records, ['a']);
+  assert.deepEqual(ts.series[0].points.map(([t]) => t), [1e-8, 2e-8, 4e-8]);
+  assert.ok(Math.abs(ts.series[0].slope + 0.5) < 1e-12, 'RMSE ∝ t^-1/2 when relative MSE ∝ 1/spp');
+});
+
+test('a cancelled render run exports its streamed levels with the render names', () => {
+  const run = {
+    kind: 'render', nName: 'spp', errorName: 'relative_mse', sceneName: 'q', settings: { n_min: 1, n_max: 4, reps: 2, seed: 1, width: 16, height: 16 },
+    workers: 2, status: 'cancelled', elapsed: 1500, order: ['a', 'b'], records: { a: record('a', [1]) }, referencePng: null,
+  };
+  const info = { name: 'q', description: 'd', kind: 'render', width: 48, height: 48, triangles: 4, lights: 2, accel: { kind: 'bvh' }, warnings: [] };
+  const r = partialResult(run, info, '0.1.0');
+  assert.equal(r.kind, 'render');
+  assert.equal(r.cancelled, true);
+  assert.deepEqual([r.scene.kind, r.scene.width, r.scene.height, r.scene.triangles], ['render', 16, 16, 4]);
+  assert.deepEqual([r.settings.n_name, r.settings.error_name, r.settings.threads], ['spp', 'relative_mse', 2]);
+  assert.deepEqual(r.estimators.map((e) => e.name), ['a']);
+  assert.equal(r.wall_time_s, 1.5);
+  assert.equal('reference_png' in r, false);
+  // an integration run's export is unchanged: no kind
+  assert.equal('kind' in partialResult({ ...run, kind: 'integral' }, { name: 'q' }), false);
+});

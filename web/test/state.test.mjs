@@ -6,6 +6,7 @@ import assert from 'node:assert/strict';
 import {
   stateToQuery, queryToState, sceneDefaults, parseWhole, paramError, reducer, initialState,
   createStore, runBlocker, statusText, buildCustomScene, customError, debugSnapshot, DEFAULTS, CUSTOM,
+  KIND, kindOf, normalizeInfo, runSettings, studyOptions, studyNames, RENDER_LIMITS,
 } from '../src/state.js';
 
 const SCENE_DEFAULTS = { scene: 'disk_quarter', estimators: null, n_min: 16, n_max: 65536, reps: 32, seed: 1 };
@@ -234,4 +235,150 @@ test('customError names the field and position of the core\'s message', () => {
   assert.deepEqual(customError({ message: 'scene.estimators[3].pdf.shape: at position 2: expected an expression' }),
     { field: 'p', message: 'scene.estimators[3].pdf.shape: at position 2: expected an expression', position: 2 });
   assert.deepEqual(customError(new Error('scene: something else')), { field: 'f', message: 'scene: something else', position: null });
+});
+
+// ---------------------------------------------------------------------------------------------
+// Render scenes
+
+// What the render core's sceneInfo says of a scene (mcp_render_scene_info), trimmed.
+const RENDER_INFO_RAW = {
+  name: 'quad_light_floor', description: 'floor', kind: 'render', width: 48, height: 48, triangles: 4, lights: 2,
+  accel: { kind: 'brute_force' }, warnings: [],
+  estimators: [
+    { name: 'bsdf', strategy: 'bsdf', light_selection: 'power', light_sampling: 'solid_angle', pixel_sampler: 'stratified' },
+    { name: 'light_area', strategy: 'light_area', light_selection: 'power', light_sampling: 'solid_angle', pixel_sampler: 'stratified' },
+  ],
+  settings: { n_min: 1, n_max: 64, reps: 4, seed: 1, threads: 1, n_name: 'spp', error_name: 'relative_mse' },
+  reference: { estimator: { strategy: 'mis_power' }, spp: 1024 },
+};
+const RENDER_ENTRY = {
+  file: 'quad_light_floor.json', name: 'quad_light_floor', description: 'floor', kind: 'render', dimension: null,
+  estimators: ['bsdf', 'light_area'], n_min: 1, n_max: 64, reps: 4, width: 48, height: 48,
+};
+
+function renderState() {
+  let s = reducer(initialState(), { type: 'core/ready', payload: { version: '0.1.0' } });
+  s = reducer(s, { type: 'scenes/loaded', payload: { scenes: [RENDER_ENTRY] } });
+  return reducer(s, { type: 'scene/loaded', payload: { sceneId: 'quad_light_floor', scene: { render: {} }, info: normalizeInfo(RENDER_INFO_RAW) } });
+}
+
+test('normalizeInfo: a render scene\'s info as the controls read it; integration info unchanged', () => {
+  const info = normalizeInfo(RENDER_INFO_RAW);
+  assert.equal(kindOf(info), KIND.RENDER);
+  assert.deepEqual(info.estimators, ['bsdf', 'light_area']);
+  assert.equal(info.estimatorDetails[1].strategy, 'light_area');
+  assert.deepEqual([info.n_min, info.n_max, info.reps, info.n_name, info.error_name], [1, 64, 4, 'spp', 'relative_mse']);
+  assert.equal(info.exact, null);
+  const integral = { name: 'exp_1d', estimators: ['uniform'], n_min: 16, n_max: 1024 };
+  assert.equal(normalizeInfo(integral), integral);
+  assert.equal(kindOf(integral), KIND.INTEGRAL);
+  assert.equal(kindOf(null), KIND.INTEGRAL);
+});
+
+test('render defaults: the scene\'s spp range (capped), replicates and size clamped to the page\'s limits', () => {
+  assert.deepEqual(sceneDefaults(normalizeInfo(RENDER_INFO_RAW)), { n_min: 1, n_max: 64, reps: 4, seed: 1, width: 48, height: 48 });
+  assert.deepEqual(sceneDefaults({ kind: 'render', n_min: 1, n_max: 1 << 16, reps: 2000, width: 4096, height: 8 }),
+    { n_min: 1, n_max: RENDER_LIMITS.firstRunSppMax, reps: 4, seed: 1, width: 256, height: 16 });
+  assert.deepEqual(sceneDefaults({ kind: 'render' }), { n_min: 1, n_max: 64, reps: 4, seed: 1, width: 64, height: 64 });
+});
+
+test('a render comparison survives the URL; width and height only for render scenes, in their range', () => {
+  const c = { scene: 'quad_light_floor', estimators: ['bsdf'], n_min: 1, n_max: 8, reps: 4, seed: 3, width: 16, height: 32, f: '', p: '' };
+  const q = stateToQuery(c);
+  assert.equal(q, '?scene=quad_light_floor&estimators=bsdf&n_min=1&n_max=8&reps=4&seed=3&width=16&height=32');
+  const d = { scene: 'quad_light_floor', estimators: null, n_min: 1, n_max: 64, reps: 4, seed: 1, width: 48, height: 48 };
+  assert.deepEqual(queryToState(q, d, KIND.RENDER), c);
+  // the render ranges: spp up to 2^20, replicates up to 1024, 16..256 pixels
+  const bad = queryToState(`?n_max=${2 ** 20 + 1}&reps=1025&width=15&height=257`, d, KIND.RENDER);
+  assert.deepEqual([bad.n_max, bad.reps, bad.width, bad.height], [64, 4, 48, 48]);
+  const good = queryToState(`?n_min=2&n_max=${2 ** 20}&reps=1024&width=256&height=16`, d, KIND.RENDER);
+  assert.deepEqual([good.n_min, good.n_max, good.reps, good.width, good.height], [2, 2 ** 20, 1024, 256, 16]);
+  // an integral's URL ignores a size, and its ranges are its own
+  const integral = queryToState('?width=16&n_max=4194304', SCENE_DEFAULTS);
+  assert.equal(integral.width, undefined);
+  assert.equal(integral.n_max, 4194304);
+
+  // the store: width and height in the URL for the render scene only
+  let s = renderState();
+  assert.equal(stateToQuery(s), '?scene=quad_light_floor&estimators=bsdf,light_area&n_min=1&n_max=64&reps=4&seed=1&width=48&height=48');
+  s = reducer(s, { type: 'scene/loaded', payload: { sceneId: 'exp_1d', scene: {}, info: { estimators: ['uniform'], n_min: 16, n_max: 1024 } } });
+  assert.doesNotMatch(stateToQuery(s), /width|height/);
+});
+
+test('render settings are checked against the render ranges, with spp in the messages', () => {
+  assert.equal(paramError('width', '64', KIND.RENDER), '');
+  assert.match(paramError('width', '300', KIND.RENDER), /width must be a whole number in 16\.\.256/);
+  assert.match(paramError('n_max', String(2 ** 21), KIND.RENDER), /spp_max must be a whole number in 1\.\.1048576/);
+  assert.match(paramError('reps', '2000', KIND.RENDER), /reps must be a whole number in 2\.\.1024/);
+  assert.equal(paramError('reps', '2000'), '', 'integrals allow more replicates');
+  let s = renderState();
+  assert.equal(runBlocker(s), '');
+  s = reducer(s, { type: 'param/set', payload: { key: 'height', value: '8' } });
+  assert.match(runBlocker(s), /height must be a whole number in 16\.\.256/);
+  assert.equal(s.params.height, 48, 'the last good value is kept');
+  s = reducer(s, { type: 'param/set', payload: { key: 'height', value: '24' } });
+  s = reducer(s, { type: 'param/set', payload: { key: 'n_min', value: '128' } });
+  assert.match(runBlocker(s), /spp_max \(64\) must be >= spp_min \(128\)/);
+});
+
+test('a render run: its settings and options, spp and relative MSE as names, images as levels come in', () => {
+  let s = renderState();
+  s = reducer(s, { type: 'param/set', payload: { key: 'width', value: '16' } });
+  const settings = runSettings(s);
+  assert.deepEqual(settings, { n_min: 1, n_max: 64, reps: 4, seed: 1, width: 16, height: 48 });
+  assert.deepEqual(studyOptions(KIND.RENDER, settings, ['bsdf']),
+    { estimators: ['bsdf'], spp_min: 1, spp_max: 64, reps: 4, seed: 1, width: 16, height: 48, previews: true });
+  assert.deepEqual(studyOptions(KIND.INTEGRAL, { n_min: 16, n_max: 32, reps: 2, seed: 1, width: 9 }, ['uniform']),
+    { n_min: 16, n_max: 32, reps: 2, seed: 1, estimators: ['uniform'] });
+  assert.deepEqual(studyNames(KIND.RENDER), { nName: 'spp', errorName: 'relative_mse' });
+  assert.deepEqual(studyNames(KIND.INTEGRAL, true), { nName: 'N', errorName: 'mse' });
+
+  s = reducer(s, { type: 'run/start', payload: { id: 1, kind: KIND.RENDER, workers: 2, settings: { ...settings, n_max: 2 }, order: ['bsdf', 'light_area'], exact: null, sceneName: 'quad_light_floor', startedAt: 0 } });
+  assert.deepEqual([s.run.kind, s.run.nName, s.run.errorName], ['render', 'spp', 'relative_mse']);
+  const est = (name, n, png) => ({
+    name, strategy: name, warnings: [], fit: { valid: false }, preview_png: `${png}-image`, error_png: `${png}-error`,
+    level: { n, variance: 1 / n, mse: 1 / n, warnings: [] },
+  });
+  s = reducer(s, { type: 'run/level', payload: { id: 1, level: { kind: 'render', level_index: 0, n: 1, estimators: [est('bsdf', 1, 'b1')] } } });
+  assert.equal(s.run.records.bsdf.preview_png, 'b1-image');
+  s = reducer(s, { type: 'run/level', payload: { id: 1, level: { kind: 'render', level_index: 1, n: 2, estimators: [est('bsdf', 2, 'b2')] } } });
+  assert.deepEqual([s.run.records.bsdf.preview_png, s.run.records.bsdf.error_png], ['b2-image', 'b2-error'], 'the latest level\'s images');
+  assert.equal(s.run.referencePng, null, 'the progress lines carry no reference');
+  let snap = debugSnapshot(s);
+  assert.deepEqual(snap.images, { reference: false, estimators: { bsdf: { preview: true, error: true, n: 2 } } });
+  assert.equal(snap.estimators[0].preview_png, undefined, 'the snapshot leaves the PNGs out');
+
+  const part = (names, seconds) => ({
+    version: 1, kind: 'render', mcplay: '0.1.0', reference_png: 'REF',
+    scene: { name: 'quad_light_floor', exact: 0.5, reference: { spp: 1024, seconds, mean_luminance: 0.5 } },
+    settings: { n_min: 1, n_max: 2, reps: 4, seed: 1, threads: 1, n_name: 'spp', error_name: 'relative_mse' },
+    cancelled: false, wall_time_s: 0.2,
+    estimators: names.map((name) => ({ name, preview_png: `${name}-final`, levels: [{ n: 1 }, { n: 2 }], fit: { valid: true, order: -1 } })),
+  });
+  s = reducer(s, { type: 'run/partial', payload: { id: 1, result: part(['light_area'], 0.31), now: 5 } });
+  assert.equal(s.run.referencePng, 'REF');
+  s = reducer(s, { type: 'run/partial', payload: { id: 1, result: part(['bsdf'], 0.29), now: 9 } });
+  assert.equal(statusText(s), 'done', 'parts whose reference took different times merge');
+  assert.equal(s.run.records.bsdf.preview_png, 'bsdf-final');
+  snap = debugSnapshot(s);
+  assert.equal(snap.images.reference, true);
+  assert.deepEqual(structuredClone(snap), snap);
+});
+
+test('choosing a render scene shows it at once from the manifest, with its size', () => {
+  let s = reducer(initialState(), { type: 'core/ready', payload: { version: '0.1.0' } });
+  s = reducer(s, { type: 'scenes/loaded', payload: { scenes: [RENDER_ENTRY] } });
+  s = reducer(s, { type: 'scene/request', payload: { sceneId: 'quad_light_floor' } });
+  assert.equal(kindOf(s.sceneInfo), KIND.RENDER);
+  assert.deepEqual(s.selected, ['bsdf', 'light_area']);
+  assert.deepEqual(s.params, { n_min: 1, n_max: 64, reps: 4, seed: 1, width: 48, height: 48 });
+  s = reducer(s, { type: 'param/set', payload: { key: 'width', value: '32' } });
+  s = reducer(s, { type: 'scene/loaded', payload: { sceneId: 'quad_light_floor', scene: { render: {} }, info: normalizeInfo(RENDER_INFO_RAW) } });
+  assert.equal(s.params.width, 32, 'an edit made while the scene loads is kept');
+  // the quick image of the scene: only the latest request's answer is kept
+  s = reducer(s, { type: 'preview/request', payload: { key: 1 } });
+  s = reducer(s, { type: 'preview/request', payload: { key: 2 } });
+  assert.equal(reducer(s, { type: 'preview/loaded', payload: { key: 1, png: 'old' } }), s);
+  s = reducer(s, { type: 'preview/loaded', payload: { key: 2, png: 'P', spp: 16, estimator: 'bsdf' } });
+  assert.deepEqual([s.scenePreview.status, s.scenePreview.png], ['ready', 'P']);
 });

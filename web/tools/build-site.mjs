@@ -1,12 +1,18 @@
 #!/usr/bin/env node
 // Assembles the playground into a static directory:
 //   node web/tools/build-site.mjs [OUT=build/site] [WASM_DIR=build-wasm]
-// OUT/index.html, style.css, src/** (the page's modules), core.js, vendor/uPlot.esm.js +
-// uPlot.min.css (+ its LICENSE) from web/node_modules/uplot/dist, mcplay_web.mjs + .wasm from
-// WASM_DIR, scenes/*.json and scenes/manifest.json ([{file, name, description, dimension,
-// estimators, n_min, n_max}] read from the scene files themselves; the page asks the core,
-// core.sceneInfo, for the rest). OUT and WASM_DIR default to build/site and build-wasm in the
-// repository. Fails with a message naming what is missing.
+// OUT/index.html, style.css, src/** (the page's modules), core.js, render_core.js,
+// vendor/uPlot.esm.js + uPlot.min.css (+ its LICENSE) from web/node_modules/uplot/dist,
+// mcplay_web.mjs + .wasm and mcplay_render_web.mjs + .wasm from WASM_DIR, scenes/*.json and
+// scenes/manifest.json ([{file, name, description, kind, dimension, estimators, n_min, n_max}],
+// render scenes also {reps, width, height}; read from the scene files themselves; the page asks
+// the core, sceneInfo, for the rest). Integration scenes come first in the manifest (the page
+// opens the first one, and only render scenes load the render module).
+// Render scenes (a "render" object) are copied with their "gltf" replaced by the glTF itself,
+// inline, its external buffers and images turned into data: URIs (a .glb becomes the same
+// JSON with its binary chunk as buffer 0), since the wasm module cannot read the site's files.
+// OUT and WASM_DIR default to build/site and build-wasm in the repository. Fails with a message
+// naming what is missing.
 import fs from 'node:fs';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
@@ -65,20 +71,120 @@ export function sceneDimension(scene) {
 }
 
 const DEFAULT_ESTIMATORS = ['uniform', 'stratified', 'latin_hypercube'];
+// The render C API's defaults (src/render_api/render_request.cpp, src/render/render_study.h):
+// every direct-lighting strategy, 64 x 64 pixels, spp 1..64, 4 replicates.
+const DEFAULT_RENDER_ESTIMATORS = ['uniform_hemisphere', 'cosine_hemisphere', 'bsdf', 'light_area',
+  'light_solid_angle', 'mis_balance', 'mis_power'];
+const RENDER_DEFAULTS = { width: 64, height: 64, spp_min: 1, spp_max: 64, reps: 4 };
 
-function manifestEntry(file, scene) {
-  const estimators = Array.isArray(scene.estimators)
-    ? scene.estimators.map((e) => (typeof e === 'string' ? e : e.name))
-    : DEFAULT_ESTIMATORS;
+/** Does a scene JSON describe a render scene (a "render" object), as the C API decides. */
+export function isRenderScene(scene) {
+  return Boolean(scene) && typeof scene === 'object' && !Array.isArray(scene) && 'render' in scene;
+}
+
+// An estimator of a scene's list: a preset name, or an object with a name (render estimators
+// default their name to their strategy).
+function estimatorName(e) {
+  if (typeof e === 'string') return e;
+  return e && (e.name ?? e.strategy);
+}
+
+export function manifestEntry(file, scene) {
+  const name = scene.name || path.basename(file, '.json');
+  const description = scene.description || '';
+  if (isRenderScene(scene)) {
+    const r = scene.render && typeof scene.render === 'object' ? scene.render : {};
+    const v = (k) => (Number.isSafeInteger(r[k]) ? r[k] : RENDER_DEFAULTS[k]);
+    return {
+      file, name, description, kind: 'render', dimension: null,
+      estimators: Array.isArray(r.estimators) ? r.estimators.map(estimatorName) : DEFAULT_RENDER_ESTIMATORS,
+      n_min: v('spp_min'), n_max: v('spp_max'), reps: v('reps'), width: v('width'), height: v('height'),
+    };
+  }
+  const estimators = Array.isArray(scene.estimators) ? scene.estimators.map(estimatorName) : DEFAULT_ESTIMATORS;
   return {
     file,
-    name: scene.name || path.basename(file, '.json'),
-    description: scene.description || '',
+    name,
+    description,
+    kind: 'integral',
     dimension: sceneDimension(scene),
     estimators,
     n_min: scene.n_min ?? 16,
     n_max: scene.n_max ?? 65536,
   };
+}
+
+const IMAGE_TYPES = { '.png': 'image/png', '.jpg': 'image/jpeg', '.jpeg': 'image/jpeg', '.webp': 'image/webp' };
+
+function dataUri(file, type) {
+  return `data:${type};base64,${fs.readFileSync(file).toString('base64')}`;
+}
+
+// The glTF JSON of a .glb: its JSON chunk, with the BIN chunk as buffer 0's data URI.
+function glbToJson(bytes, where) {
+  const u32 = (o) => bytes.readUInt32LE(o);
+  if (bytes.length < 20 || u32(0) !== 0x46546c67) throw new Error(`${where}: not a binary glTF (no "glTF" magic)`);
+  const jsonLength = u32(12);
+  if (u32(16) !== 0x4e4f534a || 20 + jsonLength > bytes.length) throw new Error(`${where}: the first chunk is not JSON`);
+  const gltf = JSON.parse(bytes.subarray(20, 20 + jsonLength).toString('utf8'));
+  const binAt = 20 + jsonLength;
+  if (binAt + 8 <= bytes.length && u32(binAt + 4) === 0x004e4942 && Array.isArray(gltf.buffers) && gltf.buffers[0]
+      && gltf.buffers[0].uri === undefined) {
+    const bin = bytes.subarray(binAt + 8, binAt + 8 + u32(binAt));
+    gltf.buffers[0].uri = `data:application/octet-stream;base64,${bin.toString('base64')}`;
+  }
+  return gltf;
+}
+
+/**
+ * The glTF file `gltfPath` as one JSON object with every external buffer and image inlined
+ * as a data: URI (files resolved relative to the glTF's folder). Throws naming what is missing.
+ */
+export function inlineGltf(gltfPath) {
+  if (!fs.existsSync(gltfPath)) throw new Error(`missing ${shown(gltfPath)}`);
+  const bytes = fs.readFileSync(gltfPath);
+  let gltf;
+  try {
+    gltf = path.extname(gltfPath).toLowerCase() === '.glb' ? glbToJson(bytes, shown(gltfPath)) : JSON.parse(bytes.toString('utf8'));
+  } catch (e) {
+    throw new Error(`${shown(gltfPath)}: ${e.message}`);
+  }
+  const dir = path.dirname(gltfPath);
+  const inline = (list, typeOf) => {
+    for (const item of Array.isArray(list) ? list : []) {
+      if (!item || typeof item.uri !== 'string' || item.uri.startsWith('data:')) continue;
+      let rel;
+      try {
+        rel = decodeURIComponent(item.uri);
+      } catch {
+        rel = item.uri;
+      }
+      const file = path.resolve(dir, rel);
+      if (!fs.existsSync(file)) throw new Error(`${shown(gltfPath)}: missing ${shown(file)} (uri '${item.uri}')`);
+      item.uri = dataUri(file, typeOf(file));
+    }
+  };
+  inline(gltf.buffers, () => 'application/octet-stream');
+  inline(gltf.images, (f) => IMAGE_TYPES[path.extname(f).toLowerCase()] || 'application/octet-stream');
+  return gltf;
+}
+
+/**
+ * The scene as the site serves it: a render scene's "gltf" file name replaced by the glTF
+ * object (inlineGltf), and a reference image file dropped (the browser renders the reference:
+ * the wasm module reads no files). Returns {scene, notes}.
+ */
+export function siteScene(scene, sceneDir) {
+  if (!isRenderScene(scene) || !scene.render || typeof scene.render !== 'object') return { scene, notes: [] };
+  const notes = [];
+  const render = { ...scene.render };
+  if (typeof render.gltf === 'string') render.gltf = inlineGltf(path.resolve(sceneDir, render.gltf));
+  if (render.reference && typeof render.reference === 'object' && 'file' in render.reference) {
+    render.reference = { ...render.reference };
+    delete render.reference.file;
+    notes.push('reference.file dropped: the page renders the reference instead');
+  }
+  return { scene: { ...scene, render }, notes };
 }
 
 function copy(from, to) {
@@ -96,11 +202,11 @@ function copyTree(from, to) {
 }
 
 function main() {
-  const wasmFiles = ['mcplay_web.mjs', 'mcplay_web.wasm'].map((f) =>
+  const wasmFiles = ['mcplay_web.mjs', 'mcplay_web.wasm', 'mcplay_render_web.mjs', 'mcplay_render_web.wasm'].map((f) =>
     need(path.join(WASM_DIR, f), `build the wasm module with \`make build-wasm\` (or pass its directory as the second argument)`));
   const uplotFiles = ['uPlot.esm.js', 'uPlot.min.css'].map((f) =>
     need(path.join(UPLOT, 'dist', f), 'install uPlot with `npm ci --prefix web` (web/package-lock.json)'));
-  for (const f of ['index.html', 'style.css', 'core.js', 'src']) need(path.join(WEB, f), 'part of the repository');
+  for (const f of ['index.html', 'style.css', 'core.js', 'render_core.js', 'src']) need(path.join(WEB, f), 'part of the repository');
   // OUT is replaced whole: only when it is empty or a site this script built.
   if (OUT === path.parse(OUT).root || ROOT === OUT || ROOT.startsWith(OUT + path.sep) ||
       [WEB, path.join(ROOT, 'scenes'), WASM_DIR].includes(OUT)) {
@@ -113,7 +219,7 @@ function main() {
   fs.rmSync(OUT, { recursive: true, force: true });
   fs.mkdirSync(OUT, { recursive: true });
 
-  for (const f of ['index.html', 'style.css', 'core.js']) copy(path.join(WEB, f), path.join(OUT, f));
+  for (const f of ['index.html', 'style.css', 'core.js', 'render_core.js']) copy(path.join(WEB, f), path.join(OUT, f));
   copyTree(path.join(WEB, 'src'), path.join(OUT, 'src'));
   for (const f of uplotFiles) copy(f, path.join(OUT, 'vendor', path.basename(f)));
   if (fs.existsSync(path.join(UPLOT, 'LICENSE'))) copy(path.join(UPLOT, 'LICENSE'), path.join(OUT, 'vendor', 'uPlot.LICENSE'));
@@ -132,15 +238,30 @@ function main() {
       fail(`scenes/${file}: invalid JSON (${e.message})`);
     }
     manifest.push(manifestEntry(file, scene));
-    copy(path.join(scenesDir, file), path.join(OUT, 'scenes', file));
+    if (isRenderScene(scene)) {
+      let site;
+      try {
+        site = siteScene(scene, scenesDir);
+      } catch (e) {
+        fail(`scenes/${file}: render.gltf: ${e.message}`);
+      }
+      for (const note of site.notes) console.log(`build-site: scenes/${file}: ${note}`);
+      fs.mkdirSync(path.join(OUT, 'scenes'), { recursive: true });
+      fs.writeFileSync(path.join(OUT, 'scenes', file), `${JSON.stringify(site.scene)}\n`);
+    } else {
+      copy(path.join(scenesDir, file), path.join(OUT, 'scenes', file));
+    }
   }
+  // Integration scenes first (the page opens the first scene), each kind in file order.
+  manifest.sort((a, b) => (a.kind === 'render') - (b.kind === 'render'));
   const names = new Set();
   for (const m of manifest) {
     if (names.has(m.name)) fail(`two scenes are named '${m.name}'`);
     names.add(m.name);
   }
   fs.writeFileSync(path.join(OUT, 'scenes', 'manifest.json'), `${JSON.stringify(manifest, null, 2)}\n`);
-  console.log(`build-site: ${shown(OUT)} (${manifest.length} scenes, wasm from ${shown(WASM_DIR)})`);
+  const renders = manifest.filter((m) => m.kind === 'render').length;
+  console.log(`build-site: ${shown(OUT)} (${manifest.length - renders} integration and ${renders} render scenes, wasm from ${shown(WASM_DIR)})`);
 }
 
 if (process.argv[1] && path.resolve(process.argv[1]) === fileURLToPath(import.meta.url)) main();

@@ -1,13 +1,16 @@
-// The form controls: scene, estimators, N range, replicates, seed, Run / Cancel, progress and
-// status. Events only dispatch actions; sync(state) writes the state back into the controls
-// (never into an input the user is typing in).
-import { CUSTOM, runBlocker, statusText } from '../state.js';
+// The form controls: scene, estimators, N range, replicates, seed (and a render scene's image
+// size), Run / Cancel, progress and status. Events only dispatch actions; sync(state) writes the
+// state back into the controls (never into an input the user is typing in), and shows the
+// panels of the kind of problem chosen: render scenes hide the custom problem and the sample
+// points, and show the image size and the images.
+import { CUSTOM, KIND, kindOf, paramRules, runBlocker, statusText } from '../state.js';
 import { colorAt } from '../palette.js';
 import { fmt } from '../series.js';
+import { renderFacts } from '../report.js';
 
 const $ = (id) => document.getElementById(id);
 
-const PARAM_INPUTS = { n_min: 'n-min', n_max: 'n-max', reps: 'reps', seed: 'seed' };
+const PARAM_INPUTS = { n_min: 'n-min', n_max: 'n-max', reps: 'reps', seed: 'seed', width: 'width', height: 'height' };
 
 export function mountControls(store) {
   const { dispatch } = store;
@@ -41,6 +44,52 @@ export function mountControls(store) {
 let scenesSig = null;
 let estimatorsSig = null;
 let calibrationSig = null;
+let kindShown = null;
+
+/** Shows the controls and panels of a kind of problem (once per change of kind). */
+function showKind(kind) {
+  if (kind === kindShown) return;
+  kindShown = kind;
+  const render = kind === KIND.RENDER;
+  for (const e of document.querySelectorAll('.render-only')) e.hidden = !render;
+  const hide = (id, yes) => { const e = $(id); if (e) e.hidden = yes; };
+  hide('custom', render);
+  hide('samples-section', render);
+  hide('render-images-section', !render);
+  $('n-min-label').textContent = render ? 'spp_min [samples per pixel]' : 'n_min [samples]';
+  $('n-max-label').textContent = render ? 'spp_max [samples per pixel]' : 'n_max [samples]';
+  $('ladder-note').textContent = render
+    ? 'spp runs over the powers of two in [spp_min, spp_max]: each estimator renders “replicates” images of width × height pixels at each spp, compared with a reference rendered first.'
+    : 'N runs over the powers of two in [n_min, n_max].';
+  const calLabel = document.querySelector('label[for="calibration-level"]');
+  if (calLabel) calLabel.textContent = render ? 'spp' : 'N';
+  const rules = paramRules(kind);
+  for (const [key, id] of Object.entries(PARAM_INPUTS)) {
+    const [lo, hi] = rules[key] || [];
+    if (lo !== undefined) $(id).min = String(lo);
+    if (hi !== undefined && hi <= Number.MAX_SAFE_INTEGER && key !== 'seed') $(id).max = String(hi);
+  }
+}
+
+function sceneFacts(info) {
+  if (!info) return '';
+  const render = info.kind === KIND.RENDER;
+  if (info.provisional) {
+    return render ? `render scene · ${info.width}×${info.height} px · loading…` : `dimension ${info.dimension ?? '?'} · loading…`;
+  }
+  if (render) {
+    const ref = info.reference || {};
+    const refEst = ref.estimator ? ref.estimator.strategy : '?';
+    return [`render scene ${info.width}×${info.height} px`, `${info.triangles} triangles`, `${info.lights} emitting triangles`,
+      info.accel ? `accelerator ${info.accel.kind}` : null, `scene's spp: ${info.n_min}..${info.n_max}, ${info.reps} replicates`,
+      `reference: ${refEst} at ${ref.spp} spp`,
+      info.warnings && info.warnings.length ? `${info.warnings.length} loader warning(s): ${info.warnings.map((w) => w.message || w).join('; ')}` : null,
+    ].filter(Boolean).join(' · ');
+  }
+  return [`dimension ${info.dimension}`, `domain ${info.domain}`,
+    info.exact === null || info.exact === undefined ? 'exact value unknown' : `exact ${fmt(info.exact, 10)}`,
+    `scene's N: ${info.n_min}..${info.n_max}`].join(' · ');
+}
 
 function option(value, text) {
   const o = document.createElement('option');
@@ -57,24 +106,32 @@ export function syncControls(state) {
   const select = $('scene');
   if (sSig !== scenesSig) {
     scenesSig = sSig;
-    select.replaceChildren(...state.scenes.map((s) => option(s.name, `${s.name}  (${s.dimension ?? '?'}D)`)),
-      option(CUSTOM, 'custom: f and p typed below'));
+    const integrals = state.scenes.filter((s) => kindOf(s) !== KIND.RENDER);
+    const renders = state.scenes.filter((s) => kindOf(s) === KIND.RENDER);
+    const group = (label, items) => {
+      const g = document.createElement('optgroup');
+      g.label = label;
+      g.append(...items);
+      return g;
+    };
+    const items = [...integrals.map((s) => option(s.name, `${s.name}  (${s.dimension ?? '?'}D)`)),
+      option(CUSTOM, 'custom: f and p typed below')];
+    select.replaceChildren(...(renders.length
+      ? [group('Integrals', items), group('Render scenes (glTF)', renders.map((s) => option(s.name, `${s.name}  (render)`)))]
+      : items));
   }
   if (state.sceneId && select.value !== state.sceneId) select.value = state.sceneId;
 
   const info = state.sceneInfo;
+  const kind = kindOf(info);
+  showKind(kind);
   $('scene-description').textContent = info ? info.description || '' : '';
-  $('scene-facts').textContent = info && info.provisional
-    ? `dimension ${info.dimension ?? '?'} · loading…`
-    : info
-    ? [`dimension ${info.dimension}`, `domain ${info.domain}`,
-      info.exact === null || info.exact === undefined ? 'exact value unknown' : `exact ${fmt(info.exact, 10)}`,
-      `scene's N: ${info.n_min}..${info.n_max}`].join(' · ')
-    : '';
+  $('scene-facts').textContent = sceneFacts(info);
 
   // Estimators
   const names = info ? info.estimators : [];
-  const eSig = JSON.stringify([state.sceneId, names]);
+  const details = info && Array.isArray(info.estimatorDetails) ? info.estimatorDetails : [];
+  const eSig = JSON.stringify([state.sceneId, names, details]);
   const list = $('estimator-list');
   if (eSig !== estimatorsSig) {
     estimatorsSig = eSig;
@@ -85,6 +142,8 @@ export function syncControls(state) {
       box.dataset.estimator = name;
       const label = document.createElement('label');
       label.htmlFor = box.id;
+      const d = details.find((e) => e && e.name === name);
+      if (d) label.title = renderFacts(d);
       const sw = document.createElement('span');
       sw.className = 'swatch';
       sw.style.background = colorAt(i);
@@ -100,8 +159,9 @@ export function syncControls(state) {
     const input = $(id);
     const invalid = Boolean(state.paramErrors[key]);
     input.setAttribute('aria-invalid', String(invalid));
-    if (!invalid && document.activeElement !== input && input.value !== String(state.params[key])) {
-      input.value = String(state.params[key]);
+    const value = state.params[key];
+    if (!invalid && document.activeElement !== input && value !== null && value !== undefined && input.value !== String(value)) {
+      input.value = String(value);
     }
   }
 
@@ -119,7 +179,12 @@ export function syncControls(state) {
   if (run.workers) {
     const secs = run.elapsed !== null ? ` in ${(run.elapsed / 1000).toFixed(2)} s` : '';
     info2 = `${run.order.length} estimator${run.order.length === 1 ? '' : 's'} on ${run.workers} worker${run.workers === 1 ? '' : 's'}${secs}`;
-    if (run.settings) info2 += ` · N ${run.settings.n_min}..${run.settings.n_max}, ${run.settings.reps} reps, seed ${run.settings.seed}`;
+    if (run.settings && run.kind === KIND.RENDER) {
+      info2 += ` · spp ${run.settings.n_min}..${run.settings.n_max}, ${run.settings.width}×${run.settings.height} px, ${run.settings.reps} reps, seed ${run.settings.seed}`;
+      if (run.status === 'running' && !run.order.some((n) => run.records[n])) info2 += ' · rendering the reference first…';
+    } else if (run.settings) {
+      info2 += ` · N ${run.settings.n_min}..${run.settings.n_max}, ${run.settings.reps} reps, seed ${run.settings.seed}`;
+    }
   }
   $('run-info').textContent = info2;
   $('notice').textContent = state.notice;

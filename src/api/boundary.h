@@ -1,0 +1,37 @@
+// Helpers of the extern "C" boundary shared by the integration API (api.cpp) and the render
+// API (src/render_api): the thread's last error message, malloc'd result strings, and JSON
+// text that never throws on odd bytes in user strings.
+#pragma once
+
+#include <cstdlib>
+#include <cstring>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+namespace mcp::boundary {
+
+inline thread_local std::string g_last_error;
+
+inline int fail(int status, const std::string& message) {
+    g_last_error = message;
+    return status;
+}
+
+inline int succeed() {
+    g_last_error.clear();
+    return 0;
+}
+
+/// A malloc'd copy for the caller to release with mcp_free (nullptr when out of memory).
+inline char* copy_out(const std::string& s) {
+    char* p = static_cast<char*>(std::malloc(s.size() + 1));
+    if (p) std::memcpy(p, s.c_str(), s.size() + 1);
+    return p;
+}
+
+inline std::string dump(const nlohmann::json& j, int indent = -1) {
+    return j.dump(indent, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
+} // namespace mcp::boundary

@@ -1,0 +1,459 @@
+// Ray-scene intersection: the watertight ray-triangle test [Woop13], a binned-SAH BVH
+// [Wald07] flattened depth first, and its traversal with a robust slab test [Ize13].
+//
+// Robustness, in order of where it matters:
+// - Triangle test: every vertex is translated and sheared into the ray's frame by the same
+//   arithmetic whichever triangle it belongs to, and the 2D edge function of an edge P->Q is
+//   an antisymmetric function of (P, Q) alone (a product difference, recomputed exactly from
+//   fma remainders when it rounds to 0), so two triangles sharing an edge see opposite signs
+//   and no ray slips between them [Woop13, sec. 3-4].
+// - Boxes: a hit accepted by the triangle test may lie outside the exact triangle by the
+//   rounding of its transformed vertices (a few ulps of |p - origin|). Node boxes are padded
+//   by 2^-32 of the scene's largest coordinate, and the slab test widens its far distances by
+//   a relative 2^-40 (far more than the 1 + 2 gamma_3 of [Ize13]), so a box never culls a
+//   hit its triangles would report: BVH and brute force return the same hits.
+// - Ties: the closest hit prefers the lower mesh triangle id among hits at exactly the same
+//   t, so the answer does not depend on traversal order.
+//
+// Timing (for the lead's benchmark): build once with Accelerator::build(scene.mesh), then
+// time a loop of N intersect() (or occluded()) calls over precomputed rays (e.g. camera
+// rays through jittered pixel positions plus cosine-distributed bounce rays from their hit
+// points), count hits so the loop is not optimised away, and report N / seconds. stats()
+// gives nodes, leaves, depth and bytes for the report. Per ray there is no allocation.
+#include "render/accel.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace mcp {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr uint32_t kMaxDepth = 64;         // build guard; also the traversal stack size
+constexpr uint32_t kLeafTriangles = 2;     // nodes this small are always leaves
+constexpr uint32_t kMaxLeafTriangles = 16; // larger nodes split even when SAH says no
+constexpr int kBins = 16;                  // [Wald07] uses 8-32
+constexpr double kTraversalCost = 1.0;     // SAH cost of one node visit ...
+constexpr double kIntersectCost = 1.0;     // ... relative to one triangle test
+constexpr double kBoxPad = 0x1p-32;        // of the scene's largest coordinate
+constexpr double kFarScale = 1.0 + 0x1p-40;
+
+/// Everything about a ray that the triangle and box tests reuse [Woop13, sec. 3; Ize13].
+struct RayPrep {
+    double o[3];
+    int kx, ky, kz;      // axis permutation: kz is the largest |direction| component
+    double sx, sy, sz;   // shear that maps the direction to (0, 0, 1)
+    double inv[3];       // 1 / direction (+-inf for zero components)
+    int near[3], far[3]; // per axis, the index into Node::bounds of the entry / exit plane
+    double zero;         // 0, from memory: a literal 0 turns the first max into a branch
+};
+
+/// False for rays no triangle can be reported for: zero, infinite or NaN direction or
+/// origin, or t_max <= 0 / NaN.
+bool prepare(const Ray& ray, RayPrep* r) {
+    const double d[3] = {ray.direction.x, ray.direction.y, ray.direction.z};
+    const double* o = &ray.origin.x;
+    // x - x is NaN exactly when x is infinite or NaN.
+    const double finite = (d[0] - d[0]) + (d[1] - d[1]) + (d[2] - d[2]) + (o[0] - o[0]) +
+                          (o[1] - o[1]) + (o[2] - o[2]);
+    if (!(finite == 0.0) || !(ray.t_max > 0.0)) return false;
+    const double ax = std::fabs(d[0]), ay = std::fabs(d[1]), az = std::fabs(d[2]);
+    const int kz = ax > ay ? (ax > az ? 0 : 2) : (ay > az ? 1 : 2);
+    if (!(std::fabs(d[kz]) > 0.0)) return false;
+    int kx = kz == 2 ? 0 : kz + 1;
+    int ky = kx == 2 ? 0 : kx + 1;
+    if (d[kz] < 0.0) std::swap(kx, ky); // keeps the winding, hence the sign of the edges
+    for (int k = 0; k < 3; ++k) {
+        r->o[k] = o[k];
+        r->inv[k] = 1.0 / d[k]; // -0 gives -inf: the sign still orders the planes
+        const int neg = std::signbit(r->inv[k]) ? 1 : 0;
+        r->near[k] = k + 3 * neg;
+        r->far[k] = k + 3 - 3 * neg;
+    }
+    r->kx = kx;
+    r->ky = ky;
+    r->kz = kz;
+    r->sz = r->inv[kz];
+    r->sx = d[kx] * r->sz;
+    r->sy = d[ky] * r->sz;
+    r->zero = 0.0;
+    return true;
+}
+
+/// a b - c d exactly rounded in sign: the rounded products plus their exact fma remainders.
+/// Called only when the plain difference rounded to 0, i.e. the rounded products are equal,
+/// where the sign of the remainders' difference is the exact sign [Woop13, sec. 4.3 uses
+/// a wider type for the same purpose].
+double exact_difference(double a, double b, double c, double d) {
+    const double p = a * b, q = c * d;
+    return (p - q) + (std::fma(a, b, -p) - std::fma(c, d, -q));
+}
+
+/// Edge functions and scaled distance of a hit: t = T / det, b1 = v / det, b2 = w / det.
+struct TriHit {
+    double t, v, w, det;
+};
+
+/// [Woop13, fig. 2] in double precision, double-sided. Fills *h on a hit with t > 0; the
+/// caller compares t with its t_max.
+inline bool watertight(const RayPrep& r, const Vec3* p, TriHit* h) {
+    const double* p0 = &p[0].x;
+    const double* p1 = &p[1].x;
+    const double* p2 = &p[2].x;
+    // Translate to the ray origin and shear: the ray becomes the +z axis.
+    const double a_z = p0[r.kz] - r.o[r.kz];
+    const double b_z = p1[r.kz] - r.o[r.kz];
+    const double c_z = p2[r.kz] - r.o[r.kz];
+    const double a_x = (p0[r.kx] - r.o[r.kx]) - r.sx * a_z;
+    const double a_y = (p0[r.ky] - r.o[r.ky]) - r.sy * a_z;
+    const double b_x = (p1[r.kx] - r.o[r.kx]) - r.sx * b_z;
+    const double b_y = (p1[r.ky] - r.o[r.ky]) - r.sy * b_z;
+    const double c_x = (p2[r.kx] - r.o[r.kx]) - r.sx * c_z;
+    const double c_y = (p2[r.ky] - r.o[r.ky]) - r.sy * c_z;
+    // 2D edge functions; the edge P->Q is always Q.x P.y - Q.y P.x.
+    double u = c_x * b_y - c_y * b_x;
+    double v = a_x * c_y - a_y * c_x;
+    double w = b_x * a_y - b_y * a_x;
+    if ((u == 0.0) | (v == 0.0) | (w == 0.0)) {
+        if (u == 0.0) u = exact_difference(c_x, b_y, c_y, b_x);
+        if (v == 0.0) v = exact_difference(a_x, c_y, a_y, c_x);
+        if (w == 0.0) w = exact_difference(b_x, a_y, b_y, a_x);
+    }
+    if (((u < 0.0) | (v < 0.0) | (w < 0.0)) & ((u > 0.0) | (v > 0.0) | (w > 0.0))) return false;
+    const double det = u + v + w;
+    if (det == 0.0) return false;
+    const double tt = (u * (r.sz * a_z) + v * (r.sz * b_z) + w * (r.sz * c_z)) / det;
+    if (!(tt > 0.0)) return false; // also rejects NaN
+    h->t = tt;
+    h->v = v;
+    h->w = w;
+    h->det = det;
+    return true;
+}
+
+inline double max_keep(double x, double y) {
+    return x > y ? x : y;
+}
+inline double min_keep(double x, double y) {
+    return x < y ? x : y;
+}
+
+/// Slab test [KayKajiya86] with the conservative far distances of [Ize13]: true when the
+/// ray's [0, t_max] meets the box, with the entry distance in *t_enter. NaN from 0 * inf
+/// (origin on a plane, direction parallel to it) leaves the interval unchanged, i.e. counts
+/// as inside.
+inline bool box_hit(const double* b, const RayPrep& r, double t_max, double* t_enter) {
+    const double tx0 = (b[r.near[0]] - r.o[0]) * r.inv[0];
+    const double tx1 = (b[r.far[0]] - r.o[0]) * r.inv[0];
+    const double ty0 = (b[r.near[1]] - r.o[1]) * r.inv[1];
+    const double ty1 = (b[r.far[1]] - r.o[1]) * r.inv[1];
+    const double tz0 = (b[r.near[2]] - r.o[2]) * r.inv[2];
+    const double tz1 = (b[r.far[2]] - r.o[2]) * r.inv[2];
+    // x > y ? x : y keeps y when x is NaN (maxsd / minsd on x86, no branch).
+    const double t0 = max_keep(tz0, max_keep(ty0, max_keep(tx0, r.zero)));
+    const double t1 = min_keep(tz1, min_keep(ty1, min_keep(tx1, t_max)));
+    *t_enter = t0;
+    return t0 <= t1 * kFarScale;
+}
+
+// --- Build ------------------------------------------------------------------------------
+
+struct Prim {
+    double lo[3], hi[3], c[3]; // bounds and their centre
+    uint32_t id;
+};
+
+struct Box {
+    double lo[3] = {kInf, kInf, kInf};
+    double hi[3] = {-kInf, -kInf, -kInf};
+    void grow(const double* plo, const double* phi) {
+        for (int k = 0; k < 3; ++k) {
+            lo[k] = std::min(lo[k], plo[k]);
+            hi[k] = std::max(hi[k], phi[k]);
+        }
+    }
+    void grow(const Box& b) { grow(b.lo, b.hi); }
+    /// Half the surface area (SAH only uses ratios).
+    double half_area() const {
+        const double dx = hi[0] - lo[0], dy = hi[1] - lo[1], dz = hi[2] - lo[2];
+        return dx * dy + dy * dz + dz * dx;
+    }
+};
+
+/// Bin of centroid coordinate c on the centroid interval [lo, lo + extent], extent > 0.
+inline int bin_of(double c, double lo, double extent) {
+    const double f = (c - lo) / extent * kBins; // in [0, kBins] as c - lo <= extent
+    const int b = static_cast<int>(f);
+    return b < 0 ? 0 : (b >= kBins ? kBins - 1 : b);
+}
+
+struct SplitDecision {
+    bool leaf;
+    uint32_t mid;
+};
+
+/// Chooses how to treat prims [begin, end) and partitions them: binned SAH on the longest
+/// axis of the centroid bounds [Wald07, sec. 3], cost C_trav + C_isect (A_L N_L + A_R N_R)/A
+/// against the leaf cost C_isect N. Equal centroids split by count.
+SplitDecision decide(std::vector<Prim>& prims, uint32_t begin, uint32_t end, uint32_t depth,
+                     const Box& bounds) {
+    const uint32_t n = end - begin;
+    if (n <= kLeafTriangles || depth >= kMaxDepth) return {true, 0};
+    Box cbox;
+    for (uint32_t i = begin; i < end; ++i) cbox.grow(prims[i].c, prims[i].c);
+    uint32_t axis = 0;
+    double extent = cbox.hi[0] - cbox.lo[0];
+    for (uint32_t k = 1; k < 3; ++k) {
+        if (cbox.hi[k] - cbox.lo[k] > extent) {
+            extent = cbox.hi[k] - cbox.lo[k];
+            axis = k;
+        }
+    }
+    if (!(extent > 0.0) || !std::isfinite(extent)) {
+        if (n <= kMaxLeafTriangles) return {true, 0};
+        // All centroids equal (or overflowing): halve by count, ordered where it means anything.
+        const uint32_t mid = begin + n / 2;
+        std::nth_element(prims.begin() + begin, prims.begin() + mid, prims.begin() + end,
+                         [axis](const Prim& a, const Prim& b) { return a.c[axis] < b.c[axis]; });
+        return {false, mid};
+    }
+    const double clo = cbox.lo[axis];
+    Box bins[kBins];
+    uint32_t counts[kBins] = {};
+    for (uint32_t i = begin; i < end; ++i) {
+        const int b = bin_of(prims[i].c[axis], clo, extent);
+        bins[b].grow(prims[i].lo, prims[i].hi);
+        ++counts[b];
+    }
+    // Sweep from the right: area and count of bins [s, kBins) for the split before bin s.
+    double right_area[kBins];
+    uint32_t right_count[kBins];
+    Box acc;
+    uint32_t cnt = 0;
+    for (int s = kBins - 1; s > 0; --s) {
+        acc.grow(bins[s]);
+        cnt += counts[s];
+        right_area[s] = acc.half_area();
+        right_count[s] = cnt;
+    }
+    acc = Box();
+    cnt = 0;
+    double best_cost = kInf;
+    int best_split = -1;
+    for (int s = 1; s < kBins; ++s) {
+        acc.grow(bins[s - 1]);
+        cnt += counts[s - 1];
+        if (cnt == 0 || right_count[s] == 0) continue;
+        const double cost = acc.half_area() * cnt + right_area[s] * right_count[s];
+        if (cost < best_cost) {
+            best_cost = cost;
+            best_split = s;
+        }
+    }
+    const double area = bounds.half_area();
+    const double split_cost = kTraversalCost * area + kIntersectCost * best_cost;
+    const double leaf_cost = kIntersectCost * n * area;
+    if (best_split < 0) return {n <= kMaxLeafTriangles, begin + n / 2}; // cannot happen
+    if (!(split_cost < leaf_cost) && n <= kMaxLeafTriangles) return {true, 0};
+    const auto it = std::partition(prims.begin() + begin, prims.begin() + end, [&](const Prim& p) {
+        return bin_of(p.c[axis], clo, extent) < best_split;
+    });
+    uint32_t mid = static_cast<uint32_t>(it - prims.begin());
+    if (mid == begin || mid == end) mid = begin + n / 2; // unreachable: both sides counted
+    return {false, mid};
+}
+
+} // namespace
+
+bool intersect_triangle(const Ray& ray, const Vec3& p0, const Vec3& p1, const Vec3& p2, double* t,
+                        double* b1, double* b2) {
+    RayPrep r;
+    if (!prepare(ray, &r)) return false;
+    const Vec3 p[3] = {p0, p1, p2};
+    TriHit h;
+    if (!watertight(r, p, &h) || !(h.t < ray.t_max)) return false;
+    *t = h.t;
+    *b1 = h.v / h.det;
+    *b2 = h.w / h.det;
+    return true;
+}
+
+void Accelerator::build(const Mesh& mesh, AccelKind kind) {
+    stats_ = AccelStats();
+    nodes_.clear();
+    vertices_.clear();
+    triangle_id_.clear();
+
+    // Usable triangles: finite vertices, nonzero cross product.
+    std::vector<Prim> prims;
+    prims.reserve(mesh.triangle_count());
+    double scale = 0.0;
+    for (size_t i = 0; i < mesh.triangle_count(); ++i) {
+        const Vec3 &p0 = mesh.vertex(i, 0), &p1 = mesh.vertex(i, 1), &p2 = mesh.vertex(i, 2);
+        bool finite = true;
+        for (int k = 0; k < 3; ++k) {
+            finite = finite && std::isfinite(p0[k]) && std::isfinite(p1[k]) && std::isfinite(p2[k]);
+        }
+        if (!finite) continue;
+        const Vec3 n = mesh.cross_normal(i);
+        if (n.x == 0.0 && n.y == 0.0 && n.z == 0.0) continue;
+        Prim prim;
+        for (int k = 0; k < 3; ++k) {
+            prim.lo[k] = std::min(std::min(p0[k], p1[k]), p2[k]);
+            prim.hi[k] = std::max(std::max(p0[k], p1[k]), p2[k]);
+            prim.c[k] = 0.5 * prim.lo[k] + 0.5 * prim.hi[k];
+            scale = std::max(scale, std::max(std::fabs(prim.lo[k]), std::fabs(prim.hi[k])));
+        }
+        prim.id = static_cast<uint32_t>(i);
+        prims.push_back(prim);
+    }
+    const uint32_t n = static_cast<uint32_t>(prims.size());
+    if (kind == AccelKind::Auto) {
+        kind = n <= kBruteForceMaxTriangles ? AccelKind::BruteForce : AccelKind::Bvh;
+    }
+    stats_.kind = kind;
+
+    if (kind == AccelKind::Bvh && n > 0) {
+        const double pad = kBoxPad * scale;
+        nodes_.reserve(2 * size_t(n) - 1);
+        struct Task {
+            uint32_t begin, end, depth, parent;
+            bool right;
+        };
+        std::vector<Task> tasks;
+        tasks.push_back({0, n, 0, 0, false});
+        while (!tasks.empty()) {
+            const Task task = tasks.back();
+            tasks.pop_back();
+            const uint32_t index = static_cast<uint32_t>(nodes_.size());
+            nodes_.emplace_back();
+            if (task.right) nodes_[task.parent].index = index;
+            Box bounds;
+            for (uint32_t i = task.begin; i < task.end; ++i) bounds.grow(prims[i].lo, prims[i].hi);
+            const SplitDecision split = decide(prims, task.begin, task.end, task.depth, bounds);
+            Node& node = nodes_[index];
+            for (int k = 0; k < 3; ++k) {
+                node.bounds[k] = bounds.lo[k] - pad;
+                node.bounds[k + 3] = bounds.hi[k] + pad;
+            }
+            stats_.max_depth = std::max(stats_.max_depth, task.depth);
+            if (split.leaf) {
+                node.index = task.begin;
+                node.count = task.end - task.begin;
+                ++stats_.leaves;
+            } else {
+                // Left child is popped next, so it lands right after its parent.
+                tasks.push_back({split.mid, task.end, task.depth + 1, index, true});
+                tasks.push_back({task.begin, split.mid, task.depth + 1, index, false});
+            }
+        }
+        nodes_.shrink_to_fit();
+        stats_.nodes = static_cast<uint32_t>(nodes_.size());
+    }
+
+    // Triangles in leaf order (build order for brute force).
+    vertices_.resize(3 * size_t(n));
+    triangle_id_.resize(n);
+    for (uint32_t i = 0; i < n; ++i) {
+        const uint32_t id = prims[i].id;
+        triangle_id_[i] = id;
+        for (int k = 0; k < 3; ++k) vertices_[3 * size_t(i) + k] = mesh.vertex(id, k);
+    }
+    stats_.bytes = nodes_.size() * sizeof(Node) + vertices_.size() * sizeof(Vec3) +
+                   triangle_id_.size() * sizeof(uint32_t);
+}
+
+template <bool kAnyHit> bool Accelerator::traverse(const Ray& ray, Hit* hit) const {
+    RayPrep r;
+    if (triangle_id_.empty() || !prepare(ray, &r)) return false;
+    const Vec3* tri = vertices_.data();
+    double best_t = ray.t_max;
+    TriHit best_hit{0.0, 0.0, 0.0, 1.0};
+    uint32_t best = 0;
+    bool found = false;
+    // Tests triangle i (leaf order); true when an any-hit query can stop.
+    auto test = [&](uint32_t i) {
+        TriHit h;
+        if (!watertight(r, tri + 3 * size_t(i), &h)) return false;
+        if (kAnyHit) return h.t < ray.t_max;
+        if (h.t < best_t || (found && h.t == best_t && triangle_id_[i] < triangle_id_[best])) {
+            best_t = h.t;
+            best_hit = h;
+            best = i;
+            found = true;
+        }
+        return false;
+    };
+
+    if (nodes_.empty()) {
+        const uint32_t n = static_cast<uint32_t>(triangle_id_.size());
+        for (uint32_t i = 0; i < n; ++i) {
+            if (test(i)) return true;
+        }
+    } else {
+        // Children are tested at their parent; the nearer one is visited first, the other
+        // waits on the stack with its entry distance and is skipped if a hit got closer.
+        struct Pending {
+            uint32_t node;
+            double t_enter;
+        };
+        Pending stack[kMaxDepth];
+        uint32_t top = 0, current = 0;
+        const Node* nodes = nodes_.data();
+        double t_root;
+        bool visit = box_hit(nodes[0].bounds, r, best_t, &t_root);
+        while (visit) {
+            const Node& node = nodes[current];
+            if (node.count == 0) {
+                uint32_t near = current + 1, far = node.index;
+                double t_near, t_far;
+                const bool hit_near = box_hit(nodes[near].bounds, r, best_t, &t_near);
+                const bool hit_far = box_hit(nodes[far].bounds, r, best_t, &t_far);
+                if (hit_near && hit_far) {
+                    if (t_far < t_near) {
+                        std::swap(near, far);
+                        std::swap(t_near, t_far);
+                    }
+                    stack[top++] = {far, t_far};
+                    current = near;
+                    continue;
+                }
+                if (hit_near | hit_far) {
+                    current = hit_near ? near : far;
+                    continue;
+                }
+            } else {
+                const uint32_t end = node.index + node.count;
+                for (uint32_t i = node.index; i < end; ++i) {
+                    if (test(i)) return true;
+                }
+            }
+            visit = false;
+            while (top > 0) {
+                const Pending& p = stack[--top];
+                if (p.t_enter <= best_t * kFarScale) {
+                    current = p.node;
+                    visit = true;
+                    break;
+                }
+            }
+        }
+    }
+    if (kAnyHit || !found) return false;
+    hit->t = best_hit.t;
+    hit->triangle = triangle_id_[best];
+    hit->b1 = best_hit.v / best_hit.det;
+    hit->b2 = best_hit.w / best_hit.det;
+    return true;
+}
+
+bool Accelerator::intersect(const Ray& ray, Hit* hit) const {
+    return traverse<false>(ray, hit);
+}
+
+bool Accelerator::occluded(const Ray& ray) const {
+    return traverse<true>(ray, nullptr);
+}
+
+} // namespace mcp

@@ -1,0 +1,63 @@
+// Ray-scene intersection: a bounding volume hierarchy built with binned SAH [Wald07], or a
+// brute-force loop when the scene is too small for a BVH to pay, both on the watertight
+// ray-triangle test of [Woop13].
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "render/scene.h"
+
+namespace mcp {
+
+/// Watertight ray-triangle intersection [Woop13, "Watertight Ray/Triangle Intersection",
+/// JCGT 2(1)]: no ray passes between two triangles that share an edge. Returns true and
+/// fills t, b1, b2 (barycentrics of p1 and p2) for a hit with 0 < t < t_max. Double-sided.
+bool intersect_triangle(const Ray& ray, const Vec3& p0, const Vec3& p1, const Vec3& p2, double* t,
+                        double* b1, double* b2);
+
+enum class AccelKind { Auto, BruteForce, Bvh };
+
+struct AccelStats {
+    AccelKind kind = AccelKind::BruteForce; ///< what was built (never Auto)
+    uint32_t nodes = 0, leaves = 0, max_depth = 0;
+    uint64_t bytes = 0; ///< memory of the structure
+};
+
+class Accelerator {
+  public:
+    /// Scenes with at most this many triangles are intersected by brute force under Auto.
+    static constexpr size_t kBruteForceMaxTriangles = 16;
+
+    /// Builds over the mesh's triangles (which must outlive nothing: the accelerator keeps
+    /// its own copy of the vertices it needs). Triangles with a non-finite vertex coordinate
+    /// or an exactly zero cross_normal are left out: they are never hit.
+    void build(const Mesh& mesh, AccelKind kind = AccelKind::Auto);
+
+    /// Closest hit with 0 < t < ray.t_max; false when there is none. Among hits at exactly
+    /// the same t the lowest triangle id wins, so BVH and brute force give the same answer.
+    bool intersect(const Ray& ray, Hit* hit) const;
+    /// Any hit with 0 < t < ray.t_max (shadow rays).
+    bool occluded(const Ray& ray) const;
+
+    const AccelStats& stats() const { return stats_; }
+
+  private:
+    /// Flattened depth-first BVH node (64 bytes): the left child of an interior node is the
+    /// next node, the right child is at `index`. Traversal tests both children's boxes at
+    /// their parent and visits the nearer first.
+    struct Node {
+        double bounds[6];   ///< lo.x, lo.y, lo.z, hi.x, hi.y, hi.z, padded outwards
+        uint32_t index = 0; ///< interior: right child; leaf: first triangle (leaf order)
+        uint32_t count = 0; ///< triangles of a leaf; 0 for an interior node
+        uint32_t unused[2] = {0, 0};
+    };
+    template <bool kAnyHit> bool traverse(const Ray& ray, Hit* hit) const;
+
+    AccelStats stats_;
+    std::vector<Node> nodes_;           // empty for brute force
+    std::vector<Vec3> vertices_;        // p0, p1, p2 of each triangle, in leaf order
+    std::vector<uint32_t> triangle_id_; // leaf order -> mesh triangle id
+};
+
+} // namespace mcp

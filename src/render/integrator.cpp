@@ -1,0 +1,366 @@
+#include "render/integrator.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+namespace mcp {
+
+namespace {
+
+struct StrategyName {
+    RadianceStrategy strategy;
+    const char* name;
+};
+constexpr StrategyName kStrategyNames[] = {
+    {RadianceStrategy::UniformHemisphere, "uniform_hemisphere"},
+    {RadianceStrategy::CosineHemisphere, "cosine_hemisphere"},
+    {RadianceStrategy::Bsdf, "bsdf"},
+    {RadianceStrategy::LightArea, "light_area"},
+    {RadianceStrategy::LightSolidAngle, "light_solid_angle"},
+    {RadianceStrategy::MisBalance, "mis_balance"},
+    {RadianceStrategy::MisPower, "mis_power"},
+    {RadianceStrategy::Path, "path"},
+};
+
+bool is_black(const Vec3& c) { return c.x == 0.0 && c.y == 0.0 && c.z == 0.0; }
+
+/// The multiple importance sampling weight of a sample drawn with density p_this when the
+/// other strategy would have drawn it with density p_other, one sample each: the balance
+/// heuristic p / (p + q), or the power heuristic p^2 / (p^2 + q^2) [Veach97, 9.2.2, 9.2.4].
+double mis_weight(double p_this, double p_other, bool power) {
+    if (!(p_this > 0.0)) return 0.0;
+    if (!(p_other > 0.0)) return 1.0;
+    if (power) {
+        // Divide first: p^2 overflows for the huge densities of tiny lights and near-mirrors.
+        double r = p_other / p_this;
+        return 1.0 / (1.0 + r * r);
+    }
+    return 1.0 / (1.0 + p_other / p_this);
+}
+
+/// A shading point: position, geometric normal turned towards the arriving ray, shading
+/// frame (interpolated normal on the same side), BRDF parameters and the outgoing direction
+/// in the shading frame.
+struct ShadingPoint {
+    Vec3 p, ng;
+    Frame frame;
+    BsdfParams bsdf;
+    Vec3 wo_local;
+    uint32_t triangle = 0;
+};
+
+ShadingPoint shade(const Scene& scene, const Ray& ray, const Hit& hit) {
+    const Mesh& mesh = scene.mesh;
+    ShadingPoint sp;
+    sp.triangle = hit.triangle;
+    const auto& idx = mesh.index[hit.triangle];
+    double b0 = 1.0 - hit.b1 - hit.b2;
+    const Vec3 &p0 = mesh.position[idx[0]], &p1 = mesh.position[idx[1]],
+               &p2 = mesh.position[idx[2]];
+    sp.p = b0 * p0 + hit.b1 * p1 + hit.b2 * p2;
+    Vec3 wo = -glm::normalize(ray.direction);
+    sp.ng = glm::normalize(glm::cross(p1 - p0, p2 - p0));
+    if (glm::dot(sp.ng, wo) < 0.0) sp.ng = -sp.ng;
+    Vec3 ns = sp.ng;
+    if (!mesh.normal.empty()) {
+        Vec3 n = b0 * mesh.normal[idx[0]] + hit.b1 * mesh.normal[idx[1]] +
+                 hit.b2 * mesh.normal[idx[2]];
+        double len = glm::length(n);
+        if (len > 0.0 && std::isfinite(len)) {
+            n /= len;
+            ns = glm::dot(n, sp.ng) < 0.0 ? -n : n;
+        }
+    }
+    sp.frame = Frame::from_normal(ns);
+    sp.wo_local = sp.frame.to_local(wo);
+    sp.bsdf = material_at(scene, hit);
+    return sp;
+}
+
+/// Is the segment from the shading point to a light point free? Both ends are moved off
+/// their surfaces, and the ray stops just short of the light point.
+bool visible(const RenderScene& rs, const ShadingPoint& sp, const Vec3& light_point,
+             const Vec3& light_normal, SampleCounters& c) {
+    Vec3 to_light = light_point - sp.p;
+    Ray shadow;
+    shadow.origin = offset_ray_origin(sp.p, sp.ng, to_light);
+    Vec3 target = offset_ray_origin(light_point, light_normal, -to_light);
+    shadow.direction = target - shadow.origin;
+    shadow.t_max = 1.0;
+    ++c.rays;
+    return !rs.accel.occluded(shadow);
+}
+
+Ray spawn_ray(const ShadingPoint& sp, const Vec3& direction) {
+    Ray r;
+    r.origin = offset_ray_origin(sp.p, sp.ng, direction);
+    r.direction = direction;
+    return r;
+}
+
+/// One light sample's contribution f Le cos / p, times its MIS weight against BSDF sampling
+/// when `mis` is set.
+Vec3 light_sample_term(const RenderScene& rs, const LightSet& lights, LightSampling mode,
+                       const ShadingPoint& sp, PixelSampler& sampler, SampleCounters& c,
+                       bool mis, bool power) {
+    double u_select = sampler.get_1d();
+    Vec2 u = sampler.get_2d();
+    LightSample ls = lights.sample(sp.p, u_select, u, mode);
+    if (!ls.valid || !(ls.pdf > 0.0)) {
+        ++c.light_misses;
+        return Vec3(0.0);
+    }
+    if (is_black(ls.radiance)) return Vec3(0.0);
+    Vec3 to_light = ls.point - sp.p;
+    double dist = glm::length(to_light);
+    if (!(dist > 0.0)) return Vec3(0.0);
+    Vec3 wi = to_light / dist;
+    if (glm::dot(wi, sp.ng) <= 0.0) return Vec3(0.0); // below the surface: no light leaks
+    Vec3 wi_local = sp.frame.to_local(wi);
+    if (wi_local.z <= 0.0) return Vec3(0.0);
+    Vec3 f = bsdf_eval(sp.bsdf, sp.wo_local, wi_local);
+    if (is_black(f)) return Vec3(0.0);
+    if (!visible(rs, sp, ls.point, ls.normal, c)) return Vec3(0.0);
+    double w = mis ? mis_weight(ls.pdf, bsdf_pdf(sp.bsdf, sp.wo_local, wi_local), power) : 1.0;
+    return f * ls.radiance * (wi_local.z * w / ls.pdf);
+}
+
+/// Emitted radiance found along a sampled direction with density `pdf` (in solid angle):
+/// traces the ray and returns Le at the hit, or 0. `hit_out` receives the hit for paths.
+struct DirectionResult {
+    bool hit = false;
+    Hit h;
+    Vec3 emitted{0.0};
+};
+DirectionResult trace_direction(const RenderScene& rs, const ShadingPoint& sp, const Vec3& wi,
+                                SampleCounters& c) {
+    DirectionResult r;
+    Ray ray = spawn_ray(sp, wi);
+    ++c.rays;
+    r.hit = rs.accel.intersect(ray, &r.h);
+    if (r.hit) r.emitted = rs.lights_uniform.emitted(r.h.triangle, -wi);
+    return r;
+}
+
+/// Direct lighting by sampling directions: wi from the uniform hemisphere, the cosine
+/// hemisphere or the BRDF, weighted f Le cos / p (times the MIS weight against light
+/// sampling when `mis` is set).
+Vec3 direction_sample_term(const RenderScene& rs, const RenderEstimator& est,
+                           const LightSet& lights, const ShadingPoint& sp,
+                           PixelSampler& sampler, SampleCounters& c, bool mis, bool power) {
+    Vec3 wi_local, f;
+    double pdf = 0.0;
+    bool delta = false;
+    switch (est.strategy) {
+    case RadianceStrategy::UniformHemisphere:
+    case RadianceStrategy::CosineHemisphere: {
+        Vec2 u = sampler.get_2d();
+        if (est.strategy == RadianceStrategy::UniformHemisphere) {
+            wi_local = sample_uniform_hemisphere(u);
+            pdf = uniform_hemisphere_pdf();
+        } else {
+            wi_local = sample_cosine_hemisphere(u);
+            pdf = cosine_hemisphere_pdf(wi_local.z);
+        }
+        if (!(pdf > 0.0) || wi_local.z <= 0.0) return Vec3(0.0);
+        f = bsdf_eval(sp.bsdf, sp.wo_local, wi_local);
+        break;
+    }
+    default: {
+        double u_lobe = sampler.get_1d();
+        Vec2 u = sampler.get_2d();
+        BsdfSample bs = bsdf_sample(sp.bsdf, sp.wo_local, u_lobe, u);
+        if (!bs.valid || !(bs.pdf > 0.0)) return Vec3(0.0);
+        wi_local = bs.wi;
+        f = bs.f;
+        pdf = bs.pdf;
+        delta = bs.delta;
+        break;
+    }
+    }
+    if (is_black(f)) return Vec3(0.0);
+    Vec3 wi = sp.frame.to_world(wi_local);
+    if (glm::dot(wi, sp.ng) <= 0.0) return Vec3(0.0);
+    DirectionResult d = trace_direction(rs, sp, wi, c);
+    if (!d.hit || is_black(d.emitted)) return Vec3(0.0);
+    double w = 1.0;
+    if (mis && !delta) {
+        Vec3 p_light = sp.p + wi * d.h.t;
+        double light_pdf = lights.pdf(sp.p, d.h.triangle, p_light, est.light_sampling);
+        w = mis_weight(pdf, light_pdf, power);
+    }
+    return f * d.emitted * (wi_local.z * w / pdf);
+}
+
+/// The direct-lighting estimators: emission seen by the camera plus one estimate of the
+/// reflected direct light at the first hit.
+RadianceSample direct_radiance(const RenderScene& rs, const RenderEstimator& est,
+                               const Ray& camera_ray, PixelSampler& sampler, SampleCounters& c) {
+    RadianceSample out;
+    Hit hit;
+    ++c.rays;
+    if (!rs.accel.intersect(camera_ray, &hit)) return out;
+    const Scene& scene = *rs.scene;
+    Vec3 wo = -glm::normalize(camera_ray.direction);
+    out.emitted = rs.lights_uniform.emitted(hit.triangle, wo);
+    ShadingPoint sp = shade(scene, camera_ray, hit);
+    if (sp.wo_local.z <= 0.0) return out;
+    const LightSet& lights = rs.lights(est.light_selection);
+    if (lights.empty()) return out;
+    switch (est.strategy) {
+    case RadianceStrategy::LightArea:
+        out.reflected =
+            light_sample_term(rs, lights, LightSampling::Area, sp, sampler, c, false, false);
+        break;
+    case RadianceStrategy::LightSolidAngle:
+        out.reflected =
+            light_sample_term(rs, lights, LightSampling::SolidAngle, sp, sampler, c, false, false);
+        break;
+    case RadianceStrategy::MisBalance:
+    case RadianceStrategy::MisPower: {
+        bool power = est.strategy == RadianceStrategy::MisPower;
+        out.reflected =
+            light_sample_term(rs, lights, est.light_sampling, sp, sampler, c, true, power) +
+            direction_sample_term(rs, est, lights, sp, sampler, c, true, power);
+        break;
+    }
+    default:
+        out.reflected = direction_sample_term(rs, est, lights, sp, sampler, c, false, false);
+        break;
+    }
+    return out;
+}
+
+/// Path tracing with next-event estimation: at every vertex one light sample and one BSDF
+/// sample, weighted by the power heuristic, the BSDF sample continuing the path [Veach97, 9.2;
+/// PharrJakobHumphreys23, 13.4]. Russian roulette from rr_depth on survives with probability
+/// min(0.95, max throughput component), dividing the throughput by it (unbiased).
+RadianceSample path_radiance(const RenderScene& rs, const RenderEstimator& est,
+                             const Ray& camera_ray, PixelSampler& sampler, SampleCounters& c) {
+    const Scene& scene = *rs.scene;
+    const LightSet& lights = rs.lights(est.light_selection);
+    Vec3 L(0.0), beta(1.0), emitted(0.0);
+    Ray ray = camera_ray;
+    bool previous_delta = true; // the camera "samples" its ray: count emission in full
+    double previous_pdf = 0.0;
+    Vec3 previous_point(0.0);
+    for (int depth = 0;; ++depth) {
+        Hit hit;
+        ++c.rays;
+        if (!rs.accel.intersect(ray, &hit)) break;
+        Vec3 wo = -glm::normalize(ray.direction);
+        Vec3 Le = lights.emitted(hit.triangle, wo);
+        if (!is_black(Le)) {
+            double w = 1.0;
+            if (!previous_delta) {
+                Vec3 p = ray.origin + ray.direction * hit.t;
+                w = mis_weight(previous_pdf,
+                               lights.pdf(previous_point, hit.triangle, p, est.light_sampling),
+                               true);
+            }
+            if (depth == 0) emitted = Le;
+            else L += beta * Le * w;
+        }
+        if (depth >= est.max_depth) break;
+        ShadingPoint sp = shade(scene, ray, hit);
+        if (sp.wo_local.z <= 0.0) break;
+        if (!lights.empty())
+            L += beta *
+                 light_sample_term(rs, lights, est.light_sampling, sp, sampler, c, true, true);
+        double u_lobe = sampler.get_1d();
+        Vec2 u = sampler.get_2d();
+        BsdfSample bs = bsdf_sample(sp.bsdf, sp.wo_local, u_lobe, u);
+        if (!bs.valid || !(bs.pdf > 0.0) || is_black(bs.f)) break;
+        Vec3 wi = sp.frame.to_world(bs.wi);
+        if (glm::dot(wi, sp.ng) <= 0.0) break;
+        beta *= bs.f * (bs.wi.z / bs.pdf);
+        previous_delta = bs.delta;
+        previous_pdf = bs.pdf;
+        previous_point = sp.p;
+        ray = spawn_ray(sp, wi);
+        if (depth + 1 >= est.rr_depth) {
+            double q = std::min(0.95, std::max(beta.x, std::max(beta.y, beta.z)));
+            if (!(q > 0.0) || sampler.rng().next_double() >= q) break;
+            beta /= q;
+        }
+    }
+    return RadianceSample{emitted, L};
+}
+
+} // namespace
+
+const char* strategy_name(RadianceStrategy s) {
+    for (const auto& n : kStrategyNames)
+        if (n.strategy == s) return n.name;
+    return "?";
+}
+
+bool parse_strategy(const std::string& name, RadianceStrategy* s) {
+    for (const auto& n : kStrategyNames)
+        if (name == n.name) {
+            *s = n.strategy;
+            return true;
+        }
+    return false;
+}
+
+bool strategy_samples_lights(RadianceStrategy s) {
+    return s == RadianceStrategy::LightArea || s == RadianceStrategy::LightSolidAngle ||
+           s == RadianceStrategy::MisBalance || s == RadianceStrategy::MisPower ||
+           s == RadianceStrategy::Path;
+}
+
+void RenderScene::build(const Scene& s, AccelKind accel_kind) {
+    scene = &s;
+    accel.build(s.mesh, accel_kind);
+    lights_uniform.build(s, LightSelection::Uniform);
+    lights_area.build(s, LightSelection::Area);
+    lights_power.build(s, LightSelection::Power);
+}
+
+const LightSet& RenderScene::lights(LightSelection selection) const {
+    switch (selection) {
+    case LightSelection::Area: return lights_area;
+    case LightSelection::Power: return lights_power;
+    default: return lights_uniform;
+    }
+}
+
+BsdfParams material_at(const Scene& scene, const Hit& hit) {
+    const Mesh& mesh = scene.mesh;
+    BsdfParams b;
+    uint32_t mi = hit.triangle < mesh.material.size() ? mesh.material[hit.triangle] : 0;
+    if (mi >= scene.materials.size()) return b;
+    const Material& m = scene.materials[mi];
+    b.base_color = m.base_color;
+    b.metallic = m.metallic;
+    b.roughness = m.roughness;
+    b.specular = m.specular;
+    if (m.base_color_texture >= 0 && size_t(m.base_color_texture) < scene.textures.size() &&
+        !mesh.uv.empty()) {
+        const Texture& t = scene.textures[size_t(m.base_color_texture)];
+        const auto& idx = mesh.index[hit.triangle];
+        double b0 = 1.0 - hit.b1 - hit.b2;
+        Vec2 uv = b0 * mesh.uv[idx[0]] + hit.b1 * mesh.uv[idx[1]] + hit.b2 * mesh.uv[idx[2]];
+        if (t.width > 0 && t.height > 0 && std::isfinite(uv.x) && std::isfinite(uv.y)) {
+            // Nearest texel, repeat wrapping (the glTF sampler default).
+            double fx = uv.x - std::floor(uv.x), fy = uv.y - std::floor(uv.y);
+            int x = std::min(t.width - 1, int(fx * t.width));
+            int y = std::min(t.height - 1, int(fy * t.height));
+            size_t k = (size_t(y) * size_t(t.width) + size_t(x)) * 3;
+            b.base_color *= Vec3(t.rgb[k], t.rgb[k + 1], t.rgb[k + 2]);
+        }
+    }
+    return b;
+}
+
+RadianceSample sample_radiance(const RenderScene& rs, const RenderEstimator& est,
+                              const Ray& camera_ray, PixelSampler& sampler,
+                              SampleCounters& counters) {
+    if (est.strategy == RadianceStrategy::Path)
+        return path_radiance(rs, est, camera_ray, sampler, counters);
+    return direct_radiance(rs, est, camera_ray, sampler, counters);
+}
+
+} // namespace mcp

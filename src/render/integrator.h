@@ -1,0 +1,97 @@
+// Estimators of the radiance arriving at the camera through one pixel sample.
+//
+// The direct-lighting estimators estimate L(x -> wo) = Le(x -> wo) + integral of
+// f(wo, wi) Li(wi) cos(theta_i) d(wi) at the first visible point x, with Li the emitted
+// radiance reached along wi. The same integral in the area form of the transport equation
+// (the course notes' formula) is an integral over the light points x':
+//   integral f(wo, wi) Le(x' -> x) v(x, x') cos(theta_i) cos(theta') / |x - x'|^2 dA(x'),
+// and the strategies differ only in the density they sample:
+//   uniform_hemisphere  1 / (2 pi) in solid angle
+//   cosine_hemisphere   cos(theta) / pi
+//   bsdf                the BRDF's own sampling density (bsdf.h)
+//   light_area          a light chosen by uniform, area or power weights, then a point
+//                       uniform in its area, the density converted to solid angle by
+//                       |x - x'|^2 / cos(theta') [course notes; PharrJakobHumphreys23, 12.2]
+//   light_solid_angle   a light chosen as above, then a direction uniform in its spherical
+//                       triangle [Arvo95]
+//   mis_balance,        one light sample and one BSDF sample combined by multiple importance
+//   mis_power           sampling with the balance or power (beta = 2) heuristic [Veach97, 9.2]
+//   path                path tracing with next-event estimation, MIS (power heuristic) of
+//                       light and BSDF samples at every vertex, a maximum number of bounces
+//                       and Russian roulette [Veach97; PharrJakobHumphreys23, 13]
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "render/accel.h"
+#include "render/bsdf.h"
+#include "render/lights.h"
+#include "render/pixel_sampler.h"
+#include "render/scene.h"
+
+namespace mcp {
+
+enum class RadianceStrategy {
+    UniformHemisphere,
+    CosineHemisphere,
+    Bsdf,
+    LightArea,
+    LightSolidAngle,
+    MisBalance,
+    MisPower,
+    Path,
+};
+const char* strategy_name(RadianceStrategy s);
+bool parse_strategy(const std::string& name, RadianceStrategy* s);
+/// Does the strategy sample the lights (and so need a light-selection distribution)?
+bool strategy_samples_lights(RadianceStrategy s);
+
+struct RenderEstimator {
+    std::string name; ///< unique within a study: keys its random streams
+    RadianceStrategy strategy = RadianceStrategy::MisPower;
+    LightSelection light_selection = LightSelection::Power;
+    /// How light samples are drawn in mis_* and path (light_area / light_solid_angle fix it).
+    LightSampling light_sampling = LightSampling::SolidAngle;
+    PixelSamplerKind pixel_sampler = PixelSamplerKind::Stratified;
+    int max_depth = 5; ///< path: bounces (1 = direct lighting only)
+    int rr_depth = 3;  ///< path: Russian roulette from this bounce on
+};
+
+/// Per-sample counters, summed per image.
+struct SampleCounters {
+    uint64_t rays = 0;         ///< camera, bounce and shadow rays traced
+    uint64_t light_misses = 0; ///< light samples that came back invalid (degenerate, pdf 0)
+};
+
+/// What the integrator needs of a scene: the scene, its accelerator, and its lights built
+/// for one light-selection rule.
+struct RenderScene {
+    const Scene* scene = nullptr;
+    Accelerator accel;
+    LightSet lights_uniform, lights_area, lights_power;
+
+    /// Builds the accelerator and the light sets (selection tables only where there is more
+    /// than one light). The scene must outlive this object.
+    void build(const Scene& s, AccelKind accel_kind = AccelKind::Auto);
+    const LightSet& lights(LightSelection selection) const;
+};
+
+/// One sample of the radiance towards the camera, split into the emission of the first
+/// visible surface (not random given the camera ray) and the estimate of the light it
+/// reflects (where the estimators differ, and where heavy tails live).
+struct RadianceSample {
+    Vec3 emitted{0.0};
+    Vec3 reflected{0.0};
+    Vec3 total() const { return emitted + reflected; }
+};
+
+/// Radiance carried towards the camera along `camera_ray` (one sample of the estimator),
+/// drawing its random numbers from `sampler`.
+RadianceSample sample_radiance(const RenderScene& rs, const RenderEstimator& est, const Ray& camera_ray,
+                     PixelSampler& sampler, SampleCounters& counters);
+
+/// The BRDF parameters at a hit: the material's factors times its base colour texture.
+BsdfParams material_at(const Scene& scene, const Hit& hit);
+
+} // namespace mcp

@@ -1,0 +1,329 @@
+// Area lights: selection tables, area sampling, spherical-triangle sampling [Arvo95] and
+// Lambert's polygon form factor [Lambert1760].
+#include "render/lights.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "core/special.h" // kPi
+
+namespace mcp {
+
+namespace {
+
+/// The spherical triangle of a mesh triangle seen from a reference point, set up for Arvo's
+/// map. Everything is derived from the vectors a, b, c from the reference point to the
+/// vertices and the edges e1 = p1 - p0, e2 = p2 - p0 taken from the world-space vertices, so
+/// that small or distant triangles keep their relative accuracy: the plane normals of the
+/// arcs are a x e1 (= a x b) and a x e2 (= a x c), the triple product is a . (e1 x e2), and
+/// angles come from atan2 of such products rather than from differences of unit vectors.
+struct SphericalTriangle {
+    Vec3 A{0.0}, B{0.0};  ///< unit directions to vertices 0 and 1
+    Vec3 tangent_ac{0.0}; ///< unit tangent at A of the arc towards C
+    double alpha = 0.0;   ///< interior angle at A, or pi minus it when obtuse
+    bool obtuse = false;  ///< alpha holds pi minus the angle (kept accurate near pi)
+    double sin_half_c = 0.0, cos_half_c = 1.0; ///< of half the arc length AB
+    double arc_b = 0.0;                        ///< arc length AC
+    double omega = 0.0;                        ///< solid angle
+};
+
+/// Solid angle of the triangle (a, b, c) seen from the origin, with det = a . (b x c)
+/// computed by the caller: tan(Omega / 2) = |det| / (|a||b||c| + (a.b)|c| + (a.c)|b| +
+/// (b.c)|a|) [VanOosteromStrackee83]. atan2 keeps the branch right past Omega = pi, where the
+/// denominator turns negative.
+double solid_angle(const Vec3& a, const Vec3& b, const Vec3& c, double det) {
+    double la = glm::length(a), lb = glm::length(b), lc = glm::length(c);
+    double denom = la * lb * lc + glm::dot(a, b) * lc + glm::dot(a, c) * lb + glm::dot(b, c) * la;
+    return 2.0 * std::atan2(std::fabs(det), denom);
+}
+
+/// Solid angles outside [kMinSphericalSolidAngle, kMaxSphericalSolidAngle] (and reference
+/// points on the triangle's plane) are sampled by area instead; see lights.h for why.
+bool spherical_applies(double det, double omega) {
+    return det != 0.0 && omega >= kMinSphericalSolidAngle && omega <= kMaxSphericalSolidAngle;
+}
+
+/// Sin and cos of half the angle between a and b, from |a x b| (computed accurately by the
+/// caller) and a . b, without the cancellation of |a||b| + a.b near antipodal directions:
+/// tan(c/2) = |a x b| / (|a||b| + a.b) = (|a||b| - a.b) / |a x b|.
+void half_angle(double cross_len, double dot_ab, double len_ab, double* sin_half,
+                double* cos_half) {
+    double s = dot_ab >= 0.0 ? cross_len : len_ab - dot_ab;
+    double c = dot_ab >= 0.0 ? len_ab + dot_ab : cross_len;
+    double r = std::hypot(s, c);
+    *sin_half = r > 0.0 ? s / r : 0.0;
+    *cos_half = r > 0.0 ? c / r : 1.0;
+}
+
+/// Fills the map's parameters of the triangle with vertex vectors a, b, c, edges e1 = b - a,
+/// e2 = c - a and triple product det = a . (e1 x e2), det != 0.
+void fill_spherical(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& e1, const Vec3& e2,
+                    double det, SphericalTriangle* st) {
+    Vec3 n_ab = glm::cross(a, e1); // normal of the great circle through A and B
+    Vec3 n_ac = glm::cross(a, e2); // ... through A and C
+    double la = glm::length(a), lb = glm::length(b);
+    // The angle at A is the angle between the two arc planes; |n_ab x n_ac| = |a| |det|
+    // since (a x e1) x (a x e2) = (a . (e1 x e2)) a. Near pi its supplement is kept instead.
+    double cos_term = glm::dot(n_ab, n_ac);
+    st->obtuse = cos_term < 0.0;
+    st->alpha = std::atan2(la * std::fabs(det), std::fabs(cos_term));
+    half_angle(glm::length(n_ab), glm::dot(a, b), la * lb, &st->sin_half_c, &st->cos_half_c);
+    st->arc_b = std::atan2(glm::length(n_ac), glm::dot(a, c));
+    st->A = a / la;
+    st->B = b / lb;
+    st->tangent_ac = glm::normalize(glm::cross(n_ac, st->A)); // (A x C) x A = C - (A.C) A
+}
+
+/// Sets up the spherical triangle; st->omega is always set, the rest only when the
+/// triangle is in the spherical regime (return value true).
+bool setup_spherical(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& e1, const Vec3& e2,
+                     SphericalTriangle* st) {
+    double det = glm::dot(a, glm::cross(e1, e2));
+    st->omega = solid_angle(a, b, c, det);
+    if (!spherical_applies(det, st->omega)) return false;
+    fill_spherical(a, b, c, e1, e2, det, st);
+    return true;
+}
+
+/// Arvo's area-preserving map from the unit square to the spherical triangle [Arvo95]:
+/// u1 picks the sub-triangle A B C' of area u1 Omega (C' on the arc AC), u2 a point on the
+/// arc B C' with 1 - cos(theta) uniform. Arvo's closed form for cos |AC'| is rewritten here
+/// as
+///   tan(|AC'| / 2) = cos(c/2) sin(A'/2) / (sin(c/2) sin(alpha - A'/2)),  A' = u1 Omega,
+/// (our derivation: with phi = A' - alpha, Arvo's law-of-cosines step gives the angle beta'
+/// of the sub-triangle at B as (sin beta', cos beta') ~ (u, -v), u = cos phi - cos alpha =
+/// 2 sin(A'/2) sin(alpha - A'/2), v = sin phi + sin alpha cos c; the four-part formula
+/// sin c cot|AC'| = cos c cos alpha + sin alpha cot beta' then simplifies by half-angle
+/// identities to tan of a double angle). Its factors are all well conditioned: no
+/// cancellation for small sub-triangles and no sqrt(1 - q^2) near q = 1. Likewise the second step,
+/// 1 - cos(theta) = u2 (1 - cos |BC'|), is solved as tan(theta/2) = sqrt(u2) s / sqrt((1 - u2) s^2
+/// + k^2) with s = |C' - B| / 2 and k = |C' + B| / 2 the sine and cosine of |BC'| / 2.
+Vec3 sample_spherical(const SphericalTriangle& st, const Vec2& u) {
+    double half_area = 0.5 * u.x * st.omega;
+    // sin(alpha - A'/2), clamped to alpha >= A'/2 (a sub-triangle fits in its lune).
+    double sin_rest = st.obtuse ? std::sin(std::fmin(kPi, st.alpha + half_area))
+                                : std::sin(std::fmax(0.0, st.alpha - half_area));
+    double num = st.cos_half_c * std::sin(half_area);
+    double den = st.sin_half_c * sin_rest;
+    double arc = std::fmin(2.0 * std::atan2(num, den), st.arc_b); // |AC'|
+    Vec3 c_hat = st.A * std::cos(arc) + st.tangent_ac * std::sin(arc);
+    double s = 0.5 * glm::length(c_hat - st.B), k = 0.5 * glm::length(c_hat + st.B);
+    double theta = 2.0 * std::atan2(std::sqrt(u.y) * s, std::sqrt((1.0 - u.y) * s * s + k * k));
+    Vec3 t = c_hat - st.B * glm::dot(c_hat, st.B);
+    double lt = glm::length(t);
+    if (!(lt > 0.0)) return st.B;
+    return st.B * std::cos(theta) + t * (std::sin(theta) / lt);
+}
+
+/// Solid-angle density of a uniform area sample at `point` seen from ref, per unit (1/A)
+/// area density: d^2 / (A |cos theta_light|) = 2 d^3 / |N . (point - ref)| with N the
+/// unnormalised cross normal (|N| = 2 A). 0 when the point is at ref or seen edge-on.
+double area_to_solid_angle(const Vec3& ref, const Vec3& point, const Vec3& cross_normal) {
+    Vec3 w = point - ref;
+    double d2 = glm::dot(w, w);
+    double cosine = std::fabs(glm::dot(cross_normal, w));
+    if (!(d2 > 0.0) || !(cosine > 0.0)) return 0.0;
+    return 2.0 * d2 * std::sqrt(d2) / cosine;
+}
+
+} // namespace
+
+// --- Light set -------------------------------------------------------------------------
+
+void LightSet::build(const Scene& scene, LightSelection selection) {
+    scene_ = &scene;
+    selection_ = selection;
+    triangles_.clear();
+    selection_cdf_.clear();
+    selection_pmf_.clear();
+    const Mesh& mesh = scene.mesh;
+    light_of_triangle_.assign(mesh.triangle_count(), -1);
+    std::vector<double> weight;
+    total_power_ = 0.0;
+    for (size_t t = 0; t < mesh.triangle_count(); ++t) {
+        uint32_t m = t < mesh.material.size() ? mesh.material[t] : 0u;
+        if (m >= scene.materials.size()) continue;
+        const Material& mat = scene.materials[m];
+        if (!mat.is_emissive()) continue;
+        double area = 0.5 * glm::length(mesh.cross_normal(t));
+        if (!(area > 0.0) || !std::isfinite(area)) continue; // degenerate: never hit
+        // Flux of a Lambertian emitter: pi L A per emitting side.
+        double power = luminance(mat.emission) * area * kPi * (mat.double_sided ? 2.0 : 1.0);
+        light_of_triangle_[t] = int32_t(triangles_.size());
+        triangles_.push_back(uint32_t(t));
+        total_power_ += power;
+        weight.push_back(selection == LightSelection::Area    ? area
+                         : selection == LightSelection::Power ? power
+                                                              : 1.0);
+    }
+    // One light, or uniform choice: no table (index and pmf are arithmetic).
+    if (triangles_.size() <= 1 || selection == LightSelection::Uniform) return;
+    double sum = 0.0;
+    for (double w : weight) sum += w;
+    selection_pmf_.resize(weight.size());
+    selection_cdf_.resize(weight.size() + 1);
+    selection_cdf_[0] = 0.0;
+    double run = 0.0;
+    for (size_t i = 0; i < weight.size(); ++i) {
+        selection_pmf_[i] = weight[i] / sum;
+        run += weight[i];
+        selection_cdf_[i + 1] = run / sum;
+    }
+    selection_cdf_.back() = 1.0;
+}
+
+int LightSet::light_index(uint32_t triangle) const {
+    return triangle < light_of_triangle_.size() ? light_of_triangle_[triangle] : -1;
+}
+
+double LightSet::total_power() const {
+    return total_power_;
+}
+
+double LightSet::selection_pmf(int light) const {
+    if (light < 0 || size_t(light) >= triangles_.size()) return 0.0;
+    if (selection_pmf_.empty()) return 1.0 / double(triangles_.size());
+    return selection_pmf_[size_t(light)];
+}
+
+int LightSet::select(double u_select, double* pmf) const {
+    size_t n = triangles_.size();
+    size_t i;
+    if (selection_cdf_.empty()) {
+        i = std::min(n - 1, size_t(std::fmax(0.0, u_select) * double(n)));
+        *pmf = 1.0 / double(n);
+    } else {
+        // cdf[i] <= u < cdf[i + 1]: lights of zero weight span an empty interval.
+        auto it = std::upper_bound(selection_cdf_.begin(), selection_cdf_.end(), u_select);
+        i = size_t(std::max<std::ptrdiff_t>(0, it - selection_cdf_.begin() - 1));
+        i = std::min(i, n - 1);
+        *pmf = selection_pmf_[i];
+    }
+    return int(i);
+}
+
+LightSample LightSet::sample(const Vec3& ref, double u_select, const Vec2& u,
+                             LightSampling mode) const {
+    LightSample s;
+    if (triangles_.empty()) return s;
+    double pmf = 0.0;
+    int light = select(u_select, &pmf);
+    uint32_t tri = triangles_[size_t(light)];
+    const Mesh& mesh = scene_->mesh;
+    const Vec3& p0 = mesh.vertex(tri, 0);
+    const Vec3& p1 = mesh.vertex(tri, 1);
+    const Vec3& p2 = mesh.vertex(tri, 2);
+    Vec3 e1 = p1 - p0, e2 = p2 - p0;
+    Vec3 n = glm::cross(e1, e2);
+    double pdf = 0.0;
+    Vec3 point;
+    SphericalTriangle st;
+    if (mode == LightSampling::SolidAngle &&
+        setup_spherical(p0 - ref, p1 - ref, p2 - ref, e1, e2, &st)) {
+        Vec3 w = sample_spherical(st, u);
+        // Where the direction meets the triangle's plane: (ref + t w - p0) . N = 0.
+        double t = glm::dot(p0 - ref, n) / glm::dot(w, n);
+        if (!(t > 0.0) || !std::isfinite(t)) return s;
+        point = ref + w * t;
+        pdf = pmf / st.omega;
+    } else {
+        Vec2 b = sample_triangle_barycentric(u); // [Turk90]
+        point = p0 * b.x + p1 * b.y + p2 * (1.0 - b.x - b.y);
+        pdf = pmf * area_to_solid_angle(ref, point, n);
+    }
+    if (!(pdf > 0.0) || !std::isfinite(pdf)) return s;
+    s.point = point;
+    s.normal = glm::normalize(n);
+    s.radiance = emitted(tri, glm::normalize(ref - point));
+    s.pdf = pdf;
+    s.triangle = tri;
+    s.valid = true;
+    return s;
+}
+
+double LightSet::pdf(const Vec3& ref, uint32_t triangle, const Vec3& point,
+                     LightSampling mode) const {
+    int light = light_index(triangle);
+    if (light < 0) return 0.0;
+    double pmf = selection_pmf(light);
+    const Mesh& mesh = scene_->mesh;
+    const Vec3& p0 = mesh.vertex(triangle, 0);
+    const Vec3& p1 = mesh.vertex(triangle, 1);
+    const Vec3& p2 = mesh.vertex(triangle, 2);
+    Vec3 e1 = p1 - p0, e2 = p2 - p0;
+    Vec3 n = glm::cross(e1, e2);
+    if (mode == LightSampling::SolidAngle) {
+        // The same rule as sample: the same solid angle and the same regime test.
+        Vec3 a = p0 - ref;
+        double det = glm::dot(a, n);
+        double omega = solid_angle(a, p1 - ref, p2 - ref, det);
+        if (spherical_applies(det, omega)) return pmf / omega;
+    }
+    return pmf * area_to_solid_angle(ref, point, n);
+}
+
+Vec3 LightSet::emitted(uint32_t triangle, const Vec3& w) const {
+    if (scene_ == nullptr || triangle >= scene_->mesh.triangle_count()) return Vec3(0.0);
+    const Mesh& mesh = scene_->mesh;
+    uint32_t m = triangle < mesh.material.size() ? mesh.material[triangle] : 0u;
+    if (m >= scene_->materials.size()) return Vec3(0.0);
+    const Material& mat = scene_->materials[m];
+    if (mat.double_sided || glm::dot(w, mesh.cross_normal(triangle)) > 0.0) return mat.emission;
+    return Vec3(0.0);
+}
+
+// --- Spherical triangles and polygons ------------------------------------------------------
+
+double spherical_triangle_area(const Vec3& a, const Vec3& b, const Vec3& c) {
+    return solid_angle(a, b, c, glm::dot(a, glm::cross(b - a, c - a)));
+}
+
+Vec3 sample_spherical_triangle(const Vec3& a, const Vec3& b, const Vec3& c, const Vec2& u,
+                               double* pdf) {
+    // The same map as the light sampler, without its fallback regimes: only a triangle of
+    // zero solid angle (or one that contains the origin in its plane) is refused.
+    Vec3 e1 = b - a, e2 = c - a;
+    double det = glm::dot(a, glm::cross(e1, e2));
+    SphericalTriangle st;
+    st.omega = solid_angle(a, b, c, det);
+    if (det == 0.0 || !(st.omega > 0.0) || !std::isfinite(st.omega)) {
+        if (pdf) *pdf = 0.0;
+        return Vec3(0.0);
+    }
+    fill_spherical(a, b, c, e1, e2, det, &st);
+    if (pdf) *pdf = 1.0 / st.omega;
+    return sample_spherical(st, u);
+}
+
+double lambert_polygon_form_factor(const Vec3& x, const Vec3& n, const Vec3* vertices, int count) {
+    constexpr int kMaxClipped = 2 * kMaxFormFactorVertices;
+    if (count < 3 || count > kMaxFormFactorVertices)
+        return std::numeric_limits<double>::quiet_NaN();
+    // Clip to the half-space n . (v - x) >= 0 (Sutherland-Hodgman): the part below the
+    // tangent plane receives no cos-weighted light.
+    Vec3 clipped[kMaxClipped];
+    int m = 0;
+    for (int i = 0; i < count; ++i) {
+        Vec3 p = vertices[i] - x, q = vertices[(i + 1) % count] - x;
+        double dp = glm::dot(n, p), dq = glm::dot(n, q);
+        if (dp >= 0.0) clipped[m++] = p;
+        if ((dp >= 0.0) != (dq >= 0.0)) clipped[m++] = p + (q - p) * (dp / (dp - dq));
+    }
+    // F = (1 / 2 pi) sum_i beta_i n . (v_i x v_i+1) / |v_i x v_i+1| [Lambert1760]: each edge
+    // contributes the angle it subtends times the cosine of its arc plane's normal.
+    double sum = 0.0;
+    for (int i = 0; i < m; ++i) {
+        double li = glm::length(clipped[i]), lj = glm::length(clipped[(i + 1) % m]);
+        if (!(li > 0.0) || !(lj > 0.0)) continue;
+        Vec3 vi = clipped[i] / li, vj = clipped[(i + 1) % m] / lj;
+        Vec3 cr = glm::cross(vi, vj);
+        double s = glm::length(cr);
+        if (!(s > 0.0)) continue;
+        sum += std::atan2(s, glm::dot(vi, vj)) * glm::dot(n, cr) / s;
+    }
+    // The sign follows the winding as seen from x; the form factor is its magnitude.
+    return std::fabs(sum) / (2.0 * kPi);
+}
+
+} // namespace mcp

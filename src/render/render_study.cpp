@@ -1,0 +1,225 @@
+#include "render/render_study.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "core/rng.h"
+#include "core/special.h"
+
+namespace mcp {
+
+namespace {
+
+double mean_luminance(const RenderImage& image, double* se) {
+    size_t n = image.pixel_count();
+    double sum = 0.0, var = 0.0;
+    for (size_t p = 0; p < n; ++p) {
+        Vec3 c(image.rgb[p * 3], image.rgb[p * 3 + 1], image.rgb[p * 3 + 2]);
+        Vec3 v(image.variance[p * 3], image.variance[p * 3 + 1], image.variance[p * 3 + 2]);
+        if (std::isfinite(luminance(c))) sum += luminance(c);
+        // Channels of one pixel share their samples; the luminance variance is bounded by
+        // (sum_c w_c sd_c)^2, which is what an error bar may honestly claim without the
+        // covariances.
+        double sd = 0.2126 * std::sqrt(v.x) + 0.7152 * std::sqrt(v.y) + 0.0722 * std::sqrt(v.z);
+        if (std::isfinite(sd)) var += sd * sd;
+    }
+    double dn = n ? double(n) : 1.0;
+    if (se) *se = std::sqrt(var) / dn;
+    return sum / dn;
+}
+
+} // namespace
+
+ImageError image_error(const RenderImage& image, const RenderImage& reference) {
+    ImageError e;
+    size_t n = std::min(image.pixel_count(), reference.pixel_count());
+    double ref_mean = mean_luminance(reference, nullptr);
+    double eps = 1e-2 * ref_mean * ref_mean;
+    if (!(eps > 0.0)) eps = 1e-2;
+    double sum = 0.0, sum_raw = 0.0;
+    uint64_t covered = 0, counted = 0;
+    for (size_t p = 0; p < n; ++p) {
+        for (int c = 0; c < 3; ++c) {
+            size_t k = p * 3 + size_t(c);
+            double d = image.rgb[k] - reference.rgb[k];
+            double r = reference.rgb[k];
+            double v_ref = std::isfinite(reference.variance[k]) ? reference.variance[k] : 0.0;
+            double denom = r * r + eps;
+            sum_raw += d * d / denom;
+            sum += (d * d - v_ref) / denom;
+            double v = image.variance[k];
+            if (std::isfinite(v) && std::isfinite(d)) {
+                ++counted;
+                if (std::fabs(d) <= 1.959963984540054 * std::sqrt(v + v_ref)) ++covered;
+            }
+        }
+    }
+    double m = n ? double(3 * n) : 1.0;
+    e.rel_mse = sum / m;
+    e.rel_mse_raw = sum_raw / m;
+    e.coverage = counted ? double(covered) / double(counted) : NAN;
+    e.mean_luminance = mean_luminance(image, &e.mean_luminance_se);
+    return e;
+}
+
+uint64_t render_stream(uint64_t seed, const std::string& estimator, uint64_t spp, int rep) {
+    uint64_t h = hash_combine(mix64(seed), hash_string(estimator.c_str()));
+    h = hash_combine(h, spp);
+    return hash_combine(h, static_cast<uint64_t>(rep));
+}
+
+LevelStats render_level_stats(const std::vector<RenderImage>& images,
+                              const RenderImage& reference) {
+    LevelStats l;
+    l.reps = int(images.size());
+    if (images.empty()) return l;
+    l.n = images[0].spp;
+    double ref_se = 0.0;
+    double ref_mean = mean_luminance(reference, &ref_se);
+    RunningMoments rel, lum;
+    double coverage = 0.0, run_se = 0.0;
+    RenderDiagnostics pooled;
+    for (const RenderImage& im : images) {
+        ImageError e = image_error(im, reference);
+        rel.add(e.rel_mse);
+        lum.add(e.mean_luminance);
+        coverage += e.coverage;
+        run_se += e.mean_luminance_se;
+        l.estimates.push_back(e.mean_luminance);
+        l.run_std_errors.push_back(e.mean_luminance_se);
+        l.time_total += im.seconds;
+        pooled.merge(im.diagnostics);
+    }
+    double R = double(images.size());
+    l.variance = rel.mean();
+    double t = images.size() > 1 ? student_t_quantile(0.975, R - 1.0) : NAN;
+    double rel_se = images.size() > 1 ? std::sqrt(rel.variance() / R) : NAN;
+    l.variance_lo = l.variance - t * rel_se;
+    l.variance_hi = l.variance + t * rel_se;
+    l.mse = l.variance;
+    l.rmse = std::sqrt(std::max(0.0, l.mse));
+    l.error = l.rmse;
+    l.has_exact = true;
+    l.mean = lum.mean();
+    // The comparison with the reference's mean carries the reference's own noise too.
+    double se_mean = images.size() > 1 ? std::sqrt(lum.variance() / R) : NAN;
+    l.std_error = std::sqrt(se_mean * se_mean + ref_se * ref_se);
+    l.ci_lo = l.mean - t * se_mean;
+    l.ci_hi = l.mean + t * se_mean;
+    l.bias = l.mean - ref_mean;
+    l.coverage = coverage / R;
+    l.mean_run_se = run_se / R;
+    l.time_mean = l.time_total / R;
+    l.efficiency = l.variance > 0.0 && l.time_mean > 0.0 ? 1.0 / (l.variance * l.time_mean) : NAN;
+    l.diagnostics.nonfinite = pooled.discarded_nonfinite;
+    l.diagnostics.nonzero = pooled.samples;
+    l.diagnostics.max_weight_share = pooled.max_sample_share;
+    l.nonzero_per_run = double(pooled.samples) / R;
+    l.ess_mean = NAN; // per pixel it is meaningless pooled over an image
+    std::sort(pooled.top.begin(), pooled.top.end(), std::greater<double>());
+    l.tail_k = hill_order(pooled.samples);
+    l.tail_k = std::min<int>(l.tail_k, int(pooled.top.size()) - 1);
+    l.tail_index = l.tail_k > 0 ? hill_tail_index(pooled.top, l.tail_k) : NAN;
+    if (l.tail_k <= 0) l.tail_k = 0;
+    return l;
+}
+
+ConvergenceFit fit_render_convergence(const std::vector<LevelStats>& levels) {
+    // Weighted least squares of y = log relMSE on x = log spp, each level weighted by the
+    // inverse variance of its log, (se / relMSE)^2 by the delta method, with se from the
+    // spread of its replicates; the slope's standard error is inflated by the residuals when
+    // they exceed that noise (chi2 / dof > 1).
+    ConvergenceFit fit;
+    std::vector<double> x, y, w;
+    for (const LevelStats& l : levels) {
+        double rel = l.variance;
+        double se = (l.variance_hi - l.variance_lo) / 2.0;
+        double t = l.reps > 1 ? student_t_quantile(0.975, double(l.reps - 1)) : NAN;
+        se /= t;
+        if (!(rel > 0.0) || !std::isfinite(rel) || !(se > 0.0)) continue;
+        double sd_log = std::max(se / rel, 1e-3);
+        x.push_back(std::log(double(l.n)));
+        y.push_back(std::log(rel));
+        w.push_back(1.0 / (sd_log * sd_log));
+    }
+    fit.levels_used = int(x.size());
+    if (x.size() < 3) {
+        fit.note = "fewer than 3 levels with a positive relative MSE above the reference's noise";
+        return fit;
+    }
+    double sw = 0.0, sx = 0.0, sy = 0.0;
+    for (size_t i = 0; i < x.size(); ++i) {
+        sw += w[i];
+        sx += w[i] * x[i];
+        sy += w[i] * y[i];
+    }
+    double mx = sx / sw, my = sy / sw, sxx = 0.0, sxy = 0.0;
+    for (size_t i = 0; i < x.size(); ++i) {
+        sxx += w[i] * (x[i] - mx) * (x[i] - mx);
+        sxy += w[i] * (x[i] - mx) * (y[i] - my);
+    }
+    if (!(sxx > 0.0)) {
+        fit.note = "all levels at one spp";
+        return fit;
+    }
+    fit.order = sxy / sxx;
+    fit.intercept = my - fit.order * mx;
+    double chi2 = 0.0;
+    for (size_t i = 0; i < x.size(); ++i) {
+        double r = y[i] - fit.intercept - fit.order * x[i];
+        chi2 += w[i] * r * r;
+    }
+    double dof = double(x.size()) - 2.0;
+    fit.order_se = std::sqrt(1.0 / sxx) * std::sqrt(std::max(1.0, chi2 / dof));
+    fit.valid = true;
+    if (fit.levels_used < int(levels.size()))
+        fit.note = "levels at or below the reference's noise are left out";
+    return fit;
+}
+
+RenderStudyResult run_render_study(const RenderScene& rs,
+                                   const std::vector<RenderEstimator>& estimators,
+                                   const RenderStudySettings& settings,
+                                   const RenderImage& reference,
+                                   const RenderStudyProgress& progress) {
+    auto start = std::chrono::steady_clock::now();
+    RenderStudyResult result;
+    result.settings = settings;
+    result.threads_used = resolve_threads(settings.threads);
+    result.reference_mean_luminance = mean_luminance(reference, nullptr);
+    for (const RenderEstimator& e : estimators) {
+        RenderEstimatorStudy s;
+        s.estimator = e;
+        result.estimators.push_back(s);
+    }
+    std::vector<uint64_t> ladder = n_ladder(settings.spp_min, settings.spp_max);
+    for (size_t li = 0; li < ladder.size(); ++li) {
+        for (RenderEstimatorStudy& s : result.estimators) {
+            std::vector<RenderImage> images;
+            for (int r = 0; r < settings.reps; ++r) {
+                RenderSettings rset;
+                rset.width = settings.width;
+                rset.height = settings.height;
+                rset.spp = ladder[li];
+                rset.stream = render_stream(settings.seed, s.estimator.name, ladder[li], r);
+                rset.threads = result.threads_used;
+                rset.jitter_pixels = settings.jitter_pixels;
+                images.push_back(render_image(rs, s.estimator, rset));
+            }
+            s.levels.push_back(render_level_stats(images, reference));
+            s.preview = std::move(images[0]);
+            s.fit = fit_render_convergence(s.levels);
+        }
+        bool go_on = !progress || progress(result, li);
+        if (!go_on && li + 1 < ladder.size()) {
+            result.cancelled = true;
+            break;
+        }
+    }
+    result.wall_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return result;
+}
+
+} // namespace mcp

@@ -1,0 +1,90 @@
+// Convergence study of radiance estimators: every estimator renders the image at every spp of
+// a ladder of powers of two, R replicates each, and is measured against a reference image by
+// its relative mean squared error, the same way the integration studies measure estimators
+// by their variance (study.h): relative MSE against spp, and against seconds per image.
+//
+// Relative MSE of an image I against the reference R [RousselleKnausZwicker11]:
+//   relMSE = mean over pixels p and channels c of ((I_pc - R_pc)^2 - v_pc) / (R_pc^2 + eps),
+// where v_pc, the variance of the reference pixel's own mean, removes the reference's noise
+// from the expected squared difference (E (I - R)^2 = MSE(I) + Var(R) for independent I and
+// R), and eps = 1e-2 times the squared mean of the reference keeps dark pixels from
+// dominating. An unbiased estimator converges as relMSE ~ 1/spp.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "estimators/study.h"
+#include "render/renderer.h"
+
+namespace mcp {
+
+struct RenderStudySettings {
+    int width = 64, height = 64;
+    uint64_t spp_min = 1, spp_max = 64;
+    int reps = 4;
+    uint64_t seed = 1;
+    int threads = 0; ///< 0: all hardware threads
+    bool jitter_pixels = true;
+};
+
+/// Error of one image against the reference.
+struct ImageError {
+    double rel_mse = 0.0;      ///< reference-noise corrected (see the header comment)
+    double rel_mse_raw = 0.0;  ///< without the correction
+    double coverage = 0.0;     ///< share of pixels whose 95% interval covers the reference
+    double mean_luminance = 0.0;
+    double mean_luminance_se = 0.0;
+};
+ImageError image_error(const RenderImage& image, const RenderImage& reference);
+
+struct RenderEstimatorStudy {
+    RenderEstimator estimator;
+    std::vector<LevelStats> levels; ///< n = spp; see render_level_stats for the fields' meaning
+    ConvergenceFit fit;             ///< of relative MSE against spp
+    RenderImage preview;            ///< replicate 0 at the largest spp rendered
+};
+
+struct RenderStudyResult {
+    RenderStudySettings settings;
+    int threads_used = 1;
+    double wall_seconds = 0.0;
+    bool cancelled = false;
+    double reference_mean_luminance = 0.0;
+    std::vector<RenderEstimatorStudy> estimators;
+};
+
+/// Stream id of one image: (seed, estimator name, spp, replicate), as for the integration
+/// studies, so results do not depend on threads or on which estimators run together.
+uint64_t render_stream(uint64_t seed, const std::string& estimator, uint64_t spp, int rep);
+
+/// Summarises R replicate images of one level in the integration studies' terms:
+///   variance, mse  relative MSE against the reference (mean over replicates), with a 95%
+///                  interval from the replicates' spread in variance_lo / variance_hi
+///   rmse, error    its square root
+///   mean, estimates, ci  the image's mean luminance per replicate and over them, with bias
+///                  against the reference's mean luminance
+///   coverage       share of (pixel, replicate) pairs whose own 95% error bar covers the
+///                  reference pixel: honest per-pixel error bars give 0.95
+///   time_mean      seconds per image; efficiency = 1 / (relMSE * seconds)
+///   diagnostics    discarded samples (nonfinite), largest single-sample share of a pixel
+///   tail_index     Hill's estimate on the luminance of the samples' reflected radiance, pooled
+///                  over the image and the replicates
+LevelStats render_level_stats(const std::vector<RenderImage>& images, const RenderImage& reference);
+
+/// Fitted order of relative MSE against spp: weighted least squares of log relMSE on log spp,
+/// weights from each level's replicate spread, the standard error inflated by the residuals.
+ConvergenceFit fit_render_convergence(const std::vector<LevelStats>& levels);
+
+/// Called after each completed level; returning false cancels the study.
+using RenderStudyProgress = std::function<bool(const RenderStudyResult& partial, size_t level)>;
+
+RenderStudyResult run_render_study(const RenderScene& rs,
+                                   const std::vector<RenderEstimator>& estimators,
+                                   const RenderStudySettings& settings,
+                                   const RenderImage& reference,
+                                   const RenderStudyProgress& progress = {});
+
+} // namespace mcp

@@ -1,0 +1,136 @@
+#include "render/renderer.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <functional>
+#include <thread>
+
+#include "estimators/estimator.h" // kTopWeights
+
+namespace mcp {
+
+namespace {
+
+/// Keeps the kTopWeights largest values seen, as a min-heap.
+void push_top(std::vector<double>& heap, double x) {
+    if (heap.size() < kTopWeights) {
+        heap.push_back(x);
+        std::push_heap(heap.begin(), heap.end(), std::greater<double>());
+    } else if (x > heap.front()) {
+        std::pop_heap(heap.begin(), heap.end(), std::greater<double>());
+        heap.back() = x;
+        std::push_heap(heap.begin(), heap.end(), std::greater<double>());
+    }
+}
+
+/// Renders rows first_row, first_row + step, ... into the image.
+void render_rows(const RenderScene& rs, const RenderEstimator& est, const RenderSettings& st,
+                 int first_row, int step, RenderImage& image, RenderDiagnostics& diag) {
+    PixelSampler sampler;
+    sampler.configure(est.pixel_sampler, st.spp);
+    for (int y = first_row; y < st.height; y += step) {
+        if (st.cancel && st.cancel->load(std::memory_order_relaxed)) return;
+        for (int x = 0; x < st.width; ++x) {
+            size_t pixel = size_t(y) * size_t(st.width) + size_t(x);
+            sampler.start_pixel(hash_combine(st.stream, pixel));
+            // Welford moments per channel [Welford62]; samples are few enough per pixel
+            // that plain double sums of them are exact to far below their noise.
+            Vec3 mean(0.0), m2(0.0);
+            double lum_sum = 0.0, lum_max = 0.0;
+            uint64_t kept = 0;
+            SampleCounters counters;
+            for (uint64_t i = 0; i < st.spp; ++i) {
+                sampler.start_sample(i);
+                Vec2 jitter = st.jitter_pixels ? sampler.get_2d() : Vec2(0.5);
+                Ray ray = camera_ray(rs.scene->camera, st.width, st.height, x + jitter.x,
+                                     y + jitter.y);
+                RadianceSample rad = sample_radiance(rs, est, ray, sampler, counters);
+                Vec3 L = rad.total();
+                if (!std::isfinite(L.x) || !std::isfinite(L.y) || !std::isfinite(L.z)) {
+                    ++diag.discarded_nonfinite;
+                    continue;
+                }
+                ++kept;
+                Vec3 delta = L - mean;
+                mean += delta / double(kept);
+                m2 += delta * (L - mean);
+                double lum = std::fabs(luminance(L));
+                lum_sum += lum;
+                lum_max = std::max(lum_max, lum);
+                double reflected = std::fabs(luminance(rad.reflected));
+                if (reflected > 0.0) push_top(diag.top, reflected);
+            }
+            diag.samples += st.spp;
+            diag.rays += counters.rays;
+            diag.light_misses += counters.light_misses;
+            if (st.spp >= 16 && lum_sum > 0.0) {
+                double share = lum_max / lum_sum;
+                diag.max_sample_share = std::max(diag.max_sample_share, share);
+                if (share > 0.5) ++diag.dominated_pixels;
+            }
+            Vec3 var_mean = kept > 1 ? m2 / (double(kept) * double(kept - 1)) : Vec3(NAN);
+            for (int c = 0; c < 3; ++c) {
+                image.rgb[pixel * 3 + size_t(c)] = kept > 0 ? mean[c] : NAN;
+                image.variance[pixel * 3 + size_t(c)] = var_mean[c];
+            }
+        }
+    }
+}
+
+} // namespace
+
+void RenderDiagnostics::merge(const RenderDiagnostics& o) {
+    samples += o.samples;
+    discarded_nonfinite += o.discarded_nonfinite;
+    rays += o.rays;
+    light_misses += o.light_misses;
+    dominated_pixels += o.dominated_pixels;
+    max_sample_share = std::max(max_sample_share, o.max_sample_share);
+    for (double x : o.top) push_top(top, x);
+}
+
+Ray camera_ray(const Camera& camera, int width, int height, double x, double y) {
+    double tan_half = std::tan(0.5 * camera.yfov);
+    double aspect = double(width) / double(height);
+    double sx = (2.0 * x / width - 1.0) * tan_half * aspect;
+    double sy = (1.0 - 2.0 * y / height) * tan_half;
+    Ray r;
+    r.origin = camera.position;
+    r.direction = glm::normalize(camera.forward + sx * camera.right + sy * camera.up);
+    return r;
+}
+
+RenderImage render_image(const RenderScene& rs, const RenderEstimator& est,
+                         const RenderSettings& settings) {
+    auto start = std::chrono::steady_clock::now();
+    RenderImage image;
+    image.width = settings.width;
+    image.height = settings.height;
+    image.spp = settings.spp;
+    image.rgb.assign(image.pixel_count() * 3, 0.0);
+    image.variance.assign(image.pixel_count() * 3, 0.0);
+    int threads = std::max(1, std::min(settings.threads, settings.height));
+    std::vector<RenderDiagnostics> diags(static_cast<size_t>(threads));
+#if defined(__EMSCRIPTEN__)
+    threads = 1;
+#endif
+    if (threads == 1) {
+        render_rows(rs, est, settings, 0, 1, image, diags[0]);
+    } else {
+        std::vector<std::thread> pool;
+        for (int t = 0; t < threads; ++t)
+            pool.emplace_back([&, t] {
+                render_rows(rs, est, settings, t, threads, image, diags[size_t(t)]);
+            });
+        for (auto& th : pool) th.join();
+    }
+    for (const auto& d : diags) image.diagnostics.merge(d);
+    std::sort(image.diagnostics.top.begin(), image.diagnostics.top.end(), std::greater<double>());
+    image.cancelled = settings.cancel && settings.cancel->load();
+    image.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return image;
+}
+
+} // namespace mcp

@@ -1,0 +1,56 @@
+// Renders an image with one radiance estimator: spp samples per pixel, each pixel from its
+// own random stream (so images are identical for any thread count), with per-pixel means,
+// variances of the means, and the sample-level diagnostics of the integration estimators.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <vector>
+
+#include "render/integrator.h"
+
+namespace mcp {
+
+struct RenderSettings {
+    int width = 64, height = 64;
+    uint64_t spp = 16;
+    uint64_t stream = 1;      ///< keys every pixel's random stream (seed, estimator, spp, replicate)
+    int threads = 1;          ///< worker threads (1 where the build has none)
+    bool jitter_pixels = true; ///< false: every sample's camera ray passes through the pixel centre
+    const std::atomic<bool>* cancel = nullptr; ///< checked once per row
+};
+
+/// Problems found while rendering, summed over the image.
+struct RenderDiagnostics {
+    uint64_t samples = 0;
+    uint64_t discarded_nonfinite = 0; ///< samples whose radiance was NaN or infinite: dropped
+    uint64_t rays = 0;
+    uint64_t light_misses = 0;       ///< light samples with no valid point (degenerate, pdf 0)
+    uint64_t dominated_pixels = 0;   ///< pixels (spp >= 16) where one sample carries > half the sum
+    double max_sample_share = 0.0;   ///< over pixels with spp >= 16: largest sample / pixel sum
+    /// The kTopWeights largest luminances of the samples' reflected part (the emission seen
+    /// directly is not random given the camera ray), decreasing: for Hill's tail index.
+    std::vector<double> top;
+
+    void merge(const RenderDiagnostics& o);
+};
+
+struct RenderImage {
+    int width = 0, height = 0;
+    uint64_t spp = 0;
+    std::vector<double> rgb;      ///< pixel means, 3 per pixel, rows from the top
+    std::vector<double> variance; ///< variance of each pixel mean, 3 per pixel
+    RenderDiagnostics diagnostics;
+    double seconds = 0.0;
+    bool cancelled = false;
+
+    size_t pixel_count() const { return size_t(width) * size_t(height); }
+};
+
+/// The camera ray through image position (x, y) in pixels from the top-left corner.
+Ray camera_ray(const Camera& camera, int width, int height, double x, double y);
+
+RenderImage render_image(const RenderScene& rs, const RenderEstimator& est,
+                         const RenderSettings& settings);
+
+} // namespace mcp

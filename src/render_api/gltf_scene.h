@@ -1,0 +1,47 @@
+// glTF 2.0 (.gltf with embedded or external buffers, or .glb) to mcp::Scene: the default scene's
+// node tree flattened into one world-space triangle mesh, its metallic-roughness materials
+// (emission = emissiveFactor x KHR_materials_emissive_strength, Fresnel layer scaled by
+// KHR_materials_specular's specularFactor), base colour textures (sRGB decoded to linear) and
+// the first perspective camera. Malformed input gives ok = false and a one-line error naming
+// the offending element; it never crashes. Features that can be ignored safely (other textures
+// and extensions, alpha, skins, morph targets, animations, punctual lights) give warnings
+// instead. Specification: Khronos glTF 2.0 [glTF2].
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "render/scene.h"
+
+namespace mcp {
+
+struct GltfLoadResult {
+    bool ok = false;
+    /// One line naming what is wrong, e.g. "meshes[0].primitives[1]: mode 1 (LINES) is not
+    /// supported; only TRIANGLES (4)".
+    std::string error;
+    /// Unsupported but ignorable features, each naming the feature and where it is used.
+    std::vector<std::string> warnings;
+    Scene scene;
+    /// The loaded scene's "extras" object as JSON text if it has one, else the root "extras"
+    /// object, else "".
+    std::string extras_json;
+    /// False when no node of the scene has a camera (scene.camera is then the default).
+    bool has_camera = false;
+};
+
+/// Limits above which loading fails (untrusted input must not exhaust memory).
+constexpr uint64_t kGltfMaxTriangles = 10000000;       ///< triangles after flattening instances
+constexpr uint64_t kGltfMaxBufferBytes = 256ull << 20; ///< all buffers together
+constexpr uint64_t kGltfMaxInputBytes = 384ull << 20;  ///< the .gltf/.glb itself (base64 buffers)
+constexpr uint64_t kGltfMaxTexels = 1ull << 24;        ///< all decoded base colour textures
+
+/// Loads a .gltf or .glb file; external buffers and images are resolved relative to its folder.
+GltfLoadResult load_gltf_file(const std::string& path);
+
+/// Same, from the bytes of a .gltf (JSON text) or .glb (detected by its "glTF" magic);
+/// relative URIs are resolved against base_dir ("" or "." for the current folder).
+GltfLoadResult load_gltf_memory(const std::string& bytes, const std::string& base_dir);
+
+} // namespace mcp

@@ -1,0 +1,42 @@
+/* mcplay render C API: small glTF scenes rendered with radiance estimators, and their
+ * convergence studies. Same conventions as mcplay.h (status codes, mcp_last_error,
+ * JSON in and out, results released with mcp_free). Built as a separate library (and a
+ * separate WebAssembly module) so that the integration playground does not carry it.
+ *
+ * Scene JSON: a render scene (docs/scene-format.md, "Render scenes"). Options JSON (may be
+ * NULL): base_dir (folder that a relative glTF path is resolved against), cache_dir (where
+ * high-spp references are cached; none when absent), and overrides of the scene's render
+ * settings: width, height, spp_min, spp_max, reps, seed, threads, estimators, reference,
+ * jitter_pixels, exposure, accel. */
+#ifndef MCPLAY_RENDER_H
+#define MCPLAY_RENDER_H
+
+#include "api/mcplay.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Convergence study: every estimator at spp = spp_min..spp_max (powers of two), reps
+ * images each, measured by relative MSE against the reference (docs/result-schema.md,
+ * "Render studies"). progress gets one JSON line per completed spp level (non-zero return
+ * cancels). Options also take previews (true: PNGs of each estimator's last image and of
+ * the reference, base64, in the result). */
+int mcp_render_study_run(const char* scene_json, const char* options_json,
+                         mcp_progress_fn progress, void* user, char** result_json);
+
+/* One image: options.estimator (a name from the scene or an estimator object; default the
+ * scene's first), options.spp (default spp_max), options.outputs (any of "png", "hdr",
+ * "error_png"; default ["png"]; "error_png" renders or reads the reference). The result
+ * carries the images base64-encoded, the diagnostics and the rays per second. */
+int mcp_render_image(const char* scene_json, const char* options_json, char** result_json);
+
+/* What a render scene holds: triangles, lights, materials, camera, accelerator, loader
+ * warnings, estimators and settings. */
+int mcp_render_scene_info(const char* scene_json, const char* options_json, char** info_json);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

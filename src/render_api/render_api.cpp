@@ -1,0 +1,442 @@
+// The render C API: scene file -> request -> renders -> JSON. Built without exceptions like
+// the integration API; every failure is a status code plus mcp_last_error.
+#include "render_api/mcplay_render.h"
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+#include "api/boundary.h"
+#include "api/scene.h"
+#include "render_api/image_io.h"
+#include "render_api/render_request.h"
+
+using mcp::boundary::copy_out;
+using mcp::boundary::dump;
+using mcp::boundary::fail;
+
+namespace mcp {
+
+namespace {
+
+constexpr int kReferenceCacheVersion = 1;
+
+const char* selection_name(LightSelection s) {
+    switch (s) {
+    case LightSelection::Area: return "area";
+    case LightSelection::Power: return "power";
+    default: return "uniform";
+    }
+}
+
+Json estimator_to_json(const RenderEstimator& e) {
+    Json j{{"name", e.name},
+           {"strategy", strategy_name(e.strategy)},
+           {"light_selection", selection_name(e.light_selection)},
+           {"light_sampling", e.light_sampling == LightSampling::Area ? "area" : "solid_angle"},
+           {"pixel_sampler",
+            e.pixel_sampler == PixelSamplerKind::Stratified ? "stratified" : "independent"}};
+    if (e.strategy == RadianceStrategy::Path) {
+        j["max_depth"] = e.max_depth;
+        j["rr_depth"] = e.rr_depth;
+    }
+    return j;
+}
+
+Json num(double x) { return std::isfinite(x) ? Json(x) : Json(nullptr); }
+
+Json warning(const char* code, const std::string& message) {
+    return Json{{"code", code}, {"message", message}};
+}
+
+std::string fmt(const char* f, double x) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, f, x);
+    return buf;
+}
+
+/// Warnings about an estimator over the whole study (the levels carry their own).
+Json render_warnings(const RenderEstimatorStudy& s) {
+    Json w = Json::array();
+    if (s.levels.empty()) return w;
+    const LevelStats& deepest = s.levels.back();
+    // Hill's tail index of sample radiance relative to the reference pixel: below 2 the
+    // per-pixel variance is infinite and relative MSE cannot fall as 1/spp [Hill75].
+    if (std::isfinite(deepest.tail_index) && deepest.tail_k > 0) {
+        double a = deepest.tail_index, se = a / std::sqrt(double(deepest.tail_k));
+        std::string where = " (from the " + std::to_string(deepest.tail_k) + " largest of " +
+                            std::to_string(deepest.diagnostics.nonzero) + " samples at spp = " +
+                            std::to_string(deepest.n) + ")";
+        if (a < 2.0 + 2.0 * se)
+            w.push_back(warning("heavy_tail", "sample radiance is heavy-tailed: tail index " +
+                                                  fmt("%.2f", a) + " +/- " + fmt("%.2f", se) +
+                                                  where +
+                                                  "; below 2 the pixel variance is infinite and "
+                                                  "the error bars are not trustworthy"));
+        else if (a < 4.0)
+            w.push_back(warning("heavy_tail_4", "sample radiance has a heavy tail: tail index " +
+                                                    fmt("%.2f", a) + where +
+                                                    " is below 4, so variance estimates are "
+                                                    "unreliable (fireflies)"));
+    }
+    if (s.fit.valid && s.fit.order > -1.0 + 3.0 * s.fit.order_se && s.fit.order > -0.8)
+        w.push_back(warning("slow_convergence",
+                            "relative MSE falls as spp^" + fmt("%.2f", s.fit.order) + " +/- " +
+                                fmt("%.2f", s.fit.order_se) +
+                                ", slower than 1/spp: infinite variance, bias against the "
+                                "reference, or a reference too noisy for this spp"));
+    if (deepest.coverage < 0.85 && deepest.n >= 16)
+        w.push_back(warning("pixel_error_bars",
+                            "only " + fmt("%.1f", 100.0 * deepest.coverage) +
+                                "% of the pixels' own 95% error bars cover the reference at spp = " +
+                                std::to_string(deepest.n) +
+                                ": per-pixel error bars are too small (heavy tails or bias)"));
+    return w;
+}
+
+Json render_level_to_json(const LevelStats& l) {
+    Json j = level_to_json(l);
+    j["relative_mse"] = num(l.variance);
+    return j;
+}
+
+struct Loaded {
+    std::shared_ptr<RenderRequest> request;
+    RenderScene scene;
+};
+
+int load(const char* scene_json, const char* options_json, Loaded* out, Json* options) {
+    Made<Json> scene = parse_json(scene_json, "scene");
+    if (!scene.ok()) return fail(MCP_ERROR_SCENE, scene.error);
+    *options = Json::object();
+    if (options_json && *options_json) {
+        Made<Json> o = parse_json(options_json, "options");
+        if (!o.ok()) return fail(MCP_ERROR_ARGUMENT, o.error);
+        if (!o.value.is_object()) return fail(MCP_ERROR_ARGUMENT, "options: expected an object");
+        *options = o.value;
+    }
+    if (!is_render_scene(scene.value))
+        return fail(MCP_ERROR_SCENE, "scene: not a render scene (no \"render\" object)");
+    Made<std::shared_ptr<RenderRequest>> req = build_render_request(scene.value, *options);
+    if (!req.ok()) return fail(MCP_ERROR_SCENE, req.error);
+    out->request = req.value;
+    out->scene.build(*out->request->scene, out->request->accel);
+    return MCP_OK;
+}
+
+std::string hex(uint64_t x) {
+    char buf[20];
+    std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(x));
+    return buf;
+}
+
+/// The reference image: read from the scene's HDR file, from the cache, or rendered (and
+/// then cached). `source` says which.
+bool obtain_reference(const Loaded& l, RenderImage* ref, Json* info, std::string* error) {
+    const RenderRequest& r = *l.request;
+    const RenderStudySettings& s = r.settings;
+    if (!r.reference.file.empty()) {
+        std::ifstream in(r.reference.file, std::ios::binary);
+        if (!in) {
+            *error = "reference.file: cannot read '" + r.reference.file + "'";
+            return false;
+        }
+        std::ostringstream ss;
+        ss << in.rdbuf();
+        if (!decode_hdr(ss.str(), ref, error)) {
+            *error = "reference.file: " + *error;
+            return false;
+        }
+        if (ref->width != s.width || ref->height != s.height) {
+            *error = "reference.file: the image is " + std::to_string(ref->width) + "x" +
+                     std::to_string(ref->height) + " but the render is " +
+                     std::to_string(s.width) + "x" + std::to_string(s.height);
+            return false;
+        }
+        *info = Json{{"source", "file"}, {"file", r.reference.file}};
+        return true;
+    }
+    const RenderEstimator& e = r.reference.estimator;
+    uint64_t key = hash_combine(r.gltf_hash, uint64_t(kReferenceCacheVersion));
+    for (uint64_t v : {uint64_t(s.width), uint64_t(s.height), uint64_t(s.jitter_pixels),
+                       uint64_t(e.strategy), uint64_t(e.light_selection),
+                       uint64_t(e.light_sampling), uint64_t(e.pixel_sampler),
+                       uint64_t(e.max_depth), uint64_t(e.rr_depth), r.reference.spp, s.seed})
+        key = hash_combine(key, v);
+    std::string cache_file =
+        r.cache_dir.empty() ? "" : r.cache_dir + "/" + (r.name.empty() ? "scene" : r.name) +
+                                       "-" + hex(key) + ".mcref";
+    *info = Json{{"estimator", estimator_to_json(e)}, {"spp", r.reference.spp}};
+    if (!cache_file.empty() && read_reference_cache(cache_file, ref) && ref->width == s.width &&
+        ref->height == s.height) {
+        (*info)["source"] = "cache";
+        (*info)["file"] = cache_file;
+        return true;
+    }
+    RenderSettings rs;
+    rs.width = s.width;
+    rs.height = s.height;
+    rs.spp = r.reference.spp;
+    // Its own stream: no study image shares random numbers with the reference.
+    rs.stream = render_stream(s.seed, "reference", r.reference.spp, -1);
+    rs.threads = resolve_threads(s.threads);
+    rs.jitter_pixels = s.jitter_pixels;
+    *ref = render_image(l.scene, e, rs);
+    (*info)["source"] = "rendered";
+    (*info)["seconds"] = num(ref->seconds);
+    if (!cache_file.empty() && write_reference_cache(cache_file, *ref))
+        (*info)["file"] = cache_file;
+    return true;
+}
+
+Json scene_to_json(const Loaded& l) {
+    const RenderRequest& r = *l.request;
+    const Scene& sc = *r.scene;
+    const AccelStats& a = l.scene.accel.stats();
+    Json warnings = Json::array();
+    for (const std::string& w : r.warnings) warnings.push_back(warning("gltf", w));
+    Json materials = Json::array();
+    for (const Material& m : sc.materials)
+        materials.push_back(Json{{"name", m.name},
+                                 {"base_color", {m.base_color.x, m.base_color.y, m.base_color.z}},
+                                 {"metallic", m.metallic},
+                                 {"roughness", m.roughness},
+                                 {"emission", {m.emission.x, m.emission.y, m.emission.z}},
+                                 {"textured", m.base_color_texture >= 0}});
+    return Json{{"name", r.name},
+                {"description", r.description},
+                {"kind", "render"},
+                {"gltf", r.gltf_path},
+                {"width", r.settings.width},
+                {"height", r.settings.height},
+                {"triangles", sc.mesh.triangle_count()},
+                {"lights", l.scene.lights_uniform.size()},
+                {"light_power", num(l.scene.lights_uniform.total_power())},
+                {"materials", materials},
+                {"textures", sc.textures.size()},
+                {"accel",
+                 {{"kind", a.kind == AccelKind::Bvh ? "bvh" : "brute_force"},
+                  {"nodes", a.nodes},
+                  {"leaves", a.leaves},
+                  {"max_depth", a.max_depth},
+                  {"bytes", a.bytes}}},
+                {"warnings", warnings}};
+}
+
+Json settings_to_json(const RenderStudySettings& s, int threads) {
+    return Json{{"n_min", s.spp_min}, {"n_max", s.spp_max},   {"reps", s.reps},
+                {"seed", s.seed},     {"threads", threads},    {"n_name", "spp"},
+                {"error_name", "relative_mse"}, {"jitter_pixels", s.jitter_pixels}};
+}
+
+Json estimator_study_to_json(const RenderEstimatorStudy& s, bool previews, double exposure,
+                             const RenderImage* reference, bool all_levels, size_t level) {
+    Json j = estimator_to_json(s.estimator);
+    j["warnings"] = render_warnings(s);
+    if (all_levels) {
+        Json levels = Json::array();
+        for (const LevelStats& l : s.levels) levels.push_back(render_level_to_json(l));
+        j["levels"] = levels;
+    } else if (level < s.levels.size()) {
+        j["level"] = render_level_to_json(s.levels[level]);
+    }
+    j["fit"] = fit_to_json(s.fit);
+    const RenderDiagnostics& d = s.preview.diagnostics;
+    j["rays_per_second"] = num(s.preview.seconds > 0 ? double(d.rays) / s.preview.seconds : NAN);
+    if (previews && s.preview.pixel_count()) {
+        j["preview_png"] = base64_encode(encode_png(s.preview, exposure));
+        if (reference) j["error_png"] = base64_encode(encode_error_png(s.preview, *reference));
+    }
+    return j;
+}
+
+bool wants(const Json& options, const char* key, bool fallback) {
+    auto it = options.find(key);
+    return it != options.end() && it->is_boolean() ? it->get<bool>() : fallback;
+}
+
+} // namespace
+
+} // namespace mcp
+
+extern "C" {
+
+int mcp_render_scene_info(const char* scene_json, const char* options_json, char** info_json) {
+    using namespace mcp;
+    if (!info_json) return fail(MCP_ERROR_ARGUMENT, "mcp_render_scene_info: info_json is NULL");
+    *info_json = nullptr;
+    Loaded l;
+    Json options;
+    if (int st = load(scene_json, options_json, &l, &options)) return st;
+    Json j = scene_to_json(l);
+    Json ests = Json::array();
+    for (const RenderEstimator& e : l.request->estimators) ests.push_back(estimator_to_json(e));
+    j["estimators"] = ests;
+    j["settings"] = settings_to_json(l.request->settings, resolve_threads(l.request->settings.threads));
+    j["reference"] = Json{{"estimator", estimator_to_json(l.request->reference.estimator)},
+                          {"spp", l.request->reference.spp},
+                          {"file", l.request->reference.file}};
+    *info_json = copy_out(dump(j));
+    if (!*info_json) return fail(MCP_ERROR_INTERNAL, "out of memory");
+    return boundary::succeed();
+}
+
+int mcp_render_image(const char* scene_json, const char* options_json, char** result_json) {
+    using namespace mcp;
+    if (!result_json) return fail(MCP_ERROR_ARGUMENT, "mcp_render_image: result_json is NULL");
+    *result_json = nullptr;
+    Loaded l;
+    Json options;
+    if (int st = load(scene_json, options_json, &l, &options)) return st;
+    const RenderRequest& r = *l.request;
+    RenderEstimator est = r.estimators.front();
+    if (auto it = options.find("estimator"); it != options.end()) {
+        bool found = false;
+        if (it->is_string())
+            for (const RenderEstimator& e : r.estimators)
+                if (e.name == it->get<std::string>()) {
+                    est = e;
+                    found = true;
+                }
+        if (!found) {
+            Made<RenderEstimator> m = parse_render_estimator(*it, "options.estimator");
+            if (!m.ok()) return fail(MCP_ERROR_ARGUMENT, m.error);
+            est = m.value;
+        }
+    }
+    uint64_t spp = r.settings.spp_max;
+    if (auto it = options.find("spp"); it != options.end()) {
+        if (!it->is_number_integer() || it->get<int64_t>() < 1 || it->get<int64_t>() > (1 << 20))
+            return fail(MCP_ERROR_ARGUMENT, "options.spp: expected a whole number in 1..1048576");
+        spp = uint64_t(it->get<int64_t>());
+    }
+    bool png = true, hdr = false, error_png = false;
+    if (auto it = options.find("outputs"); it != options.end()) {
+        png = false;
+        if (!it->is_array()) return fail(MCP_ERROR_ARGUMENT, "options.outputs: expected an array");
+        for (const Json& o : *it) {
+            std::string s = o.is_string() ? o.get<std::string>() : "";
+            if (s == "png") png = true;
+            else if (s == "hdr") hdr = true;
+            else if (s == "error_png") error_png = true;
+            else
+                return fail(MCP_ERROR_ARGUMENT, "options.outputs: unknown output " + o.dump() +
+                                                    " (known: png, hdr, error_png)");
+        }
+    }
+    RenderSettings rs;
+    rs.width = r.settings.width;
+    rs.height = r.settings.height;
+    rs.spp = spp;
+    rs.stream = render_stream(r.settings.seed, est.name, spp, 0);
+    rs.threads = resolve_threads(r.settings.threads);
+    rs.jitter_pixels = r.settings.jitter_pixels;
+    RenderImage image = render_image(l.scene, est, rs);
+    const RenderDiagnostics& d = image.diagnostics;
+    Json diag{{"samples", d.samples},
+              {"discarded_nonfinite", d.discarded_nonfinite},
+              {"rays", d.rays},
+              {"light_misses", d.light_misses},
+              {"dominated_pixels", d.dominated_pixels},
+              {"max_sample_share", num(d.max_sample_share)}};
+    Json warnings = Json::array();
+    if (d.discarded_nonfinite)
+        warnings.push_back(warning("nonfinite", std::to_string(d.discarded_nonfinite) +
+                                                    " sample(s) with NaN/Inf radiance were "
+                                                    "discarded: the image is biased there"));
+    // Penumbrae legitimately have pixels where one sample of many sees the light; a share of
+    // the image above 1% is fireflies.
+    if (d.dominated_pixels * 100 > image.pixel_count())
+        warnings.push_back(warning("fireflies", std::to_string(d.dominated_pixels) +
+                                                    " pixel(s) owe more than half their value "
+                                                    "to one sample (fireflies)"));
+    Json images = Json::object();
+    if (png) images["png"] = base64_encode(encode_png(image, r.exposure));
+    if (hdr) images["hdr"] = base64_encode(encode_hdr(image));
+    Json j{{"version", kResultSchemaVersion},
+           {"kind", "render_image"},
+           {"mcplay", mcp_version()},
+           {"scene", scene_to_json(l)},
+           {"estimator", estimator_to_json(est)},
+           {"spp", spp},
+           {"seconds", num(image.seconds)},
+           {"rays_per_second", num(image.seconds > 0 ? double(d.rays) / image.seconds : NAN)},
+           {"diagnostics", diag},
+           {"warnings", warnings}};
+    if (error_png) {
+        RenderImage ref;
+        Json info;
+        std::string err;
+        if (!obtain_reference(l, &ref, &info, &err)) return fail(MCP_ERROR_SCENE, err);
+        ImageError e = image_error(image, ref);
+        images["error_png"] = base64_encode(encode_error_png(image, ref));
+        j["reference"] = info;
+        j["relative_mse"] = num(e.rel_mse);
+        j["pixel_coverage95"] = num(e.coverage);
+    }
+    j["images"] = images;
+    *result_json = copy_out(dump(j));
+    if (!*result_json) return fail(MCP_ERROR_INTERNAL, "out of memory writing the result");
+    return boundary::succeed();
+}
+
+int mcp_render_study_run(const char* scene_json, const char* options_json,
+                         mcp_progress_fn progress, void* user, char** result_json) {
+    using namespace mcp;
+    if (!result_json) return fail(MCP_ERROR_ARGUMENT, "mcp_render_study_run: result_json is NULL");
+    *result_json = nullptr;
+    Loaded l;
+    Json options;
+    if (int st = load(scene_json, options_json, &l, &options)) return st;
+    const RenderRequest& r = *l.request;
+    bool previews = wants(options, "previews", false);
+    RenderImage reference;
+    Json ref_info;
+    std::string err;
+    if (!obtain_reference(l, &reference, &ref_info, &err)) return fail(MCP_ERROR_SCENE, err);
+    int threads = resolve_threads(r.settings.threads);
+    RenderStudyProgress on_level;
+    if (progress) {
+        on_level = [&](const RenderStudyResult& partial, size_t level) {
+            Json ests = Json::array();
+            uint64_t n = 0;
+            for (const RenderEstimatorStudy& s : partial.estimators) {
+                ests.push_back(
+                    estimator_study_to_json(s, previews, r.exposure, &reference, false, level));
+                if (level < s.levels.size()) n = s.levels[level].n;
+            }
+            Json p{{"version", kResultSchemaVersion}, {"kind", "render"}, {"level_index", level},
+                   {"n", n}, {"estimators", ests}};
+            if (previews && level == 0)
+                p["reference_png"] = base64_encode(encode_png(reference, r.exposure));
+            std::string text = dump(p);
+            return progress(text.c_str(), user) == 0;
+        };
+    }
+    RenderStudyResult result =
+        run_render_study(l.scene, r.estimators, r.settings, reference, on_level);
+    Json scene = scene_to_json(l);
+    ref_info["mean_luminance"] = num(result.reference_mean_luminance);
+    scene["reference"] = ref_info;
+    scene["exact"] = num(result.reference_mean_luminance);
+    scene["quantity"] = "relative_mse";
+    Json ests = Json::array();
+    for (const RenderEstimatorStudy& s : result.estimators)
+        ests.push_back(estimator_study_to_json(s, previews, r.exposure, &reference, true, 0));
+    Json j{{"version", kResultSchemaVersion},
+           {"kind", "render"},
+           {"mcplay", mcp_version()},
+           {"scene", scene},
+           {"settings", settings_to_json(r.settings, threads)},
+           {"cancelled", result.cancelled},
+           {"wall_time_s", num(result.wall_seconds)},
+           {"estimators", ests}};
+    if (previews) j["reference_png"] = base64_encode(encode_png(reference, r.exposure));
+    *result_json = copy_out(dump(j));
+    if (!*result_json) return fail(MCP_ERROR_INTERNAL, "out of memory writing the result");
+    if (result.cancelled) return fail(MCP_ERROR_CANCELLED, "study cancelled by the caller");
+    return boundary::succeed();
+}
+
+} // extern "C"

@@ -1,0 +1,310 @@
+#include "render_api/render_request.h"
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "core/rng.h"
+#include "render_api/gltf_scene.h"
+
+namespace mcp {
+
+namespace {
+
+constexpr int kMaxImageSide = 4096;
+constexpr uint64_t kMaxSpp = uint64_t(1) << 20;
+
+bool read_text_file(const std::string& path, std::string* out) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) return false;
+    std::ostringstream ss;
+    ss << in.rdbuf();
+    *out = ss.str();
+    return true;
+}
+
+std::string dirname_of(const std::string& path) {
+    size_t slash = path.find_last_of('/');
+    return slash == std::string::npos ? std::string(".") : path.substr(0, slash);
+}
+
+bool parse_enum(Ctx& c, const Json& obj, const char* key, const std::string& path,
+                const std::vector<std::string>& names, int* out) {
+    std::string s;
+    if (!get_string(c, obj, key, path, &s)) return false;
+    if (!find(obj, key)) return true;
+    for (size_t i = 0; i < names.size(); ++i)
+        if (names[i] == s) {
+            *out = int(i);
+            return true;
+        }
+    return c.fail(sub(path, key), "unknown value '" + s + "' (known: " + join(names) + ")");
+}
+
+std::vector<std::string> strategy_names() {
+    std::vector<std::string> names;
+    for (int s = 0; s <= int(RadianceStrategy::Path); ++s)
+        names.push_back(strategy_name(RadianceStrategy(s)));
+    return names;
+}
+
+bool parse_estimator(Ctx& c, const Json& j, const std::string& path, RenderEstimator* out) {
+    RenderEstimator e;
+    if (j.is_string()) {
+        std::string name = j.get<std::string>();
+        if (!parse_strategy(name, &e.strategy))
+            return c.fail(path, "unknown estimator '" + name + "' (known: " +
+                                    join(strategy_names()) + ")");
+        e.name = name;
+        *out = e;
+        return true;
+    }
+    if (!check_keys(c, j, path,
+                    {"name", "strategy", "light_selection", "light_sampling", "pixel_sampler",
+                     "max_depth", "rr_depth"}))
+        return false;
+    std::string strategy;
+    if (!get_string(c, j, "strategy", path, &strategy)) return false;
+    if (strategy.empty()) return c.fail(sub(path, "strategy"), "missing (known: " +
+                                                                   join(strategy_names()) + ")");
+    if (!parse_strategy(strategy, &e.strategy))
+        return c.fail(sub(path, "strategy"), "unknown strategy '" + strategy + "' (known: " +
+                                                 join(strategy_names()) + ")");
+    e.name = strategy;
+    if (!get_string(c, j, "name", path, &e.name)) return false;
+    if (e.name.empty()) return c.fail(sub(path, "name"), "must not be empty");
+    int v = int(e.light_selection);
+    if (!parse_enum(c, j, "light_selection", path, {"uniform", "area", "power"}, &v)) return false;
+    e.light_selection = LightSelection(v);
+    v = int(e.light_sampling);
+    if (!parse_enum(c, j, "light_sampling", path, {"area", "solid_angle"}, &v)) return false;
+    e.light_sampling = LightSampling(v);
+    v = int(e.pixel_sampler);
+    if (!parse_enum(c, j, "pixel_sampler", path, {"independent", "stratified"}, &v)) return false;
+    e.pixel_sampler = PixelSamplerKind(v);
+    uint64_t depth = uint64_t(e.max_depth), rr = uint64_t(e.rr_depth);
+    if (!get_count(c, j, "max_depth", path, &depth) || !get_count(c, j, "rr_depth", path, &rr))
+        return false;
+    if (depth < 1 || depth > 1024) return c.fail(sub(path, "max_depth"), "must be in 1..1024");
+    if (rr < 1 || rr > 1024) return c.fail(sub(path, "rr_depth"), "must be in 1..1024");
+    if (find(j, "max_depth") && e.strategy != RadianceStrategy::Path)
+        return c.fail(sub(path, "max_depth"), "only the 'path' strategy has bounces");
+    e.max_depth = int(depth);
+    e.rr_depth = int(rr);
+    *out = e;
+    return true;
+}
+
+/// The quantity an estimator estimates: direct lighting, or paths up to a depth. Estimators
+/// of one study must agree, or their errors against one reference mean nothing.
+std::string quantity_of(const RenderEstimator& e) {
+    if (e.strategy != RadianceStrategy::Path) return "direct lighting";
+    return "paths of up to " + std::to_string(e.max_depth) + " bounce(s)";
+}
+
+bool parse_reference(Ctx& c, const Json& j, const std::string& path, const std::string& base_dir,
+                     ReferenceSpec* out) {
+    if (!check_keys(c, j, path, {"estimator", "spp", "file"})) return false;
+    if (const Json* e = find(j, "estimator"))
+        if (!parse_estimator(c, *e, sub(path, "estimator"), &out->estimator)) return false;
+    if (!get_count(c, j, "spp", path, &out->spp)) return false;
+    if (out->spp < 1 || out->spp > kMaxSpp)
+        return c.fail(sub(path, "spp"), "must be in 1.." + std::to_string(kMaxSpp));
+    std::string file;
+    if (!get_string(c, j, "file", path, &file)) return false;
+    if (!file.empty()) out->file = file[0] == '/' ? file : base_dir + "/" + file;
+    return true;
+}
+
+bool parse_settings(Ctx& c, const Json& j, const std::string& path, RenderRequest* r) {
+    uint64_t w = uint64_t(r->settings.width), h = uint64_t(r->settings.height);
+    uint64_t reps = uint64_t(r->settings.reps), threads = uint64_t(r->settings.threads);
+    if (!get_count(c, j, "width", path, &w) || !get_count(c, j, "height", path, &h) ||
+        !get_count(c, j, "spp_min", path, &r->settings.spp_min) ||
+        !get_count(c, j, "spp_max", path, &r->settings.spp_max) ||
+        !get_count(c, j, "reps", path, &reps) || !get_count(c, j, "seed", path, &r->settings.seed) ||
+        !get_count(c, j, "threads", path, &threads) ||
+        !get_number(c, j, "exposure", path, &r->exposure))
+        return false;
+    if (w < 1 || w > kMaxImageSide) return c.fail(sub(path, "width"), "must be in 1..4096");
+    if (h < 1 || h > kMaxImageSide) return c.fail(sub(path, "height"), "must be in 1..4096");
+    if (r->settings.spp_min < 1 || r->settings.spp_min > kMaxSpp)
+        return c.fail(sub(path, "spp_min"), "must be in 1.." + std::to_string(kMaxSpp));
+    if (r->settings.spp_max < r->settings.spp_min || r->settings.spp_max > kMaxSpp)
+        return c.fail(sub(path, "spp_max"),
+                      "must be in spp_min.." + std::to_string(kMaxSpp));
+    if (reps < 2 || reps > 1024) return c.fail(sub(path, "reps"), "must be in 2..1024");
+    if (threads > 256) return c.fail(sub(path, "threads"), "must be in 0..256");
+    if (const Json* v = find(j, "jitter_pixels")) {
+        if (!v->is_boolean()) return c.fail(sub(path, "jitter_pixels"), "expected true or false");
+        r->settings.jitter_pixels = v->get<bool>();
+    }
+    if (const Json* v = find(j, "accel")) {
+        int k = int(r->accel);
+        if (!parse_enum(c, j, "accel", path, {"auto", "brute_force", "bvh"}, &k)) return false;
+        (void)v;
+        r->accel = AccelKind(k);
+    }
+    r->settings.width = int(w);
+    r->settings.height = int(h);
+    r->settings.reps = int(reps);
+    r->settings.threads = int(threads);
+    return true;
+}
+
+bool parse_estimator_list(Ctx& c, const Json& list, const std::string& path,
+                          std::vector<RenderEstimator>* out) {
+    if (!list.is_array() || list.empty())
+        return c.fail(path, "expected a non-empty array of estimator names or objects");
+    out->clear();
+    for (size_t i = 0; i < list.size(); ++i) {
+        RenderEstimator e;
+        if (!parse_estimator(c, list[i], path + "[" + std::to_string(i) + "]", &e)) return false;
+        for (const RenderEstimator& o : *out)
+            if (o.name == e.name)
+                return c.fail(path + "[" + std::to_string(i) + "]",
+                              "duplicate estimator name '" + e.name + "'");
+        out->push_back(e);
+    }
+    return true;
+}
+
+} // namespace
+
+bool is_render_scene(const Json& scene) {
+    return scene.is_object() && scene.contains("render");
+}
+
+Made<RenderEstimator> parse_render_estimator(const Json& j, const std::string& path) {
+    Ctx c;
+    RenderEstimator e;
+    if (!parse_estimator(c, j, path, &e)) return made_error<RenderEstimator>(c.error);
+    return Made<RenderEstimator>{e, ""};
+}
+
+Made<std::shared_ptr<RenderRequest>> build_render_request(const Json& scene, const Json& options) {
+    using Result = Made<std::shared_ptr<RenderRequest>>;
+    Ctx c;
+    auto r = std::make_shared<RenderRequest>();
+    auto error = [&]() { return made_error<std::shared_ptr<RenderRequest>>(c.error); };
+    if (!check_keys(c, scene, "scene", {"name", "description", "render"})) return error();
+    if (!get_string(c, scene, "name", "scene", &r->name) ||
+        !get_string(c, scene, "description", "scene", &r->description))
+        return error();
+    const Json& render = scene["render"];
+    const std::string rp = "scene.render";
+    if (!check_keys(c, render, rp,
+                    {"gltf", "width", "height", "spp_min", "spp_max", "reps", "seed", "threads",
+                     "estimators", "reference", "jitter_pixels", "exposure", "accel"}))
+        return error();
+    Json opts = options.is_null() ? Json::object() : options;
+    if (!check_keys(c, opts, "options",
+                    {"base_dir", "cache_dir", "width", "height", "spp_min", "spp_max", "reps",
+                     "seed", "threads", "estimators", "reference", "jitter_pixels", "exposure",
+                     "accel", "estimator", "spp", "outputs", "previews"}))
+        return error();
+    std::string base_dir = ".";
+    if (!get_string(c, opts, "base_dir", "options", &base_dir) ||
+        !get_string(c, opts, "cache_dir", "options", &r->cache_dir))
+        return error();
+
+    // Settings: the scene's, then the options' overrides.
+    if (!parse_settings(c, render, rp, r.get()) || !parse_settings(c, opts, "options", r.get()))
+        return error();
+
+    // The glTF: a path relative to the scene file, or the glTF JSON itself inline.
+    const Json* gltf = find(render, "gltf");
+    if (!gltf) return made_error<std::shared_ptr<RenderRequest>>(rp + ".gltf: missing");
+    GltfLoadResult loaded;
+    std::string text;
+    if (gltf->is_string()) {
+        std::string p = gltf->get<std::string>();
+        r->gltf_path = !p.empty() && p[0] == '/' ? p : base_dir + "/" + p;
+        if (!read_text_file(r->gltf_path, &text))
+            return made_error<std::shared_ptr<RenderRequest>>(
+                rp + ".gltf: cannot read '" + r->gltf_path + "'");
+        loaded = load_gltf_memory(text, dirname_of(r->gltf_path));
+    } else if (gltf->is_object()) {
+        text = gltf->dump();
+        loaded = load_gltf_memory(text, base_dir);
+    } else {
+        return made_error<std::shared_ptr<RenderRequest>>(
+            rp + ".gltf: expected a file name or a glTF object, got " + type_of(*gltf));
+    }
+    if (!loaded.ok)
+        return made_error<std::shared_ptr<RenderRequest>>(rp + ".gltf: " + loaded.error);
+    r->gltf_hash = hash_string(text.c_str());
+    r->scene = std::make_unique<Scene>(std::move(loaded.scene));
+    r->warnings = loaded.warnings;
+    if (!loaded.has_camera)
+        return made_error<std::shared_ptr<RenderRequest>>(
+            rp + ".gltf: the scene has no perspective camera (add a camera node)");
+
+    // Estimators: the scene's list (or every direct-lighting strategy), then the options'.
+    if (const Json* list = find(render, "estimators")) {
+        if (!parse_estimator_list(c, *list, rp + ".estimators", &r->estimators)) return error();
+    } else {
+        for (int s = 0; s < int(RadianceStrategy::Path); ++s) {
+            RenderEstimator e;
+            e.strategy = RadianceStrategy(s);
+            e.name = strategy_name(e.strategy);
+            r->estimators.push_back(e);
+        }
+    }
+    if (const Json* list = find(opts, "estimators")) {
+        // Names pick from the scene's estimators; anything else must be a full estimator.
+        if (!list->is_array() || list->empty())
+            return made_error<std::shared_ptr<RenderRequest>>(
+                "options.estimators: expected a non-empty array");
+        std::vector<RenderEstimator> chosen;
+        for (size_t i = 0; i < list->size(); ++i) {
+            const Json& item = (*list)[i];
+            bool found = false;
+            if (item.is_string())
+                for (const RenderEstimator& e : r->estimators)
+                    if (e.name == item.get<std::string>()) {
+                        chosen.push_back(e);
+                        found = true;
+                    }
+            if (!found) {
+                RenderEstimator e;
+                if (!parse_estimator(c, item, "options.estimators[" + std::to_string(i) + "]", &e))
+                    return error();
+                chosen.push_back(e);
+            }
+        }
+        r->estimators = chosen;
+    }
+
+    // The reference: by default the power-heuristic MIS estimator of the same quantity.
+    const RenderEstimator& first = r->estimators.front();
+    r->reference.estimator.name = "reference";
+    r->reference.estimator.strategy =
+        first.strategy == RadianceStrategy::Path ? RadianceStrategy::Path : RadianceStrategy::MisPower;
+    r->reference.estimator.max_depth = first.max_depth;
+    r->reference.estimator.rr_depth = first.rr_depth;
+    r->reference.spp = std::max<uint64_t>(256, 16 * r->settings.spp_max);
+    if (const Json* ref = find(render, "reference"))
+        if (!parse_reference(c, *ref, rp + ".reference", dirname_of(r->gltf_path.empty()
+                                                                          ? base_dir + "/x"
+                                                                          : r->gltf_path),
+                             &r->reference))
+            return error();
+    if (const Json* ref = find(opts, "reference"))
+        if (!parse_reference(c, *ref, "options.reference", base_dir, &r->reference)) return error();
+    for (const RenderEstimator& e : r->estimators)
+        if (quantity_of(e) != quantity_of(r->estimators.front()))
+            return made_error<std::shared_ptr<RenderRequest>>(
+                "estimators: '" + e.name + "' estimates " + quantity_of(e) + " but '" +
+                r->estimators.front().name + "' estimates " + quantity_of(r->estimators.front()) +
+                "; one study compares estimators of one quantity");
+    if (r->reference.file.empty() &&
+        quantity_of(r->reference.estimator) != quantity_of(r->estimators.front()))
+        return made_error<std::shared_ptr<RenderRequest>>(
+            "reference: estimates " + quantity_of(r->reference.estimator) +
+            " but the estimators estimate " + quantity_of(r->estimators.front()));
+    r->reference.estimator.name = "reference";
+    return Result{r, ""};
+}
+
+} // namespace mcp

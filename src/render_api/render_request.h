@@ -1,0 +1,46 @@
+// Render scene JSON (docs/scene-format.md, "Render scenes") -> the loaded glTF scene, the
+// estimators, the study settings and the reference. Internal to the render C API.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "api/json_read.h"
+#include "core/made.h"
+#include "render/render_study.h"
+
+namespace mcp {
+
+struct ReferenceSpec {
+    RenderEstimator estimator;
+    uint64_t spp = 1024;
+    std::string file; ///< a Radiance .hdr file instead of a render ("" = render it)
+};
+
+struct RenderRequest {
+    std::string name, description;
+    std::string gltf_path; ///< "" when the glTF was inline
+    uint64_t gltf_hash = 0; ///< of the glTF text, for the reference cache
+    std::unique_ptr<Scene> scene; ///< heap-held: RenderScene keeps a pointer to it
+    std::vector<std::string> warnings; ///< from the loader and the scene file
+    RenderStudySettings settings;
+    std::vector<RenderEstimator> estimators;
+    ReferenceSpec reference;
+    AccelKind accel = AccelKind::Auto;
+    double exposure = 0.0; ///< stops, for PNG output
+    std::string cache_dir; ///< where high-spp references are cached ("" = no cache)
+};
+
+/// Does this scene JSON describe a render scene (it has a "render" object)?
+bool is_render_scene(const Json& scene);
+
+/// Parses the scene and the option overrides, and loads the glTF. `options.base_dir`
+/// resolves a relative glTF path (the CLI passes the scene file's folder).
+Made<std::shared_ptr<RenderRequest>> build_render_request(const Json& scene, const Json& options);
+
+/// The option keys that select one estimator for mcp_render_image: "estimator" (a name or
+/// an estimator object) and "spp".
+Made<RenderEstimator> parse_render_estimator(const Json& j, const std::string& path);
+
+} // namespace mcp

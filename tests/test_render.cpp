@@ -1,0 +1,161 @@
+// The radiance estimators against closed forms: Lambert's polygon formula under a quad light,
+// furnaces (closed emitting enclosures), thread invariance and convergence orders.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "core/special.h"
+#include "render/render_study.h"
+#include "render_scenes.h"
+#include "test_support.h"
+
+namespace mcp {
+namespace {
+
+using test::diffuse;
+
+const RadianceStrategy kDirect[] = {
+    RadianceStrategy::UniformHemisphere, RadianceStrategy::CosineHemisphere,
+    RadianceStrategy::Bsdf,              RadianceStrategy::LightArea,
+    RadianceStrategy::LightSolidAngle,   RadianceStrategy::MisBalance,
+    RadianceStrategy::MisPower,
+};
+
+RenderEstimator estimator(RadianceStrategy s, PixelSamplerKind px = PixelSamplerKind::Stratified) {
+    RenderEstimator e;
+    e.strategy = s;
+    e.name = strategy_name(s);
+    e.pixel_sampler = px;
+    return e;
+}
+
+RenderSettings settings(int w, int h, uint64_t spp, uint64_t stream) {
+    RenderSettings s;
+    s.width = w;
+    s.height = h;
+    s.spp = spp;
+    s.stream = stream;
+    s.threads = 1;
+    return s;
+}
+
+// Floor radiance under the quad light: (albedo / pi) E with E = pi Le F from Lambert's
+// polygon formula at the point each pixel's centre ray hits. Every estimator, every pixel,
+// within its own error bar (z-threshold for a family-wise level of 1e-3 over all pixels).
+TEST(RenderAnalytic, QuadLightFloorMatchesLambertsFormula) {
+    const double Le = 5.0, albedo = 0.5;
+    Scene scene = test::quad_light_scene(Le);
+    RenderScene rs;
+    rs.build(scene);
+    const Vec3 light[4] = {{-0.5, 1, -0.5}, {0.5, 1, -0.5}, {0.5, 1, 0.5}, {-0.5, 1, 0.5}};
+    const int W = 8, H = 8;
+    const int tests = W * H * int(std::size(kDirect));
+    const double z_max = -normal_quantile(0.5 * test::sidak_level(1e-3, tests));
+    for (RadianceStrategy s : kDirect) {
+        RenderSettings st = settings(W, H, 512, 77);
+        st.jitter_pixels = false;
+        RenderImage im = render_image(rs, estimator(s), st);
+        EXPECT_EQ(im.diagnostics.discarded_nonfinite, 0u);
+        for (int y = 0; y < H; ++y)
+            for (int x = 0; x < W; ++x) {
+                Ray r = camera_ray(scene.camera, W, H, x + 0.5, y + 0.5);
+                ASSERT_LT(r.direction.y, 0.0);
+                Vec3 p = r.origin + r.direction * (-r.origin.y / r.direction.y);
+                double F = lambert_polygon_form_factor(p, Vec3(0, 1, 0), light, 4);
+                double expected = albedo * Le * F; // (albedo / pi) * pi Le F
+                size_t k = (size_t(y) * W + size_t(x)) * 3;
+                double se = std::sqrt(im.variance[k]);
+                EXPECT_LE(std::fabs(im.rgb[k] - expected), z_max * se + 1e-12 * expected)
+                    << strategy_name(s) << " pixel " << x << "," << y << " expected " << expected
+                    << " got " << im.rgb[k] << " +/- " << se;
+            }
+    }
+}
+
+// A closed box every face of which emits Le and reflects with albedo rho: with direct light
+// only each point returns Le (1 + rho); with every bounce Le / (1 - rho). Cosine sampling of
+// the diffuse BRDF has weight rho Le for every direction, so it is exact when no ray escapes
+// (which also tests watertight intersection).
+TEST(RenderAnalytic, FurnaceBox) {
+    const double rho = 0.5, Le = 1.0;
+    Scene scene = test::furnace_box(rho, Le, 4);
+    RenderScene rs;
+    rs.build(scene);
+    {
+        RenderImage im = render_image(rs, estimator(RadianceStrategy::CosineHemisphere),
+                                      settings(16, 16, 16, 3));
+        for (size_t k = 0; k < im.rgb.size(); ++k) ASSERT_NEAR(im.rgb[k], Le * (1 + rho), 1e-12);
+    }
+    for (RadianceStrategy s : kDirect) {
+        RenderImage im = render_image(rs, estimator(s), settings(16, 16, 64, 5));
+        ImageError e;
+        RenderImage exact = im;
+        for (double& v : exact.rgb) v = Le * (1 + rho);
+        for (double& v : exact.variance) v = 0.0;
+        e = image_error(im, exact);
+        EXPECT_NEAR(e.mean_luminance, Le * (1 + rho), 5.0 * e.mean_luminance_se + 1e-12)
+            << strategy_name(s);
+        EXPECT_EQ(im.diagnostics.discarded_nonfinite, 0u) << strategy_name(s);
+    }
+    RenderEstimator path = estimator(RadianceStrategy::Path);
+    path.max_depth = 1000;
+    RenderImage im = render_image(rs, path, settings(16, 16, 64, 9));
+    RenderImage exact = im;
+    for (double& v : exact.rgb) v = Le / (1 - rho);
+    ImageError e = image_error(im, exact);
+    EXPECT_NEAR(e.mean_luminance, Le / (1 - rho), 5.0 * e.mean_luminance_se);
+    // Depth 1 is direct lighting: Le (1 + rho) again.
+    path.max_depth = 1;
+    im = render_image(rs, path, settings(16, 16, 64, 11));
+    e = image_error(im, exact);
+    EXPECT_NEAR(e.mean_luminance, Le * (1 + rho), 5.0 * e.mean_luminance_se);
+}
+
+TEST(Render, ImagesDoNotDependOnThreads) {
+    Scene scene = test::quad_light_scene(5.0);
+    RenderScene rs;
+    rs.build(scene);
+    RenderSettings one = settings(12, 10, 8, 42);
+    RenderSettings two = one;
+    two.threads = 2;
+    for (RadianceStrategy s : {RadianceStrategy::MisPower, RadianceStrategy::Bsdf}) {
+        RenderImage a = render_image(rs, estimator(s), one);
+        RenderImage b = render_image(rs, estimator(s), two);
+        EXPECT_EQ(a.rgb, b.rgb);
+        EXPECT_EQ(a.diagnostics.rays, b.diagnostics.rays);
+    }
+}
+
+// Relative MSE against a reference falls as 1/spp for every unbiased estimator with
+// independent pixel samples (fitted order within 4 standard errors of -1, plus 0.1 for the
+// reference's own noise at the largest spp); stratified samples do at least as well.
+TEST(RenderConvergence, RelativeMseFallsAsOneOverSpp) {
+    Scene scene = test::quad_light_scene(5.0);
+    RenderScene rs;
+    rs.build(scene);
+    RenderSettings ref_settings = settings(12, 12, 8192, 1234);
+    RenderImage reference = render_image(rs, estimator(RadianceStrategy::MisPower), ref_settings);
+    RenderStudySettings st;
+    st.width = 12;
+    st.height = 12;
+    st.spp_min = 1;
+    st.spp_max = 32;
+    st.reps = 6;
+    st.threads = 1;
+    std::vector<RenderEstimator> ests;
+    for (RadianceStrategy s : kDirect) ests.push_back(estimator(s, PixelSamplerKind::Independent));
+    RenderStudyResult r = run_render_study(rs, ests, st, reference);
+    for (const RenderEstimatorStudy& e : r.estimators) {
+        ASSERT_TRUE(e.fit.valid) << e.estimator.name << ": " << e.fit.note;
+        EXPECT_NEAR(e.fit.order, -1.0, 4.0 * e.fit.order_se + 0.1) << e.estimator.name;
+    }
+    for (RenderEstimator& e : ests) e.pixel_sampler = PixelSamplerKind::Stratified;
+    r = run_render_study(rs, ests, st, reference);
+    for (const RenderEstimatorStudy& e : r.estimators) {
+        ASSERT_TRUE(e.fit.valid) << e.estimator.name;
+        EXPECT_LT(e.fit.order, -1.0 + 4.0 * e.fit.order_se + 0.1) << e.estimator.name;
+    }
+}
+
+} // namespace
+} // namespace mcp

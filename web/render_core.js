@@ -1,0 +1,83 @@
+// The only module that talks to the render wasm module (build-wasm/mcplay_render_web.mjs, the
+// C API of src/render_api/mcplay_render.h). Same style and conventions as core.js, whose
+// calling machinery it shares: plain ES module, no DOM, no Node APIs; it runs in a page, in a
+// (module) Web Worker and in Node. The playground's worker imports it (and the render module)
+// only when a render scene is asked for, so the integration page never downloads the renderer.
+//
+//   import createMcplayRender from './mcplay_render_web.mjs';
+//   const render = await loadRenderCore(createMcplayRender);   // Node: (..., {wasmBinary})
+//   const result = render.runStudy(scene, {spp_max: 16, previews: true}, (level) => draw(level));
+//
+// The scene is the whole render scene JSON with its "gltf" given inline as the glTF object
+// (the module has no file system access to the site). Every call is synchronous once the core
+// is loaded: run studies in a Worker.
+import { McplayError, Status, WASM_RUNTIME_METHODS, instantiate, wasmBridge } from './core.js';
+
+export { McplayError, Status };
+
+/** The module's exported functions this wrapper needs: exactly
+ *  src/wasm/render_exported_functions.txt (web/test/render_core.test.mjs checks it). */
+export const RENDER_WASM_FUNCTIONS = Object.freeze([
+  '_malloc', '_free',
+  '_mcp_version', '_mcp_last_error', '_mcp_render_study_run', '_mcp_render_image',
+  '_mcp_render_scene_info', '_mcp_free',
+  '_mallinfo',
+]);
+
+/** The Emscripten runtime helpers used (the same list as core.js). */
+export const RENDER_WASM_RUNTIME_METHODS = WASM_RUNTIME_METHODS;
+
+/**
+ * Instantiates the render wasm module and returns the render core.
+ * @param {Function} createMcplayRender the default export of mcplay_render_web.mjs
+ * @param {object} moduleOptions Emscripten module options, e.g. {wasmBinary} in Node
+ */
+export async function loadRenderCore(createMcplayRender, moduleOptions = {}) {
+  const M = await instantiate(createMcplayRender, moduleOptions, RENDER_WASM_FUNCTIONS,
+    'loadRenderCore', 'mcplay_render_web');
+  return makeRenderCore(M);
+}
+
+function makeRenderCore(M) {
+  const b = wasmBridge(M);
+
+  /**
+   * What a render scene holds (mcp_render_scene_info): name, description, kind "render",
+   * width, height, triangles, lights, materials, accel, warnings, estimators (objects with
+   * name, strategy, light_selection, ...), settings {n_min, n_max, reps, seed, n_name,
+   * error_name, ...} and the reference. `options` (optional) overrides the scene's settings.
+   */
+  function sceneInfo(scene, options = null) {
+    b.usable('sceneInfo');
+    return b.callJson('sceneInfo', M._mcp_render_scene_info, 'mcp_render_scene_info',
+      [b.jsonText(scene, 'scene'), b.optionalJson(options, 'options')]);
+  }
+
+  /**
+   * A render convergence study (mcp_render_study_run): every estimator at spp = spp_min ..
+   * spp_max (powers of two), reps images each, measured by relative MSE against the
+   * reference. `options`: {estimators, spp_min, spp_max, reps, seed, width, height, previews,
+   * ...} or null. onLevel(progress) gets {kind: "render", level_index, n, estimators: [{...,
+   * level, fit, preview_png?, error_png?}]} after each spp; returning exactly `true` cancels
+   * (the result then has cancelled: true). An exception thrown by onLevel cancels the study
+   * and is rethrown. Failures throw McplayError.
+   */
+  function runStudy(scene, options = null, onLevel = null) {
+    return b.study('runStudy', M._mcp_render_study_run, 'mcp_render_study_run', scene, options, onLevel);
+  }
+
+  /**
+   * One image (mcp_render_image): options {estimator, spp, outputs: ["png", "hdr",
+   * "error_png"], width, height, seed, ...}. Returns {kind: "render_image", images: {png:
+   * base64, ...}, diagnostics, seconds, rays_per_second, warnings, ...}.
+   */
+  function renderImage(scene, options = null) {
+    b.usable('renderImage');
+    return b.callJson('renderImage', M._mcp_render_image, 'mcp_render_image',
+      [b.jsonText(scene, 'scene'), b.optionalJson(options, 'options')]);
+  }
+
+  return Object.freeze({
+    version: b.version, sceneInfo, runStudy, renderImage, heapStats: b.heapStats, dispose: b.dispose,
+  });
+}

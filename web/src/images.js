@@ -1,0 +1,119 @@
+// The images of a render study: the reference, and per estimator the image of its latest level
+// (replicate 0) with its false-colour relative error against the reference, updated as levels
+// finish; before a run, a quick image of the scene. A pure render of the state (state.run,
+// state.scenePreview) into #render-images; the PNGs come base64-encoded from the render core
+// (options.previews). An <img> gets a new src only when its picture changed.
+import { colorAt } from './palette.js';
+import { el } from './dom.js';
+
+const PNG = 'data:image/png;base64,';
+
+let layoutSig = null;
+const shown = new Map(); // img key -> base64 last set
+
+function setImage(img, key, base64) {
+  if (!img) return;
+  const want = base64 || null;
+  if (shown.get(key) === want) return;
+  shown.set(key, want);
+  if (want) {
+    img.src = PNG + want;
+    img.hidden = false;
+    img.dataset.drawn = 'true';
+  } else {
+    img.removeAttribute('src');
+    img.hidden = true;
+    img.dataset.drawn = 'false';
+  }
+}
+
+function picture(role, name, caption, alt) {
+  const img = el('img', { alt, className: 'render-image', hidden: true, dataset: { role, estimator: name || '', drawn: 'false' } });
+  return el('figure', { className: 'render-figure' }, img, el('figcaption', { className: 'cap', dataset: { caption: role } }, caption));
+}
+
+function colorOf(run, name) {
+  return colorAt(run.colors && name in run.colors ? run.colors[name] : run.order.indexOf(name));
+}
+
+/** The cards: the reference (or the scene's quick preview), then one per estimator of the run. */
+function layout(container, run, size) {
+  const cards = [el('div', { className: 'image-card', dataset: { card: 'reference' } },
+    el('h3', {}, el('span', { dataset: { title: 'reference' } }, 'Reference'), el('span', { className: 'muted small', dataset: { info: 'reference' } }, '')),
+    el('div', { className: 'pair' }, picture('reference', '', 'reference image', 'reference image')),
+    el('p', { className: 'cap', dataset: { wait: 'reference' } }, ''))];
+  for (const name of run.order) {
+    cards.push(el('div', { className: 'image-card', dataset: { card: name } },
+      el('h3', {}, el('span', { className: 'swatch', style: `background: ${colorOf(run, name)}` }), name,
+        el('span', { className: 'muted small', dataset: { info: name } }, '')),
+      el('div', { className: 'pair' },
+        picture('preview', name, 'image (replicate 0)', `${name}: image of the latest level`),
+        picture('error', name, '|relative error|', `${name}: relative error against the reference`))));
+  }
+  container.replaceChildren(...cards);
+  container.style.setProperty('--image-width', `${size}px`);
+}
+
+/** Draws the images of state.run into dom.images (the #render-images grid). */
+export function renderImages(state, dom) {
+  if (!dom.images) return;
+  const run = state.run;
+  const render = state.sceneInfo && state.sceneInfo.kind === 'render';
+  if (!render) {
+    if (layoutSig !== null) {
+      dom.images.replaceChildren();
+      layoutSig = null;
+      shown.clear();
+    }
+    return;
+  }
+  const order = run.kind === 'render' ? run.order : [];
+  const w = (run.kind === 'render' && run.settings && run.settings.width) || state.params.width || 64;
+  // Small images are scaled up by whole factors (pixelated), to about 200 px.
+  const size = w * Math.max(1, Math.min(8, Math.round(200 / w)));
+  const sig = JSON.stringify([run.id, order, run.colors, size]);
+  if (sig !== layoutSig) {
+    layoutSig = sig;
+    shown.clear();
+    layout(dom.images, { ...run, order }, size);
+  }
+  const q = (sel) => dom.images.querySelector(sel);
+
+  // The reference: the study's, else the quick image of the scene (before or during a run).
+  const preview = state.scenePreview;
+  const refPng = run.kind === 'render' ? run.referencePng : null;
+  const ref = refPng || (preview && preview.png) || null;
+  setImage(q('img[data-role="reference"]'), 'reference', ref);
+  const refInfo = q('[data-info="reference"]');
+  const wait = q('[data-wait="reference"]');
+  let info = '';
+  let waitText = '';
+  if (refPng) {
+    const r = run.result && run.result.scene && run.result.scene.reference;
+    info = r && r.spp ? ` ${r.spp} spp${r.estimator ? `, ${r.estimator.strategy}` : ''}` : '';
+  } else if (preview && preview.png) {
+    info = ` ${preview.estimator}, ${preview.spp} spp`;
+    waitText = run.status === 'running' ? 'The study renders its reference first; it is shown here when the study ends.'
+      : 'Press Run: the study renders a reference at many spp and compares every image with it.';
+  } else {
+    waitText = preview && preview.status === 'error' ? `No image: ${preview.message}` : 'Rendering a quick image of the scene…';
+  }
+  if (refInfo && refInfo.textContent !== info) refInfo.textContent = info;
+  if (wait && wait.textContent !== waitText) wait.textContent = waitText;
+  const title = q('[data-title="reference"]');
+  const titleText = refPng || !(preview && preview.png) ? 'Reference' : 'The scene';
+  if (title && title.textContent !== titleText) title.textContent = titleText;
+  const caption = q('[data-caption="reference"]');
+  const captionText = refPng ? 'the study\'s reference image' : preview && preview.png ? 'a quick image, not the reference' : '';
+  if (caption && caption.textContent !== captionText) caption.textContent = captionText;
+
+  for (const name of order) {
+    const r = run.records[name];
+    setImage(q(`img[data-role="preview"][data-estimator="${CSS.escape(name)}"]`), `preview:${name}`, r && r.preview_png);
+    setImage(q(`img[data-role="error"][data-estimator="${CSS.escape(name)}"]`), `error:${name}`, r && r.error_png);
+    const last = r && r.levels.length ? r.levels[r.levels.length - 1] : null;
+    const text = last ? ` ${last.n} spp` : run.status === 'running' ? ' waiting for the first level…' : '';
+    const span = q(`[data-info="${CSS.escape(name)}"]`);
+    if (span && span.textContent !== text) span.textContent = text;
+  }
+}

@@ -1,0 +1,355 @@
+// Tests of web/render_core.js, the only code that talks to the render wasm module, under Node's
+// test runner: MCPLAY_WASM_DIR=build-wasm node --test web/test/
+// MCPLAY_WASM_DIR holds mcplay_render_web.mjs + .wasm (default build-wasm), MCPLAY_NATIVE is the
+// native CLI (default build/mcplay); relative paths are taken from the repository root. The scene is built here: a grey floor quad under a quad light and a
+// camera looking down, as glTF JSON with its buffer embedded as base64, inline in the scene
+// (as the playground passes it). A missing module fails the tests that need it.
+import { test } from 'node:test';
+import assert from 'node:assert/strict';
+import { execFileSync } from 'node:child_process';
+import fs from 'node:fs';
+import path from 'node:path';
+import { fileURLToPath, pathToFileURL } from 'node:url';
+
+import { loadRenderCore, McplayError, Status, RENDER_WASM_FUNCTIONS, RENDER_WASM_RUNTIME_METHODS } from '../render_core.js';
+import { McplayError as CoreMcplayError } from '../core.js';
+import { isRenderScene } from '../src/protocol.js';
+import { manifestEntry, siteScene, inlineGltf } from '../tools/build-site.mjs';
+
+const ROOT = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '..', '..');
+const WASM_DIR = path.resolve(ROOT, process.env.MCPLAY_WASM_DIR || 'build-wasm');
+const MJS = path.join(WASM_DIR, 'mcplay_render_web.mjs');
+const WASM = path.join(WASM_DIR, 'mcplay_render_web.wasm');
+const NATIVE = path.resolve(ROOT, process.env.MCPLAY_NATIVE || 'build/mcplay');
+
+/** A 4 x 4 m floor (albedo 0.5) at y = 0 under a 1 x 1 m light of radiance Le at height h facing
+ *  down; the camera at half the height looks straight down. One buffer: positions then indices. */
+function quadLightGltf({ h = 1, Le = 5 } = {}) {
+  const pos = new Float32Array([
+    -2, 0, -2, -2, 0, 2, 2, 0, 2, 2, 0, -2, // floor, counter-clockwise seen from +y
+    -0.5, h, -0.5, 0.5, h, -0.5, 0.5, h, 0.5, -0.5, h, 0.5, // light, counter-clockwise seen from -y
+  ]);
+  const idx = new Uint16Array([0, 1, 2, 0, 2, 3]);
+  const bytes = Buffer.concat([Buffer.from(pos.buffer), Buffer.from(idx.buffer)]);
+  return {
+    asset: { version: '2.0' },
+    extensionsUsed: ['KHR_materials_emissive_strength'],
+    scene: 0,
+    scenes: [{ nodes: [0, 1, 2] }],
+    nodes: [
+      { mesh: 0 }, { mesh: 1 },
+      // the camera looks along its -z: rotated by -90 degrees about x, it looks down (-y)
+      { camera: 0, translation: [0, 0.5 * h, 0], rotation: [-Math.SQRT1_2, 0, 0, Math.SQRT1_2] },
+    ],
+    cameras: [{ type: 'perspective', perspective: { yfov: 1.2, znear: 0.01, aspectRatio: 1 } }],
+    meshes: [
+      { primitives: [{ attributes: { POSITION: 0 }, indices: 2, material: 0 }] },
+      { primitives: [{ attributes: { POSITION: 1 }, indices: 2, material: 1 }] },
+    ],
+    materials: [
+      { pbrMetallicRoughness: { baseColorFactor: [0.5, 0.5, 0.5, 1], metallicFactor: 0, roughnessFactor: 1 } },
+      {
+        pbrMetallicRoughness: { baseColorFactor: [0, 0, 0, 1], metallicFactor: 0, roughnessFactor: 1 },
+        emissiveFactor: [1, 1, 1], extensions: { KHR_materials_emissive_strength: { emissiveStrength: Le } },
+      },
+    ],
+    buffers: [{ byteLength: bytes.length, uri: `data:application/octet-stream;base64,${bytes.toString('base64')}` }],
+    bufferViews: [
+      { buffer: 0, byteOffset: 0, byteLength: pos.byteLength, target: 34962 },
+      { buffer: 0, byteOffset: pos.byteLength, byteLength: idx.byteLength, target: 34963 },
+    ],
+    accessors: [
+      { bufferView: 0, byteOffset: 0, componentType: 5126, count: 4, type: 'VEC3', min: [-2, 0, -2], max: [2, 0, 2] },
+      { bufferView: 0, byteOffset: 48, componentType: 5126, count: 4, type: 'VEC3', min: [-0.5, h, -0.5], max: [0.5, h, 0.5] },
+      { bufferView: 1, byteOffset: 0, componentType: 5123, count: 6, type: 'SCALAR' },
+    ],
+  };
+}
+
+const ESTIMATORS = ['cosine_hemisphere', 'light_area', 'mis_power'];
+const SCENE = {
+  name: 'tiny_quad_light',
+  description: 'floor under a quad light',
+  render: { gltf: quadLightGltf(), width: 16, height: 16, spp_min: 1, spp_max: 8, reps: 3, estimators: ESTIMATORS },
+};
+const SMALL = { spp_min: 1, spp_max: 4, reps: 2, width: 8, height: 8 };
+
+let corePromise = null;
+function getCore() {
+  corePromise ??= (async () => {
+    for (const f of [MJS, WASM]) {
+      if (!fs.existsSync(f)) {
+        throw new Error(`render wasm module not found: ${f}. Build it with \`make build-wasm\` (target ` +
+          'mcplay_render_web) or point MCPLAY_WASM_DIR at the directory holding mcplay_render_web.mjs/.wasm');
+      }
+    }
+    const { default: create } = await import(pathToFileURL(MJS).href);
+    return loadRenderCore(create, { wasmBinary: fs.readFileSync(WASM) });
+  })();
+  return corePromise;
+}
+
+function exportList(file) {
+  return fs.readFileSync(path.join(ROOT, 'src', 'wasm', file), 'utf8').split('\n')
+    .map((l) => l.trim()).filter((l) => l && !l.startsWith('#'));
+}
+
+function assertMcplayError(fn, status, re) {
+  assert.throws(fn, (e) => {
+    assert.ok(e instanceof McplayError, `expected McplayError, got ${e && e.name}: ${e && e.message}`);
+    assert.equal(e.status, status, `status ${e.status} (${e.message})`);
+    assert.match(e.message, re);
+    return true;
+  });
+}
+
+// A PNG's width and height from its IHDR chunk.
+function pngSize(base64) {
+  const b = Buffer.from(base64, 'base64');
+  assert.equal(b.subarray(1, 4).toString('latin1'), 'PNG', 'not a PNG');
+  return [b.readUInt32BE(16), b.readUInt32BE(20)];
+}
+
+const withoutTimes = (levels) => levels.map((l) => {
+  const { time_mean_s: _a, time_total_s: _b, efficiency: _c, ...rest } = l;
+  return rest;
+});
+
+test('the render module is built, loads, and agrees with the wrapper on the exported names', async () => {
+  assert.ok(fs.existsSync(MJS), `missing ${MJS}: run \`make build-wasm\` or set MCPLAY_WASM_DIR`);
+  const core = await getCore();
+  assert.match(core.version(), /^\d+\.\d+\.\d+/);
+  assert.deepEqual(exportList('render_exported_functions.txt').sort(), [...RENDER_WASM_FUNCTIONS].sort(),
+    'src/wasm/render_exported_functions.txt and RENDER_WASM_FUNCTIONS in web/render_core.js differ');
+  const runtime = new Set(exportList('exported_runtime_methods.txt'));
+  for (const name of RENDER_WASM_RUNTIME_METHODS) assert.ok(runtime.has(name), name);
+  // one error class for both cores: the page tells failures apart by status, not by module
+  assert.equal(McplayError, CoreMcplayError);
+  await assert.rejects(loadRenderCore(null), /default export of mcplay_render_web\.mjs/);
+});
+
+test('sceneInfo describes the inline glTF scene', async () => {
+  const core = await getCore();
+  const info = core.sceneInfo(SCENE);
+  assert.equal(info.kind, 'render');
+  assert.equal(info.name, 'tiny_quad_light');
+  assert.equal(info.triangles, 4);
+  assert.equal(info.lights, 2, 'the light quad is two emitting triangles');
+  assert.deepEqual([info.width, info.height], [16, 16]);
+  assert.deepEqual(info.estimators.map((e) => e.name), ESTIMATORS);
+  for (const e of info.estimators) for (const k of ['strategy', 'light_selection', 'light_sampling', 'pixel_sampler']) assert.equal(typeof e[k], 'string');
+  assert.equal(info.settings.n_name, 'spp');
+  assert.equal(info.settings.error_name, 'relative_mse');
+  assert.deepEqual([info.settings.n_min, info.settings.n_max, info.settings.reps], [1, 8, 3]);
+  assert.deepEqual(info.warnings, []);
+  // options override the scene's settings; the scene may also come as JSON text
+  const small = core.sceneInfo(JSON.stringify(SCENE), { width: 32, spp_max: 64 });
+  assert.deepEqual([small.width, small.settings.n_max], [32, 64]);
+});
+
+test('runStudy gives the documented result shape, streams every level, and previews as PNG', async () => {
+  const core = await getCore();
+  const seen = [];
+  const r = core.runStudy(SCENE, { ...SMALL, previews: true }, (p) => { seen.push(p); });
+  assert.equal(r.kind, 'render');
+  assert.equal(r.cancelled, false);
+  assert.equal(r.mcplay, core.version());
+  for (const k of ['name', 'description', 'kind', 'width', 'height', 'triangles', 'lights', 'accel', 'warnings', 'reference', 'exact']) {
+    assert.ok(k in r.scene, `scene.${k} missing`);
+  }
+  assert.deepEqual([r.scene.width, r.scene.height], [8, 8]);
+  assert.equal(typeof r.scene.reference.spp, 'number');
+  assert.ok(r.scene.reference.mean_luminance > 0);
+  assert.equal(r.scene.exact, r.scene.reference.mean_luminance);
+  assert.deepEqual(
+    { n_min: r.settings.n_min, n_max: r.settings.n_max, reps: r.settings.reps, n_name: r.settings.n_name, error_name: r.settings.error_name },
+    { n_min: 1, n_max: 4, reps: 2, n_name: 'spp', error_name: 'relative_mse' });
+  assert.deepEqual(pngSize(r.reference_png), [8, 8]);
+  assert.deepEqual(r.estimators.map((e) => e.name), ESTIMATORS);
+  for (const e of r.estimators) {
+    for (const k of ['strategy', 'light_selection', 'light_sampling', 'pixel_sampler']) assert.equal(typeof e[k], 'string', k);
+    assert.ok(Array.isArray(e.warnings));
+    assert.deepEqual(e.levels.map((l) => l.n), [1, 2, 4]);
+    for (const l of e.levels) {
+      assert.equal(l.reps, 2);
+      assert.ok(l.variance > 0 && Number.isFinite(l.variance), `${e.name} spp ${l.n}: relative MSE ${l.variance}`);
+      assert.equal(l.mse, l.variance, 'a render level\'s variance is its relative MSE');
+      assert.ok(Math.abs(l.rmse - Math.sqrt(l.mse)) <= 1e-12 * l.rmse);
+      assert.ok(l.time_mean_s > 0);
+      assert.ok(l.mean > 0, 'mean image luminance');
+      assert.ok(Array.isArray(l.warnings));
+      assert.ok(l.coverage95 === null || (l.coverage95 >= 0 && l.coverage95 <= 1));
+    }
+    assert.equal(typeof e.fit.order, 'number');
+    assert.ok(e.rays_per_second > 0);
+    assert.deepEqual(pngSize(e.preview_png), [8, 8]);
+    assert.deepEqual(pngSize(e.error_png), [8, 8]);
+  }
+  // Light sampling on a diffuse floor under one quad light beats cosine-weighted directions.
+  const last = (name) => r.estimators.find((e) => e.name === name).levels.at(-1).variance;
+  assert.ok(last('light_area') < last('cosine_hemisphere'), `${last('light_area')} vs ${last('cosine_hemisphere')}`);
+
+  assert.equal(seen.length, 3, 'one progress line per spp');
+  seen.forEach((p, i) => {
+    assert.equal(p.kind, 'render');
+    assert.equal(p.level_index, i);
+    assert.equal(p.n, 1 << i);
+    assert.deepEqual(p.estimators.map((e) => e.name), ESTIMATORS);
+    p.estimators.forEach((e, k) => {
+      assert.deepEqual(withoutTimes([e.level]), withoutTimes([r.estimators[k].levels[i]]));
+      assert.deepEqual(pngSize(e.preview_png), [8, 8]);
+      assert.deepEqual(pngSize(e.error_png), [8, 8]);
+    });
+  });
+  // No previews unless asked for.
+  const plain = core.runStudy(SCENE, SMALL);
+  assert.equal(plain.reference_png, undefined);
+  assert.equal(plain.estimators[0].preview_png, undefined);
+});
+
+test('estimators have their own random streams: a study split over workers gives the same numbers', async () => {
+  const core = await getCore();
+  const all = core.runStudy(SCENE, SMALL);
+  const parts = [['cosine_hemisphere', 'mis_power'], ['light_area']].map((estimators) => core.runStudy(SCENE, { ...SMALL, estimators }));
+  for (const e of all.estimators) {
+    const part = parts.flatMap((p) => p.estimators).find((x) => x.name === e.name);
+    assert.deepEqual(withoutTimes(part.levels), withoutTimes(e.levels), e.name);
+    assert.deepEqual(part.fit, e.fit, e.name);
+  }
+  // ... and the same reference in every part
+  assert.equal(parts[0].scene.reference.mean_luminance, all.scene.reference.mean_luminance);
+  assert.equal(parts[1].scene.exact, all.scene.exact);
+});
+
+test('onLevel returning true cancels; an exception in it propagates and the core keeps working', async () => {
+  const core = await getCore();
+  let calls = 0;
+  const r = core.runStudy(SCENE, SMALL, () => ++calls === 2);
+  assert.equal(r.cancelled, true);
+  for (const e of r.estimators) assert.deepEqual(e.levels.map((l) => l.n), [1, 2]);
+  const boom = new Error('boom');
+  assert.throws(() => core.runStudy(SCENE, SMALL, () => { throw boom; }), (e) => e === boom);
+  let inner = null;
+  core.runStudy(SCENE, SMALL, () => {
+    try {
+      core.runStudy(SCENE, SMALL);
+    } catch (e) {
+      inner = e;
+    }
+    return true;
+  });
+  assert.ok(inner instanceof McplayError && inner.status === Status.ARGUMENT, String(inner));
+  assert.match(inner.message, /already running/);
+  assert.equal(core.runStudy(SCENE, SMALL).cancelled, false);
+});
+
+test('renderImage: the image as PNG with diagnostics; error_png against the reference', async () => {
+  const core = await getCore();
+  const im = core.renderImage(SCENE, { estimator: 'light_area', spp: 4, outputs: ['png', 'error_png'] });
+  assert.equal(im.kind, 'render_image');
+  assert.equal(im.estimator.name, 'light_area');
+  assert.equal(im.spp, 4);
+  assert.deepEqual(pngSize(im.images.png), [16, 16]);
+  assert.deepEqual(pngSize(im.images.error_png), [16, 16]);
+  assert.ok(im.seconds > 0 && im.rays_per_second > 0);
+  assert.equal(im.diagnostics.samples, 16 * 16 * 4);
+  assert.ok(im.relative_mse > 0);
+  // an estimator object that is not in the scene, and no outputs at all
+  const other = core.renderImage(SCENE, { estimator: { name: 'x', strategy: 'bsdf' }, spp: 1, outputs: [] });
+  assert.deepEqual(other.images, {});
+});
+
+test('errors come back as McplayError with the core\'s message', async () => {
+  const core = await getCore();
+  assertMcplayError(() => core.sceneInfo({ f: 'x' }), Status.SCENE, /not a render scene/);
+  assertMcplayError(() => core.sceneInfo('{"render": '), Status.SCENE, /invalid JSON/);
+  assertMcplayError(() => core.sceneInfo({ render: { width: 8 } }), Status.SCENE, /scene\.render\.gltf: missing/);
+  assertMcplayError(() => core.runStudy({ render: { gltf: 'nowhere.gltf' } }), Status.SCENE, /cannot read 'nowhere\.gltf'|cannot read '.*nowhere\.gltf'/);
+  assertMcplayError(() => core.sceneInfo({ render: { gltf: { asset: {} } } }), Status.SCENE, /scene\.render\.gltf: /);
+  assertMcplayError(() => core.runStudy(SCENE, { spp_max: 0 }), Status.SCENE, /options\.spp_max/);
+  assertMcplayError(() => core.runStudy(SCENE, { estimators: ['nope'] }), Status.SCENE, /unknown estimator 'nope'/);
+  assertMcplayError(() => core.runStudy(SCENE, { colour: 1 }), Status.SCENE, /unknown field 'colour'|colour/);
+  assertMcplayError(() => core.renderImage(SCENE, { spp: 0 }), Status.ARGUMENT, /options\.spp/);
+  assertMcplayError(() => core.renderImage(SCENE, { outputs: ['gif'] }), Status.ARGUMENT, /unknown output "gif"/);
+  assertMcplayError(() => core.runStudy(SCENE, '{"reps": '), Status.ARGUMENT, /^options: invalid JSON/);
+  assertMcplayError(() => core.sceneInfo(7), Status.ARGUMENT, /scene: expected an object or JSON text/);
+  assertMcplayError(() => core.runStudy(SCENE, SMALL, 'no'), Status.ARGUMENT, /onLevel/);
+  // the core works after all of that
+  assert.equal(core.sceneInfo(SCENE).triangles, 4);
+});
+
+test('repeated calls leak nothing and do not grow the wasm heap', async () => {
+  const core = await getCore();
+  const tiny = { ...SMALL, spp_max: 2, width: 4, height: 4, previews: true };
+  const cycle = (i) => {
+    switch (i % 5) {
+      case 0: return core.runStudy(SCENE, tiny, () => {});
+      case 1: return core.runStudy(SCENE, tiny, () => true); // cancelled
+      case 2: try { core.runStudy(SCENE, tiny, () => { throw new Error('x'); }); } catch { } return null;
+      case 3: try { core.sceneInfo({ render: { gltf: { asset: {} } } }); } catch { } return null;
+      default: return core.renderImage(SCENE, { spp: 1, width: 4, height: 4, outputs: ['png', 'error_png'] });
+    }
+  };
+  for (let i = 0; i < 10; i++) cycle(i); // warm up: buffers reach their size
+  const before = core.heapStats();
+  for (let i = 0; i < 60; i++) cycle(i);
+  const after = core.heapStats();
+  const grew = after.allocatedBytes - before.allocatedBytes;
+  assert.ok(grew <= 256, `malloc'd bytes in use grew by ${grew} over 60 calls`);
+  assert.equal(after.memoryBytes, before.memoryBytes, 'wasm memory grew');
+});
+
+test('a disposed render core refuses calls', async () => {
+  const { default: create } = await import(pathToFileURL(MJS).href);
+  const core = await loadRenderCore(create, { wasmBinary: fs.readFileSync(WASM) });
+  assert.equal(core.sceneInfo(SCENE).kind, 'render');
+  core.dispose();
+  assertMcplayError(() => core.sceneInfo(SCENE), Status.ARGUMENT, /disposed/);
+});
+
+test('the site: render scenes get manifest entries and their glTF inline', () => {
+  assert.equal(isRenderScene(SCENE), true);
+  assert.equal(isRenderScene(JSON.stringify(SCENE)), true);
+  for (const other of [{ f: 'x' }, '{"f": "x"}', '{"description": "\\"render\\""}', null, 'not json "render"', []]) {
+    assert.equal(isRenderScene(other), false, JSON.stringify(other));
+  }
+  const file = path.join(ROOT, 'scenes', 'quad_light_floor.json');
+  const scene = JSON.parse(fs.readFileSync(file, 'utf8'));
+  const entry = manifestEntry('quad_light_floor.json', scene);
+  assert.equal(entry.kind, 'render');
+  assert.deepEqual(entry.estimators, scene.render.estimators.map((e) => (typeof e === 'string' ? e : e.name)));
+  assert.deepEqual([entry.n_min, entry.n_max, entry.width, entry.height], [scene.render.spp_min, scene.render.spp_max, scene.render.width, scene.render.height]);
+  assert.equal(manifestEntry('exp_1d.json', { f: 'exp(x)' }).kind, 'integral');
+  const { scene: site } = siteScene(scene, path.dirname(file));
+  assert.equal(typeof site.render.gltf, 'object');
+  assert.equal(site.render.gltf.asset.version, '2.0');
+  for (const b of site.render.gltf.buffers) assert.match(b.uri, /^data:/);
+  assert.equal(scene.render.gltf, 'quad_light_floor.gltf', 'the input is not changed');
+  assert.throws(() => inlineGltf(path.join(ROOT, 'scenes', 'no_such.gltf')), /missing scenes\/no_such\.gltf/);
+});
+
+test('a scene as the site serves it (glTF inline) gives the native CLI\'s numbers for the scene file', async () => {
+  const core = await getCore();
+  const file = path.join(ROOT, 'scenes', 'quad_light_floor.json');
+  const { scene: site } = siteScene(JSON.parse(fs.readFileSync(file, 'utf8')), path.dirname(file));
+  const wasm = core.runStudy(site, { spp_min: 1, spp_max: 4, reps: 2, width: 8, height: 8, estimators: ['light_area', 'bsdf'] });
+  if (!fs.existsSync(NATIVE)) throw new Error(`native CLI not found: ${NATIVE}. Build it with \`make build\` or set MCPLAY_NATIVE`);
+  const native = JSON.parse(execFileSync(NATIVE, ['run', 'scenes/quad_light_floor.json', '--estimators', 'light_area,bsdf',
+    '--n-min', '1', '--n-max', '4', '--reps', '2', '--width', '8', '--height', '8', '--no-cache', '--format', 'json', '--quiet'],
+  { cwd: ROOT, encoding: 'utf8', maxBuffer: 64 << 20 }));
+  assert.equal(wasm.scene.triangles, native.scene.triangles);
+  assert.equal(wasm.scene.lights, native.scene.lights);
+  const close = (a, b) => Math.abs(a - b) <= 1e-9 * Math.max(Math.abs(a), Math.abs(b));
+  assert.ok(close(wasm.scene.exact, native.scene.exact), `reference luminance ${wasm.scene.exact} vs ${native.scene.exact}`);
+  wasm.estimators.forEach((we, k) => {
+    const ne = native.estimators[k];
+    assert.equal(we.name, ne.name);
+    we.levels.forEach((wl, i) => {
+      const nl = ne.levels[i];
+      assert.equal(wl.n, nl.n);
+      // the same code on both sides; only libm's last bits (sin, cos) may differ
+      assert.ok(close(wl.variance, nl.variance), `${we.name} spp ${wl.n}: relative MSE ${wl.variance} vs native ${nl.variance}`);
+      assert.ok(close(wl.mean, nl.mean), `${we.name} spp ${wl.n}: mean ${wl.mean} vs native ${nl.mean}`);
+    });
+  });
+});
