@@ -64,5 +64,31 @@ check list-presets 0 'stratified_importance' -- list
 check list-bad-dir 1 'cannot open scenes directory' -- list --scenes /nonexistent-dir
 check threads 0 '1 thread' -- run exp_1d "${small[@]}" --threads 1
 
+# Render scenes: studies through `run`, images through `render`.
+tiny=(--width 8 --height 6 --no-cache)
+check render-study 0 'fitted order: relative MSE ~ spp\^' -- run quad_light_floor --n-min 1 --n-max 4 --reps 2 --estimators bsdf,mis_power "${tiny[@]}"
+check render-list 0 'cornell_box +render, [0-9]+ triangles' -- list
+check render-png 0 'quad_light_floor: light_area at 4 spp, 8x6' -- render quad_light_floor --estimator light_area --spp 4 --out "$tmp/img.png" "${tiny[@]}"
+if [ "$(head -c 8 "$tmp/img.png" | od -An -tx1 | tr -d ' \n')" = 89504e470d0a1a0a ]; then
+    passed=$((passed + 1))
+else
+    echo "FAIL render-png: $tmp/img.png is not a PNG"; failed=$((failed + 1))
+fi
+check render-hdr 0 'relative MSE against the reference' -- render quad_light_floor --spp 2 --out "$tmp/img.hdr" --error-out "$tmp/err.png" "${tiny[@]}"
+if [ "$(head -c 10 "$tmp/img.hdr")" = "#?RADIANCE" ]; then
+    passed=$((passed + 1))
+else
+    echo "FAIL render-hdr: $tmp/img.hdr is not a Radiance HDR file"; failed=$((failed + 1))
+fi
+check render-no-out 2 'render needs --out FILE' -- render quad_light_floor
+check render-bad-ext 2 'must end in .png or .hdr' -- render quad_light_floor --out "$tmp/x.jpg"
+check render-bad-estimator 2 "unknown estimator 'lite'" -- render quad_light_floor --estimator lite --out "$tmp/x.png" "${tiny[@]}"
+check render-bad-spp 2 "--spp: expected a whole number" -- render quad_light_floor --spp many --out "$tmp/x.png"
+check render-width-on-integral 2 'for render scenes' -- run exp_1d --width 8
+printf '{"render": {"gltf": "missing.gltf"}}' >"$tmp/r.json"
+check render-missing-gltf 3 "scene.render.gltf: cannot read" -- run "$tmp/r.json"
+printf '{"render": {"gltf": {"asset": {"version": "2.0"}, "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "mode": 1}]}]}}}' >"$tmp/lines.json"
+check render-bad-gltf 3 'scene.render.gltf: ' -- run "$tmp/lines.json"
+
 echo "$passed passed, $failed failed"
 [ "$failed" = 0 ]

@@ -19,7 +19,11 @@ const add = (a, b) => [a[0] + b[0], a[1] + b[1], a[2] + b[2]];
 const sub = (a, b) => [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
 const mul = (a, s) => [a[0] * s, a[1] * s, a[2] * s];
 const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-const cross = (a, b) => [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+const cross = (a, b) => [
+  a[1] * b[2] - a[2] * b[1],
+  a[2] * b[0] - a[0] * b[2],
+  a[0] * b[1] - a[1] * b[0],
+];
 const length = (a) => Math.sqrt(dot(a, a));
 const normalize = (a) => mul(a, 1 / length(a));
 const deg = (d) => (d * Math.PI) / 180;
@@ -170,7 +174,11 @@ class Builder {
     const rgb = (v) => (Array.isArray(v) ? v : [v, v, v]);
     const m = {
       name,
-      pbrMetallicRoughness: { baseColorFactor: [...rgb(base), 1], metallicFactor: metallic, roughnessFactor: roughness },
+      pbrMetallicRoughness: {
+        baseColorFactor: [...rgb(base), 1],
+        metallicFactor: metallic,
+        roughnessFactor: roughness,
+      },
     };
     const extensions = {};
     const le = rgb(radiance);
@@ -190,7 +198,12 @@ class Builder {
     const pad = (4 - (this.byteLength % 4)) % 4;
     if (pad) this.chunks.push(new Uint8Array(pad));
     this.byteLength += pad;
-    this.bufferViews.push({ buffer: 0, byteOffset: this.byteLength, byteLength: bytes.byteLength, target });
+    this.bufferViews.push({
+      buffer: 0,
+      byteOffset: this.byteLength,
+      byteLength: bytes.byteLength,
+      target,
+    });
     this.chunks.push(new Uint8Array(bytes.buffer, bytes.byteOffset, bytes.byteLength));
     this.byteLength += bytes.byteLength;
     return this.bufferViews.length - 1;
@@ -206,12 +219,28 @@ class Builder {
       max[i % 3] = Math.max(max[i % 3], pos[i]);
     }
     const vertexCount = geometry.positions.length;
-    this.accessors.push({ bufferView: this.view(pos, 34962), componentType: 5126, count: vertexCount, type: 'VEC3', min, max });
+    this.accessors.push({
+      bufferView: this.view(pos, 34962),
+      componentType: 5126,
+      count: vertexCount,
+      type: 'VEC3',
+      min,
+      max,
+    });
     const position = this.accessors.length - 1;
     const small = vertexCount <= 65536;
     const idx = small ? new Uint16Array(geometry.indices) : new Uint32Array(geometry.indices);
-    this.accessors.push({ bufferView: this.view(idx, 34963), componentType: small ? 5123 : 5125, count: idx.length, type: 'SCALAR' });
-    this.meshes.push({ name, primitives: [{ attributes: { POSITION: position }, indices: this.accessors.length - 1, material, mode: 4 }] });
+    this.accessors.push({
+      bufferView: this.view(idx, 34963),
+      componentType: small ? 5123 : 5125,
+      count: idx.length,
+      type: 'SCALAR',
+    });
+    const indices = this.accessors.length - 1;
+    this.meshes.push({
+      name,
+      primitives: [{ attributes: { POSITION: position }, indices, material, mode: 4 }],
+    });
     this.nodes.push({ name, mesh: this.meshes.length - 1, ...transform });
     return this;
   }
@@ -222,26 +251,39 @@ class Builder {
     const r = normalize(cross(f, up));
     const u = cross(r, f);
     this.cameras.push({ type: 'perspective', perspective: { yfov, znear: 0.001 } });
-    this.nodes.push({ name: 'camera', camera: this.cameras.length - 1, translation: eye, rotation: quatFromAxes(r, u, mul(f, -1)) });
+    this.nodes.push({
+      name: 'camera',
+      camera: this.cameras.length - 1,
+      translation: eye,
+      rotation: quatFromAxes(r, u, mul(f, -1)),
+    });
     return this;
   }
 
   gltf() {
-    const bin = Buffer.concat(this.chunks.map((c) => Buffer.from(c.buffer, c.byteOffset, c.byteLength)));
+    const bin = Buffer.concat(
+      this.chunks.map((c) => Buffer.from(c.buffer, c.byteOffset, c.byteLength)));
     const used = new Set();
     for (const m of this.materials) for (const e of Object.keys(m.extensions || {})) used.add(e);
     return {
       asset: { version: '2.0', generator: 'mcplay scenes/tools/make_render_scenes.mjs' },
       ...(used.size ? { extensionsUsed: [...used].sort() } : {}),
       scene: 0,
-      scenes: [{ name: 'scene', nodes: this.nodes.map((_, i) => i), extras: { description: this.description } }],
+      scenes: [{
+        name: 'scene',
+        nodes: this.nodes.map((_, i) => i),
+        extras: { description: this.description },
+      }],
       nodes: this.nodes,
       cameras: this.cameras,
       meshes: this.meshes,
       materials: this.materials,
       accessors: this.accessors,
       bufferViews: this.bufferViews,
-      buffers: [{ byteLength: bin.length, uri: 'data:application/octet-stream;base64,' + bin.toString('base64') }],
+      buffers: [{
+        byteLength: bin.length,
+        uri: 'data:application/octet-stream;base64,' + bin.toString('base64'),
+      }],
     };
   }
 }
@@ -249,14 +291,16 @@ class Builder {
 /// JSON with arrays of numbers or strings on one line.
 function format(value, indent = '') {
   if (Array.isArray(value)) {
-    if (value.every((x) => typeof x !== 'object')) return '[' + value.map((x) => JSON.stringify(x)).join(', ') + ']';
+    if (value.every((x) => typeof x !== 'object'))
+      return '[' + value.map((x) => JSON.stringify(x)).join(', ') + ']';
     const inner = indent + '  ';
     return '[\n' + value.map((x) => inner + format(x, inner)).join(',\n') + '\n' + indent + ']';
   }
   if (value && typeof value === 'object') {
     const inner = indent + '  ';
     const keys = Object.keys(value).filter((k) => value[k] !== undefined);
-    return '{\n' + keys.map((k) => inner + JSON.stringify(k) + ': ' + format(value[k], inner)).join(',\n') + '\n' + indent + '}';
+    const members = keys.map((k) => inner + JSON.stringify(k) + ': ' + format(value[k], inner));
+    return '{\n' + members.join(',\n') + '\n' + indent + '}';
   }
   return JSON.stringify(value);
 }
@@ -264,7 +308,9 @@ function format(value, indent = '') {
 function write(name, builder) {
   const text = format(builder.gltf()) + '\n';
   writeFileSync(join(outDir, name), text);
-  const triangles = builder.accessors.filter((a) => a.type === 'SCALAR').reduce((s, a) => s + a.count / 3, 0);
+  const triangles = builder.accessors
+    .filter((a) => a.type === 'SCALAR')
+    .reduce((s, a) => s + a.count / 3, 0);
   console.log(`${name}: ${triangles} triangles, ${text.length} bytes`);
 }
 
@@ -294,7 +340,8 @@ const DOWN = [0, -1, 0];
 // light's plane, looks down so that every pixel (aspect up to 1.5) sees the floor: a pixel's
 // value is base / pi times the irradiance of Lambert's polygon formula.
 {
-  const b = new Builder('1 x 1 m light (radiance 5) at height 1 facing down over a 4 x 4 m floor (base colour 0.5)');
+  const b = new Builder(
+    '1 x 1 m light (radiance 5) at height 1 facing down over a 4 x 4 m floor (base colour 0.5)');
   const floor = b.material('floor', { base: 0.5 });
   const light = b.material('light', { base: 0, radiance: 5 });
   b.object('floor', rect([0, 0, 0], UP, X, 4, 4), floor);
@@ -323,8 +370,10 @@ const DOWN = [0, -1, 0];
   b.object('green wall', rect([0.5, 0.5, 0], [-1, 0, 0], Z, 1, 1, n, n), green);
   // Unit cubes without bottoms, placed by node transforms (165 mm and 165 x 330 mm blocks).
   const block = box([0, 0, 0], [0.5, 0.5, 0.5], 4, { skip: ['-y'] });
-  b.object('short block', block, white, { translation: [0.18, 0.15, 0.22], rotation: yRotation(-17), scale: [0.3, 0.3, 0.3] });
-  b.object('tall block', block, white, { translation: [-0.18, 0.3, -0.15], rotation: yRotation(17), scale: [0.3, 0.6, 0.3] });
+  b.object('short block', block, white,
+    { translation: [0.18, 0.15, 0.22], rotation: yRotation(-17), scale: [0.3, 0.3, 0.3] });
+  b.object('tall block', block, white,
+    { translation: [-0.18, 0.3, -0.15], rotation: yRotation(17), scale: [0.3, 0.6, 0.3] });
   b.object('light', rect([0, 0.999, 0], DOWN, X, 0.25, 0.2), light);
   // Cornell camera: 800 mm in front of the opening at mid height, field of view 39.3 degrees.
   b.camera([0, 0.5, 1.94], [0, 0.5, 0], deg(39.3));
@@ -351,7 +400,8 @@ const DOWN = [0, -1, 0];
   const quads = plates.map(({ centre, alpha }, i) => {
     // Normal halfway between the directions to the camera and to the middle of the light row.
     const n = normalize(add(normalize(sub(eye, centre)), normalize(sub([0, 0, 0], centre))));
-    const mat = b.material(`plate ${i} (alpha ${alpha})`, { base: 0.8, metallic: 1, roughness: Math.sqrt(alpha) });
+    const mat = b.material(`plate ${i} (alpha ${alpha})`,
+      { base: 0.8, metallic: 1, roughness: Math.sqrt(alpha) });
     const g = rect(centre, n, X, width, depth);
     b.object(`plate ${i}`, g, mat);
     const [p0, p1, p2] = g.positions; // grid order: p0, p0 + u, p0 + v, p0 + u + v
@@ -381,10 +431,12 @@ const DOWN = [0, -1, 0];
       const point = add(mirrored, mul(d, t));
       const view = sub(point, eye);
       const depthAlong = dot(view, f);
-      check(Math.abs(dot(view, r)) < tanHalf * depthAlong && Math.abs(dot(view, u)) < tanHalf * depthAlong,
+      const half = tanHalf * depthAlong;
+      check(Math.abs(dot(view, r)) < half && Math.abs(dot(view, u)) < half,
         `veach: highlight of the light at x = ${x} on plate ${i} is out of view`);
       quads.forEach((o, k) => {
-        if (k !== i) check(!(hitParallelogram(eye, view, o.p0, o.u, o.v) < 1), `veach: plate ${k} hides plate ${i}`);
+        const hidden = k !== i && hitParallelogram(eye, view, o.p0, o.u, o.v) < 1;
+        check(!hidden, `veach: plate ${k} hides plate ${i}`);
       });
     }
   });
@@ -407,7 +459,8 @@ const DOWN = [0, -1, 0];
 // 5. A metal plate of roughness 0.035 (GGX alpha 1.225e-3, just above a 1e-3 mirror threshold)
 // mirroring a 0.3 m light into the camera, over a diffuse floor.
 {
-  const b = new Builder('near-mirror plate (roughness 0.035) reflecting a 0.3 m light (radiance 10)');
+  const b = new Builder(
+    'near-mirror plate (roughness 0.035) reflecting a 0.3 m light (radiance 10)');
   const grey = b.material('floor', { base: 0.5 });
   const metal = b.material('near mirror', { base: 0.9, metallic: 1, roughness: 0.035 });
   const light = b.material('light', { base: 0, radiance: 10 });

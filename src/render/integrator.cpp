@@ -119,10 +119,11 @@ Vec3 light_sample_term(const RenderScene& rs, const LightSet& lights, LightSampl
     if (glm::dot(wi, sp.ng) <= 0.0) return Vec3(0.0); // below the surface: no light leaks
     Vec3 wi_local = sp.frame.to_local(wi);
     if (wi_local.z <= 0.0) return Vec3(0.0);
-    Vec3 f = bsdf_eval(sp.bsdf, sp.wo_local, wi_local);
+    double bsdf_density = 0.0;
+    Vec3 f = bsdf_eval_pdf(sp.bsdf, sp.wo_local, wi_local, &bsdf_density);
     if (is_black(f)) return Vec3(0.0);
     if (!visible(rs, sp, ls.point, ls.normal, c)) return Vec3(0.0);
-    double w = mis ? mis_weight(ls.pdf, bsdf_pdf(sp.bsdf, sp.wo_local, wi_local), power) : 1.0;
+    double w = mis ? mis_weight(ls.pdf, bsdf_density, power) : 1.0;
     return f * ls.radiance * (wi_local.z * w / ls.pdf);
 }
 
@@ -234,7 +235,7 @@ RadianceSample direct_radiance(const RenderScene& rs, const RenderEstimator& est
 
 /// Path tracing with next-event estimation: at every vertex one light sample and one BSDF
 /// sample, weighted by the power heuristic, the BSDF sample continuing the path [Veach97, 9.2;
-/// PharrJakobHumphreys23, 13.4]. Russian roulette from rr_depth on survives with probability
+/// PBR4, 13.4]. Russian roulette from rr_depth on survives with probability
 /// min(0.95, max throughput component), dividing the throughput by it (unbiased).
 RadianceSample path_radiance(const RenderScene& rs, const RenderEstimator& est,
                              const Ray& camera_ray, PixelSampler& sampler, SampleCounters& c) {

@@ -11,14 +11,14 @@
 //   bsdf                the BRDF's own sampling density (bsdf.h)
 //   light_area          a light chosen by uniform, area or power weights, then a point
 //                       uniform in its area, the density converted to solid angle by
-//                       |x - x'|^2 / cos(theta') [course notes; PharrJakobHumphreys23, 12.2]
+//                       |x - x'|^2 / cos(theta') [course notes; PBR4, 12.2]
 //   light_solid_angle   a light chosen as above, then a direction uniform in its spherical
 //                       triangle [Arvo95]
 //   mis_balance,        one light sample and one BSDF sample combined by multiple importance
 //   mis_power           sampling with the balance or power (beta = 2) heuristic [Veach97, 9.2]
 //   path                path tracing with next-event estimation, MIS (power heuristic) of
 //                       light and BSDF samples at every vertex, a maximum number of bounces
-//                       and Russian roulette [Veach97; PharrJakobHumphreys23, 13]
+//                       and Russian roulette [Veach97; PBR4, 13]
 #pragma once
 
 #include <cstdint>

@@ -269,6 +269,7 @@ Vec3 LightSet::emitted(uint32_t triangle, const Vec3& w) const {
     uint32_t m = triangle < mesh.material.size() ? mesh.material[triangle] : 0u;
     if (m >= scene_->materials.size()) return Vec3(0.0);
     const Material& mat = scene_->materials[m];
+    if (!mat.is_emissive()) return Vec3(0.0);
     if (mat.double_sided || glm::dot(w, mesh.cross_normal(triangle)) > 0.0) return mat.emission;
     return Vec3(0.0);
 }

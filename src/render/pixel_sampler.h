@@ -1,7 +1,7 @@
 // Sample values for one pixel's samples: independent uniforms, or stratified ones where every
 // 1D and 2D dimension of the path is stratified over the pixel's spp samples on its own and
 // the strata of different dimensions are paired by keyed random permutations ("padding", as
-// in pbrt's stratified sampler [PharrJakobHumphreys23, 8.5]; the permutations are those of
+// in pbrt's stratified sampler [PBR4, 8.5]; the permutations are those of
 // the core's Latin hypercube sampler [Kensler13]).
 #pragma once
 
