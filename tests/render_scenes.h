@@ -54,7 +54,7 @@ inline Scene quad_light_scene(double Le, double h = 1.0) {
     Material light = diffuse(0.0);
     light.emission = Vec3(Le);
     s.materials.push_back(light);
-    add_quad(s, {-2, 0, -2}, {-2, 0, 2}, {2, 0, 2}, {2, 0, -2}, 0); // faces +y
+    add_quad(s, {-2, 0, -2}, {-2, 0, 2}, {2, 0, 2}, {2, 0, -2}, 0);                 // faces +y
     add_quad(s, {-0.5, h, -0.5}, {0.5, h, -0.5}, {0.5, h, 0.5}, {-0.5, h, 0.5}, 1); // faces -y
     s.camera = look_at({0, 0.5 * h, 0.01}, {0, 0, 0}, {0, 0, -1}, 1.2);
     return s;

@@ -15,9 +15,12 @@ namespace {
 using test::diffuse;
 
 const RadianceStrategy kDirect[] = {
-    RadianceStrategy::UniformHemisphere, RadianceStrategy::CosineHemisphere,
-    RadianceStrategy::Bsdf,              RadianceStrategy::LightArea,
-    RadianceStrategy::LightSolidAngle,   RadianceStrategy::MisBalance,
+    RadianceStrategy::UniformHemisphere,
+    RadianceStrategy::CosineHemisphere,
+    RadianceStrategy::Bsdf,
+    RadianceStrategy::LightArea,
+    RadianceStrategy::LightSolidAngle,
+    RadianceStrategy::MisBalance,
     RadianceStrategy::MisPower,
 };
 

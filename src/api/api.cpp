@@ -5,8 +5,8 @@
 #include <cstring>
 #include <string>
 
-#include "api/mcplay.h"
 #include "api/boundary.h"
+#include "api/mcplay.h"
 #include "api/scene.h"
 
 using mcp::boundary::copy_out;

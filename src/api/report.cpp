@@ -316,7 +316,8 @@ std::string format_render_table(const Json& r) {
     for (const Json& w : list(scene, "warnings")) out << "  NOTE: " << jstr(w, "message") << "\n";
     if (jbool(r, "cancelled")) out << "  (cancelled: partial result)\n";
     for (const Json& e : list(r, "estimators")) {
-        out << "\n" << jstr(e, "name") << "  [" << jstr(e, "strategy") << ", lights by "
+        out << "\n"
+            << jstr(e, "name") << "  [" << jstr(e, "strategy") << ", lights by "
             << jstr(e, "light_selection") << ", " << jstr(e, "pixel_sampler") << " pixels]\n";
         out << padl("spp", 7) << padl("rel.MSE", 12) << padl("mean lum.", 13) << padl("bias/se", 9)
             << padl("px cover", 9) << padl("s/image", 10) << padl("efficiency", 12)
@@ -339,7 +340,8 @@ std::string format_render_table(const Json& r) {
             out << "  fitted order: none";
         if (!jstr(fit, "note").empty()) out << " (" << jstr(fit, "note") << ")";
         out << ";  " << fmt("%.3g", jnum(e, "rays_per_second")) << " rays/s\n";
-        for (const Json& w : list(e, "warnings")) out << "  WARNING: " << jstr(w, "message") << "\n";
+        for (const Json& w : list(e, "warnings"))
+            out << "  WARNING: " << jstr(w, "message") << "\n";
         const Json& levels = list(e, "levels");
         if (!levels.empty())
             for (const Json& w : list(levels.back(), "warnings"))

@@ -36,7 +36,8 @@ const char* kUsage =
     "  mcplay --help | --version\n"
     "\n"
     "SCENE is a scene JSON file, or the name of one in the scenes directory\n"
-    "(--scenes DIR, else $MCPLAY_SCENES, else ./scenes).\n"
+    "(--scenes DIR, else $MCPLAY_SCENES, else ./scenes), or a .gltf/.glb file (a render\n"
+    "scene whose settings come from its extras.mcplay, else the defaults).\n"
     "\n"
     "run options:\n"
     "  --estimators A,B,..  run only these estimators (names from the scene, or presets)\n"
@@ -102,7 +103,8 @@ std::string dirname_of(const std::string& path) {
 std::string cache_dir(const std::string& given) {
     std::string dir = given;
     if (dir.empty()) {
-        if (const char* env = std::getenv("MCPLAY_CACHE"); env && *env) dir = env;
+        if (const char* env = std::getenv("MCPLAY_CACHE"); env && *env)
+            dir = env;
         else if (const char* home = std::getenv("HOME"); home && *home)
             dir = std::string(home) + "/.cache/mcplay";
         else
@@ -118,6 +120,21 @@ std::string cache_dir(const std::string& given) {
         mkdir(partial.c_str(), 0755);
     }
     return dir;
+}
+
+// A .gltf or .glb given directly is a render scene of its own, its study settings in its
+// extras.mcplay (or the defaults).
+bool scene_from_gltf(const std::string& path, std::string* text) {
+    auto ends = [&](const char* s) {
+        size_t n = std::strlen(s);
+        return path.size() > n && path.compare(path.size() - n, n, s) == 0;
+    };
+    if (!ends(".gltf") && !ends(".glb")) return false;
+    size_t slash = path.find_last_of('/');
+    std::string file = slash == std::string::npos ? path : path.substr(slash + 1);
+    std::string stem = file.substr(0, file.find_last_of('.'));
+    *text = nlohmann::json{{"name", stem}, {"render", {{"gltf", file}}}}.dump();
+    return true;
 }
 
 bool is_render_scene_text(const std::string& text) {
@@ -218,8 +235,8 @@ int cmd_list(const std::vector<std::string>& args) {
             std::printf("  %-28s render, %d triangles, %d light triangle(s)\n  %-28s %s\n"
                         "  %-28s estimators: %s\n",
                         f.substr(0, f.size() - 5).c_str(), j["triangles"].get<int>(),
-                        j["lights"].get<int>(), "", j["description"].get<std::string>().c_str(),
-                        "", ests.c_str());
+                        j["lights"].get<int>(), "", j["description"].get<std::string>().c_str(), "",
+                        ests.c_str());
             continue;
         }
         if (mcp_scene_info(text.c_str(), &info) != MCP_OK) {
@@ -299,7 +316,8 @@ int cmd_run(const std::vector<std::string>& args) {
         } else if (a == "--width" || a == "--height") {
             if (!value(&v)) return usage_error(a + " needs a value");
             unsigned long long x = 0;
-            if (!parse_count(v, &x)) return usage_error(a + ": expected a whole number, got '" + v + "'");
+            if (!parse_count(v, &x))
+                return usage_error(a + ": expected a whole number, got '" + v + "'");
             options[a.substr(2)] = x;
         } else if (a == "--cache") {
             if (!value(&cache_arg)) return usage_error("--cache needs a directory");
@@ -330,7 +348,8 @@ int cmd_run(const std::vector<std::string>& args) {
 
     std::string path = scene_path(scene_arg, dir_arg);
     std::string text;
-    if (!is_regular_file(path) || !read_file(path, &text)) {
+    if (!(is_regular_file(path) && scene_from_gltf(path, &text)) &&
+        (!is_regular_file(path) || !read_file(path, &text))) {
         std::fprintf(stderr, "mcplay: no scene file '%s' (nor '%s')\n", scene_arg.c_str(),
                      path.c_str());
         return kExitScene;
@@ -403,7 +422,8 @@ int cmd_render(const std::vector<std::string>& args) {
             a == "--threads") {
             if (!value(&v)) return usage_error(a + " needs a value");
             unsigned long long x = 0;
-            if (!parse_count(v, &x)) return usage_error(a + ": expected a whole number, got '" + v + "'");
+            if (!parse_count(v, &x))
+                return usage_error(a + ": expected a whole number, got '" + v + "'");
             options[a.substr(2)] = x;
         } else if (a == "--estimator") {
             if (!value(&v)) return usage_error("--estimator needs a name");
@@ -438,9 +458,12 @@ int cmd_render(const std::vector<std::string>& args) {
     };
     nlohmann::json outputs = nlohmann::json::array();
     if (!out_path.empty()) {
-        if (ends_with(out_path, ".png")) outputs.push_back("png");
-        else if (ends_with(out_path, ".hdr")) outputs.push_back("hdr");
-        else return usage_error("--out: the file name must end in .png or .hdr");
+        if (ends_with(out_path, ".png"))
+            outputs.push_back("png");
+        else if (ends_with(out_path, ".hdr"))
+            outputs.push_back("hdr");
+        else
+            return usage_error("--out: the file name must end in .png or .hdr");
     }
     if (!error_path.empty()) {
         if (!ends_with(error_path, ".png")) return usage_error("--error-out: must be a .png file");
@@ -448,7 +471,8 @@ int cmd_render(const std::vector<std::string>& args) {
     }
     options["outputs"] = outputs;
     std::string path = scene_path(scene_arg, dir_arg), text;
-    if (!is_regular_file(path) || !read_file(path, &text)) {
+    if (!(is_regular_file(path) && scene_from_gltf(path, &text)) &&
+        (!is_regular_file(path) || !read_file(path, &text))) {
         std::fprintf(stderr, "mcplay: no scene file '%s' (nor '%s')\n", scene_arg.c_str(),
                      path.c_str());
         return kExitScene;

@@ -23,7 +23,9 @@ constexpr StrategyName kStrategyNames[] = {
     {RadianceStrategy::Path, "path"},
 };
 
-bool is_black(const Vec3& c) { return c.x == 0.0 && c.y == 0.0 && c.z == 0.0; }
+bool is_black(const Vec3& c) {
+    return c.x == 0.0 && c.y == 0.0 && c.z == 0.0;
+}
 
 /// The multiple importance sampling weight of a sample drawn with density p_this when the
 /// other strategy would have drawn it with density p_other, one sample each: the balance
@@ -64,8 +66,8 @@ ShadingPoint shade(const Scene& scene, const Ray& ray, const Hit& hit) {
     if (glm::dot(sp.ng, wo) < 0.0) sp.ng = -sp.ng;
     Vec3 ns = sp.ng;
     if (!mesh.normal.empty()) {
-        Vec3 n = b0 * mesh.normal[idx[0]] + hit.b1 * mesh.normal[idx[1]] +
-                 hit.b2 * mesh.normal[idx[2]];
+        Vec3 n =
+            b0 * mesh.normal[idx[0]] + hit.b1 * mesh.normal[idx[1]] + hit.b2 * mesh.normal[idx[2]];
         double len = glm::length(n);
         if (len > 0.0 && std::isfinite(len)) {
             n /= len;
@@ -102,8 +104,8 @@ Ray spawn_ray(const ShadingPoint& sp, const Vec3& direction) {
 /// One light sample's contribution f Le cos / p, times its MIS weight against BSDF sampling
 /// when `mis` is set.
 Vec3 light_sample_term(const RenderScene& rs, const LightSet& lights, LightSampling mode,
-                       const ShadingPoint& sp, PixelSampler& sampler, SampleCounters& c,
-                       bool mis, bool power) {
+                       const ShadingPoint& sp, PixelSampler& sampler, SampleCounters& c, bool mis,
+                       bool power) {
     double u_select = sampler.get_1d();
     Vec2 u = sampler.get_2d();
     LightSample ls = lights.sample(sp.p, u_select, u, mode);
@@ -148,8 +150,8 @@ DirectionResult trace_direction(const RenderScene& rs, const ShadingPoint& sp, c
 /// hemisphere or the BRDF, weighted f Le cos / p (times the MIS weight against light
 /// sampling when `mis` is set).
 Vec3 direction_sample_term(const RenderScene& rs, const RenderEstimator& est,
-                           const LightSet& lights, const ShadingPoint& sp,
-                           PixelSampler& sampler, SampleCounters& c, bool mis, bool power) {
+                           const LightSet& lights, const ShadingPoint& sp, PixelSampler& sampler,
+                           SampleCounters& c, bool mis, bool power) {
     Vec3 wi_local, f;
     double pdf = 0.0;
     bool delta = false;
@@ -260,8 +262,10 @@ RadianceSample path_radiance(const RenderScene& rs, const RenderEstimator& est,
                                lights.pdf(previous_point, hit.triangle, p, est.light_sampling),
                                true);
             }
-            if (depth == 0) emitted = Le;
-            else L += beta * Le * w;
+            if (depth == 0)
+                emitted = Le;
+            else
+                L += beta * Le * w;
         }
         if (depth >= est.max_depth) break;
         ShadingPoint sp = shade(scene, ray, hit);
@@ -357,8 +361,8 @@ BsdfParams material_at(const Scene& scene, const Hit& hit) {
 }
 
 RadianceSample sample_radiance(const RenderScene& rs, const RenderEstimator& est,
-                              const Ray& camera_ray, PixelSampler& sampler,
-                              SampleCounters& counters) {
+                               const Ray& camera_ray, PixelSampler& sampler,
+                               SampleCounters& counters) {
     if (est.strategy == RadianceStrategy::Path)
         return path_radiance(rs, est, camera_ray, sampler, counters);
     return direct_radiance(rs, est, camera_ray, sampler, counters);

@@ -88,8 +88,9 @@ struct RadianceSample {
 
 /// Radiance carried towards the camera along `camera_ray` (one sample of the estimator),
 /// drawing its random numbers from `sampler`.
-RadianceSample sample_radiance(const RenderScene& rs, const RenderEstimator& est, const Ray& camera_ray,
-                     PixelSampler& sampler, SampleCounters& counters);
+RadianceSample sample_radiance(const RenderScene& rs, const RenderEstimator& est,
+                               const Ray& camera_ray, PixelSampler& sampler,
+                               SampleCounters& counters);
 
 /// The BRDF parameters at a hit: the material's factors times its base colour texture.
 BsdfParams material_at(const Scene& scene, const Hit& hit);

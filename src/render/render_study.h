@@ -32,9 +32,9 @@ struct RenderStudySettings {
 
 /// Error of one image against the reference.
 struct ImageError {
-    double rel_mse = 0.0;      ///< reference-noise corrected (see the header comment)
-    double rel_mse_raw = 0.0;  ///< without the correction
-    double coverage = 0.0;     ///< share of pixels whose 95% interval covers the reference
+    double rel_mse = 0.0;     ///< reference-noise corrected (see the header comment)
+    double rel_mse_raw = 0.0; ///< without the correction
+    double coverage = 0.0;    ///< share of pixels whose 95% interval covers the reference
     double mean_luminance = 0.0;
     double mean_luminance_se = 0.0;
 };

@@ -43,8 +43,8 @@ void render_rows(const RenderScene& rs, const RenderEstimator& est, const Render
             for (uint64_t i = 0; i < st.spp; ++i) {
                 sampler.start_sample(i);
                 Vec2 jitter = st.jitter_pixels ? sampler.get_2d() : Vec2(0.5);
-                Ray ray = camera_ray(rs.scene->camera, st.width, st.height, x + jitter.x,
-                                     y + jitter.y);
+                Ray ray =
+                    camera_ray(rs.scene->camera, st.width, st.height, x + jitter.x, y + jitter.y);
                 RadianceSample rad = sample_radiance(rs, est, ray, sampler, counters);
                 Vec3 L = rad.total();
                 if (!std::isfinite(L.x) || !std::isfinite(L.y) || !std::isfinite(L.z)) {
@@ -120,16 +120,14 @@ RenderImage render_image(const RenderScene& rs, const RenderEstimator& est,
     } else {
         std::vector<std::thread> pool;
         for (int t = 0; t < threads; ++t)
-            pool.emplace_back([&, t] {
-                render_rows(rs, est, settings, t, threads, image, diags[size_t(t)]);
-            });
+            pool.emplace_back(
+                [&, t] { render_rows(rs, est, settings, t, threads, image, diags[size_t(t)]); });
         for (auto& th : pool) th.join();
     }
     for (const auto& d : diags) image.diagnostics.merge(d);
     std::sort(image.diagnostics.top.begin(), image.diagnostics.top.end(), std::greater<double>());
     image.cancelled = settings.cancel && settings.cancel->load();
-    image.seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    image.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return image;
 }
 

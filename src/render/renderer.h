@@ -14,8 +14,8 @@ namespace mcp {
 struct RenderSettings {
     int width = 64, height = 64;
     uint64_t spp = 16;
-    uint64_t stream = 1;      ///< keys every pixel's random stream (seed, estimator, spp, replicate)
-    int threads = 1;          ///< worker threads (1 where the build has none)
+    uint64_t stream = 1; ///< keys every pixel's random stream (seed, estimator, spp, replicate)
+    int threads = 1;     ///< worker threads (1 where the build has none)
     bool jitter_pixels = true; ///< false: every sample's camera ray passes through the pixel centre
     const std::atomic<bool>* cancel = nullptr; ///< checked once per row
 };
@@ -25,9 +25,9 @@ struct RenderDiagnostics {
     uint64_t samples = 0;
     uint64_t discarded_nonfinite = 0; ///< samples whose radiance was NaN or infinite: dropped
     uint64_t rays = 0;
-    uint64_t light_misses = 0;       ///< light samples with no valid point (degenerate, pdf 0)
-    uint64_t dominated_pixels = 0;   ///< pixels (spp >= 16) where one sample carries > half the sum
-    double max_sample_share = 0.0;   ///< over pixels with spp >= 16: largest sample / pixel sum
+    uint64_t light_misses = 0;     ///< light samples with no valid point (degenerate, pdf 0)
+    uint64_t dominated_pixels = 0; ///< pixels (spp >= 16) where one sample carries > half the sum
+    double max_sample_share = 0.0; ///< over pixels with spp >= 16: largest sample / pixel sum
     /// The kTopWeights largest luminances of the samples' reflected part (the emission seen
     /// directly is not random given the camera ray), decreasing: for Hill's tail index.
     std::vector<double> top;

@@ -39,11 +39,11 @@ struct Texture {
 
 /// One triangle mesh in world space; per-triangle arrays are indexed by triangle id.
 struct Mesh {
-    std::vector<Vec3> position;                  ///< vertices
-    std::vector<Vec3> normal;                    ///< per vertex shading normals, or empty
-    std::vector<Vec2> uv;                        ///< per vertex, or empty (no textures)
-    std::vector<std::array<uint32_t, 3>> index;  ///< per triangle: three vertex ids
-    std::vector<uint32_t> material;              ///< per triangle: index into Scene::materials
+    std::vector<Vec3> position;                 ///< vertices
+    std::vector<Vec3> normal;                   ///< per vertex shading normals, or empty
+    std::vector<Vec2> uv;                       ///< per vertex, or empty (no textures)
+    std::vector<std::array<uint32_t, 3>> index; ///< per triangle: three vertex ids
+    std::vector<uint32_t> material;             ///< per triangle: index into Scene::materials
 
     size_t triangle_count() const { return index.size(); }
     const Vec3& vertex(size_t triangle, int k) const { return position[index[triangle][k]]; }

@@ -39,8 +39,11 @@ std::string png_of(int w, int h, const std::vector<uint8_t>& rgb) {
 /// A perceptually ordered ramp from dark blue through teal and green to yellow (control
 /// points chosen here, in the spirit of viridis), t in [0, 1].
 Vec3 error_ramp(double t) {
-    static const Vec3 kStops[] = {{0.07, 0.02, 0.30}, {0.17, 0.32, 0.55}, {0.13, 0.57, 0.55},
-                                  {0.37, 0.79, 0.38}, {0.99, 0.91, 0.15}};
+    static const Vec3 kStops[] = {{0.07, 0.02, 0.30},
+                                  {0.17, 0.32, 0.55},
+                                  {0.13, 0.57, 0.55},
+                                  {0.37, 0.79, 0.38},
+                                  {0.99, 0.91, 0.15}};
     t = std::clamp(t, 0.0, 1.0) * 4.0;
     int i = std::min(3, int(t));
     double f = t - i;

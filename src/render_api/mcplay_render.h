@@ -22,8 +22,8 @@ extern "C" {
  * "Render studies"). progress gets one JSON line per completed spp level (non-zero return
  * cancels). Options also take previews (true: PNGs of each estimator's last image and of
  * the reference, base64, in the result). */
-int mcp_render_study_run(const char* scene_json, const char* options_json,
-                         mcp_progress_fn progress, void* user, char** result_json);
+int mcp_render_study_run(const char* scene_json, const char* options_json, mcp_progress_fn progress,
+                         void* user, char** result_json);
 
 /* One image: options.estimator (a name from the scene or an estimator object; default the
  * scene's first), options.spp (default spp_max), options.outputs (any of "png", "hdr",

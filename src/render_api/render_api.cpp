@@ -44,7 +44,9 @@ Json estimator_to_json(const RenderEstimator& e) {
     return j;
 }
 
-Json num(double x) { return std::isfinite(x) ? Json(x) : Json(nullptr); }
+Json num(double x) {
+    return std::isfinite(x) ? Json(x) : Json(nullptr);
+}
 
 Json warning(const char* code, const std::string& message) {
     return Json{{"code", code}, {"message", message}};
@@ -66,8 +68,8 @@ Json render_warnings(const RenderEstimatorStudy& s) {
     if (std::isfinite(deepest.tail_index) && deepest.tail_k > 0) {
         double a = deepest.tail_index, se = a / std::sqrt(double(deepest.tail_k));
         std::string where = " (from the " + std::to_string(deepest.tail_k) + " largest of " +
-                            std::to_string(deepest.diagnostics.nonzero) + " samples at spp = " +
-                            std::to_string(deepest.n) + ")";
+                            std::to_string(deepest.diagnostics.nonzero) +
+                            " samples at spp = " + std::to_string(deepest.n) + ")";
         if (a < 2.0 + 2.0 * se)
             w.push_back(warning("heavy_tail", "sample radiance is heavy-tailed: tail index " +
                                                   fmt("%.2f", a) + " +/- " + fmt("%.2f", se) +
@@ -87,11 +89,12 @@ Json render_warnings(const RenderEstimatorStudy& s) {
                                 ", slower than 1/spp: infinite variance, bias against the "
                                 "reference, or a reference too noisy for this spp"));
     if (deepest.coverage < 0.85 && deepest.n >= 16)
-        w.push_back(warning("pixel_error_bars",
-                            "only " + fmt("%.1f", 100.0 * deepest.coverage) +
-                                "% of the pixels' own 95% error bars cover the reference at spp = " +
-                                std::to_string(deepest.n) +
-                                ": per-pixel error bars are too small (heavy tails or bias)"));
+        w.push_back(
+            warning("pixel_error_bars",
+                    "only " + fmt("%.1f", 100.0 * deepest.coverage) +
+                        "% of the pixels' own 95% error bars cover the reference at spp = " +
+                        std::to_string(deepest.n) +
+                        ": per-pixel error bars are too small (heavy tails or bias)"));
     return w;
 }
 
@@ -125,6 +128,15 @@ int load(const char* scene_json, const char* options_json, Loaded* out, Json* op
     return MCP_OK;
 }
 
+/// The start of every render call: the out-parameter checked and cleared, the scene loaded.
+int begin_call(const char* function, char** out, const char* scene_json, const char* options_json,
+               Loaded* loaded, Json* options) {
+    if (!out)
+        return fail(MCP_ERROR_ARGUMENT, std::string(function) + ": the result pointer is NULL");
+    *out = nullptr;
+    return load(scene_json, options_json, loaded, options);
+}
+
 std::string hex(uint64_t x) {
     char buf[20];
     std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(x));
@@ -150,8 +162,8 @@ bool obtain_reference(const Loaded& l, RenderImage* ref, Json* info, std::string
         }
         if (ref->width != s.width || ref->height != s.height) {
             *error = "reference.file: the image is " + std::to_string(ref->width) + "x" +
-                     std::to_string(ref->height) + " but the render is " +
-                     std::to_string(s.width) + "x" + std::to_string(s.height);
+                     std::to_string(ref->height) + " but the render is " + std::to_string(s.width) +
+                     "x" + std::to_string(s.height);
             return false;
         }
         *info = Json{{"source", "file"}, {"file", r.reference.file}};
@@ -159,14 +171,15 @@ bool obtain_reference(const Loaded& l, RenderImage* ref, Json* info, std::string
     }
     const RenderEstimator& e = r.reference.estimator;
     uint64_t key = hash_combine(r.gltf_hash, uint64_t(kReferenceCacheVersion));
-    for (uint64_t v : {uint64_t(s.width), uint64_t(s.height), uint64_t(s.jitter_pixels),
-                       uint64_t(e.strategy), uint64_t(e.light_selection),
-                       uint64_t(e.light_sampling), uint64_t(e.pixel_sampler),
-                       uint64_t(e.max_depth), uint64_t(e.rr_depth), r.reference.spp, s.seed})
+    for (uint64_t v :
+         {uint64_t(s.width), uint64_t(s.height), uint64_t(s.jitter_pixels), uint64_t(e.strategy),
+          uint64_t(e.light_selection), uint64_t(e.light_sampling), uint64_t(e.pixel_sampler),
+          uint64_t(e.max_depth), uint64_t(e.rr_depth), r.reference.spp, s.seed})
         key = hash_combine(key, v);
     std::string cache_file =
-        r.cache_dir.empty() ? "" : r.cache_dir + "/" + (r.name.empty() ? "scene" : r.name) +
-                                       "-" + hex(key) + ".mcref";
+        r.cache_dir.empty()
+            ? ""
+            : r.cache_dir + "/" + (r.name.empty() ? "scene" : r.name) + "-" + hex(key) + ".mcref";
     *info = Json{{"estimator", estimator_to_json(e)}, {"spp", r.reference.spp}};
     if (!cache_file.empty() && read_reference_cache(cache_file, ref) && ref->width == s.width &&
         ref->height == s.height) {
@@ -225,9 +238,14 @@ Json scene_to_json(const Loaded& l) {
 }
 
 Json settings_to_json(const RenderStudySettings& s, int threads) {
-    return Json{{"n_min", s.spp_min}, {"n_max", s.spp_max},   {"reps", s.reps},
-                {"seed", s.seed},     {"threads", threads},    {"n_name", "spp"},
-                {"error_name", "relative_mse"}, {"jitter_pixels", s.jitter_pixels}};
+    return Json{{"n_min", s.spp_min},
+                {"n_max", s.spp_max},
+                {"reps", s.reps},
+                {"seed", s.seed},
+                {"threads", threads},
+                {"n_name", "spp"},
+                {"error_name", "relative_mse"},
+                {"jitter_pixels", s.jitter_pixels}};
 }
 
 Json estimator_study_to_json(const RenderEstimatorStudy& s, bool previews, double exposure,
@@ -264,16 +282,17 @@ extern "C" {
 
 int mcp_render_scene_info(const char* scene_json, const char* options_json, char** info_json) {
     using namespace mcp;
-    if (!info_json) return fail(MCP_ERROR_ARGUMENT, "mcp_render_scene_info: info_json is NULL");
-    *info_json = nullptr;
     Loaded l;
     Json options;
-    if (int st = load(scene_json, options_json, &l, &options)) return st;
+    if (int st =
+            begin_call("mcp_render_scene_info", info_json, scene_json, options_json, &l, &options))
+        return st;
     Json j = scene_to_json(l);
     Json ests = Json::array();
     for (const RenderEstimator& e : l.request->estimators) ests.push_back(estimator_to_json(e));
     j["estimators"] = ests;
-    j["settings"] = settings_to_json(l.request->settings, resolve_threads(l.request->settings.threads));
+    j["settings"] =
+        settings_to_json(l.request->settings, resolve_threads(l.request->settings.threads));
     j["reference"] = Json{{"estimator", estimator_to_json(l.request->reference.estimator)},
                           {"spp", l.request->reference.spp},
                           {"file", l.request->reference.file}};
@@ -284,11 +303,11 @@ int mcp_render_scene_info(const char* scene_json, const char* options_json, char
 
 int mcp_render_image(const char* scene_json, const char* options_json, char** result_json) {
     using namespace mcp;
-    if (!result_json) return fail(MCP_ERROR_ARGUMENT, "mcp_render_image: result_json is NULL");
-    *result_json = nullptr;
     Loaded l;
     Json options;
-    if (int st = load(scene_json, options_json, &l, &options)) return st;
+    if (int st =
+            begin_call("mcp_render_image", result_json, scene_json, options_json, &l, &options))
+        return st;
     const RenderRequest& r = *l.request;
     RenderEstimator est = r.estimators.front();
     if (auto it = options.find("estimator"); it != options.end()) {
@@ -317,9 +336,12 @@ int mcp_render_image(const char* scene_json, const char* options_json, char** re
         if (!it->is_array()) return fail(MCP_ERROR_ARGUMENT, "options.outputs: expected an array");
         for (const Json& o : *it) {
             std::string s = o.is_string() ? o.get<std::string>() : "";
-            if (s == "png") png = true;
-            else if (s == "hdr") hdr = true;
-            else if (s == "error_png") error_png = true;
+            if (s == "png")
+                png = true;
+            else if (s == "hdr")
+                hdr = true;
+            else if (s == "error_png")
+                error_png = true;
             else
                 return fail(MCP_ERROR_ARGUMENT, "options.outputs: unknown output " + o.dump() +
                                                     " (known: png, hdr, error_png)");
@@ -381,14 +403,14 @@ int mcp_render_image(const char* scene_json, const char* options_json, char** re
     return boundary::succeed();
 }
 
-int mcp_render_study_run(const char* scene_json, const char* options_json,
-                         mcp_progress_fn progress, void* user, char** result_json) {
+int mcp_render_study_run(const char* scene_json, const char* options_json, mcp_progress_fn progress,
+                         void* user, char** result_json) {
     using namespace mcp;
-    if (!result_json) return fail(MCP_ERROR_ARGUMENT, "mcp_render_study_run: result_json is NULL");
-    *result_json = nullptr;
     Loaded l;
     Json options;
-    if (int st = load(scene_json, options_json, &l, &options)) return st;
+    if (int st =
+            begin_call("mcp_render_study_run", result_json, scene_json, options_json, &l, &options))
+        return st;
     const RenderRequest& r = *l.request;
     bool previews = wants(options, "previews", false);
     RenderImage reference;
@@ -406,8 +428,11 @@ int mcp_render_study_run(const char* scene_json, const char* options_json,
                     estimator_study_to_json(s, previews, r.exposure, &reference, false, level));
                 if (level < s.levels.size()) n = s.levels[level].n;
             }
-            Json p{{"version", kResultSchemaVersion}, {"kind", "render"}, {"level_index", level},
-                   {"n", n}, {"estimators", ests}};
+            Json p{{"version", kResultSchemaVersion},
+                   {"kind", "render"},
+                   {"level_index", level},
+                   {"n", n},
+                   {"estimators", ests}};
             if (previews && level == 0)
                 p["reference_png"] = base64_encode(encode_png(reference, r.exposure));
             std::string text = dump(p);

@@ -4,6 +4,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "api/scene.h" // parse_json
 #include "core/rng.h"
 #include "render_api/gltf_scene.h"
 
@@ -53,8 +54,8 @@ bool parse_estimator(Ctx& c, const Json& j, const std::string& path, RenderEstim
     if (j.is_string()) {
         std::string name = j.get<std::string>();
         if (!parse_strategy(name, &e.strategy))
-            return c.fail(path, "unknown estimator '" + name + "' (known: " +
-                                    join(strategy_names()) + ")");
+            return c.fail(path, "unknown estimator '" + name +
+                                    "' (known: " + join(strategy_names()) + ")");
         e.name = name;
         *out = e;
         return true;
@@ -65,11 +66,11 @@ bool parse_estimator(Ctx& c, const Json& j, const std::string& path, RenderEstim
         return false;
     std::string strategy;
     if (!get_string(c, j, "strategy", path, &strategy)) return false;
-    if (strategy.empty()) return c.fail(sub(path, "strategy"), "missing (known: " +
-                                                                   join(strategy_names()) + ")");
+    if (strategy.empty())
+        return c.fail(sub(path, "strategy"), "missing (known: " + join(strategy_names()) + ")");
     if (!parse_strategy(strategy, &e.strategy))
-        return c.fail(sub(path, "strategy"), "unknown strategy '" + strategy + "' (known: " +
-                                                 join(strategy_names()) + ")");
+        return c.fail(sub(path, "strategy"), "unknown strategy '" + strategy +
+                                                 "' (known: " + join(strategy_names()) + ")");
     e.name = strategy;
     if (!get_string(c, j, "name", path, &e.name)) return false;
     if (e.name.empty()) return c.fail(sub(path, "name"), "must not be empty");
@@ -122,7 +123,8 @@ bool parse_settings(Ctx& c, const Json& j, const std::string& path, RenderReques
     if (!get_count(c, j, "width", path, &w) || !get_count(c, j, "height", path, &h) ||
         !get_count(c, j, "spp_min", path, &r->settings.spp_min) ||
         !get_count(c, j, "spp_max", path, &r->settings.spp_max) ||
-        !get_count(c, j, "reps", path, &reps) || !get_count(c, j, "seed", path, &r->settings.seed) ||
+        !get_count(c, j, "reps", path, &reps) ||
+        !get_count(c, j, "seed", path, &r->settings.seed) ||
         !get_count(c, j, "threads", path, &threads) ||
         !get_number(c, j, "exposure", path, &r->exposure))
         return false;
@@ -131,8 +133,7 @@ bool parse_settings(Ctx& c, const Json& j, const std::string& path, RenderReques
     if (r->settings.spp_min < 1 || r->settings.spp_min > kMaxSpp)
         return c.fail(sub(path, "spp_min"), "must be in 1.." + std::to_string(kMaxSpp));
     if (r->settings.spp_max < r->settings.spp_min || r->settings.spp_max > kMaxSpp)
-        return c.fail(sub(path, "spp_max"),
-                      "must be in spp_min.." + std::to_string(kMaxSpp));
+        return c.fail(sub(path, "spp_max"), "must be in spp_min.." + std::to_string(kMaxSpp));
     if (reps < 2 || reps > 1024) return c.fail(sub(path, "reps"), "must be in 2..1024");
     if (threads > 256) return c.fail(sub(path, "threads"), "must be in 0..256");
     if (const Json* v = find(j, "jitter_pixels")) {
@@ -208,10 +209,6 @@ Made<std::shared_ptr<RenderRequest>> build_render_request(const Json& scene, con
         !get_string(c, opts, "cache_dir", "options", &r->cache_dir))
         return error();
 
-    // Settings: the scene's, then the options' overrides.
-    if (!parse_settings(c, render, rp, r.get()) || !parse_settings(c, opts, "options", r.get()))
-        return error();
-
     // The glTF: a path relative to the scene file, or the glTF JSON itself inline.
     const Json* gltf = find(render, "gltf");
     if (!gltf) return made_error<std::shared_ptr<RenderRequest>>(rp + ".gltf: missing");
@@ -221,8 +218,8 @@ Made<std::shared_ptr<RenderRequest>> build_render_request(const Json& scene, con
         std::string p = gltf->get<std::string>();
         r->gltf_path = !p.empty() && p[0] == '/' ? p : base_dir + "/" + p;
         if (!read_text_file(r->gltf_path, &text))
-            return made_error<std::shared_ptr<RenderRequest>>(
-                rp + ".gltf: cannot read '" + r->gltf_path + "'");
+            return made_error<std::shared_ptr<RenderRequest>>(rp + ".gltf: cannot read '" +
+                                                              r->gltf_path + "'");
         loaded = load_gltf_memory(text, dirname_of(r->gltf_path));
     } else if (gltf->is_object()) {
         text = gltf->dump();
@@ -240,9 +237,32 @@ Made<std::shared_ptr<RenderRequest>> build_render_request(const Json& scene, con
         return made_error<std::shared_ptr<RenderRequest>>(
             rp + ".gltf: the scene has no perspective camera (add a camera node)");
 
-    // Estimators: the scene's list (or every direct-lighting strategy), then the options'.
-    if (const Json* list = find(render, "estimators")) {
-        if (!parse_estimator_list(c, *list, rp + ".estimators", &r->estimators)) return error();
+    // A glTF may carry its own study settings in extras.mcplay (same keys as "render"); the
+    // scene file's and then the options' values take precedence.
+    Json extras;
+    if (!loaded.extras_json.empty()) {
+        Made<Json> e = parse_json(loaded.extras_json.c_str(), "glTF extras");
+        if (e.ok() && e.value.is_object() && e.value.contains("mcplay")) extras = e.value["mcplay"];
+    }
+    const std::string ep = rp + ".gltf: extras.mcplay";
+    if (!extras.is_null()) {
+        if (!check_keys(c, extras, ep,
+                        {"width", "height", "spp_min", "spp_max", "reps", "seed", "threads",
+                         "estimators", "reference", "jitter_pixels", "exposure", "accel"}) ||
+            !parse_settings(c, extras, ep, r.get()))
+            return error();
+    }
+    if (!parse_settings(c, render, rp, r.get()) || !parse_settings(c, opts, "options", r.get()))
+        return error();
+
+    // Estimators: the scene's list (or the glTF's, or every direct-lighting strategy), then
+    // the options'.
+    const Json* scene_list = find(render, "estimators");
+    if (!scene_list) scene_list = find(extras, "estimators");
+    if (const Json* list = scene_list) {
+        std::string lp =
+            list == find(render, "estimators") ? rp + ".estimators" : ep + ".estimators";
+        if (!parse_estimator_list(c, *list, lp, &r->estimators)) return error();
     } else {
         for (int s = 0; s < int(RadianceStrategy::Path); ++s) {
             RenderEstimator e;
@@ -279,15 +299,20 @@ Made<std::shared_ptr<RenderRequest>> build_render_request(const Json& scene, con
     // The reference: by default the power-heuristic MIS estimator of the same quantity.
     const RenderEstimator& first = r->estimators.front();
     r->reference.estimator.name = "reference";
-    r->reference.estimator.strategy =
-        first.strategy == RadianceStrategy::Path ? RadianceStrategy::Path : RadianceStrategy::MisPower;
+    r->reference.estimator.strategy = first.strategy == RadianceStrategy::Path
+                                          ? RadianceStrategy::Path
+                                          : RadianceStrategy::MisPower;
     r->reference.estimator.max_depth = first.max_depth;
     r->reference.estimator.rr_depth = first.rr_depth;
     r->reference.spp = std::max<uint64_t>(256, 16 * r->settings.spp_max);
+    if (const Json* ref = find(extras, "reference"))
+        if (!parse_reference(c, *ref, ep + ".reference",
+                             dirname_of(r->gltf_path.empty() ? base_dir + "/x" : r->gltf_path),
+                             &r->reference))
+            return error();
     if (const Json* ref = find(render, "reference"))
-        if (!parse_reference(c, *ref, rp + ".reference", dirname_of(r->gltf_path.empty()
-                                                                          ? base_dir + "/x"
-                                                                          : r->gltf_path),
+        if (!parse_reference(c, *ref, rp + ".reference",
+                             dirname_of(r->gltf_path.empty() ? base_dir + "/x" : r->gltf_path),
                              &r->reference))
             return error();
     if (const Json* ref = find(opts, "reference"))

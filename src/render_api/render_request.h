@@ -20,9 +20,9 @@ struct ReferenceSpec {
 
 struct RenderRequest {
     std::string name, description;
-    std::string gltf_path; ///< "" when the glTF was inline
-    uint64_t gltf_hash = 0; ///< of the glTF text, for the reference cache
-    std::unique_ptr<Scene> scene; ///< heap-held: RenderScene keeps a pointer to it
+    std::string gltf_path;             ///< "" when the glTF was inline
+    uint64_t gltf_hash = 0;            ///< of the glTF text, for the reference cache
+    std::unique_ptr<Scene> scene;      ///< heap-held: RenderScene keeps a pointer to it
     std::vector<std::string> warnings; ///< from the loader and the scene file
     RenderStudySettings settings;
     std::vector<RenderEstimator> estimators;
