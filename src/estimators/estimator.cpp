@@ -49,6 +49,9 @@ double hill_tail_index(const std::vector<double>& top, int k) {
         return std::numeric_limits<double>::quiet_NaN();
     const double xk = top[static_cast<size_t>(k)];
     if (!(xk > 0.0)) return 0.0;
+    // Top values equal up to rounding (a constant weight computed along different paths)
+    // have no tail: their log spacings are noise of a few ulps, not a power law.
+    if (top[0] <= xk * (1.0 + 1e-12)) return std::numeric_limits<double>::infinity();
     double sum = 0.0;
     for (int i = 0; i < k; ++i) sum += std::log(top[static_cast<size_t>(i)] / xk);
     return sum > 0.0 ? k / sum : std::numeric_limits<double>::infinity();

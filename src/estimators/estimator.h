@@ -54,7 +54,7 @@ int hill_order(uint64_t samples);
 /// Hill's estimator of the tail index alpha from the k+1 largest values, sorted in
 /// decreasing order (standard error about alpha / sqrt(k)): k / sum_{i<k} log(x_i / x_k) [Hill75].
 /// P(|w| > t) ~ t^-alpha, so alpha < 2 means infinite variance. Infinite when the top values are
-/// all equal, 0 when x_k is 0 (fewer than k+1 non-zero weights).
+/// all equal (to 1e-12 relative), 0 when x_k is 0 (fewer than k+1 non-zero weights).
 double hill_tail_index(const std::vector<double>& top_descending, int k);
 
 /// Buffers reused across runs so that a run allocates nothing per block.

@@ -223,9 +223,12 @@ RadianceSample direct_radiance(const RenderScene& rs, const RenderEstimator& est
     case RadianceStrategy::MisBalance:
     case RadianceStrategy::MisPower: {
         bool power = est.strategy == RadianceStrategy::MisPower;
-        out.reflected =
-            light_sample_term(rs, lights, est.light_sampling, sp, sampler, c, true, power) +
-            direction_sample_term(rs, est, lights, sp, sampler, c, true, power);
+        // Two statements: both terms draw from the sampler, and the order in which the
+        // operands of + are evaluated is unspecified (g++ and clang differ).
+        Vec3 from_light =
+            light_sample_term(rs, lights, est.light_sampling, sp, sampler, c, true, power);
+        Vec3 from_bsdf = direction_sample_term(rs, est, lights, sp, sampler, c, true, power);
+        out.reflected = from_light + from_bsdf;
         break;
     }
     default:
