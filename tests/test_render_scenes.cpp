@@ -4,11 +4,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
 
+#include "render_api/image_io.h"
 #include "render_api/mcplay_render.h"
 #include "render_api/render_request.h"
 
@@ -263,6 +265,59 @@ TEST(RenderScenes, GltfExtrasCarrySettings) {
     scene["render"]["gltf"] = gltf;
     EXPECT_EQ(mcp_render_scene_info(scene.dump().c_str(), nullptr, &info), MCP_ERROR_SCENE);
     EXPECT_NE(std::string(mcp_last_error()).find("extras.mcplay: unknown field 'spp'"),
+              std::string::npos)
+        << mcp_last_error();
+}
+
+// The reference: rendered once, then read back from the cache with the same numbers; or
+// read from a Radiance HDR file of the right size (and refused at the wrong size).
+TEST(RenderScenes, ReferenceFromCacheAndFromHdrFile) {
+    char dir_template[] = "/tmp/mcplay_ref_XXXXXX";
+    ASSERT_NE(mkdtemp(dir_template), nullptr);
+    const std::string dir = dir_template;
+    json options{{"width", 8},
+                 {"height", 6},
+                 {"spp_min", 1},
+                 {"spp_max", 2},
+                 {"reps", 2},
+                 {"estimators", {"light_area"}},
+                 {"reference", {{"spp", 64}}},
+                 {"cache_dir", dir}};
+    json first = study("quad_light_floor", options);
+    json second = study("quad_light_floor", options);
+    EXPECT_EQ(first["scene"]["reference"]["source"], "rendered");
+    EXPECT_EQ(second["scene"]["reference"]["source"], "cache");
+    EXPECT_EQ(first["estimators"][0]["levels"][1]["variance"],
+              second["estimators"][0]["levels"][1]["variance"]);
+
+    auto r = request("quad_light_floor", json{{"width", 8}, {"height", 6}});
+    ASSERT_TRUE(r);
+    RenderScene rs;
+    rs.build(*r->scene, r->accel);
+    RenderSettings st;
+    st.width = 8;
+    st.height = 6;
+    st.spp = 64;
+    RenderImage im = render_image(rs, r->estimators.front(), st);
+    const std::string hdr = dir + "/ref.hdr";
+    {
+        std::ofstream out(hdr, std::ios::binary);
+        out << encode_hdr(im);
+    }
+    options["reference"] = {{"file", hdr}};
+    json from_file = study("quad_light_floor", options);
+    EXPECT_EQ(from_file["scene"]["reference"]["source"], "file");
+    // RGBE keeps 8 bits of mantissa: the reference is within 1% of the render's mean.
+    EXPECT_NEAR(from_file["scene"]["reference"]["mean_luminance"].get<double>(),
+                first["scene"]["reference"]["mean_luminance"].get<double>(),
+                0.02 * first["scene"]["reference"]["mean_luminance"].get<double>());
+    options["width"] = 9;
+    std::string text = read(kScenes + "/quad_light_floor.json");
+    options["base_dir"] = kScenes;
+    char* out = nullptr;
+    EXPECT_EQ(mcp_render_study_run(text.c_str(), options.dump().c_str(), nullptr, nullptr, &out),
+              MCP_ERROR_SCENE);
+    EXPECT_NE(std::string(mcp_last_error()).find("the image is 8x6 but the render is 9x6"),
               std::string::npos)
         << mcp_last_error();
 }
