@@ -75,32 +75,43 @@ Json warnings_for(const LevelStats& l) {
     return w;
 }
 
+} // namespace
+
+// Hill's tail index alpha, P(|x| > t) ~ t^-alpha, a property of the estimator: it is read at
+// the largest N, whose pooled sample reaches deepest into the tail. Below 2 the variance is
+// infinite; below 4 the variance of the sample variance is, and error bars are unreliable at
+// any practical N. Flag when alpha = 2 is within two standard errors (alpha / sqrt(k))
+// [Hill75].
+void add_tail_warnings(Json& w, const LevelStats& deepest, uint64_t pooled,
+                       const TailWording& words) {
+    if (!std::isfinite(deepest.tail_index) || deepest.tail_k <= 0) return;
+    const double a = deepest.tail_index;
+    const double se = a / std::sqrt(static_cast<double>(deepest.tail_k));
+    const std::string where = " (from the " + std::to_string(deepest.tail_k) + " largest of " +
+                              std::to_string(pooled) + " " + words.unit + " at " + words.n_name +
+                              " = " + std::to_string(deepest.n) + ")";
+    if (a < 2.0 + 2.0 * se)
+        w.push_back(warning("heavy_tail", std::string(words.what) +
+                                              " are heavy-tailed: tail index " + fmt("%.2f", a) +
+                                              " +/- " + fmt("%.2f", se) + where + ", and below 2 " +
+                                              words.variance +
+                                              " is infinite: the error bars are not trustworthy"));
+    else if (a < 4.0)
+        w.push_back(warning("heavy_tail_4", std::string(words.what) +
+                                                " have a heavy tail: tail index " + fmt("%.2f", a) +
+                                                where + " is below 4, so " + words.variance +
+                                                " is finite but its estimate is unreliable and the "
+                                                "error bars may be too small"));
+}
+
+namespace {
+
 Json estimator_warnings(const EstimatorStudy& e, const StudySettings& s) {
     Json w = Json::array();
-    // Hill's tail index alpha of the weights, P(|w| > t) ~ t^-alpha, a property of the
-    // estimator: it is read at the largest N, whose pooled sample reaches deepest into the
-    // tail. Below 2 the variance is infinite; below 4 the variance of the sample variance is,
-    // and error bars are unreliable at any practical N. Flag when alpha = 2 is within two
-    // standard errors (alpha / sqrt(k)) [Hill75].
-    const LevelStats* deepest = e.levels.empty() ? nullptr : &e.levels.back();
-    if (deepest && std::isfinite(deepest->tail_index) && deepest->tail_k > 0) {
-        const double a = deepest->tail_index;
-        const double se = a / std::sqrt(static_cast<double>(deepest->tail_k));
-        const std::string where = " (from the " + std::to_string(deepest->tail_k) + " largest of " +
-                                  std::to_string(deepest->n * deepest->reps) +
-                                  " weights at N = " + std::to_string(deepest->n) + ")";
-        if (a < 2.0 + 2.0 * se)
-            w.push_back(warning("heavy_tail", "the weights f/p are heavy-tailed: tail index " +
-                                                  fmt("%.2f", a) + " +/- " + fmt("%.2f", se) +
-                                                  where +
-                                                  ", and below 2 the variance is infinite: the "
-                                                  "error bars are not trustworthy"));
-        else if (a < 4.0)
-            w.push_back(warning("heavy_tail_4",
-                                "the weights f/p have a heavy tail: tail index " + fmt("%.2f", a) +
-                                    where +
-                                    " is below 4, so the variance is finite but its estimate is "
-                                    "unreliable and the error bars may be too small"));
+    if (!e.levels.empty()) {
+        const LevelStats& deepest = e.levels.back();
+        add_tail_warnings(w, deepest, deepest.n * static_cast<uint64_t>(deepest.reps),
+                          TailWording{"the weights f/p", "weights", "N", "the variance"});
     }
 
     if (e.support.missed > 0)

@@ -42,6 +42,19 @@ Json level_to_json(const LevelStats& level);
 Json fit_to_json(const ConvergenceFit& fit);
 Json progress_to_json(const StudyResult& partial, size_t level_index);
 
+/// Words for the tail-index warnings: "<what> are heavy-tailed ... (from the k largest of M
+/// <unit> at <n_name> = n), and below 2 <variance> is infinite".
+struct TailWording {
+    const char* what;
+    const char* unit;
+    const char* n_name;
+    const char* variance;
+};
+/// Appends the `heavy_tail` / `heavy_tail_4` warnings for the tail index of a study's deepest
+/// level, estimated from `pooled` values.
+void add_tail_warnings(Json& warnings, const LevelStats& deepest, uint64_t pooled,
+                       const TailWording& words);
+
 std::string format_table(const Json& result);
 std::string format_csv(const Json& result);
 

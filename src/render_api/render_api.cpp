@@ -63,25 +63,9 @@ Json render_warnings(const RenderEstimatorStudy& s) {
     Json w = Json::array();
     if (s.levels.empty()) return w;
     const LevelStats& deepest = s.levels.back();
-    // Hill's tail index of sample radiance relative to the reference pixel: below 2 the
-    // per-pixel variance is infinite and relative MSE cannot fall as 1/spp [Hill75].
-    if (std::isfinite(deepest.tail_index) && deepest.tail_k > 0) {
-        double a = deepest.tail_index, se = a / std::sqrt(double(deepest.tail_k));
-        std::string where = " (from the " + std::to_string(deepest.tail_k) + " largest of " +
-                            std::to_string(deepest.diagnostics.nonzero) +
-                            " samples at spp = " + std::to_string(deepest.n) + ")";
-        if (a < 2.0 + 2.0 * se)
-            w.push_back(warning("heavy_tail", "sample radiance is heavy-tailed: tail index " +
-                                                  fmt("%.2f", a) + " +/- " + fmt("%.2f", se) +
-                                                  where +
-                                                  "; below 2 the pixel variance is infinite and "
-                                                  "the error bars are not trustworthy"));
-        else if (a < 4.0)
-            w.push_back(warning("heavy_tail_4", "sample radiance has a heavy tail: tail index " +
-                                                    fmt("%.2f", a) + where +
-                                                    " is below 4, so variance estimates are "
-                                                    "unreliable (fireflies)"));
-    }
+    add_tail_warnings(w, deepest, deepest.diagnostics.nonzero,
+                      TailWording{"the samples' reflected radiance values", "samples", "spp",
+                                  "the pixel variance"});
     if (s.fit.valid && s.fit.order > -1.0 + 3.0 * s.fit.order_se && s.fit.order > -0.8)
         w.push_back(warning("slow_convergence",
                             "relative MSE falls as spp^" + fmt("%.2f", s.fit.order) + " +/- " +
