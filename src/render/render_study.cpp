@@ -69,7 +69,11 @@ uint64_t render_stream(uint64_t seed, const std::string& estimator, uint64_t spp
     return hash_combine(h, static_cast<uint64_t>(rep));
 }
 
-LevelStats render_level_stats(const std::vector<RenderImage>& images,
+ImageSummary summarise_image(const RenderImage& image, const RenderImage& reference) {
+    return ImageSummary{image_error(image, reference), image.diagnostics, image.seconds, image.spp};
+}
+
+LevelStats render_level_stats(const std::vector<ImageSummary>& images,
                               const RenderImage& reference) {
     LevelStats l;
     l.reps = int(images.size());
@@ -80,8 +84,8 @@ LevelStats render_level_stats(const std::vector<RenderImage>& images,
     RunningMoments rel, lum;
     double coverage = 0.0, run_se = 0.0;
     RenderDiagnostics pooled;
-    for (const RenderImage& im : images) {
-        ImageError e = image_error(im, reference);
+    for (const ImageSummary& im : images) {
+        const ImageError& e = im.error;
         rel.add(e.rel_mse);
         lum.add(e.mean_luminance);
         coverage += e.coverage;
@@ -196,7 +200,9 @@ RenderStudyResult run_render_study(const RenderScene& rs,
     std::vector<uint64_t> ladder = n_ladder(settings.spp_min, settings.spp_max);
     for (size_t li = 0; li < ladder.size(); ++li) {
         for (RenderEstimatorStudy& s : result.estimators) {
-            std::vector<RenderImage> images;
+            // Each image is summarised as soon as it is rendered: a level holds one image
+            // (replicate 0, the preview), not reps of them.
+            std::vector<ImageSummary> images;
             for (int r = 0; r < settings.reps; ++r) {
                 RenderSettings rset;
                 rset.width = settings.width;
@@ -205,10 +211,11 @@ RenderStudyResult run_render_study(const RenderScene& rs,
                 rset.stream = render_stream(settings.seed, s.estimator.name, ladder[li], r);
                 rset.threads = result.threads_used;
                 rset.jitter_pixels = settings.jitter_pixels;
-                images.push_back(render_image(rs, s.estimator, rset));
+                RenderImage image = render_image(rs, s.estimator, rset);
+                images.push_back(summarise_image(image, reference));
+                if (r == 0) s.preview = std::move(image);
             }
             s.levels.push_back(render_level_stats(images, reference));
-            s.preview = std::move(images[0]);
             s.fit = fit_render_convergence(s.levels);
         }
         bool go_on = !progress || progress(result, li);

@@ -72,7 +72,17 @@ uint64_t render_stream(uint64_t seed, const std::string& estimator, uint64_t spp
 ///   diagnostics    discarded samples (nonfinite), largest single-sample share of a pixel
 ///   tail_index     Hill's estimate on the luminance of the samples' reflected radiance, pooled
 ///                  over the image and the replicates
-LevelStats render_level_stats(const std::vector<RenderImage>& images, const RenderImage& reference);
+/// What a level keeps of one image.
+struct ImageSummary {
+    ImageError error;
+    RenderDiagnostics diagnostics;
+    double seconds = 0.0;
+    uint64_t spp = 0;
+};
+ImageSummary summarise_image(const RenderImage& image, const RenderImage& reference);
+
+LevelStats render_level_stats(const std::vector<ImageSummary>& images,
+                              const RenderImage& reference);
 
 /// Fitted order of relative MSE against spp: weighted least squares of log relMSE on log spp,
 /// weights from each level's replicate spread, the standard error inflated by the residuals.

@@ -13,6 +13,7 @@ namespace mcp {
 namespace {
 
 constexpr int kMaxImageSide = 4096;
+constexpr uint64_t kMaxPixels = uint64_t(1) << 22;
 constexpr uint64_t kMaxSpp = uint64_t(1) << 20;
 
 bool read_text_file(const std::string& path, std::string* out) {
@@ -130,6 +131,10 @@ bool parse_settings(Ctx& c, const Json& j, const std::string& path, RenderReques
         return false;
     if (w < 1 || w > kMaxImageSide) return c.fail(sub(path, "width"), "must be in 1..4096");
     if (h < 1 || h > kMaxImageSide) return c.fail(sub(path, "height"), "must be in 1..4096");
+    // Every image holds 6 doubles per pixel (means and variances), and a study a few images.
+    if (w * h > kMaxPixels)
+        return c.fail(path, "width x height = " + std::to_string(w * h) + " pixels; at most " +
+                                std::to_string(kMaxPixels) + " (2048 x 2048) are allowed");
     if (r->settings.spp_min < 1 || r->settings.spp_min > kMaxSpp)
         return c.fail(sub(path, "spp_min"), "must be in 1.." + std::to_string(kMaxSpp));
     if (r->settings.spp_max < r->settings.spp_min || r->settings.spp_max > kMaxSpp)
