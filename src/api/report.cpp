@@ -358,6 +358,28 @@ std::string format_render_table(const Json& r) {
             for (const Json& w : list(levels.back(), "warnings"))
                 out << "  WARNING: " << jstr(w, "message") << "\n";
     }
+    // Equal-time comparison at the largest spp: which estimator buys the least error per
+    // second of rendering.
+    const Json& ests = list(r, "estimators");
+    if (ests.size() > 1) {
+        out << "\ncomparison at the largest spp (efficiency = 1 / (relative MSE x seconds); higher "
+               "is better)\n";
+        out << padr("  estimator", 30) << padl("spp", 7) << padl("rel.MSE", 12)
+            << padl("s/image", 10) << padl("efficiency", 12) << padl("vs first", 10) << "\n";
+        double first = NAN;
+        for (const Json& e : ests) {
+            const Json& levels = list(e, "levels");
+            if (levels.empty()) continue;
+            const Json& l = levels.back();
+            const double eff = jnum(l, "efficiency");
+            if (std::isnan(first)) first = eff;
+            out << padr("  " + jstr(e, "name"), 30) << padl(fmt("%.0f", jnum(l, "n")), 7)
+                << padl(fmt("%.4e", jnum(l, "variance")), 12)
+                << padl(fmt("%.2e", jnum(l, "time_mean_s")), 10) << padl(fmt("%.3e", eff), 12)
+                << padl(first > 0 && std::isfinite(eff) ? fmt("%.3gx", eff / first) : "-", 10)
+                << "\n";
+        }
+    }
     return out.str();
 }
 
