@@ -8,13 +8,25 @@
 
 namespace mcp {
 
-namespace {
-
-// NaN and infinities become null in the JSON.
 Json num(double x) {
     return std::isfinite(x) ? Json(x) : Json(nullptr);
 }
 
+// A warning: a stable code (for clients that filter or group) and a sentence for people.
+Json warning(const char* code, const std::string& message) {
+    return Json{{"code", code}, {"message", message}};
+}
+
+std::string fmt(const char* f, double x) {
+    if (!std::isfinite(x)) return "-";
+    char buf[64];
+    std::snprintf(buf, sizeof buf, f, x);
+    return buf;
+}
+
+namespace {
+
+// NaN and infinities become null in the JSON.
 Json diagnostics_to_json(const RunDiagnostics& d) {
     return Json{{"nonfinite", d.nonfinite},
                 {"zero_pdf", d.zero_pdf},
@@ -23,12 +35,6 @@ Json diagnostics_to_json(const RunDiagnostics& d) {
 }
 
 // Plain-language warnings for a level's diagnostics.
-std::string fmt(const char* f, double x);
-
-// A warning: a stable code (for clients that filter or group) and a sentence for people.
-Json warning(const char* code, const std::string& message) {
-    return Json{{"code", code}, {"message", message}};
-}
 
 Json warnings_for(const LevelStats& l) {
     Json w = Json::array();
@@ -134,13 +140,6 @@ Json estimator_warnings(const EstimatorStudy& e, const StudySettings& s) {
                             "float32 accumulation (teaching mode): the estimates are naive "
                             "single-precision sums and stall or drift at large N"));
     return w;
-}
-
-std::string fmt(const char* f, double x) {
-    if (!std::isfinite(x)) return "-";
-    char buf[64];
-    std::snprintf(buf, sizeof buf, f, x);
-    return buf;
 }
 
 std::string padl(const std::string& s, size_t w) {

@@ -42,6 +42,13 @@ Json level_to_json(const LevelStats& level);
 Json fit_to_json(const ConvergenceFit& fit);
 Json progress_to_json(const StudyResult& partial, size_t level_index);
 
+/// A JSON number, or null when x is not finite (JSON has no NaN).
+Json num(double x);
+/// A warning object: a stable code and a sentence, {"code", "message"}.
+Json warning(const char* code, const std::string& message);
+/// One number formatted printf-style ("-" when it is not finite).
+std::string fmt(const char* f, double x);
+
 /// Words for the tail-index warnings: "<what> are heavy-tailed ... (from the k largest of M
 /// <unit> at <n_name> = n), and below 2 <variance> is infinite".
 struct TailWording {

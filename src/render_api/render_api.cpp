@@ -44,20 +44,6 @@ Json estimator_to_json(const RenderEstimator& e) {
     return j;
 }
 
-Json num(double x) {
-    return std::isfinite(x) ? Json(x) : Json(nullptr);
-}
-
-Json warning(const char* code, const std::string& message) {
-    return Json{{"code", code}, {"message", message}};
-}
-
-std::string fmt(const char* f, double x) {
-    char buf[64];
-    std::snprintf(buf, sizeof buf, f, x);
-    return buf;
-}
-
 /// Warnings about an estimator over the whole study (the levels carry their own).
 Json render_warnings(const RenderEstimatorStudy& s) {
     Json w = Json::array();
