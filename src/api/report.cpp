@@ -305,6 +305,38 @@ Json progress_to_json(const StudyResult& partial, size_t level_index) {
                 {"estimators", estimators}};
 }
 
+namespace {
+
+// The table that closes a study: each estimator at its largest level, with its error, time
+// per estimate, efficiency 1 / (error x time), and efficiency relative to the first estimator.
+struct ComparisonLabels {
+    const char* title;
+    const char *n, *error, *time;
+    size_t name_width, n_width, error_width, time_width;
+};
+
+void comparison_table(std::ostringstream& out, const Json& ests, const ComparisonLabels& c) {
+    if (ests.size() < 2) return;
+    out << "\n" << c.title << "\n";
+    out << padr("  estimator", c.name_width) << padl(c.n, c.n_width) << padl(c.error, c.error_width)
+        << padl(c.time, c.time_width) << padl("efficiency", 12) << padl("vs first", 10) << "\n";
+    double first = NAN;
+    for (const Json& e : ests) {
+        const Json& levels = list(e, "levels");
+        if (levels.empty()) continue;
+        const Json& l = levels.back();
+        const double eff = jnum(l, "efficiency");
+        if (std::isnan(first)) first = eff;
+        out << padr("  " + jstr(e, "name"), c.name_width)
+            << padl(fmt("%.0f", jnum(l, "n")), c.n_width)
+            << padl(fmt("%.4e", jnum(l, "variance")), c.error_width)
+            << padl(fmt("%.2e", jnum(l, "time_mean_s")), c.time_width) << padl(fmt("%.3e", eff), 12)
+            << padl(first > 0 && std::isfinite(eff) ? fmt("%.3gx", eff / first) : "-", 10) << "\n";
+    }
+}
+
+} // namespace
+
 // Render studies: relative MSE against spp, with the image's mean luminance for the bias.
 std::string format_render_table(const Json& r) {
     std::ostringstream out;
@@ -359,26 +391,10 @@ std::string format_render_table(const Json& r) {
     }
     // Equal-time comparison at the largest spp: which estimator buys the least error per
     // second of rendering.
-    const Json& ests = list(r, "estimators");
-    if (ests.size() > 1) {
-        out << "\ncomparison at the largest spp (efficiency = 1 / (relative MSE x seconds); higher "
-               "is better)\n";
-        out << padr("  estimator", 30) << padl("spp", 7) << padl("rel.MSE", 12)
-            << padl("s/image", 10) << padl("efficiency", 12) << padl("vs first", 10) << "\n";
-        double first = NAN;
-        for (const Json& e : ests) {
-            const Json& levels = list(e, "levels");
-            if (levels.empty()) continue;
-            const Json& l = levels.back();
-            const double eff = jnum(l, "efficiency");
-            if (std::isnan(first)) first = eff;
-            out << padr("  " + jstr(e, "name"), 30) << padl(fmt("%.0f", jnum(l, "n")), 7)
-                << padl(fmt("%.4e", jnum(l, "variance")), 12)
-                << padl(fmt("%.2e", jnum(l, "time_mean_s")), 10) << padl(fmt("%.3e", eff), 12)
-                << padl(first > 0 && std::isfinite(eff) ? fmt("%.3gx", eff / first) : "-", 10)
-                << "\n";
-        }
-    }
+    comparison_table(out, list(r, "estimators"),
+                     ComparisonLabels{"comparison at the largest spp (efficiency = 1 / (relative "
+                                      "MSE x seconds); higher is better)",
+                                      "spp", "rel.MSE", "s/image", 30, 7, 12, 10});
     return out.str();
 }
 
@@ -450,26 +466,10 @@ std::string format_table(const Json& r) {
     }
 
     // Equal-N and equal-time comparison at the largest N every estimator reached.
-    if (ests.size() > 1) {
-        out << "\ncomparison at the largest N (efficiency = 1 / (variance x time); higher is "
-               "better)\n";
-        out << padr("  estimator", 26) << padl("N", 9) << padl("variance", 13)
-            << padl("time/est", 11) << padl("efficiency", 12) << padl("vs first", 10) << "\n";
-        double first_eff = NAN;
-        for (const Json& e : ests) {
-            const Json& levels = list(e, "levels");
-            if (levels.empty()) continue;
-            const Json& l = levels.back();
-            const double eff = jnum(l, "efficiency");
-            if (std::isnan(first_eff)) first_eff = eff;
-            out << padr("  " + jstr(e, "name"), 26) << padl(fmt("%.0f", jnum(l, "n")), 9)
-                << padl(fmt("%.4e", jnum(l, "variance")), 13)
-                << padl(fmt("%.2e", jnum(l, "time_mean_s")), 11) << padl(fmt("%.3e", eff), 12)
-                << padl(first_eff > 0 && std::isfinite(eff) ? fmt("%.3gx", eff / first_eff) : "-",
-                        10)
-                << "\n";
-        }
-    }
+    comparison_table(out, ests,
+                     ComparisonLabels{"comparison at the largest N (efficiency = 1 / (variance x "
+                                      "time); higher is better)",
+                                      "N", "variance", "time/est", 26, 9, 13, 11});
     return out.str();
 }
 
