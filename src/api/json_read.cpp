@@ -1,6 +1,7 @@
 #include "api/json_read.h"
 
 #include <cmath>
+#include <cstring>
 
 namespace mcp {
 
@@ -108,6 +109,119 @@ bool get_numbers(Ctx& c, const Json& obj, const char* key, const std::string& pa
     const Json* v = find(obj, key);
     if (!v) return true;
     return to_numbers(c, *v, sub(path, key), out);
+}
+
+} // namespace mcp
+
+namespace mcp {
+
+namespace {
+
+/// nlohmann's parse error text without the token it read ("; last read: '...'"): the text
+/// may be a file that is not JSON at all, and its content is not ours to echo.
+std::string parse_error_reason(const std::string& what) {
+    std::string reason = what;
+    size_t at = reason.find("parse error");
+    if (at != std::string::npos) reason = reason.substr(at);
+    size_t last = reason.find("; last read: '");
+    if (last != std::string::npos) {
+        size_t expected = reason.rfind("; expected ");
+        std::string tail = expected != std::string::npos && expected > last
+                               ? reason.substr(expected)
+                               : std::string();
+        reason = reason.substr(0, last) + tail;
+    }
+    return reason;
+}
+
+/// SAX pass of check_json_text: tracks the JSON path, the depth and each open object's keys.
+struct CheckingSax : nlohmann::json_sax<Json> {
+    struct Frame {
+        bool object = false;
+        size_t index = 0;             ///< arrays: the next element's index
+        std::string key;              ///< objects: the current key
+        std::vector<std::string> keys; ///< objects: the keys seen so far
+    };
+    std::vector<Frame> stack;
+    std::string message, root;
+
+    std::string path() const {
+        std::string p = root;
+        for (const Frame& f : stack) {
+            if (p.size() > 200) return p + "...";
+            p += f.object ? "." + f.key : "[" + std::to_string(f.index) + "]";
+        }
+        return p;
+    }
+    bool value() {
+        if (!stack.empty() && !stack.back().object) ++stack.back().index;
+        return true;
+    }
+    bool open(bool object) {
+        if (stack.size() >= static_cast<size_t>(kMaxJsonDepth)) {
+            message = "objects and arrays are nested more than " + std::to_string(kMaxJsonDepth) +
+                      " levels deep";
+            return false;
+        }
+        stack.push_back(Frame{object, 0, {}, {}});
+        return true;
+    }
+    bool close() {
+        stack.pop_back();
+        return value();
+    }
+    bool null() override { return value(); }
+    bool boolean(bool) override { return value(); }
+    bool number_integer(number_integer_t) override { return value(); }
+    bool number_unsigned(number_unsigned_t) override { return value(); }
+    bool number_float(number_float_t, const string_t&) override { return value(); }
+    bool string(string_t&) override { return value(); }
+    bool binary(binary_t&) override { return value(); }
+    bool start_object(std::size_t) override { return open(true); }
+    bool end_object() override { return close(); }
+    bool start_array(std::size_t) override { return open(false); }
+    bool end_array() override { return close(); }
+    bool key(string_t& k) override {
+        Frame& f = stack.back();
+        for (const std::string& seen : f.keys)
+            if (seen == k) {
+                f.key = k;
+                message = "the key \"" + k.substr(0, 40) + "\" appears twice in one object (at " +
+                          path() + "); JSON objects need unique keys";
+                return false;
+            }
+        f.keys.push_back(k);
+        f.key = k;
+        return true;
+    }
+    bool parse_error(std::size_t, const std::string&, const nlohmann::detail::exception& ex) override {
+        message = parse_error_reason(ex.what());
+        return false;
+    }
+};
+
+} // namespace
+
+std::string check_json_text(const char* text, size_t size, const char* root) {
+    if (size > kMaxJsonBytes)
+        return "the text has " + std::to_string(size) + " bytes, more than the limit of " +
+               std::to_string(kMaxJsonBytes);
+    CheckingSax sax;
+    sax.root = root;
+    const bool ok = Json::sax_parse(text, text + size, &sax,
+                                    nlohmann::detail::input_format_t::json, /*strict=*/true);
+    if (ok) return "";
+    return sax.message.empty() ? "could not parse" : sax.message;
+}
+
+Made<Json> parse_json(const char* text, const char* what) {
+    if (!text) return made_error<Json>(std::string(what) + ": no text (null pointer)");
+    const size_t size = std::strlen(text);
+    std::string problem = check_json_text(text, size, what);
+    if (!problem.empty()) return made_error<Json>(std::string(what) + ": invalid JSON: " + problem);
+    Json j = Json::parse(text, text + size, nullptr, /*allow_exceptions=*/false);
+    if (j.is_discarded()) return made_error<Json>(std::string(what) + ": invalid JSON");
+    return {j, {}};
 }
 
 } // namespace mcp

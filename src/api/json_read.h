@@ -2,14 +2,32 @@
 // first error is kept as "path: message" naming the offending field.
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
+#include "core/made.h"
+
 namespace mcp {
 
 using Json = nlohmann::json;
+
+/// Limits on every JSON text mcplay reads (scenes, options, results, glTF): objects and arrays
+/// nested at most this deep, and texts of at most this many bytes.
+constexpr int kMaxJsonDepth = 64;
+constexpr uint64_t kMaxJsonBytes = 256ull << 20;
+
+/// Checks JSON text before any tree is built from it: syntax, nesting at most kMaxJsonDepth,
+/// no key twice in one object. The walk is iterative (nlohmann's SAX parser keeps its own
+/// stack), so no input can exhaust the call stack. Returns "" when the text is fine, else a
+/// reason with the line and column or the JSON path (from `root`), never quoting the text.
+std::string check_json_text(const char* text, size_t size, const char* root = "$");
+
+/// Parses JSON text (checked by check_json_text first) without exceptions; on failure the
+/// message starts with `what`.
+Made<Json> parse_json(const char* text, const char* what);
 
 // Records the first error as "path: message".
 struct Ctx {

@@ -509,42 +509,6 @@ const std::vector<EstimatorPreset>& estimator_presets() {
     return presets;
 }
 
-Made<Json> parse_json(const char* text, const char* what) {
-    if (!text) return made_error<Json>(std::string(what) + ": no text (null pointer)");
-    Json j = Json::parse(text, nullptr, /*allow_exceptions=*/false);
-    if (!j.is_discarded()) return {j, {}};
-    // Parse again with a SAX handler that records the position and reason.
-    struct ErrorSax : nlohmann::json_sax<Json> {
-        std::string message;
-        bool null() override { return true; }
-        bool boolean(bool) override { return true; }
-        bool number_integer(number_integer_t) override { return true; }
-        bool number_unsigned(number_unsigned_t) override { return true; }
-        bool number_float(number_float_t, const string_t&) override { return true; }
-        bool string(string_t&) override { return true; }
-        bool binary(binary_t&) override { return true; }
-        bool start_object(std::size_t) override { return true; }
-        bool key(string_t&) override { return true; }
-        bool end_object() override { return true; }
-        bool start_array(std::size_t) override { return true; }
-        bool end_array() override { return true; }
-        bool parse_error(std::size_t position, const std::string& last_token,
-                         const nlohmann::detail::exception& ex) override {
-            std::string reason = ex.what();
-            // nlohmann's text: "[json.exception.parse_error.101] parse error at line 2, column 5:
-            // ..."
-            size_t at = reason.find("parse error");
-            if (at != std::string::npos) reason = reason.substr(at);
-            message = reason + " (near '" + last_token.substr(0, 20) + "', byte " +
-                      std::to_string(position) + ")";
-            return false;
-        }
-    } sax;
-    Json::sax_parse(text, &sax, nlohmann::detail::input_format_t::json, /*strict=*/true);
-    return made_error<Json>(std::string(what) + ": invalid JSON: " +
-                            (sax.message.empty() ? "could not parse" : sax.message));
-}
-
 Made<SceneRequest> build_request(const Json& scene, const Json& options) {
     Ctx c;
     SceneRequest req;

@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "api/json_read.h"
 #include "core/made.h"
 #include "estimators/study.h"
 
@@ -19,9 +20,6 @@ struct SceneRequest {
     std::vector<EstimatorSpec> estimators;
     StudySettings settings;
 };
-
-/// Parses JSON text without exceptions; on failure the message gives the byte position.
-Made<Json> parse_json(const char* text, const char* what);
 
 /// Builds a study request from a scene and optional overrides (either may be null JSON).
 Made<SceneRequest> build_request(const Json& scene, const Json& options);
