@@ -160,5 +160,75 @@ TEST(RenderConvergence, RelativeMseFallsAsOneOverSpp) {
     }
 }
 
+// Issue 10: relative MSE does not depend on the radiance scale (1e-200 and 1e300 radiances
+// give the numbers of radiance 1, to rounding), is undefined (NaN) against a black
+// reference instead of 0, and the reference's noise floor has its closed form.
+RenderImage flat_image(int w, int h, double value, double variance) {
+    RenderImage im;
+    im.width = w;
+    im.height = h;
+    im.spp = 16;
+    im.rgb.assign(im.pixel_count() * 3, value);
+    im.variance.assign(im.pixel_count() * 3, variance);
+    return im;
+}
+
+TEST(RenderError, RelativeMseIsScaleFreeAndUndefinedOnBlack) {
+    RenderImage ref = flat_image(4, 3, 1.0, 0.0), im = flat_image(4, 3, 1.0, 0.01);
+    im.rgb[0] = 2.0;
+    im.rgb[7] = 0.5;
+    ImageError unit = image_error(im, ref);
+    ASSERT_GT(unit.rel_mse, 0.0);
+    for (double scale : {1e-200, 1e300}) {
+        RenderImage a = ref, b = im;
+        for (double& v : a.rgb) v *= scale;
+        for (double& v : b.rgb) v *= scale;
+        ImageError e = image_error(b, a);
+        EXPECT_NEAR(e.rel_mse, unit.rel_mse, 1e-14 * unit.rel_mse) << scale;
+        EXPECT_NEAR(e.rel_mse_raw, unit.rel_mse_raw, 1e-14 * unit.rel_mse) << scale;
+    }
+    RenderImage black = flat_image(4, 3, 0.0, 0.0);
+    ImageError e = image_error(black, black);
+    EXPECT_TRUE(std::isnan(e.rel_mse));
+    EXPECT_TRUE(std::isnan(e.rel_mse_raw));
+    EXPECT_TRUE(std::isnan(relative_mse_floor(black)));
+}
+
+TEST(RenderError, ReferenceFloorHasItsClosedForm) {
+    // A flat reference of value 2 with variance 0.04 per channel: floor = v / (R^2 + eps),
+    // eps = 1e-2 R^2 (the mean luminance of a grey image is its value).
+    RenderImage ref = flat_image(5, 4, 2.0, 0.04);
+    EXPECT_NEAR(relative_mse_floor(ref), 0.04 / (4.0 * 1.01), 1e-15);
+    EXPECT_EQ(relative_mse_floor(flat_image(5, 4, 2.0, 0.0)), 0.0); // an HDR file
+    // An image identical to the reference has corrected relative MSE -floor: below the
+    // reference's noise, flagged, without efficiency, and left out of the fit.
+    RenderImage im = ref;
+    im.seconds = 0.1;
+    std::vector<ImageSummary> images{summarise_image(im, ref), summarise_image(im, ref)};
+    LevelStats l = render_level_stats(images, ref);
+    EXPECT_NEAR(l.variance, -relative_mse_floor(ref), 1e-15);
+    EXPECT_TRUE(below_reference_noise(l, relative_mse_floor(ref)));
+    EXPECT_TRUE(std::isnan(l.efficiency));
+    LevelStats above = l;
+    above.variance = 2.0 * relative_mse_floor(ref);
+    EXPECT_FALSE(below_reference_noise(above, relative_mse_floor(ref)));
+    // Three levels falling as 1/spp above the floor, the fourth below it: the fit uses three.
+    std::vector<LevelStats> levels;
+    for (uint64_t n : {1, 2, 4, 8}) {
+        LevelStats x;
+        x.n = n;
+        x.reps = 4;
+        x.variance = 1.0 / double(n);
+        x.variance_lo = 0.9 * x.variance;
+        x.variance_hi = 1.1 * x.variance;
+        levels.push_back(x);
+    }
+    ConvergenceFit all = fit_render_convergence(levels, 0.0);
+    EXPECT_EQ(all.levels_used, 4);
+    ConvergenceFit fit = fit_render_convergence(levels, 0.15);
+    EXPECT_EQ(fit.levels_used, 3);
+    EXPECT_NEAR(fit.order, -1.0, 1e-12);
+}
+
 } // namespace
 } // namespace mcp

@@ -13,6 +13,7 @@
 #include "core/rng.h"
 #include "core/special.h"
 #include "render/lights.h"
+#include "render_scenes.h"
 #include "test_support.h"
 
 using namespace mcp;
@@ -705,4 +706,50 @@ TEST(RenderLights, EmptyAndDegenerateLightSets) {
     EXPECT_FALSE(one.sample(Vec3(0.0, 0.0, 1.0), 0.5, Vec2(0.0, 0.0), LightSampling::Area).valid);
     EXPECT_FALSE(
         one.sample(Vec3(0.0, 0.0, 1.0), 0.5, Vec2(0.4, 0.6), LightSampling::SolidAngle).valid);
+}
+
+// Issue 10: a light as bright as the largest doubles keeps a valid selection distribution
+// (its power overflows, its selection weights do not), so light samples still find it; a
+// zero-area emissive triangle and a non-finite emission are counted, never silently dropped.
+TEST(LightSet, HugeRadianceKeepsAValidSelection) {
+    Scene s = test::quad_light_scene(1e308);
+    for (LightSelection sel : {LightSelection::Uniform, LightSelection::Area, LightSelection::Power}) {
+        LightSet lights;
+        lights.build(s, sel);
+        ASSERT_EQ(lights.size(), 2u);
+        EXPECT_EQ(lights.nonfinite(), 0u);
+        EXPECT_DOUBLE_EQ(lights.selection_pmf(0) + lights.selection_pmf(1), 1.0);
+        EXPECT_NEAR(lights.selection_pmf(0), 0.5, 1e-15); // the two halves of the quad
+        for (double u : {0.1, 0.6}) {
+            LightSample ls = lights.sample(Vec3(0.0), u, Vec2(0.3, 0.4), LightSampling::Area);
+            EXPECT_TRUE(ls.valid);
+            EXPECT_TRUE(std::isfinite(ls.pdf) && ls.pdf > 0.0);
+            EXPECT_EQ(ls.radiance.x, 1e308);
+        }
+    }
+    LightSet lights;
+    lights.build(s, LightSelection::Power);
+    EXPECT_TRUE(std::isinf(lights.total_power())); // pi x 1e308 x 1 m^2: not a number to trust
+}
+
+TEST(LightSet, DegenerateAndNonFiniteLightsAreCounted) {
+    Scene s = test::quad_light_scene(5.0);
+    Material nan_light = test::diffuse(0.0);
+    nan_light.emission = Vec3(NAN, 1.0, 1.0);
+    s.materials.push_back(nan_light);
+    Material inf_light = test::diffuse(0.0);
+    inf_light.emission = Vec3(INFINITY);
+    s.materials.push_back(inf_light);
+    uint32_t base = uint32_t(s.mesh.position.size());
+    for (Vec3 p : {Vec3(0, 2, 0), Vec3(1, 2, 0), Vec3(2, 2, 0)}) s.mesh.position.push_back(p);
+    s.mesh.index.push_back({base, base + 1, base + 2}); // collinear: zero area
+    s.mesh.material.push_back(1);
+    test::add_quad(s, {0, 3, 0}, {1, 3, 0}, {1, 3, 1}, {0, 3, 1}, 2); // NaN emission
+    test::add_quad(s, {0, 4, 0}, {1, 4, 0}, {1, 4, 1}, {0, 4, 1}, 3); // infinite emission
+    LightSet lights;
+    lights.build(s, LightSelection::Power);
+    EXPECT_EQ(lights.size(), 2u);
+    EXPECT_EQ(lights.degenerate(), 1u);
+    EXPECT_EQ(lights.nonfinite(), 4u);
+    EXPECT_NEAR(lights.total_power(), 5.0 * kPi, 1e-12 * 5.0 * kPi);
 }

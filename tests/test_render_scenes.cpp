@@ -5,8 +5,11 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <sstream>
+
+#include <sys/stat.h>
 
 #include <nlohmann/json.hpp>
 
@@ -206,7 +209,7 @@ TEST(RenderScenes, BadSceneFilesGetClearErrors) {
     json no_gltf = good;
     no_gltf["render"].erase("gltf");
     const Case cases[] = {
-        {with("gltf", "missing.gltf"), "scene.render.gltf: cannot read"},
+        {with("gltf", "missing.gltf"), "scene.render.gltf: "},
         {no_gltf, "scene.render.gltf: missing"},
         {with("gltf", 3), "expected a file name or a glTF object"},
         {with("width", 0), "scene.render.width: must be in 1..4096"},
@@ -342,6 +345,310 @@ TEST(RenderScenes, RenderImageReturnsImages) {
     EXPECT_EQ(j["images"]["error_png"].get<std::string>().substr(0, 8), "iVBORw0K");
     EXPECT_EQ(j["diagnostics"]["samples"], 8 * 6 * 4);
     EXPECT_TRUE(j["relative_mse"].is_number());
+}
+
+// --- Issue 10: honest render numbers ------------------------------------------------------
+
+/// Runs a study of an inline scene; the status, the error and the result.
+struct Call {
+    int status = 0;
+    std::string error;
+    json result;
+};
+Call study_text(const json& scene, json options) {
+    char* out = nullptr;
+    Call c;
+    c.status = mcp_render_study_run(scene.dump().c_str(), options.dump().c_str(), nullptr,
+                                    nullptr, &out);
+    if (c.status != MCP_OK) c.error = mcp_last_error();
+    if (out) c.result = json::parse(out);
+    mcp_free(out);
+    return c;
+}
+
+/// quad_light_floor with its glTF inline, edited by `edit`.
+template <class Edit> json quad_scene(Edit edit, const std::string& name = "q") {
+    json gltf = json::parse(read(kScenes + "/quad_light_floor.gltf"));
+    edit(gltf);
+    return json{{"name", name}, {"render", {{"gltf", gltf}}}};
+}
+
+const json kTiny{{"width", 4}, {"height", 4}, {"spp_min", 1}, {"spp_max", 2}, {"reps", 2},
+                 {"estimators", {"light_area", "bsdf"}}, {"reference", {{"spp", 16}}}};
+
+bool has_code(const json& warnings, const std::string& code) {
+    for (const json& w : warnings)
+        if (w["code"] == code) return true;
+    return false;
+}
+
+json info_of(const json& scene) {
+    char* info = nullptr;
+    EXPECT_EQ(mcp_render_scene_info(scene.dump().c_str(), nullptr, &info), MCP_OK)
+        << mcp_last_error();
+    json j = info ? json::parse(info) : json();
+    mcp_free(info);
+    return j;
+}
+
+// No light at all: the scene says so, and relative MSE against the black reference is null
+// with a warning, never a triumphant 0.
+TEST(RenderHonesty, NoLightsWarnAndRelativeMseIsNull) {
+    json scene = quad_scene([](json& g) { g["materials"][1]["emissiveFactor"] = {0, 0, 0}; });
+    json info = info_of(scene);
+    EXPECT_EQ(info["lights"], 0);
+    EXPECT_TRUE(has_code(info["warnings"], "no_lights")) << info["warnings"].dump();
+    Call c = study_text(scene, kTiny);
+    ASSERT_EQ(c.status, MCP_OK) << c.error;
+    EXPECT_TRUE(has_code(c.result["scene"]["warnings"], "no_lights"));
+    EXPECT_TRUE(has_code(c.result["scene"]["warnings"], "black_reference"));
+    EXPECT_TRUE(c.result["scene"]["reference"]["relative_mse_floor"].is_null());
+    for (const json& e : c.result["estimators"])
+        for (const json& l : e["levels"]) {
+            EXPECT_TRUE(l["relative_mse"].is_null()) << l.dump();
+            EXPECT_TRUE(l["efficiency"].is_null());
+        }
+}
+
+// A zero-area emissive triangle is reported, not dropped silently: a light mesh of one
+// triangle with collinear vertices (float32 positions in a data: buffer).
+TEST(RenderHonesty, DegenerateLightsAreReported) {
+    json scene = quad_scene([](json& g) {
+        const float p[9] = {0.0f, 1.0f, 0.0f, 0.5f, 1.0f, 0.0f, 1.0f, 1.0f, 0.0f};
+        std::string bytes(reinterpret_cast<const char*>(p), sizeof p);
+        size_t buffer = g["buffers"].size(), view = g["bufferViews"].size(),
+               accessor = g["accessors"].size(), mesh = g["meshes"].size();
+        g["buffers"].push_back({{"byteLength", sizeof p},
+                                {"uri", "data:application/octet-stream;base64," +
+                                            base64_encode(bytes)}});
+        g["bufferViews"].push_back({{"buffer", buffer}, {"byteLength", sizeof p}});
+        g["accessors"].push_back({{"bufferView", view},
+                                  {"componentType", 5126},
+                                  {"count", 3},
+                                  {"type", "VEC3"},
+                                  {"min", {0, 1, 0}},
+                                  {"max", {1, 1, 0}}});
+        g["meshes"].push_back(
+            {{"primitives", {{{"attributes", {{"POSITION", accessor}}}, {"material", 1}}}}});
+        g["nodes"].push_back({{"name", "flat_light"}, {"mesh", mesh}});
+        g["scenes"][0]["nodes"].push_back(g["nodes"].size() - 1);
+    });
+    json info = info_of(scene);
+    EXPECT_EQ(info["lights"], 2);
+    EXPECT_EQ(info["degenerate_lights"], 1);
+    EXPECT_TRUE(has_code(info["warnings"], "degenerate_lights")) << info["warnings"].dump();
+    EXPECT_FALSE(has_code(info["warnings"], "no_lights"));
+}
+
+// emissiveStrength 1e308: the light's power overflows a double, but it is still sampled (no
+// light sample misses it) and the image is not black.
+TEST(RenderHonesty, HugeEmissionStillLights) {
+    json scene = quad_scene([](json& g) {
+        g["materials"][1]["extensions"]["KHR_materials_emissive_strength"]["emissiveStrength"] =
+            1e308;
+    });
+    json options{{"width", 4}, {"height", 4}, {"spp", 4}, {"estimator", "light_area"}};
+    char* out = nullptr;
+    ASSERT_EQ(mcp_render_image(scene.dump().c_str(), options.dump().c_str(), &out), MCP_OK)
+        << mcp_last_error();
+    json j = json::parse(out);
+    mcp_free(out);
+    EXPECT_EQ(j["scene"]["lights"], 2);
+    EXPECT_EQ(j["diagnostics"]["light_misses"], 0) << j["diagnostics"].dump();
+    EXPECT_GT(j["diagnostics"]["samples"].get<double>(),
+              j["diagnostics"]["discarded_nonfinite"].get<double>());
+}
+
+// The reference cache's file name is a hash alone: a scene name with "../" cannot place it
+// outside the cache folder. A corrupt cache file is ignored and the reference rendered again.
+TEST(RenderHonesty, CacheNameIsAHashAndCorruptCachesAreIgnored) {
+    char dir_template[] = "/tmp/mcplay_cache_XXXXXX";
+    ASSERT_NE(mkdtemp(dir_template), nullptr);
+    const std::string dir = dir_template;
+    const std::string escape = "mcplay_escape_" + dir.substr(dir.size() - 6);
+    json scene = quad_scene([](json&) {}, "../../../../../../tmp/" + escape);
+    json options = kTiny;
+    options["cache_dir"] = dir + "/sub";
+    ASSERT_EQ(mkdir((dir + "/sub").c_str(), 0700), 0);
+    Call first = study_text(scene, options);
+    ASSERT_EQ(first.status, MCP_OK) << first.error;
+    EXPECT_EQ(first.result["scene"]["reference"]["source"], "rendered");
+    std::string file = first.result["scene"]["reference"]["file"];
+    std::string base = file.substr(file.rfind('/') + 1);
+    EXPECT_EQ(file.substr(0, file.rfind('/')), dir + "/sub");
+    ASSERT_EQ(base.size(), 16u + 6u) << base;
+    EXPECT_EQ(base.find_first_not_of("0123456789abcdef"), 16u) << base;
+    EXPECT_EQ(base.substr(16), ".mcref");
+    EXPECT_EQ(std::string(escape).find('/'), std::string::npos);
+    std::ifstream outside("/tmp/" + escape);
+    EXPECT_FALSE(outside.good());
+    EXPECT_EQ(study_text(scene, options).result["scene"]["reference"]["source"], "cache");
+    // Truncated, then the right size with a wrong magic: both ignored, rendered again.
+    std::string bytes = read(file);
+    for (const std::string& bad : {bytes.substr(0, bytes.size() - 8), "XXXXXXXX" + bytes.substr(8)}) {
+        {
+            std::ofstream out(file, std::ios::binary | std::ios::trunc);
+            out << bad;
+        }
+        Call again = study_text(scene, options);
+        ASSERT_EQ(again.status, MCP_OK) << again.error;
+        EXPECT_EQ(again.result["scene"]["reference"]["source"], "rendered");
+        EXPECT_EQ(again.result["estimators"][0]["levels"][1]["variance"],
+                  first.result["estimators"][0]["levels"][1]["variance"]);
+    }
+    EXPECT_EQ(read(file), bytes); // rewritten whole
+}
+
+TEST(RenderHonesty, ReferenceCacheReaderChecksEverything) {
+    char dir_template[] = "/tmp/mcplay_cache_XXXXXX";
+    ASSERT_NE(mkdtemp(dir_template), nullptr);
+    const std::string dir = dir_template, file = dir + "/c.mcref";
+    RenderImage im;
+    im.width = 3;
+    im.height = 2;
+    im.spp = 64;
+    im.rgb.assign(18, 0.5);
+    im.variance.assign(18, 0.01);
+    ASSERT_TRUE(write_reference_cache(file, im));
+    RenderImage back;
+    ASSERT_TRUE(read_reference_cache(file, &back));
+    EXPECT_EQ(back.rgb, im.rgb);
+    EXPECT_EQ(back.variance, im.variance);
+    EXPECT_EQ(back.spp, 64u);
+    const std::string good = read(file);
+    auto rejected = [&](const std::string& bytes) {
+        {
+            std::ofstream out(file, std::ios::binary | std::ios::trunc);
+            out << bytes;
+        }
+        RenderImage x;
+        x.width = 7;
+        bool ok = read_reference_cache(file, &x);
+        EXPECT_EQ(x.width, 7); // untouched
+        return !ok;
+    };
+    auto with_header = [&](int64_t w, int64_t h, int64_t spp) {
+        std::string b = good;
+        int64_t head[3] = {w, h, spp};
+        b.replace(8, sizeof head, reinterpret_cast<const char*>(head), sizeof head);
+        return b;
+    };
+    EXPECT_TRUE(rejected(good.substr(0, good.size() - 1)));       // truncated
+    EXPECT_TRUE(rejected(good + "x"));                             // trailing bytes
+    EXPECT_TRUE(rejected(good.substr(0, 20)));                     // no header
+    EXPECT_TRUE(rejected(with_header(5000, 1, 64)));               // too wide
+    EXPECT_TRUE(rejected(with_header(-3, -2, 64)));                // negative sizes
+    EXPECT_TRUE(rejected(with_header(3, 2, 0)));                   // no spp
+    std::string inf = good;
+    double big = INFINITY;
+    std::memcpy(&inf[32], &big, sizeof big);
+    EXPECT_TRUE(rejected(inf)); // an infinite mean
+    RenderImage x;
+    EXPECT_FALSE(read_reference_cache(dir, &x)); // a directory
+}
+
+// Radiance HDR references: truncated data, a bad size line, sizes over the limits and
+// corrupt run-length data are refused with messages that quote nothing of the file.
+TEST(RenderHonesty, HdrReferencesAreChecked) {
+    for (int w : {16, 4}) { // run-length scanlines, and flat ones (width < 8)
+        RenderImage im;
+        im.width = w;
+        im.height = 8;
+        im.rgb.assign(size_t(w) * 8 * 3, 0.0);
+        for (size_t k = 0; k < im.rgb.size(); ++k) im.rgb[k] = 0.1 * double(k % 17);
+        im.variance.assign(im.rgb.size(), 0.0);
+        std::string hdr = encode_hdr(im);
+        RenderImage out;
+        std::string err;
+        ASSERT_TRUE(decode_hdr(hdr, &out, &err)) << err;
+        EXPECT_EQ(out.width, w);
+        EXPECT_EQ(out.height, 8);
+        EXPECT_FALSE(decode_hdr(hdr.substr(0, hdr.size() - 1), &out, &err));
+        EXPECT_EQ(err, "the HDR data ends after 7 of 8 scanlines");
+        size_t data = hdr.find("+X ");
+        data = hdr.find('\n', data) + 1;
+        EXPECT_FALSE(decode_hdr(hdr.substr(0, data), &out, &err));
+        EXPECT_EQ(err, "the HDR data ends after 0 of 8 scanlines");
+    }
+    const std::string head = "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n";
+    const std::string pixels(16 * 4, '\x40');
+    std::string err;
+    RenderImage out;
+    for (const char* size_line : {"-Y -4 +X 4\n", "-Y 4 +X -4\n", "+Y 4 +X 4\n", "-Y 4 +X 4",
+                                  "-Y 0 +X 4\n", "-Y 99999999999 +X 4\n", "-Y 4 -X 4\n"}) {
+        EXPECT_FALSE(decode_hdr(head + size_line + pixels, &out, &err)) << size_line;
+        EXPECT_EQ(err, "the HDR header's size line is invalid: expected '-Y <height> +X <width>' "
+                       "with positive whole sizes (other orientations are not read)")
+            << size_line;
+    }
+    EXPECT_FALSE(decode_hdr(head + "-Y 4097 +X 1\n" + pixels, &out, &err));
+    EXPECT_NE(err.find("the HDR image is 1x4097, larger than a reference may be"),
+              std::string::npos)
+        << err;
+    EXPECT_FALSE(decode_hdr(head + "-Y 4096 +X 4096\n" + pixels, &out, &err));
+    EXPECT_NE(err.find("larger than a reference may be"), std::string::npos) << err;
+    EXPECT_FALSE(decode_hdr("P6\n4 4\n255\n" + pixels, &out, &err));
+    EXPECT_NE(err.find("not a Radiance HDR file"), std::string::npos) << err;
+    EXPECT_FALSE(decode_hdr("#?RADIANCE\n\n-Y 4 +X 4\n" + pixels, &out, &err));
+    EXPECT_NE(err.find("no 'FORMAT=32-bit_rle_rgbe' line"), std::string::npos) << err;
+    EXPECT_FALSE(decode_hdr("#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n", &out, &err));
+    EXPECT_NE(err.find("does not end"), std::string::npos) << err;
+    // A run-length scanline of width 8 whose first run is longer than the scanline.
+    std::string rle = head + "-Y 1 +X 8\n" + std::string("\x02\x02\x00\x08", 4) + "\xff\x40";
+    EXPECT_FALSE(decode_hdr(rle, &out, &err));
+    EXPECT_EQ(err, "the HDR data is corrupt in scanline 1 of 1 (bad run-length encoding)");
+}
+
+// A study whose spp approaches the reference's is refused before anything is rendered; the
+// floor is reported with the reference.
+TEST(RenderHonesty, ReferenceNoiseFloorIsReportedAndGuarded) {
+    json scene = quad_scene([](json&) {});
+    json options = kTiny;
+    options["spp_max"] = 8;
+    options["reference"] = {{"spp", 16}};
+    Call c = study_text(scene, options);
+    EXPECT_EQ(c.status, MCP_ERROR_SCENE);
+    EXPECT_EQ(c.error, "scene.render.reference.spp: expected at least 4 x spp_max = 32, got 16: "
+                       "a reference with fewer samples is too noisy to judge the images");
+    options["reference"] = {{"spp", 32}};
+    c = study_text(scene, options);
+    ASSERT_EQ(c.status, MCP_OK) << c.error;
+    const json& ref = c.result["scene"]["reference"];
+    ASSERT_TRUE(ref["relative_mse_floor"].is_number()) << ref.dump();
+    EXPECT_GT(ref["relative_mse_floor"].get<double>(), 0.0);
+    for (const json& e : c.result["estimators"])
+        for (const json& l : e["levels"]) {
+            bool below = l["below_reference_noise"].get<bool>();
+            if (l["relative_mse"].get<double>() < ref["relative_mse_floor"].get<double>()) {
+                EXPECT_TRUE(below);
+                EXPECT_TRUE(has_code(l["warnings"], "below_reference_noise"));
+            } else {
+                EXPECT_FALSE(below);
+            }
+        }
+}
+
+// Work and memory are bounded before anything is rendered.
+TEST(RenderHonesty, WorkIsBoundedUpFront) {
+    json scene = quad_scene([](json&) {});
+    json big{{"width", 2048}, {"height", 2048}, {"spp_min", 1}, {"spp_max", 1048576},
+             {"reps", 2}, {"estimators", {"bsdf"}}};
+    Call c = study_text(scene, big);
+    EXPECT_EQ(c.status, MCP_ERROR_SCENE);
+    EXPECT_NE(c.error.find("scene.render: this needs"), std::string::npos) << c.error;
+    EXPECT_NE(c.error.find("more than the limit of 4.4e+12"), std::string::npos) << c.error;
+    big["spp_max"] = 1;
+    big["estimators"] = {"bsdf", "light_area", "mis_power", "mis_balance"};
+    c = study_text(scene, big);
+    EXPECT_EQ(c.status, MCP_ERROR_SCENE);
+    EXPECT_EQ(c.error, "scene.render: 6 images of 2048x2048 pixels held at once need 1152 MiB, "
+                       "more than the limit of 1024 MiB: lower the image size or the number of "
+                       "estimators");
+    json one{{"width", 2048}, {"height", 2048}, {"spp", 1048576}, {"outputs", {"error_png"}}};
+    char* out = nullptr;
+    EXPECT_EQ(mcp_render_image(scene.dump().c_str(), one.dump().c_str(), &out), MCP_ERROR_SCENE);
+    EXPECT_NE(std::string(mcp_last_error()).find("scene.render: this needs"), std::string::npos)
+        << mcp_last_error();
 }
 
 } // namespace

@@ -115,6 +115,10 @@ bool file_is_inside(const std::string& root, const std::string& path, std::strin
         *error = "does not exist";
         return false;
     }
+    if (path_real == root_real) {
+        *error = "is the scene's folder itself, not a file";
+        return false;
+    }
     if (!is_within(root_real, path_real)) {
         *error = "lies outside the scene's folder (a scene may only name files inside its own "
                  "folder)";

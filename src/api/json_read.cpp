@@ -123,6 +123,8 @@ std::string parse_error_reason(const std::string& what) {
     std::string reason = what;
     size_t at = reason.find("parse error");
     if (at != std::string::npos) reason = reason.substr(at);
+    if (reason.compare(0, 1, "[") == 0 && reason.find("] ") != std::string::npos)
+        reason = reason.substr(reason.find("] ") + 2); // "[json.exception.out_of_range.406] ..."
     size_t last = reason.find("; last read: '");
     if (last != std::string::npos) {
         size_t expected = reason.rfind("; expected ");
@@ -195,7 +197,7 @@ struct CheckingSax : nlohmann::json_sax<Json> {
         return true;
     }
     bool parse_error(std::size_t, const std::string&, const nlohmann::detail::exception& ex) override {
-        message = parse_error_reason(ex.what());
+        message = parse_error_reason(ex.what()) + " (in " + path() + ")";
         return false;
     }
 };

@@ -15,6 +15,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "api/files.h"
+#include "api/json_read.h"
 #include "api/mcplay.h"
 #include "render_api/mcplay_render.h"
 
@@ -62,29 +64,26 @@ const char* kUsage =
     "\n"
     "exit codes: 0 ok, 1 runtime error, 2 bad arguments, 3 bad scene\n";
 
+/// The exit code for a failed C API call.
+int exit_code(int status) {
+    if (status == MCP_ERROR_SCENE) return kExitScene;
+    if (status == MCP_ERROR_ARGUMENT) return kExitUsage;
+    return kExitRuntime;
+}
+
 int usage_error(const std::string& msg) {
     std::fprintf(stderr, "mcplay: %s (see mcplay --help)\n", msg.c_str());
     return kExitUsage;
 }
 
-bool read_file(const std::string& path, std::string* out) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) return false;
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    *out = ss.str();
-    return true;
+/// A scene file: a regular file of at most mcp::kMaxSceneFileBytes (never a device or FIFO).
+bool read_scene_file(const std::string& path, std::string* out, std::string* error) {
+    return mcp::read_regular_file(path, mcp::kMaxSceneFileBytes, out, error);
 }
 
-bool is_regular_file(const std::string& path) {
-    std::ifstream in(path);
-    if (!in) return false;
-    DIR* d = opendir(path.c_str());
-    if (d) {
-        closedir(d);
-        return false;
-    }
-    return true;
+bool path_exists(const std::string& path) {
+    struct stat st;
+    return ::stat(path.c_str(), &st) == 0;
 }
 
 std::string scenes_dir(const std::string& given) {
@@ -138,6 +137,8 @@ bool scene_from_gltf(const std::string& path, std::string* text) {
 }
 
 bool is_render_scene_text(const std::string& text) {
+    // Checked first (nesting, size): a text that fails goes to mcp_study_run, which says why.
+    if (!mcp::check_json_text(text.data(), text.size()).empty()) return false;
     nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
     return !j.is_discarded() && j.is_object() && j.contains("render");
 }
@@ -170,11 +171,61 @@ bool write_file(const std::string& path, const std::string& bytes) {
     return bool(out);
 }
 
-// Finds a scene: a path, or a name in the scenes directory.
-std::string scene_path(const std::string& arg, const std::string& dir_arg) {
-    if (is_regular_file(arg)) return arg;
-    return scenes_dir(dir_arg) + "/" + arg + ".json";
+// Finds a scene (a path, or a name in the scenes directory) and reads it; a .gltf/.glb file
+// becomes a render scene of its own. On failure prints why and returns false.
+bool load_scene(const std::string& arg, const std::string& dir_arg, std::string* path,
+                std::string* text) {
+    *path = arg;
+    if (!path_exists(arg)) {
+        std::string dir = scenes_dir(dir_arg);
+        while (dir.size() > 1 && dir.back() == '/') dir.pop_back();
+        const std::string named = dir + "/" + arg + ".json";
+        if (arg.find('/') != std::string::npos || !path_exists(named)) {
+            std::fprintf(stderr, "mcplay: no scene file '%s' (nor a scene named so in '%s')\n",
+                         arg.c_str(), dir.c_str());
+            return false;
+        }
+        *path = named;
+    }
+    std::string error;
+    if (mcp::is_directory(*path)) {
+        std::fprintf(stderr, "mcplay: '%s' is a directory, not a scene file\n", path->c_str());
+        return false;
+    }
+    std::string bytes;
+    if (!read_scene_file(*path, &bytes, &error)) {
+        std::fprintf(stderr, "mcplay: %s\n", error.c_str());
+        return false;
+    }
+    if (!scene_from_gltf(*path, text)) *text = bytes;
+    return true;
 }
+
+// An output file must be writable before a long run starts: opened for appending (created
+// if missing, and removed again if the run then fails).
+struct OutputFile {
+    std::string path;
+    bool created = false;
+    bool check(std::string* error) {
+        if (path.empty()) return true;
+        if (mcp::is_directory(path)) {
+            *error = "'" + path + "' is a directory";
+            return false;
+        }
+        created = !path_exists(path);
+        FILE* f = std::fopen(path.c_str(), "ab");
+        if (!f) {
+            *error = "cannot write '" + path + "': " + std::strerror(errno);
+            created = false;
+            return false;
+        }
+        std::fclose(f);
+        return true;
+    }
+    void discard() {
+        if (created) std::remove(path.c_str());
+    }
+};
 
 // Strict whole-number parsing: digits only, no sign, no trailing text, no overflow.
 bool parse_count(const std::string& text, unsigned long long* out) {
@@ -209,16 +260,17 @@ int cmd_list(const std::vector<std::string>& args) {
         }
         closedir(d);
     } else {
-        std::fprintf(stderr, "mcplay: cannot open scenes directory '%s'\n", dir.c_str());
-        return kExitRuntime;
+        std::fprintf(stderr, "mcplay: cannot open scenes directory '%s': %s\n", dir.c_str(),
+                     std::strerror(errno));
+        return kExitUsage;
     }
     std::sort(files.begin(), files.end());
     std::printf("scenes in %s:\n", dir.c_str());
     for (const std::string& f : files) {
-        std::string text, path = dir + "/" + f;
+        std::string text, error, path = dir + "/" + f;
         char* info = nullptr;
-        if (!read_file(path, &text)) {
-            std::printf("  %-28s (unreadable)\n", f.c_str());
+        if (!read_scene_file(path, &text, &error)) {
+            std::printf("  %-28s UNREADABLE: %s\n", f.c_str(), error.c_str());
             continue;
         }
         if (is_render_scene_text(text)) {
@@ -346,19 +398,19 @@ int cmd_run(const std::vector<std::string>& args) {
     }
     if (scene_arg.empty()) return usage_error("run needs a scene file or name");
 
-    std::string path = scene_path(scene_arg, dir_arg);
-    std::string text;
-    if (!(is_regular_file(path) && scene_from_gltf(path, &text)) &&
-        (!is_regular_file(path) || !read_file(path, &text))) {
-        std::fprintf(stderr, "mcplay: no scene file '%s' (nor '%s')\n", scene_arg.c_str(),
-                     path.c_str());
-        return kExitScene;
-    }
+    std::string path, text, error;
+    if (!load_scene(scene_arg, dir_arg, &path, &text)) return kExitScene;
+    const bool render_scene = is_render_scene_text(text);
+    if (!render_scene &&
+        (options.contains("width") || options.contains("height") || !cache_arg.empty()))
+        return usage_error("--width, --height and --cache are for render scenes");
+    OutputFile out_file{out_path};
+    if (!out_file.check(&error)) return usage_error("--out: " + error);
 
     const bool show_progress = !quiet && isatty(fileno(stderr));
     char* result = nullptr;
     int status;
-    if (is_render_scene_text(text)) {
+    if (render_scene) {
         // Render studies: N is samples per pixel.
         for (const char* k : {"n_min", "n_max"})
             if (options.contains(k)) {
@@ -374,20 +426,20 @@ int cmd_run(const std::vector<std::string>& args) {
         status = mcp_render_study_run(text.c_str(), opts.c_str(),
                                       show_progress ? progress_line : nullptr, nullptr, &result);
     } else {
-        if (options.contains("width") || options.contains("height") || !cache_arg.empty())
-            return usage_error("--width, --height and --cache are for render scenes");
         const std::string opts = options.dump();
         status = mcp_study_run(text.c_str(), opts.c_str(), show_progress ? progress_line : nullptr,
                                nullptr, &result);
     }
     if (status != MCP_OK && status != MCP_ERROR_CANCELLED) {
         std::fprintf(stderr, "mcplay: %s: %s\n", path.c_str(), mcp_last_error());
-        return status == MCP_ERROR_SCENE ? kExitScene : kExitUsage;
+        out_file.discard();
+        return exit_code(status);
     }
     char* formatted = nullptr;
     if (mcp_result_format(result, format.c_str(), &formatted) != MCP_OK) {
         std::fprintf(stderr, "mcplay: %s\n", mcp_last_error());
         mcp_free(result);
+        out_file.discard();
         return kExitRuntime;
     }
     mcp_free(result);
@@ -438,6 +490,8 @@ int cmd_render(const std::vector<std::string>& args) {
             if (!value(&cache_arg)) return usage_error("--cache needs a directory");
         } else if (a == "--no-cache") {
             no_cache = true;
+        } else if (a == "--quiet") {
+            // accepted as for run: a single render prints no progress lines anyway
         } else if (a == "--format") {
             if (!value(&format) || (format != "json" && format != "summary"))
                 return usage_error("--format: expected json or summary");
@@ -470,12 +524,13 @@ int cmd_render(const std::vector<std::string>& args) {
         outputs.push_back("error_png");
     }
     options["outputs"] = outputs;
-    std::string path = scene_path(scene_arg, dir_arg), text;
-    if (!(is_regular_file(path) && scene_from_gltf(path, &text)) &&
-        (!is_regular_file(path) || !read_file(path, &text))) {
-        std::fprintf(stderr, "mcplay: no scene file '%s' (nor '%s')\n", scene_arg.c_str(),
-                     path.c_str());
-        return kExitScene;
+    std::string path, text, error;
+    if (!load_scene(scene_arg, dir_arg, &path, &text)) return kExitScene;
+    OutputFile out_file{out_path}, error_file{error_path};
+    if (!out_file.check(&error)) return usage_error("--out: " + error);
+    if (!error_file.check(&error)) {
+        out_file.discard();
+        return usage_error("--error-out: " + error);
     }
     options["base_dir"] = dirname_of(path);
     if (!no_cache) {
@@ -486,7 +541,9 @@ int cmd_render(const std::vector<std::string>& args) {
     int status = mcp_render_image(text.c_str(), options.dump().c_str(), &result);
     if (status != MCP_OK) {
         std::fprintf(stderr, "mcplay: %s: %s\n", path.c_str(), mcp_last_error());
-        return status == MCP_ERROR_SCENE ? kExitScene : kExitUsage;
+        out_file.discard();
+        error_file.discard();
+        return exit_code(status);
     }
     nlohmann::json j = nlohmann::json::parse(result, nullptr, false);
     mcp_free(result);

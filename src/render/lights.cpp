@@ -139,28 +139,53 @@ void LightSet::build(const Scene& scene, LightSelection selection) {
     selection_pmf_.clear();
     const Mesh& mesh = scene.mesh;
     light_of_triangle_.assign(mesh.triangle_count(), -1);
-    std::vector<double> weight;
+    degenerate_ = nonfinite_ = 0;
     total_power_ = 0.0;
+    // First pass: the lights, their luminance and area, and the largest of each.
+    std::vector<double> lum, area, sides;
+    double max_lum = 0.0, max_area = 0.0;
     for (size_t t = 0; t < mesh.triangle_count(); ++t) {
         uint32_t m = t < mesh.material.size() ? mesh.material[t] : 0u;
         if (m >= scene.materials.size()) continue;
         const Material& mat = scene.materials[m];
-        if (!mat.is_emissive()) continue;
-        double area = 0.5 * glm::length(mesh.cross_normal(t));
-        if (!(area > 0.0) || !std::isfinite(area)) continue; // degenerate: never hit
-        // Flux of a Lambertian emitter: pi L A per emitting side.
-        double power = luminance(mat.emission) * area * kPi * (mat.double_sided ? 2.0 : 1.0);
+        const Vec3& le = mat.emission;
+        bool finite = std::isfinite(le.x) && std::isfinite(le.y) && std::isfinite(le.z);
+        if (finite && !mat.is_emissive()) continue;
+        double a = 0.5 * glm::length(mesh.cross_normal(t));
+        if (!finite || !std::isfinite(a)) { // never silently dropped: counted, and refused
+            ++nonfinite_;
+            continue;
+        }
+        if (!(a > 0.0)) { // degenerate: never hit, never sampled
+            ++degenerate_;
+            continue;
+        }
+        double l = std::max(0.0, luminance(le));
         light_of_triangle_[t] = int32_t(triangles_.size());
         triangles_.push_back(uint32_t(t));
-        total_power_ += power;
-        weight.push_back(selection == LightSelection::Area    ? area
-                         : selection == LightSelection::Power ? power
-                                                              : 1.0);
+        lum.push_back(l);
+        area.push_back(a);
+        sides.push_back(mat.double_sided ? 2.0 : 1.0);
+        max_lum = std::max(max_lum, l);
+        max_area = std::max(max_area, a);
     }
+    // Flux of a Lambertian emitter: pi L A per emitting side. The weights are taken relative
+    // to the largest radiance and area, each factor in [0, 1], so they stay finite when the
+    // power itself overflows a double.
+    std::vector<double> weight(triangles_.size(), 1.0);
+    double relative_power = 0.0;
+    for (size_t i = 0; i < triangles_.size(); ++i) {
+        double p = (max_lum > 0.0 ? lum[i] / max_lum : 0.0) * (area[i] / max_area) * sides[i];
+        relative_power += p;
+        if (selection == LightSelection::Area) weight[i] = area[i] / max_area;
+        if (selection == LightSelection::Power) weight[i] = p;
+    }
+    total_power_ = relative_power > 0.0 ? max_lum * max_area * kPi * relative_power : 0.0;
     // One light, or uniform choice: no table (index and pmf are arithmetic).
     if (triangles_.size() <= 1 || selection == LightSelection::Uniform) return;
     double sum = 0.0;
     for (double w : weight) sum += w;
+    if (!(sum > 0.0) || !std::isfinite(sum)) return; // no usable weights: uniform choice
     selection_pmf_.resize(weight.size());
     selection_cdf_.resize(weight.size() + 1);
     selection_cdf_[0] = 0.0;

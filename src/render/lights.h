@@ -25,11 +25,20 @@ struct LightSample {
 class LightSet {
   public:
     /// Collects the emissive triangles of the scene (materials with emission > 0) and builds
-    /// the selection distribution (none for a single light).
+    /// the selection distribution (none for a single light). Emissive triangles of zero area
+    /// (never hit, never sampled) are left out and counted in degenerate(); triangles whose
+    /// emission or area is not finite cannot be lights and are counted in nonfinite() (the
+    /// render API refuses such scenes). Selection weights are normalised by the largest
+    /// radiance and area before they are multiplied, so lights as bright as 1e308 keep a
+    /// valid distribution even when their power overflows (total_power() is then inf).
     void build(const Scene& scene, LightSelection selection);
 
     bool empty() const { return triangles_.empty(); }
     size_t size() const { return triangles_.size(); }
+    /// Emissive triangles left out because their area is zero.
+    size_t degenerate() const { return degenerate_; }
+    /// Emissive triangles left out because their emission or area is NaN or infinite.
+    size_t nonfinite() const { return nonfinite_; }
     /// Light number of a mesh triangle, or -1 when it does not emit.
     int light_index(uint32_t triangle) const;
     /// Total emitted power (flux) of all lights, luminance.
@@ -58,6 +67,7 @@ class LightSet {
     std::vector<double> selection_cdf_;      // empty for one light and for uniform choice
     std::vector<double> selection_pmf_;      // likewise
     double total_power_ = 0.0;
+    size_t degenerate_ = 0, nonfinite_ = 0;
 };
 
 /// Regime of LightSampling::SolidAngle: a triangle whose solid angle Omega at the reference

@@ -13,41 +13,56 @@ namespace {
 
 double mean_luminance(const RenderImage& image, double* se) {
     size_t n = image.pixel_count();
+    double dn = n ? double(n) : 1.0;
     double sum = 0.0, var = 0.0;
     for (size_t p = 0; p < n; ++p) {
         Vec3 c(image.rgb[p * 3], image.rgb[p * 3 + 1], image.rgb[p * 3 + 2]);
         Vec3 v(image.variance[p * 3], image.variance[p * 3 + 1], image.variance[p * 3 + 2]);
-        if (std::isfinite(luminance(c))) sum += luminance(c);
+        // Each term divided first: no overflow for radiances up to the largest double.
+        if (std::isfinite(luminance(c))) sum += luminance(c) / dn;
         // Channels of one pixel share their samples; the luminance variance is bounded by
         // (sum_c w_c sd_c)^2, which is what an error bar may honestly claim without the
         // covariances.
         double sd = 0.2126 * std::sqrt(v.x) + 0.7152 * std::sqrt(v.y) + 0.0722 * std::sqrt(v.z);
-        if (std::isfinite(sd)) var += sd * sd;
+        if (std::isfinite(sd)) var += (sd / dn) * (sd / dn);
     }
-    double dn = n ? double(n) : 1.0;
-    if (se) *se = std::sqrt(var) / dn;
-    return sum / dn;
+    if (se) *se = std::sqrt(var);
+    return sum;
 }
+
+/// The reference's mean luminance, the scale every pixel is divided by before squaring
+/// (so that neither 1e-200 nor 1e300 radiances underflow or overflow), or 0 when the
+/// reference is black (or has no finite positive mean): relative MSE is then undefined.
+double reference_scale(const RenderImage& reference) {
+    double m = mean_luminance(reference, nullptr);
+    return m > 0.0 && std::isfinite(m) ? m : 0.0;
+}
+
+/// eps of the relative MSE's denominator in units of the reference's squared mean.
+constexpr double kRelEps = 1e-2;
 
 } // namespace
 
 ImageError image_error(const RenderImage& image, const RenderImage& reference) {
     ImageError e;
     size_t n = std::min(image.pixel_count(), reference.pixel_count());
-    double ref_mean = mean_luminance(reference, nullptr);
-    double eps = 1e-2 * ref_mean * ref_mean;
-    if (!(eps > 0.0)) eps = 1e-2;
+    // relMSE = mean of ((I - R)^2 - v) / (R^2 + eps), eps = 1e-2 mean(R)^2
+    // [RousselleKnausZwicker11], evaluated on I / mean(R) and R / mean(R).
+    double scale = reference_scale(reference);
     double sum = 0.0, sum_raw = 0.0;
     uint64_t covered = 0, counted = 0;
     for (size_t p = 0; p < n; ++p) {
         for (int c = 0; c < 3; ++c) {
             size_t k = p * 3 + size_t(c);
             double d = image.rgb[k] - reference.rgb[k];
-            double r = reference.rgb[k];
             double v_ref = std::isfinite(reference.variance[k]) ? reference.variance[k] : 0.0;
-            double denom = r * r + eps;
-            sum_raw += d * d / denom;
-            sum += (d * d - v_ref) / denom;
+            if (scale > 0.0) {
+                double ds = d / scale, r = reference.rgb[k] / scale;
+                double vs = v_ref / scale / scale;
+                double denom = r * r + kRelEps;
+                sum_raw += ds * ds / denom;
+                sum += (ds * ds - vs) / denom;
+            }
             double v = image.variance[k];
             if (std::isfinite(v) && std::isfinite(d)) {
                 ++counted;
@@ -56,11 +71,31 @@ ImageError image_error(const RenderImage& image, const RenderImage& reference) {
         }
     }
     double m = n ? double(3 * n) : 1.0;
-    e.rel_mse = sum / m;
-    e.rel_mse_raw = sum_raw / m;
+    // A black reference: relative error has no scale, the relative MSE is undefined (NaN,
+    // null in JSON) rather than a triumphant 0.
+    e.rel_mse = scale > 0.0 ? sum / m : NAN;
+    e.rel_mse_raw = scale > 0.0 ? sum_raw / m : NAN;
     e.coverage = counted ? double(covered) / double(counted) : NAN;
     e.mean_luminance = mean_luminance(image, &e.mean_luminance_se);
     return e;
+}
+
+double relative_mse_floor(const RenderImage& reference) {
+    double scale = reference_scale(reference);
+    if (!(scale > 0.0)) return NAN;
+    size_t n = reference.pixel_count() * 3;
+    double sum = 0.0;
+    for (size_t k = 0; k < n; ++k) {
+        double v = reference.variance[k];
+        if (!std::isfinite(v)) continue; // as in image_error: no correction where unknown
+        double r = reference.rgb[k] / scale;
+        sum += v / scale / scale / (r * r + kRelEps);
+    }
+    return n ? sum / double(n) : NAN;
+}
+
+bool below_reference_noise(const LevelStats& level, double floor) {
+    return std::isfinite(level.variance) && (level.variance < 0.0 || level.variance < floor);
 }
 
 uint64_t render_stream(uint64_t seed, const std::string& estimator, uint64_t spp, int rep) {
@@ -115,7 +150,12 @@ LevelStats render_level_stats(const std::vector<ImageSummary>& images,
     l.coverage = coverage / R;
     l.mean_run_se = run_se / R;
     l.time_mean = l.time_total / R;
-    l.efficiency = l.variance > 0.0 && l.time_mean > 0.0 ? 1.0 / (l.variance * l.time_mean) : NAN;
+    // Below the reference's noise the relative MSE measures the reference, not the estimator:
+    // no efficiency (it would be arbitrarily large).
+    l.efficiency = l.variance > 0.0 && l.time_mean > 0.0 &&
+                           !below_reference_noise(l, relative_mse_floor(reference))
+                       ? 1.0 / (l.variance * l.time_mean)
+                       : NAN;
     l.diagnostics.nonfinite = pooled.discarded_nonfinite;
     l.diagnostics.nonzero = pooled.samples;
     l.diagnostics.max_weight_share = pooled.max_sample_share;
@@ -129,7 +169,7 @@ LevelStats render_level_stats(const std::vector<ImageSummary>& images,
     return l;
 }
 
-ConvergenceFit fit_render_convergence(const std::vector<LevelStats>& levels) {
+ConvergenceFit fit_render_convergence(const std::vector<LevelStats>& levels, double floor) {
     // Weighted least squares of y = log relMSE on x = log spp, each level weighted by the
     // inverse variance of its log, (se / relMSE)^2 by the delta method, with se from the
     // spread of its replicates; the slope's standard error is inflated by the residuals when
@@ -141,7 +181,8 @@ ConvergenceFit fit_render_convergence(const std::vector<LevelStats>& levels) {
         double se = (l.variance_hi - l.variance_lo) / 2.0;
         double t = l.reps > 1 ? student_t_quantile(0.975, double(l.reps - 1)) : NAN;
         se /= t;
-        if (!(rel > 0.0) || !std::isfinite(rel) || !(se > 0.0)) continue;
+        if (!(rel > 0.0) || !std::isfinite(rel) || !(se > 0.0) || below_reference_noise(l, floor))
+            continue;
         double sd_log = std::max(se / rel, 1e-3);
         x.push_back(std::log(double(l.n)));
         y.push_back(std::log(rel));
@@ -192,6 +233,7 @@ RenderStudyResult run_render_study(const RenderScene& rs,
     result.settings = settings;
     result.threads_used = resolve_threads(settings.threads);
     result.reference_mean_luminance = mean_luminance(reference, nullptr);
+    result.relative_mse_floor = relative_mse_floor(reference);
     for (const RenderEstimator& e : estimators) {
         RenderEstimatorStudy s;
         s.estimator = e;
@@ -216,7 +258,7 @@ RenderStudyResult run_render_study(const RenderScene& rs,
                 if (r == 0) s.preview = std::move(image);
             }
             s.levels.push_back(render_level_stats(images, reference));
-            s.fit = fit_render_convergence(s.levels);
+            s.fit = fit_render_convergence(s.levels, result.relative_mse_floor);
         }
         bool go_on = !progress || progress(result, li);
         if (!go_on && li + 1 < ladder.size()) {

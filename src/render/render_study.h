@@ -8,7 +8,17 @@
 // where v_pc, the variance of the reference pixel's own mean, removes the reference's noise
 // from the expected squared difference (E (I - R)^2 = MSE(I) + Var(R) for independent I and
 // R), and eps = 1e-2 times the squared mean of the reference keeps dark pixels from
-// dominating. An unbiased estimator converges as relMSE ~ 1/spp.
+// dominating. An unbiased estimator converges as relMSE ~ 1/spp. Every pixel is divided by
+// the reference's mean luminance before squaring (no overflow or underflow at any radiance
+// scale); a black reference makes relative MSE undefined (NaN, null in JSON), never 0.
+//
+// The reference's own noise, summed the same way, is the relative-MSE floor
+//   floor = mean over p, c of v_pc / (R_pc^2 + eps):
+// the raw relative MSE of a perfect estimator. v_pc is the reference pixel's sample variance
+// over spp, which for the stratified pixel sampler overestimates the variance of its mean, so
+// the subtraction can overshoot: a level whose corrected relative MSE is below the floor (or
+// negative) measures the reference rather than the estimator. Such levels are flagged
+// (below_reference_noise), have no efficiency, and are left out of the fitted order.
 #pragma once
 
 #include <cstdint>
@@ -40,6 +50,13 @@ struct ImageError {
 };
 ImageError image_error(const RenderImage& image, const RenderImage& reference);
 
+/// The relative-MSE floor of a reference (see the header comment): 0 for a noiseless
+/// reference (an HDR file), NaN for a black one.
+double relative_mse_floor(const RenderImage& reference);
+
+/// Is the level's relative MSE negative or below the reference's floor?
+bool below_reference_noise(const LevelStats& level, double floor);
+
 struct RenderEstimatorStudy {
     RenderEstimator estimator;
     std::vector<LevelStats> levels; ///< n = spp; see render_level_stats for the fields' meaning
@@ -53,6 +70,7 @@ struct RenderStudyResult {
     double wall_seconds = 0.0;
     bool cancelled = false;
     double reference_mean_luminance = 0.0;
+    double relative_mse_floor = 0.0; ///< of the reference; NaN when it is black
     std::vector<RenderEstimatorStudy> estimators;
 };
 
@@ -86,7 +104,8 @@ LevelStats render_level_stats(const std::vector<ImageSummary>& images,
 
 /// Fitted order of relative MSE against spp: weighted least squares of log relMSE on log spp,
 /// weights from each level's replicate spread, the standard error inflated by the residuals.
-ConvergenceFit fit_render_convergence(const std::vector<LevelStats>& levels);
+/// Levels below the reference's noise (below_reference_noise with `floor`) are left out.
+ConvergenceFit fit_render_convergence(const std::vector<LevelStats>& levels, double floor = 0.0);
 
 /// Called after each completed level; returning false cancels the study.
 using RenderStudyProgress = std::function<bool(const RenderStudyResult& partial, size_t level)>;

@@ -3,10 +3,14 @@
 // checks few of them. This is the project's only translation unit with the tinygltf and stb
 // implementations.
 #include "render_api/gltf_scene.h"
+#include "api/files.h"
+#include "api/json_read.h"
 
 #include <fstream> // tiny_gltf.h 2.7.0 uses std::ofstream without including it
 
 #include <algorithm>
+#include <sys/stat.h>
+
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -195,50 +199,20 @@ struct Log {
 struct LoadContext {
     const tinygltf::Model* model = nullptr; ///< filled by tinygltf while the callbacks run
     std::string base_dir;
+    std::string root;         ///< every file read must lie inside this folder
+    std::string path_problem; ///< the first URI refused for lying outside `root`
     uint64_t bytes_read = 0;                  ///< by external buffer and image reads together
     std::map<int, std::string> image_problem; ///< image index -> why it has no bytes
 };
-
-/// Reads a whole file if it holds at most `limit` bytes.
-bool read_file_bounded(const std::string& path, uint64_t limit, std::vector<unsigned char>* out,
-                       std::string* err) {
-    FILE* f = std::fopen(path.c_str(), "rb");
-    if (!f) {
-        *err = "cannot open '" + quoted(path, 200) + "': " + std::strerror(errno);
-        return false;
-    }
-    long size = -1;
-    if (std::fseek(f, 0, SEEK_END) == 0) size = std::ftell(f);
-    if (size < 0 || std::fseek(f, 0, SEEK_SET) != 0) {
-        std::fclose(f);
-        *err = "cannot determine the size of '" + quoted(path, 200) + "'";
-        return false;
-    }
-    if (static_cast<uint64_t>(size) > limit) {
-        std::fclose(f);
-        *err = "'" + quoted(path, 200) + "' has " + num(static_cast<uint64_t>(size)) +
-               " bytes, more than the limit of " + num(limit);
-        return false;
-    }
-    out->resize(static_cast<size_t>(size));
-    size_t got = size > 0 ? std::fread(out->data(), 1, out->size(), f) : 0;
-    std::fclose(f);
-    if (got != out->size()) {
-        *err = "cannot read '" + quoted(path, 200) + "'";
-        return false;
-    }
-    return true;
-}
 
 bool fs_file_exists(const std::string& path, void* user) {
     const auto* ctx = static_cast<const LoadContext*>(user);
     // tinygltf also looks in "./": only when the base folder is the current one.
     if (path.compare(0, 2, "./") == 0 && !ctx->base_dir.empty() && ctx->base_dir != ".")
         return false;
-    FILE* f = std::fopen(path.c_str(), "rb");
-    if (!f) return false;
-    std::fclose(f);
-    return true;
+    // Existence only (never opened here: opening a FIFO blocks); fs_read_whole_file decides.
+    struct stat st;
+    return ::stat(path.c_str(), &st) == 0;
 }
 
 std::string fs_expand_path(const std::string& path, void*) {
@@ -248,9 +222,21 @@ std::string fs_expand_path(const std::string& path, void*) {
 bool fs_read_whole_file(std::vector<unsigned char>* out, std::string* err, const std::string& path,
                         void* user) {
     auto* ctx = static_cast<LoadContext*>(user);
+    // A URI may only name a regular file inside the scene's folder, symbolic links resolved.
+    std::string why;
+    if (!file_is_inside(ctx->root, path, &why)) {
+        std::string uri = path;
+        if (!ctx->base_dir.empty() && path.compare(0, ctx->base_dir.size() + 1, ctx->base_dir + "/") == 0)
+            uri = path.substr(ctx->base_dir.size() + 1);
+        *err = "'" + quoted(uri, 200) + "' " + why;
+        if (ctx->path_problem.empty()) ctx->path_problem = *err;
+        return false;
+    }
     uint64_t left =
         kGltfMaxBufferBytes > ctx->bytes_read ? kGltfMaxBufferBytes - ctx->bytes_read : 0;
-    if (!read_file_bounded(path, left, out, err)) return false;
+    std::string bytes;
+    if (!read_regular_file(path, left, &bytes, err)) return false;
+    out->assign(bytes.begin(), bytes.end());
     ctx->bytes_read += out->size();
     return true;
 }
@@ -292,40 +278,6 @@ bool keep_image_bytes(tinygltf::Image* image, const int index, std::string*, std
     return true;
 }
 
-// --- JSON syntax errors with a position ------------------------------------------------------
-
-/// A SAX handler that only records the parser's error message: tinygltf, built without
-/// exceptions, reports a syntax error as "Failed to parse JSON object" alone.
-struct JsonErrorFinder {
-    using json = nlohmann::json;
-    std::string message;
-    bool null() { return true; }
-    bool boolean(bool) { return true; }
-    bool number_integer(json::number_integer_t) { return true; }
-    bool number_unsigned(json::number_unsigned_t) { return true; }
-    bool number_float(json::number_float_t, const json::string_t&) { return true; }
-    bool string(json::string_t&) { return true; }
-    bool binary(json::binary_t&) { return true; }
-    bool start_object(std::size_t) { return true; }
-    bool key(json::string_t&) { return true; }
-    bool end_object() { return true; }
-    bool start_array(std::size_t) { return true; }
-    bool end_array() { return true; }
-    bool parse_error(std::size_t, const std::string&, const nlohmann::detail::exception& e) {
-        message = e.what();
-        size_t close = message.find("] ");
-        if (message.compare(0, 1, "[") == 0 && close != std::string::npos)
-            message = message.substr(close + 2);
-        return false;
-    }
-};
-
-std::string json_syntax_error(const char* text, size_t size) {
-    JsonErrorFinder finder;
-    nlohmann::json::sax_parse(text, text + size, &finder);
-    return finder.message;
-}
-
 /// Checks a GLB container's header and chunk table (tinygltf 2.7.0 lets the BIN chunk run 8
 /// bytes past the end of the data).
 bool check_glb(const std::string& bytes, Log& log) {
@@ -355,6 +307,149 @@ bool check_glb(const std::string& bytes, Log& log) {
     }
     return true;
 }
+
+// --- Property types --------------------------------------------------------------------------
+
+/// tinygltf 2.7.0 silently replaces a property of the wrong type by its default ("roughnessFactor":
+/// "rough" reads as 1): the properties this loader uses are checked against the glTF 2.0 schema
+/// [glTF2] first, so a careless file gets an error naming the property instead of another scene.
+struct GltfTypeChecker {
+    using Json = nlohmann::json;
+    std::string error;
+
+    bool fail(const std::string& where, const std::string& what) {
+        if (error.empty()) error = where + ": expected " + what;
+        return false;
+    }
+    static std::string at(const std::string& path, size_t i) {
+        return path + "[" + std::to_string(i) + "]";
+    }
+    // kind: 'n' number, 'i' non-negative integer, 's' string, 'b' boolean, 'o' object.
+    bool is(const Json& v, char kind) const {
+        switch (kind) {
+        case 'n': return v.is_number();
+        case 'i': return v.is_number_unsigned() || (v.is_number_integer() && v.get<int64_t>() >= 0);
+        case 's': return v.is_string();
+        case 'b': return v.is_boolean();
+        default: return v.is_object();
+        }
+    }
+    static const char* word(char kind) {
+        switch (kind) {
+        case 'n': return "a number";
+        case 'i': return "a non-negative integer";
+        case 's': return "a string";
+        case 'b': return "true or false";
+        default: return "an object";
+        }
+    }
+    /// `props`: "name:k" for a scalar of kind k, "name:kN" for an array of N of them ("kN"
+    /// with N = 0 for any length).
+    bool fields(const Json& obj, const std::string& path, std::initializer_list<const char*> props) {
+        if (!obj.is_object()) return fail(path, "an object");
+        for (const char* prop : props) {
+            const std::string spec = prop;
+            const size_t colon = spec.find(':');
+            const std::string name = spec.substr(0, colon);
+            const char kind = spec[colon + 1];
+            auto it = obj.find(name);
+            if (it == obj.end()) continue;
+            const std::string where = path + "." + name;
+            if (spec.size() == colon + 2) {
+                if (!is(*it, kind)) return fail(where, word(kind));
+                continue;
+            }
+            const size_t count = std::strtoul(spec.c_str() + colon + 2, nullptr, 10);
+            if (!it->is_array() || (count && it->size() != count))
+                return fail(where, "an array of " + (count ? std::to_string(count) + " " : "") +
+                                       "values, each " + word(kind));
+            for (size_t i = 0; i < it->size(); ++i)
+                if (!is((*it)[i], kind)) return fail(at(where, i), word(kind));
+        }
+        return true;
+    }
+    /// Each element of the array `key` of the root, checked by `each`.
+    template <class F> bool each(const Json& root, const char* key, F check) {
+        auto it = root.find(key);
+        if (it == root.end()) return true;
+        if (!it->is_array()) return fail(key, "an array");
+        for (size_t i = 0; i < it->size(); ++i)
+            if (!check((*it)[i], at(key, i))) return false;
+        return true;
+    }
+
+    bool run(const Json& g) {
+        if (!g.is_object()) return fail("the glTF", "a JSON object");
+        auto asset = g.find("asset");
+        if (asset == g.end() || !asset->is_object() || !asset->contains("version") ||
+            !(*asset)["version"].is_string())
+            return fail("asset.version", "a string (\"2.0\")");
+        const std::string version = (*asset)["version"].get<std::string>();
+        if (version.compare(0, 2, "2.") != 0) {
+            error = "asset.version: '" + quoted(version, 20) + "': only glTF 2.x is supported";
+            return false;
+        }
+        if (!fields(g, "glTF", {"scene:i", "extensionsUsed:s0", "extensionsRequired:s0"}))
+            return false;
+        return each(g, "scenes", [&](const Json& s, const std::string& p) {
+                   return fields(s, p, {"nodes:i0", "name:s"});
+               }) &&
+               each(g, "nodes", [&](const Json& n, const std::string& p) {
+                   return fields(n, p, {"camera:i", "mesh:i", "children:i0", "matrix:n16",
+                                        "translation:n3", "rotation:n4", "scale:n3", "name:s"});
+               }) &&
+               each(g, "cameras", [&](const Json& c, const std::string& p) {
+                   return fields(c, p, {"type:s", "perspective:o", "orthographic:o"}) &&
+                          (!c.contains("perspective") ||
+                           fields(c["perspective"], p + ".perspective",
+                                  {"yfov:n", "znear:n", "zfar:n", "aspectRatio:n"}));
+               }) &&
+               each(g, "meshes", [&](const Json& m, const std::string& p) {
+                   if (!fields(m, p, {"name:s"})) return false;
+                   auto prims = m.find("primitives");
+                   if (prims == m.end() || !prims->is_array())
+                       return fail(p + ".primitives", "an array");
+                   for (size_t i = 0; i < prims->size(); ++i) {
+                       const Json& q = (*prims)[i];
+                       const std::string pp = at(p + ".primitives", i);
+                       if (!fields(q, pp, {"mode:i", "material:i", "indices:i", "attributes:o"}))
+                           return false;
+                       if (q.contains("attributes"))
+                           for (auto a = q["attributes"].begin(); a != q["attributes"].end(); ++a)
+                               if (!is(*a, 'i'))
+                                   return fail(pp + ".attributes." + quoted(a.key(), 40),
+                                               word('i'));
+                   }
+                   return true;
+               }) &&
+               each(g, "materials", [&](const Json& m, const std::string& p) {
+                   return fields(m, p,
+                                 {"pbrMetallicRoughness:o", "emissiveFactor:n3", "alphaMode:s",
+                                  "alphaCutoff:n", "doubleSided:b", "name:s", "extensions:o"}) &&
+                          (!m.contains("pbrMetallicRoughness") ||
+                           fields(m["pbrMetallicRoughness"], p + ".pbrMetallicRoughness",
+                                  {"baseColorFactor:n4", "metallicFactor:n", "roughnessFactor:n",
+                                   "baseColorTexture:o"}));
+               }) &&
+               each(g, "accessors", [&](const Json& a, const std::string& p) {
+                   return fields(a, p, {"bufferView:i", "byteOffset:i", "componentType:i",
+                                        "count:i", "type:s", "normalized:b", "min:n0", "max:n0"});
+               }) &&
+               each(g, "bufferViews", [&](const Json& v, const std::string& p) {
+                   return fields(v, p, {"buffer:i", "byteOffset:i", "byteLength:i", "byteStride:i",
+                                        "target:i"});
+               }) &&
+               each(g, "buffers", [&](const Json& b, const std::string& p) {
+                   return fields(b, p, {"byteLength:i", "uri:s"});
+               }) &&
+               each(g, "images", [&](const Json& im, const std::string& p) {
+                   return fields(im, p, {"uri:s", "bufferView:i", "mimeType:s"});
+               }) &&
+               each(g, "textures", [&](const Json& t, const std::string& p) {
+                   return fields(t, p, {"source:i", "sampler:i"});
+               });
+    }
+};
 
 // --- Accessors -------------------------------------------------------------------------------
 
@@ -859,6 +954,10 @@ class Converter {
                 return log_.fail(where + ": emissiveFactor[" + num(k) + "] = " + num(e) +
                                  " is not a finite number >= 0");
             out->emission[k] = e * strength;
+            if (!std::isfinite(out->emission[k]))
+                return log_.fail(where + ": emissiveFactor[" + num(k) + "] x emissiveStrength = " +
+                                 num(e) + " x " + num(strength) +
+                                 " overflows; the emitted radiance must be a finite number");
         }
         out->double_sided = mat.doubleSided;
 
@@ -1180,7 +1279,8 @@ std::string locate_tinygltf_error(const std::string& message, const tinygltf::Mo
 
 } // namespace
 
-GltfLoadResult load_gltf_memory(const std::string& bytes, const std::string& base_dir) {
+GltfLoadResult load_gltf_memory(const std::string& bytes, const std::string& base_dir,
+                                const std::string& root) {
     GltfLoadResult result;
     Log log;
     auto done = [&result, &log]() -> GltfLoadResult {
@@ -1202,11 +1302,36 @@ GltfLoadResult load_gltf_memory(const std::string& bytes, const std::string& bas
     }
     const bool binary = bytes.size() >= 4 && bytes.compare(0, 4, "glTF") == 0;
     if (binary && !check_glb(bytes, log)) return done();
+    // The JSON is checked (syntax, nesting, repeated keys) before tinygltf, whose recursive
+    // conversion of deeply nested "extras" would exhaust the stack.
+    {
+        uint32_t json_length = 0;
+        if (binary)
+            for (int k = 3; k >= 0; --k)
+                json_length = (json_length << 8) | static_cast<unsigned char>(bytes[12 + size_t(k)]);
+        const std::string problem =
+            binary ? check_json_text(bytes.data() + 20, json_length)
+                   : check_json_text(bytes.data(), bytes.size());
+        if (!problem.empty()) {
+            log.fail("invalid JSON: " + problem);
+            return done();
+        }
+        const nlohmann::json tree =
+            binary ? nlohmann::json::parse(bytes.data() + 20, bytes.data() + 20 + json_length,
+                                           nullptr, false)
+                   : nlohmann::json::parse(bytes, nullptr, false);
+        GltfTypeChecker types;
+        if (!types.run(tree)) {
+            log.fail(types.error);
+            return done();
+        }
+    }
 
     tinygltf::Model model;
     LoadContext ctx;
     ctx.model = &model;
     ctx.base_dir = base_dir;
+    ctx.root = root.empty() ? base_dir : root;
     tinygltf::TinyGLTF loader;
     tinygltf::FsCallbacks fs;
     fs.FileExists = &fs_file_exists;
@@ -1224,25 +1349,19 @@ GltfLoadResult load_gltf_memory(const std::string& bytes, const std::string& bas
                                              static_cast<unsigned int>(bytes.size()), base_dir)
                : loader.LoadASCIIFromString(&model, &err, &warn, bytes.data(),
                                             static_cast<unsigned int>(bytes.size()), base_dir);
+    if (!ctx.path_problem.empty()) {
+        // A refused URI: name the element it belongs to (images fail with a warning only).
+        std::string where = locate_tinygltf_error(err, model);
+        if (where.empty()) where = "images: ";
+        log.fail(where + "uri " + ctx.path_problem);
+        return done();
+    }
     if (!loaded) {
-        if (contains(err, "Failed to parse JSON") || contains(err, "JSON string too short")) {
-            std::string detail;
-            if (!binary)
-                detail = json_syntax_error(bytes.data(), bytes.size());
-            else {
-                uint32_t json_length = 0;
-                for (int k = 3; k >= 0; --k)
-                    json_length = (json_length << 8) | static_cast<unsigned char>(bytes[12 + k]);
-                detail = json_syntax_error(bytes.data() + 20, json_length);
-            }
-            log.fail("invalid JSON: " + one_line(detail.empty() ? err : detail));
-        } else {
-            std::string message = one_line(err);
-            if (contains(err, "Failed to decode 'uri'") && contains(err, "in Buffer"))
-                message = "the data URI is not base64 of byteLength bytes";
-            log.fail(locate_tinygltf_error(err, model) +
-                     (message.empty() ? "tinygltf could not load the file" : message));
-        }
+        std::string message = one_line(err);
+        if (contains(err, "Failed to decode 'uri'") && contains(err, "in Buffer"))
+            message = "the data URI is not base64 of byteLength bytes";
+        log.fail(locate_tinygltf_error(err, model) +
+                 (message.empty() ? "tinygltf could not load the file" : message));
         return done();
     }
     Converter converter(model, ctx, result, log);
@@ -1251,9 +1370,8 @@ GltfLoadResult load_gltf_memory(const std::string& bytes, const std::string& bas
 }
 
 GltfLoadResult load_gltf_file(const std::string& path) {
-    std::vector<unsigned char> data;
-    std::string err;
-    if (!read_file_bounded(path, kGltfMaxInputBytes, &data, &err)) {
+    std::string data, err;
+    if (!read_regular_file(path, kGltfMaxInputBytes, &data, &err)) {
         GltfLoadResult result;
         result.error = err;
         return result;
@@ -1261,7 +1379,7 @@ GltfLoadResult load_gltf_file(const std::string& path) {
     size_t slash = path.find_last_of('/');
     std::string base_dir = slash == std::string::npos ? "." : path.substr(0, slash);
     if (slash == 0) base_dir = "/";
-    return load_gltf_memory(std::string(data.begin(), data.end()), base_dir);
+    return load_gltf_memory(data, base_dir, base_dir);
 }
 
 } // namespace mcp

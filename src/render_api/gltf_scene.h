@@ -37,11 +37,15 @@ constexpr uint64_t kGltfMaxBufferBytes = 256ull << 20; ///< all buffers together
 constexpr uint64_t kGltfMaxInputBytes = 384ull << 20;  ///< the .gltf/.glb itself (base64 buffers)
 constexpr uint64_t kGltfMaxTexels = 1ull << 24;        ///< all decoded base colour textures
 
-/// Loads a .gltf or .glb file; external buffers and images are resolved relative to its folder.
+/// Loads a .gltf or .glb file; external buffers and images are resolved relative to its folder
+/// and must lie inside it.
 GltfLoadResult load_gltf_file(const std::string& path);
 
 /// Same, from the bytes of a .gltf (JSON text) or .glb (detected by its "glTF" magic);
-/// relative URIs are resolved against base_dir ("" or "." for the current folder).
-GltfLoadResult load_gltf_memory(const std::string& bytes, const std::string& base_dir);
+/// relative URIs are resolved against base_dir ("" or "." for the current folder), and every
+/// file they name must resolve, symbolic links included, to a regular file inside `root`
+/// (default: base_dir); data: URIs are always allowed.
+GltfLoadResult load_gltf_memory(const std::string& bytes, const std::string& base_dir,
+                                const std::string& root = "");
 
 } // namespace mcp

@@ -12,6 +12,8 @@
 #include <stb_image.h>
 #include <stb_image_write.h>
 
+#include "api/files.h"
+
 namespace mcp {
 
 namespace {
@@ -93,23 +95,150 @@ std::string encode_error_png(const RenderImage& image, const RenderImage& refere
     return png_of(image.width, image.height, rgb);
 }
 
+namespace {
+
+/// Sizes an HDR reference or a cached reference may have: those of a render (4096 a side,
+/// 2048 x 2048 pixels in all), checked before anything is allocated.
+bool image_size_ok(int64_t w, int64_t h) {
+    return w >= 1 && h >= 1 && w <= kMaxReferenceSide && h <= kMaxReferenceSide &&
+           uint64_t(w) * uint64_t(h) <= kMaxReferencePixels;
+}
+
+std::string size_limit_text() {
+    return "at most " + std::to_string(kMaxReferenceSide) + " a side and " +
+           std::to_string(kMaxReferencePixels) + " pixels in all";
+}
+
+/// A positive decimal number of at most 9 digits at bytes[*at], advancing *at; -1 if none.
+int64_t read_size(const std::string& bytes, size_t* at) {
+    int64_t v = 0;
+    size_t start = *at;
+    while (*at < bytes.size() && *at - start < 10 && bytes[*at] >= '0' && bytes[*at] <= '9')
+        v = v * 10 + (bytes[(*at)++] - '0');
+    size_t digits = *at - start;
+    return digits >= 1 && digits <= 9 && v > 0 ? v : -1;
+}
+
+/// Walks the Radiance RGBE pixel data [Ward91] of an h x w image starting at bytes[at] as
+/// stb_image reads it (new-style run-length scanlines for 8 <= w < 32768, else flat; a
+/// scanline without the RLE marker makes the rest of the image flat), without reading past
+/// the end. Returns the number of complete scanlines, or -1 - y when scanline y is corrupt.
+int64_t hdr_scanlines(const std::string& bytes, size_t at, int64_t w, int64_t h) {
+    const size_t size = bytes.size();
+    auto byte = [&](size_t i) { return uint8_t(bytes[i]); };
+    const uint64_t flat_line = uint64_t(w) * 4;
+    for (int64_t y = 0; y < h; ++y) {
+        bool rle = w >= 8 && w < 32768 && size - at >= 4 && byte(at) == 2 && byte(at + 1) == 2 &&
+                   !(byte(at + 2) & 0x80);
+        if (!rle) { // flat from here to the end of the image
+            uint64_t lines = uint64_t(size - at) / flat_line;
+            return y + int64_t(std::min<uint64_t>(lines, uint64_t(h - y)));
+        }
+        if (((int64_t(byte(at + 2)) << 8) | byte(at + 3)) != w) return -1 - y;
+        at += 4;
+        for (int channel = 0; channel < 4; ++channel) {
+            int64_t i = 0;
+            while (i < w) {
+                if (at >= size) return y;
+                int64_t count = byte(at++);
+                if (count > 128) { // a run: one value repeated count - 128 times
+                    count -= 128;
+                    if (count > w - i) return -1 - y;
+                    if (at >= size) return y;
+                    ++at;
+                } else { // count literal values
+                    if (count == 0 || count > w - i) return -1 - y;
+                    if (uint64_t(size - at) < uint64_t(count)) return y;
+                    at += size_t(count);
+                }
+                i += count;
+            }
+        }
+    }
+    return h;
+}
+
+} // namespace
+
 bool decode_hdr(const std::string& bytes, RenderImage* out, std::string* error) {
-    if (bytes.size() > size_t(1) << 30) {
-        *error = "image file too large";
+    // Everything stb_image will read is checked here first, within the buffer: the header,
+    // the size line, the limits, and that every scanline is there. No message quotes the
+    // file's content.
+    if (bytes.size() > size_t(kMaxReferenceFileBytes)) {
+        *error = "the HDR file has " + std::to_string(bytes.size()) +
+                 " bytes, more than the limit of " + std::to_string(kMaxReferenceFileBytes);
         return false;
     }
-    int w = 0, h = 0, channels = 0;
+    size_t at = 0;
+    for (const char* magic : {"#?RADIANCE\n", "#?RGBE\n"})
+        if (bytes.compare(0, std::strlen(magic), magic) == 0) at = std::strlen(magic);
+    if (at == 0) {
+        *error = "not a Radiance HDR file (expected it to start with '#?RADIANCE' or '#?RGBE')";
+        return false;
+    }
+    bool format = false;
+    for (;;) { // header lines up to an empty line
+        size_t end = bytes.find('\n', at);
+        if (end == std::string::npos) {
+            *error = "the HDR header does not end (no empty line before the size line)";
+            return false;
+        }
+        if (end == at) {
+            ++at;
+            break;
+        }
+        if (bytes.compare(at, end - at, "FORMAT=32-bit_rle_rgbe") == 0) format = true;
+        at = end + 1;
+    }
+    if (!format) {
+        *error = "the HDR header has no 'FORMAT=32-bit_rle_rgbe' line (only RGBE is read)";
+        return false;
+    }
+    int64_t h = -1, w = -1;
+    if (bytes.compare(at, 3, "-Y ") == 0) {
+        at += 3;
+        h = read_size(bytes, &at);
+        if (h > 0 && bytes.compare(at, 4, " +X ") == 0) {
+            at += 4;
+            w = read_size(bytes, &at);
+        }
+    }
+    if (h < 1 || w < 1 || at >= bytes.size() || bytes[at] != '\n') {
+        *error = "the HDR header's size line is invalid: expected '-Y <height> +X <width>' with "
+                 "positive whole sizes (other orientations are not read)";
+        return false;
+    }
+    ++at;
+    if (!image_size_ok(w, h)) {
+        *error = "the HDR image is " + std::to_string(w) + "x" + std::to_string(h) +
+                 ", larger than a reference may be (" + size_limit_text() + ")";
+        return false;
+    }
+    int64_t lines = hdr_scanlines(bytes, at, w, h);
+    if (lines < 0) {
+        *error = "the HDR data is corrupt in scanline " + std::to_string(-lines) + " of " +
+                 std::to_string(h) + " (bad run-length encoding)";
+        return false;
+    }
+    if (lines < h) {
+        *error = "the HDR data ends after " + std::to_string(lines) + " of " + std::to_string(h) +
+                 " scanlines";
+        return false;
+    }
+    int sw = 0, sh = 0, channels = 0;
     float* data = stbi_loadf_from_memory(reinterpret_cast<const stbi_uc*>(bytes.data()),
-                                         int(bytes.size()), &w, &h, &channels, 3);
-    if (!data) {
-        *error = std::string("cannot decode the image: ") + stbi_failure_reason();
+                                         int(bytes.size()), &sw, &sh, &channels, 3);
+    if (!data || sw != int(w) || sh != int(h)) {
+        if (data) stbi_image_free(data);
+        *error = "cannot decode the HDR data";
         return false;
     }
-    out->width = w;
-    out->height = h;
+    out->width = sw;
+    out->height = sh;
     out->spp = 0;
-    out->rgb.assign(data, data + size_t(w) * size_t(h) * 3);
+    out->rgb.assign(data, data + size_t(sw) * size_t(sh) * 3);
     out->variance.assign(out->rgb.size(), 0.0);
+    out->diagnostics = RenderDiagnostics();
     stbi_image_free(data);
     return true;
 }
@@ -132,23 +261,33 @@ bool write_reference_cache(const std::string& path, const RenderImage& image) {
 }
 
 bool read_reference_cache(const std::string& path, RenderImage* image) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) return false;
-    char magic[8];
+    // A regular file of bounded size, read whole; anything that is not exactly what
+    // write_reference_cache writes is ignored (the caller renders the reference again).
+    std::string bytes, error;
+    if (!read_regular_file(path, kMaxCacheFileBytes, &bytes, &error)) return false;
     int64_t header[3];
-    in.read(magic, sizeof magic);
-    in.read(reinterpret_cast<char*>(header), sizeof header);
-    if (!in || std::memcmp(magic, kCacheMagic, sizeof magic) != 0) return false;
-    if (header[0] < 1 || header[1] < 1 || header[0] > 4096 || header[1] > 4096) return false;
-    image->width = int(header[0]);
-    image->height = int(header[1]);
-    image->spp = uint64_t(header[2]);
-    size_t n = image->pixel_count() * 3;
-    image->rgb.resize(n);
-    image->variance.resize(n);
-    in.read(reinterpret_cast<char*>(image->rgb.data()), std::streamsize(n * sizeof(double)));
-    in.read(reinterpret_cast<char*>(image->variance.data()), std::streamsize(n * sizeof(double)));
-    return bool(in);
+    constexpr size_t kHead = sizeof kCacheMagic + sizeof header;
+    if (bytes.size() < kHead || std::memcmp(bytes.data(), kCacheMagic, sizeof kCacheMagic) != 0)
+        return false;
+    std::memcpy(header, bytes.data() + sizeof kCacheMagic, sizeof header);
+    if (!image_size_ok(header[0], header[1]) || header[2] < 1) return false;
+    size_t n = size_t(header[0]) * size_t(header[1]) * 3;
+    if (bytes.size() != kHead + 2 * n * sizeof(double)) return false;
+    RenderImage im;
+    im.width = int(header[0]);
+    im.height = int(header[1]);
+    im.spp = uint64_t(header[2]);
+    im.rgb.resize(n);
+    im.variance.resize(n);
+    std::memcpy(im.rgb.data(), bytes.data() + kHead, n * sizeof(double));
+    std::memcpy(im.variance.data(), bytes.data() + kHead + n * sizeof(double), n * sizeof(double));
+    // The renderer writes NaN only for a pixel whose every sample was discarded, never an
+    // infinite mean or a negative variance.
+    for (size_t k = 0; k < n; ++k)
+        if (std::isinf(im.rgb[k]) || im.variance[k] < 0.0 || std::isinf(im.variance[k]))
+            return false;
+    *image = std::move(im);
+    return true;
 }
 
 std::string base64_encode(const std::string& bytes) {

@@ -4,10 +4,9 @@
 
 #include <cmath>
 #include <cstdio>
-#include <fstream>
-#include <sstream>
 
 #include "api/boundary.h"
+#include "api/files.h"
 #include "api/scene.h"
 #include "render_api/image_io.h"
 #include "render_api/render_request.h"
@@ -20,7 +19,15 @@ namespace mcp {
 
 namespace {
 
-constexpr int kReferenceCacheVersion = 1;
+constexpr int kReferenceCacheVersion = 2;
+
+/// Work and memory bounds, checked before anything is rendered: samples of a whole call
+/// (every image of the study and the reference), and bytes of the images held at once
+/// (each estimator's preview, the reference and the image being rendered, 48 bytes a pixel).
+constexpr double kMaxCallSamples = 4398046511104.0; // 2^42
+constexpr double kMaxImageBytes = 1073741824.0;     // 1 GiB
+/// A rendered reference needs at least this many times the study's largest spp.
+constexpr uint64_t kReferenceSppRatio = 4;
 
 const char* selection_name(LightSelection s) {
     switch (s) {
@@ -44,10 +51,24 @@ Json estimator_to_json(const RenderEstimator& e) {
     return j;
 }
 
+/// How many levels of the study lie below the reference's noise?
+size_t levels_below_noise(const RenderEstimatorStudy& s, double floor) {
+    size_t n = 0;
+    for (const LevelStats& l : s.levels) n += below_reference_noise(l, floor) ? 1 : 0;
+    return n;
+}
+
 /// Warnings about an estimator over the whole study (the levels carry their own).
-Json render_warnings(const RenderEstimatorStudy& s) {
+Json render_warnings(const RenderEstimatorStudy& s, double floor) {
     Json w = Json::array();
     if (s.levels.empty()) return w;
+    if (size_t n = levels_below_noise(s, floor))
+        w.push_back(warning("reference_noise",
+                            std::to_string(n) + " of " + std::to_string(s.levels.size()) +
+                                " spp level(s) have a relative MSE below the reference's own "
+                                "noise (floor " +
+                                fmt("%.3e", floor) +
+                                "): those levels are left out of the fit and have no efficiency"));
     const LevelStats& deepest = s.levels.back();
     add_tail_warnings(w, deepest, deepest.diagnostics.nonzero,
                       TailWording{"the samples' reflected radiance values", "samples", "spp",
@@ -68,11 +89,24 @@ Json render_warnings(const RenderEstimatorStudy& s) {
     return w;
 }
 
-Json render_level_to_json(const LevelStats& l) {
+/// A level's JSON: relative_mse (null when undefined, see render_study.h), and a flag and a
+/// warning when it lies below the reference's relative-MSE floor.
+Json render_level_to_json(const LevelStats& l, double floor) {
     Json j = level_to_json(l);
     j["relative_mse"] = num(l.variance);
+    bool below = below_reference_noise(l, floor);
+    j["below_reference_noise"] = below;
+    if (below)
+        j["warnings"].push_back(warning(
+            "below_reference_noise",
+            "relative MSE " + fmt("%.3e", l.variance) + " at spp = " + std::to_string(l.n) +
+                " is " + (l.variance < 0.0 ? "negative" : "below") +
+                " the reference's own noise (relative-MSE floor " + fmt("%.3e", floor) +
+                "): it measures the reference, not the estimator; use a reference with more "
+                "spp"));
     return j;
 }
+
 
 struct Loaded {
     std::shared_ptr<RenderRequest> request;
@@ -95,6 +129,13 @@ int load(const char* scene_json, const char* options_json, Loaded* out, Json* op
     if (!req.ok()) return fail(MCP_ERROR_SCENE, req.error);
     out->request = req.value;
     out->scene.build(*out->request->scene, out->request->accel);
+    // A light whose emission or area is NaN or infinite cannot be rendered; dropping it would
+    // leave a silently darker image.
+    if (size_t bad = out->scene.lights_uniform.nonfinite())
+        return fail(MCP_ERROR_SCENE, "scene.render.gltf: " + std::to_string(bad) +
+                                         " emissive triangle(s) have a non-finite emission or "
+                                         "area: expected finite emissiveFactor x "
+                                         "emissiveStrength and finite positions");
     return MCP_OK;
 }
 
@@ -119,14 +160,14 @@ bool obtain_reference(const Loaded& l, RenderImage* ref, Json* info, std::string
     const RenderRequest& r = *l.request;
     const RenderStudySettings& s = r.settings;
     if (!r.reference.file.empty()) {
-        std::ifstream in(r.reference.file, std::ios::binary);
-        if (!in) {
-            *error = "reference.file: cannot read '" + r.reference.file + "'";
+        // The path was resolved and checked to lie inside the scene's folder when the request
+        // was built; here it is read only if it is a regular file of bounded size.
+        std::string bytes;
+        if (!read_regular_file(r.reference.file, kMaxReferenceFileBytes, &bytes, error)) {
+            *error = "reference.file: " + *error;
             return false;
         }
-        std::ostringstream ss;
-        ss << in.rdbuf();
-        if (!decode_hdr(ss.str(), ref, error)) {
+        if (!decode_hdr(bytes, ref, error)) {
             *error = "reference.file: " + *error;
             return false;
         }
@@ -141,18 +182,17 @@ bool obtain_reference(const Loaded& l, RenderImage* ref, Json* info, std::string
     }
     const RenderEstimator& e = r.reference.estimator;
     uint64_t key = hash_combine(r.gltf_hash, uint64_t(kReferenceCacheVersion));
+    key = hash_combine(key, hash_string(r.name.c_str()));
     for (uint64_t v :
          {uint64_t(s.width), uint64_t(s.height), uint64_t(s.jitter_pixels), uint64_t(e.strategy),
           uint64_t(e.light_selection), uint64_t(e.light_sampling), uint64_t(e.pixel_sampler),
           uint64_t(e.max_depth), uint64_t(e.rr_depth), r.reference.spp, s.seed})
         key = hash_combine(key, v);
-    std::string cache_file =
-        r.cache_dir.empty()
-            ? ""
-            : r.cache_dir + "/" + (r.name.empty() ? "scene" : r.name) + "-" + hex(key) + ".mcref";
+    // The file name is the hash alone: nothing of the scene's text reaches the path.
+    std::string cache_file = r.cache_dir.empty() ? "" : r.cache_dir + "/" + hex(key) + ".mcref";
     *info = Json{{"estimator", estimator_to_json(e)}, {"spp", r.reference.spp}};
     if (!cache_file.empty() && read_reference_cache(cache_file, ref) && ref->width == s.width &&
-        ref->height == s.height) {
+        ref->height == s.height && ref->spp == r.reference.spp) {
         (*info)["source"] = "cache";
         (*info)["file"] = cache_file;
         return true;
@@ -179,6 +219,15 @@ Json scene_to_json(const Loaded& l) {
     const AccelStats& a = l.scene.accel.stats();
     Json warnings = Json::array();
     for (const std::string& w : r.warnings) warnings.push_back(warning("gltf", w));
+    const LightSet& lights = l.scene.lights_uniform;
+    if (size_t n = lights.degenerate())
+        warnings.push_back(warning("degenerate_lights",
+                                   std::to_string(n) +
+                                       " emissive triangle(s) have zero area: they can neither be "
+                                       "hit nor sampled and are left out of the lights"));
+    if (lights.empty())
+        warnings.push_back(
+            warning("no_lights", "the scene has no emissive surface: every image is black"));
     Json materials = Json::array();
     for (const Material& m : sc.materials)
         materials.push_back(Json{{"name", m.name},
@@ -195,6 +244,7 @@ Json scene_to_json(const Loaded& l) {
                 {"height", r.settings.height},
                 {"triangles", sc.mesh.triangle_count()},
                 {"lights", l.scene.lights_uniform.size()},
+                {"degenerate_lights", l.scene.lights_uniform.degenerate()},
                 {"light_power", num(l.scene.lights_uniform.total_power())},
                 {"materials", materials},
                 {"textures", sc.textures.size()},
@@ -219,15 +269,16 @@ Json settings_to_json(const RenderStudySettings& s, int threads) {
 }
 
 Json estimator_study_to_json(const RenderEstimatorStudy& s, bool previews, double exposure,
-                             const RenderImage* reference, bool all_levels, size_t level) {
+                             const RenderImage* reference, double floor, bool all_levels,
+                             size_t level) {
     Json j = estimator_to_json(s.estimator);
-    j["warnings"] = render_warnings(s);
+    j["warnings"] = render_warnings(s, floor);
     if (all_levels) {
         Json levels = Json::array();
-        for (const LevelStats& l : s.levels) levels.push_back(render_level_to_json(l));
+        for (const LevelStats& l : s.levels) levels.push_back(render_level_to_json(l, floor));
         j["levels"] = levels;
     } else if (level < s.levels.size()) {
-        j["level"] = render_level_to_json(s.levels[level]);
+        j["level"] = render_level_to_json(s.levels[level], floor);
     }
     j["fit"] = fit_to_json(s.fit);
     const RenderDiagnostics& d = s.preview.diagnostics;
@@ -237,6 +288,43 @@ Json estimator_study_to_json(const RenderEstimatorStudy& s, bool previews, doubl
         if (reference) j["error_png"] = base64_encode(encode_error_png(s.preview, *reference));
     }
     return j;
+}
+
+/// Checks the work and memory of a call before anything is rendered: `image_spp` per image
+/// times `images` images of the estimators (one spp each, or the study's ladder), plus the
+/// reference when it is rendered, and `held` images in memory at once.
+bool check_work(const RenderRequest& r, double image_samples_per_pixel, size_t held,
+                bool reference_rendered, std::string* error) {
+    const RenderStudySettings& s = r.settings;
+    double pixels = double(s.width) * double(s.height);
+    double per_pixel = image_samples_per_pixel +
+                       (reference_rendered ? double(r.reference.spp) : 0.0);
+    double samples = pixels * per_pixel;
+    if (!(samples <= kMaxCallSamples)) {
+        *error = "scene.render: this needs " + fmt("%.3g", samples) +
+                 " samples (width x height x (spp x reps x estimators, summed over the spp "
+                 "ladder, plus the reference's spp)), more than the limit of " +
+                 fmt("%.3g", kMaxCallSamples) +
+                 ": lower spp_max, reps, the image size, the estimators or reference.spp";
+        return false;
+    }
+    double bytes = pixels * 48.0 * double(held);
+    if (!(bytes <= kMaxImageBytes)) {
+        *error = "scene.render: " + std::to_string(held) + " images of " +
+                 std::to_string(s.width) + "x" + std::to_string(s.height) +
+                 " pixels held at once need " + fmt("%.0f", bytes / 1048576.0) +
+                 " MiB, more than the limit of " + fmt("%.0f", kMaxImageBytes / 1048576.0) +
+                 " MiB: lower the image size or the number of estimators";
+        return false;
+    }
+    return true;
+}
+
+/// The warning of a result whose reference is black (relative MSE undefined, null).
+Json black_reference_warning() {
+    return warning("black_reference",
+                   "the reference image is black (mean luminance 0): relative MSE is undefined "
+                   "and reported as null");
 }
 
 bool wants(const Json& options, const char* key, bool fallback) {
@@ -317,6 +405,11 @@ int mcp_render_image(const char* scene_json, const char* options_json, char** re
                                                     " (known: png, hdr, error_png)");
         }
     }
+    {
+        std::string err;
+        bool ref_rendered = error_png && r.reference.file.empty();
+        if (!check_work(r, double(spp), 2, ref_rendered, &err)) return fail(MCP_ERROR_SCENE, err);
+    }
     RenderSettings rs;
     rs.width = r.settings.width;
     rs.height = r.settings.height;
@@ -363,9 +456,12 @@ int mcp_render_image(const char* scene_json, const char* options_json, char** re
         if (!obtain_reference(l, &ref, &info, &err)) return fail(MCP_ERROR_SCENE, err);
         ImageError e = image_error(image, ref);
         images["error_png"] = base64_encode(encode_error_png(image, ref));
+        double floor = relative_mse_floor(ref);
+        info["relative_mse_floor"] = num(floor);
         j["reference"] = info;
         j["relative_mse"] = num(e.rel_mse);
         j["pixel_coverage95"] = num(e.coverage);
+        if (!std::isfinite(e.rel_mse)) j["warnings"].push_back(black_reference_warning());
     }
     j["images"] = images;
     *result_json = copy_out(dump(j));
@@ -383,10 +479,26 @@ int mcp_render_study_run(const char* scene_json, const char* options_json, mcp_p
         return st;
     const RenderRequest& r = *l.request;
     bool previews = wants(options, "previews", false);
+    std::string err;
+    // A rendered reference must have many more samples than the study's images, or its own
+    // noise is what the study measures (docs/render-scenes.md, "The reference's noise").
+    const bool ref_rendered = r.reference.file.empty();
+    if (ref_rendered && r.settings.spp_max > r.reference.spp / kReferenceSppRatio)
+        return fail(MCP_ERROR_SCENE,
+                    "scene.render.reference.spp: expected at least " +
+                        std::to_string(kReferenceSppRatio) + " x spp_max = " +
+                        std::to_string(kReferenceSppRatio * r.settings.spp_max) + ", got " +
+                        std::to_string(r.reference.spp) +
+                        ": a reference with fewer samples is too noisy to judge the images");
+    double study_spp = 0.0;
+    for (uint64_t n : n_ladder(r.settings.spp_min, r.settings.spp_max)) study_spp += double(n);
+    study_spp *= double(r.settings.reps) * double(r.estimators.size());
+    if (!check_work(r, study_spp, r.estimators.size() + 2, ref_rendered, &err))
+        return fail(MCP_ERROR_SCENE, err);
     RenderImage reference;
     Json ref_info;
-    std::string err;
     if (!obtain_reference(l, &reference, &ref_info, &err)) return fail(MCP_ERROR_SCENE, err);
+    const double floor = relative_mse_floor(reference);
     int threads = resolve_threads(r.settings.threads);
     RenderStudyProgress on_level;
     if (progress) {
@@ -395,7 +507,7 @@ int mcp_render_study_run(const char* scene_json, const char* options_json, mcp_p
             uint64_t n = 0;
             for (const RenderEstimatorStudy& s : partial.estimators) {
                 ests.push_back(
-                    estimator_study_to_json(s, previews, r.exposure, &reference, false, level));
+                    estimator_study_to_json(s, previews, r.exposure, &reference, floor, false, level));
                 if (level < s.levels.size()) n = s.levels[level].n;
             }
             Json p{{"version", kResultSchemaVersion},
@@ -413,12 +525,15 @@ int mcp_render_study_run(const char* scene_json, const char* options_json, mcp_p
         run_render_study(l.scene, r.estimators, r.settings, reference, on_level);
     Json scene = scene_to_json(l);
     ref_info["mean_luminance"] = num(result.reference_mean_luminance);
+    ref_info["relative_mse_floor"] = num(floor);
     scene["reference"] = ref_info;
+    if (!std::isfinite(floor)) scene["warnings"].push_back(black_reference_warning());
     scene["exact"] = num(result.reference_mean_luminance);
     scene["quantity"] = "relative_mse";
     Json ests = Json::array();
     for (const RenderEstimatorStudy& s : result.estimators)
-        ests.push_back(estimator_study_to_json(s, previews, r.exposure, &reference, true, 0));
+        ests.push_back(
+            estimator_study_to_json(s, previews, r.exposure, &reference, floor, true, 0));
     Json j{{"version", kResultSchemaVersion},
            {"kind", "render"},
            {"mcplay", mcp_version()},

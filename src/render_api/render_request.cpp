@@ -1,9 +1,8 @@
 #include "render_api/render_request.h"
 
 #include <cmath>
-#include <fstream>
-#include <sstream>
 
+#include "api/files.h"
 #include "api/scene.h" // parse_json
 #include "core/rng.h"
 #include "render_api/gltf_scene.h"
@@ -15,15 +14,6 @@ namespace {
 constexpr int kMaxImageSide = 4096;
 constexpr uint64_t kMaxPixels = uint64_t(1) << 22;
 constexpr uint64_t kMaxSpp = uint64_t(1) << 20;
-
-bool read_text_file(const std::string& path, std::string* out) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) return false;
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    *out = ss.str();
-    return true;
-}
 
 std::string dirname_of(const std::string& path) {
     size_t slash = path.find_last_of('/');
@@ -104,8 +94,25 @@ std::string quantity_of(const RenderEstimator& e) {
     return "paths of up to " + std::to_string(e.max_depth) + " bounce(s)";
 }
 
-bool parse_reference(Ctx& c, const Json& j, const std::string& path, const std::string& base_dir,
-                     ReferenceSpec* out) {
+/// A file a scene names: relative to `from` (a folder inside `root`), resolving to a regular
+/// file inside `root`, the scene's folder. With no root, any path (the caller's choice).
+bool resolve_scene_file(Ctx& c, const std::string& field, const std::string& root,
+                        const std::string& from, const std::string& name, std::string* out) {
+    if (root.empty()) { // a path the caller chose: anywhere, relative to `from`
+        if (name.empty()) return c.fail(field, "is empty");
+        *out = name[0] == '/' ? name : from + "/" + name;
+        return true;
+    }
+    std::string relative = name, error;
+    if (from != root && from.compare(0, root.size() + 1, root + "/") == 0 && !name.empty() &&
+        name[0] != '/')
+        relative = from.substr(root.size() + 1) + "/" + name;
+    if (!resolve_inside(root, relative, out, &error)) return c.fail(field, error);
+    return true;
+}
+
+bool parse_reference(Ctx& c, const Json& j, const std::string& path, const std::string& root,
+                     const std::string& from, ReferenceSpec* out) {
     if (!check_keys(c, j, path, {"estimator", "spp", "file"})) return false;
     if (const Json* e = find(j, "estimator"))
         if (!parse_estimator(c, *e, sub(path, "estimator"), &out->estimator)) return false;
@@ -114,7 +121,8 @@ bool parse_reference(Ctx& c, const Json& j, const std::string& path, const std::
         return c.fail(sub(path, "spp"), "must be in 1.." + std::to_string(kMaxSpp));
     std::string file;
     if (!get_string(c, j, "file", path, &file)) return false;
-    if (!file.empty()) out->file = file[0] == '/' ? file : base_dir + "/" + file;
+    if (find(j, "file") && !resolve_scene_file(c, sub(path, "file"), root, from, file, &out->file))
+        return false;
     return true;
 }
 
@@ -219,16 +227,22 @@ Made<std::shared_ptr<RenderRequest>> build_render_request(const Json& scene, con
     if (!gltf) return made_error<std::shared_ptr<RenderRequest>>(rp + ".gltf: missing");
     GltfLoadResult loaded;
     std::string text;
+    // Every file the scene names lies inside the scene's folder (base_dir).
+    const std::string root = real_folder(base_dir);
+    if (root.empty())
+        return made_error<std::shared_ptr<RenderRequest>>("options.base_dir: the scene's folder '" +
+                                                          base_dir + "' does not exist");
     if (gltf->is_string()) {
-        std::string p = gltf->get<std::string>();
-        r->gltf_path = !p.empty() && p[0] == '/' ? p : base_dir + "/" + p;
-        if (!read_text_file(r->gltf_path, &text))
-            return made_error<std::shared_ptr<RenderRequest>>(rp + ".gltf: cannot read '" +
-                                                              r->gltf_path + "'");
-        loaded = load_gltf_memory(text, dirname_of(r->gltf_path));
+        std::string why;
+        if (!resolve_scene_file(c, rp + ".gltf", root, root, gltf->get<std::string>(),
+                                &r->gltf_path))
+            return error();
+        if (!read_regular_file(r->gltf_path, kGltfMaxInputBytes, &text, &why))
+            return made_error<std::shared_ptr<RenderRequest>>(rp + ".gltf: " + why);
+        loaded = load_gltf_memory(text, dirname_of(r->gltf_path), root);
     } else if (gltf->is_object()) {
         text = gltf->dump();
-        loaded = load_gltf_memory(text, base_dir);
+        loaded = load_gltf_memory(text, root, root);
     } else {
         return made_error<std::shared_ptr<RenderRequest>>(
             rp + ".gltf: expected a file name or a glTF object, got " + type_of(*gltf));
@@ -310,18 +324,19 @@ Made<std::shared_ptr<RenderRequest>> build_render_request(const Json& scene, con
     r->reference.estimator.max_depth = first.max_depth;
     r->reference.estimator.rr_depth = first.rr_depth;
     r->reference.spp = std::max<uint64_t>(256, 16 * r->settings.spp_max);
+    // Reference files: the glTF's extras name them relative to the glTF, the scene and the
+    // options relative to the scene's folder.
+    const std::string gltf_dir = r->gltf_path.empty() ? root : dirname_of(r->gltf_path);
     if (const Json* ref = find(extras, "reference"))
-        if (!parse_reference(c, *ref, ep + ".reference",
-                             dirname_of(r->gltf_path.empty() ? base_dir + "/x" : r->gltf_path),
-                             &r->reference))
+        if (!parse_reference(c, *ref, ep + ".reference", root, gltf_dir, &r->reference))
             return error();
     if (const Json* ref = find(render, "reference"))
-        if (!parse_reference(c, *ref, rp + ".reference",
-                             dirname_of(r->gltf_path.empty() ? base_dir + "/x" : r->gltf_path),
-                             &r->reference))
+        if (!parse_reference(c, *ref, rp + ".reference", root, root, &r->reference))
             return error();
+    // The caller's options are not scene text: their file may lie anywhere.
     if (const Json* ref = find(opts, "reference"))
-        if (!parse_reference(c, *ref, "options.reference", base_dir, &r->reference)) return error();
+        if (!parse_reference(c, *ref, "options.reference", "", root, &r->reference))
+            return error();
     for (const RenderEstimator& e : r->estimators)
         if (quantity_of(e) != quantity_of(r->estimators.front()))
             return made_error<std::shared_ptr<RenderRequest>>(
