@@ -178,6 +178,11 @@ TEST(Expression, OneArgumentFunctionsMatchStd) {
             // Folded at compile time: the same value.
             char buf[64];
             std::snprintf(buf, sizeof buf, "%s(%.17g)", fn.name, t);
+            if (!std::isfinite(fn.f(t))) { // a non-finite constant is refused (issue 10)
+                const std::string err = error_of(buf, 1);
+                EXPECT_NE(err.find("constants must be finite"), std::string::npos) << buf << err;
+                continue;
+            }
             auto c = compile_ok(buf, 1);
             ASSERT_TRUE(c);
             EXPECT_EQ(c->instruction_count(), 0u) << buf;
@@ -255,11 +260,9 @@ TEST(Expression, Powers) {
 }
 
 TEST(Expression, IeeeSpecialValues) {
-    EXPECT_TRUE(std::isnan(eval1("log(-1)", 0.0)));
     EXPECT_TRUE(std::isnan(eval1("log(x)", -1.0)));
     EXPECT_TRUE(std::isnan(eval1("sqrt(x)", -1.0)));
     EXPECT_TRUE(std::isnan(eval1("asin(x)", 2.0)));
-    EXPECT_EQ(eval1("1/0", 0.0), kInf);
     EXPECT_EQ(eval1("1/x", 0.0), kInf);
     EXPECT_EQ(eval1("-1/x", 0.0), -kInf);
     EXPECT_EQ(eval1("log(x)", 0.0), -kInf);
@@ -585,6 +588,14 @@ double reference(const Node& n, const double* x) {
 
 } // namespace
 
+/// True when some variable-free subtree evaluates to a non-finite value: the compiler folds
+/// it to a constant and refuses it (issue 10).
+bool has_nonfinite_constant(const Node& n) {
+    if ((n.a && has_nonfinite_constant(*n.a)) || (n.b && has_nonfinite_constant(*n.b)))
+        return true;
+    return !has_var(n) && !std::isfinite(reference(n, nullptr));
+}
+
 TEST(Expression, RandomExpressionsMatchDirectEvaluation) {
     Pcg32 rng(99u, 4u);
     const size_t n = 300;
@@ -601,6 +612,11 @@ TEST(Expression, RandomExpressionsMatchDirectEvaluation) {
     for (int t = 0; t < 400; ++t) {
         auto tree = random_tree(rng, 1 + static_cast<int>(rng.next_below(6)));
         const std::string text = print(*tree);
+        if (has_nonfinite_constant(*tree)) {
+            const std::string err = error_of(text, 3);
+            EXPECT_NE(err.find("constants must be finite"), std::string::npos) << text << err;
+            continue;
+        }
         auto p = compile_ok(text, 3);
         ASSERT_TRUE(p);
         p->evaluate(vars, n, out.data());
@@ -701,6 +717,53 @@ TEST(Expression, MalformedInputGivesExactMessages) {
             << "input: '" << (c.text.size() > 40 ? c.text.substr(0, 40) + "..." : c.text) << "'";
 }
 
+// Issue 10: a folded constant that is not finite is refused like the literal "1e400" (before,
+// "10^400" compiled to +inf while "1e400" was an error).
+TEST(Expression, NonFiniteConstantsAreRefusedAfterFolding) {
+    struct Case {
+        std::string text;
+        std::string message;
+    };
+    const Case cases[] = {
+        {"10^400", "at position 1: the constant '10^400' is +infinite (it overflows); constants "
+                   "must be finite"},
+        {"x + 10^400", "at position 5: the constant '10^400' is +infinite (it overflows); "
+                       "constants must be finite"},
+        {"x*(1/0)", "at position 4: the constant '1/0' is +infinite (it overflows); constants "
+                    "must be finite"},
+        {"x - -1/0", "at position 5: the constant '-1/0' is -infinite (it overflows); constants "
+                     "must be finite"},
+        {"1e308 + 1e308", "at position 1: the constant '1e308 + 1e308' is +infinite (it "
+                          "overflows); constants must be finite"},
+        {"x + log(-1)", "at position 5: the constant 'log(-1)' is NaN (not a number); constants "
+                        "must be finite"},
+        {"0/0 + x", "at position 1: the constant '0/0' is NaN (not a number); constants must be "
+                    "finite"},
+        {"exp(1000)*x", "at position 1: the constant 'exp(1000)' is +infinite (it overflows); "
+                        "constants must be finite"},
+        {"pow(10, 400)", "at position 1: the constant 'pow(10, 400)' is +infinite (it "
+                         "overflows); constants must be finite"},
+        {"x*2^(2^11)", "at position 3: the constant '2^(2^11)' is +infinite (it overflows); "
+                       "constants must be finite"},
+        // The first non-finite sub-expression is named, even if a later step would fold it away.
+        {"1/(1/0)", "at position 4: the constant '1/0' is +infinite (it overflows); constants "
+                    "must be finite"},
+        {"(1/0)^0", "at position 2: the constant '1/0' is +infinite (it overflows); constants "
+                    "must be finite"},
+    };
+    for (const Case& c : cases) EXPECT_EQ(error_of(c.text, 1), c.message) << c.text;
+    // A long constant is named by its first 37 characters.
+    const std::string long_constant = "1 + 1 + 1 + 1 + 1 + 1 + 1 + 1 + 1 + 1 + 1e308 + 1e308";
+    EXPECT_EQ(error_of(long_constant, 1),
+              "at position 1: the constant '1 + 1 + 1 + 1 + 1 + 1 + 1 + 1 + 1 + 1...' is "
+              "+infinite (it overflows); constants must be finite");
+    // Finite folds, underflow to 0, and non-finite values at run time are fine.
+    EXPECT_EQ(eval1("10^300 * x", 1.0), 1e300);
+    EXPECT_EQ(eval1("10^-400 + x", 1.0), 1.0);
+    EXPECT_EQ(eval1("x * 1e308 * 10", 1.0), kInf); // not a constant: (x * 1e308) * 10
+    EXPECT_TRUE(std::isnan(eval1("log(-x)", 1.0)));
+}
+
 TEST(Expression, ErrorsReportTheFirstProblemInReadingOrder) {
     EXPECT_EQ(error_of("foo(1) + #", 1), "at position 1: unknown function 'foo'");
     EXPECT_EQ(error_of("1 + # + foo(1)", 1), "at position 5: unexpected character '#'");
@@ -742,6 +805,23 @@ TEST(Expression, LimitsOnSizeAndNesting) {
     std::string product = "x";
     while (product.size() + 4 <= 10000) product += "*1.0";
     EXPECT_EQ(eval1(product, 3.0), 3.0);
+    // Issue 10: hostile sizes fail fast with the limit's message, never with a stack overflow:
+    // 100000 parentheses (the length limit is checked before any parsing), 200 levels inside
+    // the length limit, a 10 MB text, and 100000 signs.
+    const std::string deep_parens = std::string(100000, '(') + "x" + std::string(100000, ')');
+    EXPECT_EQ(error_of(deep_parens, 1),
+              "at position 10001: expression is longer than 10000 characters");
+    const std::string deep_in_limit = std::string(4999, '(') + "x" + std::string(4999, ')');
+    EXPECT_EQ(error_of(deep_in_limit, 1),
+              "at position 201: expression nested too deeply (more than 200 levels)");
+    std::string deep_powers = "x";
+    for (int i = 0; i < 4000; ++i) deep_powers += "^x";
+    EXPECT_EQ(error_of(deep_powers, 1),
+              "at position 402: expression nested too deeply (more than 200 levels)");
+    EXPECT_EQ(error_of(std::string(10u << 20, 'x'), 1),
+              "at position 10001: expression is longer than 10000 characters");
+    EXPECT_EQ(error_of(std::string(100000, '-') + "x", 1),
+              "at position 10001: expression is longer than 10000 characters");
     // Many registers at once: a right-nested chain of products of variables.
     std::string chain = "x";
     for (int i = 0; i < 150; ++i) chain = "x*y+(" + chain + ")";

@@ -6,8 +6,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <limits>
 #include <set>
 #include <sstream>
+
+#include "core/special.h"
 
 namespace mcp {
 
@@ -24,19 +28,79 @@ bool get_vec2(Ctx& c, const Json& v, const std::string& path, Vec2* out) {
 
 // --- domain ------------------------------------------------------------------------------
 
+/// Most dimensions of any domain, integrand or parameter array.
+constexpr int kMaxDim = 64;
+
+/// "1e-400" style order of magnitude of 10^e10 (e10 = log10 of a number outside the double
+/// range), for messages about measures that overflow or underflow.
+std::string magnitude(double e10) {
+    return "about 1e" + std::to_string(static_cast<long long>(std::floor(e10 + 1e-6)));
+}
+
+/// A number for messages ("1e+200", "0.25", "NaN", "-inf": the same on every platform).
+std::string number_text(double x) {
+    if (std::isnan(x)) return "NaN";
+    if (std::isinf(x)) return x > 0 ? "inf" : "-inf";
+    std::ostringstream s;
+    s.precision(6);
+    s << x;
+    return s.str();
+}
+
+/// A measure (a width, volume, area) must be a finite, normal positive double: otherwise every
+/// density 1/measure, every mean and every exact value built on it is inf or 0, and the study
+/// reports 0 +- 0 [Goldberg91]. Returns "" or what is wrong, given log10 of the true value.
+std::string check_measure(double measure, double log10_measure) {
+    if (std::isfinite(measure) && measure >= std::numeric_limits<double>::min()) return "";
+    const bool over = !std::isfinite(measure) || log10_measure > 0.0;
+    return std::string(over ? "overflows" : "underflows") + " the double range (" +
+           magnitude(log10_measure) +
+           "); it must be a finite, normal positive double (2.2e-308 .. 1.8e308): rescale the "
+           "problem";
+}
+
+/// The fields each domain type reads; any other field is refused, not silently ignored.
+bool check_domain_fields(Ctx& c, const Json& j, const std::string& path, const std::string& type,
+                         const std::vector<std::string>& fields) {
+    for (auto it = j.begin(); it != j.end(); ++it) {
+        bool ok = false;
+        for (const std::string& k : fields) ok = ok || k == it.key();
+        if (!ok)
+            return c.fail(sub(path, it.key().c_str()), "does not apply to a " + type +
+                                                           " domain (its fields: " + join(fields) +
+                                                           ")");
+    }
+    return true;
+}
+
 bool parse_domain(Ctx& c, const Json& j, const std::string& path, int default_dim, Domain* out) {
     std::string type = "box";
     if (!check_keys(c, j, path, {"type", "dim", "lower", "upper", "center", "radius", "vertices"}))
         return false;
     if (!get_string(c, j, "type", path, &type)) return false;
     if (type == "box" || type == "interval") {
+        if (!check_domain_fields(c, j, path, type, {"type", "dim", "lower", "upper"}))
+            return false;
         uint64_t dim = static_cast<uint64_t>(default_dim);
         if (!get_count(c, j, "dim", path, &dim)) return false;
-        if (dim < 1 || dim > 64)
-            return c.fail(sub(path, "dim"), "must be in 1..64, got " + std::to_string(dim));
+        if (dim < 1 || dim > static_cast<uint64_t>(kMaxDim))
+            return c.fail(sub(path, "dim"), "must be in 1.." + std::to_string(kMaxDim) + ", got " +
+                                                std::to_string(dim));
+        // Array lengths are checked before any array is converted.
+        for (const char* key : {"lower", "upper"})
+            if (const Json* v = find(j, key); v && v->is_array() && v->size() > size_t(kMaxDim))
+                return c.fail(sub(path, key), "has " + std::to_string(v->size()) +
+                                                  " entries; mcplay integrates in at most " +
+                                                  std::to_string(kMaxDim) + " dimensions");
         std::vector<double> lo(dim, 0.0), hi(dim, 1.0);
         if (!get_numbers(c, j, "lower", path, &lo) || !get_numbers(c, j, "upper", path, &hi))
             return false;
+        // An explicit "dim" must agree with the bounds it comes with.
+        for (const std::vector<double>* bound : {&lo, &hi})
+            if (find(j, "dim") && bound->size() != dim)
+                return c.fail(sub(path, "dim"), "is " + std::to_string(dim) + ", but \"" +
+                                                    (bound == &lo ? "lower" : "upper") + "\" has " +
+                                                    std::to_string(bound->size()) + " entries");
         if (find(j, "lower") && !find(j, "dim") && !find(j, "upper")) hi.assign(lo.size(), 1.0);
         if (find(j, "upper") && !find(j, "dim") && !find(j, "lower")) lo.assign(hi.size(), 0.0);
         if (lo.size() != hi.size())
@@ -46,10 +110,29 @@ bool parse_domain(Ctx& c, const Json& j, const std::string& path, int default_di
             return c.fail(path, "an interval has one dimension");
         Made<Domain> d = make_box(lo, hi);
         if (!d.ok()) return c.fail(path, d.error);
+        // Each width, and their product, must be a normal positive double.
+        double log10_volume = 0.0;
+        for (size_t a = 0; a < lo.size(); ++a) {
+            const double w = hi[a] - lo[a];
+            // hi - lo overflows only when both are huge: halve first for the magnitude.
+            const double lw = std::isfinite(w) ? std::log10(w)
+                                               : std::log10(0.5 * hi[a] - 0.5 * lo[a]) + 0.30103;
+            log10_volume += lw;
+            std::string bad = check_measure(w, lw);
+            if (!bad.empty())
+                return c.fail(path, "the width upper - lower of axis " + std::to_string(a) + " (" +
+                                        number_text(hi[a]) + " - " + number_text(lo[a]) + ") " +
+                                        bad);
+        }
+        std::string bad = check_measure(d.value.measure(), log10_volume);
+        if (!bad.empty())
+            return c.fail(path, "the box's volume (the product of its " +
+                                    std::to_string(lo.size()) + " widths) " + bad);
         *out = d.value;
         return true;
     }
     if (type == "disk") {
+        if (!check_domain_fields(c, j, path, type, {"type", "center", "radius"})) return false;
         Vec2 center{0.0, 0.0};
         double radius = 1.0;
         if (const Json* v = find(j, "center"); v && !get_vec2(c, *v, sub(path, "center"), &center))
@@ -57,10 +140,20 @@ bool parse_domain(Ctx& c, const Json& j, const std::string& path, int default_di
         if (!get_number(c, j, "radius", path, &radius)) return false;
         Made<Domain> d = make_disk(center, radius);
         if (!d.ok()) return c.fail(path, d.error);
+        // pi r^2, and the bounding box centre +- r, must be representable.
+        std::string bad = check_measure(d.value.measure(),
+                                        std::log10(kPi) + 2.0 * std::log10(radius));
+        if (!bad.empty())
+            return c.fail(sub(path, "radius"),
+                          "the disk's area pi r^2 with r = " + number_text(radius) + " " + bad);
+        if (!std::isfinite(center.x - radius) || !std::isfinite(center.x + radius) ||
+            !std::isfinite(center.y - radius) || !std::isfinite(center.y + radius))
+            return c.fail(path, "centre +- radius overflows the double range");
         *out = d.value;
         return true;
     }
     if (type == "triangle") {
+        if (!check_domain_fields(c, j, path, type, {"type", "vertices"})) return false;
         const Json* v = find(j, "vertices");
         if (!v) return c.fail(path, "a triangle needs \"vertices\": [[x, y], [x, y], [x, y]]");
         if (!v->is_array() || v->size() != 3)
@@ -69,17 +162,32 @@ bool parse_domain(Ctx& c, const Json& j, const std::string& path, int default_di
         for (size_t i = 0; i < 3; ++i)
             if (!get_vec2(c, (*v)[i], sub(path, "vertices") + "[" + std::to_string(i) + "]", &p[i]))
                 return false;
+        // The area from edge vectors scaled by their largest component s: |cross| s^2 / 2,
+        // so that an area outside the double range is told from a degenerate triangle.
+        const Vec2 e1 = p[1] - p[0], e2 = p[2] - p[0];
+        const double s = std::max(std::max(std::fabs(e1.x), std::fabs(e1.y)),
+                                  std::max(std::fabs(e2.x), std::fabs(e2.y)));
+        if (std::isfinite(s) && s > 0.0) {
+            const Vec2 a1 = e1 / s, a2 = e2 / s;
+            const double cross = std::fabs(a1.x * a2.y - a2.x * a1.y);
+            if (cross > 0.0) {
+                const double log10_area = std::log10(0.5 * cross) + 2.0 * std::log10(s);
+                std::string bad = check_measure(0.5 * cross * s * s, log10_area);
+                if (!bad.empty()) return c.fail(path, "the triangle's area " + bad);
+            }
+        } else if (!std::isfinite(s)) {
+            return c.fail(path, "the triangle's edges overflow the double range");
+        }
         Made<Domain> d = make_triangle(p[0], p[1], p[2]);
         if (!d.ok()) return c.fail(path, d.error);
+        std::string bad = check_measure(d.value.measure(), 0.0);
+        if (!bad.empty()) return c.fail(path, "the triangle's area " + bad);
         *out = d.value;
         return true;
     }
-    if (type == "sphere") {
-        *out = make_sphere();
-        return true;
-    }
-    if (type == "hemisphere") {
-        *out = make_hemisphere();
+    if (type == "sphere" || type == "hemisphere") {
+        if (!check_domain_fields(c, j, path, type, {"type"})) return false;
+        *out = type == "sphere" ? make_sphere() : make_hemisphere();
         return true;
     }
     return c.fail(sub(path, "type"),
@@ -102,13 +210,52 @@ bool parse_expression(Ctx& c, const Json& text, const std::string& path, int dim
     return true;
 }
 
+/// Parameter arrays whose length is a dimension.
+constexpr const char* kDimensionArrays[] = {"powers", "rates", "center", "a", "u"};
+
+/// Refuses parameter arrays longer than any domain, before they are converted.
+bool check_array_lengths(Ctx& c, const Json& j, const std::string& path) {
+    for (const char* key : kDimensionArrays)
+        if (const Json* v = find(j, key); v && v->is_array() && v->size() > size_t(kMaxDim))
+            return c.fail(sub(path, key), "has " + std::to_string(v->size()) +
+                                              " entries; mcplay integrates in at most " +
+                                              std::to_string(kMaxDim) + " dimensions");
+    return true;
+}
+
+/// A Genz "dim": a whole number in 1..64 (false with an error otherwise; *given is false when
+/// there is none).
+bool get_genz_dim(Ctx& c, const Json& j, const std::string& path, int* dim, bool* given) {
+    *given = find(j, "dim") != nullptr;
+    if (!*given) return true;
+    uint64_t d = 0;
+    if (!get_count(c, j, "dim", path, &d)) return false;
+    if (d < 1 || d > static_cast<uint64_t>(kMaxDim))
+        return c.fail(sub(path, "dim"), "must be in 1.." + std::to_string(kMaxDim) + ", got " +
+                                            std::to_string(d));
+    *dim = static_cast<int>(d);
+    return true;
+}
+
 // Genz families: explicit "a" and "u", or Genz's random normalisation from "seed" and
 // "difficulty" (dimension from "dim" or the domain).
 bool parse_genz(Ctx& c, const Json& j, const std::string& path, GenzFamily family, int dim,
                 Integrand* out) {
     if (!check_keys(c, j, path, {"type", "a", "u", "dim", "seed", "difficulty"})) return false;
+    if (!check_array_lengths(c, j, path)) return false;
+    // "dim" is never ignored: it must agree with the domain and with "a".
+    int given_dim = 0;
+    bool has_dim = false;
+    if (!get_genz_dim(c, j, path, &given_dim, &has_dim)) return false;
+    if (has_dim && given_dim != dim)
+        return c.fail(sub(path, "dim"), "is " + std::to_string(given_dim) + ", but the domain has " +
+                                            std::to_string(dim) +
+                                            (dim == 1 ? " dimension" : " dimensions"));
     std::vector<double> a, u;
     if (!get_numbers(c, j, "a", path, &a) || !get_numbers(c, j, "u", path, &u)) return false;
+    if (has_dim && find(j, "a") && a.size() != size_t(given_dim))
+        return c.fail(sub(path, "dim"), "is " + std::to_string(given_dim) + ", but \"a\" has " +
+                                            std::to_string(a.size()) + " entries");
     GenzParams params;
     if (find(j, "a")) {
         if (!find(j, "u")) u.assign(a.size(), 0.5);
@@ -167,6 +314,7 @@ bool parse_integrand(Ctx& c, const Json& j, const std::string& path, int dim, In
                       "unknown integrand '" + type + "' (known: " + kIntegrandTypes + ")");
     if (!check_keys(c, j, path, {"type", "scale", "powers", "rates", "center", "sigma", "radius"}))
         return false;
+    if (!check_array_lengths(c, j, path)) return false;
     double scale = 1.0, width = 1.0;
     std::vector<double> coeffs, center;
     if (!get_number(c, j, "scale", path, &scale)) return false;
@@ -189,50 +337,72 @@ bool parse_integrand(Ctx& c, const Json& j, const std::string& path, int dim, In
 }
 
 // The dimension an integrand asks for when the scene gives no domain: the length of its
-// parameter arrays, a Genz "dim", or the highest variable an expression uses.
-int integrand_dimension(const Json& j) {
+// parameter arrays, a Genz "dim", or the highest variable an expression uses. Errors for
+// arrays longer than 64 and for a "dim" outside 1..64.
+bool integrand_dimension(Ctx& c, const Json& j, const std::string& path, int* out) {
+    *out = 1;
     if (j.is_string() || (j.is_object() && find(j, "f") && find(j, "f")->is_string())) {
         const std::string text =
             j.is_string() ? j.get<std::string>() : find(j, "f")->get<std::string>();
-        for (int d = 1; d <= 64; ++d)
-            if (compile_expression(text, d).ok()) return d;
-        return 64; // not an expression in any dimension: the full one reports the real error
+        *out = kMaxDim; // not an expression in any dimension: the full one reports the error
+        if (!compile_expression(text, kMaxDim).ok()) return true;
+        for (int d = 1; d <= kMaxDim; ++d)
+            if (compile_expression(text, d).ok()) {
+                *out = d;
+                break;
+            }
+        return true;
     }
-    int dim = 1;
-    for (const char* key : {"powers", "rates", "center", "a", "u"})
+    if (!j.is_object()) return true; // parse_integrand reports it
+    if (!check_array_lengths(c, j, path)) return false;
+    for (const char* key : kDimensionArrays)
         if (const Json* v = find(j, key); v && v->is_array() && !v->empty())
-            dim = static_cast<int>(v->size());
-    if (const Json* v = find(j, "dim");
-        v && v->is_number_integer() && v->get<int64_t>() >= 1 && v->get<int64_t>() <= 64)
-        dim = static_cast<int>(v->get<int64_t>());
-    return dim;
+            *out = static_cast<int>(v->size());
+    int dim = 0;
+    bool given = false;
+    if (!get_genz_dim(c, j, path, &dim, &given)) return false;
+    if (given) *out = dim;
+    return true;
 }
 
 // --- pdfs --------------------------------------------------------------------------------
 
-constexpr int kMaxBins = 1 << 20;
+constexpr int kMaxBins = 1 << 20;       // bins of a 1D table
+constexpr int kMaxBinsPerAxis = 4096;   // bins per axis of a 2D table
+constexpr size_t kMaxCells = 1u << 20;  // cells of a 2D table
 constexpr int kSubSamples = 4; // shape evaluations per bin and axis when tabulating
+constexpr size_t kMaxTabulationPoints = size_t(1) << 24; // shape evaluations per table
 constexpr int kExpressionBins1D = 1024;
 constexpr int kExpressionBins2D = 64;
 
 // Tabulation values: explicit "values", or |shape| averaged over kSubSamples^d points per cell.
+// Every count is checked before any array is converted or any shape evaluated.
 bool table_values(Ctx& c, const Json& j, const std::string& path, const Problem& problem,
                   const std::vector<int>& bins, const std::vector<double>& lo,
                   const std::vector<double>& hi, std::vector<double>* values) {
     size_t cells = 1;
-    for (int b : bins) cells *= static_cast<size_t>(b);
+    for (int b : bins) cells *= static_cast<size_t>(b); // b <= 2^20, at most two axes
     if (const Json* v = find(j, "values")) {
-        if (!to_numbers(c, *v, sub(path, "values"), values)) return false;
-        if (values->size() != cells)
-            return c.fail(sub(path, "values"), "has " + std::to_string(values->size()) +
+        const size_t given = v->is_array() ? v->size() : 1;
+        if (given != cells)
+            return c.fail(sub(path, "values"), "has " + std::to_string(given) +
                                                    " entries, bins ask for " +
                                                    std::to_string(cells));
+        if (!to_numbers(c, *v, sub(path, "values"), values)) return false;
         return true;
     }
     const Json* shape = find(j, "shape");
     if (!shape) return c.fail(path, "a tabulated pdf needs \"values\" or \"shape\"");
-    Integrand f;
     const int dim = static_cast<int>(bins.size());
+    const size_t sub_count = dim == 1 ? kSubSamples : kSubSamples * kSubSamples;
+    const size_t total = cells * sub_count;
+    if (total > kMaxTabulationPoints)
+        return c.fail(sub(path, "bins"), std::to_string(cells) + " cells of " +
+                                             std::to_string(sub_count) + " points each are " +
+                                             std::to_string(total) + " shape evaluations, more "
+                                             "than the limit of " +
+                                             std::to_string(kMaxTabulationPoints));
+    Integrand f;
     if (shape->is_string() && shape->get<std::string>() == "integrand") {
         if (problem.integrand.dim != dim)
             return c.fail(sub(path, "shape"), "the integrand has " +
@@ -245,11 +415,11 @@ bool table_values(Ctx& c, const Json& j, const std::string& path, const Problem&
     values->assign(cells, 0.0);
     // kSubSamples^d points per cell, evaluated a block at a time (cell-major, so each cell's
     // points are summed in order); x fastest over the cells, matching make_tabulated_2d.
-    const size_t sub_count = dim == 1 ? kSubSamples : kSubSamples * kSubSamples;
-    const size_t total = cells * sub_count;
     PointBlock block;
     block.reset(dim, kBlockSize);
     std::vector<double> v(kBlockSize);
+    size_t bad = 0;
+    double bad_x = 0.0, bad_y = 0.0, bad_value = 0.0;
     for (size_t first = 0; first < total; first += kBlockSize) {
         block.n = std::min(kBlockSize, total - first);
         for (size_t i = 0; i < block.n; ++i) {
@@ -265,8 +435,26 @@ bool table_values(Ctx& c, const Json& j, const std::string& path, const Problem&
         evaluate_block(f, block, v.data());
         for (size_t i = 0; i < block.n; ++i) {
             const double a = std::fabs(v[i]);
-            (*values)[(first + i) / sub_count] += std::isfinite(a) ? a : 0.0;
+            if (!std::isfinite(a)) { // counted and reported, never dropped
+                if (bad++ == 0) {
+                    bad_x = block.coord(0)[i];
+                    bad_y = dim == 2 ? block.coord(1)[i] : 0.0;
+                    bad_value = v[i];
+                }
+                continue;
+            }
+            (*values)[(first + i) / sub_count] += a;
         }
+    }
+    if (bad > 0) {
+        return c.fail(sub(path, "shape"),
+                      "the pdf shape is NaN or infinite at " + std::to_string(bad) + " of " +
+                          std::to_string(total) + " tabulation points (first " +
+                          number_text(bad_value) + " at " +
+                          (dim == 2 ? "(x, y) = (" + number_text(bad_x) + ", " +
+                                          number_text(bad_y) + ")"
+                                    : "x = " + number_text(bad_x)) +
+                          "); a pdf shape must be finite on the whole domain");
     }
     for (double& value : *values) value /= static_cast<double>(sub_count);
     return true;
@@ -304,8 +492,17 @@ bool parse_pdf_1d(Ctx& c, const Json& j, const std::string& path, const Problem&
         uint64_t bins = 64;
         if (!get_count(c, j, "bins", path, &bins)) return false;
         if (bins < 1 || bins > static_cast<uint64_t>(kMaxBins))
-            return c.fail(sub(path, "bins"), "must be in 1.." + std::to_string(kMaxBins));
-        if (find(j, "values") && !find(j, "bins")) bins = find(j, "values")->size();
+            return c.fail(sub(path, "bins"), "must be in 1.." + std::to_string(kMaxBins) +
+                                                 ", got " + std::to_string(bins));
+        if (const Json* v = find(j, "values"); v && !find(j, "bins")) {
+            // Without "bins", the values set the count: the same limit, checked before reading.
+            const size_t given = v->is_array() ? v->size() : 1;
+            if (given < 1 || given > static_cast<size_t>(kMaxBins))
+                return c.fail(sub(path, "values"), "has " + std::to_string(given) +
+                                                       " entries; a tabulated pdf has 1.." +
+                                                       std::to_string(kMaxBins) + " bins");
+            bins = given;
+        }
         std::vector<double> values;
         if (!table_values(c, j, path, problem, {static_cast<int>(bins)}, {a}, {b}, &values))
             return false;
@@ -365,9 +562,18 @@ bool parse_pdf(Ctx& c, const Json& j, const std::string& path, const Problem& pr
         if (bins.size() == 1) bins.push_back(bins[0]);
         if (bins.size() != 2) return c.fail(sub(path, "bins"), "expected [nx, ny]");
         for (double b : bins)
-            if (!(b >= 1 && b <= 4096 && b == std::floor(b)))
-                return c.fail(sub(path, "bins"), "each count must be a whole number in 1..4096");
+            if (!(b >= 1 && b <= kMaxBinsPerAxis && b == std::floor(b)))
+                return c.fail(sub(path, "bins"), "each count must be a whole number in 1.." +
+                                                     std::to_string(kMaxBinsPerAxis) + ", got " +
+                                                     number_text(b));
         std::vector<int> nb{static_cast<int>(bins[0]), static_cast<int>(bins[1])};
+        const size_t cells = size_t(nb[0]) * size_t(nb[1]);
+        if (cells > kMaxCells)
+            return c.fail(sub(path, "bins"), std::to_string(nb[0]) + " x " +
+                                                 std::to_string(nb[1]) + " = " +
+                                                 std::to_string(cells) +
+                                                 " cells, more than the limit of " +
+                                                 std::to_string(kMaxCells));
         std::vector<double> values;
         if (!table_values(c, j, path, problem, nb, dom.lo, dom.hi, &values)) return false;
         Made<TabulatedDistribution2D> t =
@@ -429,6 +635,44 @@ std::vector<std::string> preset_names() {
     return names;
 }
 
+/// Levenshtein distance (insertions, deletions, substitutions), for "did you mean".
+size_t edit_distance(const std::string& a, const std::string& b) {
+    std::vector<size_t> row(b.size() + 1);
+    for (size_t k = 0; k <= b.size(); ++k) row[k] = k;
+    for (size_t i = 1; i <= a.size(); ++i) {
+        size_t diagonal = row[0];
+        row[0] = i;
+        for (size_t k = 1; k <= b.size(); ++k) {
+            const size_t up = row[k];
+            row[k] = std::min({row[k] + 1, row[k - 1] + 1, diagonal + (a[i - 1] == b[k - 1] ? 0 : 1)});
+            diagonal = up;
+        }
+    }
+    return row[b.size()];
+}
+
+/// " (did you mean 'stratified'?" or " (" : the closest preset within a third of its length.
+std::string did_you_mean(const std::string& name) {
+    if (name.size() > 64) return " (";
+    const EstimatorPreset* best = nullptr;
+    size_t best_d = 0;
+    for (const EstimatorPreset& p : estimator_presets()) {
+        const size_t d = edit_distance(name, p.name);
+        if (!best || d < best_d) {
+            best = &p;
+            best_d = d;
+        }
+    }
+    const size_t len = std::string(best->name).size();
+    if (best_d > 0 && best_d * 3 <= len) return " (did you mean '" + std::string(best->name) + "'? ";
+    return " (";
+}
+
+/// The text of an estimator name for messages: at most 64 characters.
+std::string name_text(const std::string& name) {
+    return name.size() <= 64 ? name : name.substr(0, 61) + "...";
+}
+
 bool parse_estimator(Ctx& c, const Json& j, const std::string& path, const Problem& problem,
                      EstimatorSpec* out) {
     std::string name, sampler_name_str, warp;
@@ -468,6 +712,19 @@ bool parse_estimator(Ctx& c, const Json& j, const std::string& path, const Probl
         return c.fail(sub(path, "warp"), "unknown warp '" + warp + "' (known: polar, concentric)");
     if (!warp.empty() && problem.domain.kind != DomainKind::Disk)
         return c.fail(sub(path, "warp"), "only disk domains have a choice of warp");
+    // A name runs what it says: a bare name must be a preset, and a preset is not redefined.
+    if (!preset && sampler_name_str.empty() && !pdf)
+        return c.fail(path, "unknown estimator '" + name_text(name) + "'" + did_you_mean(name) +
+                                "presets: " + join(preset_names()) +
+                                "; a new name needs \"sampler\" or \"pdf\")");
+    if (preset && !sampler_name_str.empty() && out->sampler != preset->sampler)
+        return c.fail(sub(path, "sampler"),
+                      "'" + name + "' is the preset with the " + sampler_name(preset->sampler) +
+                          " sampler; give the estimator another name to use " + sampler_name_str);
+    if (preset && pdf && !preset->needs_pdf)
+        return c.fail(sub(path, "pdf"), "'" + name +
+                                            "' is a preset with the uniform density; give the "
+                                            "estimator another name to sample a pdf");
     out->proposal = uniform_proposal(problem.domain, warp == "polar");
     if (pdf) {
         if (!parse_pdf(c, *pdf, sub(path, "pdf"), problem, &out->proposal)) return false;
@@ -535,14 +792,17 @@ Made<SceneRequest> build_request(const Json& scene, const Json& options) {
     }
     if (!integrand)
         return made_error<SceneRequest>("scene: missing \"integrand\" (or \"f\": an expression)");
-    const int default_dim = integrand_dimension(*integrand);
+    int default_dim = 1;
+    if (!integrand_dimension(c, *integrand, integrand_path, &default_dim))
+        return made_error<SceneRequest>(c.error);
     if (const Json* d = find(scene, "domain")) {
         if (!parse_domain(c, *d, "scene.domain", default_dim, &pr.domain))
             return made_error<SceneRequest>(c.error);
     } else {
-        pr.domain = make_box(std::vector<double>(static_cast<size_t>(default_dim), 0.0),
-                             std::vector<double>(static_cast<size_t>(default_dim), 1.0))
-                        .value;
+        Made<Domain> unit = make_box(std::vector<double>(static_cast<size_t>(default_dim), 0.0),
+                                     std::vector<double>(static_cast<size_t>(default_dim), 1.0));
+        if (!unit.ok()) return made_error<SceneRequest>(std::string(integrand_path) + ": " + unit.error);
+        pr.domain = unit.value;
     }
     if (!parse_integrand(c, *integrand, integrand_path, pr.domain.point_dim(), &pr.integrand))
         return made_error<SceneRequest>(c.error);
@@ -565,6 +825,14 @@ Made<SceneRequest> build_request(const Json& scene, const Json& options) {
     } else if (pr.domain.kind == DomainKind::Box) {
         std::optional<double> v = exact_integral_over_box(pr.integrand, pr.domain.lo, pr.domain.hi);
         if (v && pr.quantity == Quantity::Mean) *v /= pr.domain.measure();
+        // A closed form outside the double range would be compared with estimates as inf or
+        // NaN: refuse the scene rather than report a meaningless error.
+        if (v && !std::isfinite(*v))
+            return made_error<SceneRequest>(
+                std::string(integrand_path) + ": the exact " +
+                (pr.quantity == Quantity::Mean ? "mean" : "integral") + " over " +
+                pr.domain.describe() + " is " + number_text(*v) +
+                ", outside double precision: rescale the integrand or the domain");
         pr.exact = v;
     }
 
@@ -641,19 +909,36 @@ Made<SceneRequest> build_request(const Json& scene, const Json& options) {
                 }
                 std::vector<std::string> have;
                 for (const EstimatorSpec& e : all) have.push_back(e.name);
+                std::string hint = did_you_mean(name);
+                for (const EstimatorSpec& e : all) // a scene's own name may be the near miss
+                    if (hint == " (" && edit_distance(name, e.name) > 0 &&
+                        edit_distance(name, e.name) * 3 <= e.name.size() && name.size() <= 64)
+                        hint = " (did you mean '" + name_text(e.name) + "'? ";
                 return made_error<SceneRequest>(
-                    "unknown estimator '" + name + "' (this scene has: " + join(have) +
+                    "options.estimators[" + std::to_string(i) + "]: unknown estimator '" +
+                    name_text(name) + "'" + hint + "this scene has: " + join(have) +
                     (preset ? "; '" + name + "' needs a pdf, which only a scene can give)"
                             : "; presets: " + join(preset_names()) + ")"));
             }
         }
     }
-    if (reps > 100000) reps = 100001; // reported by check_settings
-    if (threads > 1000) threads = 1001;
-    s.reps = static_cast<int>(reps);
-    s.threads = static_cast<int>(threads);
+    // check_settings takes ints: a count beyond int is passed as INT_MAX (beyond every limit)
+    // and the message then names the count actually given.
+    constexpr uint64_t kIntMax = static_cast<uint64_t>(std::numeric_limits<int>::max());
+    s.reps = static_cast<int>(std::min(reps, kIntMax));
+    s.threads = static_cast<int>(std::min(threads, kIntMax));
     std::string bad = check_settings(s);
-    if (!bad.empty()) return made_error<SceneRequest>("settings: " + bad);
+    if (!bad.empty()) {
+        for (auto [given, passed] : {std::pair<uint64_t, int>{reps, s.reps}, {threads, s.threads}}) {
+            const std::string tail = "got " + std::to_string(passed);
+            if (given != static_cast<uint64_t>(passed) && bad.size() >= tail.size() &&
+                bad.compare(bad.size() - tail.size(), tail.size(), tail) == 0) {
+                bad = bad.substr(0, bad.size() - tail.size()) + "got " + std::to_string(given);
+                break;
+            }
+        }
+        return made_error<SceneRequest>("settings: " + bad);
+    }
     for (const EstimatorSpec& e : req.estimators)
         if (e.per_stratum > 1 && s.n_min < e.per_stratum)
             return made_error<SceneRequest>("estimator '" + e.name + "': samples_per_stratum = " +

@@ -430,6 +430,9 @@ class ExprCompiler {
         return true;
     }
     void leave() { --depth_; }
+    /// A folded constant must be finite: "10^400", "1/0", "log(-1)" are refused like "1e400",
+    /// naming the sub-expression text_[start, end of the last token read).
+    bool finite_constant(const Operand& v, size_t start);
 
     // Parser.
     bool parse_sum(Operand& v);
@@ -494,6 +497,17 @@ size_t ExprCompiler::column(size_t offset) const {
 bool ExprCompiler::fail(size_t offset, const std::string& message) {
     if (error_.empty()) error_ = "at position " + std::to_string(column(offset)) + ": " + message;
     return false;
+}
+
+bool ExprCompiler::finite_constant(const Operand& v, size_t start) {
+    if (v.kind != Operand::Const || std::isfinite(v.value)) return true;
+    std::string sub = prev_end_ > start ? text_.substr(start, prev_end_ - start) : std::string();
+    if (sub.size() > 40) sub = sub.substr(0, 37) + "...";
+    return fail(start, "the constant '" + sub + "' is " +
+                           (std::isnan(v.value) ? std::string("NaN (not a number)")
+                                                : std::string(v.value > 0 ? "+" : "-") +
+                                                      "infinite (it overflows)") +
+                           "; constants must be finite");
 }
 
 /// " (implicit multiplication ...)" when the current token directly follows a number, as in
@@ -602,6 +616,7 @@ bool ExprCompiler::advance() {
 // primary := number | constant | variable | function '(' sum (',' sum)* ')' | '(' sum ')'
 
 bool ExprCompiler::parse_sum(Operand& v) {
+    const size_t start = tok_.pos;
     if (!parse_product(v)) return false;
     while (tok_.kind == TPlus || tok_.kind == TMinus) {
         const uint8_t op = tok_.kind == TPlus ? OpAdd : OpSub;
@@ -609,11 +624,13 @@ bool ExprCompiler::parse_sum(Operand& v) {
         Operand rhs;
         if (!parse_product(rhs)) return false;
         v = binary(op, v, rhs);
+        if (!finite_constant(v, start)) return false;
     }
     return true;
 }
 
 bool ExprCompiler::parse_product(Operand& v) {
+    const size_t start = tok_.pos;
     if (!parse_factor(v)) return false;
     while (tok_.kind == TStar || tok_.kind == TSlash) {
         const uint8_t op = tok_.kind == TStar ? OpMul : OpDiv;
@@ -621,6 +638,7 @@ bool ExprCompiler::parse_product(Operand& v) {
         Operand rhs;
         if (!parse_factor(rhs)) return false;
         v = binary(op, v, rhs);
+        if (!finite_constant(v, start)) return false;
     }
     return true;
 }
@@ -632,6 +650,7 @@ bool ExprCompiler::parse_factor(Operand& v) {
         if (!advance()) return false;
     }
     const size_t mark = code_.size();
+    const size_t start = tok_.pos;
     if (!parse_primary(v)) return false;
     if (tok_.kind == TCaret) {
         const size_t caret = tok_.pos;
@@ -640,6 +659,7 @@ bool ExprCompiler::parse_factor(Operand& v) {
         if (!parse_factor(exponent)) return false; // right-associative, may carry a sign
         leave();
         v = power(v, exponent, mark);
+        if (!finite_constant(v, start)) return false;
     }
     if (negate) v = unary(OpNeg, v);
     return true;
@@ -755,7 +775,7 @@ bool ExprCompiler::parse_call(const std::string& name, size_t name_pos, Operand&
         v = binary(f->op, args[0], args[1]);
     else
         v = unary(f->op, args[0]);
-    return true;
+    return finite_constant(v, name_pos);
 }
 
 ExprCompiler::Operand ExprCompiler::unary(uint8_t op, Operand a, int k) {

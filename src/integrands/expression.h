@@ -19,12 +19,17 @@
 //               sign(t) = -1, 0 or 1 (0 keeps the sign of a zero t), NaN for NaN;
 //               min and max return NaN when either argument is NaN (unlike std::fmin).
 //   No implicit multiplication ("2x" is an error). Identifiers are case-sensitive.
-// Arithmetic is plain IEEE double: log(-1) is NaN, 1/0 is inf; evaluation never traps.
+// Arithmetic is plain IEEE double: log(x) at x = -1 is NaN, 1/x at x = 0 is inf; evaluation
+// never traps. Constants are folded at compile time, and a constant (sub-)expression that is
+// not finite is an error like "1e400": "10^400", "1/0", "log(-1)", "exp(1000)" are refused
+// ("the constant '10^400' is +infinite (it overflows); constants must be finite").
 // a^k for an integer constant |k| <= 8 is computed by repeated multiplication (a^-k as
 // 1/(a^k)), a^0.5 as sqrt(a) (so (-inf)^0.5 is NaN, not inf), a^0 is 1 (NaN^0 too, as
 // std::pow); any other power calls std::pow. pow(a, b) is the same as a^b.
 // Limits: at most 10000 bytes of text and 200 levels of nesting (parentheses, calls and
-// exponents); beyond them compile_expression returns an error, never crashes.
+// exponents); beyond them compile_expression returns an error, never crashes. The length is
+// checked before anything is read, and every recursive step of the parser counts a level, so
+// the call stack is bounded whatever the input (runs of signs and flat chains are loops).
 // Errors read "at position P: MESSAGE", P the 1-based column (in characters, UTF-8 aware)
 // of the offending token; the first problem in reading order is reported.
 #pragma once
