@@ -58,10 +58,16 @@ if node -e 'const r = JSON.parse(require("fs").readFileSync(process.argv[1])); i
 else
     echo "FAIL out-file: $tmp/result.json is not the documented JSON"; failed=$((failed + 1))
 fi
-check out-unwritable 1 "cannot write" -- run exp_1d "${small[@]}" --out /nonexistent-dir/x.json
+check out-unwritable 2 "--out: cannot write" -- run exp_1d "${small[@]}" --out /nonexistent-dir/x.json
+# An --out that is checked up front is removed again when the run then fails.
+printf '{"f": "x", "estimators": ["unifrom"]}' >"$tmp/typo.json"
+check out-removed-on-scene-error 3 "did you mean 'uniform'" -- run "$tmp/typo.json" --out "$tmp/typo.out"
+if [ -e "$tmp/typo.out" ]; then echo "FAIL out-removed-on-scene-error: $tmp/typo.out left behind"; failed=$((failed + 1)); else passed=$((passed + 1)); fi
 check list 0 'disk_quarter' -- list
 check list-presets 0 'stratified_importance' -- list
-check list-bad-dir 1 'cannot open scenes directory' -- list --scenes /nonexistent-dir
+check list-bad-dir 2 'cannot open scenes directory' -- list --scenes /nonexistent-dir
+check scene-directory 3 'is a directory, not a scene file' -- run scenes
+check scene-dev-zero 3 'not a regular file' -- run /dev/zero
 check threads 0 '1 thread' -- run exp_1d "${small[@]}" --threads 1
 
 # Render scenes: studies through `run`, images through `render`.
@@ -86,7 +92,24 @@ check render-bad-estimator 2 "unknown estimator 'lite'" -- render quad_light_flo
 check render-bad-spp 2 "--spp: expected a whole number" -- render quad_light_floor --spp many --out "$tmp/x.png"
 check render-width-on-integral 2 'for render scenes' -- run exp_1d --width 8
 printf '{"render": {"gltf": "missing.gltf"}}' >"$tmp/r.json"
-check render-missing-gltf 3 "scene.render.gltf: cannot read" -- run "$tmp/r.json"
+check render-missing-gltf 3 "scene.render.gltf: 'missing.gltf' does not exist" -- run "$tmp/r.json"
+# The path rule lets a scene use its own subfolders and links that stay inside its folder: a
+# glTF in sub/ whose buffer is one level up (still inside), reached through a symbolic link.
+mkdir -p "$tmp/own/sub"
+node -e '
+const fs = require("fs"), [src, dir] = process.argv.slice(1);
+const g = JSON.parse(fs.readFileSync(src + "/scenes/quad_light_floor.gltf"));
+fs.writeFileSync(dir + "/q.bin", Buffer.from(g.buffers[0].uri.split(",")[1], "base64"));
+g.buffers[0].uri = "../q.bin";
+fs.writeFileSync(dir + "/sub/q.gltf", JSON.stringify(g));
+fs.writeFileSync(dir + "/r.json", JSON.stringify({ name: "own", render: { gltf: "link.gltf",
+  width: 8, height: 6, spp_min: 1, spp_max: 2, reps: 2, estimators: ["light_area"] } }));
+' "$src" "$tmp/own"
+ln -s sub/q.gltf "$tmp/own/link.gltf"
+check render-own-subfolder 0 'fitted order' -- run "$tmp/own/r.json" --no-cache
+ln -s "$(cd "$src" && pwd)/scenes/quad_light_floor.gltf" "$tmp/own/escape.gltf"
+printf '{"render": {"gltf": "escape.gltf"}}' >"$tmp/own/escape.json"
+check render-link-outside 3 "scene.render.gltf: 'escape.gltf' lies outside the scene's folder" -- run "$tmp/own/escape.json"
 printf '{"render": {"gltf": {"asset": {"version": "2.0"}, "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "mode": 1}]}]}}}' >"$tmp/lines.json"
 check render-bad-gltf 3 'scene.render.gltf: ' -- run "$tmp/lines.json"
 

@@ -279,15 +279,15 @@ TEST(SceneParsing, ExpressionConstantsAndSizes) {
 
 TEST(SceneParsing, SettingsErrorsNameTheValueGiven) {
     EXPECT_EQ(error_of(R"({"f": "x"})", R"({"reps": 1000000000})"),
-              "settings: reps must be in 2..100000 (a variance needs two replicates), got "
+              "options: reps must be in 2..100000 (a variance needs two replicates), got "
               "1000000000");
     EXPECT_EQ(error_of(R"({"f": "x", "reps": 1099511627776})"),
-              "settings: reps must be in 2..100000 (a variance needs two replicates), got "
+              "scene: reps must be in 2..100000 (a variance needs two replicates), got "
               "1099511627776");
     EXPECT_EQ(error_of(R"({"f": "x"})", R"({"threads": 10000})"),
-              "settings: threads must be in 0..256 (0 = all cores), got 10000");
+              "options: threads must be in 0..256 (0 = all cores), got 10000");
     EXPECT_EQ(error_of(R"({"f": "x"})", R"({"threads": 18446744073709551615})"),
-              "settings: threads must be in 0..256 (0 = all cores), got 18446744073709551615");
+              "options: threads must be in 0..256 (0 = all cores), got 18446744073709551615");
 }
 
 // --- 8. other silently wrong values -------------------------------------------------------

@@ -18,6 +18,14 @@ inline int fail(int status, const std::string& message) {
     return status;
 }
 
+/// The status of a request that could not be built: a bad value in the caller's options is a
+/// bad argument (messages "options..."), anything else a bad scene.
+inline int request_error(const std::string& message) {
+    return fail(message.compare(0, 7, "options") == 0 ? 1 /* MCP_ERROR_ARGUMENT */
+                                                      : 2 /* MCP_ERROR_SCENE */,
+                message);
+}
+
 inline int succeed() {
     g_last_error.clear();
     return 0;

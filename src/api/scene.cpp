@@ -937,7 +937,13 @@ Made<SceneRequest> build_request(const Json& scene, const Json& options) {
                 break;
             }
         }
-        return made_error<SceneRequest>("settings: " + bad);
+        // Whose value is it: the options' (a bad argument) when they set a field the message
+        // is about, else the scene's.
+        bool from_options = false;
+        for (const char* key : {"n_min", "n_max", "reps", "threads"})
+            from_options = from_options || (options.is_object() && find(options, key) &&
+                                            bad.find(key) != std::string::npos);
+        return made_error<SceneRequest>((from_options ? "options: " : "scene: ") + bad);
     }
     for (const EstimatorSpec& e : req.estimators)
         if (e.per_stratum > 1 && s.n_min < e.per_stratum)

@@ -126,7 +126,7 @@ int load(const char* scene_json, const char* options_json, Loaded* out, Json* op
     if (!is_render_scene(scene.value))
         return fail(MCP_ERROR_SCENE, "scene: not a render scene (no \"render\" object)");
     Made<std::shared_ptr<RenderRequest>> req = build_render_request(scene.value, *options);
-    if (!req.ok()) return fail(MCP_ERROR_SCENE, req.error);
+    if (!req.ok()) return boundary::request_error(req.error);
     out->request = req.value;
     out->scene.build(*out->request->scene, out->request->accel);
     // A light whose emission or area is NaN or infinite cannot be rendered; dropping it would
