@@ -66,6 +66,8 @@ if [ -e "$tmp/typo.out" ]; then echo "FAIL out-removed-on-scene-error: $tmp/typo
 check list 0 'disk_quarter' -- list
 check list-presets 0 'stratified_importance' -- list
 check list-bad-dir 2 'cannot open scenes directory' -- list --scenes /nonexistent-dir
+mkdir -p "$tmp/fifos" && mkfifo "$tmp/fifos/blocked.json" && cp scenes/exp_1d.json "$tmp/fifos/"
+check list-fifo 0 'blocked.json +UNREADABLE: .* not a regular file' -- list --scenes "$tmp/fifos"
 check scene-directory 3 'is a directory, not a scene file' -- run scenes
 check scene-dev-zero 3 'not a regular file' -- run /dev/zero
 check threads 0 '1 thread' -- run exp_1d "${small[@]}" --threads 1

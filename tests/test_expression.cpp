@@ -591,8 +591,7 @@ double reference(const Node& n, const double* x) {
 /// True when some variable-free subtree evaluates to a non-finite value: the compiler folds
 /// it to a constant and refuses it (issue 10).
 bool has_nonfinite_constant(const Node& n) {
-    if ((n.a && has_nonfinite_constant(*n.a)) || (n.b && has_nonfinite_constant(*n.b)))
-        return true;
+    if ((n.a && has_nonfinite_constant(*n.a)) || (n.b && has_nonfinite_constant(*n.b))) return true;
     return !has_var(n) && !std::isfinite(reference(n, nullptr));
 }
 

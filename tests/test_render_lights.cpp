@@ -713,7 +713,8 @@ TEST(RenderLights, EmptyAndDegenerateLightSets) {
 // zero-area emissive triangle and a non-finite emission are counted, never silently dropped.
 TEST(LightSet, HugeRadianceKeepsAValidSelection) {
     Scene s = test::quad_light_scene(1e308);
-    for (LightSelection sel : {LightSelection::Uniform, LightSelection::Area, LightSelection::Power}) {
+    for (LightSelection sel :
+         {LightSelection::Uniform, LightSelection::Area, LightSelection::Power}) {
         LightSet lights;
         lights.build(s, sel);
         ASSERT_EQ(lights.size(), 2u);

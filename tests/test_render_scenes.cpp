@@ -358,8 +358,8 @@ struct Call {
 Call study_text(const json& scene, json options) {
     char* out = nullptr;
     Call c;
-    c.status = mcp_render_study_run(scene.dump().c_str(), options.dump().c_str(), nullptr,
-                                    nullptr, &out);
+    c.status =
+        mcp_render_study_run(scene.dump().c_str(), options.dump().c_str(), nullptr, nullptr, &out);
     if (c.status != MCP_OK) c.error = mcp_last_error();
     if (out) c.result = json::parse(out);
     mcp_free(out);
@@ -373,8 +373,13 @@ template <class Edit> json quad_scene(Edit edit, const std::string& name = "q") 
     return json{{"name", name}, {"render", {{"gltf", gltf}}}};
 }
 
-const json kTiny{{"width", 4}, {"height", 4}, {"spp_min", 1}, {"spp_max", 2}, {"reps", 2},
-                 {"estimators", {"light_area", "bsdf"}}, {"reference", {{"spp", 16}}}};
+const json kTiny{{"width", 4},
+                 {"height", 4},
+                 {"spp_min", 1},
+                 {"spp_max", 2},
+                 {"reps", 2},
+                 {"estimators", {"light_area", "bsdf"}},
+                 {"reference", {{"spp", 16}}}};
 
 bool has_code(const json& warnings, const std::string& code) {
     for (const json& w : warnings)
@@ -418,9 +423,9 @@ TEST(RenderHonesty, DegenerateLightsAreReported) {
         std::string bytes(reinterpret_cast<const char*>(p), sizeof p);
         size_t buffer = g["buffers"].size(), view = g["bufferViews"].size(),
                accessor = g["accessors"].size(), mesh = g["meshes"].size();
-        g["buffers"].push_back({{"byteLength", sizeof p},
-                                {"uri", "data:application/octet-stream;base64," +
-                                            base64_encode(bytes)}});
+        g["buffers"].push_back(
+            {{"byteLength", sizeof p},
+             {"uri", "data:application/octet-stream;base64," + base64_encode(bytes)}});
         g["bufferViews"].push_back({{"buffer", buffer}, {"byteLength", sizeof p}});
         g["accessors"].push_back({{"bufferView", view},
                                   {"componentType", 5126},
@@ -485,7 +490,8 @@ TEST(RenderHonesty, CacheNameIsAHashAndCorruptCachesAreIgnored) {
     EXPECT_EQ(study_text(scene, options).result["scene"]["reference"]["source"], "cache");
     // Truncated, then the right size with a wrong magic: both ignored, rendered again.
     std::string bytes = read(file);
-    for (const std::string& bad : {bytes.substr(0, bytes.size() - 8), "XXXXXXXX" + bytes.substr(8)}) {
+    for (const std::string& bad :
+         {bytes.substr(0, bytes.size() - 8), "XXXXXXXX" + bytes.substr(8)}) {
         {
             std::ofstream out(file, std::ios::binary | std::ios::trunc);
             out << bad;
@@ -533,12 +539,12 @@ TEST(RenderHonesty, ReferenceCacheReaderChecksEverything) {
         b.replace(8, sizeof head, reinterpret_cast<const char*>(head), sizeof head);
         return b;
     };
-    EXPECT_TRUE(rejected(good.substr(0, good.size() - 1)));       // truncated
-    EXPECT_TRUE(rejected(good + "x"));                             // trailing bytes
-    EXPECT_TRUE(rejected(good.substr(0, 20)));                     // no header
-    EXPECT_TRUE(rejected(with_header(5000, 1, 64)));               // too wide
-    EXPECT_TRUE(rejected(with_header(-3, -2, 64)));                // negative sizes
-    EXPECT_TRUE(rejected(with_header(3, 2, 0)));                   // no spp
+    EXPECT_TRUE(rejected(good.substr(0, good.size() - 1))); // truncated
+    EXPECT_TRUE(rejected(good + "x"));                      // trailing bytes
+    EXPECT_TRUE(rejected(good.substr(0, 20)));              // no header
+    EXPECT_TRUE(rejected(with_header(5000, 1, 64)));        // too wide
+    EXPECT_TRUE(rejected(with_header(-3, -2, 64)));         // negative sizes
+    EXPECT_TRUE(rejected(with_header(3, 2, 0)));            // no spp
     std::string inf = good;
     double big = INFINITY;
     std::memcpy(&inf[32], &big, sizeof big);
@@ -631,8 +637,8 @@ TEST(RenderHonesty, ReferenceNoiseFloorIsReportedAndGuarded) {
 // Work and memory are bounded before anything is rendered.
 TEST(RenderHonesty, WorkIsBoundedUpFront) {
     json scene = quad_scene([](json&) {});
-    json big{{"width", 2048}, {"height", 2048}, {"spp_min", 1}, {"spp_max", 1048576},
-             {"reps", 2}, {"estimators", {"bsdf"}}};
+    json big{{"width", 2048},      {"height", 2048}, {"spp_min", 1},
+             {"spp_max", 1048576}, {"reps", 2},      {"estimators", {"bsdf"}}};
     Call c = study_text(scene, big);
     EXPECT_EQ(c.status, MCP_ERROR_SCENE);
     EXPECT_NE(c.error.find("scene.render: this needs"), std::string::npos) << c.error;

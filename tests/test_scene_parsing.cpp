@@ -68,9 +68,10 @@ TEST(SceneParsing, UnknownEstimatorNamesAreRefused) {
 }
 
 TEST(SceneParsing, PresetsAreNotRedefined) {
-    EXPECT_EQ(error_of(R"({"f": "x", "estimators": [{"name": "uniform", "sampler": "stratified"}]})"),
-              "scene.estimators[0].sampler: 'uniform' is the preset with the independent sampler; "
-              "give the estimator another name to use stratified");
+    EXPECT_EQ(
+        error_of(R"({"f": "x", "estimators": [{"name": "uniform", "sampler": "stratified"}]})"),
+        "scene.estimators[0].sampler: 'uniform' is the preset with the independent sampler; "
+        "give the estimator another name to use stratified");
     EXPECT_EQ(error_of(R"({"f": "x", "estimators": [{"name": "stratified", "pdf": "x"}]})"),
               "scene.estimators[0].pdf: 'stratified' is a preset with the uniform density; give "
               "the estimator another name to sample a pdf");
@@ -112,21 +113,22 @@ TEST(SceneParsing, ParameterArraysLongerThan64AreRefusedByName) {
     EXPECT_EQ(error_of(R"({"integrand": {"type": "monomial", "powers": )" + powers + "}}"),
               "scene.integrand.powers: has 1000 entries; mcplay integrates in at most 64 "
               "dimensions");
-    EXPECT_EQ(error_of(R"({"integrand": {"type": "gaussian", "center": )" + repeated(65, "0") +
-                       "}}"),
-              "scene.integrand.center: has 65 entries; mcplay integrates in at most 64 "
-              "dimensions");
-    EXPECT_EQ(error_of(R"({"integrand": {"type": "genz_oscillatory", "a": )" +
-                       repeated(100, "1") + "}}"),
-              "scene.integrand.a: has 100 entries; mcplay integrates in at most 64 dimensions");
+    EXPECT_EQ(
+        error_of(R"({"integrand": {"type": "gaussian", "center": )" + repeated(65, "0") + "}}"),
+        "scene.integrand.center: has 65 entries; mcplay integrates in at most 64 "
+        "dimensions");
+    EXPECT_EQ(
+        error_of(R"({"integrand": {"type": "genz_oscillatory", "a": )" + repeated(100, "1") + "}}"),
+        "scene.integrand.a: has 100 entries; mcplay integrates in at most 64 dimensions");
     // With a domain too.
     EXPECT_EQ(error_of(R"({"domain": {"type": "box", "dim": 2}, "integrand": {"type":
-                           "exponential", "rates": )" + repeated(70, "1") + "}}"),
+                           "exponential", "rates": )" +
+                       repeated(70, "1") + "}}"),
               "scene.integrand.rates: has 70 entries; mcplay integrates in at most 64 "
               "dimensions");
-    EXPECT_EQ(error_of(R"({"domain": {"type": "box", "lower": )" + repeated(65, "0") +
-                       R"(}, "f": "x"})"),
-              "scene.domain.lower: has 65 entries; mcplay integrates in at most 64 dimensions");
+    EXPECT_EQ(
+        error_of(R"({"domain": {"type": "box", "lower": )" + repeated(65, "0") + R"(}, "f": "x"})"),
+        "scene.domain.lower: has 65 entries; mcplay integrates in at most 64 dimensions");
 }
 
 // --- 3. domain measures -------------------------------------------------------------------
@@ -172,7 +174,8 @@ TEST(SceneParsing, DomainMeasuresOutsideTheDoubleRangeAreRefused) {
               "problem");
     // Collinear is still collinear; small but normal measures are fine.
     EXPECT_NE(error_of(R"({"domain": {"type": "triangle", "vertices": [[0,0],[1,1],[2,2]]},
-                           "f": "1"})").find("collinear"),
+                           "f": "1"})")
+                  .find("collinear"),
               std::string::npos);
     Made<SceneRequest> r =
         build(R"({"domain": {"type": "box", "lower": [0, 0], "upper": [1e-100, 1e-100]},
@@ -188,7 +191,8 @@ TEST(SceneParsing, TableSizesAreCheckedBeforeAnyWork) {
     // 2,000,000 values without "bins" used to set bins = 2,000,000, past the limit.
     const std::string values = repeated(2000000, "1");
     EXPECT_EQ(error_of(R"({"f": "x", "estimators": [{"name": "t", "pdf": {"type": "tabulated",
-                           "values": )" + values + "}}]}"),
+                           "values": )" +
+                       values + "}}]}"),
               "scene.estimators[0].pdf.values: has 2000000 entries; a tabulated pdf has "
               "1..1048576 bins");
     EXPECT_EQ(error_of(R"({"f": "x", "estimators": [{"name": "t", "pdf": {"type": "tabulated",
@@ -199,7 +203,8 @@ TEST(SceneParsing, TableSizesAreCheckedBeforeAnyWork) {
               "scene.estimators[0].pdf.bins: must be in 1..1048576, got 2000000");
     // 2D: a wrong-sized values array is refused by its size, before it is read.
     EXPECT_EQ(error_of(R"({"f": "x*y", "estimators": [{"name": "t", "pdf": {"type":
-                           "tabulated_2d", "values": )" + values + "}}]}"),
+                           "tabulated_2d", "values": )" +
+                       values + "}}]}"),
               "scene.estimators[0].pdf.values: has 2000000 entries, bins ask for 1024");
     // 4096 x 4096 cells used to be tabulated for seconds before being refused.
     const auto start = std::chrono::steady_clock::now();

@@ -61,14 +61,17 @@ bool read_regular_file(const std::string& path, uint64_t limit, std::string* out
     }
     if (S_ISDIR(st.st_mode) || !S_ISREG(st.st_mode)) {
         *error = "'" + shown(path) + "' is " +
-                 (S_ISDIR(st.st_mode) ? "a directory" : "not a regular file (a device, FIFO or socket)") +
+                 (S_ISDIR(st.st_mode) ? "a directory"
+                                      : "not a regular file (a device, FIFO or socket)") +
                  ", not a file to read";
         ::close(fd);
         return false;
     }
     const auto too_large = [&](uint64_t bytes) {
-        *error = "'" + shown(path) + "' has " + (bytes > limit + 1 ? std::to_string(bytes) : "more than " + std::to_string(limit)) +
-                 " bytes, more than the limit of " + std::to_string(limit);
+        *error =
+            "'" + shown(path) + "' has " +
+            (bytes > limit + 1 ? std::to_string(bytes) : "more than " + std::to_string(limit)) +
+            " bytes, more than the limit of " + std::to_string(limit);
         ::close(fd);
         return false;
     };

@@ -140,8 +140,8 @@ std::string parse_error_reason(const std::string& what) {
 struct CheckingSax : nlohmann::json_sax<Json> {
     struct Frame {
         bool object = false;
-        size_t index = 0;             ///< arrays: the next element's index
-        std::string key;              ///< objects: the current key
+        size_t index = 0;              ///< arrays: the next element's index
+        std::string key;               ///< objects: the current key
         std::vector<std::string> keys; ///< objects: the keys seen so far
     };
     std::vector<Frame> stack;
@@ -196,7 +196,8 @@ struct CheckingSax : nlohmann::json_sax<Json> {
         f.key = k;
         return true;
     }
-    bool parse_error(std::size_t, const std::string&, const nlohmann::detail::exception& ex) override {
+    bool parse_error(std::size_t, const std::string&,
+                     const nlohmann::detail::exception& ex) override {
         message = parse_error_reason(ex.what()) + " (in " + path() + ")";
         return false;
     }
@@ -210,8 +211,8 @@ std::string check_json_text(const char* text, size_t size, const char* root) {
                std::to_string(kMaxJsonBytes);
     CheckingSax sax;
     sax.root = root;
-    const bool ok = Json::sax_parse(text, text + size, &sax,
-                                    nlohmann::detail::input_format_t::json, /*strict=*/true);
+    const bool ok = Json::sax_parse(text, text + size, &sax, nlohmann::detail::input_format_t::json,
+                                    /*strict=*/true);
     if (ok) return "";
     return sax.message.empty() ? "could not parse" : sax.message;
 }

@@ -79,8 +79,7 @@ bool parse_domain(Ctx& c, const Json& j, const std::string& path, int default_di
         return false;
     if (!get_string(c, j, "type", path, &type)) return false;
     if (type == "box" || type == "interval") {
-        if (!check_domain_fields(c, j, path, type, {"type", "dim", "lower", "upper"}))
-            return false;
+        if (!check_domain_fields(c, j, path, type, {"type", "dim", "lower", "upper"})) return false;
         uint64_t dim = static_cast<uint64_t>(default_dim);
         if (!get_count(c, j, "dim", path, &dim)) return false;
         if (dim < 1 || dim > static_cast<uint64_t>(kMaxDim))
@@ -115,8 +114,8 @@ bool parse_domain(Ctx& c, const Json& j, const std::string& path, int default_di
         for (size_t a = 0; a < lo.size(); ++a) {
             const double w = hi[a] - lo[a];
             // hi - lo overflows only when both are huge: halve first for the magnitude.
-            const double lw = std::isfinite(w) ? std::log10(w)
-                                               : std::log10(0.5 * hi[a] - 0.5 * lo[a]) + 0.30103;
+            const double lw =
+                std::isfinite(w) ? std::log10(w) : std::log10(0.5 * hi[a] - 0.5 * lo[a]) + 0.30103;
             log10_volume += lw;
             std::string bad = check_measure(w, lw);
             if (!bad.empty())
@@ -141,8 +140,8 @@ bool parse_domain(Ctx& c, const Json& j, const std::string& path, int default_di
         Made<Domain> d = make_disk(center, radius);
         if (!d.ok()) return c.fail(path, d.error);
         // pi r^2, and the bounding box centre +- r, must be representable.
-        std::string bad = check_measure(d.value.measure(),
-                                        std::log10(kPi) + 2.0 * std::log10(radius));
+        std::string bad =
+            check_measure(d.value.measure(), std::log10(kPi) + 2.0 * std::log10(radius));
         if (!bad.empty())
             return c.fail(sub(path, "radius"),
                           "the disk's area pi r^2 with r = " + number_text(radius) + " " + bad);
@@ -231,8 +230,8 @@ bool get_genz_dim(Ctx& c, const Json& j, const std::string& path, int* dim, bool
     uint64_t d = 0;
     if (!get_count(c, j, "dim", path, &d)) return false;
     if (d < 1 || d > static_cast<uint64_t>(kMaxDim))
-        return c.fail(sub(path, "dim"), "must be in 1.." + std::to_string(kMaxDim) + ", got " +
-                                            std::to_string(d));
+        return c.fail(sub(path, "dim"),
+                      "must be in 1.." + std::to_string(kMaxDim) + ", got " + std::to_string(d));
     *dim = static_cast<int>(d);
     return true;
 }
@@ -248,8 +247,8 @@ bool parse_genz(Ctx& c, const Json& j, const std::string& path, GenzFamily famil
     bool has_dim = false;
     if (!get_genz_dim(c, j, path, &given_dim, &has_dim)) return false;
     if (has_dim && given_dim != dim)
-        return c.fail(sub(path, "dim"), "is " + std::to_string(given_dim) + ", but the domain has " +
-                                            std::to_string(dim) +
+        return c.fail(sub(path, "dim"), "is " + std::to_string(given_dim) +
+                                            ", but the domain has " + std::to_string(dim) +
                                             (dim == 1 ? " dimension" : " dimensions"));
     std::vector<double> a, u;
     if (!get_numbers(c, j, "a", path, &a) || !get_numbers(c, j, "u", path, &u)) return false;
@@ -367,10 +366,10 @@ bool integrand_dimension(Ctx& c, const Json& j, const std::string& path, int* ou
 
 // --- pdfs --------------------------------------------------------------------------------
 
-constexpr int kMaxBins = 1 << 20;       // bins of a 1D table
-constexpr int kMaxBinsPerAxis = 4096;   // bins per axis of a 2D table
-constexpr size_t kMaxCells = 1u << 20;  // cells of a 2D table
-constexpr int kSubSamples = 4; // shape evaluations per bin and axis when tabulating
+constexpr int kMaxBins = 1 << 20;      // bins of a 1D table
+constexpr int kMaxBinsPerAxis = 4096;  // bins per axis of a 2D table
+constexpr size_t kMaxCells = 1u << 20; // cells of a 2D table
+constexpr int kSubSamples = 4;         // shape evaluations per bin and axis when tabulating
 constexpr size_t kMaxTabulationPoints = size_t(1) << 24; // shape evaluations per table
 constexpr int kExpressionBins1D = 1024;
 constexpr int kExpressionBins2D = 64;
@@ -399,7 +398,8 @@ bool table_values(Ctx& c, const Json& j, const std::string& path, const Problem&
     if (total > kMaxTabulationPoints)
         return c.fail(sub(path, "bins"), std::to_string(cells) + " cells of " +
                                              std::to_string(sub_count) + " points each are " +
-                                             std::to_string(total) + " shape evaluations, more "
+                                             std::to_string(total) +
+                                             " shape evaluations, more "
                                              "than the limit of " +
                                              std::to_string(kMaxTabulationPoints));
     Integrand f;
@@ -451,9 +451,9 @@ bool table_values(Ctx& c, const Json& j, const std::string& path, const Problem&
                       "the pdf shape is NaN or infinite at " + std::to_string(bad) + " of " +
                           std::to_string(total) + " tabulation points (first " +
                           number_text(bad_value) + " at " +
-                          (dim == 2 ? "(x, y) = (" + number_text(bad_x) + ", " +
-                                          number_text(bad_y) + ")"
-                                    : "x = " + number_text(bad_x)) +
+                          (dim == 2
+                               ? "(x, y) = (" + number_text(bad_x) + ", " + number_text(bad_y) + ")"
+                               : "x = " + number_text(bad_x)) +
                           "); a pdf shape must be finite on the whole domain");
     }
     for (double& value : *values) value /= static_cast<double>(sub_count);
@@ -569,9 +569,8 @@ bool parse_pdf(Ctx& c, const Json& j, const std::string& path, const Problem& pr
         std::vector<int> nb{static_cast<int>(bins[0]), static_cast<int>(bins[1])};
         const size_t cells = size_t(nb[0]) * size_t(nb[1]);
         if (cells > kMaxCells)
-            return c.fail(sub(path, "bins"), std::to_string(nb[0]) + " x " +
-                                                 std::to_string(nb[1]) + " = " +
-                                                 std::to_string(cells) +
+            return c.fail(sub(path, "bins"), std::to_string(nb[0]) + " x " + std::to_string(nb[1]) +
+                                                 " = " + std::to_string(cells) +
                                                  " cells, more than the limit of " +
                                                  std::to_string(kMaxCells));
         std::vector<double> values;
@@ -644,7 +643,8 @@ size_t edit_distance(const std::string& a, const std::string& b) {
         row[0] = i;
         for (size_t k = 1; k <= b.size(); ++k) {
             const size_t up = row[k];
-            row[k] = std::min({row[k] + 1, row[k - 1] + 1, diagonal + (a[i - 1] == b[k - 1] ? 0 : 1)});
+            row[k] =
+                std::min({row[k] + 1, row[k - 1] + 1, diagonal + (a[i - 1] == b[k - 1] ? 0 : 1)});
             diagonal = up;
         }
     }
@@ -664,7 +664,8 @@ std::string did_you_mean(const std::string& name) {
         }
     }
     const size_t len = std::string(best->name).size();
-    if (best_d > 0 && best_d * 3 <= len) return " (did you mean '" + std::string(best->name) + "'? ";
+    if (best_d > 0 && best_d * 3 <= len)
+        return " (did you mean '" + std::string(best->name) + "'? ";
     return " (";
 }
 
@@ -801,7 +802,8 @@ Made<SceneRequest> build_request(const Json& scene, const Json& options) {
     } else {
         Made<Domain> unit = make_box(std::vector<double>(static_cast<size_t>(default_dim), 0.0),
                                      std::vector<double>(static_cast<size_t>(default_dim), 1.0));
-        if (!unit.ok()) return made_error<SceneRequest>(std::string(integrand_path) + ": " + unit.error);
+        if (!unit.ok())
+            return made_error<SceneRequest>(std::string(integrand_path) + ": " + unit.error);
         pr.domain = unit.value;
     }
     if (!parse_integrand(c, *integrand, integrand_path, pr.domain.point_dim(), &pr.integrand))
@@ -929,7 +931,8 @@ Made<SceneRequest> build_request(const Json& scene, const Json& options) {
     s.threads = static_cast<int>(std::min(threads, kIntMax));
     std::string bad = check_settings(s);
     if (!bad.empty()) {
-        for (auto [given, passed] : {std::pair<uint64_t, int>{reps, s.reps}, {threads, s.threads}}) {
+        for (auto [given, passed] :
+             {std::pair<uint64_t, int>{reps, s.reps}, {threads, s.threads}}) {
             const std::string tail = "got " + std::to_string(passed);
             if (given != static_cast<uint64_t>(passed) && bad.size() >= tail.size() &&
                 bad.compare(bad.size() - tail.size(), tail.size(), tail) == 0) {

@@ -199,8 +199,8 @@ struct Log {
 struct LoadContext {
     const tinygltf::Model* model = nullptr; ///< filled by tinygltf while the callbacks run
     std::string base_dir;
-    std::string root;         ///< every file read must lie inside this folder
-    std::string path_problem; ///< the first URI refused for lying outside `root`
+    std::string root;                         ///< every file read must lie inside this folder
+    std::string path_problem;                 ///< the first URI refused for lying outside `root`
     uint64_t bytes_read = 0;                  ///< by external buffer and image reads together
     std::map<int, std::string> image_problem; ///< image index -> why it has no bytes
 };
@@ -226,7 +226,8 @@ bool fs_read_whole_file(std::vector<unsigned char>* out, std::string* err, const
     std::string why;
     if (!file_is_inside(ctx->root, path, &why)) {
         std::string uri = path;
-        if (!ctx->base_dir.empty() && path.compare(0, ctx->base_dir.size() + 1, ctx->base_dir + "/") == 0)
+        if (!ctx->base_dir.empty() &&
+            path.compare(0, ctx->base_dir.size() + 1, ctx->base_dir + "/") == 0)
             uri = path.substr(ctx->base_dir.size() + 1);
         *err = "'" + quoted(uri, 200) + "' " + why;
         if (ctx->path_problem.empty()) ctx->path_problem = *err;
@@ -345,7 +346,8 @@ struct GltfTypeChecker {
     }
     /// `props`: "name:k" for a scalar of kind k, "name:kN" for an array of N of them ("kN"
     /// with N = 0 for any length).
-    bool fields(const Json& obj, const std::string& path, std::initializer_list<const char*> props) {
+    bool fields(const Json& obj, const std::string& path,
+                std::initializer_list<const char*> props) {
         if (!obj.is_object()) return fail(path, "an object");
         for (const char* prop : props) {
             const std::string spec = prop;
@@ -391,60 +393,75 @@ struct GltfTypeChecker {
         }
         if (!fields(g, "glTF", {"scene:i", "extensionsUsed:s0", "extensionsRequired:s0"}))
             return false;
-        return each(g, "scenes", [&](const Json& s, const std::string& p) {
-                   return fields(s, p, {"nodes:i0", "name:s"});
-               }) &&
-               each(g, "nodes", [&](const Json& n, const std::string& p) {
-                   return fields(n, p, {"camera:i", "mesh:i", "children:i0", "matrix:n16",
-                                        "translation:n3", "rotation:n4", "scale:n3", "name:s"});
-               }) &&
-               each(g, "cameras", [&](const Json& c, const std::string& p) {
-                   return fields(c, p, {"type:s", "perspective:o", "orthographic:o"}) &&
-                          (!c.contains("perspective") ||
-                           fields(c["perspective"], p + ".perspective",
-                                  {"yfov:n", "znear:n", "zfar:n", "aspectRatio:n"}));
-               }) &&
-               each(g, "meshes", [&](const Json& m, const std::string& p) {
-                   if (!fields(m, p, {"name:s"})) return false;
-                   auto prims = m.find("primitives");
-                   if (prims == m.end() || !prims->is_array())
-                       return fail(p + ".primitives", "an array");
-                   for (size_t i = 0; i < prims->size(); ++i) {
-                       const Json& q = (*prims)[i];
-                       const std::string pp = at(p + ".primitives", i);
-                       if (!fields(q, pp, {"mode:i", "material:i", "indices:i", "attributes:o"}))
-                           return false;
-                       if (q.contains("attributes"))
-                           for (auto a = q["attributes"].begin(); a != q["attributes"].end(); ++a)
-                               if (!is(*a, 'i'))
-                                   return fail(pp + ".attributes." + quoted(a.key(), 40),
-                                               word('i'));
-                   }
-                   return true;
-               }) &&
-               each(g, "materials", [&](const Json& m, const std::string& p) {
-                   return fields(m, p,
-                                 {"pbrMetallicRoughness:o", "emissiveFactor:n3", "alphaMode:s",
-                                  "alphaCutoff:n", "doubleSided:b", "name:s", "extensions:o"}) &&
-                          (!m.contains("pbrMetallicRoughness") ||
-                           fields(m["pbrMetallicRoughness"], p + ".pbrMetallicRoughness",
-                                  {"baseColorFactor:n4", "metallicFactor:n", "roughnessFactor:n",
-                                   "baseColorTexture:o"}));
-               }) &&
-               each(g, "accessors", [&](const Json& a, const std::string& p) {
-                   return fields(a, p, {"bufferView:i", "byteOffset:i", "componentType:i",
-                                        "count:i", "type:s", "normalized:b", "min:n0", "max:n0"});
-               }) &&
-               each(g, "bufferViews", [&](const Json& v, const std::string& p) {
-                   return fields(v, p, {"buffer:i", "byteOffset:i", "byteLength:i", "byteStride:i",
-                                        "target:i"});
-               }) &&
-               each(g, "buffers", [&](const Json& b, const std::string& p) {
-                   return fields(b, p, {"byteLength:i", "uri:s"});
-               }) &&
-               each(g, "images", [&](const Json& im, const std::string& p) {
-                   return fields(im, p, {"uri:s", "bufferView:i", "mimeType:s"});
-               }) &&
+        return each(g, "scenes",
+                    [&](const Json& s, const std::string& p) {
+                        return fields(s, p, {"nodes:i0", "name:s"});
+                    }) &&
+               each(g, "nodes",
+                    [&](const Json& n, const std::string& p) {
+                        return fields(n, p,
+                                      {"camera:i", "mesh:i", "children:i0", "matrix:n16",
+                                       "translation:n3", "rotation:n4", "scale:n3", "name:s"});
+                    }) &&
+               each(g, "cameras",
+                    [&](const Json& c, const std::string& p) {
+                        return fields(c, p, {"type:s", "perspective:o", "orthographic:o"}) &&
+                               (!c.contains("perspective") ||
+                                fields(c["perspective"], p + ".perspective",
+                                       {"yfov:n", "znear:n", "zfar:n", "aspectRatio:n"}));
+                    }) &&
+               each(g, "meshes",
+                    [&](const Json& m, const std::string& p) {
+                        if (!fields(m, p, {"name:s"})) return false;
+                        auto prims = m.find("primitives");
+                        if (prims == m.end() || !prims->is_array())
+                            return fail(p + ".primitives", "an array");
+                        for (size_t i = 0; i < prims->size(); ++i) {
+                            const Json& q = (*prims)[i];
+                            const std::string pp = at(p + ".primitives", i);
+                            if (!fields(q, pp,
+                                        {"mode:i", "material:i", "indices:i", "attributes:o"}))
+                                return false;
+                            if (q.contains("attributes"))
+                                for (auto a = q["attributes"].begin(); a != q["attributes"].end();
+                                     ++a)
+                                    if (!is(*a, 'i'))
+                                        return fail(pp + ".attributes." + quoted(a.key(), 40),
+                                                    word('i'));
+                        }
+                        return true;
+                    }) &&
+               each(g, "materials",
+                    [&](const Json& m, const std::string& p) {
+                        return fields(m, p,
+                                      {"pbrMetallicRoughness:o", "emissiveFactor:n3", "alphaMode:s",
+                                       "alphaCutoff:n", "doubleSided:b", "name:s",
+                                       "extensions:o"}) &&
+                               (!m.contains("pbrMetallicRoughness") ||
+                                fields(m["pbrMetallicRoughness"], p + ".pbrMetallicRoughness",
+                                       {"baseColorFactor:n4", "metallicFactor:n",
+                                        "roughnessFactor:n", "baseColorTexture:o"}));
+                    }) &&
+               each(g, "accessors",
+                    [&](const Json& a, const std::string& p) {
+                        return fields(a, p,
+                                      {"bufferView:i", "byteOffset:i", "componentType:i", "count:i",
+                                       "type:s", "normalized:b", "min:n0", "max:n0"});
+                    }) &&
+               each(g, "bufferViews",
+                    [&](const Json& v, const std::string& p) {
+                        return fields(v, p,
+                                      {"buffer:i", "byteOffset:i", "byteLength:i", "byteStride:i",
+                                       "target:i"});
+                    }) &&
+               each(g, "buffers",
+                    [&](const Json& b, const std::string& p) {
+                        return fields(b, p, {"byteLength:i", "uri:s"});
+                    }) &&
+               each(g, "images",
+                    [&](const Json& im, const std::string& p) {
+                        return fields(im, p, {"uri:s", "bufferView:i", "mimeType:s"});
+                    }) &&
                each(g, "textures", [&](const Json& t, const std::string& p) {
                    return fields(t, p, {"source:i", "sampler:i"});
                });
@@ -955,8 +972,8 @@ class Converter {
                                  " is not a finite number >= 0");
             out->emission[k] = e * strength;
             if (!std::isfinite(out->emission[k]))
-                return log_.fail(where + ": emissiveFactor[" + num(k) + "] x emissiveStrength = " +
-                                 num(e) + " x " + num(strength) +
+                return log_.fail(where + ": emissiveFactor[" + num(k) +
+                                 "] x emissiveStrength = " + num(e) + " x " + num(strength) +
                                  " overflows; the emitted radiance must be a finite number");
         }
         out->double_sided = mat.doubleSided;
@@ -1308,10 +1325,10 @@ GltfLoadResult load_gltf_memory(const std::string& bytes, const std::string& bas
         uint32_t json_length = 0;
         if (binary)
             for (int k = 3; k >= 0; --k)
-                json_length = (json_length << 8) | static_cast<unsigned char>(bytes[12 + size_t(k)]);
-        const std::string problem =
-            binary ? check_json_text(bytes.data() + 20, json_length)
-                   : check_json_text(bytes.data(), bytes.size());
+                json_length =
+                    (json_length << 8) | static_cast<unsigned char>(bytes[12 + size_t(k)]);
+        const std::string problem = binary ? check_json_text(bytes.data() + 20, json_length)
+                                           : check_json_text(bytes.data(), bytes.size());
         if (!problem.empty()) {
             log.fail("invalid JSON: " + problem);
             return done();

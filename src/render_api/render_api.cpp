@@ -107,7 +107,6 @@ Json render_level_to_json(const LevelStats& l, double floor) {
     return j;
 }
 
-
 struct Loaded {
     std::shared_ptr<RenderRequest> request;
     RenderScene scene;
@@ -297,8 +296,8 @@ bool check_work(const RenderRequest& r, double image_samples_per_pixel, size_t h
                 bool reference_rendered, std::string* error) {
     const RenderStudySettings& s = r.settings;
     double pixels = double(s.width) * double(s.height);
-    double per_pixel = image_samples_per_pixel +
-                       (reference_rendered ? double(r.reference.spp) : 0.0);
+    double per_pixel =
+        image_samples_per_pixel + (reference_rendered ? double(r.reference.spp) : 0.0);
     double samples = pixels * per_pixel;
     if (!(samples <= kMaxCallSamples)) {
         *error = "scene.render: this needs " + fmt("%.3g", samples) +
@@ -310,10 +309,10 @@ bool check_work(const RenderRequest& r, double image_samples_per_pixel, size_t h
     }
     double bytes = pixels * 48.0 * double(held);
     if (!(bytes <= kMaxImageBytes)) {
-        *error = "scene.render: " + std::to_string(held) + " images of " +
-                 std::to_string(s.width) + "x" + std::to_string(s.height) +
-                 " pixels held at once need " + fmt("%.0f", bytes / 1048576.0) +
-                 " MiB, more than the limit of " + fmt("%.0f", kMaxImageBytes / 1048576.0) +
+        *error = "scene.render: " + std::to_string(held) + " images of " + std::to_string(s.width) +
+                 "x" + std::to_string(s.height) + " pixels held at once need " +
+                 fmt("%.0f", bytes / 1048576.0) + " MiB, more than the limit of " +
+                 fmt("%.0f", kMaxImageBytes / 1048576.0) +
                  " MiB: lower the image size or the number of estimators";
         return false;
     }
@@ -486,9 +485,9 @@ int mcp_render_study_run(const char* scene_json, const char* options_json, mcp_p
     if (ref_rendered && r.settings.spp_max > r.reference.spp / kReferenceSppRatio)
         return fail(MCP_ERROR_SCENE,
                     "scene.render.reference.spp: expected at least " +
-                        std::to_string(kReferenceSppRatio) + " x spp_max = " +
-                        std::to_string(kReferenceSppRatio * r.settings.spp_max) + ", got " +
-                        std::to_string(r.reference.spp) +
+                        std::to_string(kReferenceSppRatio) +
+                        " x spp_max = " + std::to_string(kReferenceSppRatio * r.settings.spp_max) +
+                        ", got " + std::to_string(r.reference.spp) +
                         ": a reference with fewer samples is too noisy to judge the images");
     double study_spp = 0.0;
     for (uint64_t n : n_ladder(r.settings.spp_min, r.settings.spp_max)) study_spp += double(n);
@@ -506,8 +505,8 @@ int mcp_render_study_run(const char* scene_json, const char* options_json, mcp_p
             Json ests = Json::array();
             uint64_t n = 0;
             for (const RenderEstimatorStudy& s : partial.estimators) {
-                ests.push_back(
-                    estimator_study_to_json(s, previews, r.exposure, &reference, floor, false, level));
+                ests.push_back(estimator_study_to_json(s, previews, r.exposure, &reference, floor,
+                                                       false, level));
                 if (level < s.levels.size()) n = s.levels[level].n;
             }
             Json p{{"version", kResultSchemaVersion},

@@ -331,12 +331,10 @@ Made<std::shared_ptr<RenderRequest>> build_render_request(const Json& scene, con
         if (!parse_reference(c, *ref, ep + ".reference", root, gltf_dir, &r->reference))
             return error();
     if (const Json* ref = find(render, "reference"))
-        if (!parse_reference(c, *ref, rp + ".reference", root, root, &r->reference))
-            return error();
+        if (!parse_reference(c, *ref, rp + ".reference", root, root, &r->reference)) return error();
     // The caller's options are not scene text: their file may lie anywhere.
     if (const Json* ref = find(opts, "reference"))
-        if (!parse_reference(c, *ref, "options.reference", "", root, &r->reference))
-            return error();
+        if (!parse_reference(c, *ref, "options.reference", "", root, &r->reference)) return error();
     for (const RenderEstimator& e : r->estimators)
         if (quantity_of(e) != quantity_of(r->estimators.front()))
             return made_error<std::shared_ptr<RenderRequest>>(
