@@ -138,8 +138,9 @@ TEST(Api, BadScenesGiveScenesErrorsNamingTheField) {
 }
 
 TEST(Api, BadOptions) {
+    // A bad value in the options is a bad argument, not a bad scene.
     Outcome o = run(kSmall, R"({"estimators": ["nope"]})");
-    EXPECT_EQ(o.status, MCP_ERROR_SCENE);
+    EXPECT_EQ(o.status, MCP_ERROR_ARGUMENT);
     EXPECT_NE(o.error.find("unknown estimator 'nope'"), std::string::npos) << o.error;
     o = run(kSmall, R"({"reps": "many"})");
     EXPECT_NE(o.error.find("options.reps"), std::string::npos) << o.error;
@@ -218,13 +219,17 @@ TEST(Api, FormatsTableCsvJson) {
 
     EXPECT_EQ(mcp_result_format(result.c_str(), "xml", &text), MCP_ERROR_ARGUMENT);
     EXPECT_NE(std::string(mcp_last_error()).find("unknown format 'xml'"), std::string::npos);
-    // Odd but valid JSON shapes are rejected or formatted, never a crash.
+    // Odd but valid JSON shapes are rejected (estimators and levels not lists of objects: see
+    // FormatRefusesResultsOfTheWrongShape) or formatted with "-" for odd fields, never a crash.
     EXPECT_EQ(mcp_result_format("[1,2]", "table", &text), MCP_ERROR_ARGUMENT);
-    ASSERT_EQ(
+    EXPECT_EQ(
         mcp_result_format(R"({"estimators": 5, "scene": [], "settings": "x"})", "table", &text),
-        MCP_OK);
+        MCP_ERROR_ARGUMENT);
+    ASSERT_EQ(mcp_result_format(R"({"estimators": [{"levels": [{"n": "x"}]}], "scene": []})",
+                                "table", &text),
+              MCP_OK);
     mcp_free(text);
-    ASSERT_EQ(mcp_result_format(R"({"estimators": [{"levels": [3, {"n": "x"}]}]})", "csv", &text),
+    ASSERT_EQ(mcp_result_format(R"({"estimators": [{"levels": [{"n": "x"}]}]})", "csv", &text),
               MCP_OK);
     mcp_free(text);
 }
@@ -300,4 +305,126 @@ TEST(Api, SceneInfoAndCatalog) {
     json cat = json::parse(out);
     mcp_free(out);
     EXPECT_GE(cat["estimators"].size(), 5u);
+}
+
+// --- Hardening (issue 10) ----------------------------------------------------------------
+
+TEST(Api, StudySizeIsCheckedBeforeAnyWork) {
+    // 2^36 samples at the largest N with 32 replicates: 4.4e12 evaluations, refused at once.
+    Outcome o = run(R"({"f": "x*x", "estimators": ["uniform"], "n_max": 68719476736, "reps": 32})");
+    EXPECT_EQ(o.status, MCP_ERROR_SCENE);
+    EXPECT_EQ(o.error.rfind("scene: n_max = 68719476736, reps = 32 and 1 estimator(s) ask for "
+                            "4398046510592 integrand evaluations",
+                            0),
+              0u)
+        << o.error;
+    EXPECT_TRUE(o.result.is_null());
+}
+
+namespace {
+Outcome plan(const std::string& scene, const char* options = nullptr) {
+    char* out = nullptr;
+    Outcome o;
+    o.status = mcp_study_plan(scene.c_str(), options, &out);
+    o.error = mcp_last_error();
+    if (out) {
+        o.result = json::parse(out);
+        mcp_free(out);
+    }
+    return o;
+}
+} // namespace
+
+TEST(Api, PlanValidatesLikeRunAndPredicts) {
+    Outcome p = plan(kSmall);
+    ASSERT_EQ(p.status, MCP_OK) << p.error;
+    const json& r = p.result;
+    EXPECT_EQ(r["evaluations"], (16 + 32 + 64) * 4 * 2);
+    EXPECT_EQ(r["levels"], json({16, 32, 64}));
+    EXPECT_EQ(r["limit_evaluations"], uint64_t(1) << 40);
+    EXPECT_EQ(r["pilot_samples"], 4096);
+    ASSERT_EQ(r["estimators"].size(), 2u);
+    EXPECT_GT(r["predicted_seconds"].get<double>(), 0.0);
+    EXPECT_LT(r["pilot_seconds"].get<double>(), 0.05);
+    // Options override as in mcp_study_run.
+    EXPECT_EQ(plan(kSmall, R"({"reps": 2, "estimators": ["uniform"]})").result["evaluations"],
+              (16 + 32 + 64) * 2);
+    // The same errors as mcp_study_run, and no result.
+    for (const char* bad :
+         {R"({"f": "x*x", "estimators": ["uniform"], "n_max": 68719476736, "reps": 32})",
+          R"({"f": "sin(", "estimators": ["uniform"]})", "{"}) {
+        Outcome a = run(bad), b = plan(bad);
+        EXPECT_EQ(a.status, b.status) << bad;
+        EXPECT_EQ(a.error, b.error) << bad;
+        EXPECT_TRUE(b.result.is_null());
+    }
+    char* out = nullptr;
+    EXPECT_EQ(mcp_study_plan(kSmall, nullptr, nullptr), MCP_ERROR_ARGUMENT);
+    EXPECT_EQ(mcp_study_plan(kSmall, "{", &out), MCP_ERROR_ARGUMENT);
+    EXPECT_EQ(out, nullptr);
+}
+
+namespace {
+Outcome format(const std::string& result, const char* fmt) {
+    char* out = nullptr;
+    Outcome o;
+    o.status = mcp_result_format(result.c_str(), fmt, &out);
+    o.error = mcp_last_error();
+    if (out) {
+        o.result = std::string(out);
+        mcp_free(out);
+    }
+    return o;
+}
+} // namespace
+
+TEST(Api, FormatRefusesResultsOfTheWrongShape) {
+    for (auto [text, message] : std::vector<std::pair<const char*, const char*>>{
+             {R"({"estimators": 5})", "result.estimators: expected an array, got number"},
+             {R"({"estimators": [3]})", "result.estimators[0]: expected an object, got number"},
+             {R"({"estimators": [{"levels": {}}]})",
+              "result.estimators[0].levels: expected an array, got object"},
+             {R"({"estimators": [{"levels": [null]}]})",
+              "result.estimators[0].levels[0]: expected an object, got null"}}) {
+        Outcome o = format(text, "table");
+        EXPECT_EQ(o.status, MCP_ERROR_ARGUMENT) << text;
+        EXPECT_EQ(o.error, message);
+        EXPECT_TRUE(o.result.is_null());
+    }
+}
+
+TEST(Api, NoNumberIsPrintedForAMissingEstimateOrANegativeVariance) {
+    Outcome o = run(kSmall);
+    ASSERT_EQ(o.status, MCP_OK) << o.error;
+    json r = o.result;
+    json& l = r["estimators"][0]["levels"][0];
+    l["variance"] = -1.0; // hand-edited: not a variance
+    l["mean"] = nullptr;
+    l["mse"] = -2.0;
+    Outcome t = format(r.dump(), "table");
+    ASSERT_EQ(t.status, MCP_OK) << t.error;
+    const std::string table = t.result.get<std::string>();
+    EXPECT_EQ(table.find("-1.0000e+00"), std::string::npos) << table;
+    EXPECT_NE(table.find("       16                -            -"), std::string::npos) << table;
+    Outcome c = format(r.dump(), "csv");
+    ASSERT_EQ(c.status, MCP_OK) << c.error;
+    const std::string csv = c.result.get<std::string>();
+    const std::string row = csv.substr(csv.find('\n') + 1, csv.find('\n', csv.find('\n') + 1));
+    EXPECT_NE(row.find(",16,4,,,"), std::string::npos) << row; // n, reps, mean, variance empty
+    EXPECT_EQ(row.find("-1"), std::string::npos) << row;
+    EXPECT_EQ(row.find("-2"), std::string::npos) << row;
+}
+
+TEST(Api, EveryNaNSampleGivesNullsAndOneWarning) {
+    Outcome o = run(R"j({"f": "log(-1-x)", "estimators": ["uniform"], "n_min": 16, "n_max": 32,
+                        "reps": 2})j");
+    ASSERT_EQ(o.status, MCP_OK) << o.error;
+    for (const json& l : o.result["estimators"][0]["levels"]) {
+        EXPECT_TRUE(l["mean"].is_null());
+        EXPECT_TRUE(l["variance"].is_null());
+        EXPECT_EQ(l["no_estimate_runs"], 2);
+        ASSERT_EQ(l["warnings"].size(), 1u);
+        EXPECT_EQ(l["warnings"][0]["code"], "no_estimate");
+    }
+    EXPECT_TRUE(o.result["estimators"][0]["warnings"].empty());
 }

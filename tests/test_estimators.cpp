@@ -381,3 +381,208 @@ TEST(Accumulation, Float32StallsWhereCompensatedDoesNot) {
     StudyResult bad = run(r.value);
     EXPECT_GT(std::fabs(bad.estimators[0].levels[0].mean - 1e8), 1e5);
 }
+
+// --- Hardening (issue 10) ----------------------------------------------------------------
+
+namespace {
+
+SceneRequest request(const Json& scene, const Json& options = Json()) {
+    Made<SceneRequest> r = build_request(scene, options);
+    EXPECT_TRUE(r.ok()) << r.error;
+    return r.value;
+}
+
+std::set<std::string> level_codes(const LevelStats& l) {
+    std::set<std::string> codes;
+    const Json j = level_to_json(l);
+    for (const Json& w : j["warnings"]) codes.insert(w["code"].get<std::string>());
+    return codes;
+}
+
+} // namespace
+
+TEST(SupportCheck, FindsANarrowSpikeInAZeroBinByQuadrature) {
+    // Width 1e-6 at the edge of the zero bin [0.5, 1]: 65,536 uniform probes land in it with
+    // probability 6%; the quadrature graded toward the bin's edges integrates it: mass 1e6 x 1e-6.
+    SceneRequest req = request(
+        {{"f", "step(0.5-x) + 1e6*step(x-0.5)*step(0.500001-x)"},
+         {"estimators",
+          {{{"name", "tab"}, {"pdf", {{"type", "tabulated"}, {"values", {1, 0}}}}}, "uniform"}}});
+    const SupportCheck c = check_support(req.problem, req.estimators[0], 1 << 16, 1);
+    EXPECT_EQ(c.method, "quadrature");
+    EXPECT_TRUE(c.flagged);
+    EXPECT_EQ(c.zero_measure, 0.5);
+    EXPECT_NEAR(c.missed_mass, 1.0, 1e-4); // quadrature to rel. 1e-6 per piece
+    EXPECT_NEAR(c.missed_fraction, 1.0 / 1.5, 0.01);
+    const SupportCheck u = check_support(req.problem, req.estimators[1], 1 << 16, 1);
+    EXPECT_EQ(u.method, "none");
+    EXPECT_FALSE(u.flagged);
+    // Through the report: the estimator carries pdf_support with the missed mass.
+    StudyResult s = run_study(req.problem, req.estimators, StudySettings{16, 64, 4, 1, 1});
+    EXPECT_TRUE(warning_codes(s.estimators[0], s.estimators[0].levels.back(), s.settings)
+                    .count("pdf_support"));
+}
+
+TEST(SupportCheck, ZeroSetWhereFIsZeroStaysQuiet) {
+    // f vanishes on the zero bin (step(0) = 1 at the single point x = 0.5 has no mass).
+    SceneRequest req =
+        request({{"f", "step(0.5-x)*exp(x)"},
+                 {"estimators",
+                  {{{"name", "tab"}, {"pdf", {{"type", "tabulated"}, {"values", {1, 0}}}}}}}});
+    const SupportCheck c = check_support(req.problem, req.estimators[0], 1 << 16, 1);
+    EXPECT_EQ(c.method, "quadrature");
+    EXPECT_EQ(c.missed_mass, 0.0);
+    EXPECT_FALSE(c.flagged);
+}
+
+TEST(SupportCheck, TwoDimensionalTablesAndProductsAreIntegratedExactly) {
+    // f = 1 on the unit square: the missed mass is the area of the zero set.
+    Json box = {{"type", "box"}, {"lower", {0, 0}}, {"upper", {1, 1}}};
+    const Json table = {
+        {"name", "table"},
+        {"pdf", {{"type", "tabulated_2d"}, {"bins", {2, 2}}, {"values", {1, 0, 1, 1}}}}};
+    const Json factors = Json::array({Json{{"type", "tabulated"}, {"values", {1, 1, 1, 0}}},
+                                      Json{{"type", "tabulated"}, {"values", {0, 1}}}});
+    const Json product = {{"name", "product"},
+                          {"pdf", {{"type", "product"}, {"factors", factors}}}};
+    SceneRequest req = request(
+        {{"domain", box}, {"f", "1 + 0*x*y"}, {"estimators", Json::array({table, product})}});
+    const SupportCheck t = check_support(req.problem, req.estimators[0], 1 << 16, 1);
+    EXPECT_EQ(t.method, "quadrature");
+    EXPECT_EQ(t.zero_measure, 0.25);
+    EXPECT_NEAR(t.missed_mass, 0.25, 1e-12);
+    EXPECT_TRUE(t.flagged);
+    // Zero where x > 3/4 or y < 1/2: 1 - (3/4)(1/2) = 5/8 of the square.
+    const SupportCheck p = check_support(req.problem, req.estimators[1], 1 << 16, 1);
+    EXPECT_EQ(p.method, "quadrature");
+    EXPECT_EQ(p.zero_measure, 0.625);
+    EXPECT_NEAR(p.missed_mass, 0.625, 1e-12);
+    EXPECT_TRUE(p.flagged);
+}
+
+TEST(SupportCheck, ElsewhereItSaysHowFarItLooked) {
+    // A product in 3D: the zero set is not integrated; the probes find nothing since f is 0 there.
+    const Json factors = Json::array({Json{{"type", "tabulated"}, {"values", {1, 0}}},
+                                      Json{{"type", "uniform"}}, Json{{"type", "uniform"}}});
+    SceneRequest req =
+        request({{"domain", {{"type", "box"}, {"lower", {0, 0, 0}}, {"upper", {1, 1, 1}}}},
+                 {"f", "step(0.5-x)*(1+y+z)"},
+                 {"estimators",
+                  Json::array({Json{{"name", "p3"},
+                                    {"pdf", {{"type", "product"}, {"factors", factors}}}}})}});
+    const SupportCheck c = check_support(req.problem, req.estimators[0], 1 << 16, 1);
+    EXPECT_EQ(c.method, "probes");
+    EXPECT_FALSE(c.flagged);
+    EXPECT_NE(c.note.find("probed 65,536 uniform points; features narrower than ~1/65,536"),
+              std::string::npos)
+        << c.note;
+}
+
+TEST(ErrorBars, ZeroErrorBarOfARandomEstimatorIsFlagged) {
+    // Two points per stratum in 2 x 2 x 2 cells: at N = 16 a replicate whose every pair agrees
+    // reports 0 +/- 0 although the replicates differ.
+    SceneRequest req =
+        request({{"domain", {{"type", "box"}, {"lower", {0, 0, 0}}, {"upper", {1, 1, 1}}}},
+                 {"f", "step(x+y+z-pi/2)"},
+                 {"estimators",
+                  {{{"name", "paired"}, {"sampler", "stratified"}, {"samples_per_stratum", 2}}}},
+                 {"n_min", 16},
+                 {"n_max", 16},
+                 {"reps", 8}});
+    StudyResult s = run(req);
+    const LevelStats& l = s.estimators[0].levels[0];
+    ASSERT_GT(l.zero_error_runs, 0) << "seed 1 gives a zero error bar at N = 16";
+    EXPECT_TRUE(l.estimates_spread);
+    EXPECT_TRUE(level_codes(l).count("zero_error_bar"));
+}
+
+TEST(ErrorBars, ExactEstimatorsStayQuiet) {
+    // f constant, and f/p constant (2x sampled from p = 2x): every replicate gives the same
+    // number, so the zero error bars are right.
+    for (const Json& scene :
+         {Json{{"f", "3"},
+               {"estimators",
+                {"uniform",
+                 {{"name", "paired"}, {"sampler", "stratified"}, {"samples_per_stratum", 2}}}}},
+          Json{{"f", "2*x"},
+               {"estimators", {{{"name", "exact"}, {"pdf", {{"type", "power"}, {"k", 1}}}}}}}}) {
+        SceneRequest req = request(scene, Json{{"n_min", 16}, {"n_max", 256}, {"reps", 8}});
+        StudyResult s = run(req);
+        for (const EstimatorStudy& e : s.estimators) {
+            EXPECT_GT(e.levels[0].zero_error_runs, 0) << e.spec.name;
+            for (const LevelStats& l : e.levels) {
+                EXPECT_FALSE(l.estimates_spread) << e.spec.name << " N=" << l.n;
+                EXPECT_TRUE(warning_codes(e, l, s.settings).empty()) << e.spec.name << " N=" << l.n;
+            }
+        }
+    }
+}
+
+TEST(Diagnostics, AllNonFiniteSamplesGiveNoEstimate) {
+    SceneRequest req = request({{"f", "log(-1-x)"}, {"estimators", {"uniform", "stratified"}}},
+                               Json{{"n_min", 16}, {"n_max", 1024}, {"reps", 4}});
+    StudyResult s = run(req);
+    for (const EstimatorStudy& e : s.estimators) {
+        for (const LevelStats& l : e.levels) {
+            EXPECT_EQ(l.no_estimate_runs, 4);
+            EXPECT_TRUE(std::isnan(l.mean));
+            const Json j = level_to_json(l);
+            EXPECT_TRUE(j["mean"].is_null());
+            EXPECT_TRUE(j["variance"].is_null());
+            ASSERT_EQ(j["warnings"].size(), 1u);
+            EXPECT_EQ(j["warnings"][0]["code"], "no_estimate");
+            EXPECT_EQ(j["warnings"][0]["message"], "every sample was NaN or infinite: no estimate");
+            for (const Json& x : j["replicates"]["estimate"]) EXPECT_TRUE(x.is_null());
+            // Exactly one warning: no tail index, ESS or exactness talk about dropped samples.
+            EXPECT_EQ(warning_codes(e, l, s.settings), std::set<std::string>{"no_estimate"});
+        }
+        EXPECT_FALSE(e.fit.valid);
+        EXPECT_EQ(e.fit.note, "no estimate at any N: no fit");
+    }
+    Json table_in = study_to_json(s);
+    const std::string table = format_table(table_in);
+    EXPECT_EQ(table.find("an exact estimator"), std::string::npos);
+    EXPECT_NE(table.find("     16                -            -"), std::string::npos) << table;
+}
+
+TEST(Diagnostics, AnOverflowedMeanIsFlaggedNotPrinted) {
+    // 32 weights of 1e307 sum beyond the double range.
+    SceneRequest req = request({{"f", "1e307 + 0*x"}, {"estimators", {"uniform"}}},
+                               Json{{"n_min", 32}, {"n_max", 32}, {"reps", 2}});
+    StudyResult s = run(req);
+    const LevelStats& l = s.estimators[0].levels[0];
+    EXPECT_FALSE(std::isfinite(l.mean));
+    EXPECT_EQ(l.no_estimate_runs, 0);
+    EXPECT_TRUE(level_codes(l).count("nonfinite_estimate"));
+    EXPECT_TRUE(level_to_json(l)["mean"].is_null());
+}
+
+TEST(Study, SizeIsCheckedBeforeWork) {
+    StudySettings s;
+    s.n_min = 16;
+    s.n_max = uint64_t(1) << 36;
+    s.reps = 32;
+    // Ladder 16 + ... + 2^36 = 2^37 - 16.
+    EXPECT_EQ(study_evaluations(s, 1), ((uint64_t(1) << 37) - 16) * 32);
+    EXPECT_EQ(check_study_size(s, 1),
+              "n_max = 68719476736, reps = 32 and 1 estimator(s) ask for 4398046510592 integrand "
+              "evaluations (sum over N of N x reps x estimators), more than the limit of "
+              "1099511627776 (2^40): lower n_max, reps or the number of estimators");
+    s.reps = 2;
+    EXPECT_EQ(check_study_size(s, 1), "");
+    s.n_max = 65536;
+    s.n_min = 1;
+    s.reps = 100000;
+    EXPECT_NE(check_study_size(s, 2).find("replicate results"), std::string::npos);
+    EXPECT_EQ(check_study_size(StudySettings{}, 5), "");
+}
+
+TEST(Study, PlanPredictsFromAShortPilot) {
+    SceneRequest req = load("exp_1d", Json{{"n_max", 1 << 20}, {"reps", 8}});
+    const StudyPlan plan = plan_study(req.problem, req.estimators, req.settings);
+    EXPECT_EQ(plan.evaluations, study_evaluations(req.settings, req.estimators.size()));
+    EXPECT_EQ(plan.levels, n_ladder(req.settings.n_min, req.settings.n_max));
+    ASSERT_EQ(plan.estimators.size(), req.estimators.size());
+    EXPECT_GT(plan.predicted_seconds, 0.0);
+    EXPECT_LT(plan.pilot_seconds, 0.05);
+}

@@ -30,8 +30,8 @@ export class McplayError extends Error {
  *  (web/test/core.test.mjs checks that the two lists agree). */
 export const WASM_FUNCTIONS = Object.freeze([
   '_malloc', '_free',
-  '_mcp_version', '_mcp_last_error', '_mcp_study_run', '_mcp_result_format', '_mcp_scene_info',
-  '_mcp_catalog', '_mcp_study_samples', '_mcp_free',
+  '_mcp_version', '_mcp_last_error', '_mcp_study_run', '_mcp_study_plan', '_mcp_result_format',
+  '_mcp_scene_info', '_mcp_catalog', '_mcp_study_samples', '_mcp_free',
   '_mallinfo',
 ]);
 
@@ -43,6 +43,10 @@ export const WASM_RUNTIME_METHODS = Object.freeze([
 ]);
 
 const FORMATS = Object.freeze(['table', 'csv', 'json']);
+
+/** Largest JSON text sent to the core: the C side's limit (kMaxJsonBytes, src/api/json_read.h),
+ *  checked here before any wasm memory is allocated for it. */
+export const MAX_JSON_BYTES = 256 * 1024 * 1024;
 
 /**
  * Instantiates the wasm module and returns the core.
@@ -122,7 +126,9 @@ export function wasmBridge(M) {
     return p;
   }
 
-  // Object or JSON text -> JSON text for the C API.
+  // Object or JSON text -> JSON text for the C API. JSON.stringify would turn NaN and
+  // +/-Infinity into null silently (an `exact` of NaN becoming "unknown"): they are refused,
+  // naming the field (`scene.exact`, `options.estimators[1].pdf.mu`).
   function jsonText(value, what) {
     let text = value;
     if (typeof value !== 'string') {
@@ -130,14 +136,35 @@ export function wasmBridge(M) {
         throw new McplayError(Status.ARGUMENT, `${what}: expected an object or JSON text, got ` +
           (value === null ? 'null' : typeof value));
       }
+      const paths = new Map(); // object -> its path, filled as stringify walks down
+      function replacer(key, v) {
+        const parent = paths.get(this);
+        const path = parent === undefined ? what
+          : Array.isArray(this) ? `${parent}[${key}]` : `${parent}.${key}`;
+        if (typeof v === 'number' && !Number.isFinite(v)) {
+          throw new McplayError(Status.ARGUMENT, `${path}: expected a finite number, got ${v}`);
+        }
+        if (v !== null && typeof v === 'object') paths.set(v, path);
+        return v;
+      }
       try {
-        text = JSON.stringify(value);
+        text = JSON.stringify(value, replacer);
       } catch (e) {
+        if (e instanceof McplayError) throw e;
         throw new McplayError(Status.ARGUMENT, `${what}: cannot be written as JSON (${e.message})`);
+      }
+      if (text === undefined) {
+        throw new McplayError(Status.ARGUMENT, `${what}: cannot be written as JSON`);
       }
     }
     if (text.includes('\0')) {
       throw new McplayError(Status.ARGUMENT, `${what}: contains a NUL character`);
+    }
+    // Before any allocation: a text beyond the C side's limit would only be refused there,
+    // after growing the wasm memory for it (or failing to).
+    if (text.length > MAX_JSON_BYTES || M.lengthBytesUTF8(text) > MAX_JSON_BYTES) {
+      throw new McplayError(Status.ARGUMENT, `${what}: the JSON text has more than the limit of ` +
+        `${MAX_JSON_BYTES} bytes`);
     }
     return text;
   }
@@ -317,16 +344,34 @@ function makeCore(M) {
     return b.study('runStudy', M._mcp_study_run, 'mcp_study_run', scene, options, onLevel);
   }
 
-  /** A study result (object or JSON text) as 'table', 'csv' or 'json' (pretty-printed) text. */
+  /**
+   * What a study would cost, without running it: validates scene and options exactly as
+   * runStudy does (the same McplayError for the same fault, including the size limit of 2^40
+   * evaluations) and returns {evaluations, limit_evaluations, predicted_seconds, threads,
+   * levels, n_min, n_max, reps, pilot_samples, pilot_seconds, estimators: [{name, evaluations,
+   * seconds_per_evaluation, predicted_seconds}]} from a pilot of a few ms (mcp_study_plan).
+   */
+  function plan(scene, options = null) {
+    b.usable('plan');
+    return b.callJson('plan', M._mcp_study_plan, 'mcp_study_plan',
+      [b.jsonText(scene, 'scene'), b.optionalJson(options, 'options')]);
+  }
+
+  /**
+   * A study result (object or JSON text) as 'table', 'csv' or 'json' (pretty-printed) text.
+   * A result of the wrong shape (estimators or their levels not lists of objects) throws a
+   * McplayError ARGUMENT naming the field, e.g. "result.estimators: expected an array, got number".
+   */
   function format(result, fmt = 'table') {
     b.usable('format');
-    if (typeof fmt !== 'string') {
+    if (typeof fmt !== 'string' || fmt.includes('\0')) {
       throw new McplayError(Status.ARGUMENT, `format: expected one of ${FORMATS.join(', ')}`);
     }
     return b.textOf(b.callOut(M._mcp_result_format, [b.jsonText(result, 'result'), fmt]), 'mcp_result_format');
   }
 
   return Object.freeze({
-    version: b.version, catalog, sceneInfo, samples, runStudy, format, heapStats: b.heapStats, dispose: b.dispose,
+    version: b.version, catalog, sceneInfo, samples, plan, runStudy, format, heapStats: b.heapStats,
+    dispose: b.dispose,
   });
 }

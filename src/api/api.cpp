@@ -41,7 +41,7 @@ int mcp_study_run(const char* scene_json, const char* options_json, mcp_progress
         options = o.value;
     }
     mcp::Made<mcp::SceneRequest> req = mcp::build_request(scene.value, options);
-    if (!req.ok()) return fail(MCP_ERROR_SCENE, req.error);
+    if (!req.ok()) return mcp::boundary::request_error(req.error);
 
     mcp::StudyProgress on_level;
     if (progress) {
@@ -55,6 +55,45 @@ int mcp_study_run(const char* scene_json, const char* options_json, mcp_progress
     *result_json = copy_out(dump(mcp::study_to_json(result)));
     if (!*result_json) return fail(MCP_ERROR_INTERNAL, "out of memory writing the result");
     if (result.cancelled) return fail(MCP_ERROR_CANCELLED, "study cancelled by the caller");
+    g_last_error.clear();
+    return MCP_OK;
+}
+
+int mcp_study_plan(const char* scene_json, const char* options_json, char** plan_json) {
+    if (!plan_json) return fail(MCP_ERROR_ARGUMENT, "mcp_study_plan: plan_json is NULL");
+    *plan_json = nullptr;
+    mcp::Made<mcp::Json> scene = mcp::parse_json(scene_json, "scene");
+    if (!scene.ok()) return fail(MCP_ERROR_SCENE, scene.error);
+    mcp::Json options;
+    if (options_json && *options_json) {
+        mcp::Made<mcp::Json> o = mcp::parse_json(options_json, "options");
+        if (!o.ok()) return fail(MCP_ERROR_ARGUMENT, o.error);
+        options = o.value;
+    }
+    mcp::Made<mcp::SceneRequest> req = mcp::build_request(scene.value, options);
+    if (!req.ok()) return mcp::boundary::request_error(req.error);
+    const mcp::StudySettings& s = req.value.settings;
+    const mcp::StudyPlan plan = mcp::plan_study(req.value.problem, req.value.estimators, s);
+    mcp::Json estimators = mcp::Json::array();
+    for (const mcp::EstimatorPlan& e : plan.estimators)
+        estimators.push_back({{"name", e.name},
+                              {"evaluations", e.evaluations},
+                              {"seconds_per_evaluation", mcp::num(e.seconds_per_evaluation)},
+                              {"predicted_seconds", mcp::num(e.predicted_seconds)}});
+    mcp::Json out{{"version", mcp::kResultSchemaVersion},
+                  {"evaluations", plan.evaluations},
+                  {"limit_evaluations", mcp::kMaxStudyEvaluations},
+                  {"predicted_seconds", mcp::num(plan.predicted_seconds)},
+                  {"threads", plan.threads},
+                  {"levels", plan.levels},
+                  {"n_min", s.n_min},
+                  {"n_max", s.n_max},
+                  {"reps", s.reps},
+                  {"pilot_samples", mcp::kPilotSamples},
+                  {"pilot_seconds", mcp::num(plan.pilot_seconds)},
+                  {"estimators", estimators}};
+    *plan_json = copy_out(dump(out));
+    if (!*plan_json) return fail(MCP_ERROR_INTERNAL, "out of memory writing the plan");
     g_last_error.clear();
     return MCP_OK;
 }
@@ -83,7 +122,7 @@ int mcp_study_samples(const char* scene_json, const char* options_json, char** s
         options.erase(key);
     }
     mcp::Made<mcp::SceneRequest> req = mcp::build_request(scene.value, options);
-    if (!req.ok()) return fail(MCP_ERROR_SCENE, req.error);
+    if (!req.ok()) return mcp::boundary::request_error(req.error);
     const mcp::Problem& problem = req.value.problem;
     const mcp::Domain& domain = problem.domain;
     mcp::Json estimators = mcp::Json::array();
@@ -156,6 +195,27 @@ int mcp_result_format(const char* result_json, const char* format, char** text) 
     if (!r.ok()) return fail(MCP_ERROR_ARGUMENT, r.error);
     if (!r.value.is_object() || !r.value.contains("estimators"))
         return fail(MCP_ERROR_ARGUMENT, "result: not an mcplay study result (no \"estimators\")");
+    // The shape the formatters read: estimators[] of objects, each with levels[] of objects.
+    const mcp::Json& ests = r.value["estimators"];
+    if (!ests.is_array())
+        return fail(MCP_ERROR_ARGUMENT,
+                    std::string("result.estimators: expected an array, got ") + ests.type_name());
+    for (size_t i = 0; i < ests.size(); ++i) {
+        const std::string at = "result.estimators[" + std::to_string(i) + "]";
+        if (!ests[i].is_object())
+            return fail(MCP_ERROR_ARGUMENT,
+                        at + ": expected an object, got " + ests[i].type_name());
+        auto levels = ests[i].find("levels");
+        if (levels == ests[i].end()) continue; // a progress record carries "level" instead
+        if (!levels->is_array())
+            return fail(MCP_ERROR_ARGUMENT,
+                        at + ".levels: expected an array, got " + levels->type_name());
+        for (size_t k = 0; k < levels->size(); ++k)
+            if (!(*levels)[k].is_object())
+                return fail(MCP_ERROR_ARGUMENT, at + ".levels[" + std::to_string(k) +
+                                                    "]: expected an object, got " +
+                                                    (*levels)[k].type_name());
+    }
     std::string out;
     const std::string f = format;
     if (f == "table")
@@ -177,7 +237,7 @@ int mcp_scene_info(const char* scene_json, char** info_json) {
     mcp::Made<mcp::Json> scene = mcp::parse_json(scene_json, "scene");
     if (!scene.ok()) return fail(MCP_ERROR_SCENE, scene.error);
     mcp::Made<mcp::SceneRequest> req = mcp::build_request(scene.value, mcp::Json());
-    if (!req.ok()) return fail(MCP_ERROR_SCENE, req.error);
+    if (!req.ok()) return mcp::boundary::request_error(req.error);
     const mcp::Problem& p = req.value.problem;
     mcp::Json names = mcp::Json::array();
     for (const mcp::EstimatorSpec& e : req.value.estimators) names.push_back(e.name);

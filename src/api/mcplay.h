@@ -36,6 +36,15 @@ const char* mcp_last_error(void);
 int mcp_study_run(const char* scene_json, const char* options_json, mcp_progress_fn progress,
                   void* user, char** result_json);
 
+/* Validates a study exactly as mcp_study_run does (including the size limits: at most 2^40
+ * integrand evaluations, sum over N of N x reps x estimators, and 2^21 replicate results) and
+ * predicts its cost from a timed pilot of 4096 samples per estimator (a few ms), without running
+ * it. Result: {"version", "evaluations", "limit_evaluations", "predicted_seconds", "threads",
+ * "levels": [N...], "n_min", "n_max", "reps", "pilot_samples", "pilot_seconds", "estimators":
+ * [{"name", "evaluations", "seconds_per_evaluation", "predicted_seconds"}]}. predicted_seconds
+ * is wall time on "threads" threads, excluding the once-per-estimator support check. */
+int mcp_study_plan(const char* scene_json, const char* options_json, char** plan_json);
+
 /* The points behind a small run of each estimator, for plotting them: options_json may give
  * {"estimators": [names], "n": points (1..4096, default 256), "seed", "grid": 1D curve points
  * (default 256)}. Result: {"version", "n", "estimators": [{"name", "sampler", "pdf", "strata",
@@ -44,7 +53,9 @@ int mcp_study_run(const char* scene_json, const char* options_json, mcp_progress
  * replicate 0 of a study at N = n, so the mean of "weight" is that replicate's estimate. */
 int mcp_study_samples(const char* scene_json, const char* options_json, char** samples_json);
 
-/* Formats a study result as "table" (human), "csv" or "json" (pretty-printed). */
+/* Formats a study result as "table" (human), "csv" or "json" (pretty-printed). The result must
+ * have the documented shape ("estimators": [{..., "levels": [{...}]}]), else MCP_ERROR_ARGUMENT
+ * naming the first field that is not (e.g. "result.estimators: expected an array, got number"). */
 int mcp_result_format(const char* result_json, const char* format, char** text);
 
 /* Validates a scene and summarises it: {"name", "description", "domain", "dimension",

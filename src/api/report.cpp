@@ -39,6 +39,37 @@ Json diagnostics_to_json(const RunDiagnostics& d) {
 Json warnings_for(const LevelStats& l) {
     Json w = Json::array();
     const RunDiagnostics& d = l.diagnostics;
+    // No estimate: one warning, and none of the diagnostics computed from dropped samples.
+    if (l.no_estimate_runs > 0) {
+        w.push_back(warning(
+            "no_estimate",
+            l.no_estimate_runs == l.reps
+                ? std::string("every sample was NaN or infinite: no estimate")
+                : "every sample was NaN or infinite in " + std::to_string(l.no_estimate_runs) +
+                      " of " + std::to_string(l.reps) +
+                      " replicates at N = " + std::to_string(l.n) + ": no estimate at this N"));
+        return w;
+    }
+    if (!std::isfinite(l.mean))
+        w.push_back(warning(
+            "nonfinite_estimate",
+            "the mean of the replicates is not a finite number at N = " + std::to_string(l.n) +
+                " (the sum of the weights overflowed): no estimate"));
+    else if (!std::isfinite(l.variance) || l.variance < 0.0)
+        w.push_back(warning("nonfinite_variance",
+                            "the variance across replicates is not a finite number >= 0 at N = " +
+                                std::to_string(l.n) + ": no error bar"));
+    // A random estimator whose own error bar is 0 while its replicates disagree: the runs saw
+    // no variation (e.g. both points of every stratum on the same side of a discontinuity),
+    // and their intervals are wrong. When every replicate agrees (f/p constant) 0 is right.
+    if (l.zero_error_runs > 0 && l.estimates_spread)
+        w.push_back(
+            warning("zero_error_bar",
+                    std::to_string(l.zero_error_runs) + " of " + std::to_string(l.reps) +
+                        " replicates reported a standard error of 0 at N = " + std::to_string(l.n) +
+                        " although the replicates differ (standard deviation " +
+                        fmt("%.3g", std::sqrt(l.variance)) +
+                        "): their error bars are wrong (too few samples to see f vary)"));
     if (d.nonfinite)
         w.push_back(warning("nonfinite", std::to_string(d.nonfinite) +
                                              " sample(s) with NaN/Inf f/p dropped: the estimate is "
@@ -120,12 +151,24 @@ Json estimator_warnings(const EstimatorStudy& e, const StudySettings& s) {
                           TailWording{"the weights f/p", "weights", "N", "the variance"});
     }
 
-    if (e.support.missed > 0)
+    const SupportCheck& sc = e.support;
+    if (sc.flagged && sc.method == "quadrature")
+        w.push_back(warning(
+            "pdf_support",
+            std::isfinite(sc.missed_mass)
+                ? "the pdf is zero on " + fmt("%.3g", 100.0 * sc.zero_measure) +
+                      "% of the domain, where the integral of |f| is " +
+                      fmt("%.6g", sc.missed_mass) + " (" + fmt("%.3g", 100.0 * sc.missed_fraction) +
+                      "% of the integral of |f|, by quadrature): the estimator never samples "
+                      "there and is biased"
+                : "the pdf is zero on " + fmt("%.3g", 100.0 * sc.zero_measure) +
+                      "% of the domain, where |f| is not finite or not integrable: the "
+                      "estimator never samples there and is biased"));
+    else if (sc.flagged)
         w.push_back(warning("pdf_support",
-                            "the pdf is zero at " + std::to_string(e.support.missed) + " of " +
-                                std::to_string(e.support.f_nonzero) +
-                                " probe points where f != 0 (" +
-                                fmt("%.3g", 100.0 * e.support.missed_fraction) +
+                            "the pdf is zero at " + std::to_string(sc.missed) + " of " +
+                                std::to_string(sc.f_nonzero) + " probe points where f != 0 (" +
+                                fmt("%.3g", 100.0 * sc.missed_fraction) +
                                 "% of |f|): the estimator never samples there and is biased"));
     if (e.consistency.dof > 0 && e.consistency.p_value < 1e-3)
         w.push_back(warning("level_drift",
@@ -204,7 +247,11 @@ Json level_to_json(const LevelStats& l) {
            {"tail_k", l.tail_k},
            {"nonzero_per_run", num(l.nonzero_per_run)},
            {"ess", num(l.ess_mean)},
+           {"no_estimate_runs", l.no_estimate_runs},
+           {"zero_error_runs", l.zero_error_runs},
            {"warnings", warnings_for(l)}};
+    // A variance below 0 is not a variance: null, like NaN (warnings_for flags both).
+    if (!(l.variance >= 0.0)) j["variance"] = j["variance_ci95"] = j["std_error"] = nullptr;
     if (l.has_exact) {
         j["bias"] = num(l.bias);
         j["mse"] = num(l.mse);
@@ -242,7 +289,16 @@ Json estimator_header(const EstimatorStudy& e, const StudySettings& s) {
                  {{"probes", e.support.probes},
                   {"f_nonzero", e.support.f_nonzero},
                   {"missed", e.support.missed},
-                  {"missed_fraction", num(e.support.missed_fraction)}}},
+                  {"missed_fraction", num(e.support.missed_fraction)},
+                  {"method", e.support.method},
+                  {"zero_measure", num(e.support.zero_measure)},
+                  {"missed_mass",
+                   e.support.method == "quadrature" ? num(e.support.missed_mass) : Json(nullptr)},
+                  {"abs_integral", num(e.support.abs_integral)},
+                  {"tolerance", kSupportTolerance},
+                  {"quadrature_evaluations", e.support.quadrature_evaluations},
+                  {"flagged", e.support.flagged},
+                  {"note", e.support.note}}},
                 {"consistency",
                  {{"chi2", num(e.consistency.chi2)},
                   {"dof", e.consistency.dof},
@@ -329,7 +385,8 @@ void comparison_table(std::ostringstream& out, const Json& ests, const Compariso
         if (std::isnan(first)) first = eff;
         out << padr("  " + jstr(e, "name"), c.name_width)
             << padl(fmt("%.0f", jnum(l, "n")), c.n_width)
-            << padl(fmt("%.4e", jnum(l, "variance")), c.error_width)
+            << padl(fmt("%.4e", jnum(l, "variance") >= 0.0 ? jnum(l, "variance") : NAN),
+                    c.error_width)
             << padl(fmt("%.2e", jnum(l, "time_mean_s")), c.time_width) << padl(fmt("%.3e", eff), 12)
             << padl(first > 0 && std::isfinite(eff) ? fmt("%.3gx", eff / first) : "-", 10) << "\n";
     }
@@ -430,7 +487,9 @@ std::string format_table(const Json& r) {
         // Level warnings repeat from N to N: the table shows each code once, at the largest N.
         std::vector<std::string> codes, messages;
         for (const Json& l : list(e, "levels")) {
-            const double mean = jnum(l, "mean"), var = jnum(l, "variance");
+            // A negative variance (a hand-edited result) is shown as "-" like a missing one.
+            const double mean = jnum(l, "mean"), raw_var = jnum(l, "variance");
+            const double var = raw_var >= 0.0 ? raw_var : NAN;
             const double ref = has_exact ? exact : mean;
             out << padl(fmt("%.0f", jnum(l, "n")), 9) << padl(fmt("%.9g", mean), 17)
                 << padl(fmt("%.4e", var), 13)
@@ -495,6 +554,10 @@ std::string format_csv(const Json& r) {
         for (char ch : s) q += ch == '"' ? std::string("\"\"") : std::string(1, ch);
         return q + "\"";
     };
+    // Spreads that are negative are not spreads: empty cells, like missing numbers.
+    auto spread = [&](const Json& v) -> std::string {
+        return v.is_number() && v.get<double>() < 0.0 ? std::string() : cell(v);
+    };
     const Json exact = get(scene, "exact");
     for (const Json& e : list(r, "estimators")) {
         for (const Json& l : list(e, "levels")) {
@@ -504,11 +567,11 @@ std::string format_csv(const Json& r) {
             out << quoted(jstr(scene, "name")) << "," << quoted(jstr(e, "name")) << ","
                 << jstr(e, "sampler") << "," << quoted(jstr(e, "pdf")) << "," << cell(get(l, "n"))
                 << "," << cell(get(l, "reps")) << "," << cell(get(l, "mean")) << ","
-                << cell(get(l, "variance")) << "," << cell(at_index(vci, 0)) << ","
-                << cell(at_index(vci, 1)) << "," << cell(get(l, "std_error")) << ","
+                << spread(get(l, "variance")) << "," << spread(at_index(vci, 0)) << ","
+                << spread(at_index(vci, 1)) << "," << spread(get(l, "std_error")) << ","
                 << cell(at_index(ci, 0)) << "," << cell(at_index(ci, 1)) << "," << cell(exact)
-                << "," << cell(get(l, "bias")) << "," << cell(get(l, "mse")) << ","
-                << cell(get(l, "rmse")) << "," << cell(get(l, "coverage95")) << ","
+                << "," << cell(get(l, "bias")) << "," << spread(get(l, "mse")) << ","
+                << spread(get(l, "rmse")) << "," << cell(get(l, "coverage95")) << ","
                 << cell(get(l, "mean_run_std_error")) << "," << cell(get(l, "time_mean_s")) << ","
                 << cell(get(l, "efficiency")) << "," << cell(get(d, "nonfinite")) << ","
                 << cell(get(d, "zero_pdf")) << "," << cell(get(d, "max_weight_share")) << "\n";

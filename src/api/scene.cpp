@@ -948,6 +948,14 @@ Made<SceneRequest> build_request(const Json& scene, const Json& options) {
                                             bad.find(key) != std::string::npos);
         return made_error<SceneRequest>((from_options ? "options: " : "scene: ") + bad);
     }
+    // The whole study's size, before any work (a run of 2^36 points is refused, not begun).
+    const std::string too_big = check_study_size(s, req.estimators.size());
+    if (!too_big.empty()) {
+        bool from_options = false;
+        for (const char* key : {"n_min", "n_max", "reps", "estimators"})
+            from_options = from_options || (options.is_object() && find(options, key));
+        return made_error<SceneRequest>((from_options ? "options: " : "scene: ") + too_big);
+    }
     for (const EstimatorSpec& e : req.estimators)
         if (e.per_stratum > 1 && s.n_min < e.per_stratum)
             return made_error<SceneRequest>("estimator '" + e.name + "': samples_per_stratum = " +

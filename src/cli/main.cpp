@@ -64,6 +64,12 @@ const char* kUsage =
     "\n"
     "exit codes: 0 ok, 1 runtime error, 2 bad arguments, 3 bad scene\n";
 
+std::string fmt_number(const char* format, double x) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, format, x);
+    return buf;
+}
+
 /// The exit code for a failed C API call.
 int exit_code(int status) {
     if (status == MCP_ERROR_SCENE) return kExitScene;
@@ -332,6 +338,25 @@ int progress_line(const char* level_json, void*) {
     return 0;
 }
 
+/// Says up front when a study is predicted to take long (mcp_study_plan times a short pilot);
+/// a study that cannot be planned is left to mcp_study_run, which reports why.
+void announce_long_study(const std::string& scene, const std::string& options) {
+    char* plan = nullptr;
+    if (mcp_study_plan(scene.c_str(), options.c_str(), &plan) != MCP_OK) return;
+    nlohmann::json p = nlohmann::json::parse(plan, nullptr, false);
+    mcp_free(plan);
+    if (p.is_discarded() || !p["predicted_seconds"].is_number()) return;
+    const double seconds = p["predicted_seconds"].get<double>();
+    if (seconds < 10.0) return;
+    const std::string when = seconds < 120.0    ? fmt_number("%.0f s", seconds)
+                             : seconds < 7200.0 ? fmt_number("%.0f min", seconds / 60.0)
+                                                : fmt_number("%.1f hours", seconds / 3600.0);
+    std::fprintf(stderr,
+                 "mcplay: this study is predicted to take about %s (%s integrand evaluations on "
+                 "%s thread(s)); Ctrl-C stops it\n",
+                 when.c_str(), p["evaluations"].dump().c_str(), p["threads"].dump().c_str());
+}
+
 int cmd_run(const std::vector<std::string>& args) {
     std::string scene_arg, format = "table", out_path, dir_arg, cache_arg;
     bool quiet = false, no_cache = false;
@@ -427,6 +452,7 @@ int cmd_run(const std::vector<std::string>& args) {
                                       show_progress ? progress_line : nullptr, nullptr, &result);
     } else {
         const std::string opts = options.dump();
+        if (!quiet) announce_long_study(text, opts);
         status = mcp_study_run(text.c_str(), opts.c_str(), show_progress ? progress_line : nullptr,
                                nullptr, &result);
     }

@@ -28,6 +28,8 @@ class Distribution1D {
     Distribution1D() = default;
 
     Dist1DKind kind() const { return kind_; }
+    /// The number of equal bins of a tabulated density (0 for the analytic kinds).
+    size_t bins() const { return func_.size(); }
     double lower() const { return a_; }
     double upper() const { return b_; }
 

@@ -168,6 +168,11 @@ RunResult run_estimate(const Problem& problem, const EstimatorSpec& spec, uint64
         break;
     }
     result.std_error = std::sqrt(variance_of_mean) * scale;
+    if (n > 0 && result.diagnostics.nonfinite == n) {
+        // Every sample was NaN or infinite: the sum of the (all dropped) weights is not an
+        // estimate of anything, so there is none (not 0 +/- 0).
+        result.estimate = result.std_error = std::numeric_limits<double>::quiet_NaN();
+    }
     const double total_abs = abs_sum.value();
     result.diagnostics.max_weight_share = total_abs > 0.0 ? max_abs / total_abs : 0.0;
     result.diagnostics.nonzero = nonzero;

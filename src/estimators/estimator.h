@@ -38,8 +38,8 @@ enum class Accumulator { Compensated, Float32 };
 
 struct RunResult {
     uint64_t n = 0;
-    double estimate = 0.0;
-    double std_error = 0.0; ///< NaN when it cannot be estimated (N = 1)
+    double estimate = 0.0;  ///< NaN when every sample was NaN/Inf (no estimate)
+    double std_error = 0.0; ///< NaN when it cannot be estimated (N = 1, or no estimate)
     double seconds = 0.0;
     RunDiagnostics diagnostics;
     std::vector<double> top; ///< the kTopWeights largest |w|, decreasing (for the tail index)

@@ -4,8 +4,11 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <functional>
 #include <limits>
 
+#include "core/quadrature.h"
 #include "core/special.h"
 
 #if defined(__EMSCRIPTEN__) && !defined(__EMSCRIPTEN_PTHREADS__)
@@ -24,11 +27,251 @@ constexpr int kMaxThreads = 256;
 constexpr uint64_t kSupportProbes = 1 << 16;
 } // namespace
 
+namespace {
+
+struct Span {
+    double a, b;
+};
+
+// Integer with thousands separators, for notes ("65,536").
+std::string count_text(uint64_t n) {
+    std::string d = std::to_string(n), out;
+    for (size_t i = 0; i < d.size(); ++i) {
+        if (i && (d.size() - i) % 3 == 0) out += ',';
+        out += d[i];
+    }
+    return out;
+}
+
+std::string g_text(double x, const char* f = "%.3g") {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, f, x);
+    return buf;
+}
+
+// Where a 1D density is zero on [a, b], as disjoint sorted intervals. Tabulated: exactly its
+// zero bins (the density is read at each bin's centre). Analytic kinds are unimodal, so their
+// zero set (where the density underflows, or a single end point) is found on a grid of 4096
+// cells whose transitions are then bisected to the last double.
+std::vector<Span> zero_spans(const Distribution1D& d) {
+    const double a = d.lower(), b = d.upper();
+    const size_t bins = d.kind() == Dist1DKind::Tabulated ? d.bins() : 0;
+    const size_t cells = bins ? bins : 4096;
+    auto edge = [&](size_t i) {
+        return i == cells ? b : a + (b - a) * (static_cast<double>(i) / static_cast<double>(cells));
+    };
+    std::vector<char> zero(cells);
+    double mid[kBlockSize], dens[kBlockSize];
+    for (size_t first = 0; first < cells; first += kBlockSize) {
+        const size_t m = std::min<size_t>(kBlockSize, cells - first);
+        for (size_t i = 0; i < m; ++i) {
+            mid[i] = 0.5 * edge(first + i) + 0.5 * edge(first + i + 1);
+            dens[i] = 1.0;
+        }
+        d.multiply_pdf_block(mid, dens, m);
+        for (size_t i = 0; i < m; ++i) zero[first + i] = !(dens[i] > 0.0);
+    }
+    // Bisects [lo, hi] (density zero at `zero_end`, positive at the other end) to the edge.
+    auto bisect = [&](double lo, double hi, bool zero_at_hi) {
+        for (int it = 0; it < 200; ++it) {
+            const double m = 0.5 * lo + 0.5 * hi;
+            if (!(m > lo && m < hi)) break;
+            const bool z = !(d.pdf(m) > 0.0);
+            if (z == zero_at_hi)
+                hi = m;
+            else
+                lo = m;
+        }
+        return zero_at_hi ? hi : lo;
+    };
+    std::vector<Span> spans;
+    for (size_t i = 0; i < cells;) {
+        if (!zero[i]) {
+            ++i;
+            continue;
+        }
+        size_t j = i;
+        while (j < cells && zero[j]) ++j;
+        double lo = edge(i), hi = edge(j);
+        if (!bins) { // analytic: the edges of the zero run lie between cell centres
+            const double c = [&](size_t k) { return 0.5 * edge(k) + 0.5 * edge(k + 1); }(i);
+            if (i > 0) lo = bisect(0.5 * edge(i - 1) + 0.5 * edge(i), c, true);
+            const double c2 = 0.5 * edge(j - 1) + 0.5 * edge(j);
+            if (j < cells) hi = bisect(c2, 0.5 * edge(j) + 0.5 * edge(j + 1), false);
+        }
+        if (hi > lo) spans.push_back({lo, hi});
+        i = j;
+    }
+    return spans;
+}
+
+double spans_length(const std::vector<Span>& spans) {
+    double total = 0.0;
+    for (const Span& s : spans) total += s.b - s.a;
+    return total;
+}
+
+// [lo, hi] minus the spans (sorted, disjoint, inside [lo, hi]).
+std::vector<Span> complement(const std::vector<Span>& spans, double lo, double hi) {
+    std::vector<Span> out;
+    double at = lo;
+    for (const Span& s : spans) {
+        if (s.a > at) out.push_back({at, s.a});
+        at = s.b;
+    }
+    if (hi > at) out.push_back({at, hi});
+    return out;
+}
+
+struct Rect {
+    Span x, y;
+};
+
+// The quadrature's evaluations are capped so that the check stays a small part of a study.
+constexpr int kSupportQuadratureBudget = 1 << 22;
+
+struct Budget {
+    int used = 0;
+    bool exceeded = false;
+};
+
+// int_a^b g by adaptive Gauss-Kronrod [Piessens83] on pieces: `uniform` equal pieces, the two
+// end pieces cut geometrically `levels` times toward a and b (widths h 2^-k), so that a feature
+// touching an end of the interval (a table's zero bin next to where f lives) is seen at its own
+// scale instead of falling between the nodes of one rule. NaN when the budget is exceeded;
+// non-finite when g is.
+double integrate_graded(const std::function<double(double)>& g, double a, double b, int uniform,
+                        int levels, Budget& budget) {
+    std::vector<double> t{0.0};
+    const double h = 1.0 / uniform;
+    for (int k = levels; k >= 1; --k) t.push_back(std::ldexp(h, -k));
+    for (int j = 1; j < uniform; ++j) t.push_back(j * h);
+    for (int k = 1; k <= levels; ++k) t.push_back(1.0 - std::ldexp(h, -k));
+    t.push_back(1.0);
+    NeumaierSum sum;
+    double x0 = a;
+    for (size_t i = 1; i < t.size(); ++i) {
+        const double x1 = i + 1 == t.size() ? b : a + (b - a) * t[i];
+        if (!(x1 > x0)) continue;
+        if (budget.used > kSupportQuadratureBudget) {
+            budget.exceeded = true;
+            return std::numeric_limits<double>::quiet_NaN();
+        }
+        const QuadratureResult r = integrate_adaptive(g, x0, x1, 1e-6, 0.0, 64);
+        budget.used += r.evaluations;
+        if (!std::isfinite(r.value)) return r.value;
+        sum.add(r.value);
+        x0 = x1;
+    }
+    return sum.value();
+}
+
+// int over a rectangle (a 1D span when dim = 1) of |f|: nested graded quadrature in 2D.
+double integrate_abs(const Integrand& f, int dim, const Rect& r, Budget& budget) {
+    if (dim == 1) {
+        auto g = [&](double x) { return std::fabs(evaluate_point(f, &x)); };
+        return integrate_graded(g, r.x.a, r.x.b, 16, 40, budget);
+    }
+    auto outer = [&](double y) {
+        if (budget.exceeded) return 0.0;
+        auto inner = [&](double x) {
+            const double p[2] = {x, y};
+            return std::fabs(evaluate_point(f, p));
+        };
+        const double v = integrate_graded(inner, r.x.a, r.x.b, 4, 16, budget);
+        return budget.exceeded ? 0.0 : v;
+    };
+    const double v = integrate_graded(outer, r.y.a, r.y.b, 4, 16, budget);
+    return budget.exceeded ? std::numeric_limits<double>::quiet_NaN() : v;
+}
+
+// The zero set of the proposal as rectangles of a 1D or 2D box, and its share of the domain's
+// measure. False when it is not known in that form.
+bool zero_set(const Proposal& p, const Domain& d, std::vector<Rect>* rects, double* share,
+              std::string* why_not) {
+    rects->clear();
+    *share = 0.0;
+    if (p.kind == ProposalKind::CosineHemisphere) return true; // zero only on z = 0 (null set)
+    if (p.kind == ProposalKind::Product1D) {
+        const size_t dim = p.marginals.size();
+        std::vector<std::vector<Span>> z(dim);
+        double positive = 1.0;
+        for (size_t j = 0; j < dim; ++j) {
+            z[j] = zero_spans(p.marginals[j]);
+            positive *= 1.0 - spans_length(z[j]) / (d.hi[j] - d.lo[j]);
+        }
+        *share = 1.0 - positive;
+        if (*share == 0.0) return true;
+        if (dim == 1) {
+            for (const Span& s : z[0]) rects->push_back({s, {0.0, 0.0}});
+            return true;
+        }
+        if (dim == 2) { // Z0 x [lo1, hi1], then (not Z0) x Z1: disjoint
+            for (const Span& s : z[0]) rects->push_back({s, {d.lo[1], d.hi[1]}});
+            for (const Span& s : complement(z[0], d.lo[0], d.hi[0]))
+                for (const Span& t : z[1]) rects->push_back({s, t});
+            return true;
+        }
+        *why_not = "the zero set of a product pdf in " + std::to_string(dim) +
+                   " dimensions is not integrated";
+        return false;
+    }
+    if (p.kind == ProposalKind::Tabulated2D) {
+        const TabulatedDistribution2D& t = p.table;
+        const int nx = t.nx(), ny = t.ny();
+        auto ex = [&](int i) { return i == nx ? t.x1() : t.x0() + (t.x1() - t.x0()) * i / nx; };
+        auto ey = [&](int i) { return i == ny ? t.y1() : t.y0() + (t.y1() - t.y0()) * i / ny; };
+        // Runs of zero cells per row; a run repeated on the next row extends its rectangle.
+        struct Open {
+            int ix0, ix1, iy0, iy1;
+        };
+        std::vector<Open> open, done;
+        size_t zero_cells = 0;
+        for (int iy = 0; iy < ny; ++iy) {
+            const double yc = 0.5 * ey(iy) + 0.5 * ey(iy + 1);
+            std::vector<Open> next;
+            for (int ix = 0; ix < nx;) {
+                if (t.pdf(0.5 * ex(ix) + 0.5 * ex(ix + 1), yc) > 0.0) {
+                    ++ix;
+                    continue;
+                }
+                int jx = ix;
+                while (jx < nx && !(t.pdf(0.5 * ex(jx) + 0.5 * ex(jx + 1), yc) > 0.0)) ++jx;
+                zero_cells += static_cast<size_t>(jx - ix);
+                Open run{ix, jx, iy, iy + 1};
+                for (Open& o : open)
+                    if (o.ix0 == ix && o.ix1 == jx && o.iy1 == iy) {
+                        run.iy0 = o.iy0;
+                        o.ix0 = -1; // taken over
+                    }
+                next.push_back(run);
+                ix = jx;
+            }
+            for (const Open& o : open)
+                if (o.ix0 >= 0) done.push_back(o);
+            open = next;
+        }
+        done.insert(done.end(), open.begin(), open.end());
+        for (const Open& o : done)
+            rects->push_back({{ex(o.ix0), ex(o.ix1)}, {ey(o.iy0), ey(o.iy1)}});
+        *share = static_cast<double>(zero_cells) / (static_cast<double>(nx) * ny);
+        return true;
+    }
+    *why_not = std::string("the zero set of pdf '") + proposal_kind_name(p.kind) +
+               "' is not known in closed form";
+    return false;
+}
+
+} // namespace
+
 SupportCheck check_support(const Problem& problem, const EstimatorSpec& spec, uint64_t probes,
                            uint64_t seed) {
     SupportCheck check;
     check.probes = probes;
-    if (!spec.proposal.importance) return check; // uniform proposals cover the whole domain
+    if (!spec.proposal.importance) { // uniform proposals cover the whole domain
+        check.note = "a uniform pdf is positive on the whole domain";
+        return check;
+    }
     const Domain& d = problem.domain;
     Pcg32 rng(mix64(seed ^ 0x737570706f7274ULL), hash_string(spec.name.c_str())); // "support"
     const Proposal uniform = uniform_proposal(d);
@@ -38,7 +281,7 @@ SupportCheck check_support(const Problem& problem, const EstimatorSpec& spec, ui
     u.reset(d.sample_dim(), kBlockSize);
     x.reset(d.point_dim(), kBlockSize);
     std::vector<double> f(kBlockSize), p(kBlockSize);
-    NeumaierSum all, missed;
+    NeumaierSum all, missed, covered;
     for (uint64_t first = 0; first < probes; first += kBlockSize) {
         const size_t count = static_cast<size_t>(std::min<uint64_t>(kBlockSize, probes - first));
         generate_block(plan, first, count, rng, u);
@@ -53,10 +296,62 @@ SupportCheck check_support(const Problem& problem, const EstimatorSpec& spec, ui
             if (!(p[i] > 0.0)) {
                 ++check.missed;
                 missed.add(a);
+            } else {
+                covered.add(a);
             }
         }
     }
     check.missed_fraction = all.value() > 0.0 ? missed.value() / all.value() : 0.0;
+    // The probes' estimate of int |f| over the support of p: measure x mean of |f| [p > 0].
+    const double support_abs =
+        probes ? d.measure() * covered.value() / static_cast<double>(probes) : 0.0;
+    check.abs_integral = d.measure() * all.value() / static_cast<double>(probes ? probes : 1);
+
+    std::vector<Rect> rects;
+    std::string why_not;
+    double share = 0.0;
+    if (zero_set(spec.proposal, d, &rects, &share, &why_not)) {
+        Budget budget;
+        NeumaierSum mass;
+        bool finite = true;
+        for (const Rect& r : rects) {
+            const double m = integrate_abs(problem.integrand, d.point_dim(), r, budget);
+            if (budget.exceeded) break;
+            if (!std::isfinite(m)) finite = false;
+            mass.add(m);
+        }
+        check.quadrature_evaluations = budget.used;
+        if (!budget.exceeded) {
+            check.method = "quadrature";
+            check.zero_measure = share;
+            check.missed_mass = finite ? mass.value() : std::numeric_limits<double>::infinity();
+            check.abs_integral = check.missed_mass + support_abs;
+            check.missed_fraction =
+                check.abs_integral > 0.0 ? check.missed_mass / check.abs_integral : 0.0;
+            check.flagged = !finite || check.missed > 0 ||
+                            check.missed_mass > kSupportTolerance * check.abs_integral;
+            if (rects.empty())
+                check.note = share == 0.0 ? "the pdf is positive on the whole domain up to a set "
+                                            "of measure zero (its zero set is known)"
+                                          : "the pdf's zero set has no area";
+            else
+                check.note =
+                    "the pdf is zero on " + g_text(100.0 * share) +
+                    "% of the domain (known from its bins or factors); |f| was integrated "
+                    "there by adaptive Gauss-Kronrod quadrature graded toward the edges (" +
+                    count_text(static_cast<uint64_t>(budget.used)) +
+                    " evaluations), which finds features touching those edges down to "
+                    "2^-40 of their width; flagged above " +
+                    g_text(kSupportTolerance) + " of the integral of |f|";
+            return check;
+        }
+        why_not = "the quadrature over the pdf's zero set stopped at its budget of " +
+                  count_text(kSupportQuadratureBudget) + " evaluations";
+    }
+    check.method = "probes";
+    check.flagged = check.missed > 0;
+    check.note = "probed " + count_text(probes) + " uniform points; features narrower than ~1/" +
+                 count_text(probes) + " of the domain can be missed (" + why_not + ")";
     return check;
 }
 
@@ -77,6 +372,40 @@ std::string check_settings(const StudySettings& s) {
     if (s.threads < 0 || s.threads > kMaxThreads)
         return "threads must be in 0.." + std::to_string(kMaxThreads) + " (0 = all cores), got " +
                std::to_string(s.threads);
+    return "";
+}
+
+uint64_t study_evaluations(const StudySettings& s, size_t estimators) {
+    const uint64_t kMax = std::numeric_limits<uint64_t>::max();
+    uint64_t ladder = 0; // <= 2^37 for n_max <= 2^36
+    for (uint64_t n : n_ladder(s.n_min, s.n_max)) ladder += n;
+    const uint64_t reps = s.reps > 0 ? static_cast<uint64_t>(s.reps) : 0;
+    const uint64_t e = static_cast<uint64_t>(estimators);
+    if (reps && ladder > kMax / reps) return kMax;
+    const uint64_t per_estimator = ladder * reps;
+    if (e && per_estimator > kMax / e) return kMax;
+    return per_estimator * e;
+}
+
+std::string check_study_size(const StudySettings& s, size_t estimators) {
+    const uint64_t evals = study_evaluations(s, estimators);
+    const std::string given = "n_max = " + std::to_string(s.n_max) +
+                              ", reps = " + std::to_string(s.reps) + " and " +
+                              std::to_string(estimators) + " estimator(s)";
+    if (evals > kMaxStudyEvaluations)
+        return given + " ask for " + std::to_string(evals) +
+               " integrand evaluations (sum over N of N x reps x estimators), more than the "
+               "limit of " +
+               std::to_string(kMaxStudyEvaluations) +
+               " (2^40): lower n_max, reps or the number of estimators";
+    const uint64_t levels = n_ladder(s.n_min, s.n_max).size();
+    const uint64_t results = levels * static_cast<uint64_t>(s.reps > 0 ? s.reps : 0) * estimators;
+    if (results > kMaxReplicateResults)
+        return given + " over " + std::to_string(levels) + " N levels keep " +
+               std::to_string(results) +
+               " replicate results (levels x reps x estimators), more than the limit of " +
+               std::to_string(kMaxReplicateResults) +
+               " (2^21): raise n_min, or lower n_max, reps or the number of estimators";
     return "";
 }
 
@@ -108,6 +437,13 @@ LevelStats summarise_level(const std::vector<RunResult>& runs, const Problem& pr
     std::vector<double> pooled;
     double nonzero = 0.0, ess = 0.0;
     for (const RunResult& r : runs) {
+        // A run whose every sample was NaN/Inf has no estimate (run_estimate gives NaN).
+        if (std::isnan(r.estimate) && r.n > 0 && r.diagnostics.nonfinite == r.n)
+            ++s.no_estimate_runs;
+        // An error bar of 0 to round-off: right only if every replicate agrees (f/p constant).
+        if (std::isfinite(r.estimate) && std::isfinite(r.std_error) &&
+            r.std_error <= 64.0 * 2.220446049250313e-16 * std::fabs(r.estimate))
+            ++s.zero_error_runs;
         ess += r.diagnostics.ess;
         pooled.insert(pooled.end(), r.top.begin(), r.top.end());
         nonzero += static_cast<double>(r.diagnostics.nonzero);
@@ -157,14 +493,30 @@ LevelStats summarise_level(const std::vector<RunResult>& runs, const Problem& pr
     } else {
         s.error = std::sqrt(s.variance);
     }
+    const double roundoff = 64.0 * 2.220446049250313e-16 * std::fabs(s.mean);
+    s.estimates_spread = std::isfinite(s.variance) && s.variance > roundoff * roundoff;
+    if (s.no_estimate_runs > 0) {
+        // No estimate: nothing derived from the (dropped) samples means anything.
+        const double nan = std::numeric_limits<double>::quiet_NaN();
+        s.mean = s.variance = s.variance_lo = s.variance_hi = s.std_error = nan;
+        s.ci_lo = s.ci_hi = s.bias = s.mse = s.rmse = s.coverage = s.mean_run_se = nan;
+        s.efficiency = s.error = s.tail_index = s.ess_mean = nan;
+        s.tail_k = 0;
+        s.estimates_spread = false;
+        s.zero_error_runs = 0;
+    }
     return s;
 }
 
 ConvergenceFit fit_convergence(const std::vector<LevelStats>& levels) {
     ConvergenceFit fit;
     std::vector<double> x, y;
-    int reps = 0, skipped = 0;
+    int reps = 0, skipped = 0, missing = 0;
     for (const LevelStats& l : levels) {
+        if (!std::isfinite(l.mean) || !std::isfinite(l.variance) || l.variance < 0.0) {
+            ++missing; // no estimate at this N (every sample NaN/Inf, or an overflow)
+            continue;
+        }
         // A variance at the round-off level of the mean (an exact estimator such as a pdf
         // proportional to f) carries no convergence information.
         const double roundoff = 64.0 * 2.220446049250313e-16 * std::fabs(l.mean);
@@ -179,10 +531,17 @@ ConvergenceFit fit_convergence(const std::vector<LevelStats>& levels) {
     fit.levels_used = static_cast<int>(x.size());
     if (skipped)
         fit.note = std::to_string(skipped) + " level(s) with zero (round-off) variance left out";
+    if (missing)
+        fit.note += (fit.note.empty() ? "" : "; ") + std::to_string(missing) +
+                    " level(s) without an estimate left out";
     if (x.size() < 3) {
-        fit.note = x.empty() && skipped ? "variance is zero at every N (an exact estimator?)"
-                                        : "fewer than 3 levels with a variance: no fit" +
-                                              (fit.note.empty() ? "" : "; " + fit.note);
+        if (x.empty() && skipped && !missing)
+            fit.note = "variance is zero at every N (an exact estimator?)";
+        else if (x.empty() && missing && !skipped)
+            fit.note = "no estimate at any N: no fit";
+        else
+            fit.note = "fewer than 3 levels with a variance: no fit" +
+                       (fit.note.empty() ? "" : "; " + fit.note);
         return fit;
     }
     LineFit line = fit_line(x, y);
@@ -226,6 +585,38 @@ int resolve_threads(int requested) {
     (void)requested;
     return 1;
 #endif
+}
+
+StudyPlan plan_study(const Problem& problem, const std::vector<EstimatorSpec>& estimators,
+                     const StudySettings& settings) {
+    const auto start = std::chrono::steady_clock::now();
+    StudyPlan plan;
+    plan.levels = n_ladder(settings.n_min, settings.n_max);
+    plan.evaluations = study_evaluations(settings, estimators.size());
+    const size_t tasks = estimators.size() * static_cast<size_t>(std::max(settings.reps, 1));
+    plan.threads = static_cast<int>(std::max<size_t>(
+        1, std::min<size_t>(static_cast<size_t>(resolve_threads(settings.threads)), tasks)));
+    const uint64_t per_estimator = study_evaluations(settings, 1);
+    Workspace ws;
+    double total = 0.0;
+    for (const EstimatorSpec& spec : estimators) {
+        EstimatorPlan e;
+        e.name = spec.name;
+        e.evaluations = per_estimator;
+        // The stream of a replicate the study never draws (rep = -1 wraps to 2^64 - 1).
+        Pcg32 rng(mix64(settings.seed ^ 0x706c616eULL), // "plan"
+                  replicate_stream(settings.seed, spec.name, kPilotSamples, -1));
+        double seconds = run_estimate(problem, spec, kPilotSamples, rng, ws).seconds;
+        if (seconds < 0.005) seconds = run_estimate(problem, spec, kPilotSamples, rng, ws).seconds;
+        e.seconds_per_evaluation = seconds / static_cast<double>(kPilotSamples);
+        e.predicted_seconds = e.seconds_per_evaluation * static_cast<double>(per_estimator);
+        total += e.predicted_seconds;
+        plan.estimators.push_back(e);
+    }
+    plan.predicted_seconds = total / plan.threads;
+    plan.pilot_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return plan;
 }
 
 StudyResult run_study(const Problem& problem, const std::vector<EstimatorSpec>& estimators,

@@ -29,6 +29,20 @@ struct StudySettings {
 /// Checks the settings; returns an error message naming the setting, or "".
 std::string check_settings(const StudySettings& s);
 
+/// Largest study: integrand evaluations summed over the ladder, sum_N N x reps x estimators
+/// (about 3 hours at 1e8 evaluations per second), and replicate results kept (levels x reps x
+/// estimators: each is held in memory and written to the result).
+constexpr uint64_t kMaxStudyEvaluations = uint64_t(1) << 40;
+constexpr uint64_t kMaxReplicateResults = uint64_t(1) << 21;
+
+/// Integrand evaluations of a study: sum over its N ladder of N x reps x estimators
+/// (saturates at UINT64_MAX).
+uint64_t study_evaluations(const StudySettings& s, size_t estimators);
+
+/// Checks the size of a study before any work: kMaxStudyEvaluations and kMaxReplicateResults.
+/// Returns an error message naming n_max, reps and the estimators, or "".
+std::string check_study_size(const StudySettings& s, size_t estimators);
+
 /// The N ladder: powers of two from the first >= n_min up to n_max.
 std::vector<uint64_t> n_ladder(uint64_t n_min, uint64_t n_max);
 
@@ -56,6 +70,11 @@ struct LevelStats {
     int tail_k = 0;               ///< its order k (standard error ~ tail_index / sqrt(k))
     double nonzero_per_run = 0.0; ///< mean number of non-zero weights per run
     double ess_mean = 0.0;        ///< mean effective sample size per run
+    int no_estimate_runs = 0;     ///< runs whose every sample was NaN/Inf: then the level has no
+                                  ///< estimate (mean, variance and what derives from them are NaN)
+    int zero_error_runs = 0; ///< runs whose own standard error is 0 (to round-off, 64 eps |I_N|)
+    bool estimates_spread = false; ///< the replicates differ beyond round-off (variance >
+                                   ///< (64 eps |mean|)^2): a zero error bar is then wrong
     std::vector<double> estimates, run_std_errors; ///< per replicate
 };
 
@@ -73,17 +92,41 @@ struct ConvergenceFit {
 /// sampling noise of log s^2 for R normal replicates, psi'((R-1)/2) [trigamma].
 ConvergenceFit fit_convergence(const std::vector<LevelStats>& levels);
 
-/// Does the proposal cover the integrand's support? Checked once per estimator with
-/// uniform points of the domain: where f != 0 but p = 0 the estimator cannot sample, and is
-/// biased by the integral over that region, which no run's own samples can reveal.
+/// Does the proposal cover the integrand's support? Checked once per estimator: where f != 0
+/// but p = 0 the estimator cannot sample, and is biased by the integral over that region,
+/// which no run's own samples can reveal.
+///
+/// Where the zero set Z of p is known (zero bins of a 1D table, zero cells of a 2D table, a
+/// product of 1D factors on a 1- or 2-dimensional box, each factor's zero set found from its
+/// bins or, for analytic factors, by bisection of where the density underflows; the cosine
+/// hemisphere, zero only on the null set z = 0), the missed mass M = int_Z |f| is integrated by
+/// adaptive Gauss-Kronrod quadrature [Piessens83] over each piece of Z, graded geometrically
+/// toward its edges (features that touch an edge of Z down to 2^-40 of its width are found),
+/// nested on 2D rectangles. The check flags when M > kSupportTolerance x int |f|, with
+/// int |f| = M + the probes' estimate of int |f| over the support. Everywhere else (a product
+/// in 3 or more dimensions, a quadrature budget exceeded) it rests on the uniform probes, and
+/// its note says how far it looked. The uniform probes always run (counts below).
+constexpr double kSupportTolerance = 1e-9;
+
 struct SupportCheck {
     uint64_t probes = 0;
     uint64_t f_nonzero = 0;       ///< probes with f != 0
     uint64_t missed = 0;          ///< probes with f != 0 and p = 0
-    double missed_fraction = 0.0; ///< share of sum |f| over the probes that lies where p = 0
+    double missed_fraction = 0.0; ///< share of int |f| where p = 0 (quadrature) or of the
+                                  ///< probes' sum |f| (probes)
+    /// "none" (a uniform pdf covers the domain), "quadrature" (zero set known, M integrated),
+    /// or "probes" (uniform probes only).
+    std::string method = "none";
+    double zero_measure = 0.0; ///< quadrature: share of the domain's measure where p = 0
+    double missed_mass = 0.0;  ///< quadrature: M = int_{p=0} |f| (inf/NaN: |f| not finite there)
+    double abs_integral = 0.0; ///< int |f| over the domain (M + the probes' estimate elsewhere)
+    int quadrature_evaluations = 0; ///< calls of f by the quadrature
+    bool flagged = false;           ///< the estimator misses mass (see above)
+    std::string note;               ///< how the check looked, in a sentence
 };
 
-/// Runs the support check with `probes` uniform points (its own random stream).
+/// Runs the support check with `probes` uniform points (its own random stream), plus the
+/// quadrature of |f| over the zero set of p where that set is known.
 SupportCheck check_support(const Problem& problem, const EstimatorSpec& spec, uint64_t probes,
                            uint64_t seed);
 
@@ -132,6 +175,31 @@ StudyResult run_study(const Problem& problem, const std::vector<EstimatorSpec>& 
 /// Threads the study will use for a requested count (0 = hardware); 1 where the build
 /// has no threads (WebAssembly without pthreads).
 int resolve_threads(int requested);
+
+/// What a study will cost, before it runs: its evaluations, and seconds predicted from a timed
+/// pilot of kPilotSamples samples per estimator (two runs when the first is short, the second
+/// timed, so that a cold first call does not count).
+constexpr uint64_t kPilotSamples = 4096;
+
+struct EstimatorPlan {
+    std::string name;
+    uint64_t evaluations = 0;
+    double seconds_per_evaluation = 0.0; ///< from the pilot
+    double predicted_seconds = 0.0;      ///< on one thread
+};
+
+struct StudyPlan {
+    std::vector<uint64_t> levels;   ///< the N ladder
+    uint64_t evaluations = 0;       ///< sum over levels of N x reps x estimators
+    int threads = 1;                ///< threads the study would use
+    double predicted_seconds = 0.0; ///< wall time: the estimators' seconds / threads
+    double pilot_seconds = 0.0;     ///< time the pilot took
+    std::vector<EstimatorPlan> estimators;
+};
+
+/// Plans a study whose settings passed check_settings and check_study_size.
+StudyPlan plan_study(const Problem& problem, const std::vector<EstimatorSpec>& estimators,
+                     const StudySettings& settings);
 
 } // namespace mcp
 

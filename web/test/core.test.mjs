@@ -10,7 +10,9 @@ import fs from 'node:fs';
 import path from 'node:path';
 import { fileURLToPath, pathToFileURL } from 'node:url';
 
-import { loadCore, McplayError, Status, WASM_FUNCTIONS, WASM_RUNTIME_METHODS } from '../core.js';
+import {
+  loadCore, McplayError, Status, WASM_FUNCTIONS, WASM_RUNTIME_METHODS, MAX_JSON_BYTES,
+} from '../core.js';
 
 const ROOT = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '..', '..');
 const WASM_DIR = path.resolve(ROOT, process.env.MCPLAY_WASM_DIR || 'build-wasm');
@@ -343,4 +345,57 @@ test('a disposed core refuses calls', async () => {
   core.dispose();
   core.dispose();
   assertMcplayError(() => core.version(), Status.ARGUMENT, /disposed/);
+});
+
+test('non-finite numbers are refused by name, not sent as null', async () => {
+  const core = await getCore();
+  assertMcplayError(() => core.runStudy({ ...TINY_SCENE, exact: NaN }, null), Status.ARGUMENT,
+    /^scene\.exact: expected a finite number, got NaN$/);
+  assertMcplayError(() => core.sceneInfo({ f: 'x', estimators: [{ name: 'g', pdf: { type: 'gaussian', mu: 0.5, sigma: Infinity } }] }),
+    Status.ARGUMENT, /^scene\.estimators\[0\]\.pdf\.sigma: expected a finite number, got Infinity$/);
+  assertMcplayError(() => core.runStudy(TINY_SCENE, { n_max: -Infinity }), Status.ARGUMENT,
+    /^options\.n_max: expected a finite number, got -Infinity$/);
+  assertMcplayError(() => core.plan(TINY_SCENE, { reps: NaN }), Status.ARGUMENT, /^options\.reps: /);
+  // Values JSON cannot hold: a clear error, and the core goes on working.
+  const cyclic = { f: 'x' };
+  cyclic.self = cyclic;
+  assertMcplayError(() => core.sceneInfo(cyclic), Status.ARGUMENT, /^scene: cannot be written as JSON/);
+  assertMcplayError(() => core.sceneInfo({ f: 'x', n_max: 10n }), Status.ARGUMENT, /^scene: cannot be written as JSON/);
+  assertMcplayError(() => core.sceneInfo(Symbol('s')), Status.ARGUMENT, /^scene: expected an object or JSON text, got symbol/);
+  assert.equal(core.runStudy(TINY_SCENE, null).estimators.length, 1);
+});
+
+test('format refuses results of the wrong shape with a clear error', async () => {
+  const core = await getCore();
+  assertMcplayError(() => core.format({ estimators: 5 }), Status.ARGUMENT,
+    /^result\.estimators: expected an array, got number$/);
+  assertMcplayError(() => core.format({ estimators: [{ levels: 'x' }] }, 'csv'), Status.ARGUMENT,
+    /^result\.estimators\[0\]\.levels: expected an array, got string$/);
+  assertMcplayError(() => core.format(core.runStudy(TINY_SCENE, null), 'table\0'), Status.ARGUMENT, /^format: expected one of/);
+  assert.match(core.format(core.runStudy(TINY_SCENE, null), 'table'), /uniform/);
+});
+
+test('a text beyond the size limit is refused before it reaches the wasm memory', async () => {
+  const core = await getCore();
+  const before = core.heapStats();
+  const huge = 'x'.repeat(MAX_JSON_BYTES + 1);
+  assertMcplayError(() => core.sceneInfo(huge), Status.ARGUMENT, /^scene: the JSON text has more than the limit/);
+  assert.equal(core.heapStats().memoryBytes, before.memoryBytes, 'no memory was grown for it');
+  assert.equal(core.sceneInfo({ f: 'x' }).dimension, 1);
+});
+
+test('plan validates like runStudy and predicts the cost of a study', async () => {
+  const core = await getCore();
+  const p = core.plan(EXP_1D, SMALL);
+  assert.equal(p.evaluations, (16 + 32 + 64 + 128 + 256) * 4 * 2);
+  assert.deepEqual(p.levels, [16, 32, 64, 128, 256]);
+  assert.equal(p.threads, 1);
+  assert.ok(p.predicted_seconds > 0 && p.pilot_seconds < 0.5);
+  assert.deepEqual(p.estimators.map((e) => e.name), ['uniform', 'stratified']);
+  // The study that is too big is refused by both, with the same message.
+  const big = { f: 'x*x', estimators: ['uniform'], n_max: 2 ** 36, reps: 32 };
+  let message = null;
+  assert.throws(() => core.runStudy(big), (e) => { message = e.message; return e.status === Status.SCENE; });
+  assert.match(message, /^scene: n_max = 68719476736, reps = 32 and 1 estimator\(s\) ask for/);
+  assertMcplayError(() => core.plan(big), Status.SCENE, new RegExp(`^${message.replace(/[()^.*+?[\]\\]/g, '\\$&')}$`));
 });
