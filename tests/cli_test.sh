@@ -40,9 +40,19 @@ check bad-format 2 "--format: expected table, json or csv, got 'xml'" -- run exp
 check two-scenes 2 'run takes one scene' -- run exp_1d disk_quarter
 check no-scene 2 'run needs a scene' -- run
 check missing-scene 3 "no scene file 'nowhere'" -- run nowhere
-check bad-settings 3 'reps must be in 2' -- run exp_1d --reps 1
-check bad-range 3 'n_max \(8\) must be >= n_min \(64\)' -- run exp_1d --n-min 64 --n-max 8
-check unknown-estimator 3 "unknown estimator 'sobol'" -- run exp_1d --estimators sobol "${small[@]}"
+# Bad values typed on the command line are bad arguments (2); the same in a scene file, 3.
+check bad-settings 2 'options: reps must be in 2' -- run exp_1d --reps 1
+check bad-range 2 'n_max \(8\) must be >= n_min \(64\)' -- run exp_1d --n-min 64 --n-max 8
+check unknown-estimator 2 "unknown estimator 'sobol'" -- run exp_1d --estimators sobol "${small[@]}"
+printf '{"f": "x", "reps": 1}' >"$tmp/reps1.json"
+check bad-settings-scene 3 'scene: reps must be in 2' -- run "$tmp/reps1.json"
+# A long study is announced before it starts (from a timed pilot); the run is then stopped.
+timeout 5 $mcplay run exp_1d --estimators uniform --n-max 68719476736 --reps 2 >"$tmp/out" 2>"$tmp/err"
+if [ $? = 124 ] && grep -qE '^mcplay: this study is predicted to take about [0-9.]+ (min|hours)' "$tmp/err"; then
+    passed=$((passed + 1))
+else
+    echo "FAIL long-study-notice: no notice before a long study"; cat "$tmp/err"; failed=$((failed + 1))
+fi
 printf '{"integrand": {"type": "monomial", "powers": [1]}, "n_mx": 3}' >"$tmp/typo.json"
 check scene-typo 3 "unknown field 'n_mx'" -- run "$tmp/typo.json"
 printf '{"integrand": ' >"$tmp/broken.json"

@@ -106,7 +106,7 @@ scene('f_and_integrand', withf({ integrand: { type: 'constant' } }), 'not both')
 scene('n_max_type', withf({ n_max: '64' }), 'scene.n_max: expected a non-negative whole number');
 scene('n_max_negative', withf({ n_max: -64 }), 'scene.n_max');
 scene('n_max_fraction', withf({ n_max: 64.5 }), 'scene.n_max');
-scene('n_max_2_36', withf({ n_max: 68719476736 }), 'n_max');
+scene('n_max_2_36_reps_32', withf({ n_max: 68719476736, reps: 32 }), 'integrand evaluations');
 scene('reps_huge', withf({ reps: 1000000000 }), 'got 1000000000');
 scene('reps_bool', withf({ reps: true }), 'scene.reps');
 scene('threads_huge', withf({ threads: 10000 }), 'got 10000');
