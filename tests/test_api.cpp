@@ -428,3 +428,17 @@ TEST(Api, EveryNaNSampleGivesNullsAndOneWarning) {
     }
     EXPECT_TRUE(o.result["estimators"][0]["warnings"].empty());
 }
+
+TEST(Api, ErrorMessagesStayOnOneLine) {
+    // User text quoted in a message (a key, a type name) may hold control characters: they
+    // are written as escapes (found by fuzz/fuzz_scene.cpp).
+    for (const char* scene : {"{\"\\n\"", R"({"integrand": {"type": "a\nb\u0001"}})",
+                              R"({"f": "x", "n\tmax": 3})"}) {
+        Outcome o = run(scene);
+        EXPECT_EQ(o.status, MCP_ERROR_SCENE) << scene;
+        EXPECT_EQ(o.error.find_first_of("\n\t\x01"), std::string::npos) << o.error;
+        EXPECT_FALSE(o.error.empty());
+    }
+    EXPECT_NE(run(R"({"integrand": {"type": "a\nb"}})").error.find("unknown integrand 'a\\nb'"),
+              std::string::npos);
+}

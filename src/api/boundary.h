@@ -13,8 +13,30 @@ namespace mcp::boundary {
 
 inline thread_local std::string g_last_error;
 
+/// A message kept to one line: control characters (from user text quoted in it, such as a
+/// key "a\nb") are written as escapes.
+inline std::string one_line(const std::string& text) {
+    std::string out;
+    out.reserve(text.size());
+    for (unsigned char ch : text) {
+        if (ch >= 0x20 && ch != 0x7f) {
+            out += static_cast<char>(ch);
+        } else if (ch == '\n') {
+            out += "\\n";
+        } else if (ch == '\t') {
+            out += "\\t";
+        } else {
+            const char* hex = "0123456789abcdef";
+            out += "\\x";
+            out += hex[ch >> 4];
+            out += hex[ch & 15];
+        }
+    }
+    return out;
+}
+
 inline int fail(int status, const std::string& message) {
-    g_last_error = message;
+    g_last_error = one_line(message);
     return status;
 }
 

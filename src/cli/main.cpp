@@ -15,6 +15,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "api/boundary.h"
 #include "api/files.h"
 #include "api/json_read.h"
 #include "api/mcplay.h"
@@ -78,7 +79,7 @@ int exit_code(int status) {
 }
 
 int usage_error(const std::string& msg) {
-    std::fprintf(stderr, "mcplay: %s (see mcplay --help)\n", msg.c_str());
+    std::fprintf(stderr, "mcplay: %s (see mcplay --help)\n", mcp::boundary::one_line(msg).c_str());
     return kExitUsage;
 }
 
@@ -188,19 +189,21 @@ bool load_scene(const std::string& arg, const std::string& dir_arg, std::string*
         const std::string named = dir + "/" + arg + ".json";
         if (arg.find('/') != std::string::npos || !path_exists(named)) {
             std::fprintf(stderr, "mcplay: no scene file '%s' (nor a scene named so in '%s')\n",
-                         arg.c_str(), dir.c_str());
+                         mcp::boundary::one_line(arg).c_str(),
+                         mcp::boundary::one_line(dir).c_str());
             return false;
         }
         *path = named;
     }
     std::string error;
     if (mcp::is_directory(*path)) {
-        std::fprintf(stderr, "mcplay: '%s' is a directory, not a scene file\n", path->c_str());
+        std::fprintf(stderr, "mcplay: '%s' is a directory, not a scene file\n",
+                     mcp::boundary::one_line(*path).c_str());
         return false;
     }
     std::string bytes;
     if (!read_scene_file(*path, &bytes, &error)) {
-        std::fprintf(stderr, "mcplay: %s\n", error.c_str());
+        std::fprintf(stderr, "mcplay: %s\n", mcp::boundary::one_line(error).c_str());
         return false;
     }
     if (!scene_from_gltf(*path, text)) *text = bytes;
@@ -457,7 +460,8 @@ int cmd_run(const std::vector<std::string>& args) {
                                nullptr, &result);
     }
     if (status != MCP_OK && status != MCP_ERROR_CANCELLED) {
-        std::fprintf(stderr, "mcplay: %s: %s\n", path.c_str(), mcp_last_error());
+        std::fprintf(stderr, "mcplay: %s: %s\n", mcp::boundary::one_line(path).c_str(),
+                     mcp_last_error());
         out_file.discard();
         return exit_code(status);
     }
@@ -566,7 +570,8 @@ int cmd_render(const std::vector<std::string>& args) {
     char* result = nullptr;
     int status = mcp_render_image(text.c_str(), options.dump().c_str(), &result);
     if (status != MCP_OK) {
-        std::fprintf(stderr, "mcplay: %s: %s\n", path.c_str(), mcp_last_error());
+        std::fprintf(stderr, "mcplay: %s: %s\n", mcp::boundary::one_line(path).c_str(),
+                     mcp_last_error());
         out_file.discard();
         error_file.discard();
         return exit_code(status);

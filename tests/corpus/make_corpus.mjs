@@ -97,6 +97,10 @@ scene('duplicate_nested', '{"f": "x", "domain": {"type": "box", "type": "disk"}}
 scene('deep_150000', '['.repeat(150000) + ']'.repeat(150000), 'nested more than 64 levels');
 scene('deep_8000_object', '{"a":'.repeat(8000) + '1' + '}'.repeat(8000), 'nested more than 64 levels');
 scene('deep_65', '{"f": "x", "notes": ' + '['.repeat(65) + ']'.repeat(65) + '}', 'nested more than 64 levels');
+// Found by fuzz_scene: user text with control characters quoted in a message must keep it to
+// one line (fuzz/findings/scene/).
+scene('fuzz_multiline_key', '{"\\n"', 'invalid JSON');
+scene('fuzz_multiline_integrand', '{"integrand":{"type":"a\\nb"}}', "unknown integrand 'a\\nb'");
 scene('bad_utf8', '{"f": "x\u00ff\u00fe", "name": "\ud800"}', 'scene.f');
 
 // --- scene fields -------------------------------------------------------------------------------
