@@ -266,9 +266,10 @@ test('errors come back as McplayError with the core\'s message', async () => {
   assertMcplayError(() => core.sceneInfo({ render: { width: 8 } }), Status.SCENE, /scene\.render\.gltf: missing/);
   assertMcplayError(() => core.runStudy({ render: { gltf: 'nowhere.gltf' } }), Status.SCENE, /scene\.render\.gltf: 'nowhere\.gltf' does not exist/);
   assertMcplayError(() => core.sceneInfo({ render: { gltf: { asset: {} } } }), Status.SCENE, /scene\.render\.gltf: /);
-  assertMcplayError(() => core.runStudy(SCENE, { spp_max: 0 }), Status.SCENE, /options\.spp_max/);
-  assertMcplayError(() => core.runStudy(SCENE, { estimators: ['nope'] }), Status.SCENE, /unknown estimator 'nope'/);
-  assertMcplayError(() => core.runStudy(SCENE, { colour: 1 }), Status.SCENE, /unknown field 'colour'|colour/);
+  // A bad value in the options is a bad argument (the scene itself is fine).
+  assertMcplayError(() => core.runStudy(SCENE, { spp_max: 0 }), Status.ARGUMENT, /options\.spp_max/);
+  assertMcplayError(() => core.runStudy(SCENE, { estimators: ['nope'] }), Status.ARGUMENT, /unknown estimator 'nope'/);
+  assertMcplayError(() => core.runStudy(SCENE, { colour: 1 }), Status.ARGUMENT, /unknown field 'colour'|colour/);
   assertMcplayError(() => core.renderImage(SCENE, { spp: 0 }), Status.ARGUMENT, /options\.spp/);
   assertMcplayError(() => core.renderImage(SCENE, { outputs: ['gif'] }), Status.ARGUMENT, /unknown output "gif"/);
   assertMcplayError(() => core.runStudy(SCENE, '{"reps": '), Status.ARGUMENT, /^options: invalid JSON/);
