@@ -399,3 +399,22 @@ test('plan validates like runStudy and predicts the cost of a study', async () =
   assert.match(message, /^scene: n_max = 68719476736, reps = 32 and 1 estimator\(s\) ask for/);
   assertMcplayError(() => core.plan(big), Status.SCENE, new RegExp(`^${message.replace(/[()^.*+?[\]\\]/g, '\\$&')}$`));
 });
+
+test('deeply nested and oversized inputs get errors and leave the module usable', async () => {
+  const core = await getCore();
+  // 8,000 levels used to overflow the wasm stack ("Maximum call stack size exceeded"), after
+  // which every call failed: the nesting is now refused before any recursive walk.
+  for (const depth of [8000, 150000]) {
+    const text = '['.repeat(depth) + ']'.repeat(depth);
+    assertMcplayError(() => core.sceneInfo(text), Status.SCENE, /nested more than 64 levels deep/);
+    assertMcplayError(() => core.runStudy(TINY_SCENE, text), Status.ARGUMENT, /^options: invalid JSON: objects and arrays are nested/);
+  }
+  assertMcplayError(() => core.sceneInfo({ f: '('.repeat(100000) + 'x' + ')'.repeat(100000) }), Status.SCENE, /^scene\.f: /);
+  assertMcplayError(() => core.sceneInfo('{"f": "x", "f": "x^2"}'), Status.SCENE, /appears twice/);
+  assertMcplayError(() => core.runStudy({ ...TINY_SCENE, n_max: 2 ** 36, reps: 32 }), Status.SCENE, /integrand evaluations/);
+  // Still usable, with the same numbers as before.
+  const a = core.runStudy(TINY_SCENE, null);
+  assert.equal(a.estimators[0].levels.length, 2);
+  assert.deepEqual(core.runStudy(TINY_SCENE, null).estimators[0].levels[0].replicates,
+    a.estimators[0].levels[0].replicates);
+});

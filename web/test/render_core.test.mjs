@@ -354,3 +354,19 @@ test('a scene as the site serves it (glTF inline) gives the native CLI\'s number
     });
   });
 });
+
+test('deep nesting, foreign paths and huge emission get errors and leave the module usable', async () => {
+  const core = await getCore();
+  const deep = JSON.parse(JSON.stringify(SCENE));
+  deep.render.gltf.extras = JSON.parse('['.repeat(100) + ']'.repeat(100));
+  assertMcplayError(() => core.sceneInfo(deep), Status.SCENE, /nested more than 64 levels deep/);
+  const escape = JSON.parse(JSON.stringify(SCENE));
+  escape.render.gltf.buffers[0].uri = '../../../../etc/passwd';
+  assertMcplayError(() => core.sceneInfo(escape), Status.SCENE, /^scene\.render\.gltf: buffers\[0\]/);
+  const bright = JSON.parse(JSON.stringify(SCENE));
+  const light = bright.render.gltf.materials.find((m) => m.emissiveFactor && m.emissiveFactor.some((v) => v > 0));
+  light.extensions = { KHR_materials_emissive_strength: { emissiveStrength: 1e308 } };
+  light.emissiveFactor = [5, 5, 5];
+  assertMcplayError(() => core.sceneInfo(bright), Status.SCENE, /overflows/);
+  assert.equal(core.sceneInfo(SCENE).triangles, 4);
+});
