@@ -5,6 +5,26 @@ SHELL := /bin/bash
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 BUILD ?= build
 BUILD_WASM ?= build-wasm
+BUILD_ASAN ?= build-asan
+BUILD_FUZZ ?= build-fuzz
+FUZZ_TARGETS ?= scene expression gltf hdr
+FUZZ_SECONDS ?= 600
+# -fork=1 runs the fuzzing in one child process at a time and goes on after a crash, a timeout
+# or an OOM (each saved in findings/), so one known bug does not end the run.
+FUZZ_FLAGS ?= -timeout=10 -rss_limit_mb=2048 -fork=1 -ignore_crashes=1 -ignore_timeouts=1 \
+	-ignore_ooms=1
+# Longest input per target: scenes and HDR images are small; the glTF seeds embed base64
+# buffers (scenes/cornell_box.gltf is 58 KB); expressions are capped at 10000 bytes.
+FUZZ_MAX_LEN_scene := 16384
+FUZZ_MAX_LEN_expression := 12000
+FUZZ_MAX_LEN_gltf := 65536
+FUZZ_MAX_LEN_hdr := 16384
+fuzz_max_len = $$(case $(1) in scene) echo $(FUZZ_MAX_LEN_scene);; \
+	expression) echo $(FUZZ_MAX_LEN_expression);; gltf) echo $(FUZZ_MAX_LEN_gltf);; \
+	*) echo $(FUZZ_MAX_LEN_hdr);; esac)
+# Seed folders of a target: its own seeds, the scenes (for scene and gltf), tests/corpus/.
+fuzz_seeds = fuzz/seeds/$(1) $$(case $(1) in scene|gltf) echo scenes;; esac) \
+	$$([ -d tests/corpus ] && echo tests/corpus)
 SCENE ?= scenes/exp_1d.json
 ARGS ?=
 PORT ?= 8000
@@ -24,7 +44,7 @@ DEP_PROBES := /usr/bin/cmake /usr/bin/g++ /usr/src/googletest/CMakeLists.txt \
 	/usr/include/tiny_gltf.h /usr/include/nlohmann/json.hpp /usr/bin/chromium
 
 .PHONY: all deps deps-web build build-wasm site test test-native test-wasm test-compare test-web-core \
-	test-e2e run cli bench format clean help
+	test-e2e test-sanitize run cli bench format clean help fuzz fuzz-build fuzz-smoke
 
 all: build
 
@@ -34,6 +54,9 @@ help:
 	@echo "make test   install what is missing, build native + wasm, run every test suite"
 	@echo "make bench  samples per second natively and in wasm under Node, and their ratio"
 	@echo "make format clang-format every C++ source"
+	@echo "make test-sanitize  the native ctest suite under ASan + UBSan ($(BUILD_ASAN); part of make test)"
+	@echo "make fuzz   libFuzzer targets, $(FUZZ_SECONDS) s each (FUZZ_TARGETS=\"$(FUZZ_TARGETS)\"); docs/fuzzing.md"
+	@echo "make fuzz-smoke  each fuzz target over its seed corpus only (seconds)"
 
 deps:
 	@missing=""; for p in $(DEP_PROBES); do [ -e $$p ] || missing="$$missing $$p"; done; \
@@ -89,7 +112,18 @@ site: build-wasm deps-web
 test-e2e: build site
 	MCPLAY_SITE=$(SITE) MCPLAY_NATIVE=$(BUILD)/mcplay MCPLAY_SHOTS=$(BUILD)/e2e node --test web/e2e/playground.e2e.mjs
 
-test: test-native test-wasm test-compare test-web-core test-e2e
+# The native suite again, built with g++ -fsanitize=address,undefined (CMake option MCPLAY_SANITIZE):
+# a leak, an out-of-bounds access or undefined behaviour fails the test that triggers it.
+# -O1 with assertions on: about 3x slower than Release, and every assert() is checked.
+$(BUILD_ASAN)/CMakeCache.txt:
+	cmake -S . -B $(BUILD_ASAN) -DMCPLAY_SANITIZE=ON -DCMAKE_BUILD_TYPE=Debug \
+	  -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g"
+
+test-sanitize: deps $(BUILD_ASAN)/CMakeCache.txt
+	cmake --build $(BUILD_ASAN) -j $(JOBS)
+	ctest --test-dir $(BUILD_ASAN) --output-on-failure -j $(JOBS)
+
+test: test-native test-wasm test-compare test-web-core test-e2e test-sanitize
 	@echo "make test: all suites passed"
 
 run: build site
@@ -105,5 +139,42 @@ bench: build build-wasm site
 format:
 	clang-format -i $$(git ls-files '*.cpp' '*.h')
 
+# ---------------------------------------------------------------------------
+# libFuzzer (docs/fuzzing.md): clang 14 + libclang-rt-14-dev, a build of its own ($(BUILD_FUZZ)),
+# one target per parser. `make fuzz` runs the targets one after the other, FUZZ_SECONDS each;
+# crashes, timeouts and OOMs go to $(BUILD_FUZZ)/findings/<target>/, the grown corpus to
+# $(BUILD_FUZZ)/corpus/<target>/, the log to $(BUILD_FUZZ)/logs/<target>.log.
+# `make fuzz FUZZ_TARGETS=scene FUZZ_SECONDS=60` runs one target for a minute.
+$(BUILD_FUZZ)/CMakeCache.txt:
+	CC=clang CXX=clang++ cmake -S . -B $(BUILD_FUZZ) -DMCPLAY_FUZZ=ON -DCMAKE_BUILD_TYPE=Debug \
+	  -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g"
+
+fuzz-build: $(BUILD_FUZZ)/CMakeCache.txt
+	@command -v clang++ >/dev/null || { echo "fuzz: needs clang++ and libclang-rt-14-dev"; exit 1; }
+	cmake --build $(BUILD_FUZZ) -j $(JOBS) --target $(addprefix fuzz_,$(FUZZ_TARGETS))
+
+fuzz: fuzz-build
+	@for t in $(FUZZ_TARGETS); do \
+	  mkdir -p $(BUILD_FUZZ)/corpus/$$t $(BUILD_FUZZ)/findings/$$t $(BUILD_FUZZ)/logs; \
+	  echo "fuzz: $$t for $(FUZZ_SECONDS) s (log $(BUILD_FUZZ)/logs/$$t.log)"; \
+	  $(BUILD_FUZZ)/fuzz_$$t $(FUZZ_FLAGS) -max_total_time=$(FUZZ_SECONDS) -max_len=$(call fuzz_max_len,$$t) \
+	    -dict=fuzz/$$t.dict -artifact_prefix=$(BUILD_FUZZ)/findings/$$t/ \
+	    $(BUILD_FUZZ)/corpus/$$t $(call fuzz_seeds,$$t) >$(BUILD_FUZZ)/logs/$$t.log 2>&1; \
+	  echo "fuzz: $$t exit $$?: $$(grep -E '^#[0-9]+' $(BUILD_FUZZ)/logs/$$t.log | tail -1)"; \
+	  ls $(BUILD_FUZZ)/findings/$$t/ 2>/dev/null | sed "s|^|fuzz: $$t finding: |"; \
+	done
+
+# Every seed once (no mutation), plus fuzz/findings/ (what earlier runs found, now fixed):
+# a few seconds; any crash fails.
+fuzz-smoke: fuzz-build
+	@for t in $(FUZZ_TARGETS); do \
+	  mkdir -p $(BUILD_FUZZ)/smoke/$$t; \
+	  $(BUILD_FUZZ)/fuzz_$$t -runs=0 -timeout=10 -rss_limit_mb=2048 -max_len=$(call fuzz_max_len,$$t) \
+	    -artifact_prefix=$(BUILD_FUZZ)/smoke/$$t/ $(call fuzz_seeds,$$t) \
+	    $$(ls -d fuzz/findings/$$t 2>/dev/null) >$(BUILD_FUZZ)/smoke/$$t.log 2>&1 \
+	    || { tail -40 $(BUILD_FUZZ)/smoke/$$t.log; echo "fuzz-smoke: $$t FAILED"; exit 1; }; \
+	  echo "fuzz-smoke: $$t $$(grep -Eo '^Done [0-9]+ runs in [0-9]+ second' $(BUILD_FUZZ)/smoke/$$t.log)s"; \
+	done
+
 clean:
-	rm -rf $(BUILD) $(BUILD_WASM)
+	rm -rf $(BUILD) $(BUILD_WASM) $(BUILD_ASAN) $(BUILD_FUZZ)

@@ -14,6 +14,26 @@ using mcp::boundary::dump;
 using mcp::boundary::fail;
 using mcp::boundary::g_last_error;
 
+namespace {
+
+/// The start of a study call: the scene and the options parsed and turned into a request.
+int load_request(const char* scene_json, const char* options_json, mcp::SceneRequest* out) {
+    mcp::Made<mcp::Json> scene = mcp::parse_json(scene_json, "scene");
+    if (!scene.ok()) return fail(MCP_ERROR_SCENE, scene.error);
+    mcp::Json options;
+    if (options_json && *options_json) {
+        mcp::Made<mcp::Json> o = mcp::parse_json(options_json, "options");
+        if (!o.ok()) return fail(MCP_ERROR_ARGUMENT, o.error);
+        options = o.value;
+    }
+    mcp::Made<mcp::SceneRequest> req = mcp::build_request(scene.value, options);
+    if (!req.ok()) return mcp::boundary::request_error(req.error);
+    *out = std::move(req.value);
+    return MCP_OK;
+}
+
+} // namespace
+
 extern "C" {
 
 const char* mcp_version(void) {
@@ -32,16 +52,8 @@ int mcp_study_run(const char* scene_json, const char* options_json, mcp_progress
                   void* user, char** result_json) {
     if (!result_json) return fail(MCP_ERROR_ARGUMENT, "mcp_study_run: result_json is NULL");
     *result_json = nullptr;
-    mcp::Made<mcp::Json> scene = mcp::parse_json(scene_json, "scene");
-    if (!scene.ok()) return fail(MCP_ERROR_SCENE, scene.error);
-    mcp::Json options;
-    if (options_json && *options_json) {
-        mcp::Made<mcp::Json> o = mcp::parse_json(options_json, "options");
-        if (!o.ok()) return fail(MCP_ERROR_ARGUMENT, o.error);
-        options = o.value;
-    }
-    mcp::Made<mcp::SceneRequest> req = mcp::build_request(scene.value, options);
-    if (!req.ok()) return mcp::boundary::request_error(req.error);
+    mcp::SceneRequest req;
+    if (int st = load_request(scene_json, options_json, &req)) return st;
 
     mcp::StudyProgress on_level;
     if (progress) {
@@ -50,8 +62,7 @@ int mcp_study_run(const char* scene_json, const char* options_json, mcp_progress
             return progress(text.c_str(), user) == 0;
         };
     }
-    mcp::StudyResult result =
-        mcp::run_study(req.value.problem, req.value.estimators, req.value.settings, on_level);
+    mcp::StudyResult result = mcp::run_study(req.problem, req.estimators, req.settings, on_level);
     *result_json = copy_out(dump(mcp::study_to_json(result)));
     if (!*result_json) return fail(MCP_ERROR_INTERNAL, "out of memory writing the result");
     if (result.cancelled) return fail(MCP_ERROR_CANCELLED, "study cancelled by the caller");
@@ -62,18 +73,10 @@ int mcp_study_run(const char* scene_json, const char* options_json, mcp_progress
 int mcp_study_plan(const char* scene_json, const char* options_json, char** plan_json) {
     if (!plan_json) return fail(MCP_ERROR_ARGUMENT, "mcp_study_plan: plan_json is NULL");
     *plan_json = nullptr;
-    mcp::Made<mcp::Json> scene = mcp::parse_json(scene_json, "scene");
-    if (!scene.ok()) return fail(MCP_ERROR_SCENE, scene.error);
-    mcp::Json options;
-    if (options_json && *options_json) {
-        mcp::Made<mcp::Json> o = mcp::parse_json(options_json, "options");
-        if (!o.ok()) return fail(MCP_ERROR_ARGUMENT, o.error);
-        options = o.value;
-    }
-    mcp::Made<mcp::SceneRequest> req = mcp::build_request(scene.value, options);
-    if (!req.ok()) return mcp::boundary::request_error(req.error);
-    const mcp::StudySettings& s = req.value.settings;
-    const mcp::StudyPlan plan = mcp::plan_study(req.value.problem, req.value.estimators, s);
+    mcp::SceneRequest req;
+    if (int st = load_request(scene_json, options_json, &req)) return st;
+    const mcp::StudySettings& s = req.settings;
+    const mcp::StudyPlan plan = mcp::plan_study(req.problem, req.estimators, s);
     mcp::Json estimators = mcp::Json::array();
     for (const mcp::EstimatorPlan& e : plan.estimators)
         estimators.push_back({{"name", e.name},
