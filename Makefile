@@ -44,7 +44,7 @@ DEP_PROBES := /usr/bin/cmake /usr/bin/g++ /usr/src/googletest/CMakeLists.txt \
 	/usr/include/tiny_gltf.h /usr/include/nlohmann/json.hpp /usr/bin/chromium
 
 .PHONY: all deps deps-web build build-wasm site test test-native test-wasm test-compare test-web-core \
-	test-e2e test-sanitize run cli bench format clean help fuzz fuzz-build fuzz-smoke
+	test-e2e test-sanitize run cli bench format clean help fuzz fuzz-build fuzz-smoke deps-fuzz
 
 all: build
 
@@ -145,12 +145,21 @@ format:
 # crashes, timeouts and OOMs go to $(BUILD_FUZZ)/findings/<target>/, the grown corpus to
 # $(BUILD_FUZZ)/corpus/<target>/, the log to $(BUILD_FUZZ)/logs/<target>.log.
 # `make fuzz FUZZ_TARGETS=scene FUZZ_SECONDS=60` runs one target for a minute.
-$(BUILD_FUZZ)/CMakeCache.txt:
+# Debian's clang and its libFuzzer runtime, installed like `make deps` does.
+deps-fuzz: deps
+	@if ! command -v clang++ >/dev/null || [ ! -e /usr/lib/llvm-14/lib/clang/14.0.6/lib/linux/libclang_rt.fuzzer-x86_64.a ]; then \
+	  if [ "$$(id -u)" = 0 ]; then \
+	    apt-get update -q && DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends clang libclang-rt-14-dev; \
+	  else \
+	    echo "fuzz: not root; run: sudo apt-get install -y --no-install-recommends clang libclang-rt-14-dev"; exit 1; \
+	  fi; \
+	fi
+
+$(BUILD_FUZZ)/CMakeCache.txt: | deps-fuzz
 	CC=clang CXX=clang++ cmake -S . -B $(BUILD_FUZZ) -DMCPLAY_FUZZ=ON -DCMAKE_BUILD_TYPE=Debug \
 	  -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g"
 
-fuzz-build: $(BUILD_FUZZ)/CMakeCache.txt
-	@command -v clang++ >/dev/null || { echo "fuzz: needs clang++ and libclang-rt-14-dev"; exit 1; }
+fuzz-build: deps-fuzz $(BUILD_FUZZ)/CMakeCache.txt
 	cmake --build $(BUILD_FUZZ) -j $(JOBS) --target $(addprefix fuzz_,$(FUZZ_TARGETS))
 
 fuzz: fuzz-build

@@ -603,6 +603,12 @@ TEST(RenderHonesty, HdrReferencesAreChecked) {
     std::string rle = head + "-Y 1 +X 8\n" + std::string("\x02\x02\x00\x08", 4) + "\xff\x40";
     EXPECT_FALSE(decode_hdr(rle, &out, &err));
     EXPECT_EQ(err, "the HDR data is corrupt in scanline 1 of 1 (bad run-length encoding)");
+    // stb_image ends the header at a line starting with NUL: such a line must not let it read
+    // another size line than the one checked (fuzz/findings/hdr/nul_header_line_size_bypass).
+    std::string nul = "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n" + std::string(1, '\0') +
+                      "\n-Y 10 +X 16777215\n\n-Y 1 +X 4\n" + std::string(16, '\x40');
+    EXPECT_FALSE(decode_hdr(nul, &out, &err));
+    EXPECT_EQ(err, "the HDR header has a control character (byte 34)");
 }
 
 // A study whose spp approaches the reference's is refused before anything is rendered; the

@@ -187,6 +187,15 @@ bool decode_hdr(const std::string& bytes, RenderImage* out, std::string* error) 
             ++at;
             break;
         }
+        // stb_image ends the header at a line starting with NUL, where this loop would not:
+        // control characters are refused, so both read the same size line (found by
+        // fuzz/fuzz_hdr.cpp: a 16 x 2 size line checked here, 16777215 x 10 decoded by stb).
+        for (size_t k = at; k < end; ++k)
+            if (static_cast<unsigned char>(bytes[k]) < 0x20 && bytes[k] != '\t' &&
+                bytes[k] != '\r') {
+                *error = "the HDR header has a control character (byte " + std::to_string(k) + ")";
+                return false;
+            }
         if (bytes.compare(at, end - at, "FORMAT=32-bit_rle_rgbe") == 0) format = true;
         at = end + 1;
     }
