@@ -53,6 +53,12 @@ if [ $? = 124 ] && grep -qE '^mcplay: this study is predicted to take about [0-9
 else
     echo "FAIL long-study-notice: no notice before a long study"; cat "$tmp/err"; failed=$((failed + 1))
 fi
+timeout 8 $mcplay run cornell_box --n-max 1024 --width 512 --height 512 --no-cache >"$tmp/out" 2>"$tmp/err"
+if [ $? = 124 ] && grep -qE '^mcplay: this study is predicted to take about [0-9.]+ (min|hours) \([0-9.e+]+ samples' "$tmp/err"; then
+    passed=$((passed + 1))
+else
+    echo "FAIL long-render-notice: no notice before a long render study"; cat "$tmp/err"; failed=$((failed + 1))
+fi
 printf '{"integrand": {"type": "monomial", "powers": [1]}, "n_mx": 3}' >"$tmp/typo.json"
 check scene-typo 3 "unknown field 'n_mx'" -- run "$tmp/typo.json"
 printf '{"integrand": ' >"$tmp/broken.json"

@@ -663,5 +663,39 @@ TEST(RenderHonesty, WorkIsBoundedUpFront) {
         << mcp_last_error();
 }
 
+// The plan of a study validates like the study, counts its samples exactly and predicts a
+// positive time from its pilot, without rendering the study.
+TEST(RenderHonesty, StudyPlanCountsTheWorkBeforeItStarts) {
+    auto plan = [](const json& scene, const json& options) {
+        char* out = nullptr;
+        Call c;
+        c.status = mcp_render_study_plan(scene.dump().c_str(), options.dump().c_str(), &out);
+        if (c.status != MCP_OK) c.error = mcp_last_error();
+        if (out) c.result = json::parse(out);
+        mcp_free(out);
+        return c;
+    };
+    json scene = quad_scene([](json&) {});
+    json options = kTiny;
+    options["spp_max"] = 8;
+    Call bad = plan(scene, options); // the reference's 16 spp are too few for spp_max = 8
+    EXPECT_EQ(bad.status, MCP_ERROR_SCENE);
+    EXPECT_EQ(bad.error, study_text(scene, options).error);
+    options["reference"] = {{"spp", 64}};
+    Call c = plan(scene, options);
+    ASSERT_EQ(c.status, MCP_OK) << c.error;
+    const double pixels = 4 * 4;
+    // spp 1, 2, 4, 8 with 2 replicates for each of 2 estimators, plus the 64-spp reference.
+    EXPECT_EQ(c.result["samples"].get<double>(), pixels * (15 * 2 * 2 + 64));
+    EXPECT_EQ(c.result["reference"]["source"], "rendered");
+    EXPECT_EQ(c.result["estimators"].size(), 2u);
+    for (const json& e : c.result["estimators"]) {
+        EXPECT_EQ(e["samples"].get<double>(), pixels * 15 * 2);
+        EXPECT_GT(e["seconds_per_sample"].get<double>(), 0.0);
+    }
+    EXPECT_GT(c.result["predicted_seconds"].get<double>(), 0.0);
+    EXPECT_EQ(c.result["levels"], json({1, 2, 4, 8}));
+}
+
 } // namespace
 } // namespace mcp

@@ -19,7 +19,7 @@ export { McplayError, Status };
  *  src/wasm/render_exported_functions.txt (web/test/render_core.test.mjs checks it). */
 export const RENDER_WASM_FUNCTIONS = Object.freeze([
   '_malloc', '_free',
-  '_mcp_version', '_mcp_last_error', '_mcp_render_study_run', '_mcp_render_image',
+  '_mcp_version', '_mcp_last_error', '_mcp_render_study_run', '_mcp_render_study_plan', '_mcp_render_image',
   '_mcp_render_scene_info', '_mcp_free',
   '_mallinfo',
 ]);
@@ -54,6 +54,18 @@ function makeRenderCore(M) {
   }
 
   /**
+   * What a study would cost before it starts (mcp_render_study_plan): {samples,
+   * predicted_seconds, threads, levels, reps, reference: {source, spp, ...}, estimators:
+   * [{name, samples, seconds_per_sample, predicted_seconds}]} from a pilot of one small image
+   * per estimator. Same errors as runStudy.
+   */
+  function plan(scene, options = null) {
+    b.usable('plan');
+    return b.callJson('plan', M._mcp_render_study_plan, 'mcp_render_study_plan',
+      [b.jsonText(scene, 'scene'), b.optionalJson(options, 'options')]);
+  }
+
+  /**
    * A render convergence study (mcp_render_study_run): every estimator at spp = spp_min ..
    * spp_max (powers of two), reps images each, measured by relative MSE against the
    * reference. `options`: {estimators, spp_min, spp_max, reps, seed, width, height, previews,
@@ -78,6 +90,6 @@ function makeRenderCore(M) {
   }
 
   return Object.freeze({
-    version: b.version, sceneInfo, runStudy, renderImage, heapStats: b.heapStats, dispose: b.dispose,
+    version: b.version, sceneInfo, plan, runStudy, renderImage, heapStats: b.heapStats, dispose: b.dispose,
   });
 }

@@ -102,6 +102,11 @@ bool is_directory(const std::string& path) {
     return ::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode);
 }
 
+bool is_regular_file(const std::string& path) {
+    struct stat st;
+    return ::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
+}
+
 std::string real_folder(const std::string& folder) {
     std::string r = real_path(folder.empty() ? "." : folder);
     return !r.empty() && is_directory(r) ? r : "";

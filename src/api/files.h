@@ -21,8 +21,9 @@ constexpr uint64_t kMaxCacheFileBytes = 256ull << 20;    ///< cached reference i
 bool read_regular_file(const std::string& path, uint64_t limit, std::string* out,
                        std::string* error);
 
-/// Is `path` an existing directory?
+/// Is `path` an existing directory? An existing regular file (symbolic links followed)?
 bool is_directory(const std::string& path);
+bool is_regular_file(const std::string& path);
 
 /// The real path of a folder (symbolic links resolved), or "" when it does not exist.
 std::string real_folder(const std::string& folder);

@@ -341,11 +341,14 @@ int progress_line(const char* level_json, void*) {
     return 0;
 }
 
-/// Says up front when a study is predicted to take long (mcp_study_plan times a short pilot);
-/// a study that cannot be planned is left to mcp_study_run, which reports why.
-void announce_long_study(const std::string& scene, const std::string& options) {
+/// Says up front when a study is predicted to take long (mcp_study_plan and
+/// mcp_render_study_plan time a short pilot); a study that cannot be planned is left to the
+/// run itself, which reports why.
+void announce_long_study(const std::string& scene, const std::string& options, bool render) {
     char* plan = nullptr;
-    if (mcp_study_plan(scene.c_str(), options.c_str(), &plan) != MCP_OK) return;
+    const int status = render ? mcp_render_study_plan(scene.c_str(), options.c_str(), &plan)
+                              : mcp_study_plan(scene.c_str(), options.c_str(), &plan);
+    if (status != MCP_OK) return;
     nlohmann::json p = nlohmann::json::parse(plan, nullptr, false);
     mcp_free(plan);
     if (p.is_discarded() || !p["predicted_seconds"].is_number()) return;
@@ -354,10 +357,13 @@ void announce_long_study(const std::string& scene, const std::string& options) {
     const std::string when = seconds < 120.0    ? fmt_number("%.0f s", seconds)
                              : seconds < 7200.0 ? fmt_number("%.0f min", seconds / 60.0)
                                                 : fmt_number("%.1f hours", seconds / 3600.0);
+    const char* unit = render ? "samples" : "integrand evaluations";
+    const nlohmann::json& count = render ? p["samples"] : p["evaluations"];
     std::fprintf(stderr,
-                 "mcplay: this study is predicted to take about %s (%s integrand evaluations on "
-                 "%s thread(s)); Ctrl-C stops it\n",
-                 when.c_str(), p["evaluations"].dump().c_str(), p["threads"].dump().c_str());
+                 "mcplay: this study is predicted to take about %s (%s %s on %s thread(s)); "
+                 "Ctrl-C stops it\n",
+                 when.c_str(), fmt_number("%.4g", count.get<double>()).c_str(), unit,
+                 p["threads"].dump().c_str());
 }
 
 int cmd_run(const std::vector<std::string>& args) {
@@ -451,11 +457,12 @@ int cmd_run(const std::vector<std::string>& args) {
             if (!dir.empty()) options["cache_dir"] = dir;
         }
         const std::string opts = options.dump();
+        if (!quiet) announce_long_study(text, opts, true);
         status = mcp_render_study_run(text.c_str(), opts.c_str(),
                                       show_progress ? progress_line : nullptr, nullptr, &result);
     } else {
         const std::string opts = options.dump();
-        if (!quiet) announce_long_study(text, opts);
+        if (!quiet) announce_long_study(text, opts, false);
         status = mcp_study_run(text.c_str(), opts.c_str(), show_progress ? progress_line : nullptr,
                                nullptr, &result);
     }

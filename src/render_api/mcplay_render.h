@@ -25,6 +25,15 @@ extern "C" {
 int mcp_render_study_run(const char* scene_json, const char* options_json, mcp_progress_fn progress,
                          void* user, char** result_json);
 
+/* What a study of the same scene and options would cost, before any of it is rendered:
+ * validates like mcp_render_study_run (the same errors), then times a pilot (each estimator
+ * renders one image of at most 64 x 64 pixels at 1 spp) and returns {"version", "kind":
+ * "render", "samples", "limit_samples", "predicted_seconds", "threads", "levels", "reps",
+ * "pilot_samples", "reference": {"source": file|cache|rendered, "spp", "samples",
+ * "predicted_seconds"}, "estimators": [{"name", "samples", "seconds_per_sample",
+ * "predicted_seconds"}]}. */
+int mcp_render_study_plan(const char* scene_json, const char* options_json, char** plan_json);
+
 /* One image: options.estimator (a name from the scene or an estimator object; default the
  * scene's first), options.spp (default spp_max), options.outputs (any of "png", "hdr",
  * "error_png"; default ["png"]; "error_png" renders or reads the reference). The result

@@ -28,6 +28,7 @@ constexpr double kMaxCallSamples = 4398046511104.0; // 2^42
 constexpr double kMaxImageBytes = 1073741824.0;     // 1 GiB
 /// A rendered reference needs at least this many times the study's largest spp.
 constexpr uint64_t kReferenceSppRatio = 4;
+constexpr int kPlanPilotSide = 64; ///< a plan's pilot images are at most this many pixels a side
 
 const char* selection_name(LightSelection s) {
     switch (s) {
@@ -155,6 +156,23 @@ std::string hex(uint64_t x) {
 
 /// The reference image: read from the scene's HDR file, from the cache, or rendered (and
 /// then cached). `source` says which.
+/// Where a rendered reference is cached ("" without a cache folder). The file name is a hash
+/// of the glTF, the scene's name and every setting alone: nothing of the scene's text reaches
+/// the path.
+std::string reference_cache_file(const RenderRequest& r) {
+    if (r.cache_dir.empty()) return "";
+    const RenderStudySettings& s = r.settings;
+    const RenderEstimator& e = r.reference.estimator;
+    uint64_t key = hash_combine(r.gltf_hash, uint64_t(kReferenceCacheVersion));
+    key = hash_combine(key, hash_string(r.name.c_str()));
+    for (uint64_t v :
+         {uint64_t(s.width), uint64_t(s.height), uint64_t(s.jitter_pixels), uint64_t(e.strategy),
+          uint64_t(e.light_selection), uint64_t(e.light_sampling), uint64_t(e.pixel_sampler),
+          uint64_t(e.max_depth), uint64_t(e.rr_depth), r.reference.spp, s.seed})
+        key = hash_combine(key, v);
+    return r.cache_dir + "/" + hex(key) + ".mcref";
+}
+
 bool obtain_reference(const Loaded& l, RenderImage* ref, Json* info, std::string* error) {
     const RenderRequest& r = *l.request;
     const RenderStudySettings& s = r.settings;
@@ -180,15 +198,7 @@ bool obtain_reference(const Loaded& l, RenderImage* ref, Json* info, std::string
         return true;
     }
     const RenderEstimator& e = r.reference.estimator;
-    uint64_t key = hash_combine(r.gltf_hash, uint64_t(kReferenceCacheVersion));
-    key = hash_combine(key, hash_string(r.name.c_str()));
-    for (uint64_t v :
-         {uint64_t(s.width), uint64_t(s.height), uint64_t(s.jitter_pixels), uint64_t(e.strategy),
-          uint64_t(e.light_selection), uint64_t(e.light_sampling), uint64_t(e.pixel_sampler),
-          uint64_t(e.max_depth), uint64_t(e.rr_depth), r.reference.spp, s.seed})
-        key = hash_combine(key, v);
-    // The file name is the hash alone: nothing of the scene's text reaches the path.
-    std::string cache_file = r.cache_dir.empty() ? "" : r.cache_dir + "/" + hex(key) + ".mcref";
+    const std::string cache_file = reference_cache_file(r);
     *info = Json{{"estimator", estimator_to_json(e)}, {"spp", r.reference.spp}};
     if (!cache_file.empty() && read_reference_cache(cache_file, ref) && ref->width == s.width &&
         ref->height == s.height && ref->spp == r.reference.spp) {
@@ -317,6 +327,30 @@ bool check_work(const RenderRequest& r, double image_samples_per_pixel, size_t h
         return false;
     }
     return true;
+}
+
+/// Samples per pixel of one estimator's study images: the spp ladder times the replicates.
+double study_spp_per_estimator(const RenderStudySettings& s) {
+    double spp = 0.0;
+    for (uint64_t n : n_ladder(s.spp_min, s.spp_max)) spp += double(n);
+    return spp * double(s.reps);
+}
+
+/// The checks of a study before anything is rendered: a rendered reference must have many
+/// more samples than the study's images, or its own noise is what the study measures
+/// (docs/render-scenes.md, "The reference's noise"); then the work and memory.
+bool check_study(const RenderRequest& r, std::string* error) {
+    const bool ref_rendered = r.reference.file.empty();
+    if (ref_rendered && r.settings.spp_max > r.reference.spp / kReferenceSppRatio) {
+        *error = "scene.render.reference.spp: expected at least " +
+                 std::to_string(kReferenceSppRatio) +
+                 " x spp_max = " + std::to_string(kReferenceSppRatio * r.settings.spp_max) +
+                 ", got " + std::to_string(r.reference.spp) +
+                 ": a reference with fewer samples is too noisy to judge the images";
+        return false;
+    }
+    return check_work(r, study_spp_per_estimator(r.settings) * double(r.estimators.size()),
+                      r.estimators.size() + 2, ref_rendered, error);
 }
 
 /// The warning of a result whose reference is black (relative MSE undefined, null).
@@ -468,6 +502,77 @@ int mcp_render_image(const char* scene_json, const char* options_json, char** re
     return boundary::succeed();
 }
 
+int mcp_render_study_plan(const char* scene_json, const char* options_json, char** plan_json) {
+    using namespace mcp;
+    Loaded l;
+    Json options;
+    if (int st =
+            begin_call("mcp_render_study_plan", plan_json, scene_json, options_json, &l, &options))
+        return st;
+    const RenderRequest& r = *l.request;
+    const RenderStudySettings& s = r.settings;
+    std::string err;
+    if (!check_study(r, &err)) return fail(MCP_ERROR_SCENE, err);
+    const int threads = resolve_threads(s.threads);
+    const double pixels = double(s.width) * double(s.height);
+    // The pilot: each estimator renders one small image (at most 64 x 64 pixels, 1 spp) on one
+    // thread; the seconds per sample scale to the study's samples over its threads.
+    RenderSettings pilot;
+    pilot.width = std::min(s.width, kPlanPilotSide);
+    pilot.height = std::min(s.height, kPlanPilotSide);
+    pilot.spp = 1;
+    pilot.threads = 1;
+    pilot.jitter_pixels = s.jitter_pixels;
+    pilot.stream = render_stream(s.seed, "pilot", 1, -2);
+    const double pilot_samples = double(pilot.width) * double(pilot.height);
+    auto seconds_per_sample = [&](const RenderEstimator& e) {
+        return render_image(l.scene, e, pilot).seconds / pilot_samples;
+    };
+    Json estimators = Json::array();
+    double samples = 0.0, predicted = 0.0;
+    const double per_estimator = pixels * study_spp_per_estimator(s);
+    for (const RenderEstimator& e : r.estimators) {
+        const double cost = seconds_per_sample(e);
+        estimators.push_back({{"name", e.name},
+                              {"samples", per_estimator},
+                              {"seconds_per_sample", num(cost)},
+                              {"predicted_seconds", num(per_estimator * cost / threads)}});
+        samples += per_estimator;
+        predicted += per_estimator * cost / threads;
+    }
+    // The reference: read from a file or the cache, or rendered first.
+    const std::string cache_file = reference_cache_file(r);
+    std::string source = "rendered";
+    if (!r.reference.file.empty())
+        source = "file";
+    else if (!cache_file.empty() && is_regular_file(cache_file))
+        source = "cache"; // its content is checked when the study reads it
+    Json reference{{"source", source}, {"spp", r.reference.spp}};
+    if (source == "rendered") {
+        const double ref_samples = pixels * double(r.reference.spp);
+        const double ref_seconds =
+            ref_samples * seconds_per_sample(r.reference.estimator) / threads;
+        reference["samples"] = ref_samples;
+        reference["predicted_seconds"] = num(ref_seconds);
+        samples += ref_samples;
+        predicted += ref_seconds;
+    }
+    Json out{{"version", kResultSchemaVersion},
+             {"kind", "render"},
+             {"samples", samples},
+             {"limit_samples", kMaxCallSamples},
+             {"predicted_seconds", num(predicted)},
+             {"threads", threads},
+             {"levels", n_ladder(s.spp_min, s.spp_max)},
+             {"reps", s.reps},
+             {"pilot_samples", pilot_samples},
+             {"reference", reference},
+             {"estimators", estimators}};
+    *plan_json = copy_out(dump(out));
+    if (!*plan_json) return fail(MCP_ERROR_INTERNAL, "out of memory writing the plan");
+    return boundary::succeed();
+}
+
 int mcp_render_study_run(const char* scene_json, const char* options_json, mcp_progress_fn progress,
                          void* user, char** result_json) {
     using namespace mcp;
@@ -479,21 +584,7 @@ int mcp_render_study_run(const char* scene_json, const char* options_json, mcp_p
     const RenderRequest& r = *l.request;
     bool previews = wants(options, "previews", false);
     std::string err;
-    // A rendered reference must have many more samples than the study's images, or its own
-    // noise is what the study measures (docs/render-scenes.md, "The reference's noise").
-    const bool ref_rendered = r.reference.file.empty();
-    if (ref_rendered && r.settings.spp_max > r.reference.spp / kReferenceSppRatio)
-        return fail(MCP_ERROR_SCENE,
-                    "scene.render.reference.spp: expected at least " +
-                        std::to_string(kReferenceSppRatio) +
-                        " x spp_max = " + std::to_string(kReferenceSppRatio * r.settings.spp_max) +
-                        ", got " + std::to_string(r.reference.spp) +
-                        ": a reference with fewer samples is too noisy to judge the images");
-    double study_spp = 0.0;
-    for (uint64_t n : n_ladder(r.settings.spp_min, r.settings.spp_max)) study_spp += double(n);
-    study_spp *= double(r.settings.reps) * double(r.estimators.size());
-    if (!check_work(r, study_spp, r.estimators.size() + 2, ref_rendered, &err))
-        return fail(MCP_ERROR_SCENE, err);
+    if (!check_study(r, &err)) return fail(MCP_ERROR_SCENE, err);
     RenderImage reference;
     Json ref_info;
     if (!obtain_reference(l, &reference, &ref_info, &err)) return fail(MCP_ERROR_SCENE, err);

@@ -370,3 +370,14 @@ test('deep nesting, foreign paths and huge emission get errors and leave the mod
   assertMcplayError(() => core.sceneInfo(bright), Status.SCENE, /overflows/);
   assert.equal(core.sceneInfo(SCENE).triangles, 4);
 });
+
+test('plan predicts a study from a pilot and validates like runStudy', async () => {
+  const core = await getCore();
+  const p = core.plan(SCENE, { ...SMALL, reference: { spp: 64 } });
+  // spp 1, 2, 4 with 2 replicates for each of 3 estimators on 8 x 8 pixels, plus the reference.
+  assert.equal(p.samples, 64 * (7 * 2 * 3 + 64));
+  assert.deepEqual(p.estimators.map((e) => e.name), ESTIMATORS);
+  assert.ok(p.predicted_seconds > 0);
+  assert.equal(p.reference.source, 'rendered');
+  assertMcplayError(() => core.plan(SCENE, { ...SMALL, reference: { spp: 8 } }), Status.SCENE, /reference\.spp: expected at least 4 x spp_max = 16/);
+});
