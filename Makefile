@@ -135,6 +135,35 @@ cli: build
 bench: build build-wasm site
 	bash bench/run_bench.sh $(BUILD)/mcplay_bench "$(NODE_RUN) --no-liftoff $(BUILD_WASM)/mcplay_bench.js"
 	node web/e2e/first_plot.bench.mjs $(SITE) exp_1d 5
+	$(MAKE) --no-print-directory bench-genz
+
+# ---------------------------------------------------------------------------
+# GSL's plain, MISER and VEGAS beside mcplay's estimators on Genz's six families
+# (docs/benchmarks.md): bench/genz_compare.cpp, built with g++ against the CMake-built static
+# libraries and Debian's libgsl-dev. `make bench-genz GENZ_ARGS=--quick` for a fast look.
+.PHONY: bench-genz deps-gsl
+GENZ_ARGS ?=
+GENZ_JSON ?= $(BUILD)/genz_compare.jsonl
+
+deps-gsl:
+	@if ! command -v gsl-config >/dev/null; then \
+	  if [ "$$(id -u)" = 0 ]; then \
+	    apt-get update -q && DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends libgsl-dev; \
+	  else \
+	    echo "deps-gsl: not root; run: sudo apt-get install -y --no-install-recommends libgsl-dev"; exit 1; \
+	  fi; \
+	fi
+
+$(BUILD)/genz_compare: bench/genz_compare.cpp $(BUILD)/libmcplay_api.a $(BUILD)/libmcplay_core.a \
+		$(wildcard src/*/*.h)
+	g++ -O2 -std=c++17 -ffp-contract=off -Isrc -I$(BUILD)/deps_include $$(gsl-config --cflags) \
+	  bench/genz_compare.cpp $(BUILD)/libmcplay_api.a $(BUILD)/libmcplay_core.a \
+	  $$(gsl-config --libs) -pthread -o $@
+
+bench-genz: deps deps-gsl $(BUILD)/CMakeCache.txt
+	cmake --build $(BUILD) -j $(JOBS) --target mcplay_api
+	$(MAKE) --no-print-directory $(BUILD)/genz_compare
+	set -o pipefail; $(BUILD)/genz_compare --json $(GENZ_JSON) $(GENZ_ARGS) | tee $(BUILD)/genz_compare.txt
 
 format:
 	clang-format -i $$(git ls-files '*.cpp' '*.h')

@@ -8,8 +8,10 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "api/scene.h"
+#include "core/stats.h"
 #include "render_api/render_request.h"
 
 using namespace mcp;
@@ -48,6 +50,75 @@ double samples_per_second(const SceneRequest& req, const EstimatorSpec& spec, ui
         if (t < best) best = t;
     }
     return static_cast<double>(n) / best;
+}
+
+// The work of a uniform estimate on the unit interval written out by hand, nothing else: PCG32
+// 53-bit uniforms (Pcg32::next_double, point-major like the independent sampler), the scene's
+// integrand through evaluate_block (the block function run_estimate calls), and Welford moments
+// (RunningMoments::add_block, as run_estimate keeps them). No sampler plan, no warp (x = u on
+// [0, 1]), no density, no diagnostics.
+struct HandLoop {
+    const Integrand& integrand;
+    PointBlock x;
+    std::vector<double> f;
+    explicit HandLoop(const Integrand& g) : integrand(g), f(kBlockSize) {
+        x.reset(g.dim, kBlockSize);
+    }
+    double run(Pcg32& rng, uint64_t count) {
+        const int d = integrand.dim;
+        RunningMoments moments;
+        for (uint64_t first = 0; first < count; first += kBlockSize) {
+            const size_t m = static_cast<size_t>(std::min<uint64_t>(kBlockSize, count - first));
+            x.n = m;
+            for (size_t i = 0; i < m; ++i)
+                for (int j = 0; j < d; ++j) x.coord(j)[i] = rng.next_double();
+            evaluate_block(integrand, x, f.data());
+            moments.add_block(f.data(), m);
+        }
+        return moments.mean();
+    }
+};
+
+// exp_1d uniform: mcplay's run_estimate against the hand loop above, n samples each, timed in
+// alternation (best of five each, after a warm-up of n/8 each) so that both see the same machine
+// load. Prints "BENCH exp_1d/uniform_hand_loop" (run_bench.sh sets it beside the wasm figure)
+// and "LOOP ..." with both rates, their ratio mcplay/hand, and whether one run of each from
+// the same seed gave the same estimate (it should: the same draws, values and sums).
+void estimator_overhead(const SceneRequest& req, uint64_t n) {
+    const Domain& dom = req.problem.domain;
+    if (dom.kind != DomainKind::Box || dom.lo != std::vector<double>(dom.lo.size(), 0.0) ||
+        dom.hi != std::vector<double>(dom.hi.size(), 1.0) ||
+        dom.point_dim() != req.problem.integrand.dim) {
+        std::fprintf(stderr, "bench: the hand loop needs a unit-cube scene\n");
+        return;
+    }
+    for (const EstimatorSpec& spec : req.estimators) {
+        if (spec.name != "uniform") continue;
+        Workspace ws;
+        HandLoop hand(req.problem.integrand);
+        Pcg32 a(7, 11), b(7, 11);
+        const double mcplay_estimate = run_estimate(req.problem, spec, n, a, ws).estimate;
+        const double hand_estimate = hand.run(b, n);
+        Pcg32 rng_m(1, 1), rng_h(1, 1);
+        run_estimate(req.problem, spec, n / 8, rng_m, ws);
+        hand.run(rng_h, n / 8);
+        double best_m = 1e300, best_h = 1e300, checksum = 0.0;
+        for (int rep = 0; rep < 5; ++rep) {
+            auto t0 = std::chrono::steady_clock::now();
+            checksum += run_estimate(req.problem, spec, n, rng_m, ws).estimate;
+            best_m = std::min(best_m, seconds_since(t0));
+            t0 = std::chrono::steady_clock::now();
+            checksum += hand.run(rng_h, n);
+            best_h = std::min(best_h, seconds_since(t0));
+        }
+        if (checksum != checksum) std::fprintf(stderr, "NaN estimate\n");
+        const double mcplay = double(n) / best_m, by_hand = double(n) / best_h;
+        std::printf("BENCH exp_1d/uniform_hand_loop %.6e\n", by_hand);
+        std::printf("LOOP exp_1d/uniform: run_estimate %.3e, hand loop %.3e samples/s, "
+                    "mcplay/hand %.2f; one run of each from the same seed: estimates %s\n",
+                    mcplay, by_hand, mcplay / by_hand,
+                    mcplay_estimate == hand_estimate ? "identical" : "DIFFER");
+    }
 }
 
 // 2^26 raw 32-bit draws; the checksum keeps the loop from being optimised away.
@@ -168,6 +239,12 @@ int main(int argc, char** argv) {
         for (const EstimatorSpec& spec : req.estimators)
             if (spec.name == c[1])
                 std::printf("BENCH %s/%s %.6e\n", c[0], c[1], samples_per_second(req, spec, n));
+    }
+
+    // run_estimate's overhead over the bare work of a uniform estimate.
+    {
+        SceneRequest req;
+        if (load(dir, "exp_1d", &req)) estimator_overhead(req, n);
     }
 
     // An expression against the same integrand compiled in C++: exp(-(x-0.5)^2/0.01) is the

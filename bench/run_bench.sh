@@ -18,7 +18,11 @@ join <(grep ^BENCH "$tmp/native" | awk '{print $2, $3}' | sort) \
     awk '{ printf "%-44s %14.3e %14.3e %7.2fx\n", $1, $2, $3, $2 / $3 }'
 echo
 echo "expression vs the same integrand compiled in C++ (evaluations per second; target ratio <= 3):"
-echo "  native: $(grep ^RATIO "$tmp/native" | cut -d' ' -f2-)    wasm: $(grep ^RATIO "$tmp/wasm" | cut -d' ' -f2-)"
+echo "  native: $(grep '^RATIO compiled/expression' "$tmp/native" | cut -d' ' -f2-)    wasm: $(grep '^RATIO compiled/expression' "$tmp/wasm" | cut -d' ' -f2-)"
+echo "run_estimate vs a hand-written loop doing the same work (PCG32 53-bit uniforms, the scene's block"
+echo "  integrand, Welford moments; best of 5 runs of 2^22 each, alternating; ratio mcplay/hand, 1 = no overhead):"
+echo "  native: $(grep '^LOOP exp_1d/uniform' "$tmp/native" | cut -d' ' -f2-)"
+echo "  wasm:   $(grep '^LOOP exp_1d/uniform' "$tmp/wasm" | cut -d' ' -f2-)"
 echo "accumulation over 2^30 terms:"
 echo "  native: $(grep ^ACCUM "$tmp/native" | cut -d' ' -f2-)"
 echo "  wasm:   $(grep ^ACCUM "$tmp/wasm" | cut -d' ' -f2-)"

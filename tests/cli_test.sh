@@ -43,7 +43,7 @@ check missing-scene 3 "no scene file 'nowhere'" -- run nowhere
 # Bad values typed on the command line are bad arguments (2); the same in a scene file, 3.
 check bad-settings 2 'options: reps must be in 2' -- run exp_1d --reps 1
 check bad-range 2 'n_max \(8\) must be >= n_min \(64\)' -- run exp_1d --n-min 64 --n-max 8
-check unknown-estimator 2 "unknown estimator 'sobol'" -- run exp_1d --estimators sobol "${small[@]}"
+check unknown-estimator 2 "unknown estimator 'faure'" -- run exp_1d --estimators faure "${small[@]}"
 printf '{"f": "x", "reps": 1}' >"$tmp/reps1.json"
 check bad-settings-scene 3 'scene: reps must be in 2' -- run "$tmp/reps1.json"
 # A long study is announced before it starts (from a timed pilot); the run is then stopped.

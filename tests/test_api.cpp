@@ -87,8 +87,8 @@ TEST(Api, BadScenesGiveScenesErrorsNamingTheField) {
         {R"({"domain": {"type": "triangle", "vertices": [[0,0],[1,1],[2,2]]}, "integrand": {"type": "constant"}})",
          "collinear"},
         {R"({"integrand": {"type": "constant"}, "estimators": ["importance"]})", "needs a pdf"},
-        {R"({"integrand": {"type": "constant"}, "estimators": [{"name": "a", "sampler": "sobol"}]})",
-         "unknown sampler 'sobol'"},
+        {R"({"integrand": {"type": "constant"}, "estimators": [{"name": "a", "sampler": "faure"}]})",
+         "unknown sampler 'faure'"},
         {R"({"integrand": {"type": "constant"}, "estimators": ["uniform", "uniform"]})",
          "duplicate estimator"},
         {R"({"integrand": {"type": "constant"}, "estimators": [{"name": "i", "pdf": {"type": "power", "k": -2}}]})",
@@ -432,8 +432,8 @@ TEST(Api, EveryNaNSampleGivesNullsAndOneWarning) {
 TEST(Api, ErrorMessagesStayOnOneLine) {
     // User text quoted in a message (a key, a type name) may hold control characters: they
     // are written as escapes (found by fuzz/fuzz_scene.cpp).
-    for (const char* scene : {"{\"\\n\"", R"({"integrand": {"type": "a\nb\u0001"}})",
-                              R"({"f": "x", "n\tmax": 3})"}) {
+    for (const char* scene :
+         {"{\"\\n\"", R"({"integrand": {"type": "a\nb\u0001"}})", R"({"f": "x", "n\tmax": 3})"}) {
         Outcome o = run(scene);
         EXPECT_EQ(o.status, MCP_ERROR_SCENE) << scene;
         EXPECT_EQ(o.error.find_first_of("\n\t\x01"), std::string::npos) << o.error;

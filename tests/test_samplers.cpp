@@ -139,5 +139,7 @@ TEST(Samplers, ParseNames) {
     SamplerKind k;
     EXPECT_TRUE(parse_sampler("latin_hypercube", &k));
     EXPECT_EQ(k, SamplerKind::LatinHypercube);
-    EXPECT_FALSE(parse_sampler("sobol", &k));
+    EXPECT_FALSE(parse_sampler("faure", &k));
+    EXPECT_TRUE(parse_sampler("sobol", &k));
+    EXPECT_EQ(k, SamplerKind::Sobol);
 }

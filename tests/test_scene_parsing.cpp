@@ -36,7 +36,8 @@ std::string repeated(size_t n, const std::string& item) {
 }
 
 constexpr const char* kPresets =
-    "presets: uniform, stratified, latin_hypercube, importance, stratified_importance";
+    "presets: uniform, stratified, latin_hypercube, importance, stratified_importance, sobol, "
+    "halton, lattice";
 
 // --- 1. estimator names -----------------------------------------------------------------
 
@@ -45,8 +46,8 @@ TEST(SceneParsing, UnknownEstimatorNamesAreRefused) {
               std::string("scene.estimators[0]: unknown estimator 'stratifed' (did you mean "
                           "'stratified'? ") +
                   kPresets + "; a new name needs \"sampler\" or \"pdf\")");
-    EXPECT_EQ(error_of(R"({"f": "x*x", "estimators": ["uniform", "sobol"]})"),
-              std::string("scene.estimators[1]: unknown estimator 'sobol' (") + kPresets +
+    EXPECT_EQ(error_of(R"({"f": "x*x", "estimators": ["uniform", "faure"]})"),
+              std::string("scene.estimators[1]: unknown estimator 'faure' (") + kPresets +
                   "; a new name needs \"sampler\" or \"pdf\")");
     // An object with only a name is a bare name too.
     EXPECT_EQ(error_of(R"({"f": "x*x", "estimators": [{"name": "latin_hypercub"}]})"),

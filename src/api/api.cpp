@@ -242,14 +242,22 @@ int mcp_scene_info(const char* scene_json, char** info_json) {
     mcp::Made<mcp::SceneRequest> req = mcp::build_request(scene.value, mcp::Json());
     if (!req.ok()) return mcp::boundary::request_error(req.error);
     const mcp::Problem& p = req.value.problem;
-    mcp::Json names = mcp::Json::array();
+    mcp::Json names = mcp::Json::array(), more = mcp::Json::array();
     for (const mcp::EstimatorSpec& e : req.value.estimators) names.push_back(e.name);
+    // The uniform-density presets the scene does not list: options.estimators can run them too.
+    for (const mcp::EstimatorPreset& preset : mcp::estimator_presets()) {
+        bool listed = false;
+        for (const mcp::EstimatorSpec& e : req.value.estimators)
+            listed = listed || e.name == preset.name;
+        if (!listed && !preset.needs_pdf) more.push_back(preset.name);
+    }
     mcp::Json info{{"name", p.name},
                    {"description", p.description},
                    {"domain", mcp::domain_kind_name(p.domain.kind)},
                    {"dimension", p.domain.point_dim()},
                    {"exact", p.exact ? mcp::Json(*p.exact) : mcp::Json(nullptr)},
                    {"estimators", names},
+                   {"more_estimators", more},
                    {"n_min", req.value.settings.n_min},
                    {"n_max", req.value.settings.n_max},
                    {"reps", req.value.settings.reps},
@@ -267,17 +275,23 @@ int mcp_catalog(char** catalog_json) {
                            {"sampler", mcp::sampler_name(p.sampler)},
                            {"needs_pdf", p.needs_pdf},
                            {"summary", p.summary}});
-    mcp::Json catalog{{"version", mcp::kResultSchemaVersion},
-                      {"estimators", presets},
-                      {"samplers", {"independent", "stratified", "latin_hypercube"}},
-                      {"pdfs",
-                       {"uniform", "power", "exponential", "gaussian", "cosine", "tabulated",
-                        "product", "tabulated_2d", "cosine_hemisphere", "expression"}},
-                      {"integrands",
-                       {"constant", "monomial", "exponential", "gaussian", "indicator_ball",
-                        "expression", "genz_oscillatory", "genz_product_peak", "genz_corner_peak",
-                        "genz_gaussian", "genz_continuous", "genz_discontinuous"}},
-                      {"domains", {"box", "interval", "disk", "triangle", "sphere", "hemisphere"}}};
+    mcp::Json catalog{
+        {"version", mcp::kResultSchemaVersion},
+        {"estimators", presets},
+        {"samplers",
+         {"independent", "stratified", "latin_hypercube", "sobol", "halton", "lattice"}},
+        {"randomizations",
+         {{"sobol", {"owen", "lms_shift", "digital_shift", "none"}},
+          {"halton", {"owen", "permutation", "none"}},
+          {"lattice", {"random_shift", "none"}}}},
+        {"pdfs",
+         {"uniform", "power", "exponential", "gaussian", "cosine", "tabulated", "product",
+          "tabulated_2d", "cosine_hemisphere", "expression"}},
+        {"integrands",
+         {"constant", "monomial", "exponential", "gaussian", "indicator_ball", "expression",
+          "genz_oscillatory", "genz_product_peak", "genz_corner_peak", "genz_gaussian",
+          "genz_continuous", "genz_discontinuous"}},
+        {"domains", {"box", "interval", "disk", "triangle", "sphere", "hemisphere"}}};
     *catalog_json = copy_out(dump(catalog));
     g_last_error.clear();
     return MCP_OK;

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "api/scene.h"
+#include "estimators/diagnostics.h"
 
 namespace mcp {
 
@@ -34,111 +35,85 @@ Json diagnostics_to_json(const RunDiagnostics& d) {
                 {"max_weight_share", num(d.max_weight_share)}};
 }
 
-// Plain-language warnings for a level's diagnostics.
+// Plain-language sentences for the flags the core raises (estimators/diagnostics.h).
+
+Json level_warning(const Flag& f, const LevelStats& l) {
+    const std::string at_n = " at N = " + std::to_string(l.n);
+    const char* code = flag_code_name(f.code);
+    switch (f.code) {
+    case FlagCode::NoEstimate:
+        return warning(code, f.count == f.of
+                                 ? std::string("every sample was NaN or infinite: no estimate")
+                                 : "every sample was NaN or infinite in " +
+                                       std::to_string(f.count) + " of " + std::to_string(f.of) +
+                                       " replicates" + at_n + ": no estimate at this N");
+    case FlagCode::NonfiniteEstimate:
+        return warning(code, "the mean of the replicates is not a finite number" + at_n +
+                                 " (the sum of the weights overflowed): no estimate");
+    case FlagCode::NonfiniteVariance:
+        return warning(code, "the variance across replicates is not a finite number >= 0" + at_n +
+                                 ": no error bar");
+    case FlagCode::ZeroErrorBar:
+        return warning(code, std::to_string(f.count) + " of " + std::to_string(f.of) +
+                                 " replicates reported a standard error of 0" + at_n +
+                                 " although the replicates differ (standard deviation " +
+                                 fmt("%.3g", f.value) +
+                                 "): their error bars are wrong (too few samples to see f vary)");
+    case FlagCode::NonfiniteSamples:
+        return warning(code, std::to_string(f.count) +
+                                 " sample(s) with NaN/Inf f/p dropped: the estimate is biased");
+    case FlagCode::ZeroPdfSamples:
+        return warning(code, std::to_string(f.count) +
+                                 " sample(s) with f != 0 where p = 0: the pdf misses part of the "
+                                 "integrand, the estimate is biased");
+    case FlagCode::DominantSample:
+        return warning(code, "one sample carried " +
+                                 std::to_string(static_cast<int>(100 * f.value + 0.5)) +
+                                 "% of a run's sum" + at_n + ": the error bar is not trustworthy");
+    case FlagCode::LowEss:
+        return warning(code, "effective sample size " + fmt("%.1f", f.value) + " of " +
+                                 std::to_string(l.n) + at_n +
+                                 ": the estimate rests on a few samples (narrow peak, small "
+                                 "support or huge weights), its error bar is unreliable");
+    case FlagCode::ExactOutsideCi:
+        return warning(
+            code, "the mean of " + std::to_string(f.of) + " replicates misses the exact value by " +
+                      (std::isfinite(f.value) ? fmt("%.1f", f.value) + " standard errors"
+                                              : std::string("a margin with zero spread")) +
+                      at_n + ": the estimator is biased or its error bars are wrong");
+    default: return warning(code, "");
+    }
+}
 
 Json warnings_for(const LevelStats& l) {
     Json w = Json::array();
-    const RunDiagnostics& d = l.diagnostics;
-    // No estimate: one warning, and none of the diagnostics computed from dropped samples.
-    if (l.no_estimate_runs > 0) {
-        w.push_back(warning(
-            "no_estimate",
-            l.no_estimate_runs == l.reps
-                ? std::string("every sample was NaN or infinite: no estimate")
-                : "every sample was NaN or infinite in " + std::to_string(l.no_estimate_runs) +
-                      " of " + std::to_string(l.reps) +
-                      " replicates at N = " + std::to_string(l.n) + ": no estimate at this N"));
-        return w;
-    }
-    if (!std::isfinite(l.mean))
-        w.push_back(warning(
-            "nonfinite_estimate",
-            "the mean of the replicates is not a finite number at N = " + std::to_string(l.n) +
-                " (the sum of the weights overflowed): no estimate"));
-    else if (!std::isfinite(l.variance) || l.variance < 0.0)
-        w.push_back(warning("nonfinite_variance",
-                            "the variance across replicates is not a finite number >= 0 at N = " +
-                                std::to_string(l.n) + ": no error bar"));
-    // A random estimator whose own error bar is 0 while its replicates disagree: the runs saw
-    // no variation (e.g. both points of every stratum on the same side of a discontinuity),
-    // and their intervals are wrong. When every replicate agrees (f/p constant) 0 is right.
-    if (l.zero_error_runs > 0 && l.estimates_spread)
-        w.push_back(
-            warning("zero_error_bar",
-                    std::to_string(l.zero_error_runs) + " of " + std::to_string(l.reps) +
-                        " replicates reported a standard error of 0 at N = " + std::to_string(l.n) +
-                        " although the replicates differ (standard deviation " +
-                        fmt("%.3g", std::sqrt(l.variance)) +
-                        "): their error bars are wrong (too few samples to see f vary)"));
-    if (d.nonfinite)
-        w.push_back(warning("nonfinite", std::to_string(d.nonfinite) +
-                                             " sample(s) with NaN/Inf f/p dropped: the estimate is "
-                                             "biased"));
-    if (d.zero_pdf)
-        w.push_back(warning("zero_pdf_samples",
-                            std::to_string(d.zero_pdf) +
-                                " sample(s) with f != 0 where p = 0: the pdf misses part of the "
-                                "integrand, the estimate is biased"));
-    // One sample carrying a large share of a big sum: the variance estimate is dominated by
-    // rare large weights (heavy tail, possibly infinite variance).
-    if (l.n >= 1024 && d.max_weight_share > 0.05)
-        w.push_back(warning("dominant_sample",
-                            "one sample carried " +
-                                std::to_string(static_cast<int>(100 * d.max_weight_share + 0.5)) +
-                                "% of a run's sum at N = " + std::to_string(l.n) +
-                                ": the error bar is not trustworthy"));
-    // Kish's effective sample size: when a handful of samples carry the sum (a narrow peak
-    // barely hit, a few huge weights), the estimate and its error bar rest on those few.
-    if (l.ess_mean < 10.0 && l.ess_mean < 0.25 * static_cast<double>(l.n))
-        w.push_back(warning("low_ess", "effective sample size " + fmt("%.1f", l.ess_mean) + " of " +
-                                           std::to_string(l.n) + " at N = " + std::to_string(l.n) +
-                                           ": the estimate rests on a few samples (narrow peak, "
-                                           "small support or huge weights), its error bar is "
-                                           "unreliable"));
-    // With the exact value known: the replicates' mean must lie within a few of its own
-    // standard errors of it, or the estimator is biased or its variance infinite.
-    if (l.has_exact) {
-        const double tolerance = 5.0 * l.std_error + 1e-12 * std::fabs(l.mean - l.bias);
-        if (std::fabs(l.bias) > tolerance)
-            w.push_back(warning(
-                "exact_outside_ci",
-                "the mean of " + std::to_string(l.reps) + " replicates misses the exact value by " +
-                    (l.std_error > 0.0
-                         ? fmt("%.1f", std::fabs(l.bias) / l.std_error) + " standard errors"
-                         : std::string("a margin with zero spread")) +
-                    " at N = " + std::to_string(l.n) +
-                    ": the estimator is biased or its error bars are wrong"));
-    }
+    for (const Flag& f : level_flags(l)) w.push_back(level_warning(f, l));
     return w;
 }
 
 } // namespace
 
-// Hill's tail index alpha, P(|x| > t) ~ t^-alpha, a property of the estimator: it is read at
-// the largest N, whose pooled sample reaches deepest into the tail. Below 2 the variance is
-// infinite; below 4 the variance of the sample variance is, and error bars are unreliable at
-// any practical N. Flag when alpha = 2 is within two standard errors (alpha / sqrt(k))
-// [Hill75].
 void add_tail_warnings(Json& w, const LevelStats& deepest, uint64_t pooled,
                        const TailWording& words) {
-    if (!std::isfinite(deepest.tail_index) || deepest.tail_k <= 0) return;
-    const double a = deepest.tail_index;
-    const double se = a / std::sqrt(static_cast<double>(deepest.tail_k));
-    const std::string where = " (from the " + std::to_string(deepest.tail_k) + " largest of " +
-                              std::to_string(pooled) + " " + words.unit + " at " + words.n_name +
-                              " = " + std::to_string(deepest.n) + ")";
-    if (a < 2.0 + 2.0 * se)
-        w.push_back(warning("heavy_tail", std::string(words.what) +
-                                              " are heavy-tailed: tail index " + fmt("%.2f", a) +
-                                              " +/- " + fmt("%.2f", se) + where + ", and below 2 " +
-                                              words.variance +
-                                              " is infinite: the error bars are not trustworthy"));
-    else if (a < 4.0)
-        w.push_back(warning("heavy_tail_4", std::string(words.what) +
-                                                " have a heavy tail: tail index " + fmt("%.2f", a) +
-                                                where + " is below 4, so " + words.variance +
-                                                " is finite but its estimate is unreliable and the "
-                                                "error bars may be too small"));
+    for (const Flag& f : tail_flags(deepest)) {
+        const std::string where = " (from the " + std::to_string(f.count) + " largest of " +
+                                  std::to_string(pooled) + " " + words.unit + " at " +
+                                  words.n_name + " = " + std::to_string(f.n) + ")";
+        if (f.code == FlagCode::HeavyTail)
+            w.push_back(
+                warning("heavy_tail", std::string(words.what) + " are heavy-tailed: tail index " +
+                                          fmt("%.2f", f.value) + " +/- " + fmt("%.2f", f.se) +
+                                          where + ", and below 2 " + words.variance +
+                                          " is infinite: the error bars are not "
+                                          "trustworthy"));
+        else
+            w.push_back(warning("heavy_tail_4", std::string(words.what) +
+                                                    " have a heavy tail: tail index " +
+                                                    fmt("%.2f", f.value) + where +
+                                                    " is below 4, so " + words.variance +
+                                                    " is finite but its estimate is unreliable "
+                                                    "and the error bars may be too small"));
+    }
 }
 
 namespace {
@@ -150,38 +125,49 @@ Json estimator_warnings(const EstimatorStudy& e, const StudySettings& s) {
         add_tail_warnings(w, deepest, deepest.n * static_cast<uint64_t>(deepest.reps),
                           TailWording{"the weights f/p", "weights", "N", "the variance"});
     }
-
     const SupportCheck& sc = e.support;
-    if (sc.flagged && sc.method == "quadrature")
-        w.push_back(warning(
-            "pdf_support",
-            std::isfinite(sc.missed_mass)
-                ? "the pdf is zero on " + fmt("%.3g", 100.0 * sc.zero_measure) +
-                      "% of the domain, where the integral of |f| is " +
-                      fmt("%.6g", sc.missed_mass) + " (" + fmt("%.3g", 100.0 * sc.missed_fraction) +
-                      "% of the integral of |f|, by quadrature): the estimator never samples "
-                      "there and is biased"
-                : "the pdf is zero on " + fmt("%.3g", 100.0 * sc.zero_measure) +
-                      "% of the domain, where |f| is not finite or not integrable: the "
-                      "estimator never samples there and is biased"));
-    else if (sc.flagged)
-        w.push_back(warning("pdf_support",
-                            "the pdf is zero at " + std::to_string(sc.missed) + " of " +
-                                std::to_string(sc.f_nonzero) + " probe points where f != 0 (" +
-                                fmt("%.3g", 100.0 * sc.missed_fraction) +
-                                "% of |f|): the estimator never samples there and is biased"));
-    if (e.consistency.dof > 0 && e.consistency.p_value < 1e-3)
-        w.push_back(warning("level_drift",
-                            "the means at different N disagree beyond their error bars (chi2 = " +
-                                fmt("%.1f", e.consistency.chi2) + " for " +
-                                std::to_string(e.consistency.dof) +
-                                " degrees of freedom, p = " + fmt("%.2g", e.consistency.p_value) +
-                                "): the error bars understate the error (heavy tails, too few "
-                                "samples, or bias)"));
-    if (s.accumulator == Accumulator::Float32)
-        w.push_back(warning("float32_accumulator",
-                            "float32 accumulation (teaching mode): the estimates are naive "
-                            "single-precision sums and stall or drift at large N"));
+    for (const Flag& f : estimator_flags(e, s)) {
+        const char* code = flag_code_name(f.code);
+        switch (f.code) {
+        case FlagCode::PdfSupport:
+            if (sc.method == "quadrature")
+                w.push_back(warning(
+                    code, std::isfinite(sc.missed_mass)
+                              ? "the pdf is zero on " + fmt("%.3g", 100.0 * sc.zero_measure) +
+                                    "% of the domain, where the integral of |f| is " +
+                                    fmt("%.6g", sc.missed_mass) + " (" +
+                                    fmt("%.3g", 100.0 * sc.missed_fraction) +
+                                    "% of the integral of |f|, by quadrature): the estimator "
+                                    "never samples there and is biased"
+                              : "the pdf is zero on " + fmt("%.3g", 100.0 * sc.zero_measure) +
+                                    "% of the domain, where |f| is not finite or not "
+                                    "integrable: the estimator never samples there and is "
+                                    "biased"));
+            else
+                w.push_back(warning(code, "the pdf is zero at " + std::to_string(sc.missed) +
+                                              " of " + std::to_string(sc.f_nonzero) +
+                                              " probe points where f != 0 (" +
+                                              fmt("%.3g", 100.0 * sc.missed_fraction) +
+                                              "% of |f|): the estimator never samples there and "
+                                              "is biased"));
+            break;
+        case FlagCode::LevelDrift:
+            w.push_back(
+                warning(code, "the means at different N disagree beyond their error bars "
+                              "(chi2 = " +
+                                  fmt("%.1f", f.value) + " for " + std::to_string(f.dof) +
+                                  " degrees of freedom, p = " + fmt("%.2g", f.p_value) +
+                                  "): the error bars understate the error (heavy tails, too "
+                                  "few samples, or bias)"));
+            break;
+        case FlagCode::Float32Accumulator:
+            w.push_back(warning(code, "float32 accumulation (teaching mode): the estimates are "
+                                      "naive single-precision sums and stall or drift at large "
+                                      "N"));
+            break;
+        default: break; // the tail flags are worded above
+        }
+    }
     return w;
 }
 
@@ -238,6 +224,9 @@ Json level_to_json(const LevelStats& l) {
            {"std_error", num(l.std_error)},
            {"ci95", {num(l.ci_lo), num(l.ci_hi)}},
            {"mean_run_std_error", num(l.mean_run_se)},
+           // The runs' 95% intervals are estimate +- t std_error, t the Student quantile with
+           // this many degrees of freedom (0: no error bar).
+           {"run_dof", l.run_dof},
            {"time_mean_s", num(l.time_mean)},
            {"time_total_s", num(l.time_total)},
            {"efficiency", num(l.efficiency)},
@@ -279,31 +268,35 @@ Json fit_to_json(const ConvergenceFit& f) {
 namespace {
 
 Json estimator_header(const EstimatorStudy& e, const StudySettings& s) {
-    return Json{{"name", e.spec.name},
-                {"sampler", sampler_name(e.spec.sampler)},
-                {"samples_per_stratum", e.spec.per_stratum},
-                {"pdf", e.spec.proposal.describe()},
-                {"importance", e.spec.proposal.importance},
-                {"error_method", error_method_name(e.error_method)},
-                {"support_check",
-                 {{"probes", e.support.probes},
-                  {"f_nonzero", e.support.f_nonzero},
-                  {"missed", e.support.missed},
-                  {"missed_fraction", num(e.support.missed_fraction)},
-                  {"method", e.support.method},
-                  {"zero_measure", num(e.support.zero_measure)},
-                  {"missed_mass",
-                   e.support.method == "quadrature" ? num(e.support.missed_mass) : Json(nullptr)},
-                  {"abs_integral", num(e.support.abs_integral)},
-                  {"tolerance", kSupportTolerance},
-                  {"quadrature_evaluations", e.support.quadrature_evaluations},
-                  {"flagged", e.support.flagged},
-                  {"note", e.support.note}}},
-                {"consistency",
-                 {{"chi2", num(e.consistency.chi2)},
-                  {"dof", e.consistency.dof},
-                  {"p_value", num(e.consistency.p_value)}}},
-                {"warnings", estimator_warnings(e, s)}};
+    return Json{
+        {"name", e.spec.name},
+        {"sampler", sampler_name(e.spec.sampler)},
+        {"samples_per_stratum", e.spec.per_stratum},
+        {"pdf", e.spec.proposal.describe()},
+        {"importance", e.spec.proposal.importance},
+        {"randomization",
+         is_qmc(e.spec.sampler) ? Json(randomization_name(e.spec.randomization)) : Json(nullptr)},
+        {"randomizations", is_qmc(e.spec.sampler) ? Json(e.spec.randomizations) : Json(nullptr)},
+        {"error_method", error_method_name(e.error_method)},
+        {"support_check",
+         {{"probes", e.support.probes},
+          {"f_nonzero", e.support.f_nonzero},
+          {"missed", e.support.missed},
+          {"missed_fraction", num(e.support.missed_fraction)},
+          {"method", e.support.method},
+          {"zero_measure", num(e.support.zero_measure)},
+          {"missed_mass",
+           e.support.method == "quadrature" ? num(e.support.missed_mass) : Json(nullptr)},
+          {"abs_integral", num(e.support.abs_integral)},
+          {"tolerance", kSupportTolerance},
+          {"quadrature_evaluations", e.support.quadrature_evaluations},
+          {"flagged", e.support.flagged},
+          {"note", e.support.note}}},
+        {"consistency",
+         {{"chi2", num(e.consistency.chi2)},
+          {"dof", e.consistency.dof},
+          {"p_value", num(e.consistency.p_value)}}},
+        {"warnings", estimator_warnings(e, s)}};
 }
 
 } // namespace
@@ -476,9 +469,12 @@ std::string format_table(const Json& r) {
 
     const Json& ests = list(r, "estimators");
     for (const Json& e : ests) {
-        out << "\n"
-            << jstr(e, "name") << "  [sampler " << jstr(e, "sampler") << ", pdf " << jstr(e, "pdf")
-            << ", per-run error: " << jstr(e, "error_method") << "]\n";
+        out << "\n" << jstr(e, "name") << "  [sampler " << jstr(e, "sampler");
+        if (get(e, "randomization").is_string())
+            out << " (" << jstr(e, "randomization") << ", "
+                << fmt("%.0f", jnum(e, "randomizations")) << " randomizations)";
+        out << ", pdf " << jstr(e, "pdf") << ", per-run error: " << jstr(e, "error_method")
+            << "]\n";
         out << padl("N", 9) << padl("mean", 17) << padl("variance", 13) << padl("rel.err", 10);
         if (has_exact) out << padl("rmse", 11) << padl("bias/se", 9) << padl("cover", 7);
         out << padl("time/est", 11) << padl("efficiency", 12) << "\n";

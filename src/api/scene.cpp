@@ -676,12 +676,15 @@ std::string name_text(const std::string& name) {
 
 bool parse_estimator(Ctx& c, const Json& j, const std::string& path, const Problem& problem,
                      EstimatorSpec* out) {
-    std::string name, sampler_name_str, warp;
+    std::string name, sampler_name_str, warp, randomization;
+    int randomizations = 0; // 0: not given
     const Json* pdf = nullptr;
     if (j.is_string()) {
         name = j.get<std::string>();
     } else if (j.is_object()) {
-        if (!check_keys(c, j, path, {"name", "sampler", "pdf", "warp", "samples_per_stratum"}))
+        if (!check_keys(c, j, path,
+                        {"name", "sampler", "pdf", "warp", "samples_per_stratum", "randomization",
+                         "randomizations"}))
             return false;
         uint64_t m = 1;
         if (!get_count(c, j, "samples_per_stratum", path, &m)) return false;
@@ -693,8 +696,14 @@ bool parse_estimator(Ctx& c, const Json& j, const std::string& path, const Probl
         out->per_stratum = m;
         if (!get_string(c, j, "name", path, &name) ||
             !get_string(c, j, "sampler", path, &sampler_name_str) ||
-            !get_string(c, j, "warp", path, &warp))
+            !get_string(c, j, "warp", path, &warp) ||
+            !get_string(c, j, "randomization", path, &randomization))
             return false;
+        if (find(j, "randomizations")) {
+            uint64_t k = 0;
+            if (!get_count(c, j, "randomizations", path, &k)) return false;
+            randomizations = static_cast<int>(std::min<uint64_t>(k, 1u << 30));
+        }
         pdf = find(j, "pdf");
     } else {
         return c.fail(path, "expected an estimator name or object, got " + type_of(j));
@@ -704,11 +713,34 @@ bool parse_estimator(Ctx& c, const Json& j, const std::string& path, const Probl
     out->name = name;
     out->sampler = preset ? preset->sampler : SamplerKind::Independent;
     if (!sampler_name_str.empty() && !parse_sampler(sampler_name_str, &out->sampler))
-        return c.fail(sub(path, "sampler"),
-                      "unknown sampler '" + sampler_name_str +
-                          "' (known: independent, stratified, latin_hypercube)");
+        return c.fail(sub(path, "sampler"), "unknown sampler '" + sampler_name_str +
+                                                "' (known: " + sampler_names() + ")");
     if (out->per_stratum != 1 && out->sampler != SamplerKind::Stratified)
         return c.fail(sub(path, "samples_per_stratum"), "applies to the stratified sampler only");
+    if (is_qmc(out->sampler)) {
+        const QmcKind q = qmc_kind_of(out->sampler);
+        out->randomization = default_randomization(q);
+        if (!randomization.empty() && !parse_randomization(randomization, &out->randomization))
+            return c.fail(sub(path, "randomization"),
+                          "unknown randomization '" + randomization +
+                              "' (known: owen, lms_shift, digital_shift, permutation, "
+                              "random_shift, none)");
+        out->randomizations =
+            out->randomization == QmcRandomization::None ? 1 : kDefaultRandomizations;
+        if (randomizations > 0) out->randomizations = randomizations;
+        const std::string bad = check_sampler_options(out->sampler, out->sampler_options(),
+                                                      problem.domain.sample_dim());
+        if (!bad.empty()) {
+            const size_t colon = bad.find(": ");
+            const std::string field = bad.substr(0, colon);
+            if (field == "randomization" || field == "randomizations")
+                return c.fail(sub(path, field.c_str()), bad.substr(colon + 2));
+            return c.fail(path, bad);
+        }
+    } else if (!randomization.empty() || randomizations > 0) {
+        return c.fail(sub(path, randomization.empty() ? "randomizations" : "randomization"),
+                      "applies to the quasi-Monte Carlo samplers only (sobol, halton, lattice)");
+    }
     if (!warp.empty() && warp != "polar" && warp != "concentric")
         return c.fail(sub(path, "warp"), "unknown warp '" + warp + "' (known: polar, concentric)");
     if (!warp.empty() && problem.domain.kind != DomainKind::Disk)
@@ -763,6 +795,12 @@ const std::vector<EstimatorPreset>& estimator_presets() {
          "independent points drawn from the given pdf"},
         {"stratified_importance", SamplerKind::Stratified, true,
          "jittered unit-cube points warped by the pdf's inverse CDF"},
+        {"sobol", SamplerKind::Sobol, false,
+         "Owen-scrambled Sobol' points: 16 randomizations of N/16 points"},
+        {"halton", SamplerKind::Halton, false,
+         "Owen-scrambled Halton points: 16 randomizations of N/16 points"},
+        {"lattice", SamplerKind::Lattice, false,
+         "randomly shifted rank-1 lattice: 16 shifts of N/16 points"},
     };
     return presets;
 }
@@ -956,11 +994,32 @@ Made<SceneRequest> build_request(const Json& scene, const Json& options) {
             from_options = from_options || (options.is_object() && find(options, key));
         return made_error<SceneRequest>((from_options ? "options: " : "scene: ") + too_big);
     }
-    for (const EstimatorSpec& e : req.estimators)
+    for (const EstimatorSpec& e : req.estimators) {
         if (e.per_stratum > 1 && s.n_min < e.per_stratum)
             return made_error<SceneRequest>("estimator '" + e.name + "': samples_per_stratum = " +
                                             std::to_string(e.per_stratum) +
                                             " needs n_min >= " + std::to_string(e.per_stratum));
+        if (!is_qmc(e.sampler)) continue;
+        const uint64_t k = static_cast<uint64_t>(e.randomizations);
+        const std::string who =
+            (options.is_object() && (find(options, "n_min") || find(options, "n_max"))
+                 ? "options: estimator '"
+                 : "scene: estimator '") +
+            name_text(e.name) + "': ";
+        const std::vector<uint64_t> ladder = n_ladder(s.n_min, s.n_max);
+        if (!ladder.empty() && ladder.front() < k)
+            return made_error<SceneRequest>(
+                who + std::to_string(k) + " randomizations need n_min >= " + std::to_string(k) +
+                " (each run is " + std::to_string(k) + " randomizations of N/" + std::to_string(k) +
+                " points), got n_min = " + std::to_string(s.n_min));
+        const uint64_t most = qmc_max_points(qmc_kind_of(e.sampler));
+        if (s.n_max / k > most)
+            return made_error<SceneRequest>(
+                who + "n_max = " + std::to_string(s.n_max) + " would give " +
+                std::to_string(s.n_max / k) + " points per randomization, beyond the " +
+                std::to_string(most) + " the " + sampler_name(e.sampler) +
+                " points are built for; lower n_max or raise randomizations");
+    }
     return {req, {}};
 }
 

@@ -1,5 +1,6 @@
 #include "core/samplers.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace mcp {
@@ -14,8 +15,51 @@ const char* sampler_name(SamplerKind kind) {
     case SamplerKind::Independent: return "independent";
     case SamplerKind::Stratified: return "stratified";
     case SamplerKind::LatinHypercube: return "latin_hypercube";
+    case SamplerKind::Sobol: return "sobol";
+    case SamplerKind::Halton: return "halton";
+    case SamplerKind::Lattice: return "lattice";
     }
     return "?";
+}
+
+const char* sampler_names() {
+    return "independent, stratified, latin_hypercube, sobol, halton, lattice";
+}
+
+bool is_qmc(SamplerKind kind) {
+    return kind == SamplerKind::Sobol || kind == SamplerKind::Halton ||
+           kind == SamplerKind::Lattice;
+}
+
+QmcKind qmc_kind_of(SamplerKind kind) {
+    return kind == SamplerKind::Halton    ? QmcKind::Halton
+           : kind == SamplerKind::Lattice ? QmcKind::Lattice
+                                          : QmcKind::Sobol;
+}
+
+std::string check_sampler_options(SamplerKind kind, const SamplerOptions& options, int dim) {
+    if (options.per_stratum != 1 && kind != SamplerKind::Stratified)
+        return "samples_per_stratum: applies to the stratified sampler only";
+    if (!is_qmc(kind)) return "";
+    const QmcKind q = qmc_kind_of(kind);
+    std::string bad = check_randomization(q, options.randomization);
+    if (!bad.empty()) return "randomization: " + bad;
+    const int k = options.randomizations;
+    if (options.randomization == QmcRandomization::None) {
+        if (k != 1)
+            return "randomizations: points without randomization are one deterministic set "
+                   "(randomizations = 1, and the run has no error bar), got " +
+                   std::to_string(k);
+    } else if (k < 2 || k > kMaxRandomizations || (k & (k - 1)) != 0) {
+        return "randomizations: must be a power of two from 2 to " +
+               std::to_string(kMaxRandomizations) +
+               " (the error bar comes from the spread of the randomizations), got " +
+               std::to_string(k);
+    }
+    if (dim > qmc_max_dim(q))
+        return std::string(sampler_name(kind)) + ": " + std::to_string(dim) +
+               " dimensions exceed the " + std::to_string(qmc_max_dim(q)) + " its table supports";
+    return "";
 }
 
 bool parse_sampler(const std::string& name, SamplerKind* kind) {
@@ -25,6 +69,12 @@ bool parse_sampler(const std::string& name, SamplerKind* kind) {
         *kind = SamplerKind::Stratified;
     else if (name == "latin_hypercube")
         *kind = SamplerKind::LatinHypercube;
+    else if (name == "sobol")
+        *kind = SamplerKind::Sobol;
+    else if (name == "halton")
+        *kind = SamplerKind::Halton;
+    else if (name == "lattice")
+        *kind = SamplerKind::Lattice;
     else
         return false;
     return true;
@@ -94,11 +144,22 @@ uint64_t permute_index(uint64_t index, uint64_t n, uint64_t key) {
 }
 
 SamplerPlan make_sampler_plan(SamplerKind kind, int dim, uint64_t n, Pcg32& rng,
-                              uint64_t per_stratum) {
+                              const SamplerOptions& options) {
     SamplerPlan plan;
     plan.kind = kind;
     plan.dim = dim;
     plan.total = n;
+    const uint64_t per_stratum = options.per_stratum;
+    if (is_qmc(kind)) {
+        const uint64_t k = std::max<uint64_t>(
+            1, std::min<uint64_t>(static_cast<uint64_t>(std::max(options.randomizations, 1)), n));
+        plan.randomizers.reserve(static_cast<size_t>(k));
+        for (uint64_t b = 0; b < k; ++b) {
+            const uint64_t hi = rng.next_u32(), lo = rng.next_u32();
+            plan.randomizers.push_back(make_qmc_randomizer(qmc_kind_of(kind), options.randomization,
+                                                           dim, (hi << 32) | lo));
+        }
+    }
     if (kind == SamplerKind::Stratified) {
         plan.per_stratum = per_stratum >= 1 && n % per_stratum == 0 ? per_stratum : 1;
         plan.strata = stratification_grid(n / plan.per_stratum, dim);
@@ -161,6 +222,27 @@ void generate_block(const SamplerPlan& plan, uint64_t first, size_t count, Pcg32
                 u.coord(j)[i] = std::fmin((static_cast<double>(slab) + rng.next_double()) * inv_n,
                                           kOneMinusEpsilon);
             }
+        }
+        break;
+    }
+    case SamplerKind::Sobol:
+    case SamplerKind::Halton:
+    case SamplerKind::Lattice: {
+        // The block may span several batches: each part comes from its own randomization,
+        // indexed from the start of its batch.
+        const size_t batches = plan.batches();
+        // total x batches stays far below 2^64 (runs are at most 2^36 points, K <= 1024).
+        size_t batch = static_cast<size_t>(first * batches / plan.total);
+        while (batch + 1 < batches && plan.batch_begin(batch + 1) <= first) ++batch;
+        while (plan.batch_begin(batch) > first) --batch;
+        size_t done = 0;
+        while (done < count) {
+            const uint64_t index = first + done;
+            const uint64_t begin = plan.batch_begin(batch), end = plan.batch_begin(batch + 1);
+            const size_t part = static_cast<size_t>(std::min<uint64_t>(count - done, end - index));
+            qmc_points(plan.randomizers[batch], index - begin, part, u, done);
+            done += part;
+            ++batch;
         }
         break;
     }

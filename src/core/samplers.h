@@ -7,6 +7,9 @@
 // - Latin hypercube (N-rooks) [McKay79]: each axis cut into N slabs, each slab of each axis
 //   holds exactly one sample; the slab orders are independent random permutations,
 //   evaluated by a keyed bijection instead of stored arrays [Kensler13].
+// - Randomized quasi-Monte Carlo (Sobol', Halton, rank-1 lattice; core/qmc.h): a run of N
+//   points is K independent randomizations of N/K points each, so that the run's error bar
+//   comes from the spread of its K batch means [Owen95, LEcuyerLemieux02].
 #pragma once
 
 #include <cstdint>
@@ -15,15 +18,39 @@
 
 #include "core/made.h"
 #include "core/points.h"
+#include "core/qmc.h"
 #include "core/rng.h"
 
 namespace mcp {
 
-enum class SamplerKind { Independent, Stratified, LatinHypercube };
+enum class SamplerKind { Independent, Stratified, LatinHypercube, Sobol, Halton, Lattice };
 
 const char* sampler_name(SamplerKind kind);
-/// Parses "independent", "stratified", "latin_hypercube"; false if unknown.
+/// Parses "independent", "stratified", "latin_hypercube", "sobol", "halton", "lattice".
 bool parse_sampler(const std::string& name, SamplerKind* kind);
+/// The names parse_sampler knows, comma separated (for messages).
+const char* sampler_names();
+/// Is the sampler a randomized quasi-Monte Carlo point set (Sobol', Halton, lattice)?
+bool is_qmc(SamplerKind kind);
+/// The point set behind a quasi-Monte Carlo sampler (is_qmc(kind) must hold).
+QmcKind qmc_kind_of(SamplerKind kind);
+
+/// Default number of independent randomizations per run of a quasi-Monte Carlo sampler.
+constexpr int kDefaultRandomizations = 16;
+/// Randomizations per run: a power of two in [2, kMaxRandomizations] (1 without randomization).
+constexpr int kMaxRandomizations = 1024;
+
+/// How a sampler places its points, beyond its kind.
+struct SamplerOptions {
+    uint64_t per_stratum = 1; ///< stratified: points per cell (1 or 2)
+    QmcRandomization randomization = QmcRandomization::Owen; ///< quasi-Monte Carlo samplers
+    int randomizations = kDefaultRandomizations;             ///< K; 1 when randomization is None
+};
+
+/// "" when the options suit the sampler kind and a sample dimension, else an error naming the
+/// field: the randomization must apply to the point set, K must be a power of two in
+/// [2, kMaxRandomizations] (exactly 1 for "none"), the dimension within the point set's table.
+std::string check_sampler_options(SamplerKind kind, const SamplerOptions& options, int dim);
 
 /// Strata counts k_0..k_{d-1} with k_0 k_1 ... k_{d-1} = n exactly, as even as the
 /// factors of n allow: k_j is the largest divisor of the remaining count not above its
@@ -44,16 +71,26 @@ struct SamplerPlan {
     std::vector<uint64_t> strata; ///< stratified: counts per axis (product = total / per_stratum)
     uint64_t per_stratum = 1;     ///< stratified: points per cell (1 or 2)
     std::vector<uint64_t> perm_keys; ///< Latin hypercube: one permutation key per axis
+    /// Quasi-Monte Carlo: one randomization per batch; batch k holds points
+    /// [batch_begin(k), batch_begin(k + 1)) of the run.
+    std::vector<QmcRandomizer> randomizers;
+    size_t batches() const { return randomizers.size(); }
+    // total x k stays far below 2^64: runs are at most 2^36 points and k <= 1024.
+    uint64_t batch_begin(size_t k) const { return total * k / randomizers.size(); }
 };
 
-/// Plans a run of n points in dim dimensions. Latin hypercube keys are drawn from rng.
+/// Plans a run of n points in dim dimensions. Latin hypercube keys and the keys of the
+/// quasi-Monte Carlo randomizations are drawn from rng.
 /// Stratified runs put per_stratum points in each of n / per_stratum cells (n must be a
 /// multiple of per_stratum; points 2c and 2c+1 share cell c when per_stratum = 2).
+/// Quasi-Monte Carlo runs are min(K, n) batches of (nearly) equal size, each the first points
+/// of its own randomization (equal sizes n / K when K divides n, as on the study's ladder).
 SamplerPlan make_sampler_plan(SamplerKind kind, int dim, uint64_t n, Pcg32& rng,
-                              uint64_t per_stratum = 1);
+                              const SamplerOptions& options = {});
 
 /// Writes points first .. first + count - 1 of the run into u (count <= u.capacity),
-/// drawing jitter from rng. Consecutive calls must cover the run in order.
+/// drawing jitter from rng. Consecutive calls must cover the run in order (quasi-Monte Carlo
+/// points draw nothing from rng and may come in any order).
 void generate_block(const SamplerPlan& plan, uint64_t first, size_t count, Pcg32& rng,
                     PointBlock& u);
 

@@ -7,6 +7,7 @@
 
 #include "core/points.h"
 #include "core/rng.h"
+#include "core/stats.h"
 #include "estimators/problem.h"
 
 namespace mcp {
@@ -28,6 +29,9 @@ enum class ErrorMethod {
     CollapsedStrata, ///< neighbouring strata paired [Cochran77, 5A.12]: conservative
     PairedStrata,    ///< two points per stratum: unbiased [Cochran77, 5.4]
     IidConservative, ///< s^2 / N for Latin hypercube: >= its variance up to N/(N-1) [Owen97]
+    Randomizations,  ///< spread of the K batch means of independent randomizations, t with K-1
+                     ///< degrees of freedom [LEcuyerLemieux02]
+    None,            ///< one deterministic point set: no error bar
 };
 const char* error_method_name(ErrorMethod m);
 ErrorMethod error_method_for(const EstimatorSpec& spec);
@@ -40,10 +44,18 @@ struct RunResult {
     uint64_t n = 0;
     double estimate = 0.0;  ///< NaN when every sample was NaN/Inf (no estimate)
     double std_error = 0.0; ///< NaN when it cannot be estimated (N = 1, or no estimate)
+    /// Degrees of freedom of the error bar's variance estimate (its 95% interval is
+    /// estimate +- t_dof se): N - 1 for independent points, the number of differences for
+    /// strata, K - 1 for K randomizations; 0 when there is no error bar. Capped at 10^6.
+    int dof = 0;
     double seconds = 0.0;
     RunDiagnostics diagnostics;
     std::vector<double> top; ///< the kTopWeights largest |w|, decreasing (for the tail index)
 };
+
+/// The 97.5% quantile behind a run's 95% interval: Student t with dof degrees of freedom
+/// (1.96 for dof = 0, where there is no variance estimate to be unsure of).
+double interval_quantile(int dof);
 
 /// Largest weights each run keeps for the tail index (enough for Hill's k = 64).
 constexpr size_t kTopWeights = 65;
@@ -57,12 +69,8 @@ int hill_order(uint64_t samples);
 /// all equal (to 1e-12 relative), 0 when x_k is 0 (fewer than k+1 non-zero weights).
 double hill_tail_index(const std::vector<double>& top_descending, int k);
 
-/// Buffers reused across runs so that a run allocates nothing per block.
-struct Workspace {
-    PointBlock u, x;
-    std::vector<double> pdf, f;
-    std::vector<double> top; ///< min-heap of the largest |w| for the tail index
-};
+/// Buffers reused across runs (estimators/block_driver.h).
+struct Workspace;
 
 /// Runs one estimate of the problem with n samples, all randomness drawn from rng.
 RunResult run_estimate(const Problem& problem, const EstimatorSpec& spec, uint64_t n, Pcg32& rng,

@@ -101,7 +101,11 @@ struct EstimatorSpec {
     std::string name;
     SamplerKind sampler = SamplerKind::Independent;
     uint64_t per_stratum = 1; ///< stratified: points per cell; 2 gives an unbiased error bar
+    QmcRandomization randomization = QmcRandomization::Owen; ///< quasi-Monte Carlo samplers
+    int randomizations = kDefaultRandomizations; ///< quasi-Monte Carlo: K batches per run
     Proposal proposal;
+
+    SamplerOptions sampler_options() const { return {per_stratum, randomization, randomizations}; }
 };
 
 } // namespace mcp

@@ -277,17 +277,13 @@ SupportCheck check_support(const Problem& problem, const EstimatorSpec& spec, ui
     const Proposal uniform = uniform_proposal(d);
     const SamplerPlan plan =
         make_sampler_plan(SamplerKind::Independent, d.sample_dim(), probes, rng);
-    PointBlock u, x;
-    u.reset(d.sample_dim(), kBlockSize);
-    x.reset(d.point_dim(), kBlockSize);
-    std::vector<double> f(kBlockSize), p(kBlockSize);
     NeumaierSum all, missed, covered;
-    for (uint64_t first = 0; first < probes; first += kBlockSize) {
-        const size_t count = static_cast<size_t>(std::min<uint64_t>(kBlockSize, probes - first));
-        generate_block(plan, first, count, rng, u);
-        warp_block(uniform, d, u, x, p.data());
-        evaluate_block(problem.integrand, x, f.data());
-        proposal_pdf_block(spec.proposal, d, x, p.data());
+    Workspace ws;
+    for_each_block(problem, uniform, plan, rng, ws, [&](const SampleBlock& b) {
+        const size_t count = b.count;
+        const double* f = b.f;
+        double* p = b.pdf; // the uniform densities, replaced by the proposal's
+        proposal_pdf_block(spec.proposal, d, *b.x, p);
         for (size_t i = 0; i < count; ++i) {
             const double a = std::fabs(f[i]);
             if (!(a > 0.0) || !std::isfinite(a)) continue;
@@ -300,7 +296,7 @@ SupportCheck check_support(const Problem& problem, const EstimatorSpec& spec, ui
                 covered.add(a);
             }
         }
-    }
+    });
     check.missed_fraction = all.value() > 0.0 ? missed.value() / all.value() : 0.0;
     // The probes' estimate of int |f| over the support of p: measure x mean of |f| [p > 0].
     const double support_abs =
@@ -422,11 +418,20 @@ uint64_t replicate_stream(uint64_t seed, const std::string& estimator, uint64_t 
     return hash_combine(h, static_cast<uint64_t>(rep));
 }
 
+Pcg32 replicate_rng(uint64_t seed, const std::string& estimator, uint64_t n, int rep) {
+    const uint64_t key = replicate_stream(seed, estimator, n, rep);
+    // Both the starting state and the stream come from the key: replicates start at
+    // unrelated points of unrelated streams.
+    return Pcg32(hash_combine(key, 0x7374617465ULL), key); // "state"
+}
+
 LevelStats summarise_level(const std::vector<RunResult>& runs, const Problem& problem) {
     LevelStats s;
     s.reps = static_cast<int>(runs.size());
     if (runs.empty()) return s;
     s.n = runs[0].n;
+    s.run_dof = runs[0].dof;
+    const double run_quantile = interval_quantile(s.run_dof);
     RunningMoments est, se;
     NeumaierSum sq_err, time;
     int covered = 0, se_count = 0;
@@ -459,7 +464,11 @@ LevelStats summarise_level(const std::vector<RunResult>& runs, const Problem& pr
         if (s.has_exact) {
             const double e = r.estimate - exact;
             sq_err.add(e * e);
-            if (std::isfinite(r.std_error) && std::fabs(e) <= 1.959963984540054 * r.std_error)
+            // An interval is never narrower than the arithmetic: an estimate exact to round-off
+            // (64 eps relative, as for zero error bars) covers.
+            if (std::isfinite(r.std_error) &&
+                std::fabs(e) <=
+                    run_quantile * r.std_error + 64.0 * 2.220446049250313e-16 * std::fabs(exact))
                 ++covered;
         }
     }
@@ -604,8 +613,7 @@ StudyPlan plan_study(const Problem& problem, const std::vector<EstimatorSpec>& e
         e.name = spec.name;
         e.evaluations = per_estimator;
         // The stream of a replicate the study never draws (rep = -1 wraps to 2^64 - 1).
-        Pcg32 rng(mix64(settings.seed ^ 0x706c616eULL), // "plan"
-                  replicate_stream(settings.seed, spec.name, kPilotSamples, -1));
+        Pcg32 rng = replicate_rng(settings.seed, spec.name, kPilotSamples, -1);
         double seconds = run_estimate(problem, spec, kPilotSamples, rng, ws).seconds;
         if (seconds < 0.005) seconds = run_estimate(problem, spec, kPilotSamples, rng, ws).seconds;
         e.seconds_per_evaluation = seconds / static_cast<double>(kPilotSamples);
@@ -636,7 +644,6 @@ StudyResult run_study(const Problem& problem, const std::vector<EstimatorSpec>& 
     const std::vector<uint64_t> ladder = n_ladder(settings.n_min, settings.n_max);
     const size_t n_est = estimators.size();
     const size_t reps = static_cast<size_t>(settings.reps);
-    const uint64_t seed_state = mix64(settings.seed ^ 0x6d63706c6179ULL); // "mcplay"
 
     for (size_t level = 0; level < ladder.size(); ++level) {
         const uint64_t n = ladder[level];
@@ -648,7 +655,7 @@ StudyResult run_study(const Problem& problem, const std::vector<EstimatorSpec>& 
             for (size_t t = next++; t < tasks; t = next++) {
                 const size_t e = t / reps;
                 const int r = static_cast<int>(t % reps);
-                Pcg32 rng(seed_state, replicate_stream(settings.seed, estimators[e].name, n, r));
+                Pcg32 rng = replicate_rng(settings.seed, estimators[e].name, n, r);
                 runs[t] = run_estimate(problem, estimators[e], n, rng, ws, settings.accumulator);
             }
         };
@@ -697,28 +704,22 @@ SampleDump dump_samples(const Problem& problem, const EstimatorSpec& spec, uint6
     dump.sample_dim = d.sample_dim();
     dump.point_dim = d.point_dim();
     // The same stream and seeding as replicate 0 of the study at this N.
-    Pcg32 rng(mix64(seed ^ 0x6d63706c6179ULL), replicate_stream(seed, spec.name, n, 0));
+    Pcg32 rng = replicate_rng(seed, spec.name, n, 0);
     const SamplerPlan plan =
-        make_sampler_plan(spec.sampler, dump.sample_dim, n, rng, spec.per_stratum);
+        make_sampler_plan(spec.sampler, dump.sample_dim, n, rng, spec.sampler_options());
     dump.strata = plan.strata;
     dump.per_stratum = plan.per_stratum;
-    PointBlock u, x;
-    u.reset(dump.sample_dim, kBlockSize);
-    x.reset(dump.point_dim, kBlockSize);
-    std::vector<double> p(kBlockSize), f(kBlockSize);
-    for (uint64_t first = 0; first < n; first += kBlockSize) {
-        const size_t count = static_cast<size_t>(std::min<uint64_t>(kBlockSize, n - first));
-        generate_block(plan, first, count, rng, u);
-        warp_block(spec.proposal, d, u, x, p.data());
-        evaluate_block(problem.integrand, x, f.data());
-        for (size_t i = 0; i < count; ++i) {
-            for (int j = 0; j < dump.sample_dim; ++j) dump.u.push_back(u.coord(j)[i]);
-            for (int j = 0; j < dump.point_dim; ++j) dump.x.push_back(x.coord(j)[i]);
-            dump.pdf.push_back(p[i]);
-            dump.f.push_back(f[i]);
-            dump.weight.push_back(p[i] > 0.0 ? f[i] / p[i] : (f[i] == 0.0 ? 0.0 : NAN));
+    Workspace ws;
+    for_each_block(problem, spec.proposal, plan, rng, ws, [&](const SampleBlock& blk) {
+        for (size_t i = 0; i < blk.count; ++i) {
+            for (int j = 0; j < dump.sample_dim; ++j) dump.u.push_back(blk.u->coord(j)[i]);
+            for (int j = 0; j < dump.point_dim; ++j) dump.x.push_back(blk.x->coord(j)[i]);
+            const double p = blk.pdf[i], f = blk.f[i];
+            dump.pdf.push_back(p);
+            dump.f.push_back(f);
+            dump.weight.push_back(p > 0.0 ? f / p : (f == 0.0 ? 0.0 : NAN));
         }
-    }
+    });
     return dump;
 }
 

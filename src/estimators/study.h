@@ -2,9 +2,10 @@
 // replicates each, summarised by level (variance of the estimator, bias, RMSE, coverage,
 // time, efficiency) and by a fitted convergence order.
 //
-// Randomness: replicate r of estimator e at level N draws from its own PCG32 stream, a hash
-// of (seed, name of e, N, r). Results are therefore identical whatever the thread count,
-// and running a subset of the estimators does not change the ones that remain.
+// Randomness: replicate r of estimator e at level N draws from its own PCG32 generator, whose
+// state and stream both derive from a hash of (seed, name of e, N, r). Results are therefore
+// identical whatever the thread count, and running a subset of the estimators does not change the
+// ones that remain.
 #pragma once
 
 #include <cstdint>
@@ -13,6 +14,7 @@
 #include <vector>
 
 #include "core/stats.h"
+#include "estimators/block_driver.h"
 #include "estimators/estimator.h"
 
 namespace mcp {
@@ -61,6 +63,7 @@ struct LevelStats {
     double rmse = 0.0;
     double coverage = 0.0;    ///< share of replicates whose own 95% interval covers exact
     double mean_run_se = 0.0; ///< average per-run standard error reported by the runs
+    int run_dof = 0;          ///< degrees of freedom of the runs' error bars (RunResult::dof)
     double time_mean = 0.0;   ///< seconds per estimate
     double time_total = 0.0;
     double efficiency = 0.0;      ///< 1 / (variance * time_mean)
@@ -166,8 +169,10 @@ using StudyProgress = std::function<bool(const StudyResult& partial, size_t leve
 /// Summarises the R runs of one level.
 LevelStats summarise_level(const std::vector<RunResult>& runs, const Problem& problem);
 
-/// The stream id of one replicate (see the header comment).
+/// The key of one replicate (see the header comment).
 uint64_t replicate_stream(uint64_t seed, const std::string& estimator, uint64_t n, int rep);
+/// The generator of one replicate: state and stream both derived from its key.
+Pcg32 replicate_rng(uint64_t seed, const std::string& estimator, uint64_t n, int rep);
 
 StudyResult run_study(const Problem& problem, const std::vector<EstimatorSpec>& estimators,
                       const StudySettings& settings, const StudyProgress& progress = {});

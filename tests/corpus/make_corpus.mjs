@@ -54,7 +54,7 @@ const cli = [
   ['run_two_scenes', ['run', ok, ok], 'run takes one scene'],
   ['estimators_empty_name', ['run', ok, '--estimators', 'uniform,,stratified'], 'empty name'],
   ['estimators_comma', ['run', ok, '--estimators', ','], '--estimators'],
-  ['estimators_unknown', ['run', ok, '--estimators', 'sobol'], "unknown estimator 'sobol'"],
+  ['estimators_unknown', ['run', ok, '--estimators', 'faure'], "unknown estimator 'faure'"],
   ['estimators_needs_pdf', ['run', ok, '--estimators', 'importance'], 'needs a pdf'],
   ['width_on_integration', ['run', ok, '--width', '8'], 'are for render scenes'],
   ['out_missing_dir', ['run', ok, '--out', '{T}/no/such/dir/result.txt'], "--out: cannot write"],
@@ -122,11 +122,14 @@ scene('name_number', withf({ name: 7 }), 'scene.name');
 scene('estimators_empty', withf({ estimators: [] }), 'scene.estimators');
 scene('estimators_object', withf({ estimators: { uniform: 1 } }), 'scene.estimators');
 scene('estimator_misspelt', withf({ estimators: ['stratifed'] }), "unknown estimator 'stratifed'");
-scene('estimator_sobol', withf({ estimators: ['sobol'] }), "unknown estimator 'sobol'");
+scene('estimator_faure', withf({ estimators: ['faure'] }), "unknown estimator 'faure'");
+scene('estimator_sobol_permutation', withf({ estimators: [{ name: 'q', sampler: 'sobol', randomization: 'permutation' }] }), "does not apply to sobol");
+scene('estimator_lattice_too_many', withf({ estimators: ['lattice'], n_max: 2 ** 30 }), 'points are built for');
+scene('estimator_sobol_k3', withf({ estimators: [{ name: 'q', sampler: 'sobol', randomizations: 3 }] }), 'must be a power of two');
 scene('estimator_name_only', withf({ estimators: [{ name: 'mine' }] }), "unknown estimator 'mine'");
 scene('estimator_number', withf({ estimators: [5] }), 'scene.estimators[0]');
 scene('estimator_duplicate', withf({ estimators: ['uniform', 'uniform'] }), 'duplicate estimator name');
-scene('estimator_sampler_bad', withf({ estimators: [{ name: 'a', sampler: 'halton' }] }), "unknown sampler 'halton'");
+scene('estimator_sampler_bad', withf({ estimators: [{ name: 'a', sampler: 'niederreiter' }] }), "unknown sampler 'niederreiter'");
 scene('estimator_per_stratum_3', withf({ estimators: [{ name: 'a', sampler: 'stratified', samples_per_stratum: 3 }] }), 'samples_per_stratum');
 scene('estimator_per_stratum_indep', withf({ estimators: [{ name: 'a', sampler: 'independent', samples_per_stratum: 2 }] }), 'stratified sampler only');
 scene('estimator_warp_box', withf({ estimators: [{ name: 'a', sampler: 'independent', warp: 'polar' }] }), 'warp');

@@ -295,7 +295,7 @@ async function applyCustom(fromUrl = null) {
     // The dimension f implies (the unit cube of its highest variable), then the whole scene.
     const first = await service.request(MSG.VALIDATE, { scene: { f } });
     const scene = buildCustomScene(f, p, first.info.dimension);
-    const { info } = await service.request(MSG.VALIDATE, { scene });
+    const info = normalizeInfo((await service.request(MSG.VALIDATE, { scene })).info);
     if (token !== sceneToken) return false;
     dispatch({
       type: 'scene/loaded',

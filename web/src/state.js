@@ -237,7 +237,14 @@ function renderDefaults(info) {
  * (settings.n_name, settings.error_name). An integration scene's info is returned unchanged.
  */
 export function normalizeInfo(info) {
-  if (!info || info.kind !== KIND.RENDER) return info;
+  if (!info) return info;
+  if (info.kind !== KIND.RENDER) {
+    // An integration scene: its own estimators (selected at first), then the uniform-density
+    // presets it does not list (sobol, halton, lattice, ...), offered unselected.
+    const own = Array.isArray(info.estimators) ? info.estimators : [];
+    const more = Array.isArray(info.more_estimators) ? info.more_estimators.filter((n) => !own.includes(n)) : [];
+    return { ...info, estimators: [...own, ...more], defaultSelected: own.slice() };
+  }
   const details = Array.isArray(info.estimators) ? info.estimators : [];
   const st = info.settings || {};
   return {
@@ -475,9 +482,10 @@ export function reducer(state, action) {
       const available = p.info.estimators || [];
       // the answer to a scene/request keeps what was chosen since
       const keep = !p.selected && !p.params && state.sceneId === p.sceneId && state.sceneInfo && state.sceneInfo.provisional;
-      let selected = keep ? state.selected : p.selected ? p.selected : available;
+      const byDefault = p.info.defaultSelected || available;
+      let selected = keep ? state.selected : p.selected ? p.selected : byDefault;
       selected = orderedSelection(available, selected);
-      if (!selected.length && !keep) selected = available.slice();
+      if (!selected.length && !keep) selected = byDefault.slice();
       let params;
       if (keep) params = state.params;
       else if (p.params) params = { ...state.params, ...p.params };

@@ -262,7 +262,7 @@ function renderState() {
   return reducer(s, { type: 'scene/loaded', payload: { sceneId: 'quad_light_floor', scene: { render: {} }, info: normalizeInfo(RENDER_INFO_RAW) } });
 }
 
-test('normalizeInfo: a render scene\'s info as the controls read it; integration info unchanged', () => {
+test('normalizeInfo: a render scene\'s info as the controls read it; integration info lists more presets', () => {
   const info = normalizeInfo(RENDER_INFO_RAW);
   assert.equal(kindOf(info), KIND.RENDER);
   assert.deepEqual(info.estimators, ['bsdf', 'light_area']);
@@ -270,8 +270,14 @@ test('normalizeInfo: a render scene\'s info as the controls read it; integration
   assert.deepEqual([info.n_min, info.n_max, info.reps, info.n_name, info.error_name], [1, 64, 4, 'spp', 'relative_mse']);
   assert.equal(info.exact, null);
   const integral = { name: 'exp_1d', estimators: ['uniform'], n_min: 16, n_max: 1024 };
-  assert.equal(normalizeInfo(integral), integral);
+  assert.deepEqual(normalizeInfo(integral), { ...integral, defaultSelected: ['uniform'] });
   assert.equal(kindOf(integral), KIND.INTEGRAL);
+  // The presets the scene does not list come after its own, unselected at first.
+  const more = normalizeInfo({ ...integral, more_estimators: ['uniform', 'sobol', 'lattice'] });
+  assert.deepEqual(more.estimators, ['uniform', 'sobol', 'lattice']);
+  assert.deepEqual(more.defaultSelected, ['uniform']);
+  const loaded = reducer(initialState(), { type: 'scene/loaded', payload: { sceneId: 'exp_1d', scene: {}, info: more } });
+  assert.deepEqual(loaded.selected, ['uniform']);
   assert.equal(kindOf(null), KIND.INTEGRAL);
 });
 

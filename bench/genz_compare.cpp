@@ -1,0 +1,749 @@
+// genz_compare: GSL's plain, MISER and VEGAS beside mcplay's estimators on Genz's six test
+// families, with the same integrand, the same budget of N integrand calls per estimate and
+// R replicates per (case, method), on one thread (docs/benchmarks.md).
+//
+//   genz_compare [--quick] [--n N] [--reps R] [--dims 2,4,8,16] [--families 1,...,6]
+//                [--methods uniform,stratified,...] [--gsl plain,miser,vegas|none]
+//                [--param-seed S] [--seed S] [--params-dir DIR] [--json FILE]
+//
+// Both sides evaluate mcplay's Genz code: GSL calls genz_evaluate_point (one point per call,
+// the only interface GSL has), mcplay runs its own block path (run_estimate ->
+// genz_evaluate_block); the two are bit-identical per point (integrands/genz.h).
+// Per (case, method), over the R replicates, against the exact integral I:
+//   rel_rmse  sqrt(mean((est - I)^2)) / |I|       rel_bias  (mean(est) - I) / |I|
+//   sig/rmse  mean(reported sigma) / RMSE: ~1 honest, << 1 over-confident, >> 1 pessimistic
+//   cov2      replicates with |est - I| <= 2 sigma (about 95% if the error bars are honest)
+//   t_med     median wall seconds per estimate (setup included)
+//   eff       1 / (rel_rmse^2 t_med): higher is better
+//   calls/N   integrand calls actually made / N (mean)
+// A reported sigma of 0, NaN or infinity, and a non-finite estimate, are counted and shown in
+// the notes column; they make sig/rmse or rel_rmse NaN rather than being dropped.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <sys/utsname.h>
+
+#include <gsl/gsl_errno.h>
+#include <gsl/gsl_monte_miser.h>
+#include <gsl/gsl_monte_plain.h>
+#include <gsl/gsl_monte_vegas.h>
+#include <gsl/gsl_rng.h>
+#include <gsl/gsl_version.h>
+
+#include "api/json_read.h"
+#include "api/scene.h"
+#include "estimators/estimator.h"
+#include "integrands/genz.h"
+
+using namespace mcp;
+
+namespace {
+
+const double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+double now_seconds() {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch())
+        .count();
+}
+
+// ---------------------------------------------------------------------------------------
+// Options
+
+struct Options {
+    uint64_t n = uint64_t(1) << 20;
+    int reps = 10;
+    std::vector<int> dims{2, 4, 8, 16};
+    std::vector<int> families{1, 2, 3, 4, 5, 6};
+    bool dims_given = false, families_given = false;
+    std::vector<std::string> methods{"uniform",  "stratified", "latin_hypercube",
+                                     "sobol",    "halton",     "lattice"};
+    std::vector<std::string> gsl{"plain", "miser", "vegas"};
+    uint64_t param_seed = 1; // genz_random(family, d, param_seed)
+    uint64_t seed = 1;       // replicate seeds
+    std::string params_dir, json_path;
+    bool quick = false;
+};
+
+std::vector<std::string> split(const std::string& s) {
+    std::vector<std::string> out;
+    std::stringstream ss(s);
+    std::string item;
+    while (std::getline(ss, item, ','))
+        if (!item.empty()) out.push_back(item);
+    return out;
+}
+
+[[noreturn]] void usage(const char* msg) {
+    if (msg) std::fprintf(stderr, "genz_compare: %s\n", msg);
+    std::fprintf(stderr,
+                 "usage: genz_compare [--quick] [--n N] [--reps R] [--dims 2,4,8,16]\n"
+                 "         [--families 1,2,3,4,5,6 | oscillatory,...] [--methods PRESET,...]\n"
+                 "         [--gsl plain,miser,vegas|none] [--param-seed S] [--seed S]\n"
+                 "         [--params-dir DIR] [--json FILE]\n");
+    std::exit(2);
+}
+
+const char* kFamilyNames[] = {"oscillatory", "product_peak", "corner_peak",
+                              "gaussian",    "continuous",   "discontinuous"};
+
+int family_number(const std::string& s) {
+    for (int i = 0; i < 6; ++i)
+        if (s == kFamilyNames[i] || s == "genz_" + std::string(kFamilyNames[i])) return i + 1;
+    char* end = nullptr;
+    long v = std::strtol(s.c_str(), &end, 10);
+    if (end && *end == 0 && v >= 1 && v <= 6) return int(v);
+    return 0;
+}
+
+uint64_t parse_u64(const char* s, const char* what) {
+    char* end = nullptr;
+    double v = std::strtod(s, &end); // accepts 1048576, 1e6, 2e5
+    if (!end || *end || !(v >= 1) || v > 1e15 || v != std::floor(v))
+        usage((std::string(what) + ": expected a positive whole number, got '" + s + "'").c_str());
+    return uint64_t(v);
+}
+
+Options parse_options(int argc, char** argv) {
+    Options o;
+    bool n_given = false, reps_given = false;
+    for (int i = 1; i < argc; ++i) {
+        std::string a = argv[i];
+        auto value = [&]() -> const char* {
+            if (i + 1 >= argc) usage((a + " needs a value").c_str());
+            return argv[++i];
+        };
+        if (a == "--quick")
+            o.quick = true;
+        else if (a == "--n")
+            o.n = parse_u64(value(), "--n"), n_given = true;
+        else if (a == "--reps")
+            o.reps = int(parse_u64(value(), "--reps")), reps_given = true;
+        else if (a == "--dims") {
+            o.dims.clear();
+            for (const std::string& s : split(value())) {
+                int d = std::atoi(s.c_str());
+                if (d < 1 || d > 64) usage(("--dims: " + s + " is not in 1..64").c_str());
+                o.dims.push_back(d);
+            }
+            o.dims_given = true;
+        } else if (a == "--families") {
+            o.families.clear();
+            for (const std::string& s : split(value())) {
+                int f = family_number(s);
+                if (!f) usage(("--families: unknown family '" + s + "'").c_str());
+                o.families.push_back(f);
+            }
+            o.families_given = true;
+        } else if (a == "--methods")
+            o.methods = split(value());
+        else if (a == "--gsl") {
+            std::string v = value();
+            o.gsl = v == "none" ? std::vector<std::string>{} : split(v);
+            for (const std::string& g : o.gsl)
+                if (g != "plain" && g != "miser" && g != "vegas")
+                    usage(("--gsl: unknown method '" + g + "' (plain, miser, vegas, none)").c_str());
+        } else if (a == "--param-seed")
+            o.param_seed = parse_u64(value(), "--param-seed");
+        else if (a == "--seed")
+            o.seed = parse_u64(value(), "--seed");
+        else if (a == "--params-dir")
+            o.params_dir = value();
+        else if (a == "--json")
+            o.json_path = value();
+        else if (a == "-h" || a == "--help")
+            usage(nullptr);
+        else
+            usage(("unknown argument '" + a + "'").c_str());
+    }
+    if (o.quick) {
+        if (!n_given) o.n = uint64_t(1) << 16;
+        if (!reps_given) o.reps = 3;
+    }
+    if (o.reps < 2) usage("--reps must be at least 2");
+    return o;
+}
+
+// ---------------------------------------------------------------------------------------
+// Cases: Genz parameters from genz_random, or from the anchors' params JSON files.
+
+struct Case {
+    std::string label; // "oscillatory d=2" (+ file name in --params-dir mode)
+    int family = 1;    // 1..6
+    GenzParams params;
+    double exact = kNaN;       // the value errors are measured against
+    double mcplay_exact = kNaN; // genz_exact(params)
+    std::string source;
+};
+
+std::vector<Case> random_cases(const Options& o) {
+    std::vector<Case> cases;
+    for (int fam : o.families)
+        for (int d : o.dims) {
+            Case c;
+            c.family = fam;
+            c.params = genz_random(GenzFamily(fam - 1), d, o.param_seed);
+            c.mcplay_exact = c.exact = genz_exact(c.params);
+            c.label = std::string(kFamilyNames[fam - 1]) + " d=" + std::to_string(d);
+            c.source = "genz_random(" + std::string(kFamilyNames[fam - 1]) + ", " +
+                       std::to_string(d) + ", seed " + std::to_string(o.param_seed) + ")";
+            cases.push_back(c);
+        }
+    return cases;
+}
+
+std::vector<Case> file_cases(const Options& o) {
+    namespace fs = std::filesystem;
+    std::vector<Case> cases;
+    std::error_code ec;
+    std::vector<fs::path> files;
+    for (const auto& e : fs::directory_iterator(o.params_dir, ec))
+        if (e.path().extension() == ".json") files.push_back(e.path());
+    if (ec) usage(("--params-dir " + o.params_dir + ": " + ec.message()).c_str());
+    std::sort(files.begin(), files.end());
+    for (const fs::path& p : files) {
+        std::ifstream in(p);
+        std::stringstream ss;
+        ss << in.rdbuf();
+        Made<Json> j = parse_json(ss.str().c_str(), p.string().c_str());
+        auto skip = [&](const std::string& why) {
+            std::printf("skipped %s: %s\n", p.filename().string().c_str(), why.c_str());
+        };
+        if (!j.ok()) {
+            skip(j.error);
+            continue;
+        }
+        const Json& v = j.value;
+        if (!v.is_object() || !v.contains("family") || !v["family"].is_number_integer() ||
+            !v.contains("a") || !v.contains("u") || !v["a"].is_array() || !v["u"].is_array()) {
+            skip("needs integer \"family\" and arrays \"a\", \"u\"");
+            continue;
+        }
+        const int fam = v["family"].get<int>();
+        if (fam < 1 || fam > 6) {
+            skip("family " + std::to_string(fam) + " is not one of Genz's six");
+            continue;
+        }
+        std::vector<double> a, u;
+        for (const Json& x : v["a"]) a.push_back(x.is_number() ? x.get<double>() : kNaN);
+        for (const Json& x : v["u"]) u.push_back(x.is_number() ? x.get<double>() : kNaN);
+        Made<GenzParams> g = make_genz(GenzFamily(fam - 1), a, u);
+        if (!g.ok()) {
+            skip(g.error);
+            continue;
+        }
+        if (v.contains("d") && v["d"].is_number_integer() && v["d"].get<int>() != g.value.dim()) {
+            skip("\"d\" does not match the length of \"a\"");
+            continue;
+        }
+        const int d = g.value.dim();
+        if (o.families_given &&
+            std::find(o.families.begin(), o.families.end(), fam) == o.families.end())
+            continue;
+        if (o.dims_given && std::find(o.dims.begin(), o.dims.end(), d) == o.dims.end()) continue;
+        Case c;
+        c.family = fam;
+        c.params = g.value;
+        c.mcplay_exact = genz_exact(c.params);
+        c.exact = v.contains("exact") && v["exact"].is_number() ? v["exact"].get<double>()
+                                                                 : c.mcplay_exact;
+        c.label = std::string(kFamilyNames[fam - 1]) + " d=" + std::to_string(d) + " (" +
+                  p.stem().string() + ")";
+        c.source = p.string();
+        cases.push_back(c);
+    }
+    std::stable_sort(cases.begin(), cases.end(), [](const Case& x, const Case& y) {
+        return x.family != y.family ? x.family < y.family : x.params.dim() < y.params.dim();
+    });
+    return cases;
+}
+
+// ---------------------------------------------------------------------------------------
+// One estimate
+
+struct Estimate {
+    double value = kNaN, sigma = kNaN, seconds = 0.0, chi2 = kNaN;
+    uint64_t calls = 0;
+    int status = 0;
+};
+
+struct GslContext {
+    const GenzParams* params;
+    uint64_t calls;
+};
+
+double gsl_integrand(double* x, size_t, void* context) {
+    GslContext* c = static_cast<GslContext*>(context);
+    ++c->calls;
+    return genz_evaluate_point(*c->params, x);
+}
+
+// VEGAS as GSL's manual recommends: a warm-up of 10^4 calls (stage 0: fresh grid) to train
+// the grid, then the main integration on that grid (stage 1: keep the grid, restart the
+// averages), all inside the budget of n calls, counted at the integrand. GSL's `calls` is per
+// iteration (params.iterations = 5 by default) and rounded down to (calls per box) x boxes^d,
+// so: while a whole main iteration still fits, one more is run (stage 3: continue the run;
+// GSL sets stage back to 1 after every call, so it is set each time); then the rest is spent
+// in single iterations re-binned to it (stage 2: keep grid and averages) while it is at least
+// 10^4 calls; a last rest under 10^4 calls goes to one iteration in GSL's importance-only
+// mode, the only mode that takes a call count exactly (one box), so the total is exactly n.
+// Everything else is GSL's default (alpha 1.5, 50 bins, mode importance or stratified).
+Estimate gsl_vegas(gsl_monte_function* F, GslContext* ctx, int d, uint64_t n, gsl_rng* r) {
+    Estimate e;
+    std::vector<double> lo(size_t(d), 0.0), hi(size_t(d), 1.0);
+    gsl_monte_vegas_state* s = gsl_monte_vegas_alloc(size_t(d));
+    gsl_monte_vegas_params vp;
+    gsl_monte_vegas_params_get(s, &vp);
+    const size_t iterations = vp.iterations; // 5
+    const uint64_t warm = std::min<uint64_t>(10000, n / 10);
+    vp.stage = 0;
+    gsl_monte_vegas_params_set(s, &vp);
+    e.status |= gsl_monte_vegas_integrate(F, lo.data(), hi.data(), size_t(d), warm / iterations, r,
+                                          s, &e.value, &e.sigma);
+    const uint64_t before_main = ctx->calls;
+    vp.stage = 1;
+    gsl_monte_vegas_params_set(s, &vp);
+    e.status |= gsl_monte_vegas_integrate(F, lo.data(), hi.data(), size_t(d),
+                                          (n - before_main) / iterations, r, s, &e.value, &e.sigma);
+    const uint64_t per_iteration = (ctx->calls - before_main) / iterations;
+    vp.iterations = 1;
+    while (per_iteration > 0 && ctx->calls + per_iteration <= n) {
+        vp.stage = 3;
+        gsl_monte_vegas_params_set(s, &vp);
+        e.status |= gsl_monte_vegas_integrate(F, lo.data(), hi.data(), size_t(d), per_iteration,
+                                              r, s, &e.value, &e.sigma);
+    }
+    while (n - ctx->calls >= 10000) { // GSL never makes more calls than asked for
+        vp.stage = 2;
+        gsl_monte_vegas_params_set(s, &vp);
+        e.status |= gsl_monte_vegas_integrate(F, lo.data(), hi.data(), size_t(d),
+                                              n - ctx->calls, r, s, &e.value, &e.sigma);
+    }
+    if (n - ctx->calls >= 2) { // one box of n - calls points (at least 2 per box)
+        vp.stage = 2;
+        vp.mode = GSL_VEGAS_MODE_IMPORTANCE_ONLY;
+        gsl_monte_vegas_params_set(s, &vp);
+        e.status |= gsl_monte_vegas_integrate(F, lo.data(), hi.data(), size_t(d),
+                                              n - ctx->calls, r, s, &e.value, &e.sigma);
+    }
+    e.chi2 = gsl_monte_vegas_chisq(s);
+    gsl_monte_vegas_free(s);
+    return e;
+}
+
+Estimate run_gsl(const std::string& method, const GenzParams& p, uint64_t n, gsl_rng* r) {
+    GslContext ctx{&p, 0};
+    gsl_monte_function F{&gsl_integrand, size_t(p.dim()), &ctx};
+    const int d = p.dim();
+    std::vector<double> lo(size_t(d), 0.0), hi(size_t(d), 1.0);
+    const double t0 = now_seconds();
+    Estimate e;
+    if (method == "plain") {
+        gsl_monte_plain_state* s = gsl_monte_plain_alloc(size_t(d));
+        e.status = gsl_monte_plain_integrate(&F, lo.data(), hi.data(), size_t(d), n, r, s,
+                                             &e.value, &e.sigma);
+        gsl_monte_plain_free(s);
+    } else if (method == "miser") {
+        gsl_monte_miser_state* s = gsl_monte_miser_alloc(size_t(d));
+        e.status = gsl_monte_miser_integrate(&F, lo.data(), hi.data(), size_t(d), n, r, s,
+                                             &e.value, &e.sigma);
+        gsl_monte_miser_free(s);
+    } else {
+        e = gsl_vegas(&F, &ctx, d, n, r);
+    }
+    e.seconds = now_seconds() - t0;
+    e.calls = ctx.calls;
+    return e;
+}
+
+// ---------------------------------------------------------------------------------------
+// Statistics of one (case, method) cell
+
+struct Cell {
+    std::string method; // gsl_plain, ..., or the mcplay preset name
+    bool gsl = false;
+    std::vector<Estimate> reps;
+    double rel_rmse = kNaN, rel_bias = kNaN, sig_rmse = kNaN, t_med = kNaN, eff = kNaN,
+           calls_frac = kNaN, chi2_med = kNaN;
+    int cov2 = 0, sigma_zero = 0, sigma_nonfinite = 0, est_nonfinite = 0, bad_status = 0;
+};
+
+double median(std::vector<double> v) {
+    if (v.empty()) return kNaN;
+    std::sort(v.begin(), v.end());
+    const size_t m = v.size() / 2;
+    return v.size() % 2 ? v[m] : 0.5 * (v[m - 1] + v[m]);
+}
+
+void summarize(Cell& c, double exact, uint64_t n) {
+    double se2 = 0.0, bias = 0.0, sig = 0.0, calls = 0.0;
+    std::vector<double> secs, chi;
+    for (const Estimate& e : c.reps) {
+        const double err = e.value - exact;
+        se2 += err * err; // NaN propagates: a non-finite estimate makes rel_rmse NaN
+        bias += err;
+        sig += e.sigma; // likewise a NaN sigma makes sig/rmse NaN
+        if (std::fabs(err) <= 2.0 * e.sigma) ++c.cov2;
+        if (e.sigma == 0.0) ++c.sigma_zero;
+        if (!std::isfinite(e.sigma)) ++c.sigma_nonfinite;
+        if (!std::isfinite(e.value)) ++c.est_nonfinite;
+        if (e.status) ++c.bad_status;
+        secs.push_back(e.seconds);
+        calls += double(e.calls);
+        if (!std::isnan(e.chi2)) chi.push_back(e.chi2);
+    }
+    const double R = double(c.reps.size());
+    const double rmse = std::sqrt(se2 / R);
+    c.rel_rmse = rmse / std::fabs(exact);
+    c.rel_bias = bias / R / std::fabs(exact);
+    c.sig_rmse = (sig / R) / rmse;
+    c.t_med = median(secs);
+    c.eff = 1.0 / (c.rel_rmse * c.rel_rmse * c.t_med);
+    c.calls_frac = calls / R / double(n);
+    c.chi2_med = median(chi);
+}
+
+std::string notes(const Cell& c) {
+    std::string s;
+    auto add = [&](const std::string& t) { s += (s.empty() ? "" : "; ") + t; };
+    const int R = int(c.reps.size());
+    if (c.est_nonfinite) add("estimate non-finite in " + std::to_string(c.est_nonfinite) + "/" + std::to_string(R));
+    if (c.sigma_zero) add("sigma = 0 in " + std::to_string(c.sigma_zero) + "/" + std::to_string(R));
+    if (c.sigma_nonfinite)
+        add("sigma NaN/inf in " + std::to_string(c.sigma_nonfinite) + "/" + std::to_string(R));
+    if (c.bad_status) add("GSL status != 0 in " + std::to_string(c.bad_status) + "/" + std::to_string(R));
+    if (!std::isnan(c.chi2_med)) {
+        char b[64];
+        std::snprintf(b, sizeof b, "chi2/dof %.2g", c.chi2_med);
+        add(b);
+    }
+    return s;
+}
+
+// Error bars that cannot be taken at face value: over-confident (sig/rmse < 0.5, NaN, or
+// coverage of the 2-sigma intervals under 70%) or pessimistic (sig/rmse > 2: safe, but the
+// estimator is better than it claims). '!' and '^' in the tables.
+bool overconfident(const Cell& c) {
+    const int R = int(c.reps.size());
+    return !(c.sig_rmse >= 0.5) || 10 * c.cov2 < 7 * R;
+}
+bool pessimistic(const Cell& c) { return c.sig_rmse > 2.0; }
+const char* mark(const Cell& c) { return overconfident(c) ? "!" : pessimistic(c) ? "^" : " "; }
+
+std::string fmt_e(double x, int prec = 2) {
+    if (std::isnan(x)) return "nan";
+    if (std::isinf(x)) return x > 0 ? "inf" : "-inf";
+    char b[32];
+    std::snprintf(b, sizeof b, "%.*e", prec, x);
+    return b;
+}
+std::string fmt_f(double x, const char* f) {
+    if (std::isnan(x)) return "nan";
+    if (std::isinf(x)) return x > 0 ? "inf" : "-inf";
+    char b[32];
+    std::snprintf(b, sizeof b, f, x);
+    return b;
+}
+
+// JSON: non-finite numbers are written as the strings "nan", "inf", "-inf" (JSON has no NaN),
+// so that they are visible, never silently null.
+Json jnum(double x) {
+    if (std::isfinite(x)) return x;
+    return std::isnan(x) ? Json("nan") : Json(x > 0 ? "inf" : "-inf");
+}
+
+// ---------------------------------------------------------------------------------------
+
+struct CaseResult {
+    const Case* c;
+    std::vector<Cell> cells;
+    int best_gsl = -1, best_mcplay = -1;
+    double ratio = kNaN;
+};
+
+int best_of(const std::vector<Cell>& cells, bool gsl) {
+    int best = -1;
+    for (size_t i = 0; i < cells.size(); ++i) {
+        if (cells[i].gsl != gsl || std::isnan(cells[i].eff)) continue;
+        if (best < 0 || cells[i].eff > cells[size_t(best)].eff) best = int(i);
+    }
+    return best;
+}
+
+Json scene_for(const Case& c, const std::string& estimator, bool exact_from_file) {
+    Json integrand = {{"type", genz_family_name(c.params.family)},
+                      {"a", c.params.a},
+                      {"u", c.params.u}};
+    Json scene = {{"name", "genz_compare"}, {"integrand", integrand},
+                  {"estimators", Json::array({estimator})}};
+    if (exact_from_file) scene["exact"] = c.exact;
+    return scene;
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+    const Options o = parse_options(argc, argv);
+    const double t_start = now_seconds();
+    gsl_set_error_handler_off();
+    const bool from_files = !o.params_dir.empty();
+    std::FILE* json = nullptr;
+    if (!o.json_path.empty()) {
+        json = std::fopen(o.json_path.c_str(), "w");
+        if (!json) usage(("--json: cannot write " + o.json_path).c_str());
+    }
+    auto emit = [&](const Json& j) {
+        if (json) std::fprintf(json, "%s\n", j.dump().c_str());
+    };
+
+    struct utsname un;
+    uname(&un);
+    char date[64];
+    std::time_t tt = std::time(nullptr);
+    std::strftime(date, sizeof date, "%Y-%m-%d %H:%M UTC", std::gmtime(&tt));
+    std::printf("genz_compare: GSL %s (plain, MISER, VEGAS; mt19937, seeds %llu..%llu) vs mcplay "
+                "run_estimate, one thread\n",
+                GSL_VERSION, (unsigned long long)o.seed,
+                (unsigned long long)(o.seed + uint64_t(o.reps) - 1));
+    std::printf("  N = %llu integrand calls per estimate, R = %d replicates, %s\n",
+                (unsigned long long)o.n, o.reps,
+                from_files ? ("parameters from " + o.params_dir + " (exact values from the files)").c_str()
+                           : ("parameters genz_random(family, d, seed " +
+                              std::to_string(o.param_seed) + "), exact values genz_exact")
+                                 .c_str());
+    std::printf("  %s, %s %s; %s\n", date, un.machine, un.release, o.quick ? "--quick" : "full run");
+    std::printf("  VEGAS: warm-up 10^4 calls (stage 0), then the main run (stage 1) on the trained "
+                "grid; total calls = N (see docs/benchmarks.md)\n");
+    std::fflush(stdout);
+    std::vector<Case> cases = from_files ? file_cases(o) : random_cases(o);
+    if (cases.empty()) usage("no cases to run");
+
+    // mcplay methods whose presets the scene API does not know are skipped, one line each.
+    std::vector<std::string> methods;
+    std::map<std::string, std::string> skipped;
+    for (const std::string& m : o.methods) {
+        Made<SceneRequest> r = build_request(scene_for(cases[0], m, from_files), Json());
+        if (!r.ok()) {
+            std::printf("skipped %s: %s\n", m.c_str(), r.error.c_str());
+            skipped[m] = r.error;
+        } else
+            methods.push_back(m);
+    }
+    std::printf("\n");
+    emit({{"kind", "meta"},
+          {"gsl_version", GSL_VERSION},
+          {"N", o.n},
+          {"R", o.reps},
+          {"seed", o.seed},
+          {"param_seed", from_files ? Json(nullptr) : Json(o.param_seed)},
+          {"params_dir", from_files ? Json(o.params_dir) : Json(nullptr)},
+          {"quick", o.quick},
+          {"date", date},
+          {"machine", std::string(un.machine) + " " + un.release},
+          {"gsl_methods", o.gsl},
+          {"mcplay_methods", methods},
+          {"skipped", skipped}});
+
+    gsl_rng* rng = gsl_rng_alloc(gsl_rng_mt19937);
+    std::vector<CaseResult> results;
+    for (size_t ci = 0; ci < cases.size(); ++ci) {
+        const Case& cs = cases[ci];
+        CaseResult cr;
+        cr.c = &cs;
+        std::fprintf(stderr, "[%5.0f s] case %zu/%zu: %s\n", now_seconds() - t_start, ci + 1,
+                     cases.size(), cs.label.c_str());
+        for (const std::string& g : o.gsl) {
+            Cell cell;
+            cell.method = "gsl_" + g;
+            cell.gsl = true;
+            for (int rep = 0; rep < o.reps; ++rep) {
+                gsl_rng_set(rng, o.seed + uint64_t(rep));
+                cell.reps.push_back(run_gsl(g, cs.params, o.n, rng));
+            }
+            cr.cells.push_back(cell);
+        }
+        for (const std::string& m : methods) {
+            Made<SceneRequest> r = build_request(scene_for(cs, m, from_files), Json());
+            if (!r.ok()) {
+                std::printf("skipped %s on %s: %s\n", m.c_str(), cs.label.c_str(), r.error.c_str());
+                continue;
+            }
+            const SceneRequest& req = r.value;
+            // The scene carries the same parameters GSL integrates (same a, u, same family).
+            const GenzParams& q = req.problem.integrand.genz;
+            if (req.problem.integrand.kind != IntegrandKind::Genz || q.family != cs.params.family ||
+                q.a != cs.params.a || q.u != cs.params.u || req.estimators.size() != 1) {
+                std::fprintf(stderr, "genz_compare: the scene for %s did not reproduce the case\n",
+                             cs.label.c_str());
+                return 1;
+            }
+            Cell cell;
+            cell.method = m;
+            Workspace ws;
+            for (int rep = 0; rep < o.reps; ++rep) {
+                Pcg32 prng(hash_combine(hash_combine(o.seed, ci), uint64_t(rep)),
+                           hash_string(m.c_str()));
+                const double t0 = now_seconds();
+                RunResult rr = run_estimate(req.problem, req.estimators[0], o.n, prng, ws);
+                Estimate e;
+                e.seconds = now_seconds() - t0;
+                e.value = rr.estimate;
+                e.sigma = rr.std_error;
+                e.calls = rr.n;
+                cell.reps.push_back(e);
+            }
+            cr.cells.push_back(cell);
+        }
+        for (Cell& cell : cr.cells) summarize(cell, cs.exact, o.n);
+        cr.best_gsl = best_of(cr.cells, true);
+        cr.best_mcplay = best_of(cr.cells, false);
+        if (cr.best_gsl >= 0 && cr.best_mcplay >= 0)
+            cr.ratio = cr.cells[size_t(cr.best_mcplay)].eff / cr.cells[size_t(cr.best_gsl)].eff;
+
+        // Table for this case.
+        std::printf("== %s: exact %.15e  [%s]\n", cs.label.c_str(), cs.exact, cs.source.c_str());
+        if (from_files)
+            std::printf("   mcplay genz_exact %.15e (relative difference %.1e)\n", cs.mcplay_exact,
+                        (cs.mcplay_exact - cs.exact) / std::fabs(cs.exact));
+        std::printf("   %-16s %9s %9s %8s %6s %9s %9s %7s  %s\n", "method", "rel_rmse", "rel_bias",
+                    "sig/rmse", "cov2", "t_med_s", "eff", "calls/N", "notes");
+        for (const Cell& c : cr.cells) {
+            std::printf("   %-16s %9s %9s %8s %3d/%-2d %9s %9s %7s  %s\n", c.method.c_str(),
+                        fmt_e(c.rel_rmse).c_str(), fmt_f(c.rel_bias, "%+.1e").c_str(),
+                        fmt_f(c.sig_rmse, "%.2f").c_str(), c.cov2, int(c.reps.size()),
+                        fmt_e(c.t_med).c_str(), fmt_e(c.eff, 1).c_str(),
+                        fmt_f(c.calls_frac, "%.4f").c_str(), notes(c).c_str());
+            Json cell = {{"kind", "cell"},
+                         {"case", cs.label},
+                         {"family", cs.family},
+                         {"family_name", kFamilyNames[cs.family - 1]},
+                         {"d", cs.params.dim()},
+                         {"exact", jnum(cs.exact)},
+                         {"method", c.method},
+                         {"tool", c.gsl ? "gsl" : "mcplay"},
+                         {"N", o.n},
+                         {"R", c.reps.size()},
+                         {"rel_rmse", jnum(c.rel_rmse)},
+                         {"rel_bias", jnum(c.rel_bias)},
+                         {"sig_over_rmse", jnum(c.sig_rmse)},
+                         {"cov2", c.cov2},
+                         {"t_med", jnum(c.t_med)},
+                         {"eff", jnum(c.eff)},
+                         {"calls_over_N", jnum(c.calls_frac)},
+                         {"sigma_zero", c.sigma_zero},
+                         {"sigma_nonfinite", c.sigma_nonfinite},
+                         {"estimate_nonfinite", c.est_nonfinite},
+                         {"gsl_status_nonzero", c.bad_status},
+                         {"chi2_dof_median", jnum(c.chi2_med)}};
+            emit(cell);
+            for (size_t rep = 0; rep < c.reps.size(); ++rep) {
+                const Estimate& e = c.reps[rep];
+                emit({{"kind", "estimate"},
+                      {"case", cs.label},
+                      {"method", c.method},
+                      {"rep", rep},
+                      {"estimate", jnum(e.value)},
+                      {"reported_sigma", jnum(e.sigma)},
+                      {"calls", e.calls},
+                      {"seconds", jnum(e.seconds)},
+                      {"chi2_dof", jnum(e.chi2)},
+                      {"status", e.status}});
+            }
+        }
+        if (cr.best_gsl >= 0 && cr.best_mcplay >= 0) {
+            const Cell& g = cr.cells[size_t(cr.best_gsl)];
+            const Cell& m = cr.cells[size_t(cr.best_mcplay)];
+            std::printf("   best GSL %s (eff %s), best mcplay %s (eff %s): mcplay/GSL %s\n\n",
+                        g.method.c_str(), fmt_e(g.eff, 1).c_str(), m.method.c_str(),
+                        fmt_e(m.eff, 1).c_str(), fmt_e(cr.ratio, 1).c_str());
+        } else
+            std::printf("   (no finite efficiency on one side: no comparison)\n\n");
+        emit({{"kind", "case"},
+              {"case", cs.label},
+              {"family", cs.family},
+              {"d", cs.params.dim()},
+              {"best_gsl", cr.best_gsl >= 0 ? Json(cr.cells[size_t(cr.best_gsl)].method) : Json(nullptr)},
+              {"best_mcplay",
+               cr.best_mcplay >= 0 ? Json(cr.cells[size_t(cr.best_mcplay)].method) : Json(nullptr)},
+              {"eff_ratio_mcplay_over_gsl", jnum(cr.ratio)}});
+        std::fflush(stdout);
+        results.push_back(cr);
+    }
+    gsl_rng_free(rng);
+
+    // Summary: best GSL against best mcplay per case.
+    std::printf("== summary: best GSL method vs best mcplay method per case (efficiency 1/(rel_rmse^2 t_med));\n"
+                "   after sig/rmse: '!' over-confident error bars (sig/rmse < 0.5 or cov2 < 70%%), '^' pessimistic "
+                "ones (sig/rmse > 2)\n");
+    std::printf("   %-28s %-12s %9s %8s  %-16s %9s %8s  %10s\n", "case", "best GSL", "eff",
+                "sig/rmse", "best mcplay", "eff", "sig/rmse", "mcplay/GSL");
+    double log_sum = 0.0;
+    int compared = 0, ahead = 0;
+    for (const CaseResult& cr : results) {
+        if (cr.best_gsl < 0 || cr.best_mcplay < 0) {
+            std::printf("   %-28s (no comparison)\n", cr.c->label.c_str());
+            continue;
+        }
+        const Cell& g = cr.cells[size_t(cr.best_gsl)];
+        const Cell& m = cr.cells[size_t(cr.best_mcplay)];
+        std::printf("   %-28s %-12s %9s %7s%s  %-16s %9s %7s%s  %10s\n", cr.c->label.c_str(),
+                    g.method.c_str(), fmt_e(g.eff, 1).c_str(), fmt_f(g.sig_rmse, "%.2f").c_str(),
+                    mark(g), m.method.c_str(), fmt_e(m.eff, 1).c_str(),
+                    fmt_f(m.sig_rmse, "%.2f").c_str(), mark(m),
+                    fmt_e(cr.ratio, 1).c_str());
+        if (std::isfinite(cr.ratio) && cr.ratio > 0) {
+            log_sum += std::log(cr.ratio);
+            ++compared;
+            if (cr.ratio > 1.0) ++ahead;
+        }
+    }
+    const double geomean = compared ? std::exp(log_sum / compared) : kNaN;
+    std::printf("   geometric mean of mcplay/GSL: %s over %d cases; mcplay ahead on %d of %zu\n",
+                fmt_e(geomean, 2).c_str(), compared, ahead, results.size());
+
+    // Error bars that cannot be taken at face value, mcplay's and GSL's.
+    int flagged = 0;
+    for (int pass = 0; pass < 2; ++pass) {
+        std::printf("\n== %s (R = %d: sig/rmse itself is uncertain by about +-%.0f%%)\n",
+                    pass == 0 ? "over-confident error bars: sig/rmse < 0.5 or cov2 < 70%"
+                              : "pessimistic error bars: sig/rmse > 2",
+                    o.reps, 100.0 / std::sqrt(2.0 * o.reps));
+        int listed = 0;
+        for (const CaseResult& cr : results)
+            for (const Cell& c : cr.cells) {
+                if (pass == 0 ? !overconfident(c) : (overconfident(c) || !pessimistic(c))) continue;
+                ++listed;
+                const std::string n = notes(c);
+                std::printf("   %-28s %-16s sig/rmse %s, cov2 %d/%zu, rel_bias %s%s%s\n",
+                            cr.c->label.c_str(), c.method.c_str(), fmt_f(c.sig_rmse, "%.2f").c_str(),
+                            c.cov2, c.reps.size(), fmt_f(c.rel_bias, "%+.1e").c_str(),
+                            n.empty() ? "" : "; ", n.c_str());
+            }
+        if (!listed) std::printf("   none\n");
+        if (pass == 0) flagged = listed;
+    }
+    for (const auto& [m, why] : skipped) std::printf("skipped %s: %s\n", m.c_str(), why.c_str());
+    const double total = now_seconds() - t_start;
+    std::printf("\ntotal wall time %.0f s\n", total);
+    emit({{"kind", "summary"},
+          {"cases", results.size()},
+          {"compared", compared},
+          {"mcplay_ahead", ahead},
+          {"geomean_eff_ratio_mcplay_over_gsl", jnum(geomean)},
+          {"overconfident_cells", flagged},
+          {"seconds", total}});
+    if (json) std::fclose(json);
+    return 0;
+}

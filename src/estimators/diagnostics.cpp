@@ -1,0 +1,146 @@
+#include "estimators/diagnostics.h"
+
+#include <cmath>
+
+namespace mcp {
+
+const char* flag_code_name(FlagCode code) {
+    switch (code) {
+    case FlagCode::NoEstimate: return "no_estimate";
+    case FlagCode::NonfiniteEstimate: return "nonfinite_estimate";
+    case FlagCode::NonfiniteVariance: return "nonfinite_variance";
+    case FlagCode::ZeroErrorBar: return "zero_error_bar";
+    case FlagCode::NonfiniteSamples: return "nonfinite";
+    case FlagCode::ZeroPdfSamples: return "zero_pdf_samples";
+    case FlagCode::DominantSample: return "dominant_sample";
+    case FlagCode::LowEss: return "low_ess";
+    case FlagCode::ExactOutsideCi: return "exact_outside_ci";
+    case FlagCode::HeavyTail: return "heavy_tail";
+    case FlagCode::HeavyTail4: return "heavy_tail_4";
+    case FlagCode::PdfSupport: return "pdf_support";
+    case FlagCode::LevelDrift: return "level_drift";
+    case FlagCode::Float32Accumulator: return "float32_accumulator";
+    }
+    return "?";
+}
+
+std::vector<Flag> level_flags(const LevelStats& l) {
+    std::vector<Flag> flags;
+    auto raise = [&](FlagCode code) -> Flag& {
+        flags.push_back(Flag{});
+        flags.back().code = code;
+        flags.back().n = l.n;
+        return flags.back();
+    };
+    const uint64_t reps = static_cast<uint64_t>(l.reps);
+    // No estimate: one flag, and none of the diagnostics computed from dropped samples.
+    if (l.no_estimate_runs > 0) {
+        Flag& f = raise(FlagCode::NoEstimate);
+        f.count = static_cast<uint64_t>(l.no_estimate_runs);
+        f.of = reps;
+        return flags;
+    }
+    if (!std::isfinite(l.mean))
+        raise(FlagCode::NonfiniteEstimate);
+    else if (!std::isfinite(l.variance) || l.variance < 0.0)
+        raise(FlagCode::NonfiniteVariance).value = l.variance;
+    // A random estimator whose own error bar is 0 while its replicates disagree: the runs saw
+    // no variation (e.g. both points of every stratum on the same side of a discontinuity),
+    // and their intervals are wrong. When every replicate agrees (f/p constant) 0 is right.
+    if (l.zero_error_runs > 0 && l.estimates_spread) {
+        Flag& f = raise(FlagCode::ZeroErrorBar);
+        f.count = static_cast<uint64_t>(l.zero_error_runs);
+        f.of = reps;
+        f.value = std::sqrt(l.variance);
+    }
+    const RunDiagnostics& d = l.diagnostics;
+    if (d.nonfinite) {
+        Flag& f = raise(FlagCode::NonfiniteSamples);
+        f.count = d.nonfinite;
+        f.of = l.n * reps;
+    }
+    if (d.zero_pdf) {
+        Flag& f = raise(FlagCode::ZeroPdfSamples);
+        f.count = d.zero_pdf;
+        f.of = l.n * reps;
+    }
+    // One sample carrying a large share of a big sum: the variance estimate is dominated by
+    // rare large weights (heavy tail, possibly infinite variance).
+    if (l.n >= kDominantSampleMinN && d.max_weight_share > kDominantSampleShare) {
+        Flag& f = raise(FlagCode::DominantSample);
+        f.value = d.max_weight_share;
+        f.threshold = kDominantSampleShare;
+    }
+    // Kish's effective sample size: when a handful of samples carry the sum (a narrow peak
+    // barely hit, a few huge weights), the estimate and its error bar rest on those few.
+    if (l.ess_mean < kLowEss && l.ess_mean < kLowEssShare * static_cast<double>(l.n)) {
+        Flag& f = raise(FlagCode::LowEss);
+        f.value = l.ess_mean;
+        f.threshold = kLowEss;
+    }
+    // With the exact value known: the replicates' mean must lie within a few of its own
+    // standard errors of it, or the estimator is biased or its variance infinite.
+    if (l.has_exact) {
+        const double tolerance = kExactOutsideZ * l.std_error + 1e-12 * std::fabs(l.mean - l.bias);
+        if (std::fabs(l.bias) > tolerance) {
+            Flag& f = raise(FlagCode::ExactOutsideCi);
+            f.value = l.std_error > 0.0 ? std::fabs(l.bias) / l.std_error
+                                        : std::numeric_limits<double>::infinity();
+            f.threshold = kExactOutsideZ;
+            f.of = reps;
+        }
+    }
+    return flags;
+}
+
+std::vector<Flag> tail_flags(const LevelStats& deepest) {
+    std::vector<Flag> flags;
+    if (!std::isfinite(deepest.tail_index) || deepest.tail_k <= 0) return flags;
+    Flag f;
+    f.n = deepest.n;
+    f.value = deepest.tail_index;
+    f.se = deepest.tail_index / std::sqrt(static_cast<double>(deepest.tail_k));
+    f.count = static_cast<uint64_t>(deepest.tail_k);
+    if (f.value < kHeavyTailAlpha + 2.0 * f.se) {
+        f.code = FlagCode::HeavyTail;
+        f.threshold = kHeavyTailAlpha;
+        flags.push_back(f);
+    } else if (f.value < kHeavyTail4Alpha) {
+        f.code = FlagCode::HeavyTail4;
+        f.threshold = kHeavyTail4Alpha;
+        flags.push_back(f);
+    }
+    return flags;
+}
+
+std::vector<Flag> estimator_flags(const EstimatorStudy& e, const StudySettings& settings) {
+    std::vector<Flag> flags;
+    if (!e.levels.empty()) flags = tail_flags(e.levels.back());
+    const SupportCheck& sc = e.support;
+    if (sc.flagged) {
+        Flag f;
+        f.code = FlagCode::PdfSupport;
+        f.value = sc.missed_fraction;
+        f.threshold = kSupportTolerance;
+        f.count = sc.missed;
+        f.of = sc.f_nonzero;
+        flags.push_back(f);
+    }
+    if (e.consistency.dof > 0 && e.consistency.p_value < kLevelDriftP) {
+        Flag f;
+        f.code = FlagCode::LevelDrift;
+        f.value = e.consistency.chi2;
+        f.dof = e.consistency.dof;
+        f.p_value = e.consistency.p_value;
+        f.threshold = kLevelDriftP;
+        flags.push_back(f);
+    }
+    if (settings.accumulator == Accumulator::Float32) {
+        Flag f;
+        f.code = FlagCode::Float32Accumulator;
+        flags.push_back(f);
+    }
+    return flags;
+}
+
+} // namespace mcp

@@ -1,0 +1,71 @@
+// Diagnostics as data: which flags a level or an estimator raises, with the thresholds and the
+// evidence behind each. The study, the renderer, stopping rules and the tests read these; the
+// API only turns them into sentences (src/api/report.cpp).
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "estimators/study.h"
+
+namespace mcp {
+
+enum class FlagCode {
+    NoEstimate,         ///< every sample of some run was NaN/Inf
+    NonfiniteEstimate,  ///< the mean of the replicates overflowed
+    NonfiniteVariance,  ///< the variance across replicates is not a finite number >= 0
+    ZeroErrorBar,       ///< runs reported se = 0 although the replicates differ
+    NonfiniteSamples,   ///< samples with NaN/Inf f/p were dropped (biased)
+    ZeroPdfSamples,     ///< samples with f != 0 where p = 0 were dropped (biased)
+    DominantSample,     ///< one sample carried a large share of a run's sum
+    LowEss,             ///< Kish's effective sample size is a handful
+    ExactOutsideCi,     ///< the replicates' mean misses the exact value
+    HeavyTail,          ///< tail index within 2 standard errors of 2 (or below)
+    HeavyTail4,         ///< tail index below 4
+    PdfSupport,         ///< the pdf is zero where f is not
+    LevelDrift,         ///< the level means disagree beyond their error bars
+    Float32Accumulator, ///< naive single-precision sums (teaching mode)
+};
+
+/// The stable code of a flag in results ("no_estimate", "heavy_tail", ...).
+const char* flag_code_name(FlagCode code);
+
+/// One raised flag and its evidence. Fields a flag does not use stay NaN / 0.
+struct Flag {
+    FlagCode code = FlagCode::NoEstimate;
+    uint64_t n = 0; ///< the level's N (0 for an estimator-wide flag)
+    double value = std::numeric_limits<double>::quiet_NaN();     ///< the statistic
+    double se = std::numeric_limits<double>::quiet_NaN();        ///< its standard error
+    double threshold = std::numeric_limits<double>::quiet_NaN(); ///< what it was compared with
+    uint64_t count = 0, of = 0; ///< e.g. runs or samples concerned, out of how many
+    int dof = 0;                ///< chi-square degrees of freedom (level drift)
+    double p_value = std::numeric_limits<double>::quiet_NaN();
+};
+
+// Thresholds (see the functions' comments for why).
+constexpr uint64_t kDominantSampleMinN = 1024; ///< below this N one sample may carry a lot
+constexpr double kDominantSampleShare = 0.05;  ///< max |w| / sum |w| above this flags
+constexpr double kLowEss = 10.0;               ///< mean ESS below this (and below N/4) flags
+constexpr double kLowEssShare = 0.25;
+constexpr double kExactOutsideZ = 5.0;  ///< |mean - exact| beyond this many standard errors
+constexpr double kLevelDriftP = 1e-3;   ///< chi-square p-value below this flags
+constexpr double kHeavyTailAlpha = 2.0; ///< infinite variance below this tail index
+constexpr double kHeavyTail4Alpha = 4.0;
+
+/// The flags of one level, from its replicates' statistics: no estimate (then nothing else),
+/// a non-finite mean or variance, wrong zero error bars, dropped samples, a dominant sample
+/// (N >= 1024 and a share > 5%), a low effective sample size (< 10 and < N/4), and, with the
+/// exact value known, a mean more than 5 standard errors (+ 1e-12 relative) away from it.
+std::vector<Flag> level_flags(const LevelStats& level);
+
+/// Hill's tail index alpha, P(|x| > t) ~ t^-alpha, read at the deepest level (the pooled sample
+/// reaches furthest into the tail): heavy_tail when alpha = 2 is within two standard errors
+/// (alpha / sqrt(k)) or above alpha, heavy_tail_4 when alpha < 4 [Hill75].
+std::vector<Flag> tail_flags(const LevelStats& deepest);
+
+/// The flags of an estimator over the whole study: the tail index at the deepest level, the
+/// support check, the consistency of the level means (p < 1e-3), float32 accumulation.
+std::vector<Flag> estimator_flags(const EstimatorStudy& e, const StudySettings& settings);
+
+} // namespace mcp

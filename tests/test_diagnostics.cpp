@@ -1,0 +1,82 @@
+// Diagnostics as data (estimators/diagnostics.h): the flags real studies raise, with their
+// evidence, read directly from the core without going through JSON.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <fstream>
+#include <sstream>
+
+#include "api/scene.h"
+#include "estimators/diagnostics.h"
+
+using namespace mcp;
+
+namespace {
+
+StudyResult study(const std::string& scene_name, const Json& options) {
+    std::ifstream in(std::string(MCPLAY_SOURCE_DIR) + "/scenes/" + scene_name + ".json");
+    std::stringstream ss;
+    ss << in.rdbuf();
+    Made<Json> j = parse_json(ss.str().c_str(), scene_name.c_str());
+    EXPECT_TRUE(j.ok()) << j.error;
+    Made<SceneRequest> r = build_request(j.value, options);
+    EXPECT_TRUE(r.ok()) << r.error;
+    return run_study(r.value.problem, r.value.estimators, r.value.settings);
+}
+
+const EstimatorStudy& named(const StudyResult& s, const std::string& name) {
+    for (const EstimatorStudy& e : s.estimators)
+        if (e.spec.name == name) return e;
+    ADD_FAILURE() << "no estimator " << name;
+    return s.estimators.at(0);
+}
+
+bool has(const std::vector<Flag>& flags, FlagCode code) {
+    return std::any_of(flags.begin(), flags.end(), [&](const Flag& f) { return f.code == code; });
+}
+
+} // namespace
+
+// x^-0.9 under uniform sampling has weights with tail index 1/0.9 = 1.11: heavy_tail, with the
+// estimate and its standard error as evidence; the exact importance pdf raises nothing.
+TEST(Diagnostics, HeavyTailCarriesItsEvidence) {
+    StudyResult s = study("singular_power_0.9",
+                          Json{{"n_min", 1024}, {"n_max", 16384}, {"reps", 16}, {"seed", 3}});
+    std::vector<Flag> uniform = estimator_flags(named(s, "uniform"), s.settings);
+    ASSERT_TRUE(has(uniform, FlagCode::HeavyTail));
+    const Flag& tail = uniform.front();
+    EXPECT_EQ(tail.code, FlagCode::HeavyTail);
+    EXPECT_EQ(tail.n, 16384u);
+    EXPECT_GT(tail.count, 0u);                         // Hill's k
+    EXPECT_NEAR(tail.value, 1.0 / 0.9, 4.0 * tail.se); // alpha = 1/0.9 within 4 se
+    EXPECT_EQ(tail.threshold, kHeavyTailAlpha);
+    const EstimatorStudy& exact = named(s, "importance_exact");
+    EXPECT_TRUE(estimator_flags(exact, s.settings).empty());
+    for (const LevelStats& l : exact.levels) EXPECT_TRUE(level_flags(l).empty()) << l.n;
+}
+
+// A bounded smooth integrand: no level flag and no estimator flag for any estimator.
+TEST(Diagnostics, QuietWhereTheAnswerIsFine) {
+    StudyResult s = study("exp_1d", Json{{"n_min", 64}, {"n_max", 4096}, {"reps", 16}});
+    for (const EstimatorStudy& e : s.estimators) {
+        for (const LevelStats& l : e.levels)
+            for (const Flag& f : level_flags(l))
+                ADD_FAILURE() << e.spec.name << " N=" << l.n << ": " << flag_code_name(f.code);
+        for (const Flag& f : estimator_flags(e, s.settings))
+            if (f.code != FlagCode::HeavyTail4) // bounded weights: only a pre-asymptotic note
+                ADD_FAILURE() << e.spec.name << ": " << flag_code_name(f.code);
+    }
+}
+
+// A pdf that is zero where f is not: pdf_support at the estimator level, with the missed share.
+TEST(Diagnostics, ZeroPdfSupportIsAnEstimatorFlag) {
+    StudyResult s = study("is_zero_pdf", Json{{"n_min", 256}, {"n_max", 1024}, {"reps", 8}});
+    bool found = false;
+    for (const EstimatorStudy& e : s.estimators)
+        for (const Flag& f : estimator_flags(e, s.settings))
+            if (f.code == FlagCode::PdfSupport) {
+                found = true;
+                EXPECT_GT(f.value, kSupportTolerance) << e.spec.name;
+            }
+    EXPECT_TRUE(found);
+}
