@@ -147,16 +147,21 @@ int mcp_study_samples(const char* scene_json, const char* options_json, char** s
             for (double x : v) out.push_back(std::isfinite(x) ? mcp::Json(x) : mcp::Json(nullptr));
             return out;
         };
-        estimators.push_back({{"name", spec.name},
-                              {"sampler", mcp::sampler_name(spec.sampler)},
-                              {"pdf", spec.proposal.describe()},
-                              {"strata", d.strata},
-                              {"samples_per_stratum", d.per_stratum},
-                              {"u", axes(d.u, d.sample_dim)},
-                              {"x", axes(d.x, d.point_dim)},
-                              {"f", values(d.f)},
-                              {"density", values(d.pdf)},
-                              {"weight", values(d.weight)}});
+        estimators.push_back(
+            {{"name", spec.name},
+             {"sampler", mcp::sampler_name(spec.sampler)},
+             {"pdf", spec.proposal.describe()},
+             {"strata", d.strata},
+             {"samples_per_stratum", d.per_stratum},
+             {"randomization", mcp::is_qmc(spec.sampler)
+                                   ? mcp::Json(mcp::randomization_name(spec.randomization))
+                                   : mcp::Json(nullptr)},
+             {"randomizations", d.randomizations},
+             {"u", axes(d.u, d.sample_dim)},
+             {"x", axes(d.x, d.point_dim)},
+             {"f", values(d.f)},
+             {"density", values(d.pdf)},
+             {"weight", values(d.weight)}});
     }
     mcp::Json result{{"version", mcp::kResultSchemaVersion},
                      {"n", n},

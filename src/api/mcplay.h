@@ -48,9 +48,10 @@ int mcp_study_plan(const char* scene_json, const char* options_json, char** plan
 /* The points behind a small run of each estimator, for plotting them: options_json may give
  * {"estimators": [names], "n": points (1..4096, default 256), "seed", "grid": 1D curve points
  * (default 256)}. Result: {"version", "n", "estimators": [{"name", "sampler", "pdf", "strata",
- * "samples_per_stratum", "u": [per axis], "x": [per axis], "f", "density", "weight"}], and for 1D
- * box domains "curve": {"x", "f", "pdf": {name: density values}}}. The points are those of
- * replicate 0 of a study at N = n, so the mean of "weight" is that replicate's estimate. */
+ * "samples_per_stratum", "randomization", "randomizations", "u": [per axis], "x": [per axis], "f",
+ * "density", "weight"}], and for 1D box domains "curve": {"x", "f", "pdf": {name: density
+ * values}}}. The points are those of replicate 0 of a study at N = n, so the mean of "weight" is
+ * that replicate's estimate. */
 int mcp_study_samples(const char* scene_json, const char* options_json, char** samples_json);
 
 /* Formats a study result as "table" (human), "csv" or "json" (pretty-printed). The result must

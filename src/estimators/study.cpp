@@ -709,6 +709,7 @@ SampleDump dump_samples(const Problem& problem, const EstimatorSpec& spec, uint6
         make_sampler_plan(spec.sampler, dump.sample_dim, n, rng, spec.sampler_options());
     dump.strata = plan.strata;
     dump.per_stratum = plan.per_stratum;
+    dump.randomizations = plan.batches();
     Workspace ws;
     for_each_block(problem, spec.proposal, plan, rng, ws, [&](const SampleBlock& blk) {
         for (size_t i = 0; i < blk.count; ++i) {

@@ -218,6 +218,7 @@ struct SampleDump {
     std::vector<double> pdf, f, weight;
     std::vector<uint64_t> strata; ///< stratified: cells per axis of the unit cube
     uint64_t per_stratum = 1;
+    size_t randomizations = 0; ///< quasi-Monte Carlo: batches, each its own randomization
 };
 
 /// Runs n samples of replicate 0's stream of the given N level (so the points are those of

@@ -612,6 +612,12 @@ function strataLines(p, cells, axis) {
 
 function strataText(e, d) {
   const s = e.strata || [];
+  if (e.randomizations > 0) {
+    const k = e.randomizations;
+    const n = Array.isArray(e.u) && e.u.length ? e.u[0].length : 0;
+    const how = e.randomization === 'none' ? 'unrandomized' : `${e.randomization} randomization`;
+    return k > 1 ? `${k} randomizations (${how}) of ${Math.round(n / k)} points each` : `one point set (${how})`;
+  }
   if (!s.length) return e.sampler === 'latin_hypercube' ? 'Latin hypercube: one point per row and column' : 'no strata';
   const shown = d > 2 ? `${s.slice(0, 2).join(' × ')} (of ${s.join(' × ')})` : s.join(' × ');
   const per = e.samples_per_stratum > 1 ? `, ${e.samples_per_stratum} points per stratum` : '';

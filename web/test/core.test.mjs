@@ -136,8 +136,11 @@ test('runStudy on exp_1d returns the documented result and reports every level',
     }
     assert.equal(typeof e.fit.order, 'number');
   }
-  // Stratification beats uniform sampling on a smooth 1D integrand.
-  assert.ok(r.estimators[1].fit.order < r.estimators[0].fit.order - 1);
+  // Uniform sampling's variance falls as 1/N, jittered sampling's as N^-3 on a smooth 1D
+  // integrand: each fitted order within 4 of its standard errors (4 replicates: wide).
+  const [uni, strat] = r.estimators.map((e) => e.fit);
+  assert.ok(Math.abs(uni.order + 1) < 4 * uni.order_se, `uniform order ${uni.order} +- ${uni.order_se}`);
+  assert.ok(Math.abs(strat.order + 3) < 4 * strat.order_se, `stratified order ${strat.order} +- ${strat.order_se}`);
 
   assert.equal(seen.length, 5, 'onLevel once per N');
   seen.forEach((level, i) => {
