@@ -44,35 +44,48 @@ void WeightAccumulator::keep_top() {
 void WeightAccumulator::add_block(uint64_t first, const double* f, const double* p, double* w,
                                   size_t count) {
     if (count == 0) return;
+    // One branch-free pass: the weights, sum |w|, max |w|, the non-zero count, and whether any
+    // weight needs the slow path (not finite, or p not > 0).
+    double block_abs = 0.0, block_max = 0.0;
+    uint64_t block_nonzero = 0, suspicious = 0;
     for (size_t i = 0; i < count; ++i) {
-        const double fi = f[i], pi = p[i];
-        double wi = fi / pi;
-        if (!std::isfinite(wi) || !(pi > 0.0)) {
-            // Rare path: classify, count, and drop (contribute 0).
-            if (pi > 0.0 && std::isfinite(pi))
-                ++diagnostics_.nonfinite; // f/p overflow, f NaN/Inf
-            else if (fi == 0.0) {
-            } // 0/0: no mass either side
-            else if (std::isnan(fi) || std::isnan(pi))
-                ++diagnostics_.nonfinite;
-            else
-                ++diagnostics_.zero_pdf; // f != 0 where p = 0
-            wi = 0.0;
-        }
+        const double wi = f[i] / p[i];
+        const double a = std::fabs(wi);
+        suspicious += !(a <= std::numeric_limits<double>::max()) | !(p[i] > 0.0);
         w[i] = wi;
+        block_abs += a;
+        block_max = a > block_max ? a : block_max;
+        block_nonzero += a != 0.0;
+    }
+    if (suspicious) {
+        // Rare path: classify, count and drop (contribute 0) the bad samples, then redo the sums.
+        block_abs = block_max = 0.0;
+        block_nonzero = 0;
+        for (size_t i = 0; i < count; ++i) {
+            const double fi = f[i], pi = p[i];
+            double wi = w[i];
+            if (!std::isfinite(wi) || !(pi > 0.0)) {
+                if (pi > 0.0 && std::isfinite(pi))
+                    ++diagnostics_.nonfinite; // f/p overflow, f NaN/Inf
+                else if (fi == 0.0) {
+                } // 0/0: no mass either side
+                else if (std::isnan(fi) || std::isnan(pi))
+                    ++diagnostics_.nonfinite;
+                else
+                    ++diagnostics_.zero_pdf; // f != 0 where p = 0
+                wi = 0.0;
+            }
+            w[i] = wi;
+            const double a = std::fabs(wi);
+            block_abs += a;
+            block_max = std::fmax(block_max, a);
+            block_nonzero += a != 0.0;
+        }
     }
     if (moments_.count() == 0) first_w_ = w[0];
     moments_.add_block(w, count);
     if (float32_)
         for (size_t i = 0; i < count; ++i) float_sum_ += static_cast<float>(w[i]);
-    double block_abs = 0.0, block_max = 0.0;
-    uint64_t block_nonzero = 0;
-    for (size_t i = 0; i < count; ++i) {
-        const double a = std::fabs(w[i]);
-        block_abs += a;
-        block_max = std::fmax(block_max, a);
-        block_nonzero += a != 0.0;
-    }
     max_abs_ = std::fmax(max_abs_, block_max);
     nonzero_ += block_nonzero;
     abs_sum_.add(block_abs);
