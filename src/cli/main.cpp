@@ -58,6 +58,8 @@ const char* kUsage =
     "  image, cached in --cache DIR (default $MCPLAY_CACHE, else ~/.cache/mcplay).\n"
     "  --width W, --height H  image size (default from the scene)\n"
     "  --cache DIR | --no-cache  where high-spp references are kept\n"
+    "  --pixel-sampler P    independent, stratified or sobol: every estimator's pixel\n"
+    "                       sampler (run and render; sobol needs a power-of-two spp)\n"
     "  render writes one image: --out FILE (.png tone-mapped sRGB, .hdr linear Radiance),\n"
     "  --error-out FILE (false-colour relative error against the reference, PNG),\n"
     "  --estimator NAME (default the scene's first), --spp N (default the scene's spp_max),\n"
@@ -249,6 +251,19 @@ bool parse_count(const std::string& text, unsigned long long* out) {
     return true;
 }
 
+/// --pixel-sampler's value: one of the render API's pixel samplers (the API checks it again).
+bool pixel_sampler_option(const std::string& v, nlohmann::json* options, std::string* error) {
+    static const char* const kKnown[] = {"independent", "stratified", "sobol"};
+    for (const char* k : kKnown)
+        if (v == k) {
+            (*options)["pixel_sampler"] = v;
+            return true;
+        }
+    *error = "--pixel-sampler: unknown pixel sampler '" + v +
+             "' (known: independent, stratified, sobol)";
+    return false;
+}
+
 int cmd_list(const std::vector<std::string>& args) {
     std::string dir_arg;
     for (size_t i = 0; i < args.size(); ++i) {
@@ -409,6 +424,11 @@ int cmd_run(const std::vector<std::string>& args) {
             if (!value(&cache_arg)) return usage_error("--cache needs a directory");
         } else if (a == "--no-cache") {
             no_cache = true;
+        } else if (a == "--pixel-sampler") {
+            if (!value(&v))
+                return usage_error("--pixel-sampler needs independent, stratified or sobol");
+            std::string why;
+            if (!pixel_sampler_option(v, &options, &why)) return usage_error(why);
         } else if (a == "--format") {
             if (!value(&v)) return usage_error("--format needs table, json or csv");
             if (v != "table" && v != "json" && v != "csv")
@@ -435,9 +455,9 @@ int cmd_run(const std::vector<std::string>& args) {
     std::string path, text, error;
     if (!load_scene(scene_arg, dir_arg, &path, &text)) return kExitScene;
     const bool render_scene = is_render_scene_text(text);
-    if (!render_scene &&
-        (options.contains("width") || options.contains("height") || !cache_arg.empty()))
-        return usage_error("--width, --height and --cache are for render scenes");
+    if (!render_scene && (options.contains("width") || options.contains("height") ||
+                          options.contains("pixel_sampler") || !cache_arg.empty()))
+        return usage_error("--width, --height, --cache and --pixel-sampler are for render scenes");
     OutputFile out_file{out_path};
     if (!out_file.check(&error)) return usage_error("--out: " + error);
 
@@ -517,6 +537,11 @@ int cmd_render(const std::vector<std::string>& args) {
         } else if (a == "--estimator") {
             if (!value(&v)) return usage_error("--estimator needs a name");
             options["estimator"] = v;
+        } else if (a == "--pixel-sampler") {
+            if (!value(&v))
+                return usage_error("--pixel-sampler needs independent, stratified or sobol");
+            std::string why;
+            if (!pixel_sampler_option(v, &options, &why)) return usage_error(why);
         } else if (a == "--out") {
             if (!value(&out_path)) return usage_error("--out needs a file name");
         } else if (a == "--error-out") {

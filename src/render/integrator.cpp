@@ -106,9 +106,8 @@ Ray spawn_ray(const ShadingPoint& sp, const Vec3& direction) {
 Vec3 light_sample_term(const RenderScene& rs, const LightSet& lights, LightSampling mode,
                        const ShadingPoint& sp, PixelSampler& sampler, SampleCounters& c, bool mis,
                        bool power) {
-    double u_select = sampler.get_1d();
-    Vec2 u = sampler.get_2d();
-    LightSample ls = lights.sample(sp.p, u_select, u, mode);
+    ChoiceSample cs = sampler.get_choice_2d();
+    LightSample ls = lights.sample(sp.p, cs.choice, cs.u, mode);
     if (!ls.valid || !(ls.pdf > 0.0)) {
         ++c.light_misses;
         return Vec3(0.0);
@@ -171,9 +170,8 @@ Vec3 direction_sample_term(const RenderScene& rs, const RenderEstimator& est,
         break;
     }
     default: {
-        double u_lobe = sampler.get_1d();
-        Vec2 u = sampler.get_2d();
-        BsdfSample bs = bsdf_sample(sp.bsdf, sp.wo_local, u_lobe, u);
+        ChoiceSample cs = sampler.get_choice_2d();
+        BsdfSample bs = bsdf_sample(sp.bsdf, sp.wo_local, cs.choice, cs.u);
         if (!bs.valid || !(bs.pdf > 0.0)) return Vec3(0.0);
         wi_local = bs.wi;
         f = bs.f;
@@ -276,9 +274,8 @@ RadianceSample path_radiance(const RenderScene& rs, const RenderEstimator& est,
         if (!lights.empty())
             L += beta *
                  light_sample_term(rs, lights, est.light_sampling, sp, sampler, c, true, true);
-        double u_lobe = sampler.get_1d();
-        Vec2 u = sampler.get_2d();
-        BsdfSample bs = bsdf_sample(sp.bsdf, sp.wo_local, u_lobe, u);
+        ChoiceSample cs = sampler.get_choice_2d();
+        BsdfSample bs = bsdf_sample(sp.bsdf, sp.wo_local, cs.choice, cs.u);
         if (!bs.valid || !(bs.pdf > 0.0) || is_black(bs.f)) break;
         Vec3 wi = sp.frame.to_world(bs.wi);
         if (glm::dot(wi, sp.ng) <= 0.0) break;
@@ -289,7 +286,8 @@ RadianceSample path_radiance(const RenderScene& rs, const RenderEstimator& est,
         ray = spawn_ray(sp, wi);
         if (depth + 1 >= est.rr_depth) {
             double q = std::min(0.95, std::max(beta.x, std::max(beta.y, beta.z)));
-            if (!(q > 0.0) || sampler.rng().next_double() >= q) break;
+            // The roulette's number is a sample dimension like any other.
+            if (!(q > 0.0) || sampler.get_1d() >= q) break;
             beta /= q;
         }
     }

@@ -53,6 +53,8 @@ struct RenderEstimator {
     LightSelection light_selection = LightSelection::Power;
     /// How light samples are drawn in mis_* and path (light_area / light_solid_angle fix it).
     LightSampling light_sampling = LightSampling::SolidAngle;
+    /// Where every number of a sample comes from (camera jitter, light selection and
+    /// sampling, BSDF sampling, Russian roulette): pixel_sampler.h.
     PixelSamplerKind pixel_sampler = PixelSamplerKind::Stratified;
     int max_depth = 5; ///< path: bounces (1 = direct lighting only)
     int rr_depth = 3;  ///< path: Russian roulette from this bounce on

@@ -1,40 +1,153 @@
-// Sample values for one pixel's samples: independent uniforms, or stratified ones where every
-// 1D and 2D dimension of the path is stratified over the pixel's spp samples on its own and
-// the strata of different dimensions are paired by keyed random permutations ("padding", as
-// in pbrt's stratified sampler [PBR4, 8.5]; the permutations are those of
-// the core's Latin hypercube sampler [Kensler13]).
+// Sample values for one pixel's samples, addressed by (pixel, sample index, dimension):
+//
+// - independent: independent uniforms from the pixel's own PCG32 stream.
+// - stratified: every 1D and 2D dimension of the path is stratified over the pixel's spp
+//   samples on its own and the strata of different dimensions are paired by keyed random
+//   permutations ("padding", as in pbrt's stratified sampler [PBR4, 8.5]; the permutations
+//   are those of the core's Latin hypercube sampler [Kensler13]).
+// - sobol: Owen-scrambled Sobol' points with the pixels decorrelated by a randomly permuted
+//   Morton (Z) order of the image, so that neighbouring pixels get complementary points and
+//   the error is spread as blue noise [AhmedWonka20; PBR4, 8.7]. Written from the papers'
+//   description:
+//     * every request (a 1D or 2D draw) is a "dimension" d of the sample; its key is a hash of
+//       the image's key (seed, estimator, spp, replicate) and d, the same for every pixel;
+//     * the sample's global index is I = morton(x, y) spp + i, with the Morton grid rounded
+//       up to a power of two at least as large as the image's larger side, i the sample index
+//       (spp must be a power of two, so I's bits are the Morton bits then the sample bits),
+//       both permuted per dimension:
+//     * the base-4 digits of the Morton index (from the top) go through random permutations
+//       of {0, 1, 2, 3} chosen by a hash of the dimension's key, the digit's position and the
+//       digits above it (a nested random permutation, so a bijection of the pixels' blocks of
+//       indices): the quadrants of every level of the image's quadtree are shuffled, and the
+//       4^k pixels of an aligned 2^k x 2^k square always share an aligned block of 4^k spp
+//       consecutive indices, whose points form a net together [AhmedWonka20]. The sample
+//       index goes through a keyed random permutation of [0, spp) (keyed by the dimension and
+//       the pixel), so that a pixel's samples of different requests are paired at random
+//       ("padding"; pbrt permutes these base-4 digits too, which pairs them less randomly:
+//       balanced within every group of 4 samples);
+//     * the Sobol' point of that index (Gray-code order, sobol_u32) in Sobol' dimension 0 for
+//       a 1D request, dimensions 0 and 1 for a 2D request: (0, 2)-sequence, so the spp points of
+//       a pixel in one 2D request form a (0, m, 2)-net (each elementary interval of area 1/spp
+//       holds exactly one point) [Sobol67; JoeKuo08]. A discrete choice and the 2D sample it
+//       conditions (get_choice_2d: a light and a point on it, a BSDF lobe and a direction)
+//       take dimensions 0, 1 for the point and 2 for the choice of one index, so that the
+//       samples making one choice keep stratified points;
+//     * nested uniform (Owen) scrambling of the 32 digits with a seed per dimension (a hash of
+//       the dimension's key) [Owen95; owen_scramble_u32], then 21 more bits hashed from the
+//       scrambled digits, 53 random bits per value in (0, 1) (bits53_to_unit).
+//   Indices beyond 32 bits (images and spp so large that 2 log2(side) + log2(spp) > 32) keep
+//   their low 32 bits for the Sobol' point and fold the rest into the scrambling seed: each
+//   block of 2^32 indices is an independently scrambled copy of the sequence.
+//
+// Everything here is integer hashing (the independent and stratified kinds add IEEE
+// arithmetic on exact values): the same numbers natively and in wasm, for any thread count.
+// No allocation per pixel or sample (configure allocates once per image), no virtual calls.
 #pragma once
 
 #include <cstdint>
+#include <string>
+#include <vector>
 
+#include "core/qmc.h"
 #include "core/rng.h"
 #include "core/samplers.h"
 #include "core/warps.h"
 
 namespace mcp {
 
-enum class PixelSamplerKind { Independent, Stratified };
+enum class PixelSamplerKind { Independent, Stratified, Sobol };
+
+/// "independent", "stratified", "sobol".
+const char* pixel_sampler_name(PixelSamplerKind kind);
+/// Every kind's name, in the enum's order.
+std::vector<std::string> pixel_sampler_names();
+bool parse_pixel_sampler(const std::string& name, PixelSamplerKind* kind);
+/// "" when the sampler can take `spp` samples per pixel, else why not (the Sobol' sampler
+/// needs a power of two, so that a pixel's samples are a whole net: "the 'sobol' pixel
+/// sampler needs a power-of-two spp, got 3 (the nearest are 2 and 4)").
+std::string check_pixel_sampler_spp(PixelSamplerKind kind, uint64_t spp);
+
+namespace pixel_sampler_detail {
+
+/// The 24 permutations of {0, 1, 2, 3}, each packed as four 2-bit images (entry j at bits
+/// 2j, 2j + 1), in lexicographic order.
+struct Perm4Table {
+    uint8_t p[24] = {};
+    constexpr Perm4Table() {
+        int n = 0;
+        for (int a = 0; a < 4; ++a)
+            for (int b = 0; b < 4; ++b)
+                for (int c = 0; c < 4; ++c)
+                    for (int d = 0; d < 4; ++d)
+                        if (a != b && a != c && a != d && b != c && b != d && c != d)
+                            p[n++] = uint8_t(a | (b << 2) | (c << 4) | (d << 6));
+    }
+};
+inline constexpr Perm4Table kPerm4{};
+
+/// Bits x0 y0 x1 y1 ... of the 16-bit coordinates interleaved (x in the even bits).
+inline uint64_t morton2(uint32_t x, uint32_t y) {
+    auto spread = [](uint64_t v) {
+        v &= 0xffffu;
+        v = (v | (v << 8)) & 0x00ff00ffu;
+        v = (v | (v << 4)) & 0x0f0f0f0fu;
+        v = (v | (v << 2)) & 0x33333333u;
+        v = (v | (v << 1)) & 0x55555555u;
+        return v;
+    };
+    return spread(x) | (spread(y) << 1);
+}
+
+/// Smallest k with 2^k >= n (0 for n <= 1).
+inline int ceil_log2(uint64_t n) {
+    int k = 0;
+    while (k < 63 && (uint64_t(1) << k) < n) ++k;
+    return k;
+}
+
+} // namespace pixel_sampler_detail
+
+struct ChoiceSample {
+    double choice = 0.5;
+    Vec2 u{0.5};
+};
 
 class PixelSampler {
   public:
-    /// Dimensions past this many per sample are independent (a path's deep bounces gain
-    /// little from stratification).
+    /// Dimensions past this many per sample are independent in the stratified sampler (a
+    /// path's deep bounces gain little from stratification). The Sobol' sampler has no limit.
     static constexpr int kStratifiedDimensions = 32;
 
-    /// Plans a pixel of `spp` samples; allocation happens here (once per image), not per pixel.
-    void configure(PixelSamplerKind kind, uint64_t spp) {
+    /// Plans an image of width x height pixels of `spp` samples, keyed by `image_key` (the
+    /// image's stream); allocation happens here (once per image), not per pixel. The Sobol'
+    /// sampler expects a power-of-two spp (check_pixel_sampler_spp; the render API refuses
+    /// others): given another, a pixel takes the first spp indices of a block of the next
+    /// power of two (still unbiased, but not a net). Sides up to 65536 pixels, spp up to 2^32.
+    void configure(PixelSamplerKind kind, uint64_t spp, int width, int height, uint64_t image_key) {
+        using namespace pixel_sampler_detail;
         kind_ = kind;
         spp_ = spp;
+        width_ = width > 0 ? uint64_t(width) : 1;
+        image_key_ = image_key;
         auto grid = stratification_grid(spp, 2);
         grid_x_ = grid[0];
         grid_y_ = grid[1];
+        int side = width > height ? width : height;
+        sample_bits_ = ceil_log2(spp);
+        if (sample_bits_ > 32) sample_bits_ = 32;
+        morton_bits_ = 2 * ceil_log2(uint64_t(side > 1 ? side : 1));
+        if (morton_bits_ > 32) morton_bits_ = 32;
     }
 
-    /// Starts pixel `pixel_key` (a hash of the image's stream and the pixel) with its own PCG32
-    /// stream; the stream also keys the stratum permutations.
-    void start_pixel(uint64_t pixel_key) {
-        key_ = pixel_key;
-        rng_.set_seed(mix64(pixel_key), pixel_key);
+    /// Starts pixel (x, y). The independent and stratified samplers give it its own PCG32
+    /// stream keyed by a hash of the image's key and the pixel number (the stream also keys
+    /// the stratum permutations); the Sobol' sampler keeps its Morton index.
+    void start_pixel(int x, int y) {
+        key_ = hash_combine(image_key_, uint64_t(y) * width_ + uint64_t(x));
+        if (kind_ == PixelSamplerKind::Sobol)
+            morton_ = pixel_sampler_detail::morton2(uint32_t(x), uint32_t(y));
+        else
+            rng_.set_seed(mix64(key_), key_);
     }
 
     void start_sample(uint64_t index) {
@@ -44,6 +157,11 @@ class PixelSampler {
 
     double get_1d() {
         int d = dimension_++;
+        if (kind_ == PixelSamplerKind::Sobol) {
+            uint64_t seeds = 0;
+            uint32_t index = sobol_index(d, &seeds);
+            return sobol_value(index, 0, seeds);
+        }
         if (kind_ == PixelSamplerKind::Independent || d >= kStratifiedDimensions || spp_ <= 1)
             return rng_.next_double();
         uint64_t stratum = permute_index(index_, spp_, hash_combine(key_, uint64_t(d)));
@@ -56,6 +174,13 @@ class PixelSampler {
     Vec2 get_2d() {
         int d = dimension_;
         dimension_ += 2;
+        if (kind_ == PixelSamplerKind::Sobol) {
+            uint64_t seeds = 0;
+            uint32_t index = sobol_index(d, &seeds);
+            double u0 = sobol_value(index, 0, seeds);
+            double u1 = sobol_value(index, 1, seeds);
+            return Vec2(u0, u1);
+        }
         double u0 = rng_.next_double();
         double u1 = rng_.next_double();
         if (kind_ == PixelSamplerKind::Independent || d >= kStratifiedDimensions || spp_ <= 1)
@@ -66,15 +191,83 @@ class PixelSampler {
                     clamp_open((static_cast<double>(cy) + u1) / static_cast<double>(grid_y_)));
     }
 
-    /// The raw generator, for choices that are not sample dimensions (Russian roulette).
-    Pcg32& rng() { return rng_; }
+    /// A discrete choice and the 2D sample it conditions (a light and a point on it, a BSDF
+    /// lobe and a direction), drawn together. The independent and stratified samplers draw
+    /// them as get_1d() then get_2d(); the Sobol' sampler takes Sobol' dimensions 0 and 1 of
+    /// one index for the point and dimension 2 for the choice, so that the samples making
+    /// each choice still have stratified points (the first three Sobol' dimensions form a
+    /// (1, 3)-sequence: the half of a pixel's 2^m points with the choice below 1/2 is a
+    /// (1, m - 1, 2)-net in the other two) instead of a random subset of them.
+    ChoiceSample get_choice_2d() {
+        if (kind_ != PixelSamplerKind::Sobol) {
+            ChoiceSample c;
+            c.choice = get_1d();
+            c.u = get_2d();
+            return c;
+        }
+        int d = dimension_;
+        dimension_ += 3;
+        uint64_t seeds = 0;
+        uint32_t index = sobol_index(d, &seeds);
+        ChoiceSample c;
+        double u0 = sobol_value(index, 0, seeds);
+        double u1 = sobol_value(index, 1, seeds);
+        c.u = Vec2(u0, u1);
+        c.choice = sobol_value(index, 2, seeds);
+        return c;
+    }
 
   private:
     static double clamp_open(double u) { return u < 1.0 ? u : 0x1.fffffffffffffp-1; }
 
+    /// The permuted global index of the current sample in the dimension keyed by dim_key:
+    /// the Morton index with its base-4 digits through a nested random permutation (each
+    /// digit's permutation keyed by the dimension, the digit's position and the original
+    /// digits above it: a bijection that keeps aligned quads of pixels on aligned blocks of
+    /// indices), times 2^sample_bits, plus the sample index through a keyed random permutation
+    /// of [0, spp) (keyed by the dimension and the pixel: requests are paired at random
+    /// within the pixel, as for the stratified sampler).
+    uint64_t permuted_index(uint64_t dim_key) const {
+        using pixel_sampler_detail::kPerm4;
+        uint64_t morton = 0;
+        for (int shift = morton_bits_ - 2; shift >= 0; shift -= 2) {
+            const uint64_t higher = morton_ >> (shift + 2);
+            const uint64_t h = mix64(dim_key ^ ((higher << 6) | uint64_t(shift)));
+            const uint32_t p = uint32_t((uint64_t(uint32_t(h >> 32)) * 24u) >> 32);
+            const uint32_t digit = uint32_t(morton_ >> shift) & 3u;
+            morton |= uint64_t((kPerm4.p[p] >> (2 * digit)) & 3u) << shift;
+        }
+        const uint64_t sample = index_ < spp_
+                                    ? permute_index(index_, spp_, hash_combine(dim_key, morton_))
+                                    : index_ & ((uint64_t(1) << sample_bits_) - 1);
+        return (morton << sample_bits_) | sample;
+    }
+
+    /// Dimension d's Sobol' index (low 32 bits of the permuted index) and its 64-bit seed
+    /// word (two 32-bit scrambling seeds, keyed by the image, d and the index's bits above 32).
+    uint32_t sobol_index(int d, uint64_t* seeds) const {
+        const uint64_t dim_key = hash_combine(image_key_, uint64_t(d));
+        const uint64_t p = permuted_index(dim_key);
+        *seeds = hash_combine(dim_key ^ 0x6f77656e5365656eULL, p >> 32); // "owenSeen"
+        return uint32_t(p);
+    }
+
+    /// Sobol' coordinate `sobol_dim` (0, 1 or 2) of point `index`, Owen-scrambled with a
+    /// 32-bit seed from `seeds` (its low half, its high half, a hash of it), with 21 fill bits
+    /// hashed from the scrambled digits and the coordinate: a value in (0, 1).
+    static double sobol_value(uint32_t index, int sobol_dim, uint64_t seeds) {
+        const uint32_t seed =
+            sobol_dim < 2 ? uint32_t(seeds >> (32 * sobol_dim)) : uint32_t(mix64(seeds));
+        const uint32_t v = owen_scramble_u32(sobol_u32(index, sobol_dim), seed);
+        const uint64_t fill = mix64(seeds ^ ((uint64_t(v) << 2) | uint64_t(sobol_dim))) >> 43;
+        return bits53_to_unit((uint64_t(v) << 21) | fill);
+    }
+
     PixelSamplerKind kind_ = PixelSamplerKind::Independent;
     uint64_t spp_ = 1, grid_x_ = 1, grid_y_ = 1;
-    uint64_t key_ = 0, index_ = 0;
+    uint64_t width_ = 1, image_key_ = 0;
+    uint64_t key_ = 0, index_ = 0, morton_ = 0;
+    int sample_bits_ = 0, morton_bits_ = 0;
     int dimension_ = 0;
     Pcg32 rng_;
 };

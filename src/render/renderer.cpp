@@ -28,12 +28,12 @@ void push_top(std::vector<double>& heap, double x) {
 void render_rows(const RenderScene& rs, const RenderEstimator& est, const RenderSettings& st,
                  int first_row, int step, RenderImage& image, RenderDiagnostics& diag) {
     PixelSampler sampler;
-    sampler.configure(est.pixel_sampler, st.spp);
+    sampler.configure(est.pixel_sampler, st.spp, st.width, st.height, st.stream);
     for (int y = first_row; y < st.height; y += step) {
         if (st.cancel && st.cancel->load(std::memory_order_relaxed)) return;
         for (int x = 0; x < st.width; ++x) {
             size_t pixel = size_t(y) * size_t(st.width) + size_t(x);
-            sampler.start_pixel(hash_combine(st.stream, pixel));
+            sampler.start_pixel(x, y);
             // Welford moments per channel [Welford62]; samples are few enough per pixel
             // that plain double sums of them are exact to far below their noise.
             Vec3 mean(0.0), m2(0.0);

@@ -1,6 +1,7 @@
-// Renders an image with one radiance estimator: spp samples per pixel, each pixel from its
-// own random stream (so images are identical for any thread count), with per-pixel means,
-// variances of the means, and the sample-level diagnostics of the integration estimators.
+// Renders an image with one radiance estimator: spp samples per pixel, each pixel's numbers
+// addressed by (image stream, pixel, sample, dimension) through its pixel sampler (so images
+// are identical for any thread count), with per-pixel means, variances of the means, and the
+// sample-level diagnostics of the integration estimators.
 #pragma once
 
 #include <atomic>
@@ -13,7 +14,7 @@ namespace mcp {
 
 struct RenderSettings {
     int width = 64, height = 64;
-    uint64_t spp = 16;
+    uint64_t spp = 16;   ///< a power of two for the Sobol' pixel sampler (check_pixel_sampler_spp)
     uint64_t stream = 1; ///< keys every pixel's random stream (seed, estimator, spp, replicate)
     int threads = 1;     ///< worker threads (1 where the build has none)
     bool jitter_pixels = true; ///< false: every sample's camera ray passes through the pixel centre

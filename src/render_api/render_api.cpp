@@ -43,8 +43,7 @@ Json estimator_to_json(const RenderEstimator& e) {
            {"strategy", strategy_name(e.strategy)},
            {"light_selection", selection_name(e.light_selection)},
            {"light_sampling", e.light_sampling == LightSampling::Area ? "area" : "solid_angle"},
-           {"pixel_sampler",
-            e.pixel_sampler == PixelSamplerKind::Stratified ? "stratified" : "independent"}};
+           {"pixel_sampler", pixel_sampler_name(e.pixel_sampler)}};
     if (e.strategy == RadianceStrategy::Path) {
         j["max_depth"] = e.max_depth;
         j["rr_depth"] = e.rr_depth;
@@ -415,11 +414,24 @@ int mcp_render_image(const char* scene_json, const char* options_json, char** re
             est = m.value;
         }
     }
+    // options.pixel_sampler (checked when the request was built) overrides the estimator's,
+    // as it does every estimator of a study.
+    if (auto it = options.find("pixel_sampler"); it != options.end() && it->is_string())
+        parse_pixel_sampler(it->get<std::string>(), &est.pixel_sampler);
     uint64_t spp = r.settings.spp_max;
+    const bool spp_given = options.find("spp") != options.end();
     if (auto it = options.find("spp"); it != options.end()) {
         if (!it->is_number_integer() || it->get<int64_t>() < 1 || it->get<int64_t>() > (1 << 20))
             return fail(MCP_ERROR_ARGUMENT, "options.spp: expected a whole number in 1..1048576");
         spp = uint64_t(it->get<int64_t>());
+    }
+    // Never a silent change of method: a spp the pixel sampler cannot take is an error.
+    if (std::string why = check_pixel_sampler_spp(est.pixel_sampler, spp); !why.empty()) {
+        if (spp_given) return fail(MCP_ERROR_ARGUMENT, "options.spp: " + why);
+        const bool from_options = options.find("spp_max") != options.end();
+        return fail(from_options ? MCP_ERROR_ARGUMENT : MCP_ERROR_SCENE,
+                    std::string(from_options ? "options" : "scene.render") + ".spp_max: " + why +
+                        " (an image is rendered at spp_max unless spp is given)");
     }
     bool png = true, hdr = false, error_png = false;
     if (auto it = options.find("outputs"); it != options.end()) {

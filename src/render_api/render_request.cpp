@@ -72,7 +72,7 @@ bool parse_estimator(Ctx& c, const Json& j, const std::string& path, RenderEstim
     if (!parse_enum(c, j, "light_sampling", path, {"area", "solid_angle"}, &v)) return false;
     e.light_sampling = LightSampling(v);
     v = int(e.pixel_sampler);
-    if (!parse_enum(c, j, "pixel_sampler", path, {"independent", "stratified"}, &v)) return false;
+    if (!parse_enum(c, j, "pixel_sampler", path, pixel_sampler_names(), &v)) return false;
     e.pixel_sampler = PixelSamplerKind(v);
     uint64_t depth = uint64_t(e.max_depth), rr = uint64_t(e.rr_depth);
     if (!get_count(c, j, "max_depth", path, &depth) || !get_count(c, j, "rr_depth", path, &rr))
@@ -215,7 +215,7 @@ Made<std::shared_ptr<RenderRequest>> build_render_request(const Json& scene, con
     if (!check_keys(c, opts, "options",
                     {"base_dir", "cache_dir", "width", "height", "spp_min", "spp_max", "reps",
                      "seed", "threads", "estimators", "reference", "jitter_pixels", "exposure",
-                     "accel", "estimator", "spp", "outputs", "previews"}))
+                     "accel", "estimator", "spp", "outputs", "previews", "pixel_sampler"}))
         return error();
     std::string base_dir = ".";
     if (!get_string(c, opts, "base_dir", "options", &base_dir) ||
@@ -314,6 +314,14 @@ Made<std::shared_ptr<RenderRequest>> build_render_request(const Json& scene, con
         }
         r->estimators = chosen;
     }
+    // options.pixel_sampler (mcplay's --pixel-sampler): every estimator's pixel sampler, not
+    // the reference's (the reference is the study's fixed target).
+    if (find(opts, "pixel_sampler")) {
+        int v = 0;
+        if (!parse_enum(c, opts, "pixel_sampler", "options", pixel_sampler_names(), &v))
+            return error();
+        for (RenderEstimator& e : r->estimators) e.pixel_sampler = PixelSamplerKind(v);
+    }
 
     // The reference: by default the power-heuristic MIS estimator of the same quantity.
     const RenderEstimator& first = r->estimators.front();
@@ -327,14 +335,31 @@ Made<std::shared_ptr<RenderRequest>> build_render_request(const Json& scene, con
     // Reference files: the glTF's extras name them relative to the glTF, the scene and the
     // options relative to the scene's folder.
     const std::string gltf_dir = r->gltf_path.empty() ? root : dirname_of(r->gltf_path);
-    if (const Json* ref = find(extras, "reference"))
+    // Where the reference's spp was last set, for the Sobol' sampler's power-of-two check.
+    std::string ref_spp_field;
+    if (const Json* ref = find(extras, "reference")) {
         if (!parse_reference(c, *ref, ep + ".reference", root, gltf_dir, &r->reference))
             return error();
-    if (const Json* ref = find(render, "reference"))
+        if (find(*ref, "spp")) ref_spp_field = ep + ".reference.spp";
+    }
+    if (const Json* ref = find(render, "reference")) {
         if (!parse_reference(c, *ref, rp + ".reference", root, root, &r->reference)) return error();
+        if (find(*ref, "spp")) ref_spp_field = rp + ".reference.spp";
+    }
     // The caller's options are not scene text: their file may lie anywhere.
-    if (const Json* ref = find(opts, "reference"))
+    if (const Json* ref = find(opts, "reference")) {
         if (!parse_reference(c, *ref, "options.reference", "", root, &r->reference)) return error();
+        if (find(*ref, "spp")) ref_spp_field = "options.reference.spp";
+    }
+    if (r->reference.file.empty()) {
+        std::string why =
+            check_pixel_sampler_spp(r->reference.estimator.pixel_sampler, r->reference.spp);
+        if (!why.empty())
+            return made_error<std::shared_ptr<RenderRequest>>(
+                (ref_spp_field.empty() ? rp + ".reference.spp" : ref_spp_field) + ": " + why +
+                (ref_spp_field.empty() ? " (the default, max(256, 16 x spp_max))" : "") +
+                " for the reference's estimator");
+    }
     for (const RenderEstimator& e : r->estimators)
         if (quantity_of(e) != quantity_of(r->estimators.front()))
             return made_error<std::shared_ptr<RenderRequest>>(
