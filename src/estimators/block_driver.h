@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <memory>
 
 #include "core/samplers.h"
 #include "estimators/accumulator.h"
@@ -18,7 +19,6 @@ namespace mcp {
 struct Workspace {
     PointBlock u, x;
     std::vector<double> pdf, f;
-    WeightAccumulator accumulator;
 };
 
 /// One block of samples: unit-cube points u, domain points x, densities pdf, values f.
@@ -34,8 +34,13 @@ struct SampleBlock {
 /// Sizes the workspace's buffers for a domain (no allocation when they already fit).
 void prepare_workspace(const Domain& domain, Workspace& ws);
 
+/// Samples first .. first + count - 1 of the plan (count <= kBlockSize; the workspace prepared
+/// for the domain): generate -> warp -> evaluate. Randomness is drawn from rng in order.
+SampleBlock sample_block(const Problem& problem, const Proposal& proposal, const SamplerPlan& plan,
+                         uint64_t first, size_t count, Pcg32& rng, Workspace& ws);
+
 /// Samples 0 .. plan.total - 1 of the plan, block by block, calling consume(const SampleBlock&)
-/// for each. Randomness (jitter, independent points) is drawn from rng in order.
+/// for each.
 template <class Consume>
 void for_each_block(const Problem& problem, const Proposal& proposal, const SamplerPlan& plan,
                     Pcg32& rng, Workspace& ws, Consume&& consume) {
@@ -43,18 +48,28 @@ void for_each_block(const Problem& problem, const Proposal& proposal, const Samp
     const uint64_t n = plan.total;
     for (uint64_t first = 0; first < n; first += kBlockSize) {
         const size_t count = static_cast<size_t>(std::min<uint64_t>(kBlockSize, n - first));
-        generate_block(plan, first, count, rng, ws.u);
-        warp_block(proposal, problem.domain, ws.u, ws.x, ws.pdf.data());
-        evaluate_block(problem.integrand, ws.x, ws.f.data());
-        SampleBlock block;
-        block.first = first;
-        block.count = count;
-        block.u = &ws.u;
-        block.x = &ws.x;
-        block.pdf = ws.pdf.data();
-        block.f = ws.f.data();
-        consume(static_cast<const SampleBlock&>(block));
+        consume(static_cast<const SampleBlock&>(
+            sample_block(problem, proposal, plan, first, count, rng, ws)));
     }
 }
+
+/// An estimator as an algorithm: it plans a run, consumes it block by block, and gives the
+/// run's result. Fixed estimators (a sampler and one proposal) are one implementation; adaptive
+/// ones (which change their proposal between blocks or iterations), multi-proposal ones and
+/// sequential ones (stopping at a tolerance) are others. Calls are per block, never per sample.
+class EstimatorAlgorithm {
+  public:
+    virtual ~EstimatorAlgorithm() = default;
+    /// Starts a run of n samples; the run's randomization is drawn from rng.
+    virtual void begin(uint64_t n, Pcg32& rng) = 0;
+    /// Samples and weighs the next block; false when the run is complete (nothing was done).
+    virtual bool run_block(Pcg32& rng, Workspace& ws) = 0;
+    /// The completed run (estimate, error bar, diagnostics; not its time).
+    virtual RunResult result() const = 0;
+};
+
+/// The algorithm of an estimator spec (today: every spec is a fixed estimator).
+std::unique_ptr<EstimatorAlgorithm>
+make_estimator(const Problem& problem, const EstimatorSpec& spec, Accumulator accumulator);
 
 } // namespace mcp

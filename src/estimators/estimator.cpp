@@ -79,19 +79,85 @@ void prepare_workspace(const Domain& domain, Workspace& ws) {
     ws.f.resize(kBlockSize);
 }
 
+SampleBlock sample_block(const Problem& problem, const Proposal& proposal, const SamplerPlan& plan,
+                         uint64_t first, size_t count, Pcg32& rng, Workspace& ws) {
+    generate_block(plan, first, count, rng, ws.u);
+    warp_block(proposal, problem.domain, ws.u, ws.x, ws.pdf.data());
+    evaluate_block(problem.integrand, ws.x, ws.f.data());
+    SampleBlock block;
+    block.first = first;
+    block.count = count;
+    block.u = &ws.u;
+    block.x = &ws.x;
+    block.pdf = ws.pdf.data();
+    block.f = ws.f.data();
+    return block;
+}
+
+namespace {
+
+// A fixed estimator: N points from one sampler, warped by one proposal, weighted f/p and summed
+// by the weight accumulator: I_N = (1/N) sum f(x_i) / p(x_i).
+class FixedEstimator final : public EstimatorAlgorithm {
+  public:
+    FixedEstimator(const Problem& problem, const EstimatorSpec& spec, Accumulator accumulator)
+        : problem_(problem), spec_(spec), float32_(accumulator == Accumulator::Float32) {}
+
+    void begin(uint64_t n, Pcg32& rng) override {
+        plan_ = make_sampler_plan(spec_.sampler, problem_.domain.sample_dim(), n, rng,
+                                  spec_.sampler_options());
+        accumulator_.reset(error_method_for(spec_), plan_, float32_);
+        next_ = 0;
+        prepared_ = false;
+    }
+
+    bool run_block(Pcg32& rng, Workspace& ws) override {
+        if (next_ >= plan_.total) return false;
+        if (!prepared_) {
+            prepare_workspace(problem_.domain, ws);
+            prepared_ = true;
+        }
+        const size_t count =
+            static_cast<size_t>(std::min<uint64_t>(kBlockSize, plan_.total - next_));
+        const SampleBlock b = sample_block(problem_, spec_.proposal, plan_, next_, count, rng, ws);
+        accumulator_.add_block(b.first, b.f, b.pdf, b.pdf, b.count); // weights overwrite p
+        next_ += count;
+        return true;
+    }
+
+    RunResult result() const override {
+        const double scale =
+            problem_.quantity == Quantity::Mean ? 1.0 / problem_.domain.measure() : 1.0;
+        RunResult r = accumulator_.finish(scale);
+        r.n = plan_.total;
+        return r;
+    }
+
+  private:
+    const Problem& problem_;
+    const EstimatorSpec& spec_;
+    bool float32_;
+    SamplerPlan plan_;
+    WeightAccumulator accumulator_;
+    uint64_t next_ = 0;
+    bool prepared_ = false;
+};
+
+} // namespace
+
+std::unique_ptr<EstimatorAlgorithm>
+make_estimator(const Problem& problem, const EstimatorSpec& spec, Accumulator accumulator) {
+    return std::make_unique<FixedEstimator>(problem, spec, accumulator);
+}
+
 RunResult run_estimate(const Problem& problem, const EstimatorSpec& spec, uint64_t n, Pcg32& rng,
                        Workspace& ws, Accumulator accumulator) {
     const auto start = std::chrono::steady_clock::now();
-    const SamplerPlan plan = make_sampler_plan(spec.sampler, problem.domain.sample_dim(), n, rng,
-                                               spec.sampler_options());
-    WeightAccumulator& acc = ws.accumulator;
-    acc.reset(error_method_for(spec), plan, accumulator == Accumulator::Float32);
-    for_each_block(problem, spec.proposal, plan, rng, ws, [&](const SampleBlock& b) {
-        acc.add_block(b.first, b.f, b.pdf, b.pdf, b.count); // the weights overwrite the densities
-    });
-    const double scale = problem.quantity == Quantity::Mean ? 1.0 / problem.domain.measure() : 1.0;
-    RunResult result = acc.finish(scale);
-    result.n = n;
+    std::unique_ptr<EstimatorAlgorithm> estimator = make_estimator(problem, spec, accumulator);
+    estimator->begin(n, rng);
+    while (estimator->run_block(rng, ws)) {
+    }
+    RunResult result = estimator->result();
     result.seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return result;
