@@ -11,12 +11,7 @@
 #include "core/quadrature.h"
 #include "core/special.h"
 
-#if defined(__EMSCRIPTEN__) && !defined(__EMSCRIPTEN_PTHREADS__)
-#define MCPLAY_HAS_THREADS 0
-#else
-#define MCPLAY_HAS_THREADS 1
-#include <thread>
-#endif
+#include "core/parallel.h"
 
 namespace mcp {
 
@@ -564,19 +559,30 @@ ConvergenceFit fit_convergence(const std::vector<LevelStats>& levels) {
 
 LevelConsistency level_consistency(const std::vector<LevelStats>& levels) {
     LevelConsistency c;
+    // Each level's error, floored at the round-off of its mean (64 eps relative, as for zero
+    // error bars): means that agree to round-off agree, whatever their spread says (an exact
+    // estimator's replicates differ in the last bits only, and so do its levels).
+    auto error_of = [](const LevelStats& l) {
+        const double roundoff = 64.0 * 2.220446049250313e-16 * std::fabs(l.mean);
+        return std::sqrt(l.std_error * l.std_error + roundoff * roundoff);
+    };
+    auto usable = [](const LevelStats& l) {
+        return std::isfinite(l.std_error) && l.std_error >= 0.0 && std::isfinite(l.mean) &&
+               (l.std_error > 0.0 || l.mean != 0.0);
+    };
     double wsum = 0.0, wmean = 0.0;
     for (const LevelStats& l : levels)
-        if (l.std_error > 0.0 && std::isfinite(l.std_error) && std::isfinite(l.mean)) {
-            const double w = 1.0 / (l.std_error * l.std_error);
-            wsum += w;
-            wmean += w * l.mean;
+        if (usable(l)) {
+            const double e = error_of(l);
+            wsum += 1.0 / (e * e);
+            wmean += l.mean / (e * e);
         }
     if (wsum == 0.0) return c;
     wmean /= wsum;
     int used = 0;
     for (const LevelStats& l : levels)
-        if (l.std_error > 0.0 && std::isfinite(l.std_error) && std::isfinite(l.mean)) {
-            const double z = (l.mean - wmean) / l.std_error;
+        if (usable(l)) {
+            const double z = (l.mean - wmean) / error_of(l);
             c.chi2 += z * z;
             ++used;
         }
@@ -650,7 +656,7 @@ StudyResult run_study(const Problem& problem, const std::vector<EstimatorSpec>& 
         const size_t tasks = n_est * reps;
         std::vector<RunResult> runs(tasks);
         std::atomic<size_t> next{0};
-        auto worker = [&]() {
+        auto worker = [&](int) {
             Workspace ws;
             for (size_t t = next++; t < tasks; t = next++) {
                 const size_t e = t / reps;
@@ -661,18 +667,7 @@ StudyResult run_study(const Problem& problem, const std::vector<EstimatorSpec>& 
         };
         const int threads =
             static_cast<int>(std::min<size_t>(static_cast<size_t>(result.threads_used), tasks));
-#if MCPLAY_HAS_THREADS
-        if (threads > 1) {
-            std::vector<std::thread> pool;
-            for (int i = 0; i < threads; ++i) pool.emplace_back(worker);
-            for (std::thread& th : pool) th.join();
-        } else {
-            worker();
-        }
-#else
-        (void)threads;
-        worker();
-#endif
+        run_workers(threads, worker);
         for (size_t e = 0; e < n_est; ++e) {
             std::vector<RunResult> level_runs(runs.begin() + static_cast<long>(e * reps),
                                               runs.begin() + static_cast<long>((e + 1) * reps));

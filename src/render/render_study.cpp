@@ -99,9 +99,7 @@ bool below_reference_noise(const LevelStats& level, double floor) {
 }
 
 uint64_t render_stream(uint64_t seed, const std::string& estimator, uint64_t spp, int rep) {
-    uint64_t h = hash_combine(mix64(seed), hash_string(estimator.c_str()));
-    h = hash_combine(h, spp);
-    return hash_combine(h, static_cast<uint64_t>(rep));
+    return replicate_stream(seed, estimator, spp, rep); // the integration studies' key
 }
 
 ImageSummary summarise_image(const RenderImage& image, const RenderImage& reference) {

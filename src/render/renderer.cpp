@@ -1,10 +1,11 @@
 #include "render/renderer.h"
 
+#include "core/parallel.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <functional>
-#include <thread>
 
 #include "estimators/estimator.h" // kTopWeights
 
@@ -111,19 +112,13 @@ RenderImage render_image(const RenderScene& rs, const RenderEstimator& est,
     image.rgb.assign(image.pixel_count() * 3, 0.0);
     image.variance.assign(image.pixel_count() * 3, 0.0);
     int threads = std::max(1, std::min(settings.threads, settings.height));
-    std::vector<RenderDiagnostics> diags(static_cast<size_t>(threads));
-#if defined(__EMSCRIPTEN__)
-    threads = 1;
+#if !MCPLAY_HAS_THREADS
+    threads = 1; // one worker renders every row
 #endif
-    if (threads == 1) {
-        render_rows(rs, est, settings, 0, 1, image, diags[0]);
-    } else {
-        std::vector<std::thread> pool;
-        for (int t = 0; t < threads; ++t)
-            pool.emplace_back(
-                [&, t] { render_rows(rs, est, settings, t, threads, image, diags[size_t(t)]); });
-        for (auto& th : pool) th.join();
-    }
+    std::vector<RenderDiagnostics> diags(static_cast<size_t>(threads));
+    run_workers(threads, [&](int t) {
+        render_rows(rs, est, settings, t, threads, image, diags[size_t(t)]);
+    });
     for (const auto& d : diags) image.diagnostics.merge(d);
     std::sort(image.diagnostics.top.begin(), image.diagnostics.top.end(), std::greater<double>());
     image.cancelled = settings.cancel && settings.cancel->load();
