@@ -16,24 +16,16 @@
 #include "render_api/image_io.h"
 #include "render_api/mcplay_render.h"
 #include "render_api/render_request.h"
+#include "scene_files.h"
 
 namespace mcp {
 namespace {
 
 using nlohmann::json;
 
-const std::string kScenes = std::string(MCPLAY_SOURCE_DIR) + "/scenes";
-
-std::string read(const std::string& path) {
-    std::ifstream in(path);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
-json scene_json(const std::string& name) {
-    return json::parse(read(kScenes + "/" + name + ".json"));
-}
+using test::kScenes;
+using test::read;
+using test::scene_json;
 
 std::shared_ptr<RenderRequest> request(const std::string& name, json options = json::object()) {
     options["base_dir"] = kScenes;

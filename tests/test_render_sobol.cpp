@@ -19,6 +19,7 @@
 #include "render_api/mcplay_render.h"
 #include "render_api/render_request.h"
 #include "render_scenes.h"
+#include "scene_files.h"
 #include "test_support.h"
 
 namespace mcp {
@@ -26,18 +27,9 @@ namespace {
 
 using nlohmann::json;
 
-const std::string kScenes = std::string(MCPLAY_SOURCE_DIR) + "/scenes";
-
-std::string read(const std::string& path) {
-    std::ifstream in(path);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
-json scene_json(const std::string& name) {
-    return json::parse(read(kScenes + "/" + name + ".json"));
-}
+using test::kScenes;
+using test::read;
+using test::scene_json;
 
 // ---------------------------------------------------------------------------------------------
 // The sampler's points.
