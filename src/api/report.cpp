@@ -93,27 +93,25 @@ Json warnings_for(const LevelStats& l) {
 
 } // namespace
 
+Json tail_warning(const Flag& f, uint64_t pooled, const TailWording& words) {
+    const std::string where = " (from the " + std::to_string(f.count) + " largest of " +
+                              std::to_string(pooled) + " " + words.unit + " at " + words.n_name +
+                              " = " + std::to_string(f.n) + ")";
+    if (f.code == FlagCode::HeavyTail)
+        return warning("heavy_tail", std::string(words.what) + " are heavy-tailed: tail index " +
+                                         fmt("%.2f", f.value) + " +/- " + fmt("%.2f", f.se) +
+                                         where + ", and below 2 " + words.variance +
+                                         " is infinite: the error bars are not trustworthy");
+    return warning("heavy_tail_4", std::string(words.what) + " have a heavy tail: tail index " +
+                                       fmt("%.2f", f.value) + where + " is below 4, so " +
+                                       words.variance +
+                                       " is finite but its estimate is unreliable and the error "
+                                       "bars may be too small");
+}
+
 void add_tail_warnings(Json& w, const LevelStats& deepest, uint64_t pooled,
                        const TailWording& words) {
-    for (const Flag& f : tail_flags(deepest)) {
-        const std::string where = " (from the " + std::to_string(f.count) + " largest of " +
-                                  std::to_string(pooled) + " " + words.unit + " at " +
-                                  words.n_name + " = " + std::to_string(f.n) + ")";
-        if (f.code == FlagCode::HeavyTail)
-            w.push_back(
-                warning("heavy_tail", std::string(words.what) + " are heavy-tailed: tail index " +
-                                          fmt("%.2f", f.value) + " +/- " + fmt("%.2f", f.se) +
-                                          where + ", and below 2 " + words.variance +
-                                          " is infinite: the error bars are not "
-                                          "trustworthy"));
-        else
-            w.push_back(warning("heavy_tail_4", std::string(words.what) +
-                                                    " have a heavy tail: tail index " +
-                                                    fmt("%.2f", f.value) + where +
-                                                    " is below 4, so " + words.variance +
-                                                    " is finite but its estimate is unreliable "
-                                                    "and the error bars may be too small"));
-    }
+    for (const Flag& f : tail_flags(deepest)) w.push_back(tail_warning(f, pooled, words));
 }
 
 namespace {

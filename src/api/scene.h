@@ -9,6 +9,7 @@
 
 #include "api/json_read.h"
 #include "core/made.h"
+#include "estimators/diagnostics.h"
 #include "estimators/study.h"
 
 namespace mcp {
@@ -59,6 +60,8 @@ struct TailWording {
 /// level, estimated from `pooled` values.
 void add_tail_warnings(Json& warnings, const LevelStats& deepest, uint64_t pooled,
                        const TailWording& words);
+/// The sentence of one heavy_tail / heavy_tail_4 flag (estimators/diagnostics.h).
+Json tail_warning(const Flag& flag, uint64_t pooled, const TailWording& words);
 
 std::string format_table(const Json& result);
 std::string format_csv(const Json& result);

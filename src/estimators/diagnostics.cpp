@@ -20,6 +20,10 @@ const char* flag_code_name(FlagCode code) {
     case FlagCode::PdfSupport: return "pdf_support";
     case FlagCode::LevelDrift: return "level_drift";
     case FlagCode::Float32Accumulator: return "float32_accumulator";
+    case FlagCode::BelowReferenceNoise: return "below_reference_noise";
+    case FlagCode::ReferenceNoise: return "reference_noise";
+    case FlagCode::SlowConvergence: return "slow_convergence";
+    case FlagCode::PixelErrorBars: return "pixel_error_bars";
     }
     return "?";
 }

@@ -26,6 +26,11 @@ enum class FlagCode {
     PdfSupport,         ///< the pdf is zero where f is not
     LevelDrift,         ///< the level means disagree beyond their error bars
     Float32Accumulator, ///< naive single-precision sums (teaching mode)
+    // Render studies (render/render_study.h: render_flags).
+    BelowReferenceNoise, ///< a level's relative MSE is below the reference's own noise
+    ReferenceNoise,      ///< some levels lie below the reference's noise (left out of the fit)
+    SlowConvergence,     ///< relative MSE falls clearly slower than 1/spp
+    PixelErrorBars,      ///< too few pixels' 95% intervals cover the reference
 };
 
 /// The stable code of a flag in results ("no_estimate", "heavy_tail", ...).

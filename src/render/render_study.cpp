@@ -98,6 +98,53 @@ bool below_reference_noise(const LevelStats& level, double floor) {
     return std::isfinite(level.variance) && (level.variance < 0.0 || level.variance < floor);
 }
 
+std::vector<Flag> render_level_flags(const LevelStats& level, double floor) {
+    std::vector<Flag> flags;
+    if (below_reference_noise(level, floor)) {
+        Flag f;
+        f.code = FlagCode::BelowReferenceNoise;
+        f.n = level.n;
+        f.value = level.variance;
+        f.threshold = floor;
+        flags.push_back(f);
+    }
+    return flags;
+}
+
+std::vector<Flag> render_flags(const RenderEstimatorStudy& s, double floor) {
+    std::vector<Flag> flags;
+    if (s.levels.empty()) return flags;
+    size_t below = 0;
+    for (const LevelStats& l : s.levels) below += below_reference_noise(l, floor) ? 1 : 0;
+    if (below > 0) {
+        Flag f;
+        f.code = FlagCode::ReferenceNoise;
+        f.count = below;
+        f.of = s.levels.size();
+        f.threshold = floor;
+        flags.push_back(f);
+    }
+    const LevelStats& deepest = s.levels.back();
+    for (const Flag& f : tail_flags(deepest)) flags.push_back(f);
+    if (s.fit.valid && s.fit.order > -1.0 + 3.0 * s.fit.order_se && s.fit.order > -0.8) {
+        Flag f;
+        f.code = FlagCode::SlowConvergence;
+        f.value = s.fit.order;
+        f.se = s.fit.order_se;
+        f.threshold = -1.0;
+        flags.push_back(f);
+    }
+    if (deepest.coverage < 0.85 && deepest.n >= 16) {
+        Flag f;
+        f.code = FlagCode::PixelErrorBars;
+        f.n = deepest.n;
+        f.value = deepest.coverage;
+        f.threshold = 0.85;
+        flags.push_back(f);
+    }
+    return flags;
+}
+
 uint64_t render_stream(uint64_t seed, const std::string& estimator, uint64_t spp, int rep) {
     return replicate_stream(seed, estimator, spp, rep); // the integration studies' key
 }

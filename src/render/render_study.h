@@ -26,6 +26,7 @@
 #include <string>
 #include <vector>
 
+#include "estimators/diagnostics.h"
 #include "estimators/study.h"
 #include "render/renderer.h"
 
@@ -73,6 +74,15 @@ struct RenderStudyResult {
     double relative_mse_floor = 0.0; ///< of the reference; NaN when it is black
     std::vector<RenderEstimatorStudy> estimators;
 };
+
+/// The flags of a render estimator over its study (diagnostics as data, worded by the API):
+/// reference_noise (levels below the reference's floor: count, of), the tail flags of the
+/// deepest level, slow_convergence (fitted order above -1 by more than 3 standard errors and
+/// above -0.8), pixel_error_bars (under 85% of the pixels' own 95% intervals cover the
+/// reference at the deepest spp, spp >= 16).
+std::vector<Flag> render_flags(const RenderEstimatorStudy& s, double floor);
+/// below_reference_noise for one level, or nothing.
+std::vector<Flag> render_level_flags(const LevelStats& level, double floor);
 
 /// Stream id of one image: (seed, estimator name, spp, replicate), as for the integration
 /// studies, so results do not depend on threads or on which estimators run together.

@@ -51,41 +51,45 @@ Json estimator_to_json(const RenderEstimator& e) {
     return j;
 }
 
-/// How many levels of the study lie below the reference's noise?
-size_t levels_below_noise(const RenderEstimatorStudy& s, double floor) {
-    size_t n = 0;
-    for (const LevelStats& l : s.levels) n += below_reference_noise(l, floor) ? 1 : 0;
-    return n;
-}
-
-/// Warnings about an estimator over the whole study (the levels carry their own).
+/// Warnings about an estimator over the whole study (the levels carry their own): the
+/// render flags of the core (render_study.h), worded.
 Json render_warnings(const RenderEstimatorStudy& s, double floor) {
     Json w = Json::array();
-    if (s.levels.empty()) return w;
-    if (size_t n = levels_below_noise(s, floor))
-        w.push_back(warning("reference_noise",
-                            std::to_string(n) + " of " + std::to_string(s.levels.size()) +
-                                " spp level(s) have a relative MSE below the reference's own "
-                                "noise (floor " +
-                                fmt("%.3e", floor) +
-                                "): those levels are left out of the fit and have no efficiency"));
-    const LevelStats& deepest = s.levels.back();
-    add_tail_warnings(w, deepest, deepest.diagnostics.nonzero,
-                      TailWording{"the samples' reflected radiance values", "samples", "spp",
-                                  "the pixel variance"});
-    if (s.fit.valid && s.fit.order > -1.0 + 3.0 * s.fit.order_se && s.fit.order > -0.8)
-        w.push_back(warning("slow_convergence",
-                            "relative MSE falls as spp^" + fmt("%.2f", s.fit.order) + " +/- " +
-                                fmt("%.2f", s.fit.order_se) +
-                                ", slower than 1/spp: infinite variance, bias against the "
-                                "reference, or a reference too noisy for this spp"));
-    if (deepest.coverage < 0.85 && deepest.n >= 16)
-        w.push_back(
-            warning("pixel_error_bars",
-                    "only " + fmt("%.1f", 100.0 * deepest.coverage) +
-                        "% of the pixels' own 95% error bars cover the reference at spp = " +
-                        std::to_string(deepest.n) +
-                        ": per-pixel error bars are too small (heavy tails or bias)"));
+    const TailWording tail_words{"the samples' reflected radiance values", "samples", "spp",
+                                 "the pixel variance"};
+    for (const Flag& f : render_flags(s, floor)) {
+        switch (f.code) {
+        case FlagCode::ReferenceNoise:
+            w.push_back(warning(flag_code_name(f.code),
+                                std::to_string(f.count) + " of " + std::to_string(f.of) +
+                                    " spp level(s) have a relative MSE below the reference's "
+                                    "own noise (floor " +
+                                    fmt("%.3e", f.threshold) +
+                                    "): those levels are left out of the fit and have no "
+                                    "efficiency"));
+            break;
+        case FlagCode::HeavyTail:
+        case FlagCode::HeavyTail4:
+            w.push_back(tail_warning(f, s.levels.back().diagnostics.nonzero, tail_words));
+            break;
+        case FlagCode::SlowConvergence:
+            w.push_back(warning(flag_code_name(f.code),
+                                "relative MSE falls as spp^" + fmt("%.2f", f.value) + " +/- " +
+                                    fmt("%.2f", f.se) +
+                                    ", slower than 1/spp: infinite variance, bias against the "
+                                    "reference, or a reference too noisy for this spp"));
+            break;
+        case FlagCode::PixelErrorBars:
+            w.push_back(warning(flag_code_name(f.code),
+                                "only " + fmt("%.1f", 100.0 * f.value) +
+                                    "% of the pixels' own 95% error bars cover the reference at "
+                                    "spp = " +
+                                    std::to_string(f.n) +
+                                    ": per-pixel error bars are too small (heavy tails or bias)"));
+            break;
+        default: break;
+        }
+    }
     return w;
 }
 
@@ -94,14 +98,14 @@ Json render_warnings(const RenderEstimatorStudy& s, double floor) {
 Json render_level_to_json(const LevelStats& l, double floor) {
     Json j = level_to_json(l);
     j["relative_mse"] = num(l.variance);
-    bool below = below_reference_noise(l, floor);
-    j["below_reference_noise"] = below;
-    if (below)
+    const std::vector<Flag> flags = render_level_flags(l, floor);
+    j["below_reference_noise"] = !flags.empty();
+    for (const Flag& f : flags)
         j["warnings"].push_back(warning(
-            "below_reference_noise",
-            "relative MSE " + fmt("%.3e", l.variance) + " at spp = " + std::to_string(l.n) +
-                " is " + (l.variance < 0.0 ? "negative" : "below") +
-                " the reference's own noise (relative-MSE floor " + fmt("%.3e", floor) +
+            flag_code_name(f.code),
+            "relative MSE " + fmt("%.3e", f.value) + " at spp = " + std::to_string(f.n) + " is " +
+                (f.value < 0.0 ? "negative" : "below") +
+                " the reference's own noise (relative-MSE floor " + fmt("%.3e", f.threshold) +
                 "): it measures the reference, not the estimator; use a reference with more "
                 "spp"));
     return j;
