@@ -559,16 +559,17 @@ ConvergenceFit fit_convergence(const std::vector<LevelStats>& levels) {
 
 LevelConsistency level_consistency(const std::vector<LevelStats>& levels) {
     LevelConsistency c;
-    // Each level's error, floored at the round-off of its mean (64 eps relative, as for zero
-    // error bars): means that agree to round-off agree, whatever their spread says (an exact
-    // estimator's replicates differ in the last bits only, and so do its levels).
+    // Levels exact to round-off (replicates that agree to 64 eps, estimates_spread false) have
+    // nothing to test: their spread is the arithmetic's, and native and wasm differ in it. The
+    // others' errors are floored at the round-off of their means: means that agree to round-off
+    // agree, whatever their spread says.
     auto error_of = [](const LevelStats& l) {
         const double roundoff = 64.0 * 2.220446049250313e-16 * std::fabs(l.mean);
         return std::sqrt(l.std_error * l.std_error + roundoff * roundoff);
     };
     auto usable = [](const LevelStats& l) {
-        return std::isfinite(l.std_error) && l.std_error >= 0.0 && std::isfinite(l.mean) &&
-               (l.std_error > 0.0 || l.mean != 0.0);
+        return std::isfinite(l.std_error) && l.std_error > 0.0 && std::isfinite(l.mean) &&
+               l.estimates_spread;
     };
     double wsum = 0.0, wmean = 0.0;
     for (const LevelStats& l : levels)

@@ -136,7 +136,8 @@ SupportCheck check_support(const Problem& problem, const EstimatorSpec& spec, ui
 /// Do the level means agree with each other? Every level estimates the same number, so
 /// chi2 = sum_l (mean_l - m)^2 / se_l^2 about their weighted mean m is chi-square with L-1
 /// degrees of freedom when the error bars are right. A tiny p-value says they are not
-/// (heavy tails, too few samples at small N), even when the exact value is unknown.
+/// (heavy tails, too few samples at small N), even when the exact value is unknown. Levels
+/// whose replicates agree to round-off are left out (nothing to test).
 struct LevelConsistency {
     double chi2 = 0.0;
     int dof = 0;
