@@ -68,8 +68,8 @@ struct Options {
     std::vector<int> dims{2, 4, 8, 16};
     std::vector<int> families{1, 2, 3, 4, 5, 6};
     bool dims_given = false, families_given = false;
-    std::vector<std::string> methods{"uniform",  "stratified", "latin_hypercube",
-                                     "sobol",    "halton",     "lattice"};
+    std::vector<std::string> methods{"uniform", "stratified", "latin_hypercube",
+                                     "sobol",   "halton",     "lattice"};
     std::vector<std::string> gsl{"plain", "miser", "vegas"};
     uint64_t param_seed = 1; // genz_random(family, d, param_seed)
     uint64_t seed = 1;       // replicate seeds
@@ -77,11 +77,11 @@ struct Options {
     bool quick = false;
 };
 
-std::vector<std::string> split(const std::string& s) {
+std::vector<std::string> split(const std::string& s, char separator = ',') {
     std::vector<std::string> out;
     std::stringstream ss(s);
     std::string item;
-    while (std::getline(ss, item, ','))
+    while (std::getline(ss, item, separator))
         if (!item.empty()) out.push_back(item);
     return out;
 }
@@ -154,7 +154,8 @@ Options parse_options(int argc, char** argv) {
             o.gsl = v == "none" ? std::vector<std::string>{} : split(v);
             for (const std::string& g : o.gsl)
                 if (g != "plain" && g != "miser" && g != "vegas")
-                    usage(("--gsl: unknown method '" + g + "' (plain, miser, vegas, none)").c_str());
+                    usage(
+                        ("--gsl: unknown method '" + g + "' (plain, miser, vegas, none)").c_str());
         } else if (a == "--param-seed")
             o.param_seed = parse_u64(value(), "--param-seed");
         else if (a == "--seed")
@@ -183,7 +184,7 @@ struct Case {
     std::string label; // "oscillatory d=2" (+ file name in --params-dir mode)
     int family = 1;    // 1..6
     GenzParams params;
-    double exact = kNaN;       // the value errors are measured against
+    double exact = kNaN;        // the value errors are measured against
     double mcplay_exact = kNaN; // genz_exact(params)
     std::string source;
 };
@@ -258,7 +259,7 @@ std::vector<Case> file_cases(const Options& o) {
         c.params = g.value;
         c.mcplay_exact = genz_exact(c.params);
         c.exact = v.contains("exact") && v["exact"].is_number() ? v["exact"].get<double>()
-                                                                 : c.mcplay_exact;
+                                                                : c.mcplay_exact;
         c.label = std::string(kFamilyNames[fam - 1]) + " d=" + std::to_string(d) + " (" +
                   p.stem().string() + ")";
         c.source = p.string();
@@ -322,21 +323,21 @@ Estimate gsl_vegas(gsl_monte_function* F, GslContext* ctx, int d, uint64_t n, gs
     while (per_iteration > 0 && ctx->calls + per_iteration <= n) {
         vp.stage = 3;
         gsl_monte_vegas_params_set(s, &vp);
-        e.status |= gsl_monte_vegas_integrate(F, lo.data(), hi.data(), size_t(d), per_iteration,
-                                              r, s, &e.value, &e.sigma);
+        e.status |= gsl_monte_vegas_integrate(F, lo.data(), hi.data(), size_t(d), per_iteration, r,
+                                              s, &e.value, &e.sigma);
     }
     while (n - ctx->calls >= 10000) { // GSL never makes more calls than asked for
         vp.stage = 2;
         gsl_monte_vegas_params_set(s, &vp);
-        e.status |= gsl_monte_vegas_integrate(F, lo.data(), hi.data(), size_t(d),
-                                              n - ctx->calls, r, s, &e.value, &e.sigma);
+        e.status |= gsl_monte_vegas_integrate(F, lo.data(), hi.data(), size_t(d), n - ctx->calls, r,
+                                              s, &e.value, &e.sigma);
     }
     if (n - ctx->calls >= 2) { // one box of n - calls points (at least 2 per box)
         vp.stage = 2;
         vp.mode = GSL_VEGAS_MODE_IMPORTANCE_ONLY;
         gsl_monte_vegas_params_set(s, &vp);
-        e.status |= gsl_monte_vegas_integrate(F, lo.data(), hi.data(), size_t(d),
-                                              n - ctx->calls, r, s, &e.value, &e.sigma);
+        e.status |= gsl_monte_vegas_integrate(F, lo.data(), hi.data(), size_t(d), n - ctx->calls, r,
+                                              s, &e.value, &e.sigma);
     }
     e.chi2 = gsl_monte_vegas_chisq(s);
     gsl_monte_vegas_free(s);
@@ -352,13 +353,13 @@ Estimate run_gsl(const std::string& method, const GenzParams& p, uint64_t n, gsl
     Estimate e;
     if (method == "plain") {
         gsl_monte_plain_state* s = gsl_monte_plain_alloc(size_t(d));
-        e.status = gsl_monte_plain_integrate(&F, lo.data(), hi.data(), size_t(d), n, r, s,
-                                             &e.value, &e.sigma);
+        e.status = gsl_monte_plain_integrate(&F, lo.data(), hi.data(), size_t(d), n, r, s, &e.value,
+                                             &e.sigma);
         gsl_monte_plain_free(s);
     } else if (method == "miser") {
         gsl_monte_miser_state* s = gsl_monte_miser_alloc(size_t(d));
-        e.status = gsl_monte_miser_integrate(&F, lo.data(), hi.data(), size_t(d), n, r, s,
-                                             &e.value, &e.sigma);
+        e.status = gsl_monte_miser_integrate(&F, lo.data(), hi.data(), size_t(d), n, r, s, &e.value,
+                                             &e.sigma);
         gsl_monte_miser_free(s);
     } else {
         e = gsl_vegas(&F, &ctx, d, n, r);
@@ -419,11 +420,13 @@ std::string notes(const Cell& c) {
     std::string s;
     auto add = [&](const std::string& t) { s += (s.empty() ? "" : "; ") + t; };
     const int R = int(c.reps.size());
-    if (c.est_nonfinite) add("estimate non-finite in " + std::to_string(c.est_nonfinite) + "/" + std::to_string(R));
+    if (c.est_nonfinite)
+        add("estimate non-finite in " + std::to_string(c.est_nonfinite) + "/" + std::to_string(R));
     if (c.sigma_zero) add("sigma = 0 in " + std::to_string(c.sigma_zero) + "/" + std::to_string(R));
     if (c.sigma_nonfinite)
         add("sigma NaN/inf in " + std::to_string(c.sigma_nonfinite) + "/" + std::to_string(R));
-    if (c.bad_status) add("GSL status != 0 in " + std::to_string(c.bad_status) + "/" + std::to_string(R));
+    if (c.bad_status)
+        add("GSL status != 0 in " + std::to_string(c.bad_status) + "/" + std::to_string(R));
     if (!std::isnan(c.chi2_med)) {
         char b[64];
         std::snprintf(b, sizeof b, "chi2/dof %.2g", c.chi2_med);
@@ -439,8 +442,12 @@ bool overconfident(const Cell& c) {
     const int R = int(c.reps.size());
     return !(c.sig_rmse >= 0.5) || 10 * c.cov2 < 7 * R;
 }
-bool pessimistic(const Cell& c) { return c.sig_rmse > 2.0; }
-const char* mark(const Cell& c) { return overconfident(c) ? "!" : pessimistic(c) ? "^" : " "; }
+bool pessimistic(const Cell& c) {
+    return c.sig_rmse > 2.0;
+}
+const char* mark(const Cell& c) {
+    return overconfident(c) ? "!" : pessimistic(c) ? "^" : " ";
+}
 
 std::string fmt_e(double x, int prec = 2) {
     if (std::isnan(x)) return "nan";
@@ -482,12 +489,22 @@ int best_of(const std::vector<Cell>& cells, bool gsl) {
     return best;
 }
 
+/// A method is a preset name, optionally with a randomization and a count of randomizations:
+/// "sobol", "sobol:lms_shift", "sobol:owen:32".
+Json estimator_for(const std::string& method) {
+    std::vector<std::string> parts = split(method, ':');
+    if (parts.size() == 1) return method;
+    Json e = {{"name", parts[0]}, {"randomization", parts[1]}};
+    if (parts.size() > 2) e["randomizations"] = std::atoll(parts[2].c_str());
+    return e;
+}
+
 Json scene_for(const Case& c, const std::string& estimator, bool exact_from_file) {
-    Json integrand = {{"type", genz_family_name(c.params.family)},
-                      {"a", c.params.a},
-                      {"u", c.params.u}};
-    Json scene = {{"name", "genz_compare"}, {"integrand", integrand},
-                  {"estimators", Json::array({estimator})}};
+    Json integrand = {
+        {"type", genz_family_name(c.params.family)}, {"a", c.params.a}, {"u", c.params.u}};
+    Json scene = {{"name", "genz_compare"},
+                  {"integrand", integrand},
+                  {"estimators", Json::array({estimator_for(estimator)})}};
     if (exact_from_file) scene["exact"] = c.exact;
     return scene;
 }
@@ -519,11 +536,13 @@ int main(int argc, char** argv) {
                 (unsigned long long)(o.seed + uint64_t(o.reps) - 1));
     std::printf("  N = %llu integrand calls per estimate, R = %d replicates, %s\n",
                 (unsigned long long)o.n, o.reps,
-                from_files ? ("parameters from " + o.params_dir + " (exact values from the files)").c_str()
-                           : ("parameters genz_random(family, d, seed " +
-                              std::to_string(o.param_seed) + "), exact values genz_exact")
-                                 .c_str());
-    std::printf("  %s, %s %s; %s\n", date, un.machine, un.release, o.quick ? "--quick" : "full run");
+                from_files
+                    ? ("parameters from " + o.params_dir + " (exact values from the files)").c_str()
+                    : ("parameters genz_random(family, d, seed " + std::to_string(o.param_seed) +
+                       "), exact values genz_exact")
+                          .c_str());
+    std::printf("  %s, %s %s; %s\n", date, un.machine, un.release,
+                o.quick ? "--quick" : "full run");
     std::printf("  VEGAS: warm-up 10^4 calls (stage 0), then the main run (stage 1) on the trained "
                 "grid; total calls = N (see docs/benchmarks.md)\n");
     std::fflush(stdout);
@@ -674,7 +693,8 @@ int main(int argc, char** argv) {
               {"case", cs.label},
               {"family", cs.family},
               {"d", cs.params.dim()},
-              {"best_gsl", cr.best_gsl >= 0 ? Json(cr.cells[size_t(cr.best_gsl)].method) : Json(nullptr)},
+              {"best_gsl",
+               cr.best_gsl >= 0 ? Json(cr.cells[size_t(cr.best_gsl)].method) : Json(nullptr)},
               {"best_mcplay",
                cr.best_mcplay >= 0 ? Json(cr.cells[size_t(cr.best_mcplay)].method) : Json(nullptr)},
               {"eff_ratio_mcplay_over_gsl", jnum(cr.ratio)}});
@@ -684,8 +704,10 @@ int main(int argc, char** argv) {
     gsl_rng_free(rng);
 
     // Summary: best GSL against best mcplay per case.
-    std::printf("== summary: best GSL method vs best mcplay method per case (efficiency 1/(rel_rmse^2 t_med));\n"
-                "   after sig/rmse: '!' over-confident error bars (sig/rmse < 0.5 or cov2 < 70%%), '^' pessimistic "
+    std::printf("== summary: best GSL method vs best mcplay method per case (efficiency "
+                "1/(rel_rmse^2 t_med));\n"
+                "   after sig/rmse: '!' over-confident error bars (sig/rmse < 0.5 or cov2 < 70%%), "
+                "'^' pessimistic "
                 "ones (sig/rmse > 2)\n");
     std::printf("   %-28s %-12s %9s %8s  %-16s %9s %8s  %10s\n", "case", "best GSL", "eff",
                 "sig/rmse", "best mcplay", "eff", "sig/rmse", "mcplay/GSL");
@@ -701,8 +723,7 @@ int main(int argc, char** argv) {
         std::printf("   %-28s %-12s %9s %7s%s  %-16s %9s %7s%s  %10s\n", cr.c->label.c_str(),
                     g.method.c_str(), fmt_e(g.eff, 1).c_str(), fmt_f(g.sig_rmse, "%.2f").c_str(),
                     mark(g), m.method.c_str(), fmt_e(m.eff, 1).c_str(),
-                    fmt_f(m.sig_rmse, "%.2f").c_str(), mark(m),
-                    fmt_e(cr.ratio, 1).c_str());
+                    fmt_f(m.sig_rmse, "%.2f").c_str(), mark(m), fmt_e(cr.ratio, 1).c_str());
         if (std::isfinite(cr.ratio) && cr.ratio > 0) {
             log_sum += std::log(cr.ratio);
             ++compared;
@@ -727,9 +748,9 @@ int main(int argc, char** argv) {
                 ++listed;
                 const std::string n = notes(c);
                 std::printf("   %-28s %-16s sig/rmse %s, cov2 %d/%zu, rel_bias %s%s%s\n",
-                            cr.c->label.c_str(), c.method.c_str(), fmt_f(c.sig_rmse, "%.2f").c_str(),
-                            c.cov2, c.reps.size(), fmt_f(c.rel_bias, "%+.1e").c_str(),
-                            n.empty() ? "" : "; ", n.c_str());
+                            cr.c->label.c_str(), c.method.c_str(),
+                            fmt_f(c.sig_rmse, "%.2f").c_str(), c.cov2, c.reps.size(),
+                            fmt_f(c.rel_bias, "%+.1e").c_str(), n.empty() ? "" : "; ", n.c_str());
             }
         if (!listed) std::printf("   none\n");
         if (pass == 0) flagged = listed;

@@ -4,6 +4,7 @@
 
 #include "core/qmc_tables.h"
 #include "core/rng.h"
+#include "core/simd.h"
 
 namespace mcp {
 
@@ -150,11 +151,36 @@ inline uint64_t dimension_key(uint32_t seed, int dim) {
     return hash_combine(seed, static_cast<uint64_t>(dim));
 }
 
-// 32 scrambled digits followed by 21 fill bits hashed from them: the digits below a nested
+// The 21 fill bits below 32 scrambled digits, hashed from them: the digits below a nested
 // scramble's precision are uniform and depend on the point's digits (distinct points have
-// distinct 32-digit prefixes, so their fills are independent draws of the hash).
-inline uint64_t owen_bits53(uint32_t scrambled, uint64_t fill_key) {
-    return (uint64_t(scrambled) << kFillBits) | (mix64(fill_key ^ scrambled) >> (64 - kFillBits));
+// distinct 32-digit prefixes, so their fills are draws of a keyed bijection). A 32-bit hash
+// (Wellons' lowbias32 [Wellons18]) so that the loop over points vectorizes.
+inline uint32_t owen_fill(uint32_t scrambled, uint32_t fill_key) {
+    uint32_t h = scrambled ^ fill_key;
+    h ^= h >> 16;
+    h *= 0x7feb352du;
+    h ^= h >> 15;
+    h *= 0x846ca68bu;
+    h ^= h >> 16;
+    return h >> (32 - kFillBits);
+}
+
+inline uint64_t owen_bits53(uint32_t scrambled, uint32_t fill_key) {
+    return (uint64_t(scrambled) << kFillBits) | owen_fill(scrambled, fill_key);
+}
+
+// (low + 1/2) 2^-53 for the low kFillBits bits of a 53-bit number k.
+inline double low_bits_term(uint64_t k53) {
+    return (static_cast<double>(k53 & ((uint64_t(1) << kFillBits) - 1)) + 0.5) * 0x1p-53;
+}
+
+// bits53_to_unit(k) with k = high 2^21 + low, given high and low_bits_term(k), without 64-bit
+// integers so that the loops over points vectorize: high 2^-32 and (low + 1/2) 2^-53 are exact,
+// and their sum is the same single rounding of (k + 1/2) 2^-53.
+inline double split_bits53_to_unit(uint32_t high, double low_plus_half_scaled) {
+    const double h = static_cast<double>(static_cast<int32_t>(high ^ 0x80000000u)) + 0x1p31;
+    const double x = h * 0x1p-32 + low_plus_half_scaled;
+    return x < 0x1p0 ? x : 0x1.fffffffffffffp-1;
 }
 
 inline uint64_t shifted_bits53(uint32_t digits, uint64_t shift) {
@@ -266,7 +292,7 @@ inline uint32_t lattice_rank(uint64_t index) {
 }
 
 inline uint32_t lattice_numerator(uint32_t rank, uint32_t z) {
-    return static_cast<uint32_t>((uint64_t(rank) * z) & kLatticeMask);
+    return (rank * z) & kLatticeMask; // the low 20 bits of the product are those mod 2^32
 }
 
 // k 2^-20 + s mod 1 in 53-bit fixed point, exact.
@@ -456,7 +482,8 @@ double qmc_coordinate(const QmcRandomizer& r, uint64_t index, int dim) {
         const uint32_t v = sobol_u32(index, dim);
         if (rand == QmcRandomization::Owen) {
             const uint32_t y = owen_scramble_u32(v, r.seeds[j]);
-            return bits53_to_unit(owen_bits53(y, dimension_key(r.seeds[j], dim)));
+            return bits53_to_unit(
+                owen_bits53(y, static_cast<uint32_t>(dimension_key(r.seeds[j], dim))));
         }
         if (rand == QmcRandomization::DigitalShift)
             return bits53_to_unit(shifted_bits53(v, r.shifts[j]));
@@ -490,46 +517,60 @@ namespace {
 
 // Walks the Gray code from point `first`: point i + 1 is point i XOR v[ctz(i + 1)]. v has 64
 // entries, zero beyond the 32 digits, so the walk agrees with sobol_from_directions for any
-// index.
-template <class Convert>
-void sobol_walk(const uint32_t* v, uint64_t first, size_t count, double* out, Convert convert) {
+// index. The walk is a serial chain of XORs; the randomization then runs over the digits in a
+// separate loop, which the compiler vectorizes.
+void sobol_walk(const uint32_t* v, uint64_t first, size_t count, uint32_t* digits) {
     uint32_t x = sobol_from_directions(v, first);
     for (size_t i = 0; i < count; ++i) {
-        out[i] = convert(x);
+        digits[i] = x;
         x ^= v[trailing_zeros((first + i + 1) | (uint64_t(1) << 63))];
     }
 }
 
-void sobol_block(const QmcRandomizer& r, QmcRandomization rand, int dim, uint64_t first,
-                 size_t count, double* out) {
+MCP_VECTOR_CLONES void sobol_block(const QmcRandomizer& r, QmcRandomization rand, int dim,
+                                   uint64_t first, size_t count, double* out) {
     const size_t j = static_cast<size_t>(dim);
     const uint32_t* directions =
         rand == QmcRandomization::LmsShift ? &r.matrices[j * kDigitBits] : tables().sobol[dim];
+    const bool reversed = rand == QmcRandomization::Owen; // the hash wants reversed digits
     uint32_t v[64] = {};
-    for (int k = 0; k < kDigitBits; ++k) v[k] = directions[k];
-    switch (rand) {
-    case QmcRandomization::Owen: {
-        // Walk the bit-reversed digits, which the hash wants: one reversal per point.
-        for (int k = 0; k < kDigitBits; ++k) v[k] = reverse_bits32(v[k]);
-        const uint32_t seed = r.seeds[j];
-        const uint64_t fill_key = dimension_key(seed, dim);
-        sobol_walk(v, first, count, out, [seed, fill_key](uint32_t reversed) {
-            const uint32_t y = reverse_bits32(owen_hash_reversed(reversed, seed));
-            return bits53_to_unit(owen_bits53(y, fill_key));
-        });
-        break;
-    }
-    case QmcRandomization::LmsShift:
-    case QmcRandomization::DigitalShift: {
-        const uint64_t shift = r.shifts[j];
-        sobol_walk(v, first, count, out,
-                   [shift](uint32_t x) { return bits53_to_unit(shifted_bits53(x, shift)); });
-        break;
-    }
-    default:
-        sobol_walk(v, first, count, out,
-                   [](uint32_t x) { return static_cast<double>(x) * 0x1p-32; });
-        break;
+    for (int k = 0; k < kDigitBits; ++k)
+        v[k] = reversed ? reverse_bits32(directions[k]) : directions[k];
+    uint32_t digits[kChunk];
+    for (size_t done = 0; done < count; done += kChunk) {
+        const size_t n = count - done < kChunk ? count - done : kChunk;
+        double* o = out + done;
+        sobol_walk(v, first + done, n, digits);
+        switch (rand) {
+        case QmcRandomization::Owen: {
+            const uint32_t seed = r.seeds[j];
+            const uint32_t fill_key = static_cast<uint32_t>(dimension_key(seed, dim));
+            uint32_t fills[kChunk];
+            for (size_t i = 0; i < n; ++i) {
+                const uint32_t y = reverse_bits32(owen_hash_reversed(digits[i], seed));
+                digits[i] = y;
+                fills[i] = owen_fill(y, fill_key);
+            }
+            for (size_t i = 0; i < n; ++i) {
+                const double fill = static_cast<double>(static_cast<int32_t>(fills[i]));
+                o[i] = split_bits53_to_unit(digits[i], (fill + 0.5) * 0x1p-53);
+            }
+            break;
+        }
+        case QmcRandomization::LmsShift:
+        case QmcRandomization::DigitalShift: {
+            // The shift's top 32 bits flip the digits; its low 21 bits are the same for every
+            // point, so (low + 1/2) 2^-53 is a constant.
+            const uint64_t shift = r.shifts[j];
+            const uint32_t high = static_cast<uint32_t>(shift >> kFillBits);
+            const double low = low_bits_term(shift);
+            for (size_t i = 0; i < n; ++i) o[i] = split_bits53_to_unit(digits[i] ^ high, low);
+            break;
+        }
+        default:
+            for (size_t i = 0; i < n; ++i) o[i] = static_cast<double>(digits[i]) * 0x1p-32;
+            break;
+        }
     }
 }
 
@@ -578,8 +619,8 @@ void halton_block(const QmcRandomizer& r, QmcRandomization rand, int dim, uint64
     }
 }
 
-void lattice_block(const QmcRandomizer& r, QmcRandomization rand, uint64_t first, size_t count,
-                   PointBlock& u, size_t offset) {
+MCP_VECTOR_CLONES void lattice_block(const QmcRandomizer& r, QmcRandomization rand, uint64_t first,
+                                     size_t count, PointBlock& u, size_t offset) {
     uint32_t ranks[kChunk];
     for (size_t done = 0; done < count; done += kChunk) {
         const size_t n = count - done < kChunk ? count - done : kChunk;
@@ -588,9 +629,14 @@ void lattice_block(const QmcRandomizer& r, QmcRandomization rand, uint64_t first
             const uint32_t z = kLatticeGenerator[dim];
             double* out = u.coord(dim) + offset + done;
             if (rand == QmcRandomization::RandomShift) {
+                // lattice_shifted in 32-bit pieces: k 2^33 + s = (k 2^12 + s_high) 2^21 + s_low,
+                // with no carry out of the low 21 bits.
                 const uint64_t shift = r.shifts[static_cast<size_t>(dim)];
+                const uint32_t high = static_cast<uint32_t>(shift >> kFillBits);
+                const double low = low_bits_term(shift);
                 for (size_t i = 0; i < n; ++i)
-                    out[i] = lattice_shifted(lattice_numerator(ranks[i], z), shift);
+                    out[i] = split_bits53_to_unit(
+                        (lattice_numerator(ranks[i], z) << (32 - kLatticeBits)) + high, low);
             } else {
                 for (size_t i = 0; i < n; ++i)
                     out[i] = static_cast<double>(lattice_numerator(ranks[i], z)) * 0x1p-20;
