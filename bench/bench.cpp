@@ -230,7 +230,9 @@ int main(int argc, char** argv) {
         {"disk_quarter", "stratified_concentric"},
         {"hemisphere_cos2", "cosine"},
     };
+    const char* only = argc > 4 && std::string(argv[3]) == "--only" ? argv[4] : nullptr;
     for (auto& c : cases) {
+        if (only && std::string(c[1]) != only) continue;
         SceneRequest req;
         if (!load(dir, c[0], &req)) {
             std::fprintf(stderr, "bench: cannot load scene %s from %s\n", c[0], dir.c_str());
@@ -241,6 +243,7 @@ int main(int argc, char** argv) {
                 std::printf("BENCH %s/%s %.6e\n", c[0], c[1], samples_per_second(req, spec, n));
     }
 
+    if (only) return 0;
     // run_estimate's overhead over the bare work of a uniform estimate.
     {
         SceneRequest req;

@@ -20,13 +20,13 @@
 #include <limits>
 #include <utility>
 
+#include "core/points.h"
 #include "core/special.h"
 #include "core/stats.h"
 
 namespace mcp {
 namespace {
 
-constexpr double kOneMinusEpsilon = 0x1.fffffffffffffp-1; // largest double below 1
 constexpr double kEpsilon = std::numeric_limits<double>::epsilon();
 constexpr double kHalfPi = 0.5 * kPi;
 constexpr double kQuarterPi = 0.25 * kPi;
@@ -299,22 +299,36 @@ struct CosineK : CosinePdfK {
 };
 
 // Piecewise constant on n equal bins: func[i] the density on bin i, cdf[i] the cdf at its left
-// edge. Sampling finds the bin by binary search, cdf[i] <= u < cdf[i + 1], which never selects a
-// bin of zero probability (its cdf entries are equal), then interpolates linearly inside it.
+// edge. Sampling finds the bin with cdf[i] <= u < cdf[i + 1], which never selects a bin of zero
+// probability (its cdf entries are equal), then interpolates linearly inside it. The bin is found
+// from a guide table [ChenAsau74]: guide[g] is the bin of u = g / n, and the search walks forward
+// from guide[floor(u n)], about two comparisons on average whatever the table's shape (a binary
+// search takes log2(n) unpredictable branches).
 struct TabulatedK {
     double a, b, width, scale; // width = (b - a) / n, scale = n / (b - a)
     const double* func;
     const double* cdf_edges;
+    const uint32_t* guide;
     size_t n;
+    size_t bin_of_u(double u) const {
+        const double scaled = u * static_cast<double>(n);
+        size_t i = guide[scaled < static_cast<double>(n) ? static_cast<size_t>(scaled) : n - 1];
+        while (i > 0 && cdf_edges[i] > u) --i; // u n rounded up onto the next guide entry
+        while (cdf_edges[i + 1] <= u) ++i;     // ends at i = n - 1 at the latest: cdf[n] = 1 > u
+        return i;
+    }
     double sample(double u) const {
         u = u > 0.0 ? std::min(u, kOneMinusEpsilon) : 0.0;
-        size_t i =
-            static_cast<size_t>(std::upper_bound(cdf_edges, cdf_edges + n + 1, u) - cdf_edges) - 1;
+        const size_t i = bin_of_u(u);
         double lo = cdf_edges[i];
         double t = (u - lo) / (cdf_edges[i + 1] - lo);
-        double x = clamp(a + (static_cast<double>(i) + t) * width, a, b);
-        // Rounding can carry x onto a neighbouring bin's edge; step back into bin i (the
-        // factory guarantees every bin holds many doubles, so this takes one or two steps).
+        const double x = clamp(a + (static_cast<double>(i) + t) * width, a, b);
+        return bin_of(x, a, scale, n) == i ? x : step_into_bin(x, i);
+    }
+    // Rounding can carry x onto a neighbouring bin's edge; step back into bin i (the factory
+    // guarantees every bin holds many doubles, so this takes one or two steps). Out of line:
+    // the common path stays small enough to inline.
+    __attribute__((noinline)) double step_into_bin(double x, size_t i) const {
         for (int guard = 0; guard < 64 && bin_of(x, a, scale, n) > i; ++guard)
             x = std::nextafter(x, -std::numeric_limits<double>::infinity());
         for (int guard = 0; guard < 64 && bin_of(x, a, scale, n) < i; ++guard)
@@ -353,6 +367,15 @@ struct Distribution1DFactory {
     static void set_table(Distribution1D& d, std::vector<double> func, std::vector<double> cdf) {
         d.func_ = std::move(func);
         d.cdf_ = std::move(cdf);
+        // guide[g] = the bin of u = g / n: the last i with cdf[i] <= g / n.
+        const size_t n = d.func_.size();
+        d.guide_.assign(n, 0);
+        size_t i = 0;
+        for (size_t g = 0; g < n; ++g) {
+            const double u = static_cast<double>(g) / static_cast<double>(n);
+            while (i + 1 < n && d.cdf_[i + 1] <= u) ++i;
+            d.guide_[g] = static_cast<uint32_t>(i);
+        }
     }
 
     // Kernels. Fields: power p0 = k, p1 = d0 (see PowerK), c0 = k + 1, c1 = 1 / (k + 1);
@@ -392,7 +415,8 @@ struct Distribution1DFactory {
         return k;
     }
     static TabulatedK tabulated(const Distribution1D& d) {
-        return {d.a_, d.b_, d.c0_, d.c1_, d.func_.data(), d.cdf_.data(), d.func_.size()};
+        return {d.a_,           d.b_,          d.c0_,           d.c1_,
+                d.func_.data(), d.cdf_.data(), d.guide_.data(), d.func_.size()};
     }
 
     /// Calls f with the kernel of d's kind: one switch, then f's loop runs on a concrete type.
@@ -658,12 +682,18 @@ void TabulatedDistribution2D::sample_block(const double* u1, const double* u2, d
         for (size_t i = 0; i < n; ++i) sample(u1[i], u2[i], x + i, y + i, pdf_out + i);
         return;
     }
-    marginal_.sample_block(u2, y, pdf_out, n); // pdf_out holds the marginal density for now
+    // The marginal and every conditional are tabulated: their kernels are used directly, so the
+    // loop has no dispatch per point. Results equal sample() point by point.
+    const TabulatedK marginal = Distribution1DFactory::tabulated(marginal_);
     const double y_scale = bin_scale(y0_, y1_, size_t(ny_));
+    const double x_scale = bin_scale(x0_, x1_, size_t(nx_));
+    for (size_t i = 0; i < n; ++i) y[i] = marginal.sample(u2[i]);
     for (size_t i = 0; i < n; ++i) {
-        size_t iy = bin_of(y[i], y0_, y_scale, size_t(ny_));
-        x[i] = conditional_[iy].sample(u1[i]);
-        pdf_out[i] = pdf(x[i], y[i]);
+        const size_t iy = bin_of(y[i], y0_, y_scale, size_t(ny_));
+        const TabulatedK row = Distribution1DFactory::tabulated(conditional_[iy]);
+        x[i] = row.sample(u1[i]);
+        const size_t ix = bin_of(x[i], x0_, x_scale, size_t(nx_));
+        pdf_out[i] = values_[iy * size_t(nx_) + ix] / total_; // pdf(x, y): both lie in the box
     }
 }
 

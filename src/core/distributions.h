@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -52,10 +53,11 @@ class Distribution1D {
     friend struct Distribution1DFactory;
     Dist1DKind kind_ = Dist1DKind::Uniform;
     double a_ = 0.0, b_ = 1.0;
-    double p0_ = 0.0, p1_ = 0.0; // kind-specific parameters and precomputed terms
-    double c0_ = 0.0, c1_ = 0.0; // (see the kernels in distributions.cpp)
-    std::vector<double> func_;   // tabulated: the normalised density of each bin
-    std::vector<double> cdf_;    // tabulated: cdf at bin edges, cdf_[0] = 0, back() = 1
+    double p0_ = 0.0, p1_ = 0.0;  // kind-specific parameters and precomputed terms
+    double c0_ = 0.0, c1_ = 0.0;  // (see the kernels in distributions.cpp)
+    std::vector<double> func_;    // tabulated: the normalised density of each bin
+    std::vector<double> cdf_;     // tabulated: cdf at bin edges, cdf_[0] = 0, back() = 1
+    std::vector<uint32_t> guide_; // tabulated: the bin of u = g / bins, g < bins
 };
 
 Made<Distribution1D> make_uniform(double a, double b);

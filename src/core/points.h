@@ -10,6 +10,15 @@ namespace mcp {
 /// block of a few dimensions stays in L1/L2 cache.
 constexpr size_t kBlockSize = 256;
 
+/// The largest double below 1: coordinates of points in [0, 1)^d never reach 1.
+constexpr double kOneMinusEpsilon = 0x1.fffffffffffffp-1;
+
+/// x kept inside [0, 1) for x >= 0 that may round up to 1, e.g. (c + xi) / k with xi close to 1
+/// and k large. x must not be NaN.
+inline double below_one(double x) {
+    return x < kOneMinusEpsilon ? x : kOneMinusEpsilon;
+}
+
 /// n points in dim dimensions; coordinate j of point i is at coord(j)[i].
 struct PointBlock {
     int dim = 0;

@@ -10,7 +10,6 @@ namespace mcp {
 
 namespace {
 
-constexpr double kOneMinusEpsilon = 0x1.fffffffffffffp-1;
 constexpr int kDigitBits = 32;             // Sobol' digits per coordinate
 constexpr int kFillBits = 53 - kDigitBits; // random bits below the digits
 constexpr uint64_t kMask53 = (uint64_t(1) << 53) - 1;
@@ -180,7 +179,7 @@ inline double low_bits_term(uint64_t k53) {
 inline double split_bits53_to_unit(uint32_t high, double low_plus_half_scaled) {
     const double h = static_cast<double>(static_cast<int32_t>(high ^ 0x80000000u)) + 0x1p31;
     const double x = h * 0x1p-32 + low_plus_half_scaled;
-    return x < 0x1p0 ? x : 0x1.fffffffffffffp-1;
+    return below_one(x);
 }
 
 inline uint64_t shifted_bits53(uint32_t digits, uint64_t shift) {

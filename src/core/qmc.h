@@ -82,7 +82,7 @@ uint32_t owen_scramble_u32(uint32_t v, uint32_t seed);
 /// top value 2^53 - 1 would round to 1, so it is kept at the largest double below 1.
 inline double bits53_to_unit(uint64_t k53) {
     const double x = (static_cast<double>(k53) + 0.5) * 0x1p-53;
-    return x < 1.0 ? x : 0x1.fffffffffffffp-1;
+    return below_one(x);
 }
 
 /// The random parameters of one randomization of one point set, drawn from a 64-bit key.

@@ -5,11 +5,6 @@
 
 namespace mcp {
 
-namespace {
-// (c + xi) / k rounds to 1 when k is large and xi close to 1; keep u inside [0, 1).
-constexpr double kOneMinusEpsilon = 0x1.fffffffffffffp-1;
-} // namespace
-
 const char* sampler_name(SamplerKind kind) {
     switch (kind) {
     case SamplerKind::Independent: return "independent";
@@ -199,8 +194,7 @@ void generate_block(const SamplerPlan& plan, uint64_t first, size_t count, Pcg32
         for (size_t i = 0; i < count; ++i) {
             for (int j = d - 1; j >= 0; --j) {
                 const double k = static_cast<double>(plan.strata[static_cast<size_t>(j)]);
-                u.coord(j)[i] = std::fmin((static_cast<double>(digits[j]) + rng.next_double()) / k,
-                                          kOneMinusEpsilon);
+                u.coord(j)[i] = below_one((static_cast<double>(digits[j]) + rng.next_double()) / k);
             }
             if (++within == plan.per_stratum) {
                 within = 0;
@@ -219,8 +213,7 @@ void generate_block(const SamplerPlan& plan, uint64_t first, size_t count, Pcg32
             for (int j = 0; j < d; ++j) {
                 uint64_t slab =
                     permute_index(index, plan.total, plan.perm_keys[static_cast<size_t>(j)]);
-                u.coord(j)[i] = std::fmin((static_cast<double>(slab) + rng.next_double()) * inv_n,
-                                          kOneMinusEpsilon);
+                u.coord(j)[i] = below_one((static_cast<double>(slab) + rng.next_double()) * inv_n);
             }
         }
         break;

@@ -8,12 +8,12 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/points.h"
 #include "core/special.h"
 
 namespace mcp {
 namespace {
 
-constexpr double kOneMinusEpsilon = 0x1.fffffffffffffp-1; // largest double below 1
 constexpr double kTwoPi = 2.0 * kPi;
 constexpr double kHalfPi = 0.5 * kPi;
 constexpr double kQuarterPi = 0.25 * kPi;

@@ -218,7 +218,7 @@ class PixelSampler {
     }
 
   private:
-    static double clamp_open(double u) { return u < 1.0 ? u : 0x1.fffffffffffffp-1; }
+    static double clamp_open(double u) { return below_one(u); }
 
     /// The permuted global index of the current sample in the dimension keyed by dim_key:
     /// the Morton index with its base-4 digits through a nested random permutation (each
