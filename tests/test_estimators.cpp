@@ -130,7 +130,10 @@ TEST(Convergence, ImportanceSamplingBeatsUniformAndPerfectPdfHasZeroVariance) {
                                            {"n_max", 1024},
                                            {"reps", 32}});
     StudyResult s = run(req);
-    EXPECT_LT(find(s, "importance").levels[0].variance * 20.0,
+    // Var[e^U] / Var[e^X / p(X)] with p proportional to e^(0.8 x) on [0, 1] is 0.24204 / 0.0093807
+    // = 25.8. The ratio of two sample variances of 32 replicates each is F(31, 31)-distributed
+    // around it: below 25.8 / 5 with probability about 1e-5 (log F has sd 0.36).
+    EXPECT_LT(find(s, "importance").levels[0].variance * 5.0,
               find(s, "uniform").levels[0].variance);
 
     // f = 3x^2 sampled from p = 3x^2 (power k = 2): every weight is exactly 1.

@@ -22,7 +22,7 @@ std::vector<std::vector<double>> generate_all(SamplerKind kind, int dim, uint64_
     std::vector<std::vector<double>> pts;
     for (uint64_t first = 0; first < n; first += block) {
         size_t count = static_cast<size_t>(std::min<uint64_t>(block, n - first));
-        generate_block(plan, first, count, rng, u);
+        generate_block(plan, first, count, u);
         for (size_t i = 0; i < count; ++i) {
             std::vector<double> p(static_cast<size_t>(dim));
             for (int j = 0; j < dim; ++j) p[static_cast<size_t>(j)] = u.coord(j)[i];
@@ -133,6 +133,56 @@ TEST(Samplers, BlockSizeDoesNotChangePoints) {
         auto b = generate_all(kind, 3, 1000, 42, 7);
         EXPECT_EQ(a, b) << sampler_name(kind);
     }
+}
+
+// A point is addressed by (plan, index, dimension): blocks generated backwards, one point at a
+// time, and sample_coordinate all give the points of the forward run, bit for bit.
+TEST(Samplers, PointsAreAddressableInAnyOrder) {
+    const SamplerKind kinds[] = {SamplerKind::Independent,    SamplerKind::Stratified,
+                                 SamplerKind::LatinHypercube, SamplerKind::Sobol,
+                                 SamplerKind::Halton,         SamplerKind::Lattice};
+    const int dim = 3;
+    const uint64_t n = 640;
+    for (SamplerKind kind : kinds) {
+        SamplerOptions options;
+        options.randomization =
+            default_randomization(is_qmc(kind) ? qmc_kind_of(kind) : QmcKind::Sobol);
+        options.randomizations = is_qmc(kind) ? 4 : 1;
+        Pcg32 rng(99, 5);
+        const SamplerPlan plan = make_sampler_plan(kind, dim, n, rng, options);
+        PointBlock forward, piece;
+        forward.reset(dim, n);
+        generate_block(plan, 0, n, forward);
+        piece.reset(dim, 100);
+        for (uint64_t end = n; end > 0;) { // backwards, in blocks of 100 (the first block 40)
+            const uint64_t first = end >= 100 ? end - 100 : 0;
+            generate_block(plan, first, size_t(end - first), piece);
+            for (uint64_t i = first; i < end; ++i)
+                for (int j = 0; j < dim; ++j)
+                    ASSERT_EQ(piece.coord(j)[i - first], forward.coord(j)[i])
+                        << sampler_name(kind) << " point " << i << " dim " << j;
+            end = first;
+        }
+        for (uint64_t i : {uint64_t(0), uint64_t(1), uint64_t(159), uint64_t(160), n - 1})
+            for (int j = 0; j < dim; ++j)
+                ASSERT_EQ(sample_coordinate(plan, i, j), forward.coord(j)[i])
+                    << sampler_name(kind) << " point " << i << " dim " << j;
+    }
+}
+
+// Two runs planned in turn from one generator draw different jitter.
+TEST(Samplers, PlansFromOneGeneratorAreDistinct) {
+    Pcg32 rng(7, 7);
+    const SamplerPlan a = make_sampler_plan(SamplerKind::Independent, 2, 64, rng);
+    const SamplerPlan b = make_sampler_plan(SamplerKind::Independent, 2, 64, rng);
+    PointBlock ua, ub;
+    ua.reset(2, 64);
+    ub.reset(2, 64);
+    generate_block(a, 0, 64, ua);
+    generate_block(b, 0, 64, ub);
+    int equal = 0;
+    for (size_t i = 0; i < 64; ++i) equal += ua.coord(0)[i] == ub.coord(0)[i];
+    EXPECT_EQ(equal, 0);
 }
 
 TEST(Samplers, ParseNames) {

@@ -165,13 +165,62 @@ SamplerPlan make_sampler_plan(SamplerKind kind, int dim, uint64_t n, Pcg32& rng,
             plan.perm_keys.push_back((hi << 32) | lo);
         }
     }
+    if (!is_qmc(kind)) {
+        // Its own seed and stream: two plans drawn in turn from one generator never share draws.
+        const uint64_t seed = (uint64_t(rng.next_u32()) << 32) | rng.next_u32();
+        const uint64_t stream = (uint64_t(rng.next_u32()) << 32) | rng.next_u32();
+        plan.jitter = Pcg32(seed, stream);
+    }
     return plan;
 }
 
-void generate_block(const SamplerPlan& plan, uint64_t first, size_t count, Pcg32& rng,
-                    PointBlock& u) {
+namespace {
+
+// The digits of cell `cell` in the mixed radix of the strata, last axis fastest.
+void cell_digits(const SamplerPlan& plan, uint64_t cell, uint64_t* digits) {
+    for (int j = plan.dim - 1; j >= 0; --j) {
+        const uint64_t k = plan.strata[static_cast<size_t>(j)];
+        digits[j] = cell % k;
+        cell /= k;
+    }
+}
+
+double stratified_coordinate(const SamplerPlan& plan, const uint64_t* digits, int j, double xi) {
+    const double k = static_cast<double>(plan.strata[static_cast<size_t>(j)]);
+    return below_one((static_cast<double>(digits[j]) + xi) / k);
+}
+
+double latin_coordinate(const SamplerPlan& plan, uint64_t index, int j, double xi) {
+    const uint64_t slab = permute_index(index, plan.total, plan.perm_keys[static_cast<size_t>(j)]);
+    return below_one((static_cast<double>(slab) + xi) / static_cast<double>(plan.total));
+}
+
+} // namespace
+
+double sample_coordinate(const SamplerPlan& plan, uint64_t index, int dim) {
+    if (is_qmc(plan.kind)) {
+        size_t batch = 0;
+        while (batch + 1 < plan.batches() && plan.batch_begin(batch + 1) <= index) ++batch;
+        return qmc_coordinate(plan.randomizers[batch], index - plan.batch_begin(batch), dim);
+    }
+    Pcg32 g = plan.jitter_at(index);
+    g.advance(2 * dim);
+    const double xi = g.next_double();
+    switch (plan.kind) {
+    case SamplerKind::Stratified: {
+        uint64_t digits[64];
+        cell_digits(plan, index / plan.per_stratum, digits);
+        return stratified_coordinate(plan, digits, dim, xi);
+    }
+    case SamplerKind::LatinHypercube: return latin_coordinate(plan, index, dim, xi);
+    default: return xi;
+    }
+}
+
+void generate_block(const SamplerPlan& plan, uint64_t first, size_t count, PointBlock& u) {
     u.n = count;
     const int d = plan.dim;
+    Pcg32 rng = is_qmc(plan.kind) ? Pcg32() : plan.jitter_at(first);
     switch (plan.kind) {
     case SamplerKind::Independent:
         // Point-major draw order so that a point's coordinates come from consecutive draws.
@@ -185,17 +234,11 @@ void generate_block(const SamplerPlan& plan, uint64_t first, size_t count, Pcg32
         // An odometer over the cells: the digits of the block's first cell once (divisions),
         // then one increment per cell (no division per sample).
         uint64_t digits[64];
-        uint64_t cell = first / plan.per_stratum, within = first % plan.per_stratum;
-        for (int j = d - 1; j >= 0; --j) {
-            const uint64_t k = plan.strata[static_cast<size_t>(j)];
-            digits[j] = cell % k;
-            cell /= k;
-        }
+        uint64_t within = first % plan.per_stratum;
+        cell_digits(plan, first / plan.per_stratum, digits);
         for (size_t i = 0; i < count; ++i) {
-            for (int j = d - 1; j >= 0; --j) {
-                const double k = static_cast<double>(plan.strata[static_cast<size_t>(j)]);
-                u.coord(j)[i] = below_one((static_cast<double>(digits[j]) + rng.next_double()) / k);
-            }
+            for (int j = 0; j < d; ++j)
+                u.coord(j)[i] = stratified_coordinate(plan, digits, j, rng.next_double());
             if (++within == plan.per_stratum) {
                 within = 0;
                 for (int j = d - 1; j >= 0; --j) {
@@ -206,18 +249,11 @@ void generate_block(const SamplerPlan& plan, uint64_t first, size_t count, Pcg32
         }
         break;
     }
-    case SamplerKind::LatinHypercube: {
-        const double inv_n = 1.0 / static_cast<double>(plan.total);
-        for (size_t i = 0; i < count; ++i) {
-            uint64_t index = first + i;
-            for (int j = 0; j < d; ++j) {
-                uint64_t slab =
-                    permute_index(index, plan.total, plan.perm_keys[static_cast<size_t>(j)]);
-                u.coord(j)[i] = below_one((static_cast<double>(slab) + rng.next_double()) * inv_n);
-            }
-        }
+    case SamplerKind::LatinHypercube:
+        for (size_t i = 0; i < count; ++i)
+            for (int j = 0; j < d; ++j)
+                u.coord(j)[i] = latin_coordinate(plan, first + i, j, rng.next_double());
         break;
-    }
     case SamplerKind::Sobol:
     case SamplerKind::Halton:
     case SamplerKind::Lattice: {

@@ -74,13 +74,24 @@ struct SamplerPlan {
     /// Quasi-Monte Carlo: one randomization per batch; batch k holds points
     /// [batch_begin(k), batch_begin(k + 1)) of the run.
     std::vector<QmcRandomizer> randomizers;
+    /// Independent, stratified and Latin hypercube runs: the generator of the jitter at the
+    /// run's first draw. Coordinate j of point i is the double drawn at steps 2 (i dim + j) and
+    /// 2 (i dim + j) + 1 of its sequence, so every coordinate of every point is addressable
+    /// (jitter_at jumps there in O(log N)): blocks may be generated in any order, by any thread.
+    Pcg32 jitter;
     size_t batches() const { return randomizers.size(); }
+    /// The jitter generator positioned at the first draw of point `index`.
+    Pcg32 jitter_at(uint64_t index) const {
+        Pcg32 g = jitter;
+        g.advance(static_cast<int64_t>(2 * index * static_cast<uint64_t>(dim)));
+        return g;
+    }
     // total x k stays far below 2^64: runs are at most 2^36 points and k <= 1024.
     uint64_t batch_begin(size_t k) const { return total * k / randomizers.size(); }
 };
 
-/// Plans a run of n points in dim dimensions. Latin hypercube keys and the keys of the
-/// quasi-Monte Carlo randomizations are drawn from rng.
+/// Plans a run of n points in dim dimensions. Latin hypercube keys, the keys of the
+/// quasi-Monte Carlo randomizations and the seed and stream of the jitter are drawn from rng.
 /// Stratified runs put per_stratum points in each of n / per_stratum cells (n must be a
 /// multiple of per_stratum; points 2c and 2c+1 share cell c when per_stratum = 2).
 /// Quasi-Monte Carlo runs are min(K, n) batches of (nearly) equal size, each the first points
@@ -88,10 +99,12 @@ struct SamplerPlan {
 SamplerPlan make_sampler_plan(SamplerKind kind, int dim, uint64_t n, Pcg32& rng,
                               const SamplerOptions& options = {});
 
-/// Writes points first .. first + count - 1 of the run into u (count <= u.capacity),
-/// drawing jitter from rng. Consecutive calls must cover the run in order (quasi-Monte Carlo
-/// points draw nothing from rng and may come in any order).
-void generate_block(const SamplerPlan& plan, uint64_t first, size_t count, Pcg32& rng,
-                    PointBlock& u);
+/// Writes points first .. first + count - 1 of the run into u (count <= u.capacity). Blocks
+/// may come in any order: a point depends on the plan and its index alone.
+void generate_block(const SamplerPlan& plan, uint64_t first, size_t count, PointBlock& u);
+
+/// Coordinate `dim` of point `index` of the run, equal bit for bit to what generate_block
+/// writes (random access; the slow path for tests and single points).
+double sample_coordinate(const SamplerPlan& plan, uint64_t index, int dim);
 
 } // namespace mcp

@@ -35,21 +35,22 @@ struct SampleBlock {
 void prepare_workspace(const Domain& domain, Workspace& ws);
 
 /// Samples first .. first + count - 1 of the plan (count <= kBlockSize; the workspace prepared
-/// for the domain): generate -> warp -> evaluate. Randomness is drawn from rng in order.
+/// for the domain): generate -> warp -> evaluate. The points depend on the plan and their
+/// indices alone, so blocks may come in any order.
 SampleBlock sample_block(const Problem& problem, const Proposal& proposal, const SamplerPlan& plan,
-                         uint64_t first, size_t count, Pcg32& rng, Workspace& ws);
+                         uint64_t first, size_t count, Workspace& ws);
 
 /// Samples 0 .. plan.total - 1 of the plan, block by block, calling consume(const SampleBlock&)
 /// for each.
 template <class Consume>
 void for_each_block(const Problem& problem, const Proposal& proposal, const SamplerPlan& plan,
-                    Pcg32& rng, Workspace& ws, Consume&& consume) {
+                    Workspace& ws, Consume&& consume) {
     prepare_workspace(problem.domain, ws);
     const uint64_t n = plan.total;
     for (uint64_t first = 0; first < n; first += kBlockSize) {
         const size_t count = static_cast<size_t>(std::min<uint64_t>(kBlockSize, n - first));
         consume(static_cast<const SampleBlock&>(
-            sample_block(problem, proposal, plan, first, count, rng, ws)));
+            sample_block(problem, proposal, plan, first, count, ws)));
     }
 }
 

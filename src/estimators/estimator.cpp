@@ -80,8 +80,8 @@ void prepare_workspace(const Domain& domain, Workspace& ws) {
 }
 
 SampleBlock sample_block(const Problem& problem, const Proposal& proposal, const SamplerPlan& plan,
-                         uint64_t first, size_t count, Pcg32& rng, Workspace& ws) {
-    generate_block(plan, first, count, rng, ws.u);
+                         uint64_t first, size_t count, Workspace& ws) {
+    generate_block(plan, first, count, ws.u);
     warp_block(proposal, problem.domain, ws.u, ws.x, ws.pdf.data());
     evaluate_block(problem.integrand, ws.x, ws.f.data());
     SampleBlock block;
@@ -119,7 +119,7 @@ class FixedEstimator final : public EstimatorAlgorithm {
         }
         const size_t count =
             static_cast<size_t>(std::min<uint64_t>(kBlockSize, plan_.total - next_));
-        const SampleBlock b = sample_block(problem_, spec_.proposal, plan_, next_, count, rng, ws);
+        const SampleBlock b = sample_block(problem_, spec_.proposal, plan_, next_, count, ws);
         accumulator_.add_block(b.first, b.f, b.pdf, b.pdf, b.count); // weights overwrite p
         next_ += count;
         return true;

@@ -274,7 +274,7 @@ SupportCheck check_support(const Problem& problem, const EstimatorSpec& spec, ui
         make_sampler_plan(SamplerKind::Independent, d.sample_dim(), probes, rng);
     NeumaierSum all, missed, covered;
     Workspace ws;
-    for_each_block(problem, uniform, plan, rng, ws, [&](const SampleBlock& b) {
+    for_each_block(problem, uniform, plan, ws, [&](const SampleBlock& b) {
         const size_t count = b.count;
         const double* f = b.f;
         double* p = b.pdf; // the uniform densities, replaced by the proposal's
@@ -707,7 +707,7 @@ SampleDump dump_samples(const Problem& problem, const EstimatorSpec& spec, uint6
     dump.per_stratum = plan.per_stratum;
     dump.randomizations = plan.batches();
     Workspace ws;
-    for_each_block(problem, spec.proposal, plan, rng, ws, [&](const SampleBlock& blk) {
+    for_each_block(problem, spec.proposal, plan, ws, [&](const SampleBlock& blk) {
         for (size_t i = 0; i < blk.count; ++i) {
             for (int j = 0; j < dump.sample_dim; ++j) dump.u.push_back(blk.u->coord(j)[i]);
             for (int j = 0; j < dump.point_dim; ++j) dump.x.push_back(blk.x->coord(j)[i]);
