@@ -206,6 +206,7 @@ TEST(RenderError, ReferenceFloorHasItsClosedForm) {
     im.seconds = 0.1;
     std::vector<ImageSummary> images{summarise_image(im, ref), summarise_image(im, ref)};
     LevelStats l = render_level_stats(images, ref);
+    EXPECT_EQ(l.measure, LevelMeasure::RelativeMse);
     EXPECT_NEAR(l.variance, -relative_mse_floor(ref), 1e-15);
     EXPECT_TRUE(below_reference_noise(l, relative_mse_floor(ref)));
     EXPECT_TRUE(std::isnan(l.efficiency));
@@ -226,6 +227,7 @@ TEST(RenderError, ReferenceFloorHasItsClosedForm) {
     ConvergenceFit all = fit_render_convergence(levels, 0.0);
     EXPECT_EQ(all.levels_used, 4);
     ConvergenceFit fit = fit_render_convergence(levels, 0.15);
+    EXPECT_EQ(fit.measure, LevelMeasure::RelativeMse);
     EXPECT_EQ(fit.levels_used, 3);
     EXPECT_NEAR(fit.order, -1.0, 1e-12);
 }

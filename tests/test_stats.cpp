@@ -60,3 +60,25 @@ TEST(Stats, LineFitExactAndUncertainty) {
     EXPECT_LT(std::fabs(g.slope - 0.5), 4.0 * g.slope_se);
     EXPECT_GT(g.slope_se, 0.0);
 }
+
+TEST(Stats, WeightedLineFit) {
+    // Four points on y = 1 - x with sd 0.1 and one far off with sd 1e3: the fit follows the four.
+    std::vector<double> x{0, 1, 2, 3, 4}, y{1, 0, -1, -2, 100}, sd{0.1, 0.1, 0.1, 0.1, 1e3};
+    LineFit f = fit_weighted_line(x, y, sd);
+    EXPECT_NEAR(f.slope, -1.0, 1e-3);
+    EXPECT_NEAR(f.intercept, 1.0, 1e-3);
+    // Residuals within the stated sd: the slope's error is the sd's, 1 / sqrt(S_xx^w) (the far
+    // point adds almost nothing to S_xx^w = 100 (sum of (x - 1.5)^2 over the four) = 500).
+    EXPECT_NEAR(f.slope_se, 1.0 / std::sqrt(500.0), 1e-4);
+    // Points scattered 10x beyond their stated sd: the error grows by about sqrt(chi^2 / dof).
+    std::vector<double> ys{1.5, -0.5, -0.5, -2.5}, xs{0, 1, 2, 3}, sds{0.1, 0.1, 0.1, 0.1};
+    LineFit g = fit_weighted_line(xs, ys, sds);
+    LineFit u = fit_line(xs, ys);
+    EXPECT_NEAR(g.slope, u.slope, 1e-12);       // equal weights: the unweighted slope
+    EXPECT_NEAR(g.slope_se, u.slope_se, 1e-12); // and, residuals dominating, its error
+    EXPECT_GT(g.residual_variance, 1.0);
+    // An unknown sd falls back to the unweighted fit.
+    LineFit h = fit_weighted_line(xs, ys, {0.1, 0.0, 0.1, 0.1});
+    EXPECT_EQ(h.slope, u.slope);
+    EXPECT_EQ(h.slope_se, u.slope_se);
+}

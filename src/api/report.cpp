@@ -216,6 +216,7 @@ bool jbool(const Json& j, const char* key) {
 Json level_to_json(const LevelStats& l) {
     Json j{{"n", l.n},
            {"reps", l.reps},
+           {"measure", level_measure_name(l.measure)},
            {"mean", num(l.mean)},
            {"variance", num(l.variance)},
            {"variance_ci95", {num(l.variance_lo), num(l.variance_hi)}},
@@ -256,6 +257,7 @@ Json level_to_json(const LevelStats& l) {
 
 Json fit_to_json(const ConvergenceFit& f) {
     return Json{{"valid", f.valid},
+                {"measure", level_measure_name(f.measure)},
                 {"order", f.valid ? num(f.order) : Json(nullptr)},
                 {"order_se", f.valid ? num(f.order_se) : Json(nullptr)},
                 {"intercept", f.valid ? num(f.intercept) : Json(nullptr)},

@@ -1,5 +1,8 @@
 #include "core/stats.h"
 
+#include <algorithm>
+#include <cmath>
+
 namespace mcp {
 
 void RunningMoments::add_block(const double* x, size_t n) {
@@ -71,6 +74,44 @@ LineFit fit_line(const std::vector<double>& x, const std::vector<double>& y) {
         fit.residual_variance = ss / static_cast<double>(n - 2);
         fit.slope_se = std::sqrt(fit.residual_variance / sxx);
     }
+    return fit;
+}
+
+LineFit fit_weighted_line(const std::vector<double>& x, const std::vector<double>& y,
+                          const std::vector<double>& sd) {
+    const size_t n = x.size();
+    bool weighted = sd.size() == n && n > 0;
+    for (size_t i = 0; weighted && i < n; ++i) weighted = sd[i] > 0.0 && std::isfinite(sd[i]);
+    if (!weighted) return fit_line(x, y);
+    LineFit fit;
+    fit.points = static_cast<int>(n);
+    if (n < 2 || y.size() != n) return fit;
+    double sw = 0.0, mx = 0.0, my = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+        const double w = 1.0 / (sd[i] * sd[i]);
+        sw += w;
+        mx += w * x[i];
+        my += w * y[i];
+    }
+    mx /= sw;
+    my /= sw;
+    double sxx = 0.0, sxy = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+        const double w = 1.0 / (sd[i] * sd[i]);
+        sxx += w * (x[i] - mx) * (x[i] - mx);
+        sxy += w * (x[i] - mx) * (y[i] - my);
+    }
+    if (!(sxx > 0.0)) return fit;
+    fit.sxx = sxx;
+    fit.slope = sxy / sxx;
+    fit.intercept = my - fit.slope * mx;
+    double chi2 = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+        const double r = (y[i] - (fit.intercept + fit.slope * x[i])) / sd[i];
+        chi2 += r * r;
+    }
+    fit.residual_variance = n > 2 ? chi2 / static_cast<double>(n - 2) : 0.0;
+    fit.slope_se = std::sqrt(std::max(1.0, fit.residual_variance) / sxx);
     return fit;
 }
 

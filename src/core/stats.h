@@ -74,4 +74,12 @@ struct LineFit {
 /// Fits a line through (x[i], y[i]); needs at least two distinct x.
 LineFit fit_line(const std::vector<double>& x, const std::vector<double>& y);
 
+/// Weighted least squares through (x[i], y[i]) where y[i] has standard deviation sd[i] > 0
+/// (weights 1 / sd^2). slope_se is the slope's standard error from those deviations, inflated
+/// by sqrt(chi^2 / dof) when the residuals exceed them; residual_variance is chi^2 / dof and
+/// sxx the weighted sum of squares. With sd empty, or any sd not positive and finite, it is
+/// fit_line (unit weights, slope_se from the residuals alone).
+LineFit fit_weighted_line(const std::vector<double>& x, const std::vector<double>& y,
+                          const std::vector<double>& sd);
+
 } // namespace mcp

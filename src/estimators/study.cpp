@@ -512,10 +512,33 @@ LevelStats summarise_level(const std::vector<RunResult>& runs, const Problem& pr
     return s;
 }
 
-ConvergenceFit fit_convergence(const std::vector<LevelStats>& levels) {
+const char* level_measure_name(LevelMeasure m) {
+    return m == LevelMeasure::RelativeMse ? "relative_mse" : "variance";
+}
+
+ConvergenceFit fit_power_law(const std::vector<FitPoint>& points, LevelMeasure measure) {
     ConvergenceFit fit;
-    std::vector<double> x, y;
-    int reps = 0, skipped = 0, missing = 0;
+    fit.measure = measure;
+    fit.levels_used = static_cast<int>(points.size());
+    if (points.size() < 3) return fit;
+    std::vector<double> x, y, sd;
+    for (const FitPoint& p : points) {
+        x.push_back(std::log(static_cast<double>(p.n)));
+        y.push_back(std::log(p.value));
+        sd.push_back(p.sd_log);
+    }
+    const LineFit line = fit_weighted_line(x, y, sd);
+    if (!(line.sxx > 0.0)) return fit;
+    fit.valid = true;
+    fit.order = line.slope;
+    fit.intercept = line.intercept;
+    fit.order_se = line.slope_se;
+    return fit;
+}
+
+ConvergenceFit fit_convergence(const std::vector<LevelStats>& levels) {
+    std::vector<FitPoint> points;
+    int skipped = 0, missing = 0;
     for (const LevelStats& l : levels) {
         if (!std::isfinite(l.mean) || !std::isfinite(l.variance) || l.variance < 0.0) {
             ++missing; // no estimate at this N (every sample NaN/Inf, or an overflow)
@@ -525,35 +548,27 @@ ConvergenceFit fit_convergence(const std::vector<LevelStats>& levels) {
         // proportional to f) carries no convergence information.
         const double roundoff = 64.0 * 2.220446049250313e-16 * std::fabs(l.mean);
         if (l.variance > roundoff * roundoff && std::isfinite(l.variance)) {
-            x.push_back(std::log(static_cast<double>(l.n)));
-            y.push_back(std::log(l.variance));
-            reps = l.reps;
+            const double sd_log = l.reps > 1 ? std::sqrt(trigamma(0.5 * (l.reps - 1))) : 0.0;
+            points.push_back({l.n, l.variance, sd_log});
         } else {
             ++skipped;
         }
     }
-    fit.levels_used = static_cast<int>(x.size());
+    ConvergenceFit fit = fit_power_law(points, LevelMeasure::Variance);
     if (skipped)
         fit.note = std::to_string(skipped) + " level(s) with zero (round-off) variance left out";
     if (missing)
         fit.note += (fit.note.empty() ? "" : "; ") + std::to_string(missing) +
                     " level(s) without an estimate left out";
-    if (x.size() < 3) {
-        if (x.empty() && skipped && !missing)
+    if (points.size() < 3) {
+        if (points.empty() && skipped && !missing)
             fit.note = "variance is zero at every N (an exact estimator?)";
-        else if (x.empty() && missing && !skipped)
+        else if (points.empty() && missing && !skipped)
             fit.note = "no estimate at any N: no fit";
         else
             fit.note = "fewer than 3 levels with a variance: no fit" +
                        (fit.note.empty() ? "" : "; " + fit.note);
-        return fit;
     }
-    LineFit line = fit_line(x, y);
-    fit.valid = true;
-    fit.order = line.slope;
-    fit.intercept = line.intercept;
-    const double noise = reps > 1 ? trigamma(0.5 * (reps - 1)) : 0.0;
-    fit.order_se = std::sqrt(std::fmax(line.residual_variance, noise) / line.sxx);
     return fit;
 }
 
@@ -649,27 +664,15 @@ StudyResult run_study(const Problem& problem, const std::vector<EstimatorSpec>& 
         result.estimators.push_back(es);
     }
     const std::vector<uint64_t> ladder = n_ladder(settings.n_min, settings.n_max);
-    const size_t n_est = estimators.size();
     const size_t reps = static_cast<size_t>(settings.reps);
-
-    for (size_t level = 0; level < ladder.size(); ++level) {
-        const uint64_t n = ladder[level];
-        const size_t tasks = n_est * reps;
-        std::vector<RunResult> runs(tasks);
-        std::atomic<size_t> next{0};
-        auto worker = [&](int) {
-            Workspace ws;
-            for (size_t t = next++; t < tasks; t = next++) {
-                const size_t e = t / reps;
-                const int r = static_cast<int>(t % reps);
-                Pcg32 rng = replicate_rng(settings.seed, estimators[e].name, n, r);
-                runs[t] = run_estimate(problem, estimators[e], n, rng, ws, settings.accumulator);
-            }
-        };
-        const int threads =
-            static_cast<int>(std::min<size_t>(static_cast<size_t>(result.threads_used), tasks));
-        run_workers(threads, worker);
-        for (size_t e = 0; e < n_est; ++e) {
+    std::vector<Workspace> workspaces(static_cast<size_t>(std::max(result.threads_used, 1)));
+    auto run = [&](size_t e, uint64_t n, int r, int worker) {
+        Pcg32 rng = replicate_rng(settings.seed, estimators[e].name, n, r);
+        return run_estimate(problem, estimators[e], n, rng, workspaces[size_t(worker)],
+                            settings.accumulator);
+    };
+    auto end_level = [&](size_t level, const std::vector<RunResult>& runs) {
+        for (size_t e = 0; e < estimators.size(); ++e) {
             std::vector<RunResult> level_runs(runs.begin() + static_cast<long>(e * reps),
                                               runs.begin() + static_cast<long>((e + 1) * reps));
             EstimatorStudy& es = result.estimators[e];
@@ -679,11 +682,10 @@ StudyResult run_study(const Problem& problem, const std::vector<EstimatorSpec>& 
         }
         result.wall_seconds =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        if (progress && !progress(result, level)) {
-            result.cancelled = level + 1 < ladder.size();
-            break;
-        }
-    }
+        return !progress || progress(result, level);
+    };
+    result.cancelled = !run_ladder<RunResult>(ladder, estimators.size(), settings.reps,
+                                              result.threads_used, run, end_level);
     result.wall_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return result;

@@ -1,6 +1,8 @@
 // Convergence study: every estimator at every N of a ladder of powers of two, R independent
 // replicates each, summarised by level (variance of the estimator, bias, RMSE, coverage,
-// time, efficiency) and by a fitted convergence order.
+// time, efficiency) and by a fitted convergence order. The ladder, the replicate keys, the
+// thread pool and the fit are the machinery of integration and render studies alike
+// (run_ladder, replicate_rng, fit_power_law; render/render_study.h measures images with them).
 //
 // Randomness: replicate r of estimator e at level N draws from its own PCG32 generator, whose
 // state and stream both derive from a hash of (seed, name of e, N, r). Results are therefore
@@ -8,11 +10,13 @@
 // ones that remain.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
 
+#include "core/parallel.h"
 #include "core/stats.h"
 #include "estimators/block_driver.h"
 #include "estimators/estimator.h"
@@ -48,10 +52,20 @@ std::string check_study_size(const StudySettings& s, size_t estimators);
 /// The N ladder: powers of two from the first >= n_min up to n_max.
 std::vector<uint64_t> n_ladder(uint64_t n_min, uint64_t n_max);
 
+/// What a level's `variance` (with variance_lo/hi and efficiency) and its study's fitted order
+/// measure.
+enum class LevelMeasure {
+    Variance,    ///< integrals: the variance of the estimate across replicates
+    RelativeMse, ///< renders: the images' relative MSE against the reference (render_study.h)
+};
+/// "variance", "relative_mse".
+const char* level_measure_name(LevelMeasure m);
+
 struct LevelStats {
     uint64_t n = 0;
     int reps = 0;
-    double mean = 0.0;        ///< mean of the R estimates
+    LevelMeasure measure = LevelMeasure::Variance; ///< what `variance` is
+    double mean = 0.0;                             ///< mean of the R estimates
     double variance = 0.0;    ///< unbiased variance of the estimator across replicates
     double variance_lo = 0.0; ///< 95% interval of the variance (chi-square, normal estimates)
     double variance_hi = 0.0;
@@ -83,16 +97,32 @@ struct LevelStats {
 
 struct ConvergenceFit {
     bool valid = false;
-    double order = 0.0;    ///< slope of log variance against log N
+    LevelMeasure measure = LevelMeasure::Variance; ///< what was fitted against N
+    double order = 0.0;    ///< slope of log variance (or the measure) against log N
     double order_se = 0.0; ///< its standard error
     double intercept = 0.0;
     int levels_used = 0;
     std::string note; ///< why the fit is missing or partial
 };
 
+/// One level in a convergence fit: value (> 0) at n, and the standard deviation of log value
+/// (0 when unknown).
+struct FitPoint {
+    uint64_t n = 0;
+    double value = 0.0;
+    double sd_log = 0.0;
+};
+
+/// The one convergence fit of the project: order and intercept of value ~ n^order by weighted
+/// least squares of log value on log n (weights 1 / sd_log^2; the slope's standard error from
+/// them, inflated by the residuals when they exceed them; unit weights and the residuals alone
+/// when an sd_log is unknown). Needs 3 points at 2 distinct n; levels_used = points.size().
+ConvergenceFit fit_power_law(const std::vector<FitPoint>& points, LevelMeasure measure);
+
 /// Least-squares fit of log variance against log N over the levels with a positive finite
-/// variance. The slope's standard error is the larger of the residual estimate and the
-/// sampling noise of log s^2 for R normal replicates, psi'((R-1)/2) [trigamma].
+/// variance (fit_power_law). Every level's log s^2 has the sampling noise of R normal
+/// replicates, variance psi'((R-1)/2) [trigamma], so the weights are equal and the slope's
+/// standard error is the larger of the residual estimate and that noise.
 ConvergenceFit fit_convergence(const std::vector<LevelStats>& levels);
 
 /// Does the proposal cover the integrand's support? Checked once per estimator: where f != 0
@@ -177,6 +207,30 @@ Pcg32 replicate_rng(uint64_t seed, const std::string& estimator, uint64_t n, int
 
 StudyResult run_study(const Problem& problem, const std::vector<EstimatorSpec>& estimators,
                       const StudySettings& settings, const StudyProgress& progress = {});
+
+/// The study loop of integrals and renders: for each N of the ladder in turn, replicate r of
+/// estimator e (task e * reps + r) runs as results[task] = run(e, N, r, worker) on the thread
+/// pool (`threads` workers, each with its index for its own scratch space), then
+/// end_level(level_index, results) summarises the level; it returns false to stop the study.
+/// Results are placed by task, so they do not depend on the thread count or the order the
+/// tasks finish in. Returns false when end_level stopped it before the last level.
+template <class Result, class Run, class EndLevel>
+bool run_ladder(const std::vector<uint64_t>& ladder, size_t estimators, int reps, int threads,
+                Run&& run, EndLevel&& end_level) {
+    const size_t r = static_cast<size_t>(reps > 0 ? reps : 0), tasks = estimators * r;
+    for (size_t level = 0; level < ladder.size(); ++level) {
+        std::vector<Result> results(tasks);
+        std::atomic<size_t> next{0};
+        const int workers = static_cast<int>(
+            std::max<size_t>(1, std::min<size_t>(threads > 0 ? size_t(threads) : 1, tasks)));
+        run_workers(workers, [&](int worker) {
+            for (size_t t = next++; t < tasks; t = next++)
+                results[t] = run(t / r, ladder[level], static_cast<int>(t % r), worker);
+        });
+        if (!end_level(level, results)) return level + 1 == ladder.size();
+    }
+    return true;
+}
 
 /// Threads the study will use for a requested count (0 = hardware); 1 where the build
 /// has no threads (WebAssembly without pthreads).

@@ -145,10 +145,6 @@ std::vector<Flag> render_flags(const RenderEstimatorStudy& s, double floor) {
     return flags;
 }
 
-uint64_t render_stream(uint64_t seed, const std::string& estimator, uint64_t spp, int rep) {
-    return replicate_stream(seed, estimator, spp, rep); // the integration studies' key
-}
-
 ImageSummary summarise_image(const RenderImage& image, const RenderImage& reference) {
     return ImageSummary{image_error(image, reference), image.diagnostics, image.seconds, image.spp};
 }
@@ -156,6 +152,7 @@ ImageSummary summarise_image(const RenderImage& image, const RenderImage& refere
 LevelStats render_level_stats(const std::vector<ImageSummary>& images,
                               const RenderImage& reference) {
     LevelStats l;
+    l.measure = LevelMeasure::RelativeMse;
     l.reps = int(images.size());
     if (images.empty()) return l;
     l.n = images[0].spp;
@@ -215,55 +212,23 @@ LevelStats render_level_stats(const std::vector<ImageSummary>& images,
 }
 
 ConvergenceFit fit_render_convergence(const std::vector<LevelStats>& levels, double floor) {
-    // Weighted least squares of y = log relMSE on x = log spp, each level weighted by the
-    // inverse variance of its log, (se / relMSE)^2 by the delta method, with se from the
-    // spread of its replicates; the slope's standard error is inflated by the residuals when
-    // they exceed that noise (chi2 / dof > 1).
-    ConvergenceFit fit;
-    std::vector<double> x, y, w;
+    // Each level's log relMSE has standard deviation se / relMSE by the delta method, with se
+    // from the spread of its replicates (floored at 1e-3: a level is never trusted beyond that).
+    std::vector<FitPoint> points;
     for (const LevelStats& l : levels) {
-        double rel = l.variance;
-        double se = (l.variance_hi - l.variance_lo) / 2.0;
-        double t = l.reps > 1 ? student_t_quantile(0.975, double(l.reps - 1)) : NAN;
-        se /= t;
+        const double rel = l.variance;
+        const double t = l.reps > 1 ? student_t_quantile(0.975, double(l.reps - 1)) : NAN;
+        const double se = (l.variance_hi - l.variance_lo) / 2.0 / t;
         if (!(rel > 0.0) || !std::isfinite(rel) || !(se > 0.0) || below_reference_noise(l, floor))
             continue;
-        double sd_log = std::max(se / rel, 1e-3);
-        x.push_back(std::log(double(l.n)));
-        y.push_back(std::log(rel));
-        w.push_back(1.0 / (sd_log * sd_log));
+        points.push_back({l.n, rel, std::max(se / rel, 1e-3)});
     }
-    fit.levels_used = int(x.size());
-    if (x.size() < 3) {
+    ConvergenceFit fit = fit_power_law(points, LevelMeasure::RelativeMse);
+    if (points.size() < 3)
         fit.note = "fewer than 3 levels with a positive relative MSE above the reference's noise";
-        return fit;
-    }
-    double sw = 0.0, sx = 0.0, sy = 0.0;
-    for (size_t i = 0; i < x.size(); ++i) {
-        sw += w[i];
-        sx += w[i] * x[i];
-        sy += w[i] * y[i];
-    }
-    double mx = sx / sw, my = sy / sw, sxx = 0.0, sxy = 0.0;
-    for (size_t i = 0; i < x.size(); ++i) {
-        sxx += w[i] * (x[i] - mx) * (x[i] - mx);
-        sxy += w[i] * (x[i] - mx) * (y[i] - my);
-    }
-    if (!(sxx > 0.0)) {
+    else if (!fit.valid)
         fit.note = "all levels at one spp";
-        return fit;
-    }
-    fit.order = sxy / sxx;
-    fit.intercept = my - fit.order * mx;
-    double chi2 = 0.0;
-    for (size_t i = 0; i < x.size(); ++i) {
-        double r = y[i] - fit.intercept - fit.order * x[i];
-        chi2 += w[i] * r * r;
-    }
-    double dof = double(x.size()) - 2.0;
-    fit.order_se = std::sqrt(1.0 / sxx) * std::sqrt(std::max(1.0, chi2 / dof));
-    fit.valid = true;
-    if (fit.levels_used < int(levels.size()))
+    else if (fit.levels_used < int(levels.size()))
         fit.note = "levels at or below the reference's noise are left out";
     return fit;
 }
@@ -284,33 +249,43 @@ RenderStudyResult run_render_study(const RenderScene& rs,
         s.estimator = e;
         result.estimators.push_back(s);
     }
-    std::vector<uint64_t> ladder = n_ladder(settings.spp_min, settings.spp_max);
-    for (size_t li = 0; li < ladder.size(); ++li) {
-        for (RenderEstimatorStudy& s : result.estimators) {
-            // Each image is summarised as soon as it is rendered: a level holds one image
-            // (replicate 0, the preview), not reps of them.
-            std::vector<ImageSummary> images;
-            for (int r = 0; r < settings.reps; ++r) {
-                RenderSettings rset;
-                rset.width = settings.width;
-                rset.height = settings.height;
-                rset.spp = ladder[li];
-                rset.stream = render_stream(settings.seed, s.estimator.name, ladder[li], r);
-                rset.threads = result.threads_used;
-                rset.jitter_pixels = settings.jitter_pixels;
-                RenderImage image = render_image(rs, s.estimator, rset);
-                images.push_back(summarise_image(image, reference));
-                if (r == 0) s.preview = std::move(image);
-            }
-            s.levels.push_back(render_level_stats(images, reference));
+    // The integration studies' loop (run_ladder), with an image as the estimate. Images run one
+    // after another, each on all the study's threads (rows of pixels), so that a level's seconds
+    // per image are the wall time of one image as a user renders it. An image is summarised as
+    // soon as it is rendered: a level keeps one image (replicate 0, the preview), not reps.
+    struct Rendered {
+        ImageSummary summary;
+        RenderImage preview; ///< replicate 0 only
+    };
+    const std::vector<uint64_t> ladder = n_ladder(settings.spp_min, settings.spp_max);
+    const size_t reps = static_cast<size_t>(settings.reps);
+    auto run = [&](size_t e, uint64_t spp, int r, int) {
+        RenderSettings rset;
+        rset.width = settings.width;
+        rset.height = settings.height;
+        rset.spp = spp;
+        rset.stream = replicate_stream(settings.seed, estimators[e].name, spp, r);
+        rset.threads = result.threads_used;
+        rset.jitter_pixels = settings.jitter_pixels;
+        Rendered out;
+        RenderImage image = render_image(rs, estimators[e], rset);
+        out.summary = summarise_image(image, reference);
+        if (r == 0) out.preview = std::move(image);
+        return out;
+    };
+    auto end_level = [&](size_t level, std::vector<Rendered>& images) {
+        for (size_t e = 0; e < estimators.size(); ++e) {
+            RenderEstimatorStudy& s = result.estimators[e];
+            std::vector<ImageSummary> summaries;
+            for (size_t r = 0; r < reps; ++r) summaries.push_back(images[e * reps + r].summary);
+            if (reps > 0) s.preview = std::move(images[e * reps].preview);
+            s.levels.push_back(render_level_stats(summaries, reference));
             s.fit = fit_render_convergence(s.levels, result.relative_mse_floor);
         }
-        bool go_on = !progress || progress(result, li);
-        if (!go_on && li + 1 < ladder.size()) {
-            result.cancelled = true;
-            break;
-        }
-    }
+        return !progress || progress(result, level);
+    };
+    result.cancelled =
+        !run_ladder<Rendered>(ladder, estimators.size(), settings.reps, 1, run, end_level);
     result.wall_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return result;

@@ -84,10 +84,6 @@ std::vector<Flag> render_flags(const RenderEstimatorStudy& s, double floor);
 /// below_reference_noise for one level, or nothing.
 std::vector<Flag> render_level_flags(const LevelStats& level, double floor);
 
-/// Stream id of one image: (seed, estimator name, spp, replicate), as for the integration
-/// studies, so results do not depend on threads or on which estimators run together.
-uint64_t render_stream(uint64_t seed, const std::string& estimator, uint64_t spp, int rep);
-
 /// Summarises R replicate images of one level in the integration studies' terms:
 ///   variance, mse  relative MSE against the reference (mean over replicates), with a 95%
 ///                  interval from the replicates' spread in variance_lo / variance_hi
@@ -112,9 +108,9 @@ ImageSummary summarise_image(const RenderImage& image, const RenderImage& refere
 LevelStats render_level_stats(const std::vector<ImageSummary>& images,
                               const RenderImage& reference);
 
-/// Fitted order of relative MSE against spp: weighted least squares of log relMSE on log spp,
-/// weights from each level's replicate spread, the standard error inflated by the residuals.
-/// Levels below the reference's noise (below_reference_noise with `floor`) are left out.
+/// Fitted order of relative MSE against spp (fit_power_law, measure RelativeMse): weights from
+/// each level's replicate spread, the standard error inflated by the residuals. Levels below
+/// the reference's noise (below_reference_noise with `floor`) are left out.
 ConvergenceFit fit_render_convergence(const std::vector<LevelStats>& levels, double floor = 0.0);
 
 /// Called after each completed level; returning false cancels the study.

@@ -214,7 +214,7 @@ bool obtain_reference(const Loaded& l, RenderImage* ref, Json* info, std::string
     rs.height = s.height;
     rs.spp = r.reference.spp;
     // Its own stream: no study image shares random numbers with the reference.
-    rs.stream = render_stream(s.seed, "reference", r.reference.spp, -1);
+    rs.stream = replicate_stream(s.seed, "reference", r.reference.spp, -1);
     rs.threads = resolve_threads(s.threads);
     rs.jitter_pixels = s.jitter_pixels;
     *ref = render_image(l.scene, e, rs);
@@ -463,7 +463,7 @@ int mcp_render_image(const char* scene_json, const char* options_json, char** re
     rs.width = r.settings.width;
     rs.height = r.settings.height;
     rs.spp = spp;
-    rs.stream = render_stream(r.settings.seed, est.name, spp, 0);
+    rs.stream = replicate_stream(r.settings.seed, est.name, spp, 0);
     rs.threads = resolve_threads(r.settings.threads);
     rs.jitter_pixels = r.settings.jitter_pixels;
     RenderImage image = render_image(l.scene, est, rs);
@@ -539,7 +539,7 @@ int mcp_render_study_plan(const char* scene_json, const char* options_json, char
     pilot.spp = 1;
     pilot.threads = 1;
     pilot.jitter_pixels = s.jitter_pixels;
-    pilot.stream = render_stream(s.seed, "pilot", 1, -2);
+    pilot.stream = replicate_stream(s.seed, "pilot", 1, -2);
     const double pilot_samples = double(pilot.width) * double(pilot.height);
     auto seconds_per_sample = [&](const RenderEstimator& e) {
         return render_image(l.scene, e, pilot).seconds / pilot_samples;
