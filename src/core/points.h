@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 namespace mcp {
@@ -17,6 +18,12 @@ constexpr double kOneMinusEpsilon = 0x1.fffffffffffffp-1;
 /// and k large. x must not be NaN.
 inline double below_one(double x) {
     return x < kOneMinusEpsilon ? x : kOneMinusEpsilon;
+}
+
+/// v (< 2^63) as a double: converted as a signed integer, one instruction natively and in wasm
+/// (unsigned 64-bit conversions take a branchy sequence); exact below 2^53.
+inline double u63_to_double(uint64_t v) {
+    return static_cast<double>(static_cast<int64_t>(v));
 }
 
 /// n points in dim dimensions; coordinate j of point i is at coord(j)[i].

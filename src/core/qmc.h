@@ -81,7 +81,7 @@ uint32_t owen_scramble_u32(uint32_t v, uint32_t seed);
 /// Above 1/2 the half step is not representable and k + 1/2 rounds to an even neighbour; the
 /// top value 2^53 - 1 would round to 1, so it is kept at the largest double below 1.
 inline double bits53_to_unit(uint64_t k53) {
-    const double x = (static_cast<double>(k53) + 0.5) * 0x1p-53;
+    const double x = (static_cast<double>(static_cast<int64_t>(k53)) + 0.5) * 0x1p-53;
     return below_one(x);
 }
 

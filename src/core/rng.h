@@ -44,7 +44,9 @@ class Pcg32 {
         uint64_t lo = next_u32() >> 6; // 26 bits
         uint64_t k = (hi << 26) | lo;
         // k + 1/2 is rounded above 2^52 (ties to even): k = 2^53 - 1 would give exactly 1.
-        const double u = (static_cast<double>(k) + 0.5) * 0x1p-53;
+        // k < 2^53 converts exactly as a signed integer: one instruction (unsigned 64-bit
+        // conversions take a branchy sequence natively and in wasm).
+        const double u = (static_cast<double>(static_cast<int64_t>(k)) + 0.5) * 0x1p-53;
         return u < 1.0 ? u : 0x1.fffffffffffffp-1;
     }
 

@@ -186,13 +186,13 @@ void cell_digits(const SamplerPlan& plan, uint64_t cell, uint64_t* digits) {
 }
 
 double stratified_coordinate(const SamplerPlan& plan, const uint64_t* digits, int j, double xi) {
-    const double k = static_cast<double>(plan.strata[static_cast<size_t>(j)]);
-    return below_one((static_cast<double>(digits[j]) + xi) / k);
+    const double k = u63_to_double(plan.strata[static_cast<size_t>(j)]);
+    return below_one((u63_to_double(digits[j]) + xi) / k);
 }
 
 double latin_coordinate(const SamplerPlan& plan, uint64_t index, int j, double xi) {
     const uint64_t slab = permute_index(index, plan.total, plan.perm_keys[static_cast<size_t>(j)]);
-    return below_one((static_cast<double>(slab) + xi) / static_cast<double>(plan.total));
+    return below_one((u63_to_double(slab) + xi) / u63_to_double(plan.total));
 }
 
 } // namespace
