@@ -353,6 +353,61 @@ TEST(Qmc, HaltonOneDimensionalStratification) {
         }
 }
 
+// A Halton Owen randomization told how many points it serves (as a run's batches are) hashes
+// the digits where those points' prefixes can agree and draws the rest at once. It must keep
+// the stratification of every b^m prefix, equal random access, stay unbiased, and put the
+// points uniformly inside their finest cells.
+TEST(Qmc, HaltonOwenBoundedByItsPointCount) {
+    struct Case {
+        int dim;
+        uint64_t base;
+        int m;
+    };
+    for (const Case& cs : {Case{0, 2, 10}, Case{1, 3, 6}, Case{4, 11, 2}}) {
+        uint64_t n = 1;
+        for (int k = 0; k < cs.m; ++k) n *= cs.base;
+        for (uint64_t key : {5ull, 6ull}) {
+            auto h = make_qmc_randomizer(QmcKind::Halton, QmcRandomization::Owen, 8, key, n);
+            PointBlock u;
+            u.reset(8, size_t(n));
+            qmc_points(h, 0, size_t(n), u);
+            for (uint64_t prefix = 1; prefix <= n; prefix *= cs.base) {
+                std::set<uint64_t> cells;
+                for (uint64_t i = 0; i < prefix; ++i)
+                    cells.insert(uint64_t(std::floor(u.coord(cs.dim)[i] * double(prefix))));
+                EXPECT_EQ(cells.size(), prefix) << "base " << cs.base << " prefix " << prefix;
+            }
+            // Positions inside the finest cells, x b^m - floor: uniform (chi-square, 8 bins).
+            std::vector<double> counts(8, 0.0);
+            for (uint64_t i = 0; i < n; ++i) {
+                ASSERT_EQ(qmc_coordinate(h, i, cs.dim), u.coord(cs.dim)[i]);
+                const double t = u.coord(cs.dim)[i] * double(n);
+                counts[size_t((t - std::floor(t)) * 8.0)] += 1.0;
+            }
+            double chi2 = 0.0;
+            for (double c : counts)
+                chi2 += (c - double(n) / 8) * (c - double(n) / 8) / (double(n) / 8);
+            EXPECT_LT(chi2, 24.3) << "base " << cs.base; // chi^2_7 upper 0.001 quantile
+        }
+    }
+    // Unbiased: 300 randomizations of 243 points (3^5) of prod 3 x_j^2 in 3 dimensions.
+    double sum = 0.0, sum2 = 0.0;
+    const int reps = 300;
+    for (int rep = 0; rep < reps; ++rep) {
+        auto h = make_qmc_randomizer(QmcKind::Halton, QmcRandomization::Owen, 3, 900 + rep, 243);
+        double e = 0.0;
+        for (uint64_t i = 0; i < 243; ++i) {
+            double p = 1.0;
+            for (int j = 0; j < 3; ++j) p *= 3.0 * std::pow(qmc_coordinate(h, i, j), 2);
+            e += p / 243.0;
+        }
+        sum += e;
+        sum2 += e * e;
+    }
+    const double mean = sum / reps, se = std::sqrt((sum2 / reps - mean * mean) / (reps - 1));
+    EXPECT_LT(std::fabs(mean - 1.0), 4.0 * se);
+}
+
 TEST(Qmc, LatticeOneDimensionalStratification) {
     // The first 2^m points of the sequence form a lattice: one point per [k/2^m, (k+1)/2^m)
     // (z_j odd). All 2^20 points through blocks in the first dimensions (a randomizer of fewer

@@ -246,16 +246,32 @@ double digits_to_unit(const uint32_t* e, int n, const HaltonBase& hb, double tai
 // Randomized coordinates carry K digits, b^-K <= 2^-53; the digits of the index beyond its
 // length are 0 and scrambled like the others. The point is the centre of its finest cell.
 inline double halton_randomized_value(const uint32_t* e, int n, const HaltonBase& hb) {
-    return std::fmin(digits_to_unit(e, n, hb, 0.5), kOneMinusEpsilon);
+    return below_one(digits_to_unit(e, n, hb, 0.5));
+}
+
+// The number of base-b digits M that tell apart the indices below `points`: b^M >= points
+// (M = hb.digits when points is 0 or beyond b^digits).
+int distinct_digits(const HaltonBase& hb, uint64_t points) {
+    if (points == 0) return hb.digits;
+    int m = 0;
+    for (uint64_t span = 1; span < points && m < hb.digits; ++m) {
+        if (span > (uint64_t(1) << 63) / hb.base) return hb.digits;
+        span *= hb.base;
+    }
+    return m;
 }
 
 // Nested scramble [Owen95]: digit k goes through a permutation keyed by the seed, k and the
 // index's digits 0 .. k-1 (the prefix index mod b^k, which is the index itself once all its
 // digits are consumed; below 2^58, so (prefix, k) packs into 64 bits without collisions).
-// Past the index's length the digit is 0 and its image the map's c.
-double halton_owen(const uint32_t* digits, int len, const HaltonBase& hb, uint64_t key) {
+// Past the index's length the digit is 0 and its image the map's c. From digit M on
+// (b^M >= the points drawn, distinct_digits) every point's prefix is its own index, distinct
+// from all others', so its digits there are independent uniform draws: they are drawn at once,
+// as one 53-bit uniform below b^-M keyed by the index, instead of one hash per digit.
+double halton_owen(const uint32_t* digits, int len, const HaltonBase& hb, uint64_t key,
+                   int free_from) {
     uint32_t e[kMaxDigits];
-    const int n = len > hb.digits ? len : hb.digits;
+    const int nested = len > free_from ? len : free_from; // len <= free_from when in range
     uint64_t prefix = 0, weight = 1;
     for (int k = 0; k < len; ++k) {
         const DigitMap map = digit_map(mix64(key ^ ((prefix << 6) | uint64_t(k))), hb.base);
@@ -263,9 +279,12 @@ double halton_owen(const uint32_t* digits, int len, const HaltonBase& hb, uint64
         prefix += digits[k] * weight;
         weight *= hb.base;
     }
-    for (int k = len; k < n; ++k)
+    for (int k = len; k < nested; ++k)
         e[k] = digit_map(mix64(key ^ ((prefix << 6) | uint64_t(k))), hb.base).c;
-    return halton_randomized_value(e, n, hb);
+    if (nested >= hb.digits) return halton_randomized_value(e, nested, hb);
+    const uint64_t tail_bits = mix64(key ^ (prefix << 6) ^ 0x3fu) >> 11; // k = 63: never a digit
+    const double tail = (u63_to_double(tail_bits) + 0.5) * 0x1p-53;
+    return below_one(digits_to_unit(e, nested, hb, tail));
 }
 
 // One random permutation per digit position, the same for every prefix [BraatenWeller79].
@@ -438,8 +457,10 @@ uint32_t owen_scramble_u32(uint32_t v, uint32_t seed) {
     return reverse_bits32(owen_hash_reversed(reverse_bits32(v), seed));
 }
 
-QmcRandomizer make_qmc_randomizer(QmcKind kind, QmcRandomization r, int dim, uint64_t key) {
+QmcRandomizer make_qmc_randomizer(QmcKind kind, QmcRandomization r, int dim, uint64_t key,
+                                  uint64_t points) {
     QmcRandomizer q;
+    q.points = points;
     q.kind = kind;
     q.randomization = r;
     q.dim = dim < 0 ? 0 : (dim > qmc_max_dim(kind) ? qmc_max_dim(kind) : dim);
@@ -493,7 +514,8 @@ double qmc_coordinate(const QmcRandomizer& r, uint64_t index, int dim) {
         uint32_t digits[kMaxDigits];
         const int len = index_digits(index, hb.base, digits);
         if (rand == QmcRandomization::Owen)
-            return halton_owen(digits, len, hb, dimension_key(r.seeds[j], dim));
+            return halton_owen(digits, len, hb, dimension_key(r.seeds[j], dim),
+                               distinct_digits(hb, r.points));
         if (rand == QmcRandomization::Permutation) {
             DigitMap maps[kMaxDigits];
             const uint64_t key = dimension_key(r.seeds[j], dim);
@@ -599,8 +621,9 @@ void halton_block(const QmcRandomizer& r, QmcRandomization rand, int dim, uint64
     switch (rand) {
     case QmcRandomization::Owen: {
         const uint64_t key = dimension_key(r.seeds[j], dim);
+        const int free_from = distinct_digits(hb, r.points);
         for (size_t i = 0; i < count; ++i, counter.increment(hb.base))
-            out[i] = halton_owen(counter.digits, counter.len, hb, key);
+            out[i] = halton_owen(counter.digits, counter.len, hb, key, free_from);
         break;
     }
     case QmcRandomization::Permutation: {

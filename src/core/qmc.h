@@ -96,13 +96,19 @@ struct QmcRandomizer {
     std::vector<uint64_t>
         shifts; ///< digital shift (53 bits) or lattice shift (53 bits) per dimension
     std::vector<uint32_t> matrices; ///< LMS: 32 scrambled direction columns per dimension
+    /// Points that will be drawn from this randomization (0: up to qmc_max_points). Halton's
+    /// nested scramble then hashes only the digits where these points' prefixes can agree and
+    /// draws the rest as one uniform (see halton_owen).
+    uint64_t points = 0;
 };
 
 /// Draws the parameters of one randomization from `key`: dimension j from its own generator
 /// seeded by (key, j), so the first dimensions do not depend on dim. dim is clamped to
 /// [0, qmc_max_dim(kind)]; r must apply to kind (check_randomization), a randomization that
 /// does not apply gives the deterministic points.
-QmcRandomizer make_qmc_randomizer(QmcKind kind, QmcRandomization r, int dim, uint64_t key);
+/// `points` (0: no bound) is how many points will be drawn, indices below it (QmcRandomizer).
+QmcRandomizer make_qmc_randomizer(QmcKind kind, QmcRandomization r, int dim, uint64_t key,
+                                  uint64_t points = 0);
 
 /// Coordinate `dim` of point `index` of the randomized point set (random access; slow path
 /// for tests and single points). index < qmc_max_points(r.kind), 0 <= dim < r.dim.

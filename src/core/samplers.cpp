@@ -149,10 +149,11 @@ SamplerPlan make_sampler_plan(SamplerKind kind, int dim, uint64_t n, Pcg32& rng,
         const uint64_t k = std::max<uint64_t>(
             1, std::min<uint64_t>(static_cast<uint64_t>(std::max(options.randomizations, 1)), n));
         plan.randomizers.reserve(static_cast<size_t>(k));
+        const uint64_t per_batch = (n + k - 1) / k; // the largest batch
         for (uint64_t b = 0; b < k; ++b) {
             const uint64_t hi = rng.next_u32(), lo = rng.next_u32();
             plan.randomizers.push_back(make_qmc_randomizer(qmc_kind_of(kind), options.randomization,
-                                                           dim, (hi << 32) | lo));
+                                                           dim, (hi << 32) | lo, per_batch));
         }
     }
     if (kind == SamplerKind::Stratified) {
