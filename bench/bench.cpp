@@ -64,8 +64,13 @@ struct HandLoop {
     explicit HandLoop(const Integrand& g) : integrand(g), f(kBlockSize) {
         x.reset(g.dim, kBlockSize);
     }
-    double run(Pcg32& rng, uint64_t count) {
+    double run(Pcg32& run_rng, uint64_t count) {
         const int d = integrand.dim;
+        // The generator the independent sampler's plan draws from run_rng (its seed and stream),
+        // so that both loops see the same uniforms.
+        const uint64_t seed = (uint64_t(run_rng.next_u32()) << 32) | run_rng.next_u32();
+        const uint64_t stream = (uint64_t(run_rng.next_u32()) << 32) | run_rng.next_u32();
+        Pcg32 rng(seed, stream);
         RunningMoments moments;
         for (uint64_t first = 0; first < count; first += kBlockSize) {
             const size_t m = static_cast<size_t>(std::min<uint64_t>(kBlockSize, count - first));

@@ -184,6 +184,26 @@ TEST(ErrorBars, CollapsedStrataIsConservative) {
     }
 }
 
+// The study loop places every task's result by (estimator, replicate), whatever the thread
+// count, and stops after the level whose summary says so.
+TEST(Study, LadderPlacesResultsByTaskAndStops) {
+    const std::vector<uint64_t> ladder = {4, 8, 16, 32};
+    for (int threads : {1, 3}) {
+        std::vector<std::vector<uint64_t>> seen;
+        auto run = [](size_t e, uint64_t n, int r, int) { return n * 1000 + e * 10 + uint64_t(r); };
+        auto end_level = [&](size_t level, const std::vector<uint64_t>& results) {
+            seen.push_back(results);
+            return level < 2; // stop after the third level
+        };
+        const bool finished = run_ladder<uint64_t>(ladder, 2, 3, threads, run, end_level);
+        EXPECT_FALSE(finished) << threads;
+        ASSERT_EQ(seen.size(), 3u);
+        for (size_t level = 0; level < 3; ++level)
+            for (size_t t = 0; t < 6; ++t)
+                EXPECT_EQ(seen[level][t], ladder[level] * 1000 + (t / 3) * 10 + t % 3);
+    }
+}
+
 TEST(Study, IdenticalWithOneAndTwoThreads) {
     Json opts{{"n_min", 16}, {"n_max", 4096}, {"reps", 8}, {"seed", 11}};
     opts["threads"] = 1;
