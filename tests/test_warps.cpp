@@ -8,6 +8,7 @@
 
 #include "core/rng.h"
 #include "core/special.h"
+#include "core/trig.h"
 #include "core/warps.h"
 #include "test_support.h"
 
@@ -401,4 +402,35 @@ TEST(Warps, PolarAndConcentricDiskMapsDiffer) {
     // And the maps disagree pointwise almost everywhere.
     Vec2 a = sample_disk_polar({0.3, 0.7}), c = sample_disk_concentric({0.3, 0.7});
     EXPECT_GT(std::hypot(a.x - c.x, a.y - c.y), 0.1);
+}
+
+// The warps' sine and cosine against long double references: within 2 ulp of the reference
+// value (the evaluation's rounding; the Taylor truncation is below 1e-19), quarter-turn
+// rotations and the ends included.
+TEST(Trig, WithinTwoUlpOfLongDouble) {
+    auto ulps = [](double got, long double ref) {
+        const double r = static_cast<double>(ref);
+        const double ulp = std::nextafter(std::fabs(r), 1.0 / 0.0) - std::fabs(r);
+        // Below 2^-60 the long double reference's own error (of pi) is what remains.
+        return static_cast<double>(std::fabs(static_cast<long double>(got) - ref)) /
+               std::max(ulp, 0x1p-60);
+    };
+    const long double pi = 3.141592653589793238462643383279502884L;
+    Pcg32 rng(2024, 12);
+    double worst_quarter = 0.0, worst_turns = 0.0;
+    std::vector<double> us = {0.0,  0.125, 0.25,    0.375,          0.5,           0.625,
+                              0.75, 0.875, 0x1p-40, 0.25 - 0x1p-54, 0.5 + 0x1p-53, 1.0 - 0x1p-53};
+    for (int i = 0; i < 100000; ++i) us.push_back(rng.next_double());
+    for (double u : us) {
+        const double t = (u - 0.5) * 0.5 * kPi; // [-pi/4, pi/4)
+        const SinCos a = sincos_quarter(t);
+        worst_quarter = std::max({worst_quarter, ulps(a.sin, std::sin(static_cast<long double>(t))),
+                                  ulps(a.cos, std::cos(static_cast<long double>(t)))});
+        const SinCos b = sincos_turns(u);
+        const long double phi = 2.0L * pi * static_cast<long double>(u);
+        worst_turns =
+            std::max({worst_turns, ulps(b.sin, std::sin(phi)), ulps(b.cos, std::cos(phi))});
+    }
+    EXPECT_LE(worst_quarter, 2.0);
+    EXPECT_LE(worst_turns, 2.0);
 }

@@ -10,12 +10,12 @@
 
 #include "core/points.h"
 #include "core/special.h"
+#include "core/trig.h"
 
 namespace mcp {
 namespace {
 
 constexpr double kTwoPi = 2.0 * kPi;
-constexpr double kHalfPi = 0.5 * kPi;
 constexpr double kQuarterPi = 0.25 * kPi;
 constexpr double kFourOverPi = 4.0 / kPi;
 
@@ -36,9 +36,9 @@ double azimuth_unit(double y, double x) {
 // --- Unit disk -------------------------------------------------------------------------
 
 Vec2 sample_disk_polar(Vec2 u) {
-    double r = std::sqrt(u.x);
-    double phi = kTwoPi * u.y;
-    return {r * std::cos(phi), r * std::sin(phi)};
+    const double r = std::sqrt(u.x);
+    const SinCos phi = sincos_turns(u.y);
+    return {r * phi.cos, r * phi.sin};
 }
 
 Vec2 invert_disk_polar(Vec2 p) {
@@ -46,20 +46,18 @@ Vec2 invert_disk_polar(Vec2 p) {
 }
 
 // [ShirleyChiu97]: with (a, b) = 2u - 1, the square ring max(|a|, |b|) = r goes to the circle
-// of radius r; on the wedge |a| > |b| the angle is (pi/4) b/a, on |b| >= |a| it is
-// pi/2 - (pi/4) a/b. A negative r puts the point on the opposite side of the centre.
+// of radius r; on the wedge |a| > |b| the angle is t = (pi/4) b/a, on |b| >= |a| it is
+// pi/2 - t with t = (pi/4) a/b, whose cosine and sine are sin t and cos t. A negative r puts
+// the point on the opposite side of the centre. |t| <= pi/4: no range reduction.
 Vec2 sample_disk_concentric(Vec2 u) {
-    double a = 2.0 * u.x - 1.0, b = 2.0 * u.y - 1.0;
+    const double a = 2.0 * u.x - 1.0, b = 2.0 * u.y - 1.0;
     if (a == 0.0 && b == 0.0) return {0.0, 0.0};
-    double r, phi;
     if (std::fabs(a) > std::fabs(b)) {
-        r = a;
-        phi = kQuarterPi * (b / a);
-    } else {
-        r = b;
-        phi = kHalfPi - kQuarterPi * (a / b);
+        const SinCos t = sincos_quarter(kQuarterPi * (b / a));
+        return {a * t.cos, a * t.sin};
     }
-    return {r * std::cos(phi), r * std::sin(phi)};
+    const SinCos t = sincos_quarter(kQuarterPi * (a / b));
+    return {b * t.sin, b * t.cos};
 }
 
 // Inverse of the concentric map. Reflecting the point through the centre when the signed
@@ -103,8 +101,8 @@ Vec2 invert_triangle_barycentric(Vec2 b) {
 Vec3 sample_uniform_sphere(Vec2 u) {
     double z = 1.0 - 2.0 * u.x;
     double r = 2.0 * std::sqrt(u.x * (1.0 - u.x));
-    double phi = kTwoPi * u.y;
-    return {r * std::cos(phi), r * std::sin(phi), z};
+    const SinCos phi = sincos_turns(u.y);
+    return {r * phi.cos, r * phi.sin, z};
 }
 
 Vec2 invert_uniform_sphere(Vec3 w) {
@@ -114,8 +112,8 @@ Vec2 invert_uniform_sphere(Vec3 w) {
 Vec3 sample_uniform_hemisphere(Vec2 u) {
     double z = u.x;
     double r = std::sqrt(std::max(0.0, (1.0 - z) * (1.0 + z)));
-    double phi = kTwoPi * u.y;
-    return {r * std::cos(phi), r * std::sin(phi), z};
+    const SinCos phi = sincos_turns(u.y);
+    return {r * phi.cos, r * phi.sin, z};
 }
 
 Vec2 invert_uniform_hemisphere(Vec3 w) {

@@ -1,0 +1,59 @@
+// Sine and cosine for the warps: of an angle already in [-pi/4, pi/4], and of a fraction of a
+// full turn. Plain arithmetic (no libm call), so the same on every platform and inlinable into
+// the block loops; within about 1 ulp of the correctly rounded values (tests/test_warps.cpp).
+#pragma once
+
+#include "core/special.h"
+
+namespace mcp {
+
+struct SinCos {
+    double sin = 0.0, cos = 1.0;
+};
+
+/// sin t and cos t for |t| <= pi/4 by their Taylor polynomials to degree 17 and 18, evaluated
+/// by Horner in t^2: the truncation error is below (pi/4)^19 / 19! < 1e-19, so only the
+/// rounding of the evaluation remains.
+inline SinCos sincos_quarter(double t) {
+    const double t2 = t * t;
+    // sin t = t + t^3 (-1/3! + t^2 (1/5! - t^2 (1/7! - ...)))
+    double s = 1.0 / 355687428096000.0; // 1/17!
+    s = s * t2 - 1.0 / 1307674368000.0; // 1/15!
+    s = s * t2 + 1.0 / 6227020800.0;    // 1/13!
+    s = s * t2 - 1.0 / 39916800.0;      // 1/11!
+    s = s * t2 + 1.0 / 362880.0;        // 1/9!
+    s = s * t2 - 1.0 / 5040.0;          // 1/7!
+    s = s * t2 + 1.0 / 120.0;           // 1/5!
+    s = s * t2 - 1.0 / 6.0;             // 1/3!
+    // cos t = 1 + t^2 (-1/2! + t^2 (1/4! - ...))
+    double c = 1.0 / 6402373705728000.0; // 1/18!
+    c = c * t2 - 1.0 / 20922789888000.0; // 1/16!
+    c = c * t2 + 1.0 / 87178291200.0;    // 1/14!
+    c = c * t2 - 1.0 / 479001600.0;      // 1/12!
+    c = c * t2 + 1.0 / 3628800.0;        // 1/10!
+    c = c * t2 - 1.0 / 40320.0;          // 1/8!
+    c = c * t2 + 1.0 / 720.0;            // 1/6!
+    c = c * t2 - 1.0 / 24.0;             // 1/4! (with the sign of the t^4 term folded below)
+    SinCos r;
+    r.sin = t + t * t2 * s;
+    r.cos = 1.0 + t2 * (-0.5 - t2 * c);
+    return r;
+}
+
+/// sin(2 pi u) and cos(2 pi u) for u in [0, 1]. The reduction is exact: 4u = q + f with q the
+/// nearest integer (the quarter turn; truncation of 4u + 1/2 >= 0) and |f| <= 1/2, f exact;
+/// then t = f pi/2 is the one rounded step, and the quadrant rotates (sin, cos) of t. More
+/// accurate than std::sin(2 pi u), which rounds 2 pi u first.
+inline SinCos sincos_turns(double u) {
+    const double v = 4.0 * u;
+    const int q = static_cast<int>(v + 0.5);
+    const SinCos a = sincos_quarter((v - q) * (0.5 * kPi));
+    switch (q & 3) {
+    case 0: return a;
+    case 1: return {a.cos, -a.sin};
+    case 2: return {-a.sin, -a.cos};
+    default: return {-a.cos, a.sin};
+    }
+}
+
+} // namespace mcp
