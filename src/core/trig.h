@@ -11,32 +11,36 @@ struct SinCos {
     double sin = 0.0, cos = 1.0;
 };
 
-/// sin t and cos t for |t| <= pi/4 by their Taylor polynomials to degree 17 and 18, evaluated
-/// by Horner in t^2: the truncation error is below (pi/4)^19 / 19! < 1e-19, so only the
-/// rounding of the evaluation remains.
+/// c[0] x^(N-1) + c[1] x^(N-2) + ... + c[N-1] by Horner's scheme.
+template <int N> inline double horner(double x, const double (&c)[N]) {
+    double p = c[0];
+    for (int i = 1; i < N; ++i) p = p * x + c[i];
+    return p;
+}
+
+/// sin t = t + t^3 P(t^2) and cos t = 1 + t^2 Q(t^2): the Taylor coefficients, highest first:
+/// P from (-1)^8/17! to -1/3!, Q from (-1)^9/18! to -1/2! (17! and 18! are exact in double).
+constexpr double kSinTaylor[] = {
+    1.0 / 355687428096000.0, -1.0 / 1307674368000.0, 1.0 / 6227020800.0, -1.0 / 39916800.0,
+    1.0 / 362880.0,          -1.0 / 5040.0,          1.0 / 120.0,        -1.0 / 6.0};
+constexpr double kCosTaylor[] = {-1.0 / 6402373705728000.0,
+                                 1.0 / 20922789888000.0,
+                                 -1.0 / 87178291200.0,
+                                 1.0 / 479001600.0,
+                                 -1.0 / 3628800.0,
+                                 1.0 / 40320.0,
+                                 -1.0 / 720.0,
+                                 1.0 / 24.0,
+                                 -0.5};
+
+/// sin t and cos t for |t| <= pi/4 by their Taylor polynomials to degree 17 and 18: the
+/// truncation error is below (pi/4)^19 / 19! < 1e-19, so only the rounding of the evaluation
+/// remains.
 inline SinCos sincos_quarter(double t) {
     const double t2 = t * t;
-    // sin t = t + t^3 (-1/3! + t^2 (1/5! - t^2 (1/7! - ...)))
-    double s = 1.0 / 355687428096000.0; // 1/17!
-    s = s * t2 - 1.0 / 1307674368000.0; // 1/15!
-    s = s * t2 + 1.0 / 6227020800.0;    // 1/13!
-    s = s * t2 - 1.0 / 39916800.0;      // 1/11!
-    s = s * t2 + 1.0 / 362880.0;        // 1/9!
-    s = s * t2 - 1.0 / 5040.0;          // 1/7!
-    s = s * t2 + 1.0 / 120.0;           // 1/5!
-    s = s * t2 - 1.0 / 6.0;             // 1/3!
-    // cos t = 1 + t^2 (-1/2! + t^2 (1/4! - ...))
-    double c = 1.0 / 6402373705728000.0; // 1/18!
-    c = c * t2 - 1.0 / 20922789888000.0; // 1/16!
-    c = c * t2 + 1.0 / 87178291200.0;    // 1/14!
-    c = c * t2 - 1.0 / 479001600.0;      // 1/12!
-    c = c * t2 + 1.0 / 3628800.0;        // 1/10!
-    c = c * t2 - 1.0 / 40320.0;          // 1/8!
-    c = c * t2 + 1.0 / 720.0;            // 1/6!
-    c = c * t2 - 1.0 / 24.0;             // 1/4! (with the sign of the t^4 term folded below)
     SinCos r;
-    r.sin = t + t * t2 * s;
-    r.cos = 1.0 + t2 * (-0.5 - t2 * c);
+    r.sin = t + t * t2 * horner(t2, kSinTaylor);
+    r.cos = 1.0 + t2 * horner(t2, kCosTaylor);
     return r;
 }
 
