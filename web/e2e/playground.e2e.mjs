@@ -76,17 +76,19 @@ function cliFits(scene, estimators, settings) {
 
 async function configure(scene, estimators, settings) {
   const before = await page.evaluate(() => window.mcplayDebug.state().sceneInfo?.name);
-  await page.selectOption('#scene', scene); // option values are scene names
+  // Selecting the scene already shown would draw its estimator list again under our feet.
+  if (before !== scene) await page.selectOption('#scene', scene); // option values are scene names
+  // the core's answer about the scene (it may bring the scene's own image size)
+  await page.waitForFunction((name) => {
+    const s = window.mcplayDebug.state();
+    return s.sceneInfo?.name === name && !s.sceneInfo.provisional;
+  }, scene, { timeout: 20000 });
   await page.waitForSelector(`input[data-estimator="${estimators[0]}"]`, { state: 'attached' });
-  if (before !== scene) {
-    // the core's answer about the scene (it may bring the scene's own image size)
-    await page.waitForFunction((name) => {
-      const s = window.mcplayDebug.state();
-      return s.sceneInfo?.name === name && !s.sceneInfo.provisional;
-    }, scene, { timeout: 20000 });
-  }
-  for (const box of await page.$$('input[type=checkbox][data-estimator]')) {
-    const name = await box.getAttribute('data-estimator');
+  // Locators by name, resolved at each action: a list drawn again meanwhile is no stale handle.
+  const names = await page.$$eval('input[type=checkbox][data-estimator]',
+    (boxes) => boxes.map((b) => b.getAttribute('data-estimator')));
+  for (const name of names) {
+    const box = page.locator(`input[type=checkbox][data-estimator="${name}"]`);
     if ((await box.isChecked()) !== estimators.includes(name)) await box.click();
   }
   await page.fill('#n-min', String(settings.nMin));
