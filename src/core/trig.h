@@ -11,11 +11,13 @@ struct SinCos {
     double sin = 0.0, cos = 1.0;
 };
 
-/// c[0] x^(N-1) + c[1] x^(N-2) + ... + c[N-1] by Horner's scheme.
-template <int N> inline double horner(double x, const double (&c)[N]) {
-    double p = c[0];
-    for (int i = 1; i < N; ++i) p = p * x + c[i];
-    return p;
+/// c[0] x^7 + c[1] x^6 + ... + c[7] by Estrin's scheme: pairs, then pairs of pairs, three
+/// dependent multiply-adds deep instead of Horner's seven (the warps are latency-bound).
+inline double estrin8(double x, const double* c) {
+    const double x2 = x * x, x4 = x2 * x2;
+    const double a0 = c[0] * x + c[1], a1 = c[2] * x + c[3];
+    const double a2 = c[4] * x + c[5], a3 = c[6] * x + c[7];
+    return (a0 * x2 + a1) * x4 + (a2 * x2 + a3);
 }
 
 /// sin t = t + t^3 P(t^2) and cos t = 1 + t^2 Q(t^2): the Taylor coefficients, highest first:
@@ -39,8 +41,9 @@ constexpr double kCosTaylor[] = {-1.0 / 6402373705728000.0,
 inline SinCos sincos_quarter(double t) {
     const double t2 = t * t;
     SinCos r;
-    r.sin = t + t * t2 * horner(t2, kSinTaylor);
-    r.cos = 1.0 + t2 * horner(t2, kCosTaylor);
+    const double t8 = (t2 * t2) * (t2 * t2);
+    r.sin = t + t * t2 * estrin8(t2, kSinTaylor);
+    r.cos = 1.0 + t2 * (kCosTaylor[0] * t8 + estrin8(t2, kCosTaylor + 1));
     return r;
 }
 
