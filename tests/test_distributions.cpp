@@ -324,6 +324,13 @@ TEST_P(Dist1D, BlocksEqualScalarCalls) {
     u[0] = 0.5;
     u[1] = 0x1p-54;
     u[2] = 1.0 - 0x1p-53;
+    // Just below the cdf at evenly spaced points (a table's bin edges among them), where
+    // rounding can carry a sample onto the next bin: the block path repairs it as sample() does.
+    for (int k = 1; k < 64; ++k) {
+        const double edge = d.lower() + (d.upper() - d.lower()) * k / 64.0;
+        const double below = std::nextafter(d.cdf(edge), 0.0);
+        if (below >= 0x1p-54) u[2 + size_t(k)] = below; // no smaller u is ever drawn
+    }
     std::vector<double> x(u.size()), pdf(u.size()), product(u.size(), 3.0);
     d.sample_block(u.data(), x.data(), pdf.data(), u.size());
     d.multiply_pdf_block(x.data(), product.data(), u.size());

@@ -50,18 +50,18 @@ inline SinCos sincos_quarter(double t) {
 
 /// sin(2 pi u) and cos(2 pi u) for u in [0, 1]. The reduction is exact: 4u = q + f with q the
 /// nearest integer (the quarter turn; truncation of 4u + 1/2 >= 0) and |f| <= 1/2, f exact;
-/// then t = f pi/2 is the one rounded step, and the quadrant rotates (sin, cos) of t. More
-/// accurate than std::sin(2 pi u), which rounds 2 pi u first.
+/// then t = f pi/2 is the one rounded step, and the quadrant rotates (sin, cos) of t:
+/// q = 0, 1, 2, 3 give (s, c), (c, -s), (-s, -c), (-c, s). More accurate than
+/// std::sin(2 pi u), which rounds 2 pi u first. The rotation is selects and exact sign
+/// flips, not a branch on the quadrant (random in a block loop, so mispredicted).
 inline SinCos sincos_turns(double u) {
     const double v = 4.0 * u;
     const int q = static_cast<int>(v + 0.5);
     const SinCos a = sincos_quarter((v - q) * (0.5 * kPi));
-    switch (q & 3) {
-    case 0: return a;
-    case 1: return {a.cos, -a.sin};
-    case 2: return {-a.sin, -a.cos};
-    default: return {-a.cos, a.sin};
-    }
+    const bool odd = (q & 1) != 0;
+    const double sin_sign = (q & 2) != 0 ? -1.0 : 1.0;
+    const double cos_sign = ((q + 1) & 2) != 0 ? -1.0 : 1.0;
+    return {sin_sign * (odd ? a.cos : a.sin), cos_sign * (odd ? a.sin : a.cos)};
 }
 
 } // namespace mcp

@@ -1,4 +1,4 @@
-// Warps from the unit square: the scalar sample/invert pairs declared in warps.h.
+// Warps from the unit square: the inverses declared in warps.h (the forward maps are inline).
 //
 // Every inverse returns u in [0, 1)^2: azimuths come from atan2 (range (-pi, pi]) shifted to
 // [0, 2 pi), and an angle that rounds up to 2 pi is the direction of angle 0, so it maps to
@@ -10,13 +10,11 @@
 
 #include "core/points.h"
 #include "core/special.h"
-#include "core/trig.h"
 
 namespace mcp {
 namespace {
 
 constexpr double kTwoPi = 2.0 * kPi;
-constexpr double kQuarterPi = 0.25 * kPi;
 constexpr double kFourOverPi = 4.0 / kPi;
 
 double clamp_unit(double v) {
@@ -35,29 +33,8 @@ double azimuth_unit(double y, double x) {
 
 // --- Unit disk -------------------------------------------------------------------------
 
-Vec2 sample_disk_polar(Vec2 u) {
-    const double r = std::sqrt(u.x);
-    const SinCos phi = sincos_turns(u.y);
-    return {r * phi.cos, r * phi.sin};
-}
-
 Vec2 invert_disk_polar(Vec2 p) {
     return {clamp_unit(p.x * p.x + p.y * p.y), azimuth_unit(p.y, p.x)};
-}
-
-// [ShirleyChiu97]: with (a, b) = 2u - 1, the square ring max(|a|, |b|) = r goes to the circle
-// of radius r; on the wedge |a| > |b| the angle is t = (pi/4) b/a, on |b| >= |a| it is
-// pi/2 - t with t = (pi/4) a/b, whose cosine and sine are sin t and cos t. A negative r puts
-// the point on the opposite side of the centre. |t| <= pi/4: no range reduction.
-Vec2 sample_disk_concentric(Vec2 u) {
-    const double a = 2.0 * u.x - 1.0, b = 2.0 * u.y - 1.0;
-    if (a == 0.0 && b == 0.0) return {0.0, 0.0};
-    if (std::fabs(a) > std::fabs(b)) {
-        const SinCos t = sincos_quarter(kQuarterPi * (b / a));
-        return {a * t.cos, a * t.sin};
-    }
-    const SinCos t = sincos_quarter(kQuarterPi * (a / b));
-    return {b * t.sin, b * t.cos};
 }
 
 // Inverse of the concentric map. Reflecting the point through the centre when the signed
@@ -82,12 +59,7 @@ Vec2 invert_disk_concentric(Vec2 p) {
 
 // --- Triangle --------------------------------------------------------------------------
 
-// b0 = 1 - sqrt(u1), b1 = u2 sqrt(u1); so sqrt(u1) = 1 - b0 and u2 = b1 / (1 - b0).
-Vec2 sample_triangle_barycentric(Vec2 u) {
-    double su = std::sqrt(u.x);
-    return {1.0 - su, u.y * su};
-}
-
+// sqrt(u1) = 1 - b0 and u2 = b1 / (1 - b0).
 Vec2 invert_triangle_barycentric(Vec2 b) {
     double s = 1.0 - b.x;
     if (!(s > 0.0)) return {0.0, 0.0}; // the vertex b0 = 1, where u2 is arbitrary
@@ -96,36 +68,12 @@ Vec2 invert_triangle_barycentric(Vec2 b) {
 
 // --- Sphere and hemisphere ------------------------------------------------------------
 
-// z = 1 - 2 u1; the radius of the circle of latitude sqrt(1 - z^2) = sqrt((1 - z)(1 + z))
-// = 2 sqrt(u1 (1 - u1)) keeps its relative precision near the poles.
-Vec3 sample_uniform_sphere(Vec2 u) {
-    double z = 1.0 - 2.0 * u.x;
-    double r = 2.0 * std::sqrt(u.x * (1.0 - u.x));
-    const SinCos phi = sincos_turns(u.y);
-    return {r * phi.cos, r * phi.sin, z};
-}
-
 Vec2 invert_uniform_sphere(Vec3 w) {
     return {clamp_unit(0.5 * (1.0 - w.z)), azimuth_unit(w.y, w.x)};
 }
 
-Vec3 sample_uniform_hemisphere(Vec2 u) {
-    double z = u.x;
-    double r = std::sqrt(std::max(0.0, (1.0 - z) * (1.0 + z)));
-    const SinCos phi = sincos_turns(u.y);
-    return {r * phi.cos, r * phi.sin, z};
-}
-
 Vec2 invert_uniform_hemisphere(Vec3 w) {
     return {clamp_unit(w.z), azimuth_unit(w.y, w.x)};
-}
-
-// Malley's method [PBR4, A.5]: the projection of a cosine-weighted direction onto the
-// disk is uniform, so lift a concentric disk sample and invert through the disk.
-Vec3 sample_cosine_hemisphere(Vec2 u) {
-    Vec2 d = sample_disk_concentric(u);
-    double z = std::sqrt(std::max(0.0, 1.0 - d.x * d.x - d.y * d.y));
-    return {d.x, d.y, z};
 }
 
 Vec2 invert_cosine_hemisphere(Vec3 w) {

@@ -233,14 +233,19 @@ void warp_block(const Proposal& p, const Domain& d, const PointBlock& u, PointBl
     case ProposalKind::DiskPolar:
     case ProposalKind::DiskConcentric: {
         const double density = 1.0 / d.measure();
-        const bool polar = p.kind == ProposalKind::DiskPolar;
-        for (size_t i = 0; i < n; ++i) {
-            Vec2 uv{u.coord(0)[i], u.coord(1)[i]};
-            Vec2 q = polar ? sample_disk_polar(uv) : sample_disk_concentric(uv);
-            x.coord(0)[i] = d.center.x + d.radius * q.x;
-            x.coord(1)[i] = d.center.y + d.radius * q.y;
-            pdf[i] = density;
-        }
+        // One loop per map, each with the map inlined (no per-point choice of map).
+        auto warp_disk = [&](auto map) {
+            for (size_t i = 0; i < n; ++i) {
+                const Vec2 q = map(Vec2{u.coord(0)[i], u.coord(1)[i]});
+                x.coord(0)[i] = d.center.x + d.radius * q.x;
+                x.coord(1)[i] = d.center.y + d.radius * q.y;
+                pdf[i] = density;
+            }
+        };
+        if (p.kind == ProposalKind::DiskPolar)
+            warp_disk([](Vec2 v) { return sample_disk_polar(v); });
+        else
+            warp_disk([](Vec2 v) { return sample_disk_concentric(v); });
         break;
     }
     case ProposalKind::Triangle: {
@@ -257,18 +262,24 @@ void warp_block(const Proposal& p, const Domain& d, const PointBlock& u, PointBl
     case ProposalKind::Sphere:
     case ProposalKind::Hemisphere:
     case ProposalKind::CosineHemisphere: {
-        for (size_t i = 0; i < n; ++i) {
-            Vec2 uv{u.coord(0)[i], u.coord(1)[i]};
-            Vec3 w = p.kind == ProposalKind::Sphere       ? sample_uniform_sphere(uv)
-                     : p.kind == ProposalKind::Hemisphere ? sample_uniform_hemisphere(uv)
-                                                          : sample_cosine_hemisphere(uv);
-            x.coord(0)[i] = w.x;
-            x.coord(1)[i] = w.y;
-            x.coord(2)[i] = w.z;
-            pdf[i] = p.kind == ProposalKind::Sphere       ? uniform_sphere_pdf()
-                     : p.kind == ProposalKind::Hemisphere ? uniform_hemisphere_pdf()
-                                                          : cosine_hemisphere_pdf(w.z);
-        }
+        auto warp_sphere = [&](auto map, auto density) {
+            for (size_t i = 0; i < n; ++i) {
+                const Vec3 w = map(Vec2{u.coord(0)[i], u.coord(1)[i]});
+                x.coord(0)[i] = w.x;
+                x.coord(1)[i] = w.y;
+                x.coord(2)[i] = w.z;
+                pdf[i] = density(w.z);
+            }
+        };
+        if (p.kind == ProposalKind::Sphere)
+            warp_sphere([](Vec2 v) { return sample_uniform_sphere(v); },
+                        [](double) { return uniform_sphere_pdf(); });
+        else if (p.kind == ProposalKind::Hemisphere)
+            warp_sphere([](Vec2 v) { return sample_uniform_hemisphere(v); },
+                        [](double) { return uniform_hemisphere_pdf(); });
+        else
+            warp_sphere([](Vec2 v) { return sample_cosine_hemisphere(v); },
+                        [](double z) { return cosine_hemisphere_pdf(z); });
         break;
     }
     case ProposalKind::Product1D: {
