@@ -674,17 +674,48 @@ std::string name_text(const std::string& name) {
     return name.size() <= 64 ? name : name.substr(0, 61) + "...";
 }
 
+/// The "vegas" object of an estimator: every field optional, each bounded before any work.
+bool parse_vegas_options(Ctx& c, const Json& j, const std::string& path, int dim,
+                         VegasOptions* out) {
+    if (!check_keys(c, j, path, {"increments", "alpha", "train_fraction", "train_iterations"}))
+        return false;
+    uint64_t increments = 0, iterations = static_cast<uint64_t>(out->train_iterations);
+    if (!get_count(c, j, "increments", path, &increments) ||
+        !get_number(c, j, "alpha", path, &out->alpha) ||
+        !get_number(c, j, "train_fraction", path, &out->train_fraction) ||
+        !get_count(c, j, "train_iterations", path, &iterations))
+        return false;
+    // The map holds dim x increments edges and sums: at most 2^22 of each.
+    if (find(j, "increments") &&
+        (increments < 1 || increments * static_cast<uint64_t>(dim) > (uint64_t(1) << 22)))
+        return c.fail(sub(path, "increments"),
+                      "must be >= 1 and at most 4194304 / dimension (" +
+                          std::to_string((uint64_t(1) << 22) / static_cast<uint64_t>(dim)) +
+                          " here), got " + std::to_string(increments));
+    if (!(out->alpha >= 0.0 && out->alpha <= 4.0))
+        return c.fail(sub(path, "alpha"), "must be in [0, 4] (vegas uses 0.5, GSL 1.5)");
+    if (!(out->train_fraction >= 0.0 && out->train_fraction <= 0.9))
+        return c.fail(sub(path, "train_fraction"),
+                      "must be in [0, 0.9]: the share of N that trains the map");
+    if (iterations < 1 || iterations > 1000)
+        return c.fail(sub(path, "train_iterations"), "must be in [1, 1000]");
+    out->increments = static_cast<int>(increments);
+    out->train_iterations = static_cast<int>(iterations);
+    return true;
+}
+
 bool parse_estimator(Ctx& c, const Json& j, const std::string& path, const Problem& problem,
                      EstimatorSpec* out) {
     std::string name, sampler_name_str, warp, randomization;
     int randomizations = 0; // 0: not given
     const Json* pdf = nullptr;
+    const Json* vegas = nullptr;
     if (j.is_string()) {
         name = j.get<std::string>();
     } else if (j.is_object()) {
         if (!check_keys(c, j, path,
                         {"name", "sampler", "pdf", "warp", "samples_per_stratum", "randomization",
-                         "randomizations"}))
+                         "randomizations", "vegas"}))
             return false;
         uint64_t m = 1;
         if (!get_count(c, j, "samples_per_stratum", path, &m)) return false;
@@ -705,6 +736,7 @@ bool parse_estimator(Ctx& c, const Json& j, const std::string& path, const Probl
             randomizations = static_cast<int>(std::min<uint64_t>(k, 1u << 30));
         }
         pdf = find(j, "pdf");
+        vegas = find(j, "vegas");
     } else {
         return c.fail(path, "expected an estimator name or object, got " + type_of(j));
     }
@@ -746,10 +778,10 @@ bool parse_estimator(Ctx& c, const Json& j, const std::string& path, const Probl
     if (!warp.empty() && problem.domain.kind != DomainKind::Disk)
         return c.fail(sub(path, "warp"), "only disk domains have a choice of warp");
     // A name runs what it says: a bare name must be a preset, and a preset is not redefined.
-    if (!preset && sampler_name_str.empty() && !pdf)
+    if (!preset && sampler_name_str.empty() && !pdf && !vegas)
         return c.fail(path, "unknown estimator '" + name_text(name) + "'" + did_you_mean(name) +
                                 "presets: " + join(preset_names()) +
-                                "; a new name needs \"sampler\" or \"pdf\")");
+                                "; a new name needs \"sampler\", \"pdf\" or \"vegas\")");
     if (preset && !sampler_name_str.empty() && out->sampler != preset->sampler)
         return c.fail(sub(path, "sampler"),
                       "'" + name + "' is the preset with the " + sampler_name(preset->sampler) +
@@ -758,6 +790,13 @@ bool parse_estimator(Ctx& c, const Json& j, const std::string& path, const Probl
         return c.fail(sub(path, "pdf"), "'" + name +
                                             "' is a preset with the uniform density; give the "
                                             "estimator another name to sample a pdf");
+    out->vegas = preset && preset->vegas;
+    if (vegas) {
+        out->vegas = true;
+        if (!parse_vegas_options(c, *vegas, sub(path, "vegas"), problem.domain.sample_dim(),
+                                 &out->vegas_options))
+            return false;
+    }
     out->proposal = uniform_proposal(problem.domain, warp == "polar");
     if (pdf) {
         if (!parse_pdf(c, *pdf, sub(path, "pdf"), problem, &out->proposal)) return false;
@@ -801,6 +840,10 @@ const std::vector<EstimatorPreset>& estimator_presets() {
          "Owen-scrambled Halton points: 16 randomizations of N/16 points"},
         {"lattice", SamplerKind::Lattice, false,
          "randomly shifted rank-1 lattice: 16 shifts of N/16 points"},
+        {"vegas", SamplerKind::Independent, false,
+         "VEGAS: a map trained on a quarter of N, then frozen for independent points", true},
+        {"vegas_sobol", SamplerKind::Sobol, false,
+         "VEGAS map trained, then frozen for 16 Owen-scrambled Sobol' nets", true},
     };
     return presets;
 }

@@ -31,6 +31,7 @@ struct EstimatorPreset {
     SamplerKind sampler;
     bool needs_pdf;
     const char* summary;
+    bool vegas = false; ///< trains a VEGAS map first
 };
 const std::vector<EstimatorPreset>& estimator_presets();
 

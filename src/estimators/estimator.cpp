@@ -143,10 +143,126 @@ class FixedEstimator final : public EstimatorAlgorithm {
     bool prepared_ = false;
 };
 
+// VEGAS [Lepage21]: training iterations of independent points through the current map adapt
+// it; then the map is frozen and N_final points of the spec's sampler, mapped, warped and
+// weighted, make an ordinary estimate with an ordinary error bar (iid, strata or
+// randomizations): the training points are not in it, so they cannot bias it. The result
+// counts all N evaluations.
+constexpr uint64_t kVegasIterationPoints = 1000;
+
+class VegasEstimator final : public EstimatorAlgorithm {
+  public:
+    VegasEstimator(const Problem& problem, const EstimatorSpec& spec, Accumulator accumulator)
+        : problem_(problem), spec_(spec), float32_(accumulator == Accumulator::Float32) {}
+
+    void begin(uint64_t n, Pcg32& /*rng*/) override {
+        const VegasOptions& o = spec_.vegas_options;
+        const int dim = problem_.domain.sample_dim();
+        total_ = n;
+        uint64_t train = static_cast<uint64_t>(o.train_fraction * static_cast<double>(n));
+        // At least kVegasIterationPoints points per training iteration where the share allows:
+        // fewer, and the map learns from noise.
+        iterations_ = static_cast<int>(
+            std::min<uint64_t>(static_cast<uint64_t>(std::max(o.train_iterations, 1)),
+                               std::max<uint64_t>(1, train / kVegasIterationPoints)));
+        if (train < 2) train = 0;
+        final_ = n - train;
+        // A net's randomizations are full nets when each holds a power of two points: the
+        // estimation share is rounded down to K 2^m, and training takes the rest.
+        if (spec_.sampler == SamplerKind::Sobol && train > 0) {
+            const uint64_t k = static_cast<uint64_t>(std::max(spec_.randomizations, 1));
+            uint64_t per = 1;
+            while (2 * per * k <= final_) per *= 2;
+            if (per * k >= 2) final_ = per * k;
+        }
+        train_ = n - final_;
+        if (train_ == 0) iterations_ = 0;
+        const uint64_t per_iteration = iterations_ > 0 ? train_ / iterations_ : 0;
+        map_ = VegasMap(dim, spec_.vegas_options.increments > 0
+                                 ? spec_.vegas_options.increments
+                                 : vegas_increments(dim, per_iteration));
+        iteration_ = 0;
+        next_ = 0;
+        plan_ready_ = false;
+        prepared_ = false;
+        jacobian_.assign(kBlockSize, 1.0);
+        bins_.assign(static_cast<size_t>(dim) * kBlockSize, 0);
+    }
+
+    bool run_block(Pcg32& rng, Workspace& ws) override {
+        if (!prepared_) {
+            prepare_workspace(problem_.domain, ws);
+            prepared_ = true;
+        }
+        const bool training = iteration_ < iterations_;
+        if (!plan_ready_) {
+            const int dim = problem_.domain.sample_dim();
+            if (training) {
+                // Iteration sizes differ by at most one point.
+                const uint64_t size =
+                    train_ * (iteration_ + 1) / iterations_ - train_ * iteration_ / iterations_;
+                plan_ = make_sampler_plan(SamplerKind::Independent, dim, size, rng, {});
+            } else {
+                if (final_ == 0) return false;
+                plan_ = make_sampler_plan(spec_.sampler, dim, final_, rng, spec_.sampler_options());
+                accumulator_.reset(error_method_for(spec_), plan_, float32_);
+            }
+            plan_ready_ = true;
+            next_ = 0;
+        }
+        if (!training && next_ >= plan_.total) return false;
+        const size_t count =
+            static_cast<size_t>(std::min<uint64_t>(kBlockSize, plan_.total - next_));
+        generate_block(plan_, next_, count, ws.u);
+        map_.apply_block(ws.u, jacobian_.data(), training ? bins_.data() : nullptr);
+        warp_block(spec_.proposal, problem_.domain, ws.u, ws.x, ws.pdf.data());
+        for (size_t i = 0; i < count; ++i) ws.pdf[i] /= jacobian_[i]; // p(x) / J(y)
+        evaluate_block(problem_.integrand, ws.x, ws.f.data());
+        if (training) {
+            for (size_t i = 0; i < count; ++i) jacobian_[i] = ws.f[i] / ws.pdf[i]; // weights
+            map_.add_training(bins_.data(), jacobian_.data(), count);
+            next_ += count;
+            if (next_ == plan_.total) {
+                map_.adapt(spec_.vegas_options.alpha);
+                ++iteration_;
+                plan_ready_ = false;
+            }
+            return true;
+        }
+        accumulator_.add_block(next_, ws.f.data(), ws.pdf.data(), ws.pdf.data(), count);
+        next_ += count;
+        return true;
+    }
+
+    RunResult result() const override {
+        const double scale =
+            problem_.quantity == Quantity::Mean ? 1.0 / problem_.domain.measure() : 1.0;
+        RunResult r = accumulator_.finish(scale);
+        r.n = total_;
+        return r;
+    }
+
+    const VegasMap& map() const { return map_; }
+
+  private:
+    const Problem& problem_;
+    const EstimatorSpec& spec_;
+    bool float32_;
+    uint64_t total_ = 0, train_ = 0, final_ = 0, next_ = 0;
+    int iterations_ = 0, iteration_ = 0;
+    bool plan_ready_ = false, prepared_ = false;
+    VegasMap map_;
+    SamplerPlan plan_;
+    WeightAccumulator accumulator_;
+    std::vector<double> jacobian_;
+    std::vector<uint32_t> bins_;
+};
+
 } // namespace
 
 std::unique_ptr<EstimatorAlgorithm>
 make_estimator(const Problem& problem, const EstimatorSpec& spec, Accumulator accumulator) {
+    if (spec.vegas) return std::make_unique<VegasEstimator>(problem, spec, accumulator);
     return std::make_unique<FixedEstimator>(problem, spec, accumulator);
 }
 

@@ -11,6 +11,7 @@
 #include "core/points.h"
 #include "core/samplers.h"
 #include "core/warps.h"
+#include "estimators/vegas.h"
 #include "integrands/integrand.h"
 
 namespace mcp {
@@ -104,6 +105,10 @@ struct EstimatorSpec {
     QmcRandomization randomization = QmcRandomization::Owen; ///< quasi-Monte Carlo samplers
     int randomizations = kDefaultRandomizations; ///< quasi-Monte Carlo: K batches per run
     Proposal proposal;
+    /// VEGAS: train a map of the unit cube on a share of the N evaluations, then estimate with
+    /// the frozen map composed before the proposal's warp (estimators/vegas.h).
+    bool vegas = false;
+    VegasOptions vegas_options;
 
     SamplerOptions sampler_options() const { return {per_stratum, randomization, randomizations}; }
 };

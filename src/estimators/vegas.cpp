@@ -1,0 +1,108 @@
+#include "estimators/vegas.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace mcp {
+
+int vegas_increments(int dim, uint64_t points_per_iteration) {
+    const uint64_t most = dim <= 4 ? 1000 : (dim <= 8 ? 500 : 200);
+    return static_cast<int>(std::max<uint64_t>(2, std::min(most, points_per_iteration / 100)));
+}
+
+VegasMap::VegasMap(int dim, int increments)
+    : dim_(dim), k_(increments), edges_(static_cast<size_t>(dim) * (increments + 1)),
+      sum_w2_(static_cast<size_t>(dim) * increments, 0.0),
+      counts_(static_cast<size_t>(dim) * increments, 0) {
+    for (int j = 0; j < dim; ++j) {
+        double* e = edges_.data() + static_cast<size_t>(j) * (k_ + 1);
+        for (int i = 0; i <= k_; ++i) e[i] = static_cast<double>(i) / k_;
+        e[k_] = 1.0;
+    }
+}
+
+void VegasMap::apply_block(PointBlock& points, double* jacobian, uint32_t* bins) const {
+    const size_t n = points.n;
+    const double k = static_cast<double>(k_);
+    for (size_t i = 0; i < n; ++i) jacobian[i] = 1.0;
+    for (int j = 0; j < dim_; ++j) {
+        double* y = points.coord(j);
+        const double* e = edges(j);
+        uint32_t* bin = bins ? bins + static_cast<size_t>(j) * kBlockSize : nullptr;
+        for (size_t i = 0; i < n; ++i) {
+            const double t = y[i] * k; // y < 1, so t < K up to rounding
+            const int b = std::min(static_cast<int>(t), k_ - 1);
+            const double width = e[b + 1] - e[b];
+            y[i] = below_one(e[b] + (t - b) * width);
+            jacobian[i] *= k * width;
+            if (bin) bin[i] = static_cast<uint32_t>(b);
+        }
+    }
+}
+
+void VegasMap::add_training(const uint32_t* bins, const double* weights, size_t count) {
+    for (int j = 0; j < dim_; ++j) {
+        const uint32_t* bin = bins + static_cast<size_t>(j) * kBlockSize;
+        double* sums = sum_w2_.data() + static_cast<size_t>(j) * k_;
+        uint64_t* counts = counts_.data() + static_cast<size_t>(j) * k_;
+        for (size_t i = 0; i < count; ++i) {
+            const double w = weights[i];
+            if (!std::isfinite(w)) continue;
+            sums[bin[i]] += w * w;
+            counts[bin[i]] += 1;
+        }
+    }
+}
+
+void VegasMap::adapt(double alpha) {
+    std::vector<double> d(static_cast<size_t>(k_)), smooth(static_cast<size_t>(k_));
+    std::vector<double> fresh(static_cast<size_t>(k_) + 1);
+    for (int j = 0; j < dim_; ++j) {
+        double* sums = sum_w2_.data() + static_cast<size_t>(j) * k_;
+        uint64_t* counts = counts_.data() + static_cast<size_t>(j) * k_;
+        for (int i = 0; i < k_; ++i)
+            d[i] = counts[i] > 0 ? sums[i] / static_cast<double>(counts[i]) : 0.0;
+        std::fill(sums, sums + k_, 0.0);
+        std::fill(counts, counts + k_, uint64_t(0));
+        if (k_ == 1) continue;
+        // Smoothing with the neighbours [Lepage21]: 1, 6, 1 over 8 inside, 7, 1 at the ends.
+        smooth[0] = (7.0 * d[0] + d[1]) / 8.0;
+        smooth[k_ - 1] = (7.0 * d[k_ - 1] + d[k_ - 2]) / 8.0;
+        for (int i = 1; i + 1 < k_; ++i) smooth[i] = (d[i - 1] + 6.0 * d[i] + d[i + 1]) / 8.0;
+        double total = 0.0;
+        for (int i = 0; i < k_; ++i) total += smooth[i];
+        if (!(total > 0.0) || !std::isfinite(total)) continue; // nothing learnt on this axis
+        // Damping: ((1 - d) / ln(1 / d))^alpha of the normalised d keeps the map from jumping
+        // to a noisy optimum; alpha = 0 leaves it uniform in d (every increment kept).
+        double damped_total = 0.0;
+        for (int i = 0; i < k_; ++i) {
+            const double r = smooth[i] / total;
+            double v = 0.0;
+            if (r >= 1.0)
+                v = 1.0;
+            else if (r > 0.0)
+                v = std::pow((1.0 - r) / std::log(1.0 / r), alpha);
+            smooth[i] = v;
+            damped_total += v;
+        }
+        if (!(damped_total > 0.0)) continue;
+        // New edges: increment i of the old map holds a share smooth[i] of the total, spread
+        // evenly over it; the new edges cut the total into K equal shares.
+        const double* e = edges(j);
+        const double share = damped_total / k_;
+        fresh[0] = 0.0;
+        double below = 0.0; // the total of the old increments before `old`
+        int old = 0;
+        for (int i = 1; i < k_; ++i) {
+            const double target = share * i;
+            while (old + 1 < k_ && below + smooth[old] < target) below += smooth[old++];
+            const double within =
+                smooth[old] > 0.0 ? std::min(1.0, (target - below) / smooth[old]) : 1.0;
+            fresh[i] = std::max(fresh[i - 1], e[old] + within * (e[old + 1] - e[old]));
+        }
+        fresh[k_] = 1.0;
+        std::copy(fresh.begin(), fresh.end(), edges_.begin() + static_cast<long>(j) * (k_ + 1));
+    }
+}
+
+} // namespace mcp
