@@ -69,7 +69,8 @@ struct Options {
     std::vector<int> families{1, 2, 3, 4, 5, 6};
     bool dims_given = false, families_given = false;
     std::vector<std::string> methods{"uniform", "stratified", "latin_hypercube",
-                                     "sobol",   "halton",     "lattice"};
+                                     "sobol",   "halton",     "lattice",
+                                     "vegas",   "vegas_sobol"};
     std::vector<std::string> gsl{"plain", "miser", "vegas"};
     uint64_t param_seed = 1; // genz_random(family, d, param_seed)
     uint64_t seed = 1;       // replicate seeds

@@ -677,12 +677,14 @@ std::string name_text(const std::string& name) {
 /// The "vegas" object of an estimator: every field optional, each bounded before any work.
 bool parse_vegas_options(Ctx& c, const Json& j, const std::string& path, int dim,
                          VegasOptions* out) {
-    if (!check_keys(c, j, path, {"increments", "alpha", "train_fraction", "train_iterations"}))
+    if (!check_keys(c, j, path,
+                    {"increments", "alpha", "train_fraction", "train_iterations", "uniform_share"}))
         return false;
     uint64_t increments = 0, iterations = static_cast<uint64_t>(out->train_iterations);
     if (!get_count(c, j, "increments", path, &increments) ||
         !get_number(c, j, "alpha", path, &out->alpha) ||
         !get_number(c, j, "train_fraction", path, &out->train_fraction) ||
+        !get_number(c, j, "uniform_share", path, &out->uniform_share) ||
         !get_count(c, j, "train_iterations", path, &iterations))
         return false;
     // The map holds dim x increments edges and sums: at most 2^22 of each.
@@ -697,6 +699,8 @@ bool parse_vegas_options(Ctx& c, const Json& j, const std::string& path, int dim
     if (!(out->train_fraction >= 0.0 && out->train_fraction <= 0.9))
         return c.fail(sub(path, "train_fraction"),
                       "must be in [0, 0.9]: the share of N that trains the map");
+    if (!(out->uniform_share >= 0.0 && out->uniform_share <= 1.0))
+        return c.fail(sub(path, "uniform_share"), "must be in [0, 1]");
     if (iterations < 1 || iterations > 1000)
         return c.fail(sub(path, "train_iterations"), "must be in [1, 1000]");
     out->increments = static_cast<int>(increments);

@@ -223,7 +223,7 @@ class VegasEstimator final : public EstimatorAlgorithm {
             map_.add_training(bins_.data(), jacobian_.data(), count);
             next_ += count;
             if (next_ == plan_.total) {
-                map_.adapt(spec_.vegas_options.alpha);
+                map_.adapt(spec_.vegas_options.alpha, spec_.vegas_options.uniform_share);
                 ++iteration_;
                 plan_ready_ = false;
             }

@@ -54,7 +54,7 @@ void VegasMap::add_training(const uint32_t* bins, const double* weights, size_t 
     }
 }
 
-void VegasMap::adapt(double alpha) {
+void VegasMap::adapt(double alpha, double uniform_share) {
     std::vector<double> d(static_cast<size_t>(k_)), smooth(static_cast<size_t>(k_));
     std::vector<double> fresh(static_cast<size_t>(k_) + 1);
     for (int j = 0; j < dim_; ++j) {
@@ -86,6 +86,16 @@ void VegasMap::adapt(double alpha) {
             damped_total += v;
         }
         if (!(damped_total > 0.0)) continue;
+        // A share of the increments spread evenly over the axis, whatever the training saw:
+        // no increment is wider than 1 / (share K), so the axis's Jacobian stays below
+        // 1 / share. Without it a region where f was seen as 0 collapses into one increment
+        // that also reaches into a region where f is large (a discontinuity), and the rare
+        // points there carry huge weights (heavy tails, error bars that miss).
+        const double* edge = edges(j);
+        for (int i = 0; i < k_; ++i)
+            smooth[i] = (1.0 - uniform_share) * smooth[i] / damped_total +
+                        uniform_share * (edge[i + 1] - edge[i]);
+        damped_total = 1.0;
         // New edges: increment i of the old map holds a share smooth[i] of the total, spread
         // evenly over it; the new edges cut the total into K equal shares.
         const double* e = edges(j);

@@ -15,6 +15,7 @@ struct VegasOptions {
     double alpha = 0.5;           ///< damping exponent of the refinement [Lepage21, eq. 22]
     double train_fraction = 0.25; ///< share of the N evaluations spent training the map
     int train_iterations = 10;    ///< the training share is split into this many iterations
+    double uniform_share = 0.05;  ///< share of each axis's increments spread evenly
 };
 
 /// Increments per axis: about 100 training points per increment per iteration (fewer make the
@@ -49,7 +50,7 @@ class VegasMap {
     /// 7, 1 at the ends), normalised to sum 1, damped to ((1 - d_i) / ln(1 / d_i))^alpha, and
     /// the new edges give every increment an equal share of the damped d. An axis with no
     /// non-zero data keeps its edges.
-    void adapt(double alpha);
+    void adapt(double alpha, double uniform_share);
 
   private:
     int dim_ = 0, k_ = 0;
