@@ -7,6 +7,7 @@
 
 #include "api/scene.h"
 #include "estimators/block_driver.h"
+#include "estimators/diagnostics.h"
 #include "estimators/vegas.h"
 
 using namespace mcp;
@@ -171,6 +172,37 @@ TEST(VegasEstimator, HonestAcrossADiscontinuity) {
     }
 }
 
+// The iteration average, as vegas and GSL report it: on a smooth peak its iterations agree (the
+// pooled chi^2 raises no flag) and its mean is within 4 standard errors of the exact value;
+// across a discontinuity with the even share turned off, the iterations disagree, and the flag
+// says so where the frozen map's runs only show a heavy tail.
+TEST(VegasIterations, AgreeOnAPeakAndDisagreeAcrossACut) {
+    StudySettings settings;
+    settings.n_min = settings.n_max = 1 << 18;
+    settings.reps = 32;
+    settings.seed = 5;
+    settings.threads = 2;
+    Made<SceneRequest> peak =
+        request(gaussian_scene(0.02, R"([{"name": "it", "vegas": {"report": "iterations"}}])"));
+    ASSERT_TRUE(peak.ok()) << peak.error;
+    StudyResult s = run_study(peak.value.problem, peak.value.estimators, settings);
+    const LevelStats& l = s.estimators[0].levels[0];
+    EXPECT_EQ(l.iteration_dof, 32 * 4); // 5 iterations per run
+    EXPECT_LE(std::fabs(l.bias), 4.0 * l.std_error);
+    for (const Flag& f : level_flags(l)) ADD_FAILURE() << flag_code_name(f.code);
+
+    Made<SceneRequest> cut = request(
+        R"({"name": "d", "integrand": {"type": "genz_discontinuous", "a": [12, 8],
+            "u": [0.2, 0.4]}, "estimators": [{"name": "it",
+            "vegas": {"report": "iterations", "uniform_share": 0}}]})");
+    ASSERT_TRUE(cut.ok()) << cut.error;
+    s = run_study(cut.value.problem, cut.value.estimators, settings);
+    bool flagged = false;
+    for (const Flag& f : level_flags(s.estimators[0].levels[0]))
+        flagged = flagged || f.code == FlagCode::IterationsDisagree;
+    EXPECT_TRUE(flagged);
+}
+
 TEST(VegasEstimator, TinyRunsSkipTraining) {
     Made<SceneRequest> r = request(gaussian_scene(0.1, R"(["vegas"])"));
     ASSERT_TRUE(r.ok()) << r.error;
@@ -192,6 +224,8 @@ TEST(VegasOptions, BadValuesAreNamed) {
         {R"({"increments": 3000000})", "vegas.increments"},
         {R"({"increments": 0})", "vegas.increments"},
         {R"({"uniform_share": 1.5})", "vegas.uniform_share"},
+        {R"({"report": "average"})", "vegas.report"},
+        {R"({"report": "iterations", "iterations": 1})", "vegas.iterations"},
         {R"({"bins": 4})", "unknown field 'bins'"},
     };
     for (const Case& c : cases) {

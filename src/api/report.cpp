@@ -81,6 +81,15 @@ Json level_warning(const Flag& f, const LevelStats& l) {
                       (std::isfinite(f.value) ? fmt("%.1f", f.value) + " standard errors"
                                               : std::string("a margin with zero spread")) +
                       at_n + ": the estimator is biased or its error bars are wrong");
+    case FlagCode::IterationsDisagree:
+        return warning(code, "the iterations of the runs disagree beyond their error bars" + at_n +
+                                 " (chi2 = " + fmt("%.1f", f.value) + " for " +
+                                 std::to_string(f.dof) + " degrees of freedom over " +
+                                 std::to_string(f.of) +
+                                 " replicates, p = " + fmt("%.2g", f.p_value) +
+                                 "): the weighted average and its error bar are not "
+                                 "trustworthy (the map was still changing, or the integrand "
+                                 "has a feature the iterations saw differently)");
     default: return warning(code, "");
     }
 }
@@ -248,6 +257,11 @@ Json level_to_json(const LevelStats& l) {
     } else {
         j["bias"] = j["mse"] = j["rmse"] = j["coverage95"] = nullptr;
     }
+    // Iteration averages (VEGAS "report": "iterations"): the pooled consistency of iterations.
+    if (l.iteration_dof > 0)
+        j["iterations"] = {{"chi2", num(l.iteration_chi2)},
+                           {"dof", l.iteration_dof},
+                           {"p_value", num(chi_square_sf(l.iteration_chi2, l.iteration_dof))}};
     Json est = Json::array(), se = Json::array();
     for (double x : l.estimates) est.push_back(num(x));
     for (double x : l.run_std_errors) se.push_back(num(x));

@@ -678,14 +678,18 @@ std::string name_text(const std::string& name) {
 bool parse_vegas_options(Ctx& c, const Json& j, const std::string& path, int dim,
                          VegasOptions* out) {
     if (!check_keys(c, j, path,
-                    {"increments", "alpha", "train_fraction", "train_iterations", "uniform_share"}))
+                    {"increments", "alpha", "train_fraction", "train_iterations", "uniform_share",
+                     "report", "iterations"}))
         return false;
     uint64_t increments = 0, iterations = static_cast<uint64_t>(out->train_iterations);
+    uint64_t rounds = static_cast<uint64_t>(out->iterations);
+    std::string report;
     if (!get_count(c, j, "increments", path, &increments) ||
         !get_number(c, j, "alpha", path, &out->alpha) ||
         !get_number(c, j, "train_fraction", path, &out->train_fraction) ||
         !get_number(c, j, "uniform_share", path, &out->uniform_share) ||
-        !get_count(c, j, "train_iterations", path, &iterations))
+        !get_count(c, j, "train_iterations", path, &iterations) ||
+        !get_count(c, j, "iterations", path, &rounds) || !get_string(c, j, "report", path, &report))
         return false;
     // The map holds dim x increments edges and sums: at most 2^22 of each.
     if (find(j, "increments") &&
@@ -703,6 +707,17 @@ bool parse_vegas_options(Ctx& c, const Json& j, const std::string& path, int dim
         return c.fail(sub(path, "uniform_share"), "must be in [0, 1]");
     if (iterations < 1 || iterations > 1000)
         return c.fail(sub(path, "train_iterations"), "must be in [1, 1000]");
+    if (report == "iterations")
+        out->report = VegasReport::Iterations;
+    else if (report == "frozen" || report.empty())
+        out->report = VegasReport::Frozen;
+    else
+        return c.fail(sub(path, "report"), "expected \"frozen\" (train, then estimate with the "
+                                           "frozen map) or \"iterations\" (the weighted average "
+                                           "of adapting iterations), got \"" +
+                                               report.substr(0, 64) + "\"");
+    if (rounds < 2 || rounds > 1000) return c.fail(sub(path, "iterations"), "must be in [2, 1000]");
+    out->iterations = static_cast<int>(rounds);
     out->increments = static_cast<int>(increments);
     out->train_iterations = static_cast<int>(iterations);
     return true;

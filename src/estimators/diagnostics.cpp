@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "core/special.h"
+
 namespace mcp {
 
 const char* flag_code_name(FlagCode code) {
@@ -19,6 +21,7 @@ const char* flag_code_name(FlagCode code) {
     case FlagCode::HeavyTail4: return "heavy_tail_4";
     case FlagCode::PdfSupport: return "pdf_support";
     case FlagCode::LevelDrift: return "level_drift";
+    case FlagCode::IterationsDisagree: return "iterations_disagree";
     case FlagCode::Float32Accumulator: return "float32_accumulator";
     case FlagCode::BelowReferenceNoise: return "below_reference_noise";
     case FlagCode::ReferenceNoise: return "reference_noise";
@@ -81,6 +84,19 @@ std::vector<Flag> level_flags(const LevelStats& l) {
         Flag& f = raise(FlagCode::LowEss);
         f.value = l.ess_mean;
         f.threshold = kLowEss;
+    }
+    // An iteration average whose iterations disagree: the error bar of the weighted mean
+    // assumes they estimate one value (vegas's and GSL's chi^2 / dof check, pooled over runs).
+    if (l.iteration_dof > 0) {
+        const double p = chi_square_sf(l.iteration_chi2, l.iteration_dof);
+        if (p < kLevelDriftP) {
+            Flag& f = raise(FlagCode::IterationsDisagree);
+            f.value = l.iteration_chi2;
+            f.dof = l.iteration_dof;
+            f.p_value = p;
+            f.threshold = kLevelDriftP;
+            f.of = reps;
+        }
     }
     // With the exact value known: the replicates' mean must lie within a few of its own
     // standard errors of it, or the estimator is biased or its variance infinite.

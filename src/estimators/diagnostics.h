@@ -26,6 +26,7 @@ enum class FlagCode {
     PdfSupport,         ///< the pdf is zero where f is not
     LevelDrift,         ///< the level means disagree beyond their error bars
     Float32Accumulator, ///< naive single-precision sums (teaching mode)
+    IterationsDisagree, ///< an iteration average's iterations disagree beyond their error bars
     // Render studies (render/render_study.h: render_flags).
     BelowReferenceNoise, ///< a level's relative MSE is below the reference's own noise
     ReferenceNoise,      ///< some levels lie below the reference's noise (left out of the fit)
@@ -61,7 +62,9 @@ constexpr double kHeavyTail4Alpha = 4.0;
 /// The flags of one level, from its replicates' statistics: no estimate (then nothing else),
 /// a non-finite mean or variance, wrong zero error bars, dropped samples, a dominant sample
 /// (N >= 1024 and a share > 5%), a low effective sample size (< 10 and < N/4), and, with the
-/// exact value known, a mean more than 5 standard errors (+ 1e-12 relative) away from it.
+/// exact value known, a mean more than 5 standard errors (+ 1e-12 relative) away from it;
+/// for iteration averages, iterations that disagree: the chi^2 summed over the runs has
+/// p < 1e-3 (pooled, so that the 1 run in 100 with p < 0.01 by chance raises nothing).
 std::vector<Flag> level_flags(const LevelStats& level);
 
 /// Hill's tail index alpha, P(|x| > t) ~ t^-alpha, read at the deepest level (the pooled sample

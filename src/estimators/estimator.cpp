@@ -177,6 +177,14 @@ class VegasEstimator final : public EstimatorAlgorithm {
         }
         train_ = n - final_;
         if (train_ == 0) iterations_ = 0;
+        // Iteration average: the estimation share in `iterations` parts (each at least 2 points).
+        rounds_ = 1;
+        if (o.report == VegasReport::Iterations)
+            rounds_ = static_cast<int>(std::max<uint64_t>(
+                1,
+                std::min<uint64_t>(static_cast<uint64_t>(std::max(o.iterations, 1)), final_ / 2)));
+        round_ = 0;
+        rounds_done_.clear();
         const uint64_t per_iteration = iterations_ > 0 ? train_ / iterations_ : 0;
         map_ = VegasMap(dim, spec_.vegas_options.increments > 0
                                  ? spec_.vegas_options.increments
@@ -203,18 +211,19 @@ class VegasEstimator final : public EstimatorAlgorithm {
                     train_ * (iteration_ + 1) / iterations_ - train_ * iteration_ / iterations_;
                 plan_ = make_sampler_plan(SamplerKind::Independent, dim, size, rng, {});
             } else {
-                if (final_ == 0) return false;
-                plan_ = make_sampler_plan(spec_.sampler, dim, final_, rng, spec_.sampler_options());
+                if (final_ == 0 || round_ >= rounds_) return false;
+                const uint64_t size = final_ * (round_ + 1) / rounds_ - final_ * round_ / rounds_;
+                plan_ = make_sampler_plan(spec_.sampler, dim, size, rng, spec_.sampler_options());
                 accumulator_.reset(error_method_for(spec_), plan_, float32_);
             }
             plan_ready_ = true;
             next_ = 0;
         }
-        if (!training && next_ >= plan_.total) return false;
+        const bool averaging = rounds_ > 1; // iteration average: the map keeps learning
         const size_t count =
             static_cast<size_t>(std::min<uint64_t>(kBlockSize, plan_.total - next_));
         generate_block(plan_, next_, count, ws.u);
-        map_.apply_block(ws.u, jacobian_.data(), training ? bins_.data() : nullptr);
+        map_.apply_block(ws.u, jacobian_.data(), training || averaging ? bins_.data() : nullptr);
         warp_block(spec_.proposal, problem_.domain, ws.u, ws.x, ws.pdf.data());
         for (size_t i = 0; i < count; ++i) ws.pdf[i] /= jacobian_[i]; // p(x) / J(y)
         evaluate_block(problem_.integrand, ws.x, ws.f.data());
@@ -230,14 +239,20 @@ class VegasEstimator final : public EstimatorAlgorithm {
             return true;
         }
         accumulator_.add_block(next_, ws.f.data(), ws.pdf.data(), ws.pdf.data(), count);
+        if (averaging) map_.add_training(bins_.data(), ws.pdf.data(), count); // the weights
         next_ += count;
+        if (next_ == plan_.total) {
+            // One estimation iteration done: keep its result, adapt for the next.
+            rounds_done_.push_back(finish_round());
+            if (averaging) map_.adapt(spec_.vegas_options.alpha, spec_.vegas_options.uniform_share);
+            ++round_;
+            plan_ready_ = false;
+        }
         return true;
     }
 
     RunResult result() const override {
-        const double scale =
-            problem_.quantity == Quantity::Mean ? 1.0 / problem_.domain.measure() : 1.0;
-        RunResult r = accumulator_.finish(scale);
+        RunResult r = rounds_done_.size() == 1 ? rounds_done_[0] : average(rounds_done_);
         r.n = total_;
         return r;
     }
@@ -245,11 +260,66 @@ class VegasEstimator final : public EstimatorAlgorithm {
     const VegasMap& map() const { return map_; }
 
   private:
+    RunResult finish_round() const {
+        const double scale =
+            problem_.quantity == Quantity::Mean ? 1.0 / problem_.domain.measure() : 1.0;
+        return accumulator_.finish(scale);
+    }
+
+    /// The weighted average of the iterations, weights 1 / se_i^2, its standard error
+    /// (sum 1 / se_i^2)^-1/2, and chi^2 = sum (I_i - I)^2 / se_i^2 on (iterations - 1) degrees
+    /// of freedom [Lepage78]. An iteration without a positive finite error bar (an exact or
+    /// empty one) makes the weights meaningless: then the plain mean, and no chi^2.
+    static RunResult average(const std::vector<RunResult>& rounds) {
+        RunResult r;
+        if (rounds.empty()) {
+            r.estimate = r.std_error = std::numeric_limits<double>::quiet_NaN();
+            return r;
+        }
+        bool weighted = true;
+        for (const RunResult& x : rounds)
+            weighted = weighted && std::isfinite(x.estimate) && std::isfinite(x.std_error) &&
+                       x.std_error > 0.0;
+        NeumaierSum sum_w, sum_wi, sum_se2;
+        long dof = 0;
+        for (const RunResult& x : rounds) {
+            const double w = weighted ? 1.0 / (x.std_error * x.std_error) : 1.0;
+            sum_w.add(w);
+            sum_wi.add(w * x.estimate);
+            sum_se2.add(x.std_error * x.std_error);
+            dof += x.dof;
+            const double ess = r.diagnostics.ess + x.diagnostics.ess;
+            r.diagnostics.merge(x.diagnostics);
+            r.diagnostics.ess = ess;
+            r.top.insert(r.top.end(), x.top.begin(), x.top.end());
+        }
+        const double m = static_cast<double>(rounds.size());
+        r.estimate = sum_wi.value() / sum_w.value();
+        r.std_error = weighted ? 1.0 / std::sqrt(sum_w.value()) : std::sqrt(sum_se2.value()) / m;
+        r.dof = static_cast<int>(std::min<long>(dof, 1000000));
+        std::sort(r.top.begin(), r.top.end(), std::greater<double>());
+        if (r.top.size() > kTopWeights) r.top.resize(kTopWeights);
+        if (weighted && rounds.size() > 1) {
+            NeumaierSum chi2;
+            for (const RunResult& x : rounds) {
+                const double z = (x.estimate - r.estimate) / x.std_error;
+                chi2.add(z * z);
+            }
+            r.iteration_chi2 = chi2.value();
+            r.iteration_dof = static_cast<int>(rounds.size()) - 1;
+        }
+        return r;
+    }
+
+  public:
+  private:
     const Problem& problem_;
     const EstimatorSpec& spec_;
     bool float32_;
     uint64_t total_ = 0, train_ = 0, final_ = 0, next_ = 0;
-    int iterations_ = 0, iteration_ = 0;
+    int iterations_ = 0, iteration_ = 0; // training iterations
+    int rounds_ = 1, round_ = 0;         // estimation iterations (1 unless averaging)
+    std::vector<RunResult> rounds_done_;
     bool plan_ready_ = false, prepared_ = false;
     VegasMap map_;
     SamplerPlan plan_;

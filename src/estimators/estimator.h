@@ -51,6 +51,11 @@ struct RunResult {
     double seconds = 0.0;
     RunDiagnostics diagnostics;
     std::vector<double> top; ///< the kTopWeights largest |w|, decreasing (for the tail index)
+    /// Estimators that average iterations (VEGAS's iteration average): chi^2 of the iteration
+    /// estimates about their weighted mean, on iteration_dof = iterations - 1 degrees of
+    /// freedom (0: not such an estimator).
+    double iteration_chi2 = 0.0;
+    int iteration_dof = 0;
 };
 
 /// The 97.5% quantile behind a run's 95% interval: Student t with dof degrees of freedom

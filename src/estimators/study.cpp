@@ -445,6 +445,10 @@ LevelStats summarise_level(const std::vector<RunResult>& runs, const Problem& pr
             r.std_error <= 64.0 * 2.220446049250313e-16 * std::fabs(r.estimate))
             ++s.zero_error_runs;
         ess += r.diagnostics.ess;
+        if (r.iteration_dof > 0 && std::isfinite(r.iteration_chi2)) {
+            s.iteration_chi2 += r.iteration_chi2;
+            s.iteration_dof += r.iteration_dof;
+        }
         pooled.insert(pooled.end(), r.top.begin(), r.top.end());
         nonzero += static_cast<double>(r.diagnostics.nonzero);
         est.add(r.estimate);

@@ -89,6 +89,11 @@ struct LevelStats {
     double ess_mean = 0.0;        ///< mean effective sample size per run
     int no_estimate_runs = 0;     ///< runs whose every sample was NaN/Inf: then the level has no
                                   ///< estimate (mean, variance and what derives from them are NaN)
+    /// Iteration averages (VEGAS): chi^2 of every run's iterations about their weighted mean,
+    /// summed over the runs, and its degrees of freedom (0: no such runs). Under consistent
+    /// iterations the sum is chi-square on the summed degrees of freedom.
+    double iteration_chi2 = 0.0;
+    int iteration_dof = 0;
     int zero_error_runs = 0; ///< runs whose own standard error is 0 (to round-off, 64 eps |I_N|)
     bool estimates_spread = false; ///< the replicates differ beyond round-off (variance >
                                    ///< (64 eps |mean|)^2): a zero error bar is then wrong

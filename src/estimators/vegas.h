@@ -9,6 +9,13 @@
 
 namespace mcp {
 
+/// How a VEGAS run reports its estimate.
+enum class VegasReport {
+    Frozen,    ///< train, freeze the map, estimate from fresh points: an ordinary error bar
+    Iterations ///< keep adapting over `iterations` iterations and report their weighted
+               ///< average with chi^2 / dof, as vegas and GSL do [Lepage78, eq. 6-8]
+};
+
 /// The options of a VEGAS estimator (scene field "vegas"; docs/scene-format.md).
 struct VegasOptions {
     int increments = 0;           ///< per axis; 0 chooses vegas_increments()
@@ -16,6 +23,8 @@ struct VegasOptions {
     double train_fraction = 0.25; ///< share of the N evaluations spent training the map
     int train_iterations = 10;    ///< the training share is split into this many iterations
     double uniform_share = 0.05;  ///< share of each axis's increments spread evenly
+    VegasReport report = VegasReport::Frozen;
+    int iterations = 5; ///< Iterations: the estimation share is split into this many
 };
 
 /// Increments per axis: about 100 training points per increment per iteration (fewer make the
