@@ -37,7 +37,7 @@ std::string repeated(size_t n, const std::string& item) {
 
 constexpr const char* kPresets =
     "presets: uniform, stratified, latin_hypercube, importance, stratified_importance, sobol, "
-    "halton, lattice, vegas, vegas_sobol";
+    "halton, lattice, vegas, vegas_sobol, vegas_plus";
 
 // --- 1. estimator names -----------------------------------------------------------------
 

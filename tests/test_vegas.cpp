@@ -203,6 +203,49 @@ TEST(VegasIterations, AgreeOnAPeakAndDisagreeAcrossACut) {
     EXPECT_TRUE(flagged);
 }
 
+// VEGAS+: hypercubes with points allocated by sigma_h^0.75 on top of the map. On a peak of
+// width 0.05 it beats the map alone (F test as above), and its stratified error bar (per
+// hypercube variances, Satterthwaite's degrees of freedom) covers as it should.
+TEST(VegasPlus, UnbiasedCalibratedAndBetterThanTheMapAlone) {
+    Made<SceneRequest> r = request(gaussian_scene(0.05, R"(["vegas", "vegas_plus"])"));
+    ASSERT_TRUE(r.ok()) << r.error;
+    const Problem& problem = r.value.problem;
+    const double exact = *problem.exact;
+    const int runs = 200;
+    double variance[2] = {0, 0};
+    for (size_t e = 0; e < 2; ++e) {
+        Workspace ws;
+        double sum = 0.0, sum2 = 0.0;
+        int covered = 0;
+        for (int k = 0; k < runs; ++k) {
+            Pcg32 rng(4048u + static_cast<uint64_t>(k), 9u + e);
+            const RunResult run = run_estimate(problem, r.value.estimators[e], 65536, rng, ws);
+            EXPECT_EQ(run.n, 65536u);
+            sum += run.estimate;
+            sum2 += run.estimate * run.estimate;
+            covered +=
+                std::fabs(run.estimate - exact) <= interval_quantile(run.dof) * run.std_error;
+        }
+        const double mean = sum / runs;
+        variance[e] = (sum2 - runs * mean * mean) / (runs - 1);
+        EXPECT_LE(std::fabs(mean - exact), 4.0 * std::sqrt(variance[e] / runs));
+        EXPECT_GE(covered, static_cast<int>(0.88 * runs)) << e;
+        EXPECT_LE(covered, static_cast<int>(0.995 * runs)) << e;
+    }
+    EXPECT_GT(variance[0] / variance[1], 2.0);
+}
+
+TEST(VegasPlus, OnePointRunHasNoErrorBar) {
+    Made<SceneRequest> r = request(gaussian_scene(0.1, R"(["vegas_plus"])"));
+    ASSERT_TRUE(r.ok()) << r.error;
+    Workspace ws;
+    Pcg32 rng(5u, 2u);
+    const RunResult run = run_estimate(r.value.problem, r.value.estimators[0], 1, rng, ws);
+    EXPECT_EQ(run.n, 1u);
+    EXPECT_TRUE(std::isfinite(run.estimate));
+    EXPECT_TRUE(std::isnan(run.std_error));
+}
+
 TEST(VegasEstimator, TinyRunsSkipTraining) {
     Made<SceneRequest> r = request(gaussian_scene(0.1, R"(["vegas"])"));
     ASSERT_TRUE(r.ok()) << r.error;
@@ -226,6 +269,9 @@ TEST(VegasOptions, BadValuesAreNamed) {
         {R"({"uniform_share": 1.5})", "vegas.uniform_share"},
         {R"({"report": "average"})", "vegas.report"},
         {R"({"report": "iterations", "iterations": 1})", "vegas.iterations"},
+        {R"({"beta": 3})", "vegas.beta"},
+        {R"({"stratify": 1})", "vegas.stratify"},
+        {R"({"stratify": true, "report": "iterations"})", "vegas.report"},
         {R"({"bins": 4})", "unknown field 'bins'"},
     };
     for (const Case& c : cases) {

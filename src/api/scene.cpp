@@ -679,7 +679,7 @@ bool parse_vegas_options(Ctx& c, const Json& j, const std::string& path, int dim
                          VegasOptions* out) {
     if (!check_keys(c, j, path,
                     {"increments", "alpha", "train_fraction", "train_iterations", "uniform_share",
-                     "report", "iterations"}))
+                     "report", "iterations", "stratify", "beta"}))
         return false;
     uint64_t increments = 0, iterations = static_cast<uint64_t>(out->train_iterations);
     uint64_t rounds = static_cast<uint64_t>(out->iterations);
@@ -689,7 +689,8 @@ bool parse_vegas_options(Ctx& c, const Json& j, const std::string& path, int dim
         !get_number(c, j, "train_fraction", path, &out->train_fraction) ||
         !get_number(c, j, "uniform_share", path, &out->uniform_share) ||
         !get_count(c, j, "train_iterations", path, &iterations) ||
-        !get_count(c, j, "iterations", path, &rounds) || !get_string(c, j, "report", path, &report))
+        !get_count(c, j, "iterations", path, &rounds) ||
+        !get_string(c, j, "report", path, &report) || !get_number(c, j, "beta", path, &out->beta))
         return false;
     // The map holds dim x increments edges and sums: at most 2^22 of each.
     if (find(j, "increments") &&
@@ -716,6 +717,17 @@ bool parse_vegas_options(Ctx& c, const Json& j, const std::string& path, int dim
                                            "frozen map) or \"iterations\" (the weighted average "
                                            "of adapting iterations), got \"" +
                                                report.substr(0, 64) + "\"");
+    if (const Json* st = find(j, "stratify")) {
+        if (!st->is_boolean())
+            return c.fail(sub(path, "stratify"), "expected true or false, got " + type_of(*st));
+        out->stratify = st->get<bool>();
+    }
+    if (!(out->beta >= 0.0 && out->beta <= 2.0))
+        return c.fail(sub(path, "beta"),
+                      "must be in [0, 2] (0: equal points per hypercube; vegas uses 0.75)");
+    if (out->stratify && out->report == VegasReport::Iterations)
+        return c.fail(sub(path, "report"), "adaptive stratification (\"stratify\") reports the "
+                                           "frozen map and allocation only");
     if (rounds < 2 || rounds > 1000) return c.fail(sub(path, "iterations"), "must be in [2, 1000]");
     out->iterations = static_cast<int>(rounds);
     out->increments = static_cast<int>(increments);
@@ -810,12 +822,16 @@ bool parse_estimator(Ctx& c, const Json& j, const std::string& path, const Probl
                                             "' is a preset with the uniform density; give the "
                                             "estimator another name to sample a pdf");
     out->vegas = preset && preset->vegas;
+    out->vegas_options.stratify = preset && std::string(preset->name) == "vegas_plus";
     if (vegas) {
         out->vegas = true;
         if (!parse_vegas_options(c, *vegas, sub(path, "vegas"), problem.domain.sample_dim(),
                                  &out->vegas_options))
             return false;
     }
+    if (out->vegas && out->vegas_options.stratify && out->sampler != SamplerKind::Independent)
+        return c.fail(sub(path, "sampler"), "VEGAS+ (\"stratify\": true) draws its own points in "
+                                            "its hypercubes: the sampler must be independent");
     out->proposal = uniform_proposal(problem.domain, warp == "polar");
     if (pdf) {
         if (!parse_pdf(c, *pdf, sub(path, "pdf"), problem, &out->proposal)) return false;
@@ -863,6 +879,10 @@ const std::vector<EstimatorPreset>& estimator_presets() {
          "VEGAS: a map trained on a quarter of N, then frozen for independent points", true},
         {"vegas_sobol", SamplerKind::Sobol, false,
          "VEGAS map trained, then frozen for 16 Owen-scrambled Sobol' nets", true},
+        {"vegas_plus", SamplerKind::Independent, false,
+         "VEGAS+: the map and hypercubes with points allocated by sigma^0.75, trained then "
+         "frozen",
+         true},
     };
     return presets;
 }

@@ -69,7 +69,12 @@ class EstimatorAlgorithm {
     virtual RunResult result() const = 0;
 };
 
-/// The algorithm of an estimator spec (today: every spec is a fixed estimator).
+/// VEGAS+ (estimators/vegas_plus.cpp): the VEGAS map and adaptive stratification.
+std::unique_ptr<EstimatorAlgorithm> make_vegas_plus_estimator(const Problem& problem,
+                                                              const EstimatorSpec& spec,
+                                                              Accumulator accumulator);
+
+/// The algorithm of an estimator spec: fixed, VEGAS or VEGAS+.
 std::unique_ptr<EstimatorAlgorithm>
 make_estimator(const Problem& problem, const EstimatorSpec& spec, Accumulator accumulator);
 

@@ -13,7 +13,7 @@ int vegas_increments(int dim, uint64_t points_per_iteration) {
 VegasMap::VegasMap(int dim, int increments)
     : dim_(dim), k_(increments), edges_(static_cast<size_t>(dim) * (increments + 1)),
       sum_w2_(static_cast<size_t>(dim) * increments, 0.0),
-      counts_(static_cast<size_t>(dim) * increments, 0) {
+      counts_(static_cast<size_t>(dim) * increments, 0.0) {
     for (int j = 0; j < dim; ++j) {
         double* e = edges_.data() + static_cast<size_t>(j) * (k_ + 1);
         for (int i = 0; i <= k_; ++i) e[i] = static_cast<double>(i) / k_;
@@ -41,15 +41,20 @@ void VegasMap::apply_block(PointBlock& points, double* jacobian, uint32_t* bins)
 }
 
 void VegasMap::add_training(const uint32_t* bins, const double* weights, size_t count) {
+    add_training(bins, weights, nullptr, count);
+}
+
+void VegasMap::add_training(const uint32_t* bins, const double* weights, const double* importance,
+                            size_t count) {
     for (int j = 0; j < dim_; ++j) {
         const uint32_t* bin = bins + static_cast<size_t>(j) * kBlockSize;
         double* sums = sum_w2_.data() + static_cast<size_t>(j) * k_;
-        uint64_t* counts = counts_.data() + static_cast<size_t>(j) * k_;
+        double* counts = counts_.data() + static_cast<size_t>(j) * k_;
         for (size_t i = 0; i < count; ++i) {
-            const double w = weights[i];
+            const double w = weights[i], c = importance ? importance[i] : 1.0;
             if (!std::isfinite(w)) continue;
-            sums[bin[i]] += w * w;
-            counts[bin[i]] += 1;
+            sums[bin[i]] += c * w * w;
+            counts[bin[i]] += c;
         }
     }
 }
@@ -59,11 +64,10 @@ void VegasMap::adapt(double alpha, double uniform_share) {
     std::vector<double> fresh(static_cast<size_t>(k_) + 1);
     for (int j = 0; j < dim_; ++j) {
         double* sums = sum_w2_.data() + static_cast<size_t>(j) * k_;
-        uint64_t* counts = counts_.data() + static_cast<size_t>(j) * k_;
-        for (int i = 0; i < k_; ++i)
-            d[i] = counts[i] > 0 ? sums[i] / static_cast<double>(counts[i]) : 0.0;
+        double* counts = counts_.data() + static_cast<size_t>(j) * k_;
+        for (int i = 0; i < k_; ++i) d[i] = counts[i] > 0.0 ? sums[i] / counts[i] : 0.0;
         std::fill(sums, sums + k_, 0.0);
-        std::fill(counts, counts + k_, uint64_t(0));
+        std::fill(counts, counts + k_, 0.0);
         if (k_ == 1) continue;
         // Smoothing with the neighbours [Lepage21]: 1, 6, 1 over 8 inside, 7, 1 at the ends.
         smooth[0] = (7.0 * d[0] + d[1]) / 8.0;

@@ -25,6 +25,10 @@ struct VegasOptions {
     double uniform_share = 0.05;  ///< share of each axis's increments spread evenly
     VegasReport report = VegasReport::Frozen;
     int iterations = 5; ///< Iterations: the estimation share is split into this many
+    /// VEGAS+ [Lepage21, sec. 3]: hypercubes of the y space, each sampled with n_h >= 2 points,
+    /// n_h proportional to sigma_h^beta from the previous iteration.
+    bool stratify = false;
+    double beta = 0.75;
 };
 
 /// Increments per axis: about 100 training points per increment per iteration (fewer make the
@@ -53,6 +57,11 @@ class VegasMap {
     /// Adds training data: the squared weights w^2 of a block's points, to the increments
     /// apply_block wrote in `bins`. Non-finite weights are skipped.
     void add_training(const uint32_t* bins, const double* weights, size_t count);
+    /// The same for points drawn with density q(y) other than uniform (VEGAS+'s stratified
+    /// points): each point counts with `importance` = 1 / q(y) (up to a constant), so that an
+    /// increment's mean w^2 stays the mean over y uniform in it.
+    void add_training(const uint32_t* bins, const double* weights, const double* importance,
+                      size_t count);
 
     /// Refines the map from the training data and clears it [Lepage21, sec. 2.2]: per axis the
     /// mean w^2 of each increment d_i is smoothed with its neighbours (weights 1, 6, 1 over 8;
@@ -63,9 +72,9 @@ class VegasMap {
 
   private:
     int dim_ = 0, k_ = 0;
-    std::vector<double> edges_;    ///< dim x (K + 1)
-    std::vector<double> sum_w2_;   ///< dim x K: sum of w^2 per increment
-    std::vector<uint64_t> counts_; ///< dim x K: points per increment
+    std::vector<double> edges_;  ///< dim x (K + 1)
+    std::vector<double> sum_w2_; ///< dim x K: sum of w^2 per increment
+    std::vector<double> counts_; ///< dim x K: points per increment (weighted by importance)
 };
 
 } // namespace mcp

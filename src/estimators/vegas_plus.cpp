@@ -1,0 +1,257 @@
+// VEGAS+ [Lepage21, sec. 3]: the VEGAS map, and adaptive stratification of the y space before
+// it. The unit cube of y is cut into M^d hypercubes h of volume V = M^-d; each iteration puts
+// n_h >= 2 points in h, n_h proportional to sigma_h^beta (sigma_h the standard deviation of the
+// weights w = f J / p in h at the previous iteration), and estimates
+//   I = sum_h V mean_h(w),   var(I) = sum_h V^2 s_h^2 / n_h.
+// Training iterations adapt the map and the allocation; the final iteration freezes both.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "core/stats.h"
+#include "estimators/block_driver.h"
+
+namespace mcp {
+namespace {
+
+constexpr uint64_t kIterationPoints = 1000; // least points per training iteration (as VEGAS)
+constexpr uint64_t kMaxHypercubes = uint64_t(1) << 20;
+
+class VegasPlusEstimator final : public EstimatorAlgorithm {
+  public:
+    VegasPlusEstimator(const Problem& problem, const EstimatorSpec& spec, Accumulator accumulator)
+        : problem_(problem), spec_(spec), float32_(accumulator == Accumulator::Float32) {}
+
+    void begin(uint64_t n, Pcg32& /*rng*/) override {
+        const VegasOptions& o = spec_.vegas_options;
+        dim_ = problem_.domain.sample_dim();
+        total_ = n;
+        uint64_t train = static_cast<uint64_t>(o.train_fraction * static_cast<double>(n));
+        iterations_ = static_cast<int>(
+            std::min<uint64_t>(static_cast<uint64_t>(std::max(o.train_iterations, 1)),
+                               std::max<uint64_t>(1, train / kIterationPoints)));
+        final_ = n - train;
+        // The grid of hypercubes: M per axis with about 4 points per hypercube in the smallest
+        // iteration (at least 2 each, as the per-hypercube variances need).
+        const uint64_t smallest = train >= 2 ? std::min(final_, train / iterations_) : final_;
+        per_axis_ = 1;
+        while (true) {
+            uint64_t cubes = 1;
+            bool fits = true;
+            for (int j = 0; j < dim_ && fits; ++j) {
+                cubes *= per_axis_ + 1;
+                fits = cubes * 4 <= smallest && cubes <= kMaxHypercubes;
+            }
+            if (!fits) break;
+            ++per_axis_;
+        }
+        cubes_ = 1;
+        for (int j = 0; j < dim_; ++j) cubes_ *= per_axis_;
+        if (train < 2 * cubes_) train = 0; // too small to train: one frozen (uniform) iteration
+        if (train == 0) iterations_ = 0;
+        final_ = n - train;
+        train_ = train;
+        map_ = VegasMap(
+            dim_, o.increments > 0
+                      ? o.increments
+                      : vegas_increments(dim_, iterations_ > 0 ? train_ / iterations_ : final_));
+        sigma_.assign(cubes_, 1.0); // uniform allocation first
+        iteration_ = 0;
+        planned_ = false;
+        prepared_ = false;
+        finished_final_ = false;
+        jacobian_.assign(kBlockSize, 1.0);
+        importance_.assign(kBlockSize, 1.0);
+        weight_.assign(kBlockSize, 0.0);
+        cube_of_.assign(kBlockSize, 0);
+        bins_.assign(static_cast<size_t>(dim_) * kBlockSize, 0);
+    }
+
+    bool run_block(Pcg32& rng, Workspace& ws) override {
+        if (!prepared_) {
+            prepare_workspace(problem_.domain, ws);
+            prepared_ = true;
+        }
+        const bool training = iteration_ < iterations_;
+        if (!planned_) {
+            if (!training && finished_final_) return false;
+            start_iteration(training ? train_ * (iteration_ + 1) / iterations_ -
+                                           train_ * iteration_ / iterations_
+                                     : final_,
+                            rng, training);
+        }
+        // The next block: points of the current hypercube, then the next ones.
+        size_t count = 0;
+        while (count < kBlockSize && cube_ < cubes_) {
+            if (left_in_cube_ == 0) {
+                if (++cube_ == cubes_) break;
+                advance_digits();
+                left_in_cube_ = allocation_[cube_];
+                continue;
+            }
+            for (int j = 0; j < dim_; ++j)
+                ws.u.coord(j)[count] = below_one(
+                    (static_cast<double>(digits_[j]) + jitter_.next_double()) / per_axis_);
+            cube_of_[count] = static_cast<uint32_t>(cube_);
+            --left_in_cube_;
+            ++count;
+        }
+        if (count == 0) {
+            finish_iteration(training);
+            return true;
+        }
+        ws.u.n = count;
+        map_.apply_block(ws.u, jacobian_.data(), training ? bins_.data() : nullptr);
+        warp_block(spec_.proposal, problem_.domain, ws.u, ws.x, ws.pdf.data());
+        evaluate_block(problem_.integrand, ws.x, ws.f.data());
+        const double n_iteration = static_cast<double>(points_);
+        for (size_t i = 0; i < count; ++i) {
+            ws.pdf[i] /= jacobian_[i]; // p(x) / J(y)
+            const double w = ws.f[i] / ws.pdf[i];
+            // Dropped as 0, as the weight accumulator drops (and counts) them.
+            weight_[i] = std::isfinite(w) && !(ws.pdf[i] == 0.0 && ws.f[i] != 0.0) ? w : 0.0;
+            cube_moments_[cube_of_[i]].add(weight_[i]);
+            // 1 / q(y) relative to uniform: V N / n_h.
+            importance_[i] = n_iteration / (static_cast<double>(cubes_) *
+                                            static_cast<double>(allocation_[cube_of_[i]]));
+        }
+        if (training) {
+            map_.add_training(bins_.data(), weight_.data(), importance_.data(), count);
+        } else {
+            // The accumulator sees the weights scaled by V N / n_h (its plain mean is then the
+            // stratified estimate), for its diagnostics: non-finite and zero-pdf counts, the
+            // largest weights, the effective sample size.
+            for (size_t i = 0; i < count; ++i) ws.pdf[i] /= importance_[i];
+            accumulator_.add_block(accumulated_, ws.f.data(), ws.pdf.data(), ws.pdf.data(), count);
+            accumulated_ += count;
+        }
+        return true;
+    }
+
+    RunResult result() const override {
+        RunResult r = final_result_;
+        r.n = total_;
+        return r;
+    }
+
+  private:
+    // Allocation n_h = 2 + the rest of the iteration's points in proportion to sigma_h^beta
+    // (largest remainders), so that they sum to the iteration's size exactly.
+    void start_iteration(uint64_t points, Pcg32& rng, bool training) {
+        // Two points per hypercube; one only in a run of one point (then no error bar).
+        const uint64_t least = points >= 2 * cubes_ ? 2 : 1;
+        points_ = std::max<uint64_t>(points, least * cubes_);
+        allocation_.assign(cubes_, least);
+        const uint64_t rest = points_ - least * cubes_;
+        std::vector<double> share(cubes_);
+        double total = 0.0;
+        for (uint64_t h = 0; h < cubes_; ++h) {
+            share[h] = std::pow(sigma_[h], spec_.vegas_options.beta);
+            if (!std::isfinite(share[h])) share[h] = 0.0;
+            total += share[h];
+        }
+        if (!(total > 0.0)) {
+            std::fill(share.begin(), share.end(), 1.0);
+            total = static_cast<double>(cubes_);
+        }
+        uint64_t given = 0;
+        std::vector<std::pair<double, uint64_t>> remainders(cubes_);
+        for (uint64_t h = 0; h < cubes_; ++h) {
+            const double exact = static_cast<double>(rest) * share[h] / total;
+            const uint64_t whole = static_cast<uint64_t>(exact);
+            allocation_[h] += whole;
+            given += whole;
+            remainders[h] = {exact - static_cast<double>(whole), h};
+        }
+        std::sort(remainders.begin(), remainders.end(),
+                  [](const auto& a, const auto& b) { return a.first > b.first; });
+        for (uint64_t k = 0; given < rest; ++k, ++given) ++allocation_[remainders[k].second];
+        cube_moments_.assign(cubes_, RunningMoments());
+        const uint64_t seed = (uint64_t(rng.next_u32()) << 32) | rng.next_u32();
+        const uint64_t stream = (uint64_t(rng.next_u32()) << 32) | rng.next_u32();
+        jitter_ = Pcg32(seed, stream);
+        cube_ = 0;
+        digits_.assign(static_cast<size_t>(dim_), 0);
+        left_in_cube_ = allocation_[0];
+        if (!training) {
+            plan_ = SamplerPlan(); // the accumulator's iid error method reads no plan data
+            plan_.dim = dim_;
+            plan_.total = points_;
+            accumulator_.reset(ErrorMethod::Iid, plan_, float32_);
+            accumulated_ = 0;
+        }
+        planned_ = true;
+    }
+
+    void advance_digits() {
+        for (int j = dim_ - 1; j >= 0; --j) {
+            if (++digits_[j] < per_axis_) return;
+            digits_[j] = 0;
+        }
+    }
+
+    void finish_iteration(bool training) {
+        // sigma_h for the next allocation; the stratified estimate and its variance.
+        const double volume = 1.0 / static_cast<double>(cubes_);
+        NeumaierSum estimate, variance;
+        double satterthwaite = 0.0;
+        bool variances = true;
+        for (uint64_t h = 0; h < cubes_; ++h) {
+            const RunningMoments& m = cube_moments_[h];
+            variances = variances && m.count() > 1;
+            const double s2 = m.count() > 1 ? m.variance() : 0.0;
+            sigma_[h] = std::sqrt(s2);
+            estimate.add(volume * m.mean());
+            const double a = volume * volume * s2 / static_cast<double>(m.count());
+            variance.add(a);
+            if (m.count() > 1) satterthwaite += a * a / static_cast<double>(m.count() - 1);
+        }
+        planned_ = false;
+        if (training) {
+            map_.adapt(spec_.vegas_options.alpha, spec_.vegas_options.uniform_share);
+            ++iteration_;
+            return;
+        }
+        const double scale =
+            problem_.quantity == Quantity::Mean ? 1.0 / problem_.domain.measure() : 1.0;
+        final_result_ = accumulator_.finish(scale);
+        final_result_.estimate = scale * estimate.value();
+        final_result_.std_error = variances ? scale * std::sqrt(std::max(0.0, variance.value()))
+                                            : std::numeric_limits<double>::quiet_NaN();
+        // Satterthwaite's degrees of freedom of a sum of variance estimates.
+        const double v = variance.value();
+        final_result_.dof =
+            satterthwaite > 0.0
+                ? static_cast<int>(std::min(1e6, std::max(1.0, v * v / satterthwaite)))
+                : static_cast<int>(std::min<uint64_t>(1000000, points_ - cubes_));
+        finished_final_ = true;
+    }
+
+    const Problem& problem_;
+    const EstimatorSpec& spec_;
+    bool float32_;
+    int dim_ = 1;
+    uint64_t total_ = 0, train_ = 0, final_ = 0, points_ = 0, accumulated_ = 0;
+    uint64_t per_axis_ = 1, cubes_ = 1, cube_ = 0, left_in_cube_ = 0;
+    int iterations_ = 0, iteration_ = 0;
+    bool planned_ = false, prepared_ = false, finished_final_ = false;
+    VegasMap map_;
+    Pcg32 jitter_;
+    std::vector<uint64_t> digits_, allocation_;
+    std::vector<double> sigma_, jacobian_, importance_, weight_;
+    std::vector<uint32_t> cube_of_, bins_;
+    std::vector<RunningMoments> cube_moments_;
+    SamplerPlan plan_; // outlives the accumulator's use of it
+    WeightAccumulator accumulator_;
+    RunResult final_result_;
+};
+
+} // namespace
+
+std::unique_ptr<EstimatorAlgorithm> make_vegas_plus_estimator(const Problem& problem,
+                                                              const EstimatorSpec& spec,
+                                                              Accumulator accumulator) {
+    return std::make_unique<VegasPlusEstimator>(problem, spec, accumulator);
+}
+
+} // namespace mcp
