@@ -37,7 +37,7 @@ std::string repeated(size_t n, const std::string& item) {
 
 constexpr const char* kPresets =
     "presets: uniform, stratified, latin_hypercube, importance, stratified_importance, sobol, "
-    "halton, lattice, vegas, vegas_sobol, vegas_plus";
+    "halton, lattice, vegas, vegas_sobol, miser, vegas_plus";
 
 // --- 1. estimator names -----------------------------------------------------------------
 
@@ -45,15 +45,15 @@ TEST(SceneParsing, UnknownEstimatorNamesAreRefused) {
     EXPECT_EQ(error_of(R"({"f": "x*x", "estimators": ["stratifed"]})"),
               std::string("scene.estimators[0]: unknown estimator 'stratifed' (did you mean "
                           "'stratified'? ") +
-                  kPresets + "; a new name needs \"sampler\", \"pdf\" or \"vegas\")");
+                  kPresets + "; a new name needs \"sampler\", \"pdf\", \"vegas\" or \"miser\")");
     EXPECT_EQ(error_of(R"({"f": "x*x", "estimators": ["uniform", "faure"]})"),
               std::string("scene.estimators[1]: unknown estimator 'faure' (") + kPresets +
-                  "; a new name needs \"sampler\", \"pdf\" or \"vegas\")");
+                  "; a new name needs \"sampler\", \"pdf\", \"vegas\" or \"miser\")");
     // An object with only a name is a bare name too.
     EXPECT_EQ(error_of(R"({"f": "x*x", "estimators": [{"name": "latin_hypercub"}]})"),
               std::string("scene.estimators[0]: unknown estimator 'latin_hypercub' (did you "
                           "mean 'latin_hypercube'? ") +
-                  kPresets + "; a new name needs \"sampler\", \"pdf\" or \"vegas\")");
+                  kPresets + "; a new name needs \"sampler\", \"pdf\", \"vegas\" or \"miser\")");
     // A new name with its sampler or pdf spelled out is fine, and runs what it says.
     Made<SceneRequest> r = build(
         R"({"f": "x*x", "estimators": [{"name": "jitter", "sampler": "stratified"},

@@ -735,18 +735,45 @@ bool parse_vegas_options(Ctx& c, const Json& j, const std::string& path, int dim
     return true;
 }
 
+/// The "miser" object of an estimator: every field optional, each bounded.
+bool parse_miser_options(Ctx& c, const Json& j, const std::string& path, MiserOptions* out) {
+    if (!check_keys(
+            c, j, path,
+            {"estimate_fraction", "min_calls", "min_calls_per_bisection", "alpha", "dither"}))
+        return false;
+    if (!get_number(c, j, "estimate_fraction", path, &out->estimate_fraction) ||
+        !get_count(c, j, "min_calls", path, &out->min_calls) ||
+        !get_count(c, j, "min_calls_per_bisection", path, &out->min_calls_per_bisection) ||
+        !get_number(c, j, "alpha", path, &out->alpha) ||
+        !get_number(c, j, "dither", path, &out->dither))
+        return false;
+    if (!(out->estimate_fraction > 0.0 && out->estimate_fraction <= 0.5))
+        return c.fail(sub(path, "estimate_fraction"),
+                      "must be in (0, 0.5]: the share of a region's calls that probe it");
+    if (find(j, "min_calls") && (out->min_calls < 2 || out->min_calls > (uint64_t(1) << 30)))
+        return c.fail(sub(path, "min_calls"), "must be in [2, 2^30]");
+    if (out->min_calls_per_bisection > (uint64_t(1) << 40))
+        return c.fail(sub(path, "min_calls_per_bisection"), "must be at most 2^40");
+    if (!(out->alpha >= 0.0 && out->alpha <= 10.0))
+        return c.fail(sub(path, "alpha"), "must be in [0, 10] (GSL uses 2)");
+    if (!(out->dither >= 0.0 && out->dither <= 0.25))
+        return c.fail(sub(path, "dither"), "must be in [0, 0.25] (typical: 0.05 to 0.1)");
+    return true;
+}
+
 bool parse_estimator(Ctx& c, const Json& j, const std::string& path, const Problem& problem,
                      EstimatorSpec* out) {
     std::string name, sampler_name_str, warp, randomization;
     int randomizations = 0; // 0: not given
     const Json* pdf = nullptr;
     const Json* vegas = nullptr;
+    const Json* miser = nullptr;
     if (j.is_string()) {
         name = j.get<std::string>();
     } else if (j.is_object()) {
         if (!check_keys(c, j, path,
                         {"name", "sampler", "pdf", "warp", "samples_per_stratum", "randomization",
-                         "randomizations", "vegas"}))
+                         "randomizations", "vegas", "miser"}))
             return false;
         uint64_t m = 1;
         if (!get_count(c, j, "samples_per_stratum", path, &m)) return false;
@@ -768,6 +795,7 @@ bool parse_estimator(Ctx& c, const Json& j, const std::string& path, const Probl
         }
         pdf = find(j, "pdf");
         vegas = find(j, "vegas");
+        miser = find(j, "miser");
     } else {
         return c.fail(path, "expected an estimator name or object, got " + type_of(j));
     }
@@ -809,10 +837,10 @@ bool parse_estimator(Ctx& c, const Json& j, const std::string& path, const Probl
     if (!warp.empty() && problem.domain.kind != DomainKind::Disk)
         return c.fail(sub(path, "warp"), "only disk domains have a choice of warp");
     // A name runs what it says: a bare name must be a preset, and a preset is not redefined.
-    if (!preset && sampler_name_str.empty() && !pdf && !vegas)
+    if (!preset && sampler_name_str.empty() && !pdf && !vegas && !miser)
         return c.fail(path, "unknown estimator '" + name_text(name) + "'" + did_you_mean(name) +
                                 "presets: " + join(preset_names()) +
-                                "; a new name needs \"sampler\", \"pdf\" or \"vegas\")");
+                                "; a new name needs \"sampler\", \"pdf\", \"vegas\" or \"miser\")");
     if (preset && !sampler_name_str.empty() && out->sampler != preset->sampler)
         return c.fail(sub(path, "sampler"),
                       "'" + name + "' is the preset with the " + sampler_name(preset->sampler) +
@@ -829,6 +857,13 @@ bool parse_estimator(Ctx& c, const Json& j, const std::string& path, const Probl
                                  &out->vegas_options))
             return false;
     }
+    out->miser = (preset && std::string(preset->name) == "miser") || miser;
+    if (miser && !parse_miser_options(c, *miser, sub(path, "miser"), &out->miser_options))
+        return false;
+    if (out->miser && out->vegas) return c.fail(path, "an estimator is VEGAS or MISER, not both");
+    if (out->miser && out->sampler != SamplerKind::Independent)
+        return c.fail(sub(path, "sampler"), "MISER draws its own points in its regions: the "
+                                            "sampler must be independent");
     if (out->vegas && out->vegas_options.stratify && out->sampler != SamplerKind::Independent)
         return c.fail(sub(path, "sampler"), "VEGAS+ (\"stratify\": true) draws its own points in "
                                             "its hypercubes: the sampler must be independent");
@@ -879,6 +914,8 @@ const std::vector<EstimatorPreset>& estimator_presets() {
          "VEGAS: a map trained on a quarter of N, then frozen for independent points", true},
         {"vegas_sobol", SamplerKind::Sobol, false,
          "VEGAS map trained, then frozen for 16 Owen-scrambled Sobol' nets", true},
+        {"miser", SamplerKind::Independent, false,
+         "MISER: recursive bisection, calls to the halves by their spread (GSL's defaults)"},
         {"vegas_plus", SamplerKind::Independent, false,
          "VEGAS+: the map and hypercubes with points allocated by sigma^0.75, trained then "
          "frozen",

@@ -74,7 +74,11 @@ std::unique_ptr<EstimatorAlgorithm> make_vegas_plus_estimator(const Problem& pro
                                                               const EstimatorSpec& spec,
                                                               Accumulator accumulator);
 
-/// The algorithm of an estimator spec: fixed, VEGAS or VEGAS+.
+/// MISER (estimators/miser.cpp): recursive stratified sampling.
+std::unique_ptr<EstimatorAlgorithm>
+make_miser_estimator(const Problem& problem, const EstimatorSpec& spec, Accumulator accumulator);
+
+/// The algorithm of an estimator spec: fixed, VEGAS, VEGAS+ or MISER.
 std::unique_ptr<EstimatorAlgorithm>
 make_estimator(const Problem& problem, const EstimatorSpec& spec, Accumulator accumulator);
 

@@ -332,6 +332,7 @@ class VegasEstimator final : public EstimatorAlgorithm {
 
 std::unique_ptr<EstimatorAlgorithm>
 make_estimator(const Problem& problem, const EstimatorSpec& spec, Accumulator accumulator) {
+    if (spec.miser) return make_miser_estimator(problem, spec, accumulator);
     if (spec.vegas && spec.vegas_options.stratify)
         return make_vegas_plus_estimator(problem, spec, accumulator);
     if (spec.vegas) return std::make_unique<VegasEstimator>(problem, spec, accumulator);

@@ -98,6 +98,16 @@ void proposal_pdf_block(const Proposal& proposal, const Domain& domain, const Po
                         double* pdf);
 
 /// An estimator: how the unit-cube points are placed, and which density warps them.
+/// MISER's options [PressFarrar90] (scene field "miser"; docs/scene-format.md); the defaults
+/// are GSL's.
+struct MiserOptions {
+    double estimate_fraction = 0.1;       ///< share of a region's calls that probe it
+    uint64_t min_calls = 0;               ///< least calls per probe and per half; 0: 16 d
+    uint64_t min_calls_per_bisection = 0; ///< fewer calls: plain Monte Carlo; 0: 32 min_calls
+    double alpha = 2.0;                   ///< calls split as sigma^(2/(1+alpha)) between the halves
+    double dither = 0.0; ///< the cut moves by +-dither of the width (breaks symmetry)
+};
+
 struct EstimatorSpec {
     std::string name;
     SamplerKind sampler = SamplerKind::Independent;
@@ -109,6 +119,10 @@ struct EstimatorSpec {
     /// the frozen map composed before the proposal's warp (estimators/vegas.h).
     bool vegas = false;
     VegasOptions vegas_options;
+    /// MISER: recursive stratified sampling of the unit cube before the warp
+    /// (estimators/miser.cpp).
+    bool miser = false;
+    MiserOptions miser_options;
 
     SamplerOptions sampler_options() const { return {per_stratum, randomization, randomizations}; }
 };

@@ -154,6 +154,13 @@ class VegasPlusEstimator final : public EstimatorAlgorithm {
             std::fill(share.begin(), share.end(), 1.0);
             total = static_cast<double>(cubes_);
         }
+        // The even share (as for the map's increments): a hypercube whose training points all
+        // saw f = 0 may still hold a sliver of a large f (a cut); with only its 2 points it would
+        // mostly miss it and report a variance of 0.
+        const double even = spec_.vegas_options.uniform_share;
+        for (uint64_t h = 0; h < cubes_; ++h)
+            share[h] = (1.0 - even) * share[h] / total + even / static_cast<double>(cubes_);
+        total = 1.0;
         uint64_t given = 0;
         std::vector<std::pair<double, uint64_t>> remainders(cubes_);
         for (uint64_t h = 0; h < cubes_; ++h) {
