@@ -70,7 +70,8 @@ struct Options {
     bool dims_given = false, families_given = false;
     std::vector<std::string> methods{"uniform", "stratified", "latin_hypercube",
                                      "sobol",   "halton",     "lattice",
-                                     "vegas",   "vegas_sobol"};
+                                     "vegas",   "vegas_sobol", "vegas_plus",
+                                     "miser"};
     std::vector<std::string> gsl{"plain", "miser", "vegas"};
     uint64_t param_seed = 1; // genz_random(family, d, param_seed)
     uint64_t seed = 1;       // replicate seeds
