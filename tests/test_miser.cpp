@@ -7,6 +7,7 @@
 #include "api/scene.h"
 #include "estimators/block_driver.h"
 #include "estimators/miser.h"
+#include "estimators/study.h"
 
 using namespace mcp;
 
@@ -81,6 +82,22 @@ TEST(Miser, CallsFollowTheVariance) {
     EXPECT_LT(calls, n);
     EXPECT_GT(calls, n / 4);
     EXPECT_LT(left, calls / 20); // uniform would give half
+}
+
+// The sample view: the leaves' points (not the probes) and the leaf boxes, which tile the square.
+TEST(Miser, SampleDumpShowsTheLeavesAndTheirPoints) {
+    Made<SceneRequest> r = request(R"(["miser"])", 0.75);
+    ASSERT_TRUE(r.ok()) << r.error;
+    const SampleDump d = dump_samples(r.value.problem, r.value.estimators[0], 4096, 1);
+    ASSERT_FALSE(d.adaptive.box_lo.empty());
+    ASSERT_EQ(d.adaptive.box_lo.size(), d.adaptive.box_hi.size());
+    double area = 0.0;
+    for (size_t b = 0; b < d.adaptive.box_lo.size(); ++b)
+        area += (d.adaptive.box_hi[b][0] - d.adaptive.box_lo[b][0]) *
+                (d.adaptive.box_hi[b][1] - d.adaptive.box_lo[b][1]);
+    EXPECT_NEAR(area, 1.0, 1e-12);
+    EXPECT_GT(d.weight.size(), 0u);
+    EXPECT_LT(d.weight.size(), 4096u); // the probes are not shown
 }
 
 TEST(Miser, TinyRunsArePlainMonteCarlo) {

@@ -8,6 +8,7 @@
 #include "api/scene.h"
 #include "estimators/block_driver.h"
 #include "estimators/diagnostics.h"
+#include "estimators/study.h"
 #include "estimators/vegas.h"
 
 using namespace mcp;
@@ -244,6 +245,23 @@ TEST(VegasPlus, OnePointRunHasNoErrorBar) {
     EXPECT_EQ(run.n, 1u);
     EXPECT_TRUE(std::isfinite(run.estimate));
     EXPECT_TRUE(std::isnan(run.std_error));
+}
+
+// The sample view: the points the frozen map's estimate is made from (not the training ones),
+// and the map's edges, increasing from 0 to 1 on each axis.
+TEST(VegasEstimator, SampleDumpShowsTheEstimatePointsAndTheMap) {
+    Made<SceneRequest> r = request(gaussian_scene(0.05, R"(["vegas"])"));
+    ASSERT_TRUE(r.ok()) << r.error;
+    const SampleDump d = dump_samples(r.value.problem, r.value.estimators[0], 4096, 1);
+    EXPECT_EQ(d.weight.size(), 4096u - 1024u); // a quarter trains the map
+    ASSERT_EQ(d.adaptive.edges.size(), 2u);
+    for (const std::vector<double>& e : d.adaptive.edges) {
+        ASSERT_GE(e.size(), 3u);
+        EXPECT_EQ(e.front(), 0.0);
+        EXPECT_EQ(e.back(), 1.0);
+        for (size_t i = 1; i < e.size(); ++i) EXPECT_LE(e[i - 1], e[i]);
+    }
+    for (double w : d.weight) EXPECT_TRUE(std::isfinite(w));
 }
 
 TEST(VegasEstimator, TinyRunsSkipTraining) {

@@ -162,6 +162,12 @@ int mcp_study_samples(const char* scene_json, const char* options_json, char** s
              {"f", values(d.f)},
              {"density", values(d.pdf)},
              {"weight", values(d.weight)}});
+        // What an adaptive estimator learnt: VEGAS's map (increment edges per axis of the
+        // unit cube) and MISER's leaf boxes (lo and hi corners).
+        mcp::Json& e = estimators.back();
+        if (!d.adaptive.edges.empty()) e["map_edges"] = d.adaptive.edges;
+        if (!d.adaptive.box_lo.empty())
+            e["boxes"] = {{"lo", d.adaptive.box_lo}, {"hi", d.adaptive.box_hi}};
     }
     mcp::Json result{{"version", mcp::kResultSchemaVersion},
                      {"n", n},

@@ -6,7 +6,9 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <functional>
 #include <memory>
+#include <vector>
 
 #include "core/samplers.h"
 #include "estimators/accumulator.h"
@@ -40,6 +42,9 @@ void prepare_workspace(const Domain& domain, Workspace& ws);
 SampleBlock sample_block(const Problem& problem, const Proposal& proposal, const SamplerPlan& plan,
                          uint64_t first, size_t count, Workspace& ws);
 
+/// The workspace's current buffers as the block of samples first .. first + count - 1.
+SampleBlock block_of(Workspace& ws, uint64_t first, size_t count);
+
 /// Samples 0 .. plan.total - 1 of the plan, block by block, calling consume(const SampleBlock&)
 /// for each.
 template <class Consume>
@@ -58,15 +63,36 @@ void for_each_block(const Problem& problem, const Proposal& proposal, const Samp
 /// run's result. Fixed estimators (a sampler and one proposal) are one implementation; adaptive
 /// ones (which change their proposal between blocks or iterations), multi-proposal ones and
 /// sequential ones (stopping at a tolerance) are others. Calls are per block, never per sample.
+/// What an adaptive estimator learnt in its last run, for looking at it (the sample view).
+struct AdaptiveView {
+    std::vector<std::vector<double>> edges; ///< VEGAS: per axis, the frozen map's increment edges
+    std::vector<std::vector<double>> box_lo, box_hi; ///< MISER: the leaf boxes (the first 4096)
+};
+
+/// A VEGAS map's edges, per axis, as a view.
+AdaptiveView view_of(const VegasMap& map);
+
 class EstimatorAlgorithm {
   public:
     virtual ~EstimatorAlgorithm() = default;
+    /// Called with every block the estimate is made from (not training or probing blocks),
+    /// before the weights overwrite the densities: for looking at the points. Per block.
+    using BlockObserver = std::function<void(const SampleBlock&)>;
+    void observe(BlockObserver observer) { observer_ = std::move(observer); }
+    /// The state an adaptive estimator ended its last run with (empty for fixed ones).
+    virtual AdaptiveView adaptive_view() const { return {}; }
     /// Starts a run of n samples; the run's randomization is drawn from rng.
     virtual void begin(uint64_t n, Pcg32& rng) = 0;
     /// Samples and weighs the next block; false when the run is complete (nothing was done).
     virtual bool run_block(Pcg32& rng, Workspace& ws) = 0;
     /// The completed run (estimate, error bar, diagnostics; not its time).
     virtual RunResult result() const = 0;
+
+  protected:
+    void notify(const SampleBlock& block) const {
+        if (observer_) observer_(block);
+    }
+    BlockObserver observer_;
 };
 
 /// VEGAS+ (estimators/vegas_plus.cpp): the VEGAS map and adaptive stratification.

@@ -79,11 +79,7 @@ void prepare_workspace(const Domain& domain, Workspace& ws) {
     ws.f.resize(kBlockSize);
 }
 
-SampleBlock sample_block(const Problem& problem, const Proposal& proposal, const SamplerPlan& plan,
-                         uint64_t first, size_t count, Workspace& ws) {
-    generate_block(plan, first, count, ws.u);
-    warp_block(proposal, problem.domain, ws.u, ws.x, ws.pdf.data());
-    evaluate_block(problem.integrand, ws.x, ws.f.data());
+SampleBlock block_of(Workspace& ws, uint64_t first, size_t count) {
     SampleBlock block;
     block.first = first;
     block.count = count;
@@ -92,6 +88,21 @@ SampleBlock sample_block(const Problem& problem, const Proposal& proposal, const
     block.pdf = ws.pdf.data();
     block.f = ws.f.data();
     return block;
+}
+
+SampleBlock sample_block(const Problem& problem, const Proposal& proposal, const SamplerPlan& plan,
+                         uint64_t first, size_t count, Workspace& ws) {
+    generate_block(plan, first, count, ws.u);
+    warp_block(proposal, problem.domain, ws.u, ws.x, ws.pdf.data());
+    evaluate_block(problem.integrand, ws.x, ws.f.data());
+    return block_of(ws, first, count);
+}
+
+AdaptiveView view_of(const VegasMap& map) {
+    AdaptiveView v;
+    for (int j = 0; j < map.dim(); ++j)
+        v.edges.emplace_back(map.edges(j), map.edges(j) + map.increments() + 1);
+    return v;
 }
 
 namespace {
@@ -120,6 +131,7 @@ class FixedEstimator final : public EstimatorAlgorithm {
         const size_t count =
             static_cast<size_t>(std::min<uint64_t>(kBlockSize, plan_.total - next_));
         const SampleBlock b = sample_block(problem_, spec_.proposal, plan_, next_, count, ws);
+        notify(b);
         accumulator_.add_block(b.first, b.f, b.pdf, b.pdf, b.count); // weights overwrite p
         next_ += count;
         return true;
@@ -238,6 +250,7 @@ class VegasEstimator final : public EstimatorAlgorithm {
             }
             return true;
         }
+        if (observer_) notify(block_of(ws, next_, count));
         accumulator_.add_block(next_, ws.f.data(), ws.pdf.data(), ws.pdf.data(), count);
         if (averaging) map_.add_training(bins_.data(), ws.pdf.data(), count); // the weights
         next_ += count;
@@ -257,7 +270,7 @@ class VegasEstimator final : public EstimatorAlgorithm {
         return r;
     }
 
-    const VegasMap& map() const { return map_; }
+    AdaptiveView adaptive_view() const override { return view_of(map_); }
 
   private:
     RunResult finish_round() const {

@@ -36,6 +36,7 @@ class MiserEstimator final : public EstimatorAlgorithm {
         const uint64_t stream = (uint64_t(rng.next_u32()) << 32) | rng.next_u32();
         points_ = Pcg32(seed, stream);
         done_ = false;
+        view_ = AdaptiveView();
     }
 
     bool run_block(Pcg32& /*rng*/, Workspace& ws) override {
@@ -73,6 +74,8 @@ class MiserEstimator final : public EstimatorAlgorithm {
         r.n = total_;
         return r;
     }
+
+    AdaptiveView adaptive_view() const override { return view_; }
 
     /// Records the leaves (at most `limit`) of the runs that follow.
     void record_leaves(std::vector<MiserBox>* out, size_t limit) {
@@ -122,8 +125,17 @@ class MiserEstimator final : public EstimatorAlgorithm {
         // Weights scaled by V N / n for the accumulator, which keeps the diagnostics (dropped
         // samples, the largest weights, the effective sample size: all scale-free).
         const double scale = volume * static_cast<double>(total_) / static_cast<double>(n);
+        if (observer_ && view_.box_lo.size() < kViewBoxes) {
+            view_.box_lo.push_back(lo);
+            view_.box_hi.push_back(hi);
+        }
         sample_box(lo, hi, n, [&](const SampleBlock& b, const double* w) {
             m.add_block(w, b.count);
+            if (observer_) {
+                SampleBlock seen = b;
+                seen.first = accumulated_;
+                notify(seen);
+            }
             for (size_t i = 0; i < b.count; ++i) b.pdf[i] /= scale;
             accumulator_.add_block(accumulated_, b.f, b.pdf, b.pdf, b.count);
             accumulated_ += b.count;
@@ -192,6 +204,7 @@ class MiserEstimator final : public EstimatorAlgorithm {
     }
 
     static constexpr int kMaxDepth = 200;
+    static constexpr size_t kViewBoxes = 4096;
 
     const Problem& problem_;
     const EstimatorSpec& spec_;
@@ -202,6 +215,7 @@ class MiserEstimator final : public EstimatorAlgorithm {
     Pcg32 points_;
     Workspace* ws_ = nullptr;
     std::vector<MiserBox>* recorded_ = nullptr;
+    AdaptiveView view_; // the leaves, when observed
     size_t record_limit_ = 0;
     NeumaierSum estimate_, variance_;
     double satterthwaite_ = 0.0;

@@ -705,15 +705,20 @@ SampleDump dump_samples(const Problem& problem, const EstimatorSpec& spec, uint6
     const Domain& d = problem.domain;
     dump.sample_dim = d.sample_dim();
     dump.point_dim = d.point_dim();
-    // The same stream and seeding as replicate 0 of the study at this N.
+    // The same stream and seeding as replicate 0 of the study at this N; the plan drawn from a
+    // copy of it is the one a fixed estimator draws (its strata and batches).
     Pcg32 rng = replicate_rng(seed, spec.name, n, 0);
+    Pcg32 plan_rng = rng;
     const SamplerPlan plan =
-        make_sampler_plan(spec.sampler, dump.sample_dim, n, rng, spec.sampler_options());
-    dump.strata = plan.strata;
-    dump.per_stratum = plan.per_stratum;
-    dump.randomizations = plan.batches();
-    Workspace ws;
-    for_each_block(problem, spec.proposal, plan, ws, [&](const SampleBlock& blk) {
+        make_sampler_plan(spec.sampler, dump.sample_dim, n, plan_rng, spec.sampler_options());
+    if (!spec.vegas && !spec.miser) {
+        dump.strata = plan.strata;
+        dump.per_stratum = plan.per_stratum;
+        dump.randomizations = plan.batches();
+    }
+    std::unique_ptr<EstimatorAlgorithm> estimator =
+        make_estimator(problem, spec, Accumulator::Compensated);
+    estimator->observe([&](const SampleBlock& blk) {
         for (size_t i = 0; i < blk.count; ++i) {
             for (int j = 0; j < dump.sample_dim; ++j) dump.u.push_back(blk.u->coord(j)[i]);
             for (int j = 0; j < dump.point_dim; ++j) dump.x.push_back(blk.x->coord(j)[i]);
@@ -723,6 +728,11 @@ SampleDump dump_samples(const Problem& problem, const EstimatorSpec& spec, uint6
             dump.weight.push_back(p > 0.0 ? f / p : (f == 0.0 ? 0.0 : NAN));
         }
     });
+    Workspace ws;
+    estimator->begin(n, rng);
+    while (estimator->run_block(rng, ws)) {
+    }
+    dump.adaptive = estimator->adaptive_view();
     return dump;
 }
 

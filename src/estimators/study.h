@@ -279,10 +279,13 @@ struct SampleDump {
     std::vector<uint64_t> strata; ///< stratified: cells per axis of the unit cube
     uint64_t per_stratum = 1;
     size_t randomizations = 0; ///< quasi-Monte Carlo: batches, each its own randomization
+    AdaptiveView adaptive;     ///< VEGAS's frozen map, MISER's leaves
 };
 
-/// Runs n samples of replicate 0's stream of the given N level (so the points are those of
-/// the study's first replicate at N = n) and records them.
+/// Runs replicate 0's estimate at N = n (the points are those of the study's first replicate
+/// at that N) and records the points the estimate is made from: all n for fixed estimators,
+/// the estimation share for VEGAS (not its training points), the leaves' points for MISER
+/// (not its probes).
 SampleDump dump_samples(const Problem& problem, const EstimatorSpec& spec, uint64_t n,
                         uint64_t seed);
 

@@ -121,12 +121,15 @@ class VegasPlusEstimator final : public EstimatorAlgorithm {
             // The accumulator sees the weights scaled by V N / n_h (its plain mean is then the
             // stratified estimate), for its diagnostics: non-finite and zero-pdf counts, the
             // largest weights, the effective sample size.
+            if (observer_) notify(block_of(ws, accumulated_, count));
             for (size_t i = 0; i < count; ++i) ws.pdf[i] /= importance_[i];
             accumulator_.add_block(accumulated_, ws.f.data(), ws.pdf.data(), ws.pdf.data(), count);
             accumulated_ += count;
         }
         return true;
     }
+
+    AdaptiveView adaptive_view() const override { return view_of(map_); }
 
     RunResult result() const override {
         RunResult r = final_result_;

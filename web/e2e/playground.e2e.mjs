@@ -189,6 +189,32 @@ test('randomized QMC: presets a scene does not list are offered; a sobol study a
   await page.screenshot({ path: join(shots, 'sobol_sin_product_2d.png'), fullPage: true });
 });
 
+test('adaptive estimators: a VEGAS and a MISER study, and their map and boxes in the sample view', async () => {
+  const settings = { nMin: 1024, nMax: 16384, reps: 8, seed: 1 };
+  const estimators = ['vegas', 'miser'];
+  await configure('vegas_corner_peak', estimators, settings);
+  await page.click('#run');
+  await page.waitForFunction(() => document.querySelector('#status')?.textContent.startsWith('done'), null,
+    { timeout: 60000 });
+  const fits = cliFits('vegas_corner_peak', estimators, settings);
+  for (const name of estimators) {
+    assert.ok(fits[name].valid, `${name}: the CLI has no fit (${fits[name].note})`);
+    const text = await page.textContent(`[data-fit="${name}"]`);
+    const shown = Number(text.match(/-?\d+\.\d{3}/)?.[0]);
+    assert.equal(shown.toFixed(3), fits[name].order.toFixed(3), `${name}: page ${shown} vs CLI ${fits[name].order}`);
+  }
+  // The sample view: the estimate's points, VEGAS's trained map and MISER's leaf boxes.
+  await page.waitForFunction(() => {
+    const s = window.mcplayDebug.state().samples;
+    return s.status === 'ready' && s.points.vegas > 0 && s.points.miser > 0;
+  }, null, { timeout: 20000 });
+  const summary = await page.evaluate(() => window.mcplayDebug.state().samples.estimators);
+  const byName = Object.fromEntries(summary.map((e) => [e.name, e]));
+  assert.ok(byName.vegas.mapIncrements >= 2, `vegas map: ${JSON.stringify(byName.vegas)}`);
+  assert.ok(byName.miser.boxes >= 1, `miser boxes: ${JSON.stringify(byName.miser)}`);
+  await page.screenshot({ path: join(shots, 'adaptive_vegas_corner_peak.png'), fullPage: true });
+});
+
 test('a malformed expression is reported inline at its position', async () => {
   await page.fill('#custom-f', 'sin(');
   await page.click('#custom-apply');

@@ -610,7 +610,59 @@ function strataLines(p, cells, axis) {
   ctx.stroke();
 }
 
+/**
+ * VEGAS's map on the first two axes of the unit square: a line at every edge of its increments
+ * (every k-th edge when there are more than GRID_MAX), so that dense lines show where the map
+ * puts its points.
+ */
+function mapLines(p, edges, axis) {
+  if (!Array.isArray(edges) || edges.length < 3) return;
+  const { ctx, X, Y } = p;
+  const step = Math.ceil((edges.length - 1) / GRID_MAX);
+  ctx.strokeStyle = 'rgba(150, 80, 20, 0.45)';
+  ctx.lineWidth = 1;
+  ctx.beginPath();
+  for (let k = step; k < edges.length - 1; k += step) {
+    const v = edges[k];
+    if (axis === 'x') {
+      const x = Math.round(X(v)) + 0.5;
+      ctx.moveTo(x, Y(0));
+      ctx.lineTo(x, Y(1));
+    } else {
+      const y = Math.round(Y(v)) + 0.5;
+      ctx.moveTo(X(0), y);
+      ctx.lineTo(X(1), y);
+    }
+  }
+  ctx.stroke();
+}
+
+/** MISER's leaf boxes on the first two axes of the unit square (1D: their left edges). */
+function boxOutlines(p, boxes, d) {
+  if (!boxes || !Array.isArray(boxes.lo)) return;
+  const { ctx, X, Y } = p;
+  ctx.strokeStyle = 'rgba(150, 80, 20, 0.5)';
+  ctx.lineWidth = 1;
+  ctx.beginPath();
+  boxes.lo.forEach((lo, b) => {
+    const hi = boxes.hi[b];
+    if (d >= 2) ctx.rect(X(lo[0]), Y(hi[1]), X(hi[0]) - X(lo[0]), Y(lo[1]) - Y(hi[1]));
+    else {
+      ctx.moveTo(X(lo[0]), Y(0));
+      ctx.lineTo(X(lo[0]), Y(1));
+    }
+  });
+  ctx.stroke();
+}
+
 function strataText(e, d) {
+  if (Array.isArray(e.map_edges) && e.map_edges.length) {
+    const k = e.map_edges[0].length - 1;
+    return `VEGAS map: ${k} increments per axis (brown lines${k > GRID_MAX ? `: every ${Math.ceil(k / GRID_MAX)}th edge` : ''}); the points the estimate uses, not the training ones`;
+  }
+  if (e.boxes && Array.isArray(e.boxes.lo)) {
+    return `MISER: ${e.boxes.lo.length} leaf regions (brown boxes); the points the estimate uses, not the probes`;
+  }
   const s = e.strata || [];
   if (e.randomizations > 0) {
     const k = e.randomizations;
@@ -636,6 +688,11 @@ function renderScatter(state, data) {
     const pu = panel(PANEL, PANEL, [0, 1], [0, 1]);
     strataLines(pu, e.strata[0], 'x');
     if (d >= 2) strataLines(pu, e.strata[1], 'y');
+    if (e.map_edges) {
+      mapLines(pu, e.map_edges[0], 'x');
+      if (d >= 2) mapLines(pu, e.map_edges[1], 'y');
+    }
+    if (e.boxes) boxOutlines(pu, e.boxes, d);
     pu.frame();
     pu.ctx.save();
     pu.clip();

@@ -587,6 +587,8 @@ export function samplesSummary(samples) {
     estimators: samples.estimators.map((e) => ({
       name: e.name, sampler: e.sampler, points: e.u && e.u[0] ? e.u[0].length : 0,
       strata: (e.strata || []).slice(), samplesPerStratum: e.samples_per_stratum,
+      mapIncrements: Array.isArray(e.map_edges) && e.map_edges.length ? e.map_edges[0].length - 1 : 0,
+      boxes: e.boxes && Array.isArray(e.boxes.lo) ? e.boxes.lo.length : 0,
     })),
   };
 }
