@@ -8,6 +8,7 @@
 #include "estimators/block_driver.h"
 #include "estimators/miser.h"
 #include "estimators/study.h"
+#include "independent_runs.h"
 
 using namespace mcp;
 
@@ -37,23 +38,13 @@ TEST(Miser, UnbiasedCalibratedAndBelowUniform) {
     const int runs = 200;
     double variance[3] = {0, 0, 0};
     for (size_t e = 0; e < 3; ++e) {
-        Workspace ws;
-        double sum = 0.0, sum2 = 0.0;
-        int covered = 0;
-        for (int k = 0; k < runs; ++k) {
-            Pcg32 rng(99u + static_cast<uint64_t>(k), 4u + e);
-            const RunResult run = run_estimate(problem, r.value.estimators[e], 65536, rng, ws);
-            EXPECT_EQ(run.n, 65536u);
-            sum += run.estimate;
-            sum2 += run.estimate * run.estimate;
-            covered +=
-                std::fabs(run.estimate - exact) <= interval_quantile(run.dof) * run.std_error;
-        }
-        const double mean = sum / runs;
-        variance[e] = (sum2 - runs * mean * mean) / (runs - 1);
-        EXPECT_LE(std::fabs(mean - exact), 4.0 * std::sqrt(variance[e] / runs)) << e;
-        EXPECT_GE(covered, static_cast<int>(0.88 * runs)) << e;
-        EXPECT_LE(covered, static_cast<int>(0.995 * runs)) << e;
+        const test::IndependentRuns runs_of =
+            test::independent_runs(problem, r.value.estimators[e], 65536, runs, 99, 4 + e, exact);
+        EXPECT_TRUE(runs_of.every_n_reported);
+        variance[e] = runs_of.variance;
+        EXPECT_LE(std::fabs(runs_of.mean - exact), 4.0 * std::sqrt(variance[e] / runs)) << e;
+        EXPECT_GE(runs_of.covered, static_cast<int>(0.88 * runs)) << e;
+        EXPECT_LE(runs_of.covered, static_cast<int>(0.995 * runs)) << e;
     }
     EXPECT_GT(variance[0] / variance[1], 4.0);
     EXPECT_GT(variance[0] / variance[2], 4.0);

@@ -10,6 +10,7 @@
 #include "estimators/diagnostics.h"
 #include "estimators/study.h"
 #include "estimators/vegas.h"
+#include "independent_runs.h"
 
 using namespace mcp;
 
@@ -116,28 +117,18 @@ TEST(VegasEstimator, UnbiasedCalibratedAndBetterThanUniform) {
     ASSERT_TRUE(problem.exact.has_value());
     const double exact = *problem.exact;
     const int runs = 200;
-    const uint64_t n = 65536;
     double variance[3] = {0, 0, 0};
     for (size_t e = 0; e < 3; ++e) {
         const EstimatorSpec& spec = r.value.estimators[e];
-        Workspace ws;
-        double sum = 0.0, sum2 = 0.0;
-        int covered = 0;
-        for (int k = 0; k < runs; ++k) {
-            Pcg32 rng(2024u + static_cast<uint64_t>(k), 7u + e);
-            const RunResult run = run_estimate(problem, spec, n, rng, ws);
-            EXPECT_EQ(run.n, n) << spec.name; // training counts in N
-            sum += run.estimate;
-            sum2 += run.estimate * run.estimate;
-            covered +=
-                std::fabs(run.estimate - exact) <= interval_quantile(run.dof) * run.std_error;
-        }
-        const double mean = sum / runs;
-        variance[e] = (sum2 - runs * mean * mean) / (runs - 1);
-        EXPECT_LE(std::fabs(mean - exact), 4.0 * std::sqrt(variance[e] / runs)) << spec.name;
+        const test::IndependentRuns runs_of =
+            test::independent_runs(problem, spec, 65536, runs, 2024, 7 + e, exact);
+        EXPECT_TRUE(runs_of.every_n_reported) << spec.name; // training counts in N
+        variance[e] = runs_of.variance;
+        EXPECT_LE(std::fabs(runs_of.mean - exact), 4.0 * std::sqrt(variance[e] / runs))
+            << spec.name;
         if (e > 0) {
-            EXPECT_GE(covered, static_cast<int>(0.88 * runs)) << spec.name;
-            EXPECT_LE(covered, static_cast<int>(0.995 * runs)) << spec.name;
+            EXPECT_GE(runs_of.covered, static_cast<int>(0.88 * runs)) << spec.name;
+            EXPECT_LE(runs_of.covered, static_cast<int>(0.995 * runs)) << spec.name;
         }
     }
     // Uniform's variance over the map's is F-distributed under equal variances; with
@@ -157,17 +148,9 @@ TEST(VegasEstimator, HonestAcrossADiscontinuity) {
                 "u": [0.2, 0.4]}, "estimators": [")" +
             std::string(estimator) + R"("]})");
         ASSERT_TRUE(r.ok()) << r.error;
-        const double exact = *r.value.problem.exact;
-        const int runs = 64;
-        int covered = 0;
-        Workspace ws;
-        for (int k = 0; k < runs; ++k) {
-            Pcg32 rng(77u + static_cast<uint64_t>(k), 3u);
-            const RunResult run =
-                run_estimate(r.value.problem, r.value.estimators[0], 1 << 18, rng, ws);
-            covered +=
-                std::fabs(run.estimate - exact) <= interval_quantile(run.dof) * run.std_error;
-        }
+        const test::IndependentRuns runs_of = test::independent_runs(
+            r.value.problem, r.value.estimators[0], 1 << 18, 64, 77, 3, *r.value.problem.exact);
+        const int covered = runs_of.covered;
         // Binomial(64, 0.95): 55 or fewer has probability 0.003.
         EXPECT_GE(covered, 56) << estimator;
     }
@@ -215,23 +198,13 @@ TEST(VegasPlus, UnbiasedCalibratedAndBetterThanTheMapAlone) {
     const int runs = 200;
     double variance[2] = {0, 0};
     for (size_t e = 0; e < 2; ++e) {
-        Workspace ws;
-        double sum = 0.0, sum2 = 0.0;
-        int covered = 0;
-        for (int k = 0; k < runs; ++k) {
-            Pcg32 rng(4048u + static_cast<uint64_t>(k), 9u + e);
-            const RunResult run = run_estimate(problem, r.value.estimators[e], 65536, rng, ws);
-            EXPECT_EQ(run.n, 65536u);
-            sum += run.estimate;
-            sum2 += run.estimate * run.estimate;
-            covered +=
-                std::fabs(run.estimate - exact) <= interval_quantile(run.dof) * run.std_error;
-        }
-        const double mean = sum / runs;
-        variance[e] = (sum2 - runs * mean * mean) / (runs - 1);
-        EXPECT_LE(std::fabs(mean - exact), 4.0 * std::sqrt(variance[e] / runs));
-        EXPECT_GE(covered, static_cast<int>(0.88 * runs)) << e;
-        EXPECT_LE(covered, static_cast<int>(0.995 * runs)) << e;
+        const test::IndependentRuns runs_of =
+            test::independent_runs(problem, r.value.estimators[e], 65536, runs, 4048, 9 + e, exact);
+        EXPECT_TRUE(runs_of.every_n_reported);
+        variance[e] = runs_of.variance;
+        EXPECT_LE(std::fabs(runs_of.mean - exact), 4.0 * std::sqrt(variance[e] / runs));
+        EXPECT_GE(runs_of.covered, static_cast<int>(0.88 * runs)) << e;
+        EXPECT_LE(runs_of.covered, static_cast<int>(0.995 * runs)) << e;
     }
     EXPECT_GT(variance[0] / variance[1], 2.0);
 }

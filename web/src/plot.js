@@ -588,15 +588,13 @@ function dots(ctx, xs, ys, X, Y, color, n) {
 
 const GRID_MAX = 64; // more cells per axis than this: the grid is not drawn (it would be a grey fill)
 
-/** Strata lines at k / cells on the horizontal (axis 'x') or vertical axis. */
-function strataLines(p, cells, axis) {
-  if (!(cells > 1) || cells > GRID_MAX) return;
+/** Lines across the unit square at the values v on the horizontal (axis 'x') or vertical axis. */
+function linesAt(p, values, axis, style) {
   const { ctx, X, Y } = p;
-  ctx.strokeStyle = cells > 64 ? 'rgba(90, 100, 112, 0.18)' : 'rgba(90, 100, 112, 0.45)';
+  ctx.strokeStyle = style;
   ctx.lineWidth = 1;
   ctx.beginPath();
-  for (let k = 1; k < cells; k++) {
-    const v = k / cells;
+  for (const v of values) {
     if (axis === 'x') {
       const x = Math.round(X(v)) + 0.5;
       ctx.moveTo(x, Y(0));
@@ -610,6 +608,12 @@ function strataLines(p, cells, axis) {
   ctx.stroke();
 }
 
+/** Strata lines at k / cells on the horizontal (axis 'x') or vertical axis. */
+function strataLines(p, cells, axis) {
+  if (!(cells > 1) || cells > GRID_MAX) return;
+  linesAt(p, Array.from({ length: cells - 1 }, (_, k) => (k + 1) / cells), axis, 'rgba(90, 100, 112, 0.45)');
+}
+
 /**
  * VEGAS's map on the first two axes of the unit square: a line at every edge of its increments
  * (every k-th edge when there are more than GRID_MAX), so that dense lines show where the map
@@ -617,24 +621,9 @@ function strataLines(p, cells, axis) {
  */
 function mapLines(p, edges, axis) {
   if (!Array.isArray(edges) || edges.length < 3) return;
-  const { ctx, X, Y } = p;
   const step = Math.ceil((edges.length - 1) / GRID_MAX);
-  ctx.strokeStyle = 'rgba(150, 80, 20, 0.45)';
-  ctx.lineWidth = 1;
-  ctx.beginPath();
-  for (let k = step; k < edges.length - 1; k += step) {
-    const v = edges[k];
-    if (axis === 'x') {
-      const x = Math.round(X(v)) + 0.5;
-      ctx.moveTo(x, Y(0));
-      ctx.lineTo(x, Y(1));
-    } else {
-      const y = Math.round(Y(v)) + 0.5;
-      ctx.moveTo(X(0), y);
-      ctx.lineTo(X(1), y);
-    }
-  }
-  ctx.stroke();
+  const inner = edges.filter((_, k) => k > 0 && k < edges.length - 1 && k % step === 0);
+  linesAt(p, inner, axis, 'rgba(150, 80, 20, 0.45)');
 }
 
 /** MISER's leaf boxes on the first two axes of the unit square (1D: their left edges). */
