@@ -173,8 +173,12 @@ class VegasPlusEstimator final : public EstimatorAlgorithm {
             given += whole;
             remainders[h] = {exact - static_cast<double>(whole), h};
         }
-        std::sort(remainders.begin(), remainders.end(),
-                  [](const auto& a, const auto& b) { return a.first > b.first; });
+        // Largest remainder first, ties (every hypercube alike in the first iteration) to the
+        // lower index: a total order, so that every standard library allocates alike (native
+        // and wasm gave different points with an order left to std::sort).
+        std::sort(remainders.begin(), remainders.end(), [](const auto& a, const auto& b) {
+            return a.first != b.first ? a.first > b.first : a.second < b.second;
+        });
         for (uint64_t k = 0; given < rest; ++k, ++given) ++allocation_[remainders[k].second];
         cube_moments_.assign(cubes_, RunningMoments());
         const uint64_t seed = (uint64_t(rng.next_u32()) << 32) | rng.next_u32();
