@@ -160,8 +160,6 @@ class FixedEstimator final : public EstimatorAlgorithm {
 // weighted, make an ordinary estimate with an ordinary error bar (iid, strata or
 // randomizations): the training points are not in it, so they cannot bias it. The result
 // counts all N evaluations.
-constexpr uint64_t kVegasIterationPoints = 1000;
-
 class VegasEstimator final : public EstimatorAlgorithm {
   public:
     VegasEstimator(const Problem& problem, const EstimatorSpec& spec, Accumulator accumulator)
@@ -172,11 +170,7 @@ class VegasEstimator final : public EstimatorAlgorithm {
         const int dim = problem_.domain.sample_dim();
         total_ = n;
         uint64_t train = static_cast<uint64_t>(o.train_fraction * static_cast<double>(n));
-        // At least kVegasIterationPoints points per training iteration where the share allows:
-        // fewer, and the map learns from noise.
-        iterations_ = static_cast<int>(
-            std::min<uint64_t>(static_cast<uint64_t>(std::max(o.train_iterations, 1)),
-                               std::max<uint64_t>(1, train / kVegasIterationPoints)));
+        iterations_ = vegas_training_iterations(o, train);
         if (train < 2) train = 0;
         final_ = n - train;
         // A net's randomizations are full nets when each holds a power of two points: the
@@ -218,13 +212,11 @@ class VegasEstimator final : public EstimatorAlgorithm {
         if (!plan_ready_) {
             const int dim = problem_.domain.sample_dim();
             if (training) {
-                // Iteration sizes differ by at most one point.
-                const uint64_t size =
-                    train_ * (iteration_ + 1) / iterations_ - train_ * iteration_ / iterations_;
+                const uint64_t size = part_of(train_, iterations_, iteration_);
                 plan_ = make_sampler_plan(SamplerKind::Independent, dim, size, rng, {});
             } else {
                 if (final_ == 0 || round_ >= rounds_) return false;
-                const uint64_t size = final_ * (round_ + 1) / rounds_ - final_ * round_ / rounds_;
+                const uint64_t size = part_of(final_, rounds_, round_);
                 plan_ = make_sampler_plan(spec_.sampler, dim, size, rng, spec_.sampler_options());
                 accumulator_.reset(error_method_for(spec_), plan_, float32_);
             }

@@ -10,6 +10,12 @@ int vegas_increments(int dim, uint64_t points_per_iteration) {
     return static_cast<int>(std::max<uint64_t>(2, std::min(most, points_per_iteration / 100)));
 }
 
+int vegas_training_iterations(const VegasOptions& options, uint64_t calls) {
+    return static_cast<int>(
+        std::min<uint64_t>(static_cast<uint64_t>(std::max(options.train_iterations, 1)),
+                           std::max<uint64_t>(1, calls / kVegasIterationPoints)));
+}
+
 VegasMap::VegasMap(int dim, int increments)
     : dim_(dim), k_(increments), edges_(static_cast<size_t>(dim) * (increments + 1)),
       sum_w2_(static_cast<size_t>(dim) * increments, 0.0),

@@ -31,6 +31,20 @@ struct VegasOptions {
     double beta = 0.75;
 };
 
+/// Least points per training iteration where the training share allows: fewer, and the map
+/// learns from noise (vegas's own examples train on 1000 points per iteration).
+constexpr uint64_t kVegasIterationPoints = 1000;
+
+/// Training iterations for `calls` training calls: options.train_iterations, fewer when an
+/// iteration would hold fewer than kVegasIterationPoints calls, at least 1.
+int vegas_training_iterations(const VegasOptions& options, uint64_t calls);
+
+/// The calls of part i of `calls` split into `parts` (sizes differ by at most one).
+inline uint64_t part_of(uint64_t calls, int parts, int i) {
+    return calls * static_cast<uint64_t>(i + 1) / static_cast<uint64_t>(parts) -
+           calls * static_cast<uint64_t>(i) / static_cast<uint64_t>(parts);
+}
+
 /// Increments per axis: about 100 training points per increment per iteration (fewer make the
 /// mean w^2 of an increment, and so the map, noisy: on a 2-D Gaussian of width 0.02 at
 /// N = 2^20, 1000 increments gave 1.7x the variance of 250), and at most 1000 up to d = 4,

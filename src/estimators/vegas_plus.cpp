@@ -14,7 +14,6 @@
 namespace mcp {
 namespace {
 
-constexpr uint64_t kIterationPoints = 1000; // least points per training iteration (as VEGAS)
 constexpr uint64_t kMaxHypercubes = uint64_t(1) << 20;
 
 class VegasPlusEstimator final : public EstimatorAlgorithm {
@@ -27,9 +26,7 @@ class VegasPlusEstimator final : public EstimatorAlgorithm {
         dim_ = problem_.domain.sample_dim();
         total_ = n;
         uint64_t train = static_cast<uint64_t>(o.train_fraction * static_cast<double>(n));
-        iterations_ = static_cast<int>(
-            std::min<uint64_t>(static_cast<uint64_t>(std::max(o.train_iterations, 1)),
-                               std::max<uint64_t>(1, train / kIterationPoints)));
+        iterations_ = vegas_training_iterations(o, train);
         final_ = n - train;
         // The grid of hypercubes: M per axis with about 4 points per hypercube in the smallest
         // iteration (at least 2 each, as the per-hypercube variances need).
@@ -75,10 +72,8 @@ class VegasPlusEstimator final : public EstimatorAlgorithm {
         const bool training = iteration_ < iterations_;
         if (!planned_) {
             if (!training && finished_final_) return false;
-            start_iteration(training ? train_ * (iteration_ + 1) / iterations_ -
-                                           train_ * iteration_ / iterations_
-                                     : final_,
-                            rng, training);
+            start_iteration(training ? part_of(train_, iterations_, iteration_) : final_, rng,
+                            training);
         }
         // The next block: points of the current hypercube, then the next ones.
         size_t count = 0;
