@@ -237,14 +237,20 @@ TEST(VegasEstimator, SampleDumpShowsTheEstimatePointsAndTheMap) {
     for (double w : d.weight) EXPECT_TRUE(std::isfinite(w));
 }
 
-TEST(VegasEstimator, TinyRunsSkipTraining) {
-    Made<SceneRequest> r = request(gaussian_scene(0.1, R"(["vegas"])"));
+// Runs of 1 to 40 calls (the sample view asks for as few as 1): every preset finishes, reports
+// its n, and estimates; vegas_sobol's net rounding never asks for more points than n.
+TEST(VegasEstimator, TinyRunsFinish) {
+    Made<SceneRequest> r =
+        request(gaussian_scene(0.1, R"(["vegas", "vegas_sobol", "vegas_plus"])"));
     ASSERT_TRUE(r.ok()) << r.error;
     Workspace ws;
-    Pcg32 rng(5u, 1u);
-    const RunResult run = run_estimate(r.value.problem, r.value.estimators[0], 3, rng, ws);
-    EXPECT_EQ(run.n, 3u);
-    EXPECT_TRUE(std::isfinite(run.estimate));
+    for (const EstimatorSpec& spec : r.value.estimators)
+        for (uint64_t n = 1; n <= 40; ++n) {
+            Pcg32 rng(5u, n);
+            const RunResult run = run_estimate(r.value.problem, spec, n, rng, ws);
+            EXPECT_EQ(run.n, n) << spec.name;
+            EXPECT_TRUE(std::isfinite(run.estimate)) << spec.name << " n=" << n;
+        }
 }
 
 TEST(VegasOptions, BadValuesAreNamed) {

@@ -175,11 +175,11 @@ class VegasEstimator final : public EstimatorAlgorithm {
         final_ = n - train;
         // A net's randomizations are full nets when each holds a power of two points: the
         // estimation share is rounded down to K 2^m, and training takes the rest.
-        if (spec_.sampler == SamplerKind::Sobol && train > 0) {
-            const uint64_t k = static_cast<uint64_t>(std::max(spec_.randomizations, 1));
-            uint64_t per = 1;
+        const uint64_t k = static_cast<uint64_t>(std::max(spec_.randomizations, 1));
+        if (spec_.sampler == SamplerKind::Sobol && train > 0 && final_ >= k) {
+            uint64_t per = 1; // per k <= final_ throughout
             while (2 * per * k <= final_) per *= 2;
-            if (per * k >= 2) final_ = per * k;
+            final_ = per * k;
         }
         train_ = n - final_;
         if (train_ == 0) iterations_ = 0;
