@@ -35,6 +35,9 @@ std::string repeated(size_t n, const std::string& item) {
     return s + "]";
 }
 
+constexpr const char* kNewName = "; a new name needs \"sampler\", \"pdf\", \"vegas\", "
+                                 "\"miser\", \"proposals\" or \"control_variates\")";
+
 constexpr const char* kPresets =
     "presets: uniform, stratified, latin_hypercube, importance, stratified_importance, sobol, "
     "halton, lattice, vegas, vegas_sobol, miser, vegas_plus";
@@ -45,15 +48,15 @@ TEST(SceneParsing, UnknownEstimatorNamesAreRefused) {
     EXPECT_EQ(error_of(R"({"f": "x*x", "estimators": ["stratifed"]})"),
               std::string("scene.estimators[0]: unknown estimator 'stratifed' (did you mean "
                           "'stratified'? ") +
-                  kPresets + "; a new name needs \"sampler\", \"pdf\", \"vegas\" or \"miser\")");
+                  kPresets + kNewName);
     EXPECT_EQ(error_of(R"({"f": "x*x", "estimators": ["uniform", "faure"]})"),
               std::string("scene.estimators[1]: unknown estimator 'faure' (") + kPresets +
-                  "; a new name needs \"sampler\", \"pdf\", \"vegas\" or \"miser\")");
+                  kNewName);
     // An object with only a name is a bare name too.
     EXPECT_EQ(error_of(R"({"f": "x*x", "estimators": [{"name": "latin_hypercub"}]})"),
               std::string("scene.estimators[0]: unknown estimator 'latin_hypercub' (did you "
                           "mean 'latin_hypercube'? ") +
-                  kPresets + "; a new name needs \"sampler\", \"pdf\", \"vegas\" or \"miser\")");
+                  kPresets + kNewName);
     // A new name with its sampler or pdf spelled out is fine, and runs what it says.
     Made<SceneRequest> r = build(
         R"({"f": "x*x", "estimators": [{"name": "jitter", "sampler": "stratified"},
@@ -325,6 +328,64 @@ TEST(SceneParsing, FieldsThatDoNotApplyOrDisagreeAreRefused) {
     EXPECT_EQ(error_of(R"({"f": "x", "estimators": [{"name": "t", "pdf": {"type": "tabulated",
                            "bins": true, "values": [1]}}]})"),
               "scene.estimators[0].pdf.bins: expected a non-negative whole number, got a boolean");
+}
+
+// Multiple importance sampling and control variates: every field bounded and named.
+TEST(SceneParsing, MisAndControlVariateFieldsAreChecked) {
+    const std::string head = R"({"f": "x", "estimators": [)";
+    auto est = [&](const std::string& e) { return error_of(head + e + "]}"); };
+    const std::string g = R"({"type": "gaussian", "mu": 0.5, "sigma": 0.1})";
+    EXPECT_EQ(est(R"({"name": "m", "proposals": []})"),
+              "scene.estimators[0].proposals: expected an array of pdfs (or \"uniform\"), got an "
+              "array");
+    EXPECT_EQ(est(R"({"name": "m", "proposals": [)" + g + R"(, "uniform"], "fractions": [1]})"),
+              "scene.estimators[0].fractions: has 1 entries for 2 proposals");
+    EXPECT_EQ(est(R"({"name": "m", "proposals": [)" + g + R"(, "uniform"], "fractions": [1, 0]})"),
+              "scene.estimators[0].fractions: each share must be positive (and at most 1e6), "
+              "got 0");
+    EXPECT_EQ(est(R"({"name": "m", "proposals": [)" + g + R"(], "heuristic": "veach"})"),
+              "scene.estimators[0].heuristic: unknown heuristic 'veach' (known: balance, power, "
+              "maximum, cutoff, optimal)");
+    EXPECT_EQ(est(R"({"name": "m", "proposals": [)" + g + R"(], "beta": 2})"),
+              "scene.estimators[0].beta: applies to the power heuristic only");
+    EXPECT_EQ(est(R"({"name": "m", "proposals": [)" + g + R"(], "heuristic": "power", "beta": 0.5})"),
+              "scene.estimators[0].beta: must be in [1, 16] (Veach uses 2), got 0.5");
+    EXPECT_EQ(est(R"({"name": "m", "proposals": [)" + g + R"(], "heuristic": "cutoff", "cutoff": 2})"),
+              "scene.estimators[0].cutoff: must be in [0, 1] (Veach uses 0.1), got 2");
+    EXPECT_EQ(est(R"({"name": "m", "pdf": )" + g + R"(, "defensive": 1})"),
+              "scene.estimators[0].defensive: must be in (0, 1): the uniform density's share of "
+              "the mixture (Hesterberg suggests 0.1 to 0.5), got 1");
+    EXPECT_EQ(est(R"({"name": "m", "pdf": )" + g + R"(, "proposals": ["uniform"]})"),
+              "scene.estimators[0].pdf: an estimator has \"pdf\" or \"proposals\", not both");
+    EXPECT_EQ(est(R"({"name": "m", "sampler": "sobol", "proposals": ["uniform"]})"),
+              "scene.estimators[0].sampler: multiple importance sampling needs the independent "
+              "sampler (its error bar is that of independent points)");
+    EXPECT_EQ(est(R"({"name": "m", "proposals": [)" + g + R"(], "one_sample": 1})"),
+              "scene.estimators[0].one_sample: expected true or false, got a number");
+    EXPECT_EQ(est(R"({"name": "m", "proposals": )" + repeated(17, "\"uniform\"") + "}"),
+              "scene.estimators[0].proposals: has 17 entries; at most 16 techniques are combined");
+    EXPECT_EQ(est(R"({"name": "c", "control_variates": [{"g": "x*x"}]})"),
+              "scene.estimators[0].control_variates[0]: needs \"integral\": the integral of g "
+              "over the domain (known in closed form only for built-in integrands on boxes)");
+    EXPECT_EQ(est(R"({"name": "c", "control_variates": [{"g": "x", "integral": 0.5}],
+                      "coefficients": [1, 2]})"),
+              "scene.estimators[0].coefficients: has 2 entries for 1 control variates");
+    EXPECT_EQ(est(R"({"name": "c", "coefficients": [1]})"),
+              "scene.estimators[0].coefficients: applies with \"control_variates\" only");
+    EXPECT_EQ(est(R"({"name": "c", "control_variates": [{"g": "x", "integral": 0.5, "G": 1}]})"),
+              "scene.estimators[0].control_variates[0]: unknown field 'G' (known: g, integral)");
+    // A built-in g brings its own integral; a defensive pdf is MIS with the uniform density.
+    Made<SceneRequest> ok = build(
+        R"({"f": "x*x", "estimators": [{"name": "c", "control_variates": [{"g": {"type":
+            "monomial", "powers": [1]}}]}, {"name": "d", "pdf": )" +
+        g + R"(, "defensive": 0.2}]})");
+    ASSERT_TRUE(ok.ok()) << ok.error;
+    EXPECT_DOUBLE_EQ(ok.value.estimators[0].control_variate_options.variates[0].integral, 0.5);
+    const MisOptions& d = ok.value.estimators[1].mis_options;
+    ASSERT_EQ(d.proposals.size(), 2u);
+    EXPECT_EQ(d.proposals[1].kind, ProposalKind::UniformBox);
+    EXPECT_DOUBLE_EQ(d.fractions[0], 0.8);
+    EXPECT_DOUBLE_EQ(d.fractions[1], 0.2);
 }
 
 TEST(SceneParsing, SceneInfoReportsTheSameErrors) {

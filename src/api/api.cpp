@@ -101,6 +101,34 @@ int mcp_study_plan(const char* scene_json, const char* options_json, char** plan
     return MCP_OK;
 }
 
+namespace {
+
+/// An MIS estimator's weight for each technique over the grid xs (q_k = c_k p_k; the optimal
+/// combination is drawn with the balance weights it starts from, as its own depend on a run).
+mcp::Json mis_weight_curves(const mcp::EstimatorSpec& spec, const mcp::Domain& domain,
+                            const mcp::PointBlock& xs) {
+    const mcp::MisOptions& m = spec.mis_options;
+    const size_t k_count = m.proposals.size();
+    std::vector<std::vector<double>> q(k_count, std::vector<double>(xs.n));
+    std::vector<const double*> rows(k_count);
+    for (size_t k = 0; k < k_count; ++k) {
+        mcp::proposal_pdf_block(m.proposals[k], domain, xs, q[k].data());
+        for (double& v : q[k]) v *= m.fractions[k];
+        rows[k] = q[k].data();
+    }
+    const mcp::MisWeighting weighting = m.optimal ? mcp::MisWeighting{} : m.weighting;
+    mcp::Json out = mcp::Json::array();
+    std::vector<double> w(xs.n);
+    for (size_t k = 0; k < k_count; ++k) {
+        mcp::mis_weight_block(weighting, rows.data(), static_cast<int>(k_count),
+                              static_cast<int>(k), xs.n, w.data());
+        out.push_back(w);
+    }
+    return out;
+}
+
+} // namespace
+
 int mcp_study_samples(const char* scene_json, const char* options_json, char** samples_json) {
     if (!samples_json) return fail(MCP_ERROR_ARGUMENT, "mcp_study_samples: samples_json is NULL");
     *samples_json = nullptr;
@@ -150,7 +178,7 @@ int mcp_study_samples(const char* scene_json, const char* options_json, char** s
         estimators.push_back(
             {{"name", spec.name},
              {"sampler", mcp::sampler_name(spec.sampler)},
-             {"pdf", spec.proposal.describe()},
+             {"pdf", mcp::describe_sampling(spec)},
              {"strata", d.strata},
              {"samples_per_stratum", d.per_stratum},
              {"randomization", mcp::is_qmc(spec.sampler)
@@ -190,11 +218,14 @@ int mcp_study_samples(const char* scene_json, const char* options_json, char** s
             xj.push_back(xs.coord(0)[i]);
             fj.push_back(std::isfinite(fv[i]) ? mcp::Json(fv[i]) : mcp::Json(nullptr));
         }
+        mcp::Json mis_weights = mcp::Json::object();
         for (const mcp::EstimatorSpec& spec : req.value.estimators) {
-            mcp::proposal_pdf_block(spec.proposal, domain, xs, pv.data());
+            mcp::sampling_density_block(spec, domain, xs, pv.data());
             pdfs[spec.name] = std::vector<double>(pv.begin(), pv.end());
+            if (spec.mis) mis_weights[spec.name] = mis_weight_curves(spec, domain, xs);
         }
         result["curve"] = {{"x", xj}, {"f", fj}, {"pdf", pdfs}};
+        if (!mis_weights.empty()) result["curve"]["mis_weights"] = mis_weights;
     }
     *samples_json = copy_out(dump(result));
     g_last_error.clear();

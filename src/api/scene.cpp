@@ -761,6 +761,165 @@ bool parse_miser_options(Ctx& c, const Json& j, const std::string& path, MiserOp
     return true;
 }
 
+/// Multiple importance sampling fields of an estimator object: "proposals" (pdfs, or "uniform"
+/// for the domain's uniform density), "fractions", "heuristic" (with "beta" or "cutoff"),
+/// "one_sample" and "defensive" (Hesterberg's mixture: the uniform density joins with that
+/// share). A lone "pdf" with "defensive" is the first proposal.
+bool parse_mis_options(Ctx& c, const Json& j, const std::string& path, const Problem& problem,
+                       const Json* pdf, MisOptions* out) {
+    const Json* proposals = find(j, "proposals");
+    std::vector<Json> entries;
+    if (proposals) {
+        if (pdf)
+            return c.fail(sub(path, "pdf"), "an estimator has \"pdf\" or \"proposals\", not both");
+        if (!proposals->is_array() || proposals->empty())
+            return c.fail(sub(path, "proposals"),
+                          "expected an array of pdfs (or \"uniform\"), got " + type_of(*proposals));
+        if (proposals->size() > static_cast<size_t>(kMaxMisTechniques))
+            return c.fail(sub(path, "proposals"),
+                          "has " + std::to_string(proposals->size()) + " entries; at most " +
+                              std::to_string(kMaxMisTechniques) + " techniques are combined");
+        for (const Json& e : *proposals) entries.push_back(e);
+    } else if (pdf) {
+        entries.push_back(*pdf);
+    } else {
+        entries.push_back("uniform");
+    }
+    for (size_t k = 0; k < entries.size(); ++k) {
+        const std::string at = (proposals ? sub(path, "proposals") + "[" + std::to_string(k) + "]"
+                                          : sub(path, "pdf"));
+        Proposal prop = uniform_proposal(problem.domain);
+        if (!(entries[k].is_string() && entries[k] == "uniform") &&
+            !parse_pdf(c, entries[k], at, problem, &prop))
+            return false;
+        out->proposals.push_back(prop);
+    }
+    const size_t k_count = out->proposals.size();
+    out->fractions.assign(k_count, 1.0 / static_cast<double>(k_count));
+    if (find(j, "fractions")) {
+        std::vector<double> f;
+        if (!get_numbers(c, j, "fractions", path, &f)) return false;
+        if (f.size() != k_count)
+            return c.fail(sub(path, "fractions"), "has " + std::to_string(f.size()) +
+                                                      " entries for " + std::to_string(k_count) +
+                                                      " proposals");
+        double total = 0.0;
+        for (double x : f) {
+            if (!(x > 0.0 && x <= 1e6))
+                return c.fail(sub(path, "fractions"),
+                              "each share must be positive (and at most 1e6), got " + number_text(x));
+            total += x;
+        }
+        for (size_t k = 0; k < k_count; ++k) out->fractions[k] = f[k] / total;
+    }
+    double defensive = 0.0;
+    if (!get_number(c, j, "defensive", path, &defensive)) return false;
+    if (find(j, "defensive")) {
+        if (!(defensive > 0.0 && defensive < 1.0))
+            return c.fail(sub(path, "defensive"),
+                          "must be in (0, 1): the uniform density's share of the mixture "
+                          "(Hesterberg suggests 0.1 to 0.5), got " + number_text(defensive));
+        if (k_count + 1 > static_cast<size_t>(kMaxMisTechniques))
+            return c.fail(sub(path, "defensive"), "the uniform density would be technique " +
+                                                      std::to_string(k_count + 1) + "; at most " +
+                                                      std::to_string(kMaxMisTechniques));
+        for (double& f : out->fractions) f *= 1.0 - defensive;
+        out->proposals.push_back(uniform_proposal(problem.domain));
+        out->fractions.push_back(defensive);
+    }
+    std::string heuristic = "balance";
+    if (!get_string(c, j, "heuristic", path, &heuristic)) return false;
+    if (heuristic == "balance")
+        out->weighting.heuristic = MisHeuristic::Balance;
+    else if (heuristic == "power")
+        out->weighting.heuristic = MisHeuristic::Power;
+    else if (heuristic == "maximum")
+        out->weighting.heuristic = MisHeuristic::Maximum;
+    else if (heuristic == "cutoff")
+        out->weighting.heuristic = MisHeuristic::Cutoff;
+    else if (heuristic == "optimal")
+        out->optimal = true;
+    else
+        return c.fail(sub(path, "heuristic"),
+                      "unknown heuristic '" + heuristic.substr(0, 64) +
+                          "' (known: balance, power, maximum, cutoff, optimal)");
+    if (find(j, "beta")) {
+        if (out->weighting.heuristic != MisHeuristic::Power || out->optimal)
+            return c.fail(sub(path, "beta"), "applies to the power heuristic only");
+        if (!get_number(c, j, "beta", path, &out->weighting.beta)) return false;
+        if (!(out->weighting.beta >= 1.0 && out->weighting.beta <= 16.0))
+            return c.fail(sub(path, "beta"), "must be in [1, 16] (Veach uses 2), got " +
+                                                  number_text(out->weighting.beta));
+    }
+    if (find(j, "cutoff")) {
+        if (out->weighting.heuristic != MisHeuristic::Cutoff || out->optimal)
+            return c.fail(sub(path, "cutoff"), "applies to the cutoff heuristic only");
+        if (!get_number(c, j, "cutoff", path, &out->weighting.cutoff)) return false;
+        if (!(out->weighting.cutoff >= 0.0 && out->weighting.cutoff <= 1.0))
+            return c.fail(sub(path, "cutoff"), "must be in [0, 1] (Veach uses 0.1), got " +
+                                                    number_text(out->weighting.cutoff));
+    }
+    if (const Json* one = find(j, "one_sample")) {
+        if (!one->is_boolean())
+            return c.fail(sub(path, "one_sample"), "expected true or false, got " + type_of(*one));
+        out->one_sample = one->get<bool>();
+    }
+    return true;
+}
+
+/// Control-variate fields: "control_variates": [{"g": integrand, "integral": G}, ...] and the
+/// optional "coefficients" (one per variate; fitted when absent).
+bool parse_control_variates(Ctx& c, const Json& j, const std::string& path,
+                            const Problem& problem, ControlVariateOptions* out) {
+    const Json* list = find(j, "control_variates");
+    const std::string at = sub(path, "control_variates");
+    if (!list->is_array() || list->empty())
+        return c.fail(at, "expected an array of {\"g\": ..., \"integral\": ...}, got " +
+                              type_of(*list));
+    if (list->size() > static_cast<size_t>(kMaxControlVariates))
+        return c.fail(at, "has " + std::to_string(list->size()) + " entries; at most " +
+                              std::to_string(kMaxControlVariates));
+    for (size_t k = 0; k < list->size(); ++k) {
+        const std::string here = at + "[" + std::to_string(k) + "]";
+        const Json& e = (*list)[k];
+        if (!e.is_object())
+            return c.fail(here, "expected {\"g\": ..., \"integral\": ...}, got " + type_of(e));
+        if (!check_keys(c, e, here, {"g", "integral"})) return false;
+        const Json* g = find(e, "g");
+        if (!g) return c.fail(here, "a control variate needs \"g\": an expression or integrand");
+        ControlVariate cv;
+        if (!parse_integrand(c, *g, sub(here, "g"), problem.domain.point_dim(), &cv.g))
+            return false;
+        cv.text = g->is_string() ? g->get<std::string>().substr(0, 200) : g->dump().substr(0, 200);
+        if (find(e, "integral")) {
+            if (!get_number(c, e, "integral", here, &cv.integral)) return false;
+            if (!std::isfinite(cv.integral))
+                return c.fail(sub(here, "integral"), "must be a finite number");
+        } else {
+            std::optional<double> known =
+                problem.domain.kind == DomainKind::Box
+                    ? exact_integral_over_box(cv.g, problem.domain.lo, problem.domain.hi)
+                    : std::nullopt;
+            if (!known)
+                return c.fail(here, "needs \"integral\": the integral of g over the domain (known "
+                                    "in closed form only for built-in integrands on boxes)");
+            cv.integral = *known;
+        }
+        out->variates.push_back(cv);
+    }
+    if (find(j, "coefficients")) {
+        if (!get_numbers(c, j, "coefficients", path, &out->coefficients)) return false;
+        if (out->coefficients.size() != out->variates.size())
+            return c.fail(sub(path, "coefficients"),
+                          "has " + std::to_string(out->coefficients.size()) + " entries for " +
+                              std::to_string(out->variates.size()) + " control variates");
+        for (double x : out->coefficients)
+            if (!std::isfinite(x))
+                return c.fail(sub(path, "coefficients"), "must be finite numbers");
+    }
+    return true;
+}
+
 bool parse_estimator(Ctx& c, const Json& j, const std::string& path, const Problem& problem,
                      EstimatorSpec* out) {
     std::string name, sampler_name_str, warp, randomization;
@@ -768,12 +927,15 @@ bool parse_estimator(Ctx& c, const Json& j, const std::string& path, const Probl
     const Json* pdf = nullptr;
     const Json* vegas = nullptr;
     const Json* miser = nullptr;
+    bool mis = false, control = false;
     if (j.is_string()) {
         name = j.get<std::string>();
     } else if (j.is_object()) {
         if (!check_keys(c, j, path,
                         {"name", "sampler", "pdf", "warp", "samples_per_stratum", "randomization",
-                         "randomizations", "vegas", "miser"}))
+                         "randomizations", "vegas", "miser", "proposals", "fractions", "heuristic",
+                         "beta", "cutoff", "one_sample", "defensive", "control_variates",
+                         "coefficients"}))
             return false;
         uint64_t m = 1;
         if (!get_count(c, j, "samples_per_stratum", path, &m)) return false;
@@ -796,6 +958,12 @@ bool parse_estimator(Ctx& c, const Json& j, const std::string& path, const Probl
         pdf = find(j, "pdf");
         vegas = find(j, "vegas");
         miser = find(j, "miser");
+        for (const char* key : {"proposals", "fractions", "heuristic", "beta", "cutoff",
+                                "one_sample", "defensive"})
+            mis = mis || find(j, key);
+        control = find(j, "control_variates") != nullptr;
+        if (!control && find(j, "coefficients"))
+            return c.fail(sub(path, "coefficients"), "applies with \"control_variates\" only");
     } else {
         return c.fail(path, "expected an estimator name or object, got " + type_of(j));
     }
@@ -837,10 +1005,11 @@ bool parse_estimator(Ctx& c, const Json& j, const std::string& path, const Probl
     if (!warp.empty() && problem.domain.kind != DomainKind::Disk)
         return c.fail(sub(path, "warp"), "only disk domains have a choice of warp");
     // A name runs what it says: a bare name must be a preset, and a preset is not redefined.
-    if (!preset && sampler_name_str.empty() && !pdf && !vegas && !miser)
+    if (!preset && sampler_name_str.empty() && !pdf && !vegas && !miser && !mis && !control)
         return c.fail(path, "unknown estimator '" + name_text(name) + "'" + did_you_mean(name) +
                                 "presets: " + join(preset_names()) +
-                                "; a new name needs \"sampler\", \"pdf\", \"vegas\" or \"miser\")");
+                                "; a new name needs \"sampler\", \"pdf\", \"vegas\", \"miser\", "
+                                "\"proposals\" or \"control_variates\")");
     if (preset && !sampler_name_str.empty() && out->sampler != preset->sampler)
         return c.fail(sub(path, "sampler"),
                       "'" + name + "' is the preset with the " + sampler_name(preset->sampler) +
@@ -867,6 +1036,30 @@ bool parse_estimator(Ctx& c, const Json& j, const std::string& path, const Probl
     if (out->vegas && out->vegas_options.stratify && out->sampler != SamplerKind::Independent)
         return c.fail(sub(path, "sampler"), "VEGAS+ (\"stratify\": true) draws its own points in "
                                             "its hypercubes: the sampler must be independent");
+    if (mis || control) {
+        const char* what = mis ? "multiple importance sampling" : "control variates";
+        if (out->vegas || out->miser)
+            return c.fail(path, std::string(what) + " does not combine with VEGAS or MISER");
+        if (out->sampler != SamplerKind::Independent)
+            return c.fail(sub(path, "sampler"), std::string(what) +
+                                                    " needs the independent sampler (its error "
+                                                    "bar is that of independent points)");
+        if (mis && control)
+            return c.fail(sub(path, "control_variates"),
+                          "not with multiple importance sampling (\"heuristic\": \"optimal\" "
+                          "is MIS with the densities as control variates)");
+    }
+    if (control && !parse_control_variates(c, j, path, problem, &out->control_variate_options))
+        return false;
+    out->control_variates = control;
+    if (mis) {
+        if (preset)
+            return c.fail(path, "'" + name + "' is a preset; give the MIS estimator another name");
+        if (!parse_mis_options(c, j, path, problem, pdf, &out->mis_options)) return false;
+        out->mis = true;
+        out->proposal = out->mis_options.proposals[0];
+        return true;
+    }
     out->proposal = uniform_proposal(problem.domain, warp == "polar");
     if (pdf) {
         if (!parse_pdf(c, *pdf, sub(path, "pdf"), problem, &out->proposal)) return false;

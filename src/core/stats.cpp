@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 namespace mcp {
 
@@ -113,6 +114,42 @@ LineFit fit_weighted_line(const std::vector<double>& x, const std::vector<double
     fit.residual_variance = n > 2 ? chi2 / static_cast<double>(n - 2) : 0.0;
     fit.slope_se = std::sqrt(std::max(1.0, fit.residual_variance) / sxx);
     return fit;
+}
+
+void StratifiedSum::add(double a, const RunningMoments& m) {
+    const uint64_t n = m.count();
+    if (n == 0) return;
+    estimate_.add(a * m.mean());
+    complete_ = complete_ && n > 1;
+    if (n < 2) return;
+    const double v = a * a * m.variance() / static_cast<double>(n);
+    variance_.add(v);
+    satterthwaite_ += v * v / static_cast<double>(n - 1);
+    free_ += n - 1;
+}
+
+int StratifiedSum::dof() const {
+    const double v = variance();
+    if (satterthwaite_ > 0.0) return static_cast<int>(std::min(1e6, std::max(1.0, v * v / satterthwaite_)));
+    return static_cast<int>(std::min<uint64_t>(1000000, free_));
+}
+
+void allocate_largest_remainders(uint64_t points, const std::vector<double>& share,
+                                 std::vector<uint64_t>* counts) {
+    const size_t n = share.size();
+    uint64_t given = 0;
+    std::vector<std::pair<double, size_t>> remainders(n);
+    for (size_t h = 0; h < n; ++h) {
+        const double exact = static_cast<double>(points) * share[h];
+        const uint64_t whole = std::min(points - given, static_cast<uint64_t>(exact));
+        (*counts)[h] += whole;
+        given += whole;
+        remainders[h] = {exact - static_cast<double>(whole), h};
+    }
+    std::sort(remainders.begin(), remainders.end(), [](const auto& a, const auto& b) {
+        return a.first != b.first ? a.first > b.first : a.second < b.second;
+    });
+    for (size_t k = 0; given < points; k = (k + 1) % n, ++given) ++(*counts)[remainders[k].second];
 }
 
 } // namespace mcp

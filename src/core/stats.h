@@ -61,6 +61,35 @@ class RunningMoments {
     double m2_ = 0.0;
 };
 
+/// A sum of independent estimates, as stratified sampling, MISER's leaves and multi-sample MIS
+/// make: I = sum_h a_h mean_h with variance sum_h a_h^2 s_h^2 / n_h, and the degrees of freedom
+/// of that variance estimate by Satterthwaite's approximation [Satterthwaite46]:
+/// (sum_h v_h)^2 / sum_h v_h^2 / (n_h - 1).
+class StratifiedSum {
+  public:
+    /// Adds a_h times the mean of the stratum's values m.
+    void add(double a, const RunningMoments& m);
+    double estimate() const { return estimate_.value(); }
+    double variance() const { return variance_.value() > 0.0 ? variance_.value() : 0.0; }
+    /// Whether every stratum had two values or more (else there is no variance estimate).
+    bool has_variance() const { return complete_; }
+    /// Satterthwaite's degrees of freedom, capped at 10^6; when every variance is 0, the
+    /// values' own count sum_h (n_h - 1).
+    int dof() const;
+
+  private:
+    NeumaierSum estimate_, variance_;
+    double satterthwaite_ = 0.0;
+    uint64_t free_ = 0;
+    bool complete_ = true;
+};
+
+/// Adds `points` to the counts in proportion to share[h] (shares >= 0 summing to 1): the whole
+/// parts, then one more to the largest remainders until the total is exact, ties to the lower
+/// index (a total order, so every standard library allocates alike).
+void allocate_largest_remainders(uint64_t points, const std::vector<double>& share,
+                                 std::vector<uint64_t>* counts);
+
 /// Ordinary least squares y = intercept + slope * x.
 struct LineFit {
     double slope = 0.0;

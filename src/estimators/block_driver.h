@@ -104,6 +104,15 @@ std::unique_ptr<EstimatorAlgorithm> make_vegas_plus_estimator(const Problem& pro
 std::unique_ptr<EstimatorAlgorithm>
 make_miser_estimator(const Problem& problem, const EstimatorSpec& spec, Accumulator accumulator);
 
+/// Multiple importance sampling (estimators/mis.cpp): heuristics, one-sample, optimal.
+std::unique_ptr<EstimatorAlgorithm>
+make_mis_estimator(const Problem& problem, const EstimatorSpec& spec, Accumulator accumulator);
+
+/// Control variates with fitted or given coefficients (estimators/control_variates.cpp).
+std::unique_ptr<EstimatorAlgorithm> make_control_variate_estimator(const Problem& problem,
+                                                                   const EstimatorSpec& spec,
+                                                                   Accumulator accumulator);
+
 /// The algorithm of an estimator spec: fixed, VEGAS, VEGAS+ or MISER.
 std::unique_ptr<EstimatorAlgorithm>
 make_estimator(const Problem& problem, const EstimatorSpec& spec, Accumulator accumulator);

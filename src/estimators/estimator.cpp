@@ -337,6 +337,8 @@ class VegasEstimator final : public EstimatorAlgorithm {
 
 std::unique_ptr<EstimatorAlgorithm>
 make_estimator(const Problem& problem, const EstimatorSpec& spec, Accumulator accumulator) {
+    if (spec.mis) return make_mis_estimator(problem, spec, accumulator);
+    if (spec.control_variates) return make_control_variate_estimator(problem, spec, accumulator);
     if (spec.miser) return make_miser_estimator(problem, spec, accumulator);
     if (spec.vegas && spec.vegas_options.stratify)
         return make_vegas_plus_estimator(problem, spec, accumulator);

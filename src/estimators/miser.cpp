@@ -47,24 +47,18 @@ class MiserEstimator final : public EstimatorAlgorithm {
         plan_.dim = dim_;
         plan_.total = total_;
         accumulator_.reset(ErrorMethod::Iid, plan_, float32_);
-        estimate_ = variance_ = NeumaierSum();
-        satterthwaite_ = 0.0;
-        variances_ = true;
-        accumulated_ = leaf_points_ = 0;
+        strata_ = StratifiedSum();
+        accumulated_ = 0;
         // Depth first: a region is probed and cut, or sampled as a leaf, before the next.
         region(std::vector<double>(static_cast<size_t>(dim_), 0.0),
                std::vector<double>(static_cast<size_t>(dim_), 1.0), total_, 0);
         const double unit =
             problem_.quantity == Quantity::Mean ? 1.0 / problem_.domain.measure() : 1.0;
         result_ = accumulator_.finish(unit);
-        result_.estimate = unit * estimate_.value();
-        const double v = std::max(0.0, variance_.value());
-        result_.std_error =
-            variances_ ? unit * std::sqrt(v) : std::numeric_limits<double>::quiet_NaN();
-        // Satterthwaite's degrees of freedom of a sum of variance estimates.
-        result_.dof = satterthwaite_ > 0.0
-                          ? static_cast<int>(std::min(1e6, std::max(1.0, v * v / satterthwaite_)))
-                          : static_cast<int>(std::min<uint64_t>(1000000, leaf_points_));
+        result_.estimate = unit * strata_.estimate();
+        result_.std_error = strata_.has_variance() ? unit * std::sqrt(strata_.variance())
+                                                   : std::numeric_limits<double>::quiet_NaN();
+        result_.dof = strata_.dof();
         done_ = true;
         return true;
     }
@@ -140,13 +134,7 @@ class MiserEstimator final : public EstimatorAlgorithm {
             accumulator_.add_block(accumulated_, b.f, b.pdf, b.pdf, b.count);
             accumulated_ += b.count;
         });
-        leaf_points_ += n;
-        estimate_.add(volume * m.mean());
-        variances_ = variances_ && m.count() > 1;
-        const double s2 = m.count() > 1 ? m.variance() : 0.0;
-        const double a = volume * volume * s2 / static_cast<double>(m.count());
-        variance_.add(a);
-        if (m.count() > 1) satterthwaite_ += a * a / static_cast<double>(m.count() - 1);
+        strata_.add(volume, m);
     }
 
     /// The region [lo, hi) with n calls: a leaf, or probed, cut and recursed into.
@@ -217,10 +205,8 @@ class MiserEstimator final : public EstimatorAlgorithm {
     std::vector<MiserBox>* recorded_ = nullptr;
     AdaptiveView view_; // the leaves, when observed
     size_t record_limit_ = 0;
-    NeumaierSum estimate_, variance_;
-    double satterthwaite_ = 0.0;
-    bool variances_ = true;
-    uint64_t accumulated_ = 0, leaf_points_ = 0;
+    StratifiedSum strata_;
+    uint64_t accumulated_ = 0;
     SamplerPlan plan_; // outlives the accumulator's use of it
     WeightAccumulator accumulator_;
     RunResult result_;

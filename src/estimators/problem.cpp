@@ -1,6 +1,8 @@
 #include "estimators/problem.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 
 #include "core/special.h"
@@ -332,6 +334,45 @@ void proposal_pdf_block(const Proposal& p, const Domain& d, const PointBlock& x,
         for (size_t i = 0; i < n; ++i) pdf[i] = p.table.pdf(x.coord(0)[i], x.coord(1)[i]);
         break;
     }
+}
+
+std::vector<const Proposal*> proposals_of(const EstimatorSpec& spec) {
+    std::vector<const Proposal*> out;
+    if (!spec.mis) {
+        out.push_back(&spec.proposal);
+        return out;
+    }
+    for (const Proposal& p : spec.mis_options.proposals) out.push_back(&p);
+    return out;
+}
+
+void sampling_density_block(const EstimatorSpec& spec, const Domain& domain, const PointBlock& x,
+                            double* pdf) {
+    if (!spec.mis) {
+        proposal_pdf_block(spec.proposal, domain, x, pdf);
+        return;
+    }
+    std::vector<double> one(x.n);
+    std::fill(pdf, pdf + x.n, 0.0);
+    const MisOptions& m = spec.mis_options;
+    for (size_t k = 0; k < m.proposals.size(); ++k) {
+        proposal_pdf_block(m.proposals[k], domain, x, one.data());
+        for (size_t i = 0; i < x.n; ++i) pdf[i] += m.fractions[k] * one[i];
+    }
+}
+
+std::string describe_sampling(const EstimatorSpec& spec) {
+    if (!spec.mis) return spec.proposal.describe();
+    const MisOptions& m = spec.mis_options;
+    std::string s = std::string("mis(") +
+                    (m.optimal ? "optimal" : mis_heuristic_name(m.weighting.heuristic)) +
+                    (m.one_sample ? ", one-sample" : "") + ": ";
+    for (size_t k = 0; k < m.proposals.size(); ++k) {
+        char share[32];
+        std::snprintf(share, sizeof share, " %.3g", m.fractions[k]);
+        s += (k ? ", " : "") + m.proposals[k].describe() + share;
+    }
+    return s + ")";
 }
 
 } // namespace mcp

@@ -8,6 +8,7 @@
 
 #include "core/distributions.h"
 #include "core/made.h"
+#include "core/mis.h"
 #include "core/points.h"
 #include "core/samplers.h"
 #include "core/warps.h"
@@ -108,6 +109,32 @@ struct MiserOptions {
     double dither = 0.0; ///< the cut moves by +-dither of the width (breaks symmetry)
 };
 
+/// Multiple importance sampling [Veach97, ch. 9] (scene fields "proposals", "heuristic", ...;
+/// docs/scene-format.md): technique k draws from proposals[k], the techniques' samples are
+/// combined by a heuristic's weights or by the optimal weights of [Kondapaneni19].
+struct MisOptions {
+    std::vector<Proposal> proposals;
+    /// Multi-sample: the shares of N each technique draws (rounded to whole counts); one-sample:
+    /// the probabilities of choosing each technique. Positive, summing to 1.
+    std::vector<double> fractions;
+    MisWeighting weighting;
+    bool optimal = false;    ///< weights solved from the samples' regression [Kondapaneni19]
+    bool one_sample = false; ///< each sample picks its technique at random [Veach97, 9.2.4]
+};
+
+/// Control variates: f - c . (g - G), with g functions of known integrals G and c fitted by
+/// least squares on the same samples (or given) [Owen13, 8.9].
+struct ControlVariate {
+    Integrand g;
+    double integral = 0.0; ///< G: the integral of g over the domain
+    std::string text;      ///< how the scene named g (for reports)
+};
+constexpr int kMaxControlVariates = 16;
+struct ControlVariateOptions {
+    std::vector<ControlVariate> variates;
+    std::vector<double> coefficients; ///< given c (one per variate); empty: fitted
+};
+
 struct EstimatorSpec {
     std::string name;
     SamplerKind sampler = SamplerKind::Independent;
@@ -124,7 +151,26 @@ struct EstimatorSpec {
     bool miser = false;
     MiserOptions miser_options;
 
+    /// Multiple importance sampling (estimators/mis.cpp); `proposal` is then the first technique's.
+    bool mis = false;
+    MisOptions mis_options;
+    /// Control variates (estimators/control_variates.cpp).
+    bool control_variates = false;
+    ControlVariateOptions control_variate_options;
+
     SamplerOptions sampler_options() const { return {per_stratum, randomization, randomizations}; }
 };
+
+/// The proposals an estimator draws from: its one proposal, or its MIS techniques.
+std::vector<const Proposal*> proposals_of(const EstimatorSpec& spec);
+
+/// pdf[i] = the density of the estimator's points at x, on average over its techniques: its
+/// proposal's, or for MIS the mixture sum_k c_k p_k(x) with the techniques' shares c_k (zero
+/// exactly where every technique's density is).
+void sampling_density_block(const EstimatorSpec& spec, const Domain& domain, const PointBlock& x,
+                            double* pdf);
+
+/// The density as a report names it: the proposal's, or "mis(balance: a 0.5, b 0.5)".
+std::string describe_sampling(const EstimatorSpec& spec);
 
 } // namespace mcp

@@ -263,10 +263,11 @@ SupportCheck check_support(const Problem& problem, const EstimatorSpec& spec, ui
                            uint64_t seed) {
     SupportCheck check;
     check.probes = probes;
-    if (!spec.proposal.importance) { // uniform proposals cover the whole domain
-        check.note = "a uniform pdf is positive on the whole domain";
-        return check;
-    }
+    for (const Proposal* p : proposals_of(spec))
+        if (!p->importance) { // uniform proposals cover the whole domain
+            check.note = "a uniform pdf is positive on the whole domain";
+            return check;
+        }
     const Domain& d = problem.domain;
     Pcg32 rng(mix64(seed ^ 0x737570706f7274ULL), hash_string(spec.name.c_str())); // "support"
     const Proposal uniform = uniform_proposal(d);
@@ -278,7 +279,7 @@ SupportCheck check_support(const Problem& problem, const EstimatorSpec& spec, ui
         const size_t count = b.count;
         const double* f = b.f;
         double* p = b.pdf; // the uniform densities, replaced by the proposal's
-        proposal_pdf_block(spec.proposal, d, *b.x, p);
+        sampling_density_block(spec, d, *b.x, p);
         for (size_t i = 0; i < count; ++i) {
             const double a = std::fabs(f[i]);
             if (!(a > 0.0) || !std::isfinite(a)) continue;
@@ -301,7 +302,9 @@ SupportCheck check_support(const Problem& problem, const EstimatorSpec& spec, ui
     std::vector<Rect> rects;
     std::string why_not;
     double share = 0.0;
-    if (zero_set(spec.proposal, d, &rects, &share, &why_not)) {
+    if (spec.mis)
+        why_not = "the zero set of a mixture of pdfs is not computed";
+    else if (zero_set(spec.proposal, d, &rects, &share, &why_not)) {
         Budget budget;
         NeumaierSum mass;
         bool finite = true;

@@ -158,23 +158,7 @@ class VegasPlusEstimator final : public EstimatorAlgorithm {
         const double even = spec_.vegas_options.uniform_share;
         for (uint64_t h = 0; h < cubes_; ++h)
             share[h] = (1.0 - even) * share[h] / total + even / static_cast<double>(cubes_);
-        total = 1.0;
-        uint64_t given = 0;
-        std::vector<std::pair<double, uint64_t>> remainders(cubes_);
-        for (uint64_t h = 0; h < cubes_; ++h) {
-            const double exact = static_cast<double>(rest) * share[h] / total;
-            const uint64_t whole = static_cast<uint64_t>(exact);
-            allocation_[h] += whole;
-            given += whole;
-            remainders[h] = {exact - static_cast<double>(whole), h};
-        }
-        // Largest remainder first, ties (every hypercube alike in the first iteration) to the
-        // lower index: a total order, so that every standard library allocates alike (native
-        // and wasm gave different points with an order left to std::sort).
-        std::sort(remainders.begin(), remainders.end(), [](const auto& a, const auto& b) {
-            return a.first != b.first ? a.first > b.first : a.second < b.second;
-        });
-        for (uint64_t k = 0; given < rest; ++k, ++given) ++allocation_[remainders[k].second];
+        allocate_largest_remainders(rest, share, &allocation_);
         cube_moments_.assign(cubes_, RunningMoments());
         const uint64_t seed = (uint64_t(rng.next_u32()) << 32) | rng.next_u32();
         const uint64_t stream = (uint64_t(rng.next_u32()) << 32) | rng.next_u32();
@@ -202,18 +186,11 @@ class VegasPlusEstimator final : public EstimatorAlgorithm {
     void finish_iteration(bool training) {
         // sigma_h for the next allocation; the stratified estimate and its variance.
         const double volume = 1.0 / static_cast<double>(cubes_);
-        NeumaierSum estimate, variance;
-        double satterthwaite = 0.0;
-        bool variances = true;
+        StratifiedSum strata;
         for (uint64_t h = 0; h < cubes_; ++h) {
             const RunningMoments& m = cube_moments_[h];
-            variances = variances && m.count() > 1;
-            const double s2 = m.count() > 1 ? m.variance() : 0.0;
-            sigma_[h] = std::sqrt(s2);
-            estimate.add(volume * m.mean());
-            const double a = volume * volume * s2 / static_cast<double>(m.count());
-            variance.add(a);
-            if (m.count() > 1) satterthwaite += a * a / static_cast<double>(m.count() - 1);
+            sigma_[h] = std::sqrt(m.variance());
+            strata.add(volume, m);
         }
         planned_ = false;
         if (training) {
@@ -224,15 +201,10 @@ class VegasPlusEstimator final : public EstimatorAlgorithm {
         const double scale =
             problem_.quantity == Quantity::Mean ? 1.0 / problem_.domain.measure() : 1.0;
         final_result_ = accumulator_.finish(scale);
-        final_result_.estimate = scale * estimate.value();
-        final_result_.std_error = variances ? scale * std::sqrt(std::max(0.0, variance.value()))
-                                            : std::numeric_limits<double>::quiet_NaN();
-        // Satterthwaite's degrees of freedom of a sum of variance estimates.
-        const double v = variance.value();
-        final_result_.dof =
-            satterthwaite > 0.0
-                ? static_cast<int>(std::min(1e6, std::max(1.0, v * v / satterthwaite)))
-                : static_cast<int>(std::min<uint64_t>(1000000, points_ - cubes_));
+        final_result_.estimate = scale * strata.estimate();
+        final_result_.std_error = strata.has_variance() ? scale * std::sqrt(strata.variance())
+                                                        : std::numeric_limits<double>::quiet_NaN();
+        final_result_.dof = strata.dof();
         finished_final_ = true;
     }
 

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstring>
 
+#include "core/mis.h"
+
 namespace mcp {
 
 namespace {
@@ -28,17 +30,12 @@ bool is_black(const Vec3& c) {
 }
 
 /// The multiple importance sampling weight of a sample drawn with density p_this when the
-/// other strategy would have drawn it with density p_other, one sample each: the balance
-/// heuristic p / (p + q), or the power heuristic p^2 / (p^2 + q^2) [Veach97, 9.2.2, 9.2.4].
+/// other strategy would have drawn it with density p_other, one sample each: the balance or
+/// the power (beta = 2) heuristic [Veach97, 9.2.2, 9.2.4] of the shared weight module.
 double mis_weight(double p_this, double p_other, bool power) {
-    if (!(p_this > 0.0)) return 0.0;
-    if (!(p_other > 0.0)) return 1.0;
-    if (power) {
-        // Divide first: p^2 overflows for the huge densities of tiny lights and near-mirrors.
-        double r = p_other / p_this;
-        return 1.0 / (1.0 + r * r);
-    }
-    return 1.0 / (1.0 + p_other / p_this);
+    static constexpr MisWeighting kBalance{MisHeuristic::Balance};
+    static constexpr MisWeighting kPower{MisHeuristic::Power};
+    return mcp::mis_weight(power ? kPower : kBalance, p_this, p_other);
 }
 
 /// A shading point: position, geometric normal turned towards the arriving ray, shading
