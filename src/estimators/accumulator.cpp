@@ -134,6 +134,8 @@ void WeightAccumulator::add_block(uint64_t first, const double* f, const double*
     }
     case ErrorMethod::Iid:
     case ErrorMethod::IidConservative:
+    case ErrorMethod::PartsSum:
+    case ErrorMethod::Regression:
     case ErrorMethod::None: break;
     }
     last_w_ = w[count - 1];
@@ -188,6 +190,8 @@ RunResult WeightAccumulator::finish(double scale) const {
         break;
     case ErrorMethod::Iid:
     case ErrorMethod::IidConservative:
+    case ErrorMethod::PartsSum:   // the estimator replaces this by its parts' sum
+    case ErrorMethod::Regression: // and this by its residuals'
         if (n > 1) {
             variance_of_mean = moments_.variance() / nd;
             result.dof = interval_dof(n - 1);

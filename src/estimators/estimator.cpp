@@ -28,6 +28,8 @@ const char* error_method_name(ErrorMethod m) {
     case ErrorMethod::IidConservative: return "iid_conservative";
     case ErrorMethod::Randomizations: return "randomizations";
     case ErrorMethod::None: return "none";
+    case ErrorMethod::PartsSum: return "parts_sum";
+    case ErrorMethod::Regression: return "regression";
     }
     return "?";
 }
@@ -37,6 +39,12 @@ double interval_quantile(int dof) {
 }
 
 ErrorMethod error_method_for(const EstimatorSpec& spec) {
+    if (spec.miser || (spec.vegas && spec.vegas_options.stratify) || spec.control_variates)
+        return ErrorMethod::PartsSum;
+    if (spec.mis) {
+        if (!spec.mis_options.one_sample) return ErrorMethod::PartsSum;
+        return spec.mis_options.optimal ? ErrorMethod::Regression : ErrorMethod::Iid;
+    }
     switch (spec.sampler) {
     case SamplerKind::Independent: return ErrorMethod::Iid;
     case SamplerKind::Stratified:

@@ -32,6 +32,11 @@ enum class ErrorMethod {
     Randomizations,  ///< spread of the K batch means of independent randomizations, t with K-1
                      ///< degrees of freedom [LEcuyerLemieux02]
     None,            ///< one deterministic point set: no error bar
+    /// A sum of independent parts (MISER's leaves, VEGAS+'s hypercubes, MIS techniques,
+    /// control-variate folds): the sum of their variances, Satterthwaite's dof [Satterthwaite46]
+    PartsSum,
+    /// One-sample optimal MIS: residuals of the samples' own regression, N - K dof
+    Regression,
 };
 const char* error_method_name(ErrorMethod m);
 ErrorMethod error_method_for(const EstimatorSpec& spec);
