@@ -196,6 +196,16 @@ int mcp_study_samples(const char* scene_json, const char* options_json, char** s
         if (!d.adaptive.edges.empty()) e["map_edges"] = d.adaptive.edges;
         if (!d.adaptive.box_lo.empty())
             e["boxes"] = {{"lo", d.adaptive.box_lo}, {"hi", d.adaptive.box_hi}};
+        // MIS: each technique's density and share, in the order of curve.mis_weights.
+        if (spec.mis) {
+            const mcp::MisOptions& m = spec.mis_options;
+            mcp::Json techniques = mcp::Json::array();
+            for (size_t k = 0; k < m.proposals.size(); ++k)
+                techniques.push_back(
+                    {{"pdf", m.proposals[k].describe()}, {"share", m.fractions[k]}});
+            e["techniques"] = techniques;
+            e["heuristic"] = m.optimal ? "optimal" : mcp::mis_heuristic_name(m.weighting.heuristic);
+        }
     }
     mcp::Json result{{"version", mcp::kResultSchemaVersion},
                      {"n", n},

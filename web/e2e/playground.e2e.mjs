@@ -215,6 +215,29 @@ test('adaptive estimators: a VEGAS and a MISER study, and their map and boxes in
   await page.screenshot({ path: join(shots, 'adaptive_vegas_corner_peak.png'), fullPage: true });
 });
 
+test('multiple importance sampling: a study of the heuristics and each technique\'s weight over x', async () => {
+  const settings = { nMin: 256, nMax: 4096, reps: 8, seed: 1 };
+  const estimators = ['mis_balance', 'mis_optimal'];
+  await configure('mis_peak_and_plateau_1d', estimators, settings);
+  await page.click('#run');
+  await page.waitForFunction(() => document.querySelector('#status')?.textContent.startsWith('done'), null,
+    { timeout: 60000 });
+  const fits = cliFits('mis_peak_and_plateau_1d', estimators, settings);
+  for (const name of estimators) {
+    assert.ok(fits[name].valid, `${name}: the CLI has no fit (${fits[name].note})`);
+    const text = await page.textContent(`[data-fit="${name}"]`);
+    const shown = Number(text.match(/-?\d+\.\d{3}/)?.[0]);
+    assert.equal(shown.toFixed(3), fits[name].order.toFixed(3), `${name}: page ${shown} vs CLI ${fits[name].order}`);
+  }
+  // The MIS weights: two techniques per estimator, drawn below the densities.
+  await page.waitForFunction(() => !document.querySelector('#misweights-block')?.hidden
+    && document.querySelectorAll('#legend-misweights li').length === 4, null, { timeout: 20000 });
+  const labels = await page.$$eval('#legend-misweights li', (lis) => lis.map((li) => li.textContent));
+  assert.ok(labels.some((t) => t.includes('truncated_gaussian')) && labels.some((t) => t.includes('uniform')),
+    `legend: ${labels.join(' | ')}`);
+  await page.screenshot({ path: join(shots, 'mis_peak_and_plateau_1d.png'), fullPage: true });
+});
+
 test('a malformed expression is reported inline at its position', async () => {
   await page.fill('#custom-f', 'sin(');
   await page.click('#custom-apply');

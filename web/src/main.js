@@ -51,6 +51,8 @@ initPlots({
   'legend-variance': $('legend-variance'), 'legend-time': $('legend-time'),
   'legend-calibration': $('legend-calibration'), 'legend-coverage': $('legend-coverage'),
   samples: $('plot-samples'), overlay: $('plot-overlay'), weights: $('plot-weights'),
+  misweights: $('plot-misweights'), misweightsBlock: $('misweights-block'),
+  'legend-misweights': $('legend-misweights'),
   'legend-overlay': $('legend-overlay'), 'legend-weights': $('legend-weights'),
   samplesNote: $('samples-note'), overlayNote: $('overlay-note'), weightsNote: $('weights-note'),
 });

@@ -5,7 +5,7 @@
 import uPlot from '../vendor/uPlot.esm.js';
 import {
   varianceSeries, anchorOf, referenceLines, timeSeries, calibrationSeries, coverageSeries,
-  decadeRange, fitText, fmt, curveOverlay, weightBins, weightHistogram, domainView, mapFor, mappedGrid,
+  decadeRange, fitText, fmt, curveOverlay, misWeightCurves, weightBins, weightHistogram, domainView, mapFor, mappedGrid,
 } from './series.js';
 import { colorAt, withAlpha } from './palette.js';
 import { el } from './dom.js';
@@ -201,7 +201,7 @@ export function initPlots(elements) {
         if (size.width !== c.u.width || size.height !== c.u.height) c.u.setSize(size);
       }
     });
-    for (const k of ['variance', 'time', 'calibration', 'coverage', 'overlay', 'weights']) if (dom[k]) ro.observe(dom[k]);
+    for (const k of ['variance', 'time', 'calibration', 'coverage', 'overlay', 'misweights', 'weights']) if (dom[k]) ro.observe(dom[k]);
   }
 }
 
@@ -528,6 +528,7 @@ function renderSampleViews(state) {
     renderScatter(state, smp.data);
   }
   renderOverlay(state, smp.data);
+  renderMisWeights(state, smp.data);
   renderWeights(state, smp.weights);
 }
 
@@ -805,6 +806,34 @@ function renderOverlay(state, data) {
       + (ov.areaFrom === 'exact' ? ' Here f is divided by its exact integral: the grid misses the mass of its singularity.' : '')
       + (ov.clipped ? ` The y axis is cut at ${fmt(ov.yRange[1], 3)}: a spike goes above it.` : '');
   }
+}
+
+const DASHES = [[], [8, 5], [2, 4], [10, 4, 2, 4]];
+
+function renderMisWeights(state, data) {
+  if (!dom.misweights) return;
+  const lines = data ? misWeightCurves(data, data.estimators.map((e) => e.name)) : [];
+  dom.misweightsBlock.hidden = !lines.length;
+  if (!lines.length) {
+    drop('misweights');
+    setLegend('misweights', dom['legend-misweights'], []);
+    return;
+  }
+  const x = data.curve.x;
+  const series = [{}, ...lines.map((l) => ({
+    label: `${l.name}: ${l.label}`, stroke: sceneColor(state, l.name), width: 1.75,
+    dash: DASHES[l.k % DASHES.length], points: { show: false },
+  }))];
+  draw('misweights', dom.misweights, JSON.stringify(['misweights', lines.map((l) => [l.name, l.k])]), (c) => ({
+    scales: { x: { time: false, range: () => c.xRange }, y: { range: () => [0, 1.02] } },
+    axes: [{ ...AXIS, label: 'x', space: 40 }, { ...AXIS, label: 'weight', size: 52 }],
+    series,
+    cursor: { drag: { x: false, y: false } },
+  }), [x, ...lines.map((l) => l.y)], { xRange: [x[0], x[x.length - 1]] });
+  setLegend('misweights', dom['legend-misweights'], lines.map((l) => ({
+    name: l.name, color: sceneColor(state, l.name), dashed: l.k > 0,
+    data: { misweights: l.name, technique: String(l.k) }, parts: [{ text: l.label, className: 'fit' }],
+  })));
 }
 
 function renderWeights(state, weights) {

@@ -511,6 +511,30 @@ export function curveOverlay(curve, order, { exact = null } = {}) {
 }
 
 /**
+ * The MIS weight curves of a samples answer: for each estimator in `order` that has
+ * curve.mis_weights, one line per technique k, w_k(x) on the curve's grid, labelled by the
+ * technique's density and share (from the estimator's "techniques"). `dash` numbers the
+ * technique within its estimator (0: solid).
+ */
+export function misWeightCurves(samples, order) {
+  const curve = samples && samples.curve;
+  if (!curve || !curve.mis_weights || !Array.isArray(curve.x)) return [];
+  const byName = Object.fromEntries((samples.estimators || []).map((e) => [e.name, e]));
+  const out = [];
+  for (const name of order) {
+    const rows = curve.mis_weights[name];
+    if (!Array.isArray(rows)) continue;
+    const techniques = (byName[name] && byName[name].techniques) || [];
+    rows.forEach((y, k) => {
+      const t = techniques[k];
+      const label = t ? `${t.pdf} (${fmt(t.share, 2)})` : `technique ${k + 1}`;
+      out.push({ name, k, label, y: y.map((v) => (Number.isFinite(v) ? v : null)) });
+    });
+  }
+  return out;
+}
+
+/**
  * Common log-spaced bins of |w| for the weight histograms of several estimators: edges are
  * powers of 10^(1/binsPerDecade) covering the largest |w| and at most maxDecades below it
  * (smaller non-zero |w| go to the first bin's "below" count).

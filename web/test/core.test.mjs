@@ -208,6 +208,27 @@ test('samples returns the points of the study\'s first replicate', async () => {
   assertMcplayError(() => core.samples(EXP_1D, { n: 100000 }), Status.ARGUMENT, /options\.n/);
 });
 
+test('samples of an MIS estimator: weights that average to its estimate, technique weights that sum to 1', async () => {
+  const core = await getCore();
+  const scene = {
+    name: 'mis', domain: { type: 'interval', lower: 0, upper: 1 }, f: '1 + x + exp(-50 * (x - 0.3)^2)',
+    estimators: [{ name: 'mis', proposals: [{ type: 'gaussian', mu: 0.3, sigma: 0.1 }, 'uniform'], heuristic: 'power' }],
+  };
+  const options = { reps: 2, n_min: 64, n_max: 64, seed: 3 };
+  const result = core.runStudy(scene, options);
+  const dump = core.samples(scene, { n: 64, grid: 32, seed: 3 });
+  const d = dump.estimators[0];
+  const mean = d.weight.reduce((a, b) => a + b, 0) / 64;
+  const estimate = result.estimators[0].levels[0].replicates.estimate[0];
+  assert.ok(Math.abs(mean - estimate) <= 1e-12 * Math.abs(estimate), `${mean} vs ${estimate}`);
+  assert.equal(d.heuristic, 'power');
+  assert.deepEqual(d.techniques.map((t) => t.share), [0.5, 0.5]);
+  const w = dump.curve.mis_weights.mis;
+  assert.equal(w.length, 2);
+  for (let i = 0; i < 32; i++) assert.ok(Math.abs(w[0][i] + w[1][i] - 1) < 1e-12);
+  assert.ok(w[0][Math.round(0.3 * 31)] > 0.5 && w[1][31] > 0.9, 'the peak pdf takes the peak, uniform the far end');
+});
+
 test('onLevel returning true cancels the study after that level', async () => {
   const core = await getCore();
   let calls = 0;

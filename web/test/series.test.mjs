@@ -312,7 +312,7 @@ test('fmt and decadeRange', () => {
 
 import {
   trapezoidAbs, normalizeCurve, curveOverlay, weightBins, weightHistogram, samplesSummary, domainView,
-  mapFor, DISK_MAPS,
+  mapFor, DISK_MAPS, misWeightCurves,
 } from '../src/series.js';
 
 test('normalizeCurve: f divided by the trapezoid integral of |f|', () => {
@@ -340,6 +340,19 @@ test('curveOverlay: pdfs in order, exact integral for a singular f >= 0, clipped
   assert.equal(s.clipped, true);
   assert.ok(s.yRange[1] < 1000 / 50);
   assert.equal(curveOverlay(null, []), null);
+});
+
+test('misWeightCurves: one line per technique of each MIS estimator, in order, labelled', () => {
+  const samples = {
+    curve: { x: [0, 1], mis_weights: { b: [[0.2, NaN], [0.8, 1]], a: [[1, 0]] } },
+    estimators: [{ name: 'a' }, { name: 'b', techniques: [{ pdf: 'gaussian', share: 0.25 }, { pdf: 'uniform', share: 0.75 }] }],
+  };
+  const lines = misWeightCurves(samples, ['a', 'b', 'c']);
+  assert.deepEqual(lines.map((l) => [l.name, l.k, l.label]),
+    [['a', 0, 'technique 1'], ['b', 0, 'gaussian (0.25)'], ['b', 1, 'uniform (0.75)']]);
+  assert.deepEqual(lines[1].y, [0.2, null]);
+  assert.deepEqual(misWeightCurves({ curve: { x: [0] } }, ['a']), []);
+  assert.deepEqual(misWeightCurves(null, ['a']), []);
 });
 
 test('weight histograms: log bins of |w|, zeros and non-finite apart, tail ratio', () => {
