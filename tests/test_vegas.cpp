@@ -253,6 +253,32 @@ TEST(VegasEstimator, TinyRunsFinish) {
         }
 }
 
+// The calls and time spent learning are reported (the time plot draws them): a quarter of N
+// trains vegas and vegas_plus, half of 2^16 trains vegas_sobol (its estimate takes K 2^m
+// points), MISER's probes are some of N, a fixed estimator learns nothing.
+TEST(VegasEstimator, TrainingCallsAndTimeAreReported) {
+    Made<SceneRequest> r = request(
+        gaussian_scene(0.1, R"(["vegas", "vegas_sobol", "vegas_plus", "miser", "uniform"])"));
+    ASSERT_TRUE(r.ok()) << r.error;
+    Workspace ws;
+    const uint64_t n = 65536;
+    const uint64_t expected[] = {n / 4, n / 2, n / 4};
+    for (size_t e = 0; e < r.value.estimators.size(); ++e) {
+        Pcg32 rng(8u, e);
+        const RunResult run = run_estimate(r.value.problem, r.value.estimators[e], n, rng, ws);
+        const std::string& name = r.value.estimators[e].name;
+        if (e < 3) EXPECT_EQ(run.training_n, expected[e]) << name;
+        if (name == "miser") {
+            EXPECT_GT(run.training_n, 0u);
+            EXPECT_LT(run.training_n, n);
+        }
+        if (name == "uniform") EXPECT_EQ(run.training_n, 0u);
+        EXPECT_GE(run.training_seconds, 0.0) << name;
+        EXPECT_LE(run.training_seconds, run.seconds) << name;
+        EXPECT_EQ(run.training_seconds > 0.0, run.training_n > 0) << name;
+    }
+}
+
 TEST(VegasOptions, BadValuesAreNamed) {
     struct Case {
         const char* options;

@@ -237,6 +237,10 @@ Json level_to_json(const LevelStats& l) {
            {"run_dof", l.run_dof},
            {"time_mean_s", num(l.time_mean)},
            {"time_total_s", num(l.time_total)},
+           // Adaptive estimators: the share of the calls and the seconds per estimate spent
+           // training or probing (in n and time_mean_s too; 0 for fixed estimators).
+           {"training_share", num(l.training_share)},
+           {"training_time_mean_s", num(l.training_time_mean)},
            {"efficiency", num(l.efficiency)},
            {"error", num(l.error)},
            {"diagnostics", diagnostics_to_json(l.diagnostics)},

@@ -69,6 +69,10 @@ struct AdaptiveView {
     std::vector<std::vector<double>> box_lo, box_hi; ///< MISER: the leaf boxes (the first 4096)
 };
 
+/// Seconds since an arbitrary start (steady clock): for timing an estimator's phases, once per
+/// phase or region, never per sample.
+double clock_seconds();
+
 /// A VEGAS map's edges, per axis, as a view.
 AdaptiveView view_of(const VegasMap& map);
 

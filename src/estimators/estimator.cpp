@@ -106,6 +106,11 @@ SampleBlock sample_block(const Problem& problem, const Proposal& proposal, const
     return block_of(ws, first, count);
 }
 
+double clock_seconds() {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch())
+        .count();
+}
+
 AdaptiveView view_of(const VegasMap& map) {
     AdaptiveView v;
     for (int j = 0; j < map.dim(); ++j)
@@ -207,6 +212,9 @@ class VegasEstimator final : public EstimatorAlgorithm {
         next_ = 0;
         plan_ready_ = false;
         prepared_ = false;
+        trained_n_ = 0;
+        training_start_ = clock_seconds();
+        training_seconds_ = 0.0;
         jacobian_.assign(kBlockSize, 1.0);
         bins_.assign(static_cast<size_t>(dim) * kBlockSize, 0);
     }
@@ -224,6 +232,7 @@ class VegasEstimator final : public EstimatorAlgorithm {
                 plan_ = make_sampler_plan(SamplerKind::Independent, dim, size, rng, {});
             } else {
                 if (final_ == 0 || round_ >= rounds_) return false;
+                if (round_ == 0) training_seconds_ = clock_seconds() - training_start_;
                 const uint64_t size = part_of(final_, rounds_, round_);
                 plan_ = make_sampler_plan(spec_.sampler, dim, size, rng, spec_.sampler_options());
                 accumulator_.reset(error_method_for(spec_), plan_, float32_);
@@ -243,6 +252,7 @@ class VegasEstimator final : public EstimatorAlgorithm {
             for (size_t i = 0; i < count; ++i) jacobian_[i] = ws.f[i] / ws.pdf[i]; // weights
             map_.add_training(bins_.data(), jacobian_.data(), count);
             next_ += count;
+            trained_n_ += count;
             if (next_ == plan_.total) {
                 map_.adapt(spec_.vegas_options.alpha, spec_.vegas_options.uniform_share);
                 ++iteration_;
@@ -267,6 +277,8 @@ class VegasEstimator final : public EstimatorAlgorithm {
     RunResult result() const override {
         RunResult r = rounds_done_.size() == 1 ? rounds_done_[0] : average(rounds_done_);
         r.n = total_;
+        r.training_n = trained_n_;
+        r.training_seconds = training_seconds_;
         return r;
     }
 
@@ -329,7 +341,8 @@ class VegasEstimator final : public EstimatorAlgorithm {
     const Problem& problem_;
     const EstimatorSpec& spec_;
     bool float32_;
-    uint64_t total_ = 0, train_ = 0, final_ = 0, next_ = 0;
+    uint64_t total_ = 0, train_ = 0, final_ = 0, next_ = 0, trained_n_ = 0;
+    double training_start_ = 0.0, training_seconds_ = 0.0;
     int iterations_ = 0, iteration_ = 0; // training iterations
     int rounds_ = 1, round_ = 0;         // estimation iterations (1 unless averaging)
     std::vector<RunResult> rounds_done_;

@@ -61,6 +61,10 @@ struct RunResult {
     /// freedom (0: not such an estimator).
     double iteration_chi2 = 0.0;
     int iteration_dof = 0;
+    /// Adaptive estimators: the integrand calls and the time spent learning rather than
+    /// estimating (VEGAS's training iterations, MISER's probes); they count in n and seconds.
+    uint64_t training_n = 0;
+    double training_seconds = 0.0;
 };
 
 /// The 97.5% quantile behind a run's 95% interval: Student t with dof degrees of freedom

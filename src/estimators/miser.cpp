@@ -49,6 +49,8 @@ class MiserEstimator final : public EstimatorAlgorithm {
         accumulator_.reset(ErrorMethod::Iid, plan_, float32_);
         strata_ = StratifiedSum();
         accumulated_ = 0;
+        probed_n_ = 0;
+        probe_seconds_ = 0.0;
         // Depth first: a region is probed and cut, or sampled as a leaf, before the next.
         region(std::vector<double>(static_cast<size_t>(dim_), 0.0),
                std::vector<double>(static_cast<size_t>(dim_), 1.0), total_, 0);
@@ -66,6 +68,8 @@ class MiserEstimator final : public EstimatorAlgorithm {
     RunResult result() const override {
         RunResult r = result_;
         r.n = total_;
+        r.training_n = probed_n_;
+        r.training_seconds = probe_seconds_;
         return r;
     }
 
@@ -157,6 +161,7 @@ class MiserEstimator final : public EstimatorAlgorithm {
         // the first weight against cancellation).
         std::vector<RunningMoments> below(static_cast<size_t>(dim_)),
             above(static_cast<size_t>(dim_));
+        const double probe_start = clock_seconds();
         sample_box(lo, hi, probes, [&](const SampleBlock& b, const double* w) {
             for (int j = 0; j < dim_; ++j) {
                 const double* u = b.u->coord(j);
@@ -164,6 +169,8 @@ class MiserEstimator final : public EstimatorAlgorithm {
                     (u[i] < mid[j] ? below[j] : above[j]).add(w[i]);
             }
         });
+        probe_seconds_ += clock_seconds() - probe_start;
+        probed_n_ += probes;
         const double power = 2.0 / (1.0 + o.alpha);
         int axis = -1;
         double best = std::numeric_limits<double>::infinity(), share_below = 0.5;
@@ -206,7 +213,8 @@ class MiserEstimator final : public EstimatorAlgorithm {
     AdaptiveView view_; // the leaves, when observed
     size_t record_limit_ = 0;
     StratifiedSum strata_;
-    uint64_t accumulated_ = 0;
+    uint64_t accumulated_ = 0, probed_n_ = 0;
+    double probe_seconds_ = 0.0;
     SamplerPlan plan_; // outlives the accumulator's use of it
     WeightAccumulator accumulator_;
     RunResult result_;

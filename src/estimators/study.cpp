@@ -431,7 +431,8 @@ LevelStats summarise_level(const std::vector<RunResult>& runs, const Problem& pr
     s.run_dof = runs[0].dof;
     const double run_quantile = interval_quantile(s.run_dof);
     RunningMoments est, se;
-    NeumaierSum sq_err, time;
+    NeumaierSum sq_err, time, training_time;
+    double training_share = 0.0;
     int covered = 0, se_count = 0;
     s.has_exact = problem.exact.has_value();
     const double exact = s.has_exact ? *problem.exact : 0.0;
@@ -456,6 +457,9 @@ LevelStats summarise_level(const std::vector<RunResult>& runs, const Problem& pr
         nonzero += static_cast<double>(r.diagnostics.nonzero);
         est.add(r.estimate);
         time.add(r.seconds);
+        training_time.add(r.training_seconds);
+        training_share += r.n > 0 ? static_cast<double>(r.training_n) / static_cast<double>(r.n)
+                                  : 0.0;
         s.diagnostics.merge(r.diagnostics);
         s.estimates.push_back(r.estimate);
         s.run_std_errors.push_back(r.std_error);
@@ -493,6 +497,8 @@ LevelStats summarise_level(const std::vector<RunResult>& runs, const Problem& pr
     s.mean_run_se = se_count ? se.mean() : std::numeric_limits<double>::quiet_NaN();
     s.time_total = time.value();
     s.time_mean = s.time_total / R;
+    s.training_time_mean = training_time.value() / R;
+    s.training_share = training_share / R;
     s.efficiency = s.variance > 0.0 && s.time_mean > 0.0 ? 1.0 / (s.variance * s.time_mean)
                                                          : std::numeric_limits<double>::infinity();
     if (s.has_exact) {

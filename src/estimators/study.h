@@ -80,6 +80,10 @@ struct LevelStats {
     int run_dof = 0;          ///< degrees of freedom of the runs' error bars (RunResult::dof)
     double time_mean = 0.0;   ///< seconds per estimate
     double time_total = 0.0;
+    /// Adaptive estimators: mean share of the calls and mean seconds per estimate spent
+    /// training (VEGAS) or probing (MISER), included in n and time_mean.
+    double training_share = 0.0;
+    double training_time_mean = 0.0;
     double efficiency = 0.0;      ///< 1 / (variance * time_mean)
     double error = 0.0;           ///< rmse when exact is known, else sqrt(variance)
     RunDiagnostics diagnostics;   ///< summed over replicates

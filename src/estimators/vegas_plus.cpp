@@ -57,6 +57,9 @@ class VegasPlusEstimator final : public EstimatorAlgorithm {
         planned_ = false;
         prepared_ = false;
         finished_final_ = false;
+        trained_n_ = 0;
+        training_start_ = clock_seconds();
+        training_seconds_ = 0.0;
         jacobian_.assign(kBlockSize, 1.0);
         importance_.assign(kBlockSize, 1.0);
         weight_.assign(kBlockSize, 0.0);
@@ -72,6 +75,7 @@ class VegasPlusEstimator final : public EstimatorAlgorithm {
         const bool training = iteration_ < iterations_;
         if (!planned_) {
             if (!training && finished_final_) return false;
+            if (!training) training_seconds_ = clock_seconds() - training_start_;
             start_iteration(training ? part_of(train_, iterations_, iteration_) : final_, rng,
                             training);
         }
@@ -112,6 +116,7 @@ class VegasPlusEstimator final : public EstimatorAlgorithm {
         }
         if (training) {
             map_.add_training(bins_.data(), weight_.data(), importance_.data(), count);
+            trained_n_ += count;
         } else {
             // The accumulator sees the weights scaled by V N / n_h (its plain mean is then the
             // stratified estimate), for its diagnostics: non-finite and zero-pdf counts, the
@@ -129,6 +134,8 @@ class VegasPlusEstimator final : public EstimatorAlgorithm {
     RunResult result() const override {
         RunResult r = final_result_;
         r.n = total_;
+        r.training_n = trained_n_;
+        r.training_seconds = training_seconds_;
         return r;
     }
 
@@ -216,6 +223,8 @@ class VegasPlusEstimator final : public EstimatorAlgorithm {
     uint64_t per_axis_ = 1, cubes_ = 1, cube_ = 0, left_in_cube_ = 0;
     int iterations_ = 0, iteration_ = 0;
     bool planned_ = false, prepared_ = false, finished_final_ = false;
+    uint64_t trained_n_ = 0;
+    double training_start_ = 0.0, training_seconds_ = 0.0;
     VegasMap map_;
     Pcg32 jitter_;
     std::vector<uint64_t> digits_, allocation_;

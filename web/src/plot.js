@@ -351,9 +351,10 @@ function pathsInOrder(getPaths) {
     ctx.beginPath();
     ctx.rect(u.bbox.left, u.bbox.top, u.bbox.width, u.bbox.height);
     ctx.clip();
-    for (const { color, points } of getPaths()) {
+    for (const { color, points, dash = null } of getPaths()) {
       ctx.strokeStyle = color;
-      ctx.lineWidth = 2 * px;
+      ctx.lineWidth = (dash ? 1.5 : 2) * px;
+      ctx.setLineDash(dash ? dash.map((v) => v * px) : []);
       ctx.beginPath();
       points.forEach(([x, y], i) => {
         const cx = u.valToPos(x, 'x', true);
@@ -376,10 +377,15 @@ function renderTime(state, run, records) {
     return { label: s.name, stroke: color, width: 2, paths: noLine, points: { show: true, size: 7, fill: color } };
   })];
   const lines = ts.series.map((s) => ({ color: colorOf(run, s.name), points: s.points.map(([t, e]) => [t, lg(e)]) }));
+  // Adaptive estimators: dashed, the error at the time spent estimating only; the gap to the
+  // solid line is what training (VEGAS) or probing (MISER) cost.
+  for (const s of ts.series) {
+    if (s.estimating.length) lines.push({ color: colorOf(run, s.name), dash: [6, 4], points: s.estimating.map(([t, e]) => [t, lg(e)]) });
+  }
   const render = isRender(run);
   const names = runLabels(run);
   const known = render || (run.exact !== null && run.exact !== undefined);
-  const xRange = decadeRange(ts.x, [1e-6, 1]);
+  const xRange = decadeRange([...ts.x, ...ts.series.flatMap((s) => s.estimating.map(([t]) => t))], [1e-6, 1]);
   const yRange = log10Range(ts.series.flatMap((s) => s.y));
   const yLabel = render ? names.rootAxis || names.error : known ? 'RMSE (error against the exact value)' : 'error = sqrt(variance)';
   const sig = JSON.stringify([run.order, run.colors, known, yLabel, names.timeAxis]);
@@ -403,7 +409,8 @@ function renderTime(state, run, records) {
   setLegend('time', dom['legend-time'], ts.series.map((s) => ({
     name: s.name,
     color: colorOf(run, s.name),
-    parts: [s.slope === null ? '' : { text: `error ∝ t^${s.slope.toFixed(2)}`, className: 'fit' }],
+    parts: [s.slope === null ? '' : { text: `error ∝ t^${s.slope.toFixed(2)}`, className: 'fit' },
+      s.trainingShare === null ? '' : { text: `training: ${Math.round(100 * s.trainingShare)}% of the time (dashed: without it)`, className: 'fit' }],
   })));
 }
 

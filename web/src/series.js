@@ -201,7 +201,9 @@ export function fitSlope(xs, ys) {
  * RMSE when the exact value is known, else sqrt(variance)), on the sorted union of all times
  * (uPlot's aligned data; null where a series has no point), the points in the order of N
  * (`points`: [time, error] pairs, for joining them), and the least-squares slope of log error on
- * log time.
+ * log time. Adaptive estimators also get `estimating` (the [time minus training time, error]
+ * pairs) and `trainingShare` (the mean share of the time spent training or probing; null for
+ * the others).
  */
 export function timeSeries(records, order) {
   const named = order.filter((n) => records[n]);
@@ -214,7 +216,14 @@ export function timeSeries(records, order) {
     const y = new Array(x.length).fill(null);
     for (const [t, e] of pts[k]) y[index.get(t)] = e;
     const fit = fitSlope(pts[k].map((p) => p[0]), pts[k].map((p) => p[1]));
-    return { name, y, points: pts[k], slope: fit ? fit.slope : null };
+    // Adaptive estimators: the same errors at the time spent estimating only (training or
+    // probing left out), and the mean share of the time that training took.
+    const levels = records[name].levels.filter((l) => positive(l.time_mean_s) !== null && positive(l.error) !== null);
+    const trained = levels.filter((l) => l.training_time_mean_s > 0 && l.training_time_mean_s < l.time_mean_s);
+    const estimating = trained.map((l) => [l.time_mean_s - l.training_time_mean_s, l.error]);
+    const trainingShare = trained.length
+      ? trained.reduce((a, l) => a + l.training_time_mean_s / l.time_mean_s, 0) / trained.length : null;
+    return { name, y, points: pts[k], slope: fit ? fit.slope : null, estimating, trainingShare };
   });
   return { x, series };
 }

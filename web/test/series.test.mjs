@@ -130,6 +130,15 @@ test('error against time: aligned on the union of times, points kept in the orde
   const c = record('c', [16, 32, 64, 128]);
   c.levels.forEach((l) => { l.time_mean_s = l.n * 1e-7; l.error = 3 / Math.sqrt(l.n); });
   assert.ok(Math.abs(timeSeries({ c }, ['c']).series[0].slope + 0.5) < 1e-12);
+  assert.equal(ts.series[0].trainingShare, null);
+  assert.deepEqual(ts.series[0].estimating, []);
+  // An adaptive estimator: the estimation-only times, and the mean share of the training.
+  const v = record('v', [16, 32]);
+  v.levels.forEach((l) => { l.time_mean_s = 4e-6; l.training_time_mean_s = 1e-6; });
+  v.levels[1].training_time_mean_s = 3e-6;
+  const tv = timeSeries({ v }, ['v']).series[0];
+  assert.deepEqual(tv.estimating.map(([t]) => t), [4e-6 - 1e-6, 4e-6 - 3e-6]);
+  assert.ok(Math.abs(tv.trainingShare - 0.5) < 1e-12);
 });
 
 test('z-scores against the exact value, or each level\'s mean when it is unknown', () => {
