@@ -237,6 +237,43 @@ TEST(VegasEstimator, SampleDumpShowsTheEstimatePointsAndTheMap) {
     for (double w : d.weight) EXPECT_TRUE(std::isfinite(w));
 }
 
+// The map's history for the animation: asked to show 256 points of a run of 2^16 calls, the
+// dump holds 256 estimate points and the map before training and after each of its 10
+// training iterations, on 2 axes, thinned to at most 65 edges; the first snapshot is the
+// identity, the last is the frozen map's edges thinned, and the peak at 0.3 draws edges in.
+TEST(VegasEstimator, SampleDumpKeepsTheMapOfEveryTrainingIteration) {
+    Made<SceneRequest> r = request(gaussian_scene(0.05, R"(["vegas", "vegas_plus"])"));
+    ASSERT_TRUE(r.ok()) << r.error;
+    for (const EstimatorSpec& spec : r.value.estimators) {
+        const SampleDump d = dump_samples(r.value.problem, spec, 256, 1, 65536);
+        EXPECT_EQ(d.weight.size(), 256u) << spec.name;
+        const auto& h = d.adaptive.history;
+        ASSERT_EQ(h.size(), 11u) << spec.name;
+        for (const auto& snapshot : h) {
+            ASSERT_EQ(snapshot.size(), 2u);
+            for (const std::vector<double>& e : snapshot) {
+                ASSERT_GE(e.size(), 3u);
+                EXPECT_LE(e.size(), 65u);
+                EXPECT_EQ(e.front(), 0.0);
+                EXPECT_EQ(e.back(), 1.0);
+            }
+        }
+        const size_t m = h[0][0].size() - 1;
+        for (size_t i = 0; i <= m; ++i) EXPECT_NEAR(h[0][0][i], double(i) / m, 1e-12);
+        const std::vector<double>& frozen = d.adaptive.edges[0];
+        const size_t step = (frozen.size() - 1) / m;
+        for (size_t i = 0; i <= m; ++i) EXPECT_EQ(h.back()[0][i], frozen[i * step]);
+        // Share of the thinned edges within 0.1 of the peak (0.3 on axis 0): 0.2 for the
+        // identity, far more once trained.
+        auto near_peak = [](const std::vector<double>& e) {
+            int c = 0;
+            for (double v : e) c += std::fabs(v - 0.3) < 0.1;
+            return static_cast<double>(c) / e.size();
+        };
+        EXPECT_GT(near_peak(h.back()[0]), 0.5) << spec.name;
+    }
+}
+
 // Runs of 1 to 40 calls (the sample view asks for as few as 1): every preset finishes, reports
 // its n, and estimates; vegas_sobol's net rounding never asks for more points than n.
 TEST(VegasEstimator, TinyRunsFinish) {

@@ -141,16 +141,24 @@ int mcp_study_samples(const char* scene_json, const char* options_json, char** s
         options = o.value;
     }
     if (!options.is_object()) return fail(MCP_ERROR_ARGUMENT, "options: expected an object");
-    // "n" and "grid" belong to this call; the rest selects estimators and the seed.
-    uint64_t n = 256, grid = 256;
-    for (auto [key, target] : {std::pair<const char*, uint64_t*>{"n", &n}, {"grid", &grid}}) {
-        auto it = options.find(key);
+    // "n", "grid" and "adaptive_n" belong to this call; the rest selects estimators and the
+    // seed. Adaptive estimators run at N = adaptive_n (up to 2^20) and show n of its points.
+    uint64_t n = 256, grid = 256, adaptive_n = 0;
+    struct Bounded {
+        const char* key;
+        uint64_t* target;
+        int64_t most;
+        const char* text;
+    };
+    for (const Bounded& b : {Bounded{"n", &n, 4096, "1..4096"}, Bounded{"grid", &grid, 4096, "1..4096"},
+                             Bounded{"adaptive_n", &adaptive_n, int64_t(1) << 20, "1..1048576"}}) {
+        auto it = options.find(b.key);
         if (it == options.end()) continue;
-        if (!it->is_number_integer() || it->get<int64_t>() < 1 || it->get<int64_t>() > 4096)
+        if (!it->is_number_integer() || it->get<int64_t>() < 1 || it->get<int64_t>() > b.most)
             return fail(MCP_ERROR_ARGUMENT,
-                        std::string("options.") + key + ": expected a whole number in 1..4096");
-        *target = static_cast<uint64_t>(it->get<int64_t>());
-        options.erase(key);
+                        std::string("options.") + b.key + ": expected a whole number in " + b.text);
+        *b.target = static_cast<uint64_t>(it->get<int64_t>());
+        options.erase(b.key);
     }
     mcp::Made<mcp::SceneRequest> req = mcp::build_request(scene.value, options);
     if (!req.ok()) return mcp::boundary::request_error(req.error);
@@ -158,7 +166,8 @@ int mcp_study_samples(const char* scene_json, const char* options_json, char** s
     const mcp::Domain& domain = problem.domain;
     mcp::Json estimators = mcp::Json::array();
     for (const mcp::EstimatorSpec& spec : req.value.estimators) {
-        mcp::SampleDump d = mcp::dump_samples(problem, spec, n, req.value.settings.seed);
+        mcp::SampleDump d =
+            mcp::dump_samples(problem, spec, n, req.value.settings.seed, adaptive_n);
         auto axes = [&](const std::vector<double>& flat, int dim) {
             mcp::Json out = mcp::Json::array();
             for (int j = 0; j < dim; ++j) {
@@ -194,6 +203,8 @@ int mcp_study_samples(const char* scene_json, const char* options_json, char** s
         // unit cube) and MISER's leaf boxes (lo and hi corners).
         mcp::Json& e = estimators.back();
         if (!d.adaptive.edges.empty()) e["map_edges"] = d.adaptive.edges;
+        if (!d.adaptive.history.empty()) e["map_history"] = d.adaptive.history;
+        if (spec.vegas || spec.miser) e["run_n"] = std::max(n, adaptive_n);
         if (!d.adaptive.box_lo.empty())
             e["boxes"] = {{"lo", d.adaptive.box_lo}, {"hi", d.adaptive.box_hi}};
         // MIS: each technique's density and share, in the order of curve.mis_weights.

@@ -47,11 +47,16 @@ int mcp_study_plan(const char* scene_json, const char* options_json, char** plan
 
 /* The points behind a small run of each estimator, for plotting them: options_json may give
  * {"estimators": [names], "n": points (1..4096, default 256), "seed", "grid": 1D curve points
- * (default 256)}. Result: {"version", "n", "estimators": [{"name", "sampler", "pdf", "strata",
- * "samples_per_stratum", "randomization", "randomizations", "u": [per axis], "x": [per axis], "f",
- * "density", "weight"}], and for 1D box domains "curve": {"x", "f", "pdf": {name: density
- * values}}}. The points are those of replicate 0 of a study at N = n, so the mean of "weight" is
- * that replicate's estimate. */
+ * (default 256), "adaptive_n": calls of the adaptive estimators' run (1..2^20)}. Result:
+ * {"version", "n", "estimators": [{"name", "sampler", "pdf", "strata", "samples_per_stratum",
+ * "randomization", "randomizations", "u": [per axis], "x": [per axis], "f", "density", "weight"}],
+ * and for 1D box domains "curve": {"x", "f", "pdf": {name: density values}, "mis_weights":
+ * {name: [per technique: weights]}}}. The points are those of replicate 0 of a study at N = n,
+ * so the mean of "weight" is that replicate's estimate. Adaptive estimators (VEGAS, MISER) run
+ * at N = max(n, adaptive_n) ("run_n") and show the first n points of their estimate, with what
+ * they learnt: "map_edges" (VEGAS's frozen map, per axis), "map_history" (the map's first two
+ * axes before and after each training iteration, at most 65 edges each), "boxes" (MISER's
+ * leaves). MIS estimators add "heuristic" and "techniques": [{"pdf", "share"}]. */
 int mcp_study_samples(const char* scene_json, const char* options_json, char** samples_json);
 
 /* Formats a study result as "table" (human), "csv" or "json" (pretty-printed). The result must

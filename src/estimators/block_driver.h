@@ -66,6 +66,10 @@ void for_each_block(const Problem& problem, const Proposal& proposal, const Samp
 /// What an adaptive estimator learnt in its last run, for looking at it (the sample view).
 struct AdaptiveView {
     std::vector<std::vector<double>> edges; ///< VEGAS: per axis, the frozen map's increment edges
+    /// VEGAS: the map before training and after each training iteration (at most
+    /// kViewIterations snapshots, evenly picked), each the first two axes' edges thinned to at
+    /// most kViewEdges + 1 (every k-th, both ends kept): for watching the map learn.
+    std::vector<std::vector<std::vector<double>>> history;
     std::vector<std::vector<double>> box_lo, box_hi; ///< MISER: the leaf boxes (the first 4096)
 };
 
@@ -75,6 +79,14 @@ double clock_seconds();
 
 /// A VEGAS map's edges, per axis, as a view.
 AdaptiveView view_of(const VegasMap& map);
+
+constexpr int kViewIterations = 100;
+constexpr int kViewEdges = 64;
+
+/// Appends the map as a history snapshot (the first two axes, thinned; see AdaptiveView) when
+/// snapshot `iteration` of `iterations` + 1 is among the kept ones.
+void record_history(const VegasMap& map, int iteration, int iterations,
+                    std::vector<std::vector<std::vector<double>>>* history);
 
 class EstimatorAlgorithm {
   public:

@@ -118,6 +118,23 @@ AdaptiveView view_of(const VegasMap& map) {
     return v;
 }
 
+void record_history(const VegasMap& map, int iteration, int iterations,
+                    std::vector<std::vector<std::vector<double>>>* history) {
+    // Snapshots 0 .. iterations; keep about kViewIterations of them, evenly, and the last.
+    const int stride = std::max(1, (iterations + kViewIterations - 1) / kViewIterations);
+    if (iteration % stride != 0 && iteration != iterations) return;
+    const int k = map.increments();
+    const int step = std::max(1, (k + kViewEdges - 1) / kViewEdges);
+    std::vector<std::vector<double>> axes;
+    for (int j = 0; j < std::min(map.dim(), 2); ++j) {
+        std::vector<double> e;
+        for (int i = 0; i <= k; i += step) e.push_back(map.edges(j)[i]);
+        if ((k % step) != 0) e.push_back(map.edges(j)[k]);
+        axes.push_back(e);
+    }
+    history->push_back(axes);
+}
+
 namespace {
 
 // A fixed estimator: N points from one sampler, warped by one proposal, weighted f/p and summed
@@ -215,6 +232,8 @@ class VegasEstimator final : public EstimatorAlgorithm {
         trained_n_ = 0;
         training_start_ = clock_seconds();
         training_seconds_ = 0.0;
+        history_.clear();
+        if (observer_) record_history(map_, 0, iterations_, &history_);
         jacobian_.assign(kBlockSize, 1.0);
         bins_.assign(static_cast<size_t>(dim) * kBlockSize, 0);
     }
@@ -256,6 +275,7 @@ class VegasEstimator final : public EstimatorAlgorithm {
             if (next_ == plan_.total) {
                 map_.adapt(spec_.vegas_options.alpha, spec_.vegas_options.uniform_share);
                 ++iteration_;
+                if (observer_) record_history(map_, iteration_, iterations_, &history_);
                 plan_ready_ = false;
             }
             return true;
@@ -282,7 +302,11 @@ class VegasEstimator final : public EstimatorAlgorithm {
         return r;
     }
 
-    AdaptiveView adaptive_view() const override { return view_of(map_); }
+    AdaptiveView adaptive_view() const override {
+        AdaptiveView v = view_of(map_);
+        v.history = history_;
+        return v;
+    }
 
   private:
     RunResult finish_round() const {
@@ -346,6 +370,7 @@ class VegasEstimator final : public EstimatorAlgorithm {
     int iterations_ = 0, iteration_ = 0; // training iterations
     int rounds_ = 1, round_ = 0;         // estimation iterations (1 unless averaging)
     std::vector<RunResult> rounds_done_;
+    std::vector<std::vector<std::vector<double>>> history_;
     bool plan_ready_ = false, prepared_ = false;
     VegasMap map_;
     SamplerPlan plan_;

@@ -709,8 +709,10 @@ StudyResult run_study(const Problem& problem, const std::vector<EstimatorSpec>& 
 namespace mcp {
 
 SampleDump dump_samples(const Problem& problem, const EstimatorSpec& spec, uint64_t n,
-                        uint64_t seed) {
+                        uint64_t seed, uint64_t adaptive_n) {
     SampleDump dump;
+    const uint64_t shown = n;
+    if (spec.vegas || spec.miser) n = std::max(n, adaptive_n);
     const Domain& d = problem.domain;
     dump.sample_dim = d.sample_dim();
     dump.point_dim = d.point_dim();
@@ -728,7 +730,7 @@ SampleDump dump_samples(const Problem& problem, const EstimatorSpec& spec, uint6
     std::unique_ptr<EstimatorAlgorithm> estimator =
         make_estimator(problem, spec, Accumulator::Compensated);
     estimator->observe([&](const SampleBlock& blk) {
-        for (size_t i = 0; i < blk.count; ++i) {
+        for (size_t i = 0; i < blk.count && dump.f.size() < shown; ++i) {
             for (int j = 0; j < dump.sample_dim; ++j) dump.u.push_back(blk.u->coord(j)[i]);
             for (int j = 0; j < dump.point_dim; ++j) dump.x.push_back(blk.x->coord(j)[i]);
             const double p = blk.pdf[i], f = blk.f[i];

@@ -289,8 +289,10 @@ struct SampleDump {
 /// Runs replicate 0's estimate at N = n (the points are those of the study's first replicate
 /// at that N) and records the points the estimate is made from: all n for fixed estimators,
 /// the estimation share for VEGAS (not its training points), the leaves' points for MISER
-/// (not its probes).
+/// (not its probes). Adaptive estimators (VEGAS, MISER) run at N = max(n, adaptive_n) instead,
+/// so that they learn what a real run learns, and the first n of their estimate's points are
+/// recorded.
 SampleDump dump_samples(const Problem& problem, const EstimatorSpec& spec, uint64_t n,
-                        uint64_t seed);
+                        uint64_t seed, uint64_t adaptive_n = 0);
 
 } // namespace mcp

@@ -60,6 +60,8 @@ class VegasPlusEstimator final : public EstimatorAlgorithm {
         trained_n_ = 0;
         training_start_ = clock_seconds();
         training_seconds_ = 0.0;
+        history_.clear();
+        if (observer_) record_history(map_, 0, iterations_, &history_);
         jacobian_.assign(kBlockSize, 1.0);
         importance_.assign(kBlockSize, 1.0);
         weight_.assign(kBlockSize, 0.0);
@@ -129,7 +131,11 @@ class VegasPlusEstimator final : public EstimatorAlgorithm {
         return true;
     }
 
-    AdaptiveView adaptive_view() const override { return view_of(map_); }
+    AdaptiveView adaptive_view() const override {
+        AdaptiveView v = view_of(map_);
+        v.history = history_;
+        return v;
+    }
 
     RunResult result() const override {
         RunResult r = final_result_;
@@ -203,6 +209,7 @@ class VegasPlusEstimator final : public EstimatorAlgorithm {
         if (training) {
             map_.adapt(spec_.vegas_options.alpha, spec_.vegas_options.uniform_share);
             ++iteration_;
+            if (observer_) record_history(map_, iteration_, iterations_, &history_);
             return;
         }
         const double scale =
@@ -225,6 +232,7 @@ class VegasPlusEstimator final : public EstimatorAlgorithm {
     bool planned_ = false, prepared_ = false, finished_final_ = false;
     uint64_t trained_n_ = 0;
     double training_start_ = 0.0, training_seconds_ = 0.0;
+    std::vector<std::vector<std::vector<double>>> history_;
     VegasMap map_;
     Pcg32 jitter_;
     std::vector<uint64_t> digits_, allocation_;

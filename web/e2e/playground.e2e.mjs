@@ -212,6 +212,16 @@ test('adaptive estimators: a VEGAS and a MISER study, and their map and boxes in
   const byName = Object.fromEntries(summary.map((e) => [e.name, e]));
   assert.ok(byName.vegas.mapIncrements >= 2, `vegas map: ${JSON.stringify(byName.vegas)}`);
   assert.ok(byName.miser.boxes >= 1, `miser boxes: ${JSON.stringify(byName.miser)}`);
+  // They learnt from a run of 2^16 calls; VEGAS's map before training and after each of its
+  // 10 iterations is there to replay, with a slider.
+  assert.equal(byName.vegas.runN, 65536);
+  assert.equal(byName.vegas.mapHistory, 11);
+  const slider = page.locator('.sample-card[data-estimator="vegas"] input.map-iteration');
+  await slider.fill('0');
+  assert.match(await page.textContent('.sample-card[data-estimator="vegas"] .map-step'), /before training/);
+  await page.click('.sample-card[data-estimator="vegas"] button.replay');
+  await page.waitForFunction(() => /frozen/.test(document.querySelector('.sample-card[data-estimator="vegas"] .map-step')?.textContent ?? ''),
+    null, { timeout: 10000 });
   await page.screenshot({ path: join(shots, 'adaptive_vegas_corner_peak.png'), fullPage: true });
 });
 

@@ -150,6 +150,9 @@ store.subscribe((state, action) => {
 // at once when Run is pressed; the weight histograms get a second call with n = WEIGHT_SAMPLES.
 
 const SAMPLES_DEBOUNCE_MS = 250;
+// Adaptive estimators in the sample view learn from a run of this many calls (VEGAS's ten
+// training iterations then see a quarter of it), and show n of its estimate's points.
+const ADAPTIVE_RUN_N = 65536;
 let sceneSerial = 0;     // counts scenes loaded (a key of the samples)
 let samplesTimer = null;
 
@@ -175,7 +178,7 @@ function requestSamples() {
   dispatch({ type: 'samples/request', payload: { key: keys.key, weightsKey: wantWeights ? keys.weightsKey : null, points: wantPoints || s.samples.status === 'error' } });
   const fail = (key) => (e) => dispatch({ type: 'samples/failed', payload: { key, message: e && e.message ? e.message : String(e) } });
   if (wantPoints || s.samples.status === 'error') {
-    service.request(MSG.SAMPLES, { scene, options: { estimators, n: s.samples.n, seed } })
+    service.request(MSG.SAMPLES, { scene, options: { estimators, n: s.samples.n, seed, adaptive_n: ADAPTIVE_RUN_N } })
       .then(({ samples }) => dispatch({ type: 'samples/loaded', payload: { key: keys.key, samples } }))
       .catch(fail(keys.key));
   }

@@ -577,7 +577,11 @@ function panel(w, h, xr, yr) {
     ctx.rect(PAD.l, PAD.t, iw, ih);
     ctx.clip();
   };
-  return { c, ctx, X, Y, frame, clip, iw, ih };
+  const clear = () => {
+    ctx.fillStyle = '#fff';
+    ctx.fillRect(0, 0, w, h);
+  };
+  return { c, ctx, X, Y, frame, clip, clear, iw, ih };
 }
 
 function dots(ctx, xs, ys, X, Y, color, n) {
@@ -683,19 +687,24 @@ function renderScatter(state, data) {
     const n = e.u[0] ? e.u[0].length : 0;
     // u space: the sampler's unit square (1D: u against the point's index)
     const pu = panel(PANEL, PANEL, [0, 1], [0, 1]);
-    strataLines(pu, e.strata[0], 'x');
-    if (d >= 2) strataLines(pu, e.strata[1], 'y');
-    if (e.map_edges) {
-      mapLines(pu, e.map_edges[0], 'x');
-      if (d >= 2) mapLines(pu, e.map_edges[1], 'y');
-    }
-    if (e.boxes) boxOutlines(pu, e.boxes, d);
-    pu.frame();
-    pu.ctx.save();
-    pu.clip();
     const uy = d >= 2 ? e.u[1] : e.u[0].map((_, i) => (i + 0.5) / n);
-    dots(pu.ctx, e.u[0], uy, pu.X, pu.Y, color, n);
-    pu.ctx.restore();
+    const drawU = (edges) => {
+      pu.clear();
+      strataLines(pu, e.strata[0], 'x');
+      if (d >= 2) strataLines(pu, e.strata[1], 'y');
+      if (edges) {
+        mapLines(pu, edges[0], 'x');
+        if (d >= 2 && edges[1]) mapLines(pu, edges[1], 'y');
+      }
+      if (e.boxes) boxOutlines(pu, e.boxes, d);
+      pu.frame();
+      pu.ctx.save();
+      pu.clip();
+      dots(pu.ctx, e.u[0], uy, pu.X, pu.Y, color, n);
+      pu.ctx.restore();
+    };
+    drawU(e.map_edges);
+    const training = mapTraining(e, drawU);
     // x space: the domain (1D: f at the points, with the curve of f)
     let px;
     if (d === 1) {
@@ -769,16 +778,58 @@ function renderScatter(state, data) {
     return el('div', { className: 'sample-card', dataset: { estimator: e.name, points: String(n) } },
       el('h3', {}, swatch(color), e.name, el('span', { className: 'muted small' }, `${n} points`)),
       el('p', { className: 'facts' }, facts),
+      training,
       el('div', { className: 'pair' },
         el('div', {}, pu.c, el('p', { className: 'cap' }, d === 1 ? 'u (across) by point index (up)' : d > 2 ? 'u: first two axes' : 'u (unit square)')),
         el('div', {}, px.c, el('p', { className: 'cap' }, d === 1 ? 'x (across), f(x) (up); grey: f' : `x: ${view.labels.join(', ')}${view.note ? ` (${view.note})` : ''}${mapped[e.name] ? `; strata through the ${mapped[e.name]} map` : ''}`))));
   });
   dom.samples.replaceChildren(...cards);
+  const adaptive = data.estimators.find((e) => e.run_n > data.n);
   if (dom.samplesNote) {
     dom.samplesNote.textContent = `The first ${data.n} points of each selected estimator (replicate 0 of the study at N = ${data.n}, seed ${data.seed}):`
       + ' left in the unit square of its sampler (u) with its strata grid, right in the domain (x)'
-      + `${view.note ? `, ${view.note}` : ''}. A polar map squeezes the cells of u near r = 0; the concentric map keeps them even.`;
+      + `${view.note ? `, ${view.note}` : ''}. A polar map squeezes the cells of u near r = 0; the concentric map keeps them even.`
+      + (adaptive ? ` Adaptive estimators (VEGAS, MISER) learn from a run of N = ${adaptive.run_n} (replicate 0 at that N):`
+        + ` they show what it learnt and the first ${data.n} points of its estimate; the slider replays VEGAS's training.` : '');
   }
+}
+
+let trainingTimer = null;
+
+/**
+ * VEGAS's map through its training (e.map_history: the first two axes' edges before training
+ * and after each iteration): a slider over the snapshots and a replay button that steps through
+ * them. `drawU(edges)` redraws the unit-square panel; the last snapshot shows the frozen map.
+ */
+function mapTraining(e, drawU) {
+  const h = e.map_history;
+  if (!Array.isArray(h) || h.length < 2) return null;
+  const last = h.length - 1;
+  const label = el('span', { className: 'small muted map-step' });
+  const slider = el('input', { type: 'range', min: '0', max: String(last), value: String(last), className: 'map-iteration' });
+  slider.setAttribute('aria-label', `${e.name}: VEGAS map after training step`);
+  const show = (k) => {
+    slider.value = String(k);
+    label.textContent = k === 0 ? 'map before training' : k === last ? `map after training (${last} steps): frozen` : `map after training step ${k} of ${last}`;
+    drawU(k === last ? e.map_edges : h[k]);
+  };
+  slider.addEventListener('input', () => {
+    clearInterval(trainingTimer);
+    show(Number(slider.value));
+  });
+  const play = el('button', { type: 'button', className: 'replay', textContent: '▶ replay training' });
+  play.addEventListener('click', () => {
+    clearInterval(trainingTimer);
+    let k = 0;
+    show(k);
+    trainingTimer = setInterval(() => {
+      k += 1;
+      show(k);
+      if (k >= last) clearInterval(trainingTimer);
+    }, 350);
+  });
+  show(last);
+  return el('div', { className: 'map-training', dataset: { steps: String(last) } }, play, slider, label);
 }
 
 function renderOverlay(state, data) {

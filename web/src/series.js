@@ -622,6 +622,8 @@ export function samplesSummary(samples) {
       strata: (e.strata || []).slice(), samplesPerStratum: e.samples_per_stratum,
       mapIncrements: Array.isArray(e.map_edges) && e.map_edges.length ? e.map_edges[0].length - 1 : 0,
       boxes: e.boxes && Array.isArray(e.boxes.lo) ? e.boxes.lo.length : 0,
+      mapHistory: Array.isArray(e.map_history) ? e.map_history.length : 0,
+      runN: e.run_n || samples.n,
     })),
   };
 }

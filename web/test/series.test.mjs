@@ -385,12 +385,15 @@ test('weight histograms: log bins of |w|, zeros and non-finite apart, tail ratio
 test('samplesSummary and domainView', () => {
   const e = { name: 'a', sampler: 'stratified', strata: [2, 2], samples_per_stratum: 1, u: [[0.1, 0.9], [0.2, 0.7]], x: [[0.1, 0.9], [0.2, 0.7]] };
   const smp = { n: 2, seed: 3, domain: 'box', dimension: 2, estimators: [e] };
-  assert.deepEqual(samplesSummary(smp).estimators[0], { name: 'a', sampler: 'stratified', points: 2, strata: [2, 2], samplesPerStratum: 1, mapIncrements: 0, boxes: 0 });
+  assert.deepEqual(samplesSummary(smp).estimators[0], { name: 'a', sampler: 'stratified', points: 2, strata: [2, 2], samplesPerStratum: 1, mapIncrements: 0, boxes: 0, mapHistory: 0, runN: 2 });
   // adaptive estimators: VEGAS's map edges (K + 1 per axis) and MISER's leaf boxes
-  const vegas = { ...e, name: 'v', strata: [], map_edges: [[0, 0.2, 1], [0, 0.5, 1]] };
+  const vegas = { ...e, name: 'v', strata: [], map_edges: [[0, 0.2, 1], [0, 0.5, 1]], run_n: 64,
+    map_history: [[[0, 0.5, 1], [0, 0.5, 1]], [[0, 0.2, 1], [0, 0.5, 1]]] };
   const miser = { ...e, name: 'm', strata: [], boxes: { lo: [[0, 0], [0.5, 0]], hi: [[0.5, 1], [1, 1]] } };
   const s2 = samplesSummary({ ...smp, estimators: [vegas, miser] });
   assert.equal(s2.estimators[0].mapIncrements, 2);
+  assert.equal(s2.estimators[0].mapHistory, 2);
+  assert.equal(s2.estimators[0].runN, 64);
   assert.equal(s2.estimators[1].boxes, 2);
   assert.deepEqual(domainView(smp).xRange, [0, 1]);
   assert.match(domainView({ ...smp, dimension: 5 }).note, /first two of 5/);
