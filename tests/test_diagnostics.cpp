@@ -80,3 +80,33 @@ TEST(Diagnostics, ZeroPdfSupportIsAnEstimatorFlag) {
             }
     EXPECT_TRUE(found);
 }
+
+// Error bars too small for the replicates' spread, known or unknown exact value: VEGAS's
+// iteration average without the even share, across Genz's discontinuity, whose iterations trust
+// a map that collapsed the zero region (docs/scene-format.md). The F statistic s^2 / mean se^2
+// is far above 1 there; on the smooth peak the same estimator is quiet.
+TEST(Diagnostics, ErrorBarsThatUnderstateTheSpreadAreFlagged) {
+    const Json options{{"estimators", {"vegas_iterations_no_share"}},
+                       {"n_min", 131072},
+                       {"n_max", 131072},
+                       {"reps", 32},
+                       {"seed", 5}};
+    StudyResult s = study("miser_discontinuous", options);
+    const LevelStats& l = s.estimators[0].levels[0];
+    const std::vector<Flag> flags = level_flags(l);
+    auto it = std::find_if(flags.begin(), flags.end(),
+                           [](const Flag& f) { return f.code == FlagCode::ErrorBarsUnderstate; });
+    ASSERT_NE(it, flags.end());
+    EXPECT_GT(it->value, 4.0); // s^2 over the mean se^2
+    EXPECT_LT(it->p_value, 1e-3);
+    EXPECT_EQ(it->dof, 31);
+    // The same statistic on a smooth integrand stays near 1: no flag.
+    StudyResult q = study("vegas_corner_peak", Json{{"estimators", {"vegas", "vegas_plus", "miser"}},
+                                                    {"n_min", 4096},
+                                                    {"n_max", 65536},
+                                                    {"reps", 16}});
+    for (const EstimatorStudy& e : q.estimators)
+        for (const LevelStats& level : e.levels)
+            EXPECT_FALSE(has(level_flags(level), FlagCode::ErrorBarsUnderstate))
+                << e.spec.name << " N=" << level.n;
+}

@@ -63,3 +63,24 @@ TEST(Special, TrigammaKnownValues) {
     EXPECT_NEAR(trigamma(0.5), kPi * kPi / 2.0, 1e-12);
     EXPECT_NEAR(trigamma(10.5) - trigamma(11.5), 1.0 / (10.5 * 10.5), 1e-14);
 }
+
+TEST(Special, IncompleteBetaAndFTailIdentities) {
+    for (double x : {0.01, 0.3, 0.5, 0.9, 0.999}) {
+        EXPECT_NEAR(beta_regularized(2.5, 1.0, x), std::pow(x, 2.5), 1e-13);
+        EXPECT_NEAR(beta_regularized(1.0, 3.5, x), 1.0 - std::pow(1.0 - x, 3.5), 1e-13);
+        EXPECT_NEAR(beta_regularized(4.2, 7.3, x), 1.0 - beta_regularized(7.3, 4.2, 1.0 - x),
+                    1e-13);
+    }
+    // F(2, 2): P(F > f) = 1 / (1 + f).
+    for (double f : {0.1, 1.0, 7.0, 300.0}) EXPECT_NEAR(f_sf(f, 2.0, 2.0), 1.0 / (1.0 + f), 1e-13);
+    // F(1, nu) is T(nu)^2: P(F > t^2) = 2 P(T > t) = 0.05 at t = t_0.975 (the quantile is a
+    // Cornish-Fisher expansion, good to 1e-3 for nu >= 3).
+    for (double nu : {5.0, 12.0, 40.0}) {
+        const double t = student_t_quantile(0.975, nu);
+        EXPECT_NEAR(f_sf(t * t, 1.0, nu), 0.05, 2e-4) << nu;
+    }
+    // d2 -> infinity: d1 F -> chi^2(d1).
+    EXPECT_NEAR(f_sf(1.7, 15.0, 1e8), chi_square_sf(15.0 * 1.7, 15.0), 1e-6);
+    EXPECT_EQ(f_sf(0.0, 3.0, 4.0), 1.0);
+    EXPECT_EQ(f_sf(std::numeric_limits<double>::infinity(), 3.0, 4.0), 0.0);
+}

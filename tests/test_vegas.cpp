@@ -304,12 +304,16 @@ TEST(VegasEstimator, TrainingCallsAndTimeAreReported) {
         Pcg32 rng(8u, e);
         const RunResult run = run_estimate(r.value.problem, r.value.estimators[e], n, rng, ws);
         const std::string& name = r.value.estimators[e].name;
-        if (e < 3) EXPECT_EQ(run.training_n, expected[e]) << name;
+        if (e < 3) {
+            EXPECT_EQ(run.training_n, expected[e]) << name;
+        }
         if (name == "miser") {
             EXPECT_GT(run.training_n, 0u);
             EXPECT_LT(run.training_n, n);
         }
-        if (name == "uniform") EXPECT_EQ(run.training_n, 0u);
+        if (name == "uniform") {
+            EXPECT_EQ(run.training_n, 0u);
+        }
         EXPECT_GE(run.training_seconds, 0.0) << name;
         EXPECT_LE(run.training_seconds, run.seconds) << name;
         EXPECT_EQ(run.training_seconds > 0.0, run.training_n > 0) << name;

@@ -146,4 +146,53 @@ double trigamma(double x) {
     return acc + series;
 }
 
+namespace {
+
+// Continued fraction of I_x(a, b) by the modified Lentz method [NR07, 6.4].
+double beta_continued_fraction(double a, double b, double x) {
+    const double qab = a + b, qap = a + 1.0, qam = a - 1.0;
+    double c = 1.0, d = 1.0 - qab * x / qap;
+    if (std::fabs(d) < kTiny) d = kTiny;
+    d = 1.0 / d;
+    double h = d;
+    for (int m = 1; m < kGammaMaxIter; ++m) {
+        const double m2 = 2.0 * m;
+        double aa = m * (b - m) * x / ((qam + m2) * (a + m2));
+        d = 1.0 + aa * d;
+        if (std::fabs(d) < kTiny) d = kTiny;
+        c = 1.0 + aa / c;
+        if (std::fabs(c) < kTiny) c = kTiny;
+        d = 1.0 / d;
+        h *= d * c;
+        aa = -(a + m) * (qab + m) * x / ((a + m2) * (qap + m2));
+        d = 1.0 + aa * d;
+        if (std::fabs(d) < kTiny) d = kTiny;
+        c = 1.0 + aa / c;
+        if (std::fabs(c) < kTiny) c = kTiny;
+        d = 1.0 / d;
+        const double del = d * c;
+        h *= del;
+        if (std::fabs(del - 1.0) < kGammaEps) break;
+    }
+    return h;
+}
+
+} // namespace
+
+double beta_regularized(double a, double b, double x) {
+    if (!(x > 0.0)) return 0.0;
+    if (!(x < 1.0)) return 1.0;
+    // x^a (1-x)^b / (a B(a, b)), in logs.
+    const double front = std::exp(std::lgamma(a + b) - std::lgamma(a) - std::lgamma(b) +
+                                  a * std::log(x) + b * std::log1p(-x));
+    if (x < (a + 1.0) / (a + b + 2.0)) return front * beta_continued_fraction(a, b, x) / a;
+    return 1.0 - front * beta_continued_fraction(b, a, 1.0 - x) / b;
+}
+
+double f_sf(double f, double d1, double d2) {
+    if (!(f > 0.0)) return 1.0;
+    if (std::isinf(f)) return 0.0;
+    return beta_regularized(0.5 * d2, 0.5 * d1, d2 / (d2 + d1 * f));
+}
+
 } // namespace mcp

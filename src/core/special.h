@@ -32,6 +32,14 @@ double chi_square_sf(double x, double k);
 /// Quantile of the chi-square distribution: P(X <= x) = p.
 double chi_square_quantile(double p, double k);
 
+/// Regularised incomplete beta I_x(a, b) for a, b > 0 and x in [0, 1], by its continued
+/// fraction [NR07, 6.4] (on the side where it converges fast).
+double beta_regularized(double a, double b, double x);
+
+/// Upper tail probability of Snedecor's F distribution with (d1, d2) degrees of freedom:
+/// P(F > f) = I_{d2 / (d2 + d1 f)}(d2 / 2, d1 / 2).
+double f_sf(double f, double d1, double d2);
+
 /// Trigamma psi'(x) for x > 0 (recurrence up to x >= 10, then the asymptotic series).
 /// Var[log s^2] = psi'((R - 1) / 2) for a sample variance of R normal values.
 double trigamma(double x);

@@ -22,6 +22,7 @@ const char* flag_code_name(FlagCode code) {
     case FlagCode::PdfSupport: return "pdf_support";
     case FlagCode::LevelDrift: return "level_drift";
     case FlagCode::IterationsDisagree: return "iterations_disagree";
+    case FlagCode::ErrorBarsUnderstate: return "error_bars_understate";
     case FlagCode::Float32Accumulator: return "float32_accumulator";
     case FlagCode::BelowReferenceNoise: return "below_reference_noise";
     case FlagCode::ReferenceNoise: return "reference_noise";
@@ -59,6 +60,25 @@ std::vector<Flag> level_flags(const LevelStats& l) {
         f.count = static_cast<uint64_t>(l.zero_error_runs);
         f.of = reps;
         f.value = std::sqrt(l.variance);
+    }
+    // The replicates' spread against their own error bars, with or without an exact value: each
+    // run's se^2 estimates the variance of its estimate, so s^2 (across the R replicates) over
+    // the mean se^2 is F(R - 1, sum of the runs' dof) for normal estimates [Snedecor]. Far above
+    // (p < 1e-3): the error bars are too small, e.g. a stratified or randomized-QMC error bar
+    // whose few strata or randomizations all missed a discontinuity's sliver.
+    if (l.reps >= 4 && l.estimates_spread && l.zero_error_runs == 0 &&
+        l.mean_run_variance > 0.0 && std::isfinite(l.mean_run_variance) &&
+        std::isfinite(l.variance) && l.run_dof_total >= 1.0) {
+        const double ratio = l.variance / l.mean_run_variance;
+        const double p = f_sf(ratio, static_cast<double>(l.reps - 1), l.run_dof_total);
+        if (ratio > 1.0 && p < kLevelDriftP) {
+            Flag& f = raise(FlagCode::ErrorBarsUnderstate);
+            f.value = ratio;
+            f.dof = l.reps - 1;
+            f.p_value = p;
+            f.threshold = kLevelDriftP;
+            f.of = reps;
+        }
     }
     const RunDiagnostics& d = l.diagnostics;
     if (d.nonfinite) {

@@ -27,6 +27,7 @@ enum class FlagCode {
     LevelDrift,         ///< the level means disagree beyond their error bars
     Float32Accumulator, ///< naive single-precision sums (teaching mode)
     IterationsDisagree, ///< an iteration average's iterations disagree beyond their error bars
+    ErrorBarsUnderstate, ///< the replicates spread more than their own error bars allow
     // Render studies (render/render_study.h: render_flags).
     BelowReferenceNoise, ///< a level's relative MSE is below the reference's own noise
     ReferenceNoise,      ///< some levels lie below the reference's noise (left out of the fit)

@@ -434,6 +434,8 @@ LevelStats summarise_level(const std::vector<RunResult>& runs, const Problem& pr
     NeumaierSum sq_err, time, training_time;
     double training_share = 0.0;
     int covered = 0, se_count = 0;
+    NeumaierSum se2;
+    double run_dof_sum = 0.0;
     s.has_exact = problem.exact.has_value();
     const double exact = s.has_exact ? *problem.exact : 0.0;
     // Every run keeps its kTopWeights largest |w|, so the largest of the pooled tops are the
@@ -465,6 +467,8 @@ LevelStats summarise_level(const std::vector<RunResult>& runs, const Problem& pr
         s.run_std_errors.push_back(r.std_error);
         if (std::isfinite(r.std_error)) {
             se.add(r.std_error);
+            se2.add(r.std_error * r.std_error);
+            run_dof_sum += std::max(r.dof, 0);
             ++se_count;
         }
         if (s.has_exact) {
@@ -495,6 +499,8 @@ LevelStats summarise_level(const std::vector<RunResult>& runs, const Problem& pr
     s.ci_lo = s.mean - t * s.std_error;
     s.ci_hi = s.mean + t * s.std_error;
     s.mean_run_se = se_count ? se.mean() : std::numeric_limits<double>::quiet_NaN();
+    s.mean_run_variance = se_count ? se2.value() / se_count : std::numeric_limits<double>::quiet_NaN();
+    s.run_dof_total = run_dof_sum;
     s.time_total = time.value();
     s.time_mean = s.time_total / R;
     s.training_time_mean = training_time.value() / R;
@@ -517,6 +523,7 @@ LevelStats summarise_level(const std::vector<RunResult>& runs, const Problem& pr
         const double nan = std::numeric_limits<double>::quiet_NaN();
         s.mean = s.variance = s.variance_lo = s.variance_hi = s.std_error = nan;
         s.ci_lo = s.ci_hi = s.bias = s.mse = s.rmse = s.coverage = s.mean_run_se = nan;
+        s.mean_run_variance = nan;
         s.efficiency = s.error = s.tail_index = s.ess_mean = nan;
         s.tail_k = 0;
         s.estimates_spread = false;

@@ -77,6 +77,8 @@ struct LevelStats {
     double rmse = 0.0;
     double coverage = 0.0;    ///< share of replicates whose own 95% interval covers exact
     double mean_run_se = 0.0; ///< average per-run standard error reported by the runs
+    double mean_run_variance = 0.0; ///< average of the runs' se^2 (finite ones)
+    double run_dof_total = 0.0;     ///< the runs' error-bar degrees of freedom, summed
     int run_dof = 0;          ///< degrees of freedom of the runs' error bars (RunResult::dof)
     double time_mean = 0.0;   ///< seconds per estimate
     double time_total = 0.0;
