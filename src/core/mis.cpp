@@ -62,11 +62,6 @@ double mis_weight(const MisWeighting& w, const double* q, int techniques, int i)
     return 0.0;
 }
 
-double mis_weight(const MisWeighting& w, double q_this, double q_other) {
-    const double q[2] = {q_this, q_other};
-    return mis_weight(w, q, 2, 0);
-}
-
 void mis_weight_block(const MisWeighting& w, const double* const* q, int techniques, int i,
                       size_t count, double* out) {
     double at[kMaxMisTechniques];

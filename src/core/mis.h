@@ -34,8 +34,19 @@ struct MisWeighting {
 /// themselves.
 double mis_weight(const MisWeighting& w, const double* q, int techniques, int i);
 
-/// Two techniques: the weight of the one with q_this against the other's q_other.
-double mis_weight(const MisWeighting& w, double q_this, double q_other);
+/// Two techniques: the weight of the one with q_this against the other's q_other (inline for the
+/// renderer's per-sample use: the balance and beta = 2 power heuristics as one division).
+inline double mis_weight(const MisWeighting& w, double q_this, double q_other) {
+    const bool simple = w.heuristic == MisHeuristic::Balance ||
+                        (w.heuristic == MisHeuristic::Power && w.beta == 2.0);
+    if (simple && q_this > 0.0 && q_this < 1e300) {
+        if (!(q_other > 0.0)) return 1.0;
+        const double r = q_other / q_this; // divided first: q^2 overflows for huge densities
+        return 1.0 / (1.0 + (w.heuristic == MisHeuristic::Balance ? r : r * r));
+    }
+    const double q[2] = {q_this, q_other};
+    return mis_weight(w, q, 2, 0);
+}
 
 /// The weights of technique i for a block: q[k][j] is q_k at point j (j < count),
 /// techniques <= kMaxMisTechniques.
