@@ -101,10 +101,11 @@ TEST(Diagnostics, ErrorBarsThatUnderstateTheSpreadAreFlagged) {
     EXPECT_LT(it->p_value, 1e-3);
     EXPECT_EQ(it->dof, 31);
     // The same statistic on a smooth integrand stays near 1: no flag.
-    StudyResult q = study("vegas_corner_peak", Json{{"estimators", {"vegas", "vegas_plus", "miser"}},
-                                                    {"n_min", 4096},
-                                                    {"n_max", 65536},
-                                                    {"reps", 16}});
+    StudyResult q =
+        study("vegas_corner_peak", Json{{"estimators", {"vegas", "vegas_plus", "miser"}},
+                                        {"n_min", 4096},
+                                        {"n_max", 65536},
+                                        {"reps", 16}});
     for (const EstimatorStudy& e : q.estimators)
         for (const LevelStats& level : e.levels)
             EXPECT_FALSE(has(level_flags(level), FlagCode::ErrorBarsUnderstate))

@@ -373,10 +373,10 @@ TEST(AdaptiveGenz, ConvergeOrFlagAndCoverWhereNotFlagged) {
     for (int family = 0; family < 6; ++family)
         for (int d : {2, 4, 8}) {
             const GenzParams p = genz_random(static_cast<GenzFamily>(family), d, 9000 + family);
-            const Json scene = {{"name", "genz"},
-                                {"integrand",
-                                 {{"type", genz_family_name(p.family)}, {"a", p.a}, {"u", p.u}}},
-                                {"estimators", names}};
+            const Json scene = {
+                {"name", "genz"},
+                {"integrand", {{"type", genz_family_name(p.family)}, {"a", p.a}, {"u", p.u}}},
+                {"estimators", names}};
             Made<SceneRequest> r = build_request(
                 scene, Json{{"n_min", 8192}, {"n_max", 8192}, {"reps", 12}, {"seed", 31}});
             ASSERT_TRUE(r.ok()) << r.error;
@@ -385,8 +385,8 @@ TEST(AdaptiveGenz, ConvergeOrFlagAndCoverWhereNotFlagged) {
             for (const EstimatorStudy& e : s.estimators) {
                 const LevelStats& l = e.levels[0];
                 const bool flagged = !warning_codes(e, l, s.settings).empty();
-                const std::string where = std::string(genz_family_name(p.family)) + " d=" +
-                                          std::to_string(d) + " / " + e.spec.name;
+                const std::string where = std::string(genz_family_name(p.family)) +
+                                          " d=" + std::to_string(d) + " / " + e.spec.name;
                 EXPECT_TRUE(flagged || std::fabs(l.mean - exact) <=
                                            5.0 * l.std_error + 1e-12 * std::fabs(exact))
                     << where << ": mean " << l.mean << " +/- " << l.std_error << ", exact "

@@ -26,7 +26,8 @@ const char* kPeak = R"({"type": "gaussian", "mu": 0.3, "sigma": 0.08})";
 /// f = 1 + x + a Gaussian bump (sigma 0.05 at 0.3) on [0, 1]; techniques: a Gaussian pdf
 /// (sigma 0.08 at 0.3, truncated to [0, 1]) and the uniform density.
 /// Its integral: 1.5 + Phi(14) - Phi(-6).
-const double kExact = 2.5 - 0.5 * std::erfc(6.0 / std::sqrt(2.0)) - 0.5 * std::erfc(14.0 / std::sqrt(2.0));
+const double kExact =
+    2.5 - 0.5 * std::erfc(6.0 / std::sqrt(2.0)) - 0.5 * std::erfc(14.0 / std::sqrt(2.0));
 
 Made<SceneRequest> request(const std::string& estimators, const std::string& f = "",
                            double exact = kExact) {
@@ -35,8 +36,9 @@ Made<SceneRequest> request(const std::string& estimators, const std::string& f =
     char exact_text[64];
     std::snprintf(exact_text, sizeof exact_text, "%.17g", exact);
     const std::string scene = R"({"name": "m", "domain": {"type": "interval", "lower": 0,
-        "upper": 1}, "integrand": ")" + integrand + R"(", "exact": )" + exact_text +
-                              R"(, "estimators": )" + estimators + "}";
+        "upper": 1}, "integrand": ")" +
+                              integrand + R"(", "exact": )" + exact_text + R"(, "estimators": )" +
+                              estimators + "}";
     Made<Json> j = parse_json(scene.c_str(), "scene");
     EXPECT_TRUE(j.ok()) << j.error;
     return build_request(j.value, Json());
@@ -81,8 +83,8 @@ double mis_variance(const Problem& problem, const MisOptions& m, uint64_t n, boo
     auto y_of = [&](size_t k, double x) {
         std::vector<double> q(k_count);
         for (size_t j = 0; j < k_count; ++j) q[j] = a[j] * density(m.proposals[j], d, x);
-        const double w = mis_weight(m.weighting, q.data(), static_cast<int>(k_count),
-                                    static_cast<int>(k));
+        const double w =
+            mis_weight(m.weighting, q.data(), static_cast<int>(k_count), static_cast<int>(k));
         return q[k] > 0.0 ? w * value(problem.integrand, x) / q[k] : 0.0;
     };
     const double exact = *problem.exact;
@@ -106,8 +108,8 @@ double mis_variance(const Problem& problem, const MisOptions& m, uint64_t n, boo
 
 TEST(MisWeights, HeuristicsSumToOneAndFollowTheirFormulas) {
     const double q[3] = {0.2, 1.0, 3.0};
-    for (MisHeuristic h :
-         {MisHeuristic::Balance, MisHeuristic::Power, MisHeuristic::Maximum, MisHeuristic::Cutoff}) {
+    for (MisHeuristic h : {MisHeuristic::Balance, MisHeuristic::Power, MisHeuristic::Maximum,
+                           MisHeuristic::Cutoff}) {
         MisWeighting w{h, 2.0, 0.1};
         double sum = 0.0;
         for (int i = 0; i < 3; ++i) sum += mis_weight(w, q, 3, i);
@@ -162,7 +164,8 @@ TEST(Regression, CovarianceMatchesTwoPassAndSolveDropsDependentColumns) {
     for (int i = 0; i < 1000; ++i) mt += t[i], mv += v[i];
     mt /= 1000, mv /= 1000;
     double ctt = 0, ctv = 0;
-    for (int i = 0; i < 1000; ++i) ctt += (t[i] - mt) * (t[i] - mt), ctv += (t[i] - mt) * (v[i] - mv);
+    for (int i = 0; i < 1000; ++i)
+        ctt += (t[i] - mt) * (t[i] - mt), ctv += (t[i] - mt) * (v[i] - mv);
     EXPECT_NEAR(c.mean(0), mt, 1e-9);
     EXPECT_NEAR(c.comoment(0, 0), ctt, 1e-8 * ctt);
     EXPECT_NEAR(c.comoment(0, 2), ctv, 1e-8 * std::fabs(ctv));
@@ -180,14 +183,13 @@ TEST(Regression, CovarianceMatchesTwoPassAndSolveDropsDependentColumns) {
 // formula's (R - 1) s^2 / V ~ chi^2(399): inside [0.80, 1.23] V (two-sided p = 0.002), the mean
 // within 4 standard errors of the exact value, and the 95% intervals cover 90-99% of the time.
 TEST(Mis, EveryCombinationHasTheVarianceItsFormulaGivesAndHonestIntervals) {
-    Made<SceneRequest> r = request(
-        "[" + mis("balance", R"(, "heuristic": "balance")") + "," +
-        mis("power", R"(, "heuristic": "power")") + "," +
-        mis("power3", R"(, "heuristic": "power", "beta": 3)") + "," +
-        mis("maximum", R"(, "heuristic": "maximum")") + "," +
-        mis("cutoff", R"(, "heuristic": "cutoff", "cutoff": 0.3)") + "," +
-        mis("uneven", R"(, "fractions": [3, 1])") + "," +
-        mis("one_sample", R"(, "one_sample": true)") + "]");
+    Made<SceneRequest> r = request("[" + mis("balance", R"(, "heuristic": "balance")") + "," +
+                                   mis("power", R"(, "heuristic": "power")") + "," +
+                                   mis("power3", R"(, "heuristic": "power", "beta": 3)") + "," +
+                                   mis("maximum", R"(, "heuristic": "maximum")") + "," +
+                                   mis("cutoff", R"(, "heuristic": "cutoff", "cutoff": 0.3)") +
+                                   "," + mis("uneven", R"(, "fractions": [3, 1])") + "," +
+                                   mis("one_sample", R"(, "one_sample": true)") + "]");
     ASSERT_TRUE(r.ok()) << r.error;
     const Problem& problem = r.value.problem;
     const double exact = *problem.exact;
@@ -196,7 +198,8 @@ TEST(Mis, EveryCombinationHasTheVarianceItsFormulaGivesAndHonestIntervals) {
     for (size_t e = 0; e < r.value.estimators.size(); ++e) {
         const EstimatorSpec& spec = r.value.estimators[e];
         const double v = mis_variance(problem, spec.mis_options, n, spec.mis_options.one_sample);
-        const test::IndependentRuns s = test::independent_runs(problem, spec, n, runs, 17, e, exact);
+        const test::IndependentRuns s =
+            test::independent_runs(problem, spec, n, runs, 17, e, exact);
         EXPECT_TRUE(s.every_n_reported) << spec.name;
         EXPECT_GT(s.variance, 0.80 * v) << spec.name;
         EXPECT_LT(s.variance, 1.23 * v) << spec.name;
@@ -212,8 +215,8 @@ TEST(Mis, EveryCombinationHasTheVarianceItsFormulaGivesAndHonestIntervals) {
 // variances are compared, and the measured ones agree with them (previous test).
 TEST(Mis, BalanceIsNeverAboveTheWorstSingleTechnique) {
     const char* wide = R"({"type": "gaussian", "mu": 0.3, "sigma": 0.3})";
-    Made<SceneRequest> r = request("[" + mis("balance", "", wide) + R"(, {"name": "peak", "pdf": )" +
-                                   wide + R"(}, "uniform"])");
+    Made<SceneRequest> r = request("[" + mis("balance", "", wide) +
+                                   R"(, {"name": "peak", "pdf": )" + wide + R"(}, "uniform"])");
     ASSERT_TRUE(r.ok()) << r.error;
     const Problem& problem = r.value.problem;
     const uint64_t n = 1024;
@@ -225,8 +228,8 @@ TEST(Mis, BalanceIsNeverAboveTheWorstSingleTechnique) {
         alone.fractions = {1.0};
         worst = std::max(worst, mis_variance(problem, alone, n, false));
         // and measured: the single technique's runs agree with its formula
-        const test::IndependentRuns s = test::independent_runs(
-            problem, r.value.estimators[e], n, 400, 23, e, *problem.exact);
+        const test::IndependentRuns s =
+            test::independent_runs(problem, r.value.estimators[e], n, 400, 23, e, *problem.exact);
         EXPECT_GT(s.variance, 0.80 * mis_variance(problem, alone, n, false)) << e;
         EXPECT_LT(s.variance, 1.23 * mis_variance(problem, alone, n, false)) << e;
     }
@@ -237,9 +240,9 @@ TEST(Mis, BalanceIsNeverAboveTheWorstSingleTechnique) {
 // heuristic's (s_opt^2 / s_bal^2 below F(399, 399) at p = 0.001, about 1.36), its intervals
 // cover, and where f is a combination of the densities it is exact.
 TEST(Mis, OptimalWeightsAreAtOrBelowBalanceAndExactOnACombinationOfTheDensities) {
-    Made<SceneRequest> r = request(
-        "[" + mis("balance", "") + "," + mis("optimal", R"(, "heuristic": "optimal")") + "," +
-        mis("optimal_one", R"(, "heuristic": "optimal", "one_sample": true)") + "]");
+    Made<SceneRequest> r =
+        request("[" + mis("balance", "") + "," + mis("optimal", R"(, "heuristic": "optimal")") +
+                "," + mis("optimal_one", R"(, "heuristic": "optimal", "one_sample": true)") + "]");
     ASSERT_TRUE(r.ok()) << r.error;
     const Problem& problem = r.value.problem;
     const double exact = *problem.exact;
@@ -258,9 +261,9 @@ TEST(Mis, OptimalWeightsAreAtOrBelowBalanceAndExactOnACombinationOfTheDensities)
 
     // f = 3 p_uniform + 2 Z p_peak, with Z = Phi(8.75) - Phi(-3.75) the truncated Gaussian's
     // mass on [0, 1]: the regression fits it exactly, so every run returns 3 + 2 Z.
-    Made<SceneRequest> c = request(
-        "[" + mis("optimal", R"(, "heuristic": "optimal")") + "]",
-        "3 + 2 * exp(-0.5 * ((x - 0.3) / 0.08)^2) / (0.08 * sqrt(2 * pi))", 5.0);
+    Made<SceneRequest> c =
+        request("[" + mis("optimal", R"(, "heuristic": "optimal")") + "]",
+                "3 + 2 * exp(-0.5 * ((x - 0.3) / 0.08)^2) / (0.08 * sqrt(2 * pi))", 5.0);
     ASSERT_TRUE(c.ok()) << c.error;
     Workspace ws;
     Pcg32 rng(5u, 5u);
@@ -271,10 +274,11 @@ TEST(Mis, OptimalWeightsAreAtOrBelowBalanceAndExactOnACombinationOfTheDensities)
     mid.coord(0)[0] = 0.3;
     // The truncated pdf's normaliser, from the code's own density at the mode.
     double p_mode = 0.0;
-    proposal_pdf_block(c.value.estimators[0].mis_options.proposals[0], c.value.problem.domain,
-                       mid, &p_mode);
+    proposal_pdf_block(c.value.estimators[0].mis_options.proposals[0], c.value.problem.domain, mid,
+                       &p_mode);
     const double z = 1.0 / (0.08 * std::sqrt(2.0 * M_PI) * p_mode);
-    EXPECT_NEAR(z, 0.5 * (std::erf(8.75 / std::sqrt(2.0)) + std::erf(3.75 / std::sqrt(2.0))), 1e-12);
+    EXPECT_NEAR(z, 0.5 * (std::erf(8.75 / std::sqrt(2.0)) + std::erf(3.75 / std::sqrt(2.0))),
+                1e-12);
     EXPECT_NEAR(one.estimate, 3.0 + 2.0 * z, 1e-9);
     EXPECT_LT(one.std_error, 1e-9);
 }
@@ -308,9 +312,9 @@ TEST(Mis, ANarrowAndAWidePdfEachFailWhereTheirCombinationDoesNot) {
 
 // Small budgets: every run finishes with N reported, down to fewer points than techniques.
 TEST(Mis, RunsOfOneToFortyPointsFinish) {
-    Made<SceneRequest> r = request("[" + mis("balance", "") + "," +
-                                   mis("optimal", R"(, "heuristic": "optimal")") + "," +
-                                   mis("one", R"(, "one_sample": true)") + "]");
+    Made<SceneRequest> r =
+        request("[" + mis("balance", "") + "," + mis("optimal", R"(, "heuristic": "optimal")") +
+                "," + mis("one", R"(, "one_sample": true)") + "]");
     ASSERT_TRUE(r.ok()) << r.error;
     Workspace ws;
     for (const EstimatorSpec& spec : r.value.estimators)

@@ -348,10 +348,12 @@ TEST(SceneParsing, MisAndControlVariateFieldsAreChecked) {
               "maximum, cutoff, optimal)");
     EXPECT_EQ(est(R"({"name": "m", "proposals": [)" + g + R"(], "beta": 2})"),
               "scene.estimators[0].beta: applies to the power heuristic only");
-    EXPECT_EQ(est(R"({"name": "m", "proposals": [)" + g + R"(], "heuristic": "power", "beta": 0.5})"),
-              "scene.estimators[0].beta: must be in [1, 16] (Veach uses 2), got 0.5");
-    EXPECT_EQ(est(R"({"name": "m", "proposals": [)" + g + R"(], "heuristic": "cutoff", "cutoff": 2})"),
-              "scene.estimators[0].cutoff: must be in [0, 1] (Veach uses 0.1), got 2");
+    EXPECT_EQ(
+        est(R"({"name": "m", "proposals": [)" + g + R"(], "heuristic": "power", "beta": 0.5})"),
+        "scene.estimators[0].beta: must be in [1, 16] (Veach uses 2), got 0.5");
+    EXPECT_EQ(
+        est(R"({"name": "m", "proposals": [)" + g + R"(], "heuristic": "cutoff", "cutoff": 2})"),
+        "scene.estimators[0].cutoff: must be in [0, 1] (Veach uses 0.1), got 2");
     EXPECT_EQ(est(R"({"name": "m", "pdf": )" + g + R"(, "defensive": 1})"),
               "scene.estimators[0].defensive: must be in (0, 1): the uniform density's share of "
               "the mixture (Hesterberg suggests 0.1 to 0.5), got 1");

@@ -150,8 +150,9 @@ int mcp_study_samples(const char* scene_json, const char* options_json, char** s
         int64_t most;
         const char* text;
     };
-    for (const Bounded& b : {Bounded{"n", &n, 4096, "1..4096"}, Bounded{"grid", &grid, 4096, "1..4096"},
-                             Bounded{"adaptive_n", &adaptive_n, int64_t(1) << 20, "1..1048576"}}) {
+    for (const Bounded& b :
+         {Bounded{"n", &n, 4096, "1..4096"}, Bounded{"grid", &grid, 4096, "1..4096"},
+          Bounded{"adaptive_n", &adaptive_n, int64_t(1) << 20, "1..1048576"}}) {
         auto it = options.find(b.key);
         if (it == options.end()) continue;
         if (!it->is_number_integer() || it->get<int64_t>() < 1 || it->get<int64_t>() > b.most)

@@ -60,8 +60,8 @@ Json level_warning(const Flag& f, const LevelStats& l) {
                                  fmt("%.3g", f.value) +
                                  "): their error bars are wrong (too few samples to see f vary)");
     case FlagCode::ErrorBarsUnderstate:
-        return warning(code, "the " + std::to_string(f.of) + " replicates" + at_n +
-                                 " spread " + fmt("%.3g", std::sqrt(f.value)) +
+        return warning(code, "the " + std::to_string(f.of) + " replicates" + at_n + " spread " +
+                                 fmt("%.3g", std::sqrt(f.value)) +
                                  " times more than their own standard errors say (F test, p = " +
                                  fmt("%.2g", f.p_value) +
                                  "): the error bars are too small (too few strata, "

@@ -786,8 +786,8 @@ bool parse_mis_options(Ctx& c, const Json& j, const std::string& path, const Pro
         entries.push_back("uniform");
     }
     for (size_t k = 0; k < entries.size(); ++k) {
-        const std::string at = (proposals ? sub(path, "proposals") + "[" + std::to_string(k) + "]"
-                                          : sub(path, "pdf"));
+        const std::string at =
+            (proposals ? sub(path, "proposals") + "[" + std::to_string(k) + "]" : sub(path, "pdf"));
         Proposal prop = uniform_proposal(problem.domain);
         if (!(entries[k].is_string() && entries[k] == "uniform") &&
             !parse_pdf(c, entries[k], at, problem, &prop))
@@ -807,7 +807,8 @@ bool parse_mis_options(Ctx& c, const Json& j, const std::string& path, const Pro
         for (double x : f) {
             if (!(x > 0.0 && x <= 1e6))
                 return c.fail(sub(path, "fractions"),
-                              "each share must be positive (and at most 1e6), got " + number_text(x));
+                              "each share must be positive (and at most 1e6), got " +
+                                  number_text(x));
             total += x;
         }
         for (size_t k = 0; k < k_count; ++k) out->fractions[k] = f[k] / total;
@@ -818,7 +819,8 @@ bool parse_mis_options(Ctx& c, const Json& j, const std::string& path, const Pro
         if (!(defensive > 0.0 && defensive < 1.0))
             return c.fail(sub(path, "defensive"),
                           "must be in (0, 1): the uniform density's share of the mixture "
-                          "(Hesterberg suggests 0.1 to 0.5), got " + number_text(defensive));
+                          "(Hesterberg suggests 0.1 to 0.5), got " +
+                              number_text(defensive));
         if (k_count + 1 > static_cast<size_t>(kMaxMisTechniques))
             return c.fail(sub(path, "defensive"), "the uniform density would be technique " +
                                                       std::to_string(k_count + 1) + "; at most " +
@@ -849,7 +851,7 @@ bool parse_mis_options(Ctx& c, const Json& j, const std::string& path, const Pro
         if (!get_number(c, j, "beta", path, &out->weighting.beta)) return false;
         if (!(out->weighting.beta >= 1.0 && out->weighting.beta <= 16.0))
             return c.fail(sub(path, "beta"), "must be in [1, 16] (Veach uses 2), got " +
-                                                  number_text(out->weighting.beta));
+                                                 number_text(out->weighting.beta));
     }
     if (find(j, "cutoff")) {
         if (out->weighting.heuristic != MisHeuristic::Cutoff || out->optimal)
@@ -857,7 +859,7 @@ bool parse_mis_options(Ctx& c, const Json& j, const std::string& path, const Pro
         if (!get_number(c, j, "cutoff", path, &out->weighting.cutoff)) return false;
         if (!(out->weighting.cutoff >= 0.0 && out->weighting.cutoff <= 1.0))
             return c.fail(sub(path, "cutoff"), "must be in [0, 1] (Veach uses 0.1), got " +
-                                                    number_text(out->weighting.cutoff));
+                                                   number_text(out->weighting.cutoff));
     }
     if (const Json* one = find(j, "one_sample")) {
         if (!one->is_boolean())
@@ -869,8 +871,8 @@ bool parse_mis_options(Ctx& c, const Json& j, const std::string& path, const Pro
 
 /// Control-variate fields: "control_variates": [{"g": integrand, "integral": G}, ...] and the
 /// optional "coefficients" (one per variate; fitted when absent).
-bool parse_control_variates(Ctx& c, const Json& j, const std::string& path,
-                            const Problem& problem, ControlVariateOptions* out) {
+bool parse_control_variates(Ctx& c, const Json& j, const std::string& path, const Problem& problem,
+                            ControlVariateOptions* out) {
     const Json* list = find(j, "control_variates");
     const std::string at = sub(path, "control_variates");
     if (!list->is_array() || list->empty())
@@ -958,8 +960,8 @@ bool parse_estimator(Ctx& c, const Json& j, const std::string& path, const Probl
         pdf = find(j, "pdf");
         vegas = find(j, "vegas");
         miser = find(j, "miser");
-        for (const char* key : {"proposals", "fractions", "heuristic", "beta", "cutoff",
-                                "one_sample", "defensive"})
+        for (const char* key :
+             {"proposals", "fractions", "heuristic", "beta", "cutoff", "one_sample", "defensive"})
             mis = mis || find(j, key);
         control = find(j, "control_variates") != nullptr;
         if (!control && find(j, "coefficients"))

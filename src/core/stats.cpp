@@ -130,7 +130,8 @@ void StratifiedSum::add(double a, const RunningMoments& m) {
 
 int StratifiedSum::dof() const {
     const double v = variance();
-    if (satterthwaite_ > 0.0) return static_cast<int>(std::min(1e6, std::max(1.0, v * v / satterthwaite_)));
+    if (satterthwaite_ > 0.0)
+        return static_cast<int>(std::min(1e6, std::max(1.0, v * v / satterthwaite_)));
     return static_cast<int>(std::min<uint64_t>(1000000, free_));
 }
 

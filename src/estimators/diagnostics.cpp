@@ -66,9 +66,8 @@ std::vector<Flag> level_flags(const LevelStats& l) {
     // the mean se^2 is F(R - 1, sum of the runs' dof) for normal estimates [Snedecor]. Far above
     // (p < 1e-3): the error bars are too small, e.g. a stratified or randomized-QMC error bar
     // whose few strata or randomizations all missed a discontinuity's sliver.
-    if (l.reps >= 4 && l.estimates_spread && l.zero_error_runs == 0 &&
-        l.mean_run_variance > 0.0 && std::isfinite(l.mean_run_variance) &&
-        std::isfinite(l.variance) && l.run_dof_total >= 1.0) {
+    if (l.reps >= 4 && l.estimates_spread && l.zero_error_runs == 0 && l.mean_run_variance > 0.0 &&
+        std::isfinite(l.mean_run_variance) && std::isfinite(l.variance) && l.run_dof_total >= 1.0) {
         const double ratio = l.variance / l.mean_run_variance;
         const double p = f_sf(ratio, static_cast<double>(l.reps - 1), l.run_dof_total);
         if (ratio > 1.0 && p < kLevelDriftP) {

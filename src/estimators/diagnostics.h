@@ -12,21 +12,21 @@
 namespace mcp {
 
 enum class FlagCode {
-    NoEstimate,         ///< every sample of some run was NaN/Inf
-    NonfiniteEstimate,  ///< the mean of the replicates overflowed
-    NonfiniteVariance,  ///< the variance across replicates is not a finite number >= 0
-    ZeroErrorBar,       ///< runs reported se = 0 although the replicates differ
-    NonfiniteSamples,   ///< samples with NaN/Inf f/p were dropped (biased)
-    ZeroPdfSamples,     ///< samples with f != 0 where p = 0 were dropped (biased)
-    DominantSample,     ///< one sample carried a large share of a run's sum
-    LowEss,             ///< Kish's effective sample size is a handful
-    ExactOutsideCi,     ///< the replicates' mean misses the exact value
-    HeavyTail,          ///< tail index within 2 standard errors of 2 (or below)
-    HeavyTail4,         ///< tail index below 4
-    PdfSupport,         ///< the pdf is zero where f is not
-    LevelDrift,         ///< the level means disagree beyond their error bars
-    Float32Accumulator, ///< naive single-precision sums (teaching mode)
-    IterationsDisagree, ///< an iteration average's iterations disagree beyond their error bars
+    NoEstimate,          ///< every sample of some run was NaN/Inf
+    NonfiniteEstimate,   ///< the mean of the replicates overflowed
+    NonfiniteVariance,   ///< the variance across replicates is not a finite number >= 0
+    ZeroErrorBar,        ///< runs reported se = 0 although the replicates differ
+    NonfiniteSamples,    ///< samples with NaN/Inf f/p were dropped (biased)
+    ZeroPdfSamples,      ///< samples with f != 0 where p = 0 were dropped (biased)
+    DominantSample,      ///< one sample carried a large share of a run's sum
+    LowEss,              ///< Kish's effective sample size is a handful
+    ExactOutsideCi,      ///< the replicates' mean misses the exact value
+    HeavyTail,           ///< tail index within 2 standard errors of 2 (or below)
+    HeavyTail4,          ///< tail index below 4
+    PdfSupport,          ///< the pdf is zero where f is not
+    LevelDrift,          ///< the level means disagree beyond their error bars
+    Float32Accumulator,  ///< naive single-precision sums (teaching mode)
+    IterationsDisagree,  ///< an iteration average's iterations disagree beyond their error bars
     ErrorBarsUnderstate, ///< the replicates spread more than their own error bars allow
     // Render studies (render/render_study.h: render_flags).
     BelowReferenceNoise, ///< a level's relative MSE is below the reference's own noise

@@ -91,7 +91,8 @@ class MisEstimator final : public EstimatorAlgorithm {
                                       counts_[t], rng);
             plan_ready_ = true;
         }
-        const size_t count = static_cast<size_t>(std::min<uint64_t>(kBlockSize, plan_.total - next_));
+        const size_t count =
+            static_cast<size_t>(std::min<uint64_t>(kBlockSize, plan_.total - next_));
         const Proposal& own = options_.proposals[t];
         SampleBlock b = sample_block(problem_, own, plan_, next_, count, ws);
         weigh(b, t);
@@ -137,8 +138,7 @@ class MisEstimator final : public EstimatorAlgorithm {
             optimal_estimate(scale, &r);
         } else if (!options_.one_sample) {
             StratifiedSum strata;
-            for (size_t t = 0; t < moments_.size(); ++t)
-                strata.add(share_[t], moments_[t]);
+            for (size_t t = 0; t < moments_.size(); ++t) strata.add(share_[t], moments_[t]);
             r.estimate = scale * strata.estimate();
             r.std_error = strata.has_variance() ? scale * std::sqrt(strata.variance())
                                                 : std::numeric_limits<double>::quiet_NaN();
@@ -202,7 +202,8 @@ class MisEstimator final : public EstimatorAlgorithm {
         v[m] = 1.0;
         const double n_all = static_cast<double>(total_);
         const double fitted = n_all > rank ? n_all / (n_all - rank) : 1.0;
-        r->estimate = total_ > 0 ? scale * estimate.value() : std::numeric_limits<double>::quiet_NaN();
+        r->estimate =
+            total_ > 0 ? scale * estimate.value() : std::numeric_limits<double>::quiet_NaN();
         if (options_.one_sample) {
             const RunningCovariance& c = covariance_[0];
             const double dof = n_all - rank;
@@ -228,8 +229,8 @@ class MisEstimator final : public EstimatorAlgorithm {
                 continue;
             }
             const double nt = static_cast<double>(c.count());
-            const double vt = share_[t] * share_[t] * c.quadratic_form(v) / (nt - 1.0) / nt *
-                              fitted;
+            const double vt =
+                share_[t] * share_[t] * c.quadratic_form(v) / (nt - 1.0) / nt * fitted;
             variance.add(vt);
             satterthwaite += vt * vt / (nt - 1.0);
         }
@@ -258,9 +259,8 @@ class MisEstimator final : public EstimatorAlgorithm {
 
 } // namespace
 
-std::unique_ptr<EstimatorAlgorithm> make_mis_estimator(const Problem& problem,
-                                                       const EstimatorSpec& spec,
-                                                       Accumulator accumulator) {
+std::unique_ptr<EstimatorAlgorithm>
+make_mis_estimator(const Problem& problem, const EstimatorSpec& spec, Accumulator accumulator) {
     return std::make_unique<MisEstimator>(problem, spec, accumulator);
 }
 

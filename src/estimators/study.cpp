@@ -460,8 +460,8 @@ LevelStats summarise_level(const std::vector<RunResult>& runs, const Problem& pr
         est.add(r.estimate);
         time.add(r.seconds);
         training_time.add(r.training_seconds);
-        training_share += r.n > 0 ? static_cast<double>(r.training_n) / static_cast<double>(r.n)
-                                  : 0.0;
+        training_share +=
+            r.n > 0 ? static_cast<double>(r.training_n) / static_cast<double>(r.n) : 0.0;
         s.diagnostics.merge(r.diagnostics);
         s.estimates.push_back(r.estimate);
         s.run_std_errors.push_back(r.std_error);
@@ -499,7 +499,8 @@ LevelStats summarise_level(const std::vector<RunResult>& runs, const Problem& pr
     s.ci_lo = s.mean - t * s.std_error;
     s.ci_hi = s.mean + t * s.std_error;
     s.mean_run_se = se_count ? se.mean() : std::numeric_limits<double>::quiet_NaN();
-    s.mean_run_variance = se_count ? se2.value() / se_count : std::numeric_limits<double>::quiet_NaN();
+    s.mean_run_variance =
+        se_count ? se2.value() / se_count : std::numeric_limits<double>::quiet_NaN();
     s.run_dof_total = run_dof_sum;
     s.time_total = time.value();
     s.time_mean = s.time_total / R;

@@ -75,12 +75,12 @@ struct LevelStats {
     double bias = 0.0; ///< mean - exact
     double mse = 0.0;  ///< mean of (estimate - exact)^2
     double rmse = 0.0;
-    double coverage = 0.0;    ///< share of replicates whose own 95% interval covers exact
-    double mean_run_se = 0.0; ///< average per-run standard error reported by the runs
+    double coverage = 0.0;          ///< share of replicates whose own 95% interval covers exact
+    double mean_run_se = 0.0;       ///< average per-run standard error reported by the runs
     double mean_run_variance = 0.0; ///< average of the runs' se^2 (finite ones)
     double run_dof_total = 0.0;     ///< the runs' error-bar degrees of freedom, summed
-    int run_dof = 0;          ///< degrees of freedom of the runs' error bars (RunResult::dof)
-    double time_mean = 0.0;   ///< seconds per estimate
+    int run_dof = 0;                ///< degrees of freedom of the runs' error bars (RunResult::dof)
+    double time_mean = 0.0;         ///< seconds per estimate
     double time_total = 0.0;
     /// Adaptive estimators: mean share of the calls and mean seconds per estimate spent
     /// training (VEGAS) or probing (MISER), included in n and time_mean.
