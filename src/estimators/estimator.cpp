@@ -169,7 +169,7 @@ class FixedEstimator final : public EstimatorAlgorithm {
 
     RunResult result() const override {
         const double scale =
-            problem_.quantity == Quantity::Mean ? 1.0 / problem_.domain.measure() : 1.0;
+            quantity_scale(problem_);
         RunResult r = accumulator_.finish(scale);
         r.n = plan_.total;
         return r;
@@ -311,7 +311,7 @@ class VegasEstimator final : public EstimatorAlgorithm {
   private:
     RunResult finish_round() const {
         const double scale =
-            problem_.quantity == Quantity::Mean ? 1.0 / problem_.domain.measure() : 1.0;
+            quantity_scale(problem_);
         return accumulator_.finish(scale);
     }
 

@@ -131,7 +131,7 @@ class MisEstimator final : public EstimatorAlgorithm {
 
     RunResult result() const override {
         const double scale =
-            problem_.quantity == Quantity::Mean ? 1.0 / problem_.domain.measure() : 1.0;
+            quantity_scale(problem_);
         RunResult r = accumulator_.finish(scale);
         r.n = total_;
         if (options_.optimal) {

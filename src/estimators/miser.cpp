@@ -55,7 +55,7 @@ class MiserEstimator final : public EstimatorAlgorithm {
         region(std::vector<double>(static_cast<size_t>(dim_), 0.0),
                std::vector<double>(static_cast<size_t>(dim_), 1.0), total_, 0);
         const double unit =
-            problem_.quantity == Quantity::Mean ? 1.0 / problem_.domain.measure() : 1.0;
+            quantity_scale(problem_);
         result_ = accumulator_.finish(unit);
         result_.estimate = unit * strata_.estimate();
         result_.std_error = strata_.has_variance() ? unit * std::sqrt(strata_.variance())

@@ -58,6 +58,11 @@ struct Problem {
     std::optional<double> exact;
 };
 
+/// The factor from the integral to the reported quantity: 1, or 1 / measure for a mean.
+inline double quantity_scale(const Problem& p) {
+    return p.quantity == Quantity::Mean ? 1.0 / p.domain.measure() : 1.0;
+}
+
 enum class ProposalKind {
     UniformBox,       ///< x = lo + (hi - lo) u
     DiskPolar,        ///< course-notes polar map

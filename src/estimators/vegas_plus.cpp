@@ -213,7 +213,7 @@ class VegasPlusEstimator final : public EstimatorAlgorithm {
             return;
         }
         const double scale =
-            problem_.quantity == Quantity::Mean ? 1.0 / problem_.domain.measure() : 1.0;
+            quantity_scale(problem_);
         final_result_ = accumulator_.finish(scale);
         final_result_.estimate = scale * strata.estimate();
         final_result_.std_error = strata.has_variance() ? scale * std::sqrt(strata.variance())

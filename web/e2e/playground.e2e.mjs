@@ -74,6 +74,23 @@ function cliFits(scene, estimators, settings) {
   return Object.fromEntries(result.estimators.map((e) => [e.name, e.fit]));
 }
 
+/** Runs a study in the page and checks that each estimator's fitted order, as the legend shows
+ *  it, is the CLI's for the same scene and settings; returns the CLI's fits. */
+async function runAndMatchFits(scene, estimators, settings) {
+  await configure(scene, estimators, settings);
+  await page.click('#run');
+  await page.waitForFunction(() => document.querySelector('#status')?.textContent.startsWith('done'), null,
+    { timeout: 60000 });
+  const fits = cliFits(scene, estimators, settings);
+  for (const name of estimators) {
+    assert.ok(fits[name].valid, `${name}: the CLI has no fit (${fits[name].note})`);
+    const text = await page.textContent(`[data-fit="${name}"]`);
+    const shown = Number(text.match(/-?\d+\.\d{3}/)?.[0]);
+    assert.equal(shown.toFixed(3), fits[name].order.toFixed(3), `${name}: page ${shown} vs CLI ${fits[name].order}`);
+  }
+  return fits;
+}
+
 async function configure(scene, estimators, settings) {
   const before = await page.evaluate(() => window.mcplayDebug.state().sceneInfo?.name);
   // Selecting the scene already shown would draw its estimator list again under our feet.
@@ -169,16 +186,7 @@ test('randomized QMC: presets a scene does not list are offered; a sobol study a
   }
   const settings = { nMin: 16, nMax: 4096, reps: 16, seed: 1 };
   const estimators = ['uniform', 'sobol'];
-  await configure('sin_product_2d', estimators, settings);
-  await page.click('#run');
-  await page.waitForFunction(() => document.querySelector('#status')?.textContent.startsWith('done'), null,
-    { timeout: 60000 });
-  const fits = cliFits('sin_product_2d', estimators, settings);
-  for (const name of estimators) {
-    const text = await page.textContent(`[data-fit="${name}"]`);
-    const shown = Number(text.match(/-?\d+\.\d{3}/)?.[0]);
-    assert.equal(shown.toFixed(3), fits[name].order.toFixed(3), `${name}: page ${shown} vs CLI ${fits[name].order}`);
-  }
+  const fits = await runAndMatchFits('sin_product_2d', estimators, settings);
   // Scrambled Sobol' points on a smooth integrand: far steeper than 1/N.
   assert.ok(fits.sobol.order < -2, `sobol order ${fits.sobol.order} is not below -2`);
   // The sample view draws the first replicate's Sobol' points.
@@ -192,17 +200,7 @@ test('randomized QMC: presets a scene does not list are offered; a sobol study a
 test('adaptive estimators: a VEGAS and a MISER study, and their map and boxes in the sample view', async () => {
   const settings = { nMin: 1024, nMax: 16384, reps: 8, seed: 1 };
   const estimators = ['vegas', 'miser'];
-  await configure('vegas_corner_peak', estimators, settings);
-  await page.click('#run');
-  await page.waitForFunction(() => document.querySelector('#status')?.textContent.startsWith('done'), null,
-    { timeout: 60000 });
-  const fits = cliFits('vegas_corner_peak', estimators, settings);
-  for (const name of estimators) {
-    assert.ok(fits[name].valid, `${name}: the CLI has no fit (${fits[name].note})`);
-    const text = await page.textContent(`[data-fit="${name}"]`);
-    const shown = Number(text.match(/-?\d+\.\d{3}/)?.[0]);
-    assert.equal(shown.toFixed(3), fits[name].order.toFixed(3), `${name}: page ${shown} vs CLI ${fits[name].order}`);
-  }
+  await runAndMatchFits('vegas_corner_peak', estimators, settings);
   // The sample view: the estimate's points, VEGAS's trained map and MISER's leaf boxes.
   await page.waitForFunction(() => {
     const s = window.mcplayDebug.state().samples;
@@ -228,17 +226,7 @@ test('adaptive estimators: a VEGAS and a MISER study, and their map and boxes in
 test('multiple importance sampling: a study of the heuristics and each technique\'s weight over x', async () => {
   const settings = { nMin: 256, nMax: 4096, reps: 8, seed: 1 };
   const estimators = ['mis_balance', 'mis_optimal'];
-  await configure('mis_peak_and_plateau_1d', estimators, settings);
-  await page.click('#run');
-  await page.waitForFunction(() => document.querySelector('#status')?.textContent.startsWith('done'), null,
-    { timeout: 60000 });
-  const fits = cliFits('mis_peak_and_plateau_1d', estimators, settings);
-  for (const name of estimators) {
-    assert.ok(fits[name].valid, `${name}: the CLI has no fit (${fits[name].note})`);
-    const text = await page.textContent(`[data-fit="${name}"]`);
-    const shown = Number(text.match(/-?\d+\.\d{3}/)?.[0]);
-    assert.equal(shown.toFixed(3), fits[name].order.toFixed(3), `${name}: page ${shown} vs CLI ${fits[name].order}`);
-  }
+  await runAndMatchFits('mis_peak_and_plateau_1d', estimators, settings);
   // The MIS weights: two techniques per estimator, drawn below the densities.
   await page.waitForFunction(() => !document.querySelector('#misweights-block')?.hidden
     && document.querySelectorAll('#legend-misweights li').length === 4, null, { timeout: 20000 });
