@@ -287,19 +287,14 @@ std::set<std::string> warning_codes(const EstimatorStudy& e, const LevelStats& l
 // A confident wrong answer is a replicate whose own interval misses the exact value by more
 // than 5 standard errors (in units of its own interval, widened by t at small N) while nothing
 // warns. No estimator of any stiff scene may give one.
-class StiffScene : public ::testing::TestWithParam<const char*> {};
-
-TEST_P(StiffScene, NoConfidentWrongAnswer) {
-    SceneRequest req =
-        load(GetParam(), Json{{"n_min", 16}, {"n_max", 16384}, {"reps", 16}, {"seed", 99}});
+void expect_no_confident_wrong_answer(const char* scene, const Json& options) {
+    SceneRequest req = load(scene, options);
     ASSERT_TRUE(req.problem.exact.has_value());
     const double exact = *req.problem.exact;
     StudyResult s = run(req);
-    int warned = 0;
     for (const EstimatorStudy& e : s.estimators)
         for (const LevelStats& l : e.levels) {
             std::set<std::string> codes = warning_codes(e, l, s.settings);
-            warned += !codes.empty();
             for (size_t r = 0; r < l.estimates.size(); ++r) {
                 const double miss = std::fabs(l.estimates[r] - exact);
                 const double se = l.run_std_errors[r];
@@ -308,11 +303,17 @@ TEST_P(StiffScene, NoConfidentWrongAnswer) {
                 const double z = 5.0 * interval_quantile(l.run_dof) / interval_quantile(0);
                 const bool confident_and_wrong = !(miss <= z * se + 1e-12 * std::fabs(exact));
                 EXPECT_FALSE(confident_and_wrong && codes.empty())
-                    << GetParam() << " / " << e.spec.name << " N=" << l.n << " replicate " << r
+                    << scene << " / " << e.spec.name << " N=" << l.n << " replicate " << r
                     << ": estimate " << l.estimates[r] << " +/- " << se << ", exact " << exact;
             }
         }
-    (void)warned;
+}
+
+class StiffScene : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(StiffScene, NoConfidentWrongAnswer) {
+    expect_no_confident_wrong_answer(
+        GetParam(), Json{{"n_min", 16}, {"n_max", 16384}, {"reps", 16}, {"seed", 99}});
 }
 
 INSTANTIATE_TEST_SUITE_P(StiffScenes, StiffScene,
@@ -331,28 +332,32 @@ INSTANTIATE_TEST_SUITE_P(StiffScenes, StiffScene,
 class StiffSceneAdaptive : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(StiffSceneAdaptive, NoConfidentWrongAnswer) {
-    SceneRequest req = load(GetParam(), Json{{"n_min", 1024},
-                                             {"n_max", 65536},
-                                             {"reps", 16},
-                                             {"seed", 77},
-                                             {"estimators", {"vegas", "miser"}}});
-    ASSERT_TRUE(req.problem.exact.has_value());
-    const double exact = *req.problem.exact;
-    StudyResult s = run(req);
-    for (const EstimatorStudy& e : s.estimators)
-        for (const LevelStats& l : e.levels) {
-            std::set<std::string> codes = warning_codes(e, l, s.settings);
-            for (size_t r = 0; r < l.estimates.size(); ++r) {
-                const double miss = std::fabs(l.estimates[r] - exact);
-                const double z = 5.0 * interval_quantile(l.run_dof) / interval_quantile(0);
-                const bool confident_and_wrong =
-                    !(miss <= z * l.run_std_errors[r] + 1e-12 * std::fabs(exact));
-                EXPECT_FALSE(confident_and_wrong && codes.empty())
-                    << GetParam() << " / " << e.spec.name << " N=" << l.n << " replicate " << r
-                    << ": estimate " << l.estimates[r] << " +/- " << l.run_std_errors[r]
-                    << ", exact " << exact;
-            }
-        }
+    expect_no_confident_wrong_answer(GetParam(), Json{{"n_min", 1024},
+                                                      {"n_max", 65536},
+                                                      {"reps", 16},
+                                                      {"seed", 77},
+                                                      {"estimators", {"vegas", "miser"}}});
+}
+
+// The MIS scenes' combinations, from N = 16: no confident wrong answer. (Their single
+// techniques are there to fail: the narrow ones are flagged, and uniform points at small N miss
+// a narrow feature with no possible flag, as the defensive mixture's 20% of them miss the
+// ridge outside the spot at N = 16.)
+TEST(MisScenes, NoConfidentWrongAnswer) {
+    expect_no_confident_wrong_answer(
+        "mis_peak_and_plateau_1d",
+        Json{{"n_min", 16},
+             {"n_max", 16384},
+             {"reps", 16},
+             {"seed", 99},
+             {"estimators",
+              {"mis_balance", "mis_power", "mis_maximum", "mis_one_sample", "mis_optimal"}}});
+    expect_no_confident_wrong_answer(
+        "mis_ridge_and_spot_2d", Json{{"n_min", 16},
+                                      {"n_max", 16384},
+                                      {"reps", 16},
+                                      {"seed", 99},
+                                      {"estimators", {"mis_balance", "mis_power", "mis_optimal"}}});
 }
 
 INSTANTIATE_TEST_SUITE_P(StiffScenes, StiffSceneAdaptive,
