@@ -322,7 +322,8 @@ INSTANTIATE_TEST_SUITE_P(StiffScenes, StiffScene,
                                            "is_near_zero_pdf", "is_zero_pdf", "oscillatory_cos1000",
                                            "offset_1e8_sin", "heavy_tail_abs", "genz_gaussian_32d",
                                            "genz_oscillatory_64d", "genz_corner_peak_12d",
-                                           "vegas_corner_peak", "miser_discontinuous"));
+                                           "vegas_corner_peak", "miser_discontinuous",
+                                           "singular_product_2d", "genz_product_peak_6d"));
 
 // The adaptive estimators with independent points (VEGAS's frozen map, MISER's plain leaves) on
 // the stiff scenes: no confident wrong answer either. vegas_sobol and vegas_plus are not here:
