@@ -83,10 +83,29 @@ AdaptiveView view_of(const VegasMap& map);
 constexpr int kViewIterations = 100;
 constexpr int kViewEdges = 64;
 
-/// Appends the map as a history snapshot (the first two axes, thinned; see AdaptiveView) when
-/// snapshot `iteration` of `iterations` + 1 is among the kept ones.
-void record_history(const VegasMap& map, int iteration, int iterations,
-                    std::vector<std::vector<std::vector<double>>>* history);
+/// What a VEGAS run (plain or VEGAS+) spends on training and learns there: the calls and seconds
+/// (RunResult::training_n, training_seconds) and, when recording, the map before training and
+/// after each iteration (AdaptiveView::history: the first two axes, thinned). Per iteration,
+/// never per sample.
+class TrainingLog {
+  public:
+    void begin(const VegasMap& map, int iterations, bool record);
+    void trained(uint64_t calls) { calls_ += calls; }
+    /// After training iteration `iteration` (1-based) adapted the map.
+    void adapted(const VegasMap& map, int iteration);
+    /// Training is over (the first call counts).
+    void end_training();
+    void report(RunResult* r) const;
+    void add_history(AdaptiveView* view) const { view->history = history_; }
+
+  private:
+    void record(const VegasMap& map, int iteration);
+    bool record_ = false, ended_ = false;
+    int iterations_ = 0;
+    uint64_t calls_ = 0;
+    double start_ = 0.0, seconds_ = 0.0;
+    std::vector<std::vector<std::vector<double>>> history_;
+};
 
 class EstimatorAlgorithm {
   public:

@@ -118,11 +118,37 @@ AdaptiveView view_of(const VegasMap& map) {
     return v;
 }
 
-void record_history(const VegasMap& map, int iteration, int iterations,
-                    std::vector<std::vector<std::vector<double>>>* history) {
+void TrainingLog::begin(const VegasMap& map, int iterations, bool record) {
+    record_ = record;
+    ended_ = false;
+    iterations_ = iterations;
+    calls_ = 0;
+    start_ = clock_seconds();
+    seconds_ = 0.0;
+    history_.clear();
+    this->record(map, 0);
+}
+
+void TrainingLog::adapted(const VegasMap& map, int iteration) {
+    record(map, iteration);
+}
+
+void TrainingLog::end_training() {
+    if (ended_) return;
+    ended_ = true;
+    seconds_ = clock_seconds() - start_;
+}
+
+void TrainingLog::report(RunResult* r) const {
+    r->training_n = calls_;
+    r->training_seconds = calls_ > 0 ? seconds_ : 0.0;
+}
+
+void TrainingLog::record(const VegasMap& map, int iteration) {
+    if (!record_) return;
     // Snapshots 0 .. iterations; keep about kViewIterations of them, evenly, and the last.
-    const int stride = std::max(1, (iterations + kViewIterations - 1) / kViewIterations);
-    if (iteration % stride != 0 && iteration != iterations) return;
+    const int stride = std::max(1, (iterations_ + kViewIterations - 1) / kViewIterations);
+    if (iteration % stride != 0 && iteration != iterations_) return;
     const int k = map.increments();
     const int step = std::max(1, (k + kViewEdges - 1) / kViewEdges);
     std::vector<std::vector<double>> axes;
@@ -132,7 +158,7 @@ void record_history(const VegasMap& map, int iteration, int iterations,
         if ((k % step) != 0) e.push_back(map.edges(j)[k]);
         axes.push_back(e);
     }
-    history->push_back(axes);
+    history_.push_back(axes);
 }
 
 namespace {
@@ -168,8 +194,7 @@ class FixedEstimator final : public EstimatorAlgorithm {
     }
 
     RunResult result() const override {
-        const double scale =
-            quantity_scale(problem_);
+        const double scale = quantity_scale(problem_);
         RunResult r = accumulator_.finish(scale);
         r.n = plan_.total;
         return r;
@@ -229,11 +254,7 @@ class VegasEstimator final : public EstimatorAlgorithm {
         next_ = 0;
         plan_ready_ = false;
         prepared_ = false;
-        trained_n_ = 0;
-        training_start_ = clock_seconds();
-        training_seconds_ = 0.0;
-        history_.clear();
-        if (observer_) record_history(map_, 0, iterations_, &history_);
+        log_.begin(map_, iterations_, static_cast<bool>(observer_));
         jacobian_.assign(kBlockSize, 1.0);
         bins_.assign(static_cast<size_t>(dim) * kBlockSize, 0);
     }
@@ -251,7 +272,7 @@ class VegasEstimator final : public EstimatorAlgorithm {
                 plan_ = make_sampler_plan(SamplerKind::Independent, dim, size, rng, {});
             } else {
                 if (final_ == 0 || round_ >= rounds_) return false;
-                if (round_ == 0) training_seconds_ = clock_seconds() - training_start_;
+                log_.end_training();
                 const uint64_t size = part_of(final_, rounds_, round_);
                 plan_ = make_sampler_plan(spec_.sampler, dim, size, rng, spec_.sampler_options());
                 accumulator_.reset(error_method_for(spec_), plan_, float32_);
@@ -271,11 +292,11 @@ class VegasEstimator final : public EstimatorAlgorithm {
             for (size_t i = 0; i < count; ++i) jacobian_[i] = ws.f[i] / ws.pdf[i]; // weights
             map_.add_training(bins_.data(), jacobian_.data(), count);
             next_ += count;
-            trained_n_ += count;
+            log_.trained(count);
             if (next_ == plan_.total) {
                 map_.adapt(spec_.vegas_options.alpha, spec_.vegas_options.uniform_share);
                 ++iteration_;
-                if (observer_) record_history(map_, iteration_, iterations_, &history_);
+                log_.adapted(map_, iteration_);
                 plan_ready_ = false;
             }
             return true;
@@ -297,21 +318,19 @@ class VegasEstimator final : public EstimatorAlgorithm {
     RunResult result() const override {
         RunResult r = rounds_done_.size() == 1 ? rounds_done_[0] : average(rounds_done_);
         r.n = total_;
-        r.training_n = trained_n_;
-        r.training_seconds = training_seconds_;
+        log_.report(&r);
         return r;
     }
 
     AdaptiveView adaptive_view() const override {
         AdaptiveView v = view_of(map_);
-        v.history = history_;
+        log_.add_history(&v);
         return v;
     }
 
   private:
     RunResult finish_round() const {
-        const double scale =
-            quantity_scale(problem_);
+        const double scale = quantity_scale(problem_);
         return accumulator_.finish(scale);
     }
 
@@ -365,12 +384,11 @@ class VegasEstimator final : public EstimatorAlgorithm {
     const Problem& problem_;
     const EstimatorSpec& spec_;
     bool float32_;
-    uint64_t total_ = 0, train_ = 0, final_ = 0, next_ = 0, trained_n_ = 0;
-    double training_start_ = 0.0, training_seconds_ = 0.0;
+    uint64_t total_ = 0, train_ = 0, final_ = 0, next_ = 0;
+    TrainingLog log_;
     int iterations_ = 0, iteration_ = 0; // training iterations
     int rounds_ = 1, round_ = 0;         // estimation iterations (1 unless averaging)
     std::vector<RunResult> rounds_done_;
-    std::vector<std::vector<std::vector<double>>> history_;
     bool plan_ready_ = false, prepared_ = false;
     VegasMap map_;
     SamplerPlan plan_;

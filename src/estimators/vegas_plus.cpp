@@ -57,11 +57,7 @@ class VegasPlusEstimator final : public EstimatorAlgorithm {
         planned_ = false;
         prepared_ = false;
         finished_final_ = false;
-        trained_n_ = 0;
-        training_start_ = clock_seconds();
-        training_seconds_ = 0.0;
-        history_.clear();
-        if (observer_) record_history(map_, 0, iterations_, &history_);
+        log_.begin(map_, iterations_, static_cast<bool>(observer_));
         jacobian_.assign(kBlockSize, 1.0);
         importance_.assign(kBlockSize, 1.0);
         weight_.assign(kBlockSize, 0.0);
@@ -77,7 +73,7 @@ class VegasPlusEstimator final : public EstimatorAlgorithm {
         const bool training = iteration_ < iterations_;
         if (!planned_) {
             if (!training && finished_final_) return false;
-            if (!training) training_seconds_ = clock_seconds() - training_start_;
+            if (!training) log_.end_training();
             start_iteration(training ? part_of(train_, iterations_, iteration_) : final_, rng,
                             training);
         }
@@ -118,7 +114,7 @@ class VegasPlusEstimator final : public EstimatorAlgorithm {
         }
         if (training) {
             map_.add_training(bins_.data(), weight_.data(), importance_.data(), count);
-            trained_n_ += count;
+            log_.trained(count);
         } else {
             // The accumulator sees the weights scaled by V N / n_h (its plain mean is then the
             // stratified estimate), for its diagnostics: non-finite and zero-pdf counts, the
@@ -133,15 +129,14 @@ class VegasPlusEstimator final : public EstimatorAlgorithm {
 
     AdaptiveView adaptive_view() const override {
         AdaptiveView v = view_of(map_);
-        v.history = history_;
+        log_.add_history(&v);
         return v;
     }
 
     RunResult result() const override {
         RunResult r = final_result_;
         r.n = total_;
-        r.training_n = trained_n_;
-        r.training_seconds = training_seconds_;
+        log_.report(&r);
         return r;
     }
 
@@ -209,11 +204,10 @@ class VegasPlusEstimator final : public EstimatorAlgorithm {
         if (training) {
             map_.adapt(spec_.vegas_options.alpha, spec_.vegas_options.uniform_share);
             ++iteration_;
-            if (observer_) record_history(map_, iteration_, iterations_, &history_);
+            log_.adapted(map_, iteration_);
             return;
         }
-        const double scale =
-            quantity_scale(problem_);
+        const double scale = quantity_scale(problem_);
         final_result_ = accumulator_.finish(scale);
         final_result_.estimate = scale * strata.estimate();
         final_result_.std_error = strata.has_variance() ? scale * std::sqrt(strata.variance())
@@ -230,9 +224,7 @@ class VegasPlusEstimator final : public EstimatorAlgorithm {
     uint64_t per_axis_ = 1, cubes_ = 1, cube_ = 0, left_in_cube_ = 0;
     int iterations_ = 0, iteration_ = 0;
     bool planned_ = false, prepared_ = false, finished_final_ = false;
-    uint64_t trained_n_ = 0;
-    double training_start_ = 0.0, training_seconds_ = 0.0;
-    std::vector<std::vector<std::vector<double>>> history_;
+    TrainingLog log_;
     VegasMap map_;
     Pcg32 jitter_;
     std::vector<uint64_t> digits_, allocation_;
