@@ -118,7 +118,9 @@ class MisEstimator final : public EstimatorAlgorithm {
             const double* columns[kMaxMisTechniques + 1];
             for (size_t k = 0; k < static_cast<size_t>(techniques_); ++k) {
                 double* z = density_.data() + k * kBlockSize;
-                for (size_t i = 0; i < count; ++i) z[i] /= mixture_[i];
+                // (A point whose every density is 0, at a warp's edge, has y = 0: left out.)
+                for (size_t i = 0; i < count; ++i)
+                    z[i] = mixture_[i] > 0.0 ? z[i] / mixture_[i] : 0.0;
                 columns[k] = z;
             }
             columns[techniques_] = y;
@@ -130,8 +132,7 @@ class MisEstimator final : public EstimatorAlgorithm {
     }
 
     RunResult result() const override {
-        const double scale =
-            quantity_scale(problem_);
+        const double scale = quantity_scale(problem_);
         RunResult r = accumulator_.finish(scale);
         r.n = total_;
         if (options_.optimal) {
