@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "core/distributions.h"
+#include "core/float_index.h"
 #include "core/rng.h"
 #include "core/special.h"
 #include "test_support.h"
@@ -797,5 +798,30 @@ TEST(Tabulated2D, FactoryRejectsBadInput) {
         EXPECT_FALSE(b.made.ok()) << "expected an error containing: " << b.expect;
         EXPECT_NE(b.made.error.find(b.expect), std::string::npos)
             << "message: " << b.made.error << "\nexpected to contain: " << b.expect;
+    }
+}
+
+// floor_to_index (core/float_index.h), the conversion the tabulated and VEGAS kernels use:
+// equal to std::floor on [0, 2^31) at integers, one ulp either side of them, halves (where
+// round-to-nearest-even would go the wrong way) and random values of every magnitude.
+TEST(FloorToIndex, EqualsFloorOnItsRange) {
+    auto check = [](double x) {
+        ASSERT_EQ(floor_to_index(x), static_cast<uint32_t>(std::floor(x))) << "x = " << x;
+    };
+    for (double k : {0.0, 1.0, 2.0, 3.0, 15.0, 16.0, 1023.0, 4194303.0, 2147483646.0}) {
+        check(k);
+        check(std::nextafter(k, 1e300));
+        if (k > 0.0) check(std::nextafter(k, 0.0));
+        check(k + 0.5);
+    }
+    check(std::nextafter(2147483648.0, 0.0));
+    check(std::numeric_limits<double>::denorm_min());
+    Pcg32 rng(7, 11);
+    for (int i = 0; i < 1000000; ++i) {
+        const double u = rng.next_double();
+        check(u);
+        check(u * 16.0);
+        check(u * 2147483648.0);
+        check(std::ldexp(u, -(i % 60)));
     }
 }

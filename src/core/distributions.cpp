@@ -20,6 +20,7 @@
 #include <limits>
 #include <utility>
 
+#include "core/float_index.h"
 #include "core/points.h"
 #include "core/special.h"
 #include "core/stats.h"
@@ -84,7 +85,7 @@ double bin_scale(double a, double b, size_t n) {
 size_t bin_of(double x, double a, double scale, size_t n) {
     double r = (x - a) * scale;
     if (!(r > 0.0)) return 0;
-    size_t i = r < static_cast<double>(n) ? static_cast<size_t>(r) : n - 1;
+    size_t i = r < static_cast<double>(n) ? floor_to_index(r) : n - 1;
     return std::min(i, n - 1);
 }
 
@@ -312,7 +313,7 @@ struct TabulatedK {
     size_t n;
     size_t bin_of_u(double u) const {
         const double scaled = u * static_cast<double>(n);
-        size_t i = guide[scaled < static_cast<double>(n) ? static_cast<size_t>(scaled) : n - 1];
+        size_t i = guide[scaled < static_cast<double>(n) ? floor_to_index(scaled) : n - 1];
         while (i > 0 && cdf_edges[i] > u) --i; // u n rounded up onto the next guide entry
         while (cdf_edges[i + 1] <= u) ++i;     // ends at i = n - 1 at the latest: cdf[n] = 1 > u
         return i;

@@ -4,6 +4,7 @@
 // for sincos_turns; tests/test_warps.cpp asserts 2).
 #pragma once
 
+#include "core/float_index.h"
 #include "core/special.h"
 
 namespace mcp {
@@ -49,14 +50,14 @@ inline SinCos sincos_quarter(double t) {
 }
 
 /// sin(2 pi u) and cos(2 pi u) for u in [0, 1]. The reduction is exact: 4u = q + f with q the
-/// nearest integer (the quarter turn; truncation of 4u + 1/2 >= 0) and |f| <= 1/2, f exact;
+/// nearest integer (the quarter turn; floor of 4u + 1/2 >= 0) and |f| <= 1/2, f exact;
 /// then t = f pi/2 is the one rounded step, and the quadrant rotates (sin, cos) of t:
 /// q = 0, 1, 2, 3 give (s, c), (c, -s), (-s, -c), (-c, s). More accurate than
 /// std::sin(2 pi u), which rounds 2 pi u first. The rotation is selects and exact sign
 /// flips, not a branch on the quadrant (random in a block loop, so mispredicted).
 inline SinCos sincos_turns(double u) {
     const double v = 4.0 * u;
-    const int q = static_cast<int>(v + 0.5);
+    const int q = static_cast<int>(floor_to_index(v + 0.5));
     const SinCos a = sincos_quarter((v - q) * (0.5 * kPi));
     const bool odd = (q & 1) != 0;
     const double sin_sign = (q & 2) != 0 ? -1.0 : 1.0;

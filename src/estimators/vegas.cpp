@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/float_index.h"
+
 namespace mcp {
 
 int vegas_increments(int dim, uint64_t points_per_iteration) {
@@ -37,7 +39,7 @@ void VegasMap::apply_block(PointBlock& points, double* jacobian, uint32_t* bins)
         uint32_t* bin = bins ? bins + static_cast<size_t>(j) * kBlockSize : nullptr;
         for (size_t i = 0; i < n; ++i) {
             const double t = y[i] * k; // y < 1, so t < K up to rounding
-            const int b = std::min(static_cast<int>(t), k_ - 1);
+            const int b = std::min(static_cast<int>(floor_to_index(t)), k_ - 1);
             const double width = e[b + 1] - e[b];
             y[i] = below_one(e[b] + (t - b) * width);
             jacobian[i] *= k * width;
