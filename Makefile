@@ -54,6 +54,7 @@ help:
 	@echo "make test   install what is missing, build native + wasm, run every test suite"
 	@echo "make bench  samples per second natively and in wasm under Node, and their ratio; then bench-genz"
 	@echo "make bench-genz  mcplay beside GSL plain/MISER/VEGAS on Genz's families (GENZ_ARGS=--quick: 15 s)"
+	@echo "make bench-qmc  mcplay's randomized QMC beside QMCPy's and scipy's on Genz 1, 4, 5 (pip venv in build/)"
 	@echo "make format clang-format every C++ source"
 	@echo "make test-sanitize  the native ctest suite under ASan + UBSan ($(BUILD_ASAN); part of make test)"
 	@echo "make fuzz   libFuzzer targets, $(FUZZ_SECONDS) s each (FUZZ_TARGETS=\"$(FUZZ_TARGETS)\"); docs/fuzzing.md"
@@ -165,6 +166,43 @@ bench-genz: deps deps-gsl $(BUILD)/CMakeCache.txt
 	cmake --build $(BUILD) -j $(JOBS) --target mcplay_api
 	$(MAKE) --no-print-directory $(BUILD)/genz_compare
 	set -o pipefail; $(BUILD)/genz_compare --json $(GENZ_JSON) $(GENZ_ARGS) | tee $(BUILD)/genz_compare.txt
+
+# ---------------------------------------------------------------------------
+# Randomized QMC beside QMCPy's and scipy's (docs/benchmarks.md): genz_compare writes the
+# cases' parameters, bench/qmc_tools.py runs the other tools on them (installed with pip into a
+# virtual environment under $(BUILD); nothing else uses it), genz_compare runs mcplay's RQMC
+# estimators and GSL's plain and MISER and prints all of them in one table.
+# QMC_REPS replicates per (case, method); `make bench-qmc QMC_REPS=5` for a fast look.
+.PHONY: bench-qmc deps-venv
+QMC_REPS ?= 40
+QMC_DIR := $(BUILD)/bench-qmc
+QMC_VENV := $(BUILD)/bench-venv
+QMC_CASES := --families 1,4,5 --dims 2,4,8,16
+
+deps-venv:
+	@if ! python3 -c 'import ensurepip, venv' 2>/dev/null; then \
+	  if [ "$$(id -u)" = 0 ]; then \
+	    apt-get update -q && DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends python3-venv; \
+	  else \
+	    echo "deps-venv: not root; run: sudo apt-get install -y --no-install-recommends python3-venv"; exit 1; \
+	  fi; \
+	fi
+
+$(QMC_VENV)/installed: | deps-venv
+	python3 -m venv $(QMC_VENV)
+	$(QMC_VENV)/bin/pip install -q qmcpy==2.4 scipy numpy
+	@touch $@
+
+bench-qmc: deps deps-gsl $(BUILD)/CMakeCache.txt $(QMC_VENV)/installed
+	cmake --build $(BUILD) -j $(JOBS) --target mcplay_api
+	$(MAKE) --no-print-directory $(BUILD)/genz_compare
+	rm -rf $(QMC_DIR)/params && $(BUILD)/genz_compare $(QMC_CASES) --write-params $(QMC_DIR)/params
+	$(QMC_VENV)/bin/python bench/qmc_tools.py $(QMC_DIR)/params --n 1048576 --reps $(QMC_REPS) \
+	  > $(QMC_DIR)/tools.jsonl
+	set -o pipefail; $(BUILD)/genz_compare $(QMC_CASES) --params-dir $(QMC_DIR)/params \
+	  --external $(QMC_DIR)/tools.jsonl --n 1048576 --reps $(QMC_REPS) --gsl plain,miser \
+	  --methods sobol,sobol:lms_shift,sobol:digital_shift,lattice,halton \
+	  --json $(QMC_DIR)/compare.jsonl | tee $(QMC_DIR)/compare.txt
 
 format:
 	clang-format -i $$(git ls-files '*.cpp' '*.h')

@@ -5,6 +5,7 @@
 //   genz_compare [--quick] [--n N] [--reps R] [--dims 2,4,8,16] [--families 1,...,6]
 //                [--methods uniform,stratified,...] [--gsl plain,miser,vegas|none]
 //                [--param-seed S] [--seed S] [--params-dir DIR] [--json FILE]
+//                [--write-params DIR] [--external FILE.jsonl]
 //
 // Both sides evaluate mcplay's Genz code: GSL calls genz_evaluate_point (one point per call,
 // the only interface GSL has), mcplay runs its own block path (run_estimate ->
@@ -16,8 +17,15 @@
 //   t_med     median wall seconds per estimate (setup included)
 //   eff       1 / (rel_rmse^2 t_med): higher is better
 //   calls/N   integrand calls actually made / N (mean)
+//   eff_sig   1 / (mean(sigma^2) / I^2 t_med): efficiency from the mean reported variance,
+//             which for randomized QMC (K randomizations per estimate) pools R (K - 1) degrees
+//             of freedom where the RMSE has R; shown beside eff when the error bars are honest
 // A reported sigma of 0, NaN or infinity, and a non-finite estimate, are counted and shown in
 // the notes column; they make sig/rmse or rel_rmse NaN rather than being dropped.
+//
+// Other tools join the same tables through --external: JSON lines {"tool", "method", "case",
+// "estimate", "reported_sigma", "calls", "seconds"} for cases named as --write-params names
+// them (bench/qmc_tools.py writes QMCPy's and scipy's; `make bench-qmc` runs the three steps).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -68,14 +76,13 @@ struct Options {
     std::vector<int> dims{2, 4, 8, 16};
     std::vector<int> families{1, 2, 3, 4, 5, 6};
     bool dims_given = false, families_given = false;
-    std::vector<std::string> methods{"uniform", "stratified", "latin_hypercube",
-                                     "sobol",   "halton",     "lattice",
-                                     "vegas",   "vegas_sobol", "vegas_plus",
-                                     "miser"};
+    std::vector<std::string> methods{"uniform",    "stratified", "latin_hypercube", "sobol",
+                                     "halton",     "lattice",    "vegas",           "vegas_sobol",
+                                     "vegas_plus", "miser"};
     std::vector<std::string> gsl{"plain", "miser", "vegas"};
     uint64_t param_seed = 1; // genz_random(family, d, param_seed)
     uint64_t seed = 1;       // replicate seeds
-    std::string params_dir, json_path;
+    std::string params_dir, json_path, write_params_dir, external_path;
     bool quick = false;
 };
 
@@ -94,7 +101,8 @@ std::vector<std::string> split(const std::string& s, char separator = ',') {
                  "usage: genz_compare [--quick] [--n N] [--reps R] [--dims 2,4,8,16]\n"
                  "         [--families 1,2,3,4,5,6 | oscillatory,...] [--methods PRESET,...]\n"
                  "         [--gsl plain,miser,vegas|none] [--param-seed S] [--seed S]\n"
-                 "         [--params-dir DIR] [--json FILE]\n");
+                 "         [--params-dir DIR] [--json FILE] [--write-params DIR]\n"
+                 "         [--external FILE.jsonl]\n");
     std::exit(2);
 }
 
@@ -166,6 +174,10 @@ Options parse_options(int argc, char** argv) {
             o.params_dir = value();
         else if (a == "--json")
             o.json_path = value();
+        else if (a == "--write-params")
+            o.write_params_dir = value();
+        else if (a == "--external")
+            o.external_path = value();
         else if (a == "-h" || a == "--help")
             usage(nullptr);
         else
@@ -184,6 +196,7 @@ Options parse_options(int argc, char** argv) {
 
 struct Case {
     std::string label; // "oscillatory d=2" (+ file name in --params-dir mode)
+    std::string name;  // "f1_d2", or the file's stem in --params-dir mode
     int family = 1;    // 1..6
     GenzParams params;
     double exact = kNaN;        // the value errors are measured against
@@ -200,6 +213,7 @@ std::vector<Case> random_cases(const Options& o) {
             c.params = genz_random(GenzFamily(fam - 1), d, o.param_seed);
             c.mcplay_exact = c.exact = genz_exact(c.params);
             c.label = std::string(kFamilyNames[fam - 1]) + " d=" + std::to_string(d);
+            c.name = "f" + std::to_string(fam) + "_d" + std::to_string(d);
             c.source = "genz_random(" + std::string(kFamilyNames[fam - 1]) + ", " +
                        std::to_string(d) + ", seed " + std::to_string(o.param_seed) + ")";
             cases.push_back(c);
@@ -265,6 +279,7 @@ std::vector<Case> file_cases(const Options& o) {
         c.label = std::string(kFamilyNames[fam - 1]) + " d=" + std::to_string(d) + " (" +
                   p.stem().string() + ")";
         c.source = p.string();
+        c.name = p.stem().string();
         cases.push_back(c);
     }
     std::stable_sort(cases.begin(), cases.end(), [](const Case& x, const Case& y) {
@@ -371,15 +386,88 @@ Estimate run_gsl(const std::string& method, const GenzParams& p, uint64_t n, gsl
     return e;
 }
 
+/// Writes one params file per case, in the format --params-dir reads (and other tools'
+/// harnesses: bench/qmc_tools.py), named after the case.
+void write_params(const std::vector<Case>& cases, const std::string& dir) {
+    std::error_code ec;
+    std::filesystem::create_directories(dir, ec);
+    if (ec) usage(("--write-params " + dir + ": " + ec.message()).c_str());
+    for (const Case& c : cases) {
+        const Json j = {{"name", c.name},
+                        {"family", c.family},
+                        {"family_name", kFamilyNames[c.family - 1]},
+                        {"d", c.params.dim()},
+                        {"a", c.params.a},
+                        {"u", c.params.u},
+                        {"exact", c.exact},
+                        {"source", c.source}};
+        const std::string path = dir + "/" + c.name + ".json";
+        std::ofstream out(path);
+        out << j.dump() << "\n";
+        if (!out) usage(("--write-params: cannot write " + path).c_str());
+    }
+    std::printf("wrote %zu params files to %s\n", cases.size(), dir.c_str());
+}
+
+/// Estimates of other tools, JSON lines {"tool", "method", "case", "estimate",
+/// "reported_sigma", "calls", "seconds"}: by case name, then method, in file order. A line
+/// that is not such an object is reported and skipped; a non-finite value is kept (it shows
+/// as NaN in the tables, as for any tool).
+struct External {
+    std::map<std::string, std::map<std::string, std::vector<Estimate>>> by_case;
+    std::map<std::string, std::string> tool_of_method;
+};
+
+External read_external(const std::string& path) {
+    External ext;
+    std::ifstream in(path);
+    if (!in) usage(("--external: cannot read " + path).c_str());
+    std::string line;
+    size_t line_no = 0, skipped = 0;
+    auto number = [](const Json& v, const char* key) {
+        if (!v.contains(key)) return kNaN;
+        const Json& x = v[key];
+        return x.is_number() ? x.get<double>() : kNaN;
+    };
+    while (std::getline(in, line)) {
+        ++line_no;
+        if (line.empty()) continue;
+        Made<Json> j = parse_json(line.c_str(), path.c_str());
+        const bool ok = j.ok() && j.value.is_object() && j.value.contains("tool") &&
+                        j.value["tool"].is_string() && j.value.contains("method") &&
+                        j.value["method"].is_string() && j.value.contains("case") &&
+                        j.value["case"].is_string();
+        if (!ok) {
+            if (++skipped <= 5)
+                std::printf("--external %s:%zu: skipped (needs \"tool\", \"method\", \"case\")\n",
+                            path.c_str(), line_no);
+            continue;
+        }
+        const Json& v = j.value;
+        Estimate e;
+        e.value = number(v, "estimate");
+        e.sigma = number(v, "reported_sigma");
+        e.seconds = number(v, "seconds");
+        const double calls = number(v, "calls");
+        e.calls = calls >= 0 && calls < 1e18 ? uint64_t(calls) : 0;
+        const std::string method = v["method"].get<std::string>();
+        ext.by_case[v["case"].get<std::string>()][method].push_back(e);
+        ext.tool_of_method[method] = v["tool"].get<std::string>();
+    }
+    if (skipped) std::printf("--external: %zu lines skipped\n", skipped);
+    return ext;
+}
+
 // ---------------------------------------------------------------------------------------
 // Statistics of one (case, method) cell
 
 struct Cell {
-    std::string method; // gsl_plain, ..., or the mcplay preset name
-    bool gsl = false;
+    std::string method; // gsl_plain, ..., the mcplay preset name, or an --external method
+    std::string tool;   // "mcplay", "gsl", or the --external line's "tool"
     std::vector<Estimate> reps;
     double rel_rmse = kNaN, rel_bias = kNaN, sig_rmse = kNaN, t_med = kNaN, eff = kNaN,
-           calls_frac = kNaN, chi2_med = kNaN;
+           eff_sig = kNaN, calls_frac = kNaN, chi2_med = kNaN;
+    bool mcplay() const { return tool == "mcplay"; }
     int cov2 = 0, sigma_zero = 0, sigma_nonfinite = 0, est_nonfinite = 0, bad_status = 0;
 };
 
@@ -391,13 +479,14 @@ double median(std::vector<double> v) {
 }
 
 void summarize(Cell& c, double exact, uint64_t n) {
-    double se2 = 0.0, bias = 0.0, sig = 0.0, calls = 0.0;
+    double se2 = 0.0, bias = 0.0, sig = 0.0, sig2 = 0.0, calls = 0.0;
     std::vector<double> secs, chi;
     for (const Estimate& e : c.reps) {
         const double err = e.value - exact;
         se2 += err * err; // NaN propagates: a non-finite estimate makes rel_rmse NaN
         bias += err;
         sig += e.sigma; // likewise a NaN sigma makes sig/rmse NaN
+        sig2 += e.sigma * e.sigma;
         if (std::fabs(err) <= 2.0 * e.sigma) ++c.cov2;
         if (e.sigma == 0.0) ++c.sigma_zero;
         if (!std::isfinite(e.sigma)) ++c.sigma_nonfinite;
@@ -414,6 +503,7 @@ void summarize(Cell& c, double exact, uint64_t n) {
     c.sig_rmse = (sig / R) / rmse;
     c.t_med = median(secs);
     c.eff = 1.0 / (c.rel_rmse * c.rel_rmse * c.t_med);
+    c.eff_sig = exact * exact / (sig2 / R * c.t_med);
     c.calls_frac = calls / R / double(n);
     c.chi2_med = median(chi);
 }
@@ -478,16 +568,25 @@ Json jnum(double x) {
 struct CaseResult {
     const Case* c;
     std::vector<Cell> cells;
-    int best_gsl = -1, best_mcplay = -1;
-    double ratio = kNaN;
+    int best_other = -1, best_mcplay = -1; // best eff of GSL and --external, best of mcplay
+    double ratio = kNaN, ratio_sig = kNaN;
 };
 
-int best_of(const std::vector<Cell>& cells, bool gsl) {
+int best_of(const std::vector<Cell>& cells, bool mcplay) {
     int best = -1;
     for (size_t i = 0; i < cells.size(); ++i) {
-        if (cells[i].gsl != gsl || std::isnan(cells[i].eff)) continue;
+        if (cells[i].mcplay() != mcplay || std::isnan(cells[i].eff)) continue;
         if (best < 0 || cells[i].eff > cells[size_t(best)].eff) best = int(i);
     }
+    return best;
+}
+
+/// The highest eff_sig among one side's cells whose error bars are not over-confident (an
+/// over-confident sigma says nothing about the variance); NaN if there is none.
+double best_eff_sig(const std::vector<Cell>& cells, bool mcplay) {
+    double best = kNaN;
+    for (const Cell& c : cells)
+        if (c.mcplay() == mcplay && !overconfident(c) && !(c.eff_sig <= best)) best = c.eff_sig;
     return best;
 }
 
@@ -550,6 +649,11 @@ int main(int argc, char** argv) {
     std::fflush(stdout);
     std::vector<Case> cases = from_files ? file_cases(o) : random_cases(o);
     if (cases.empty()) usage("no cases to run");
+    if (!o.write_params_dir.empty()) {
+        write_params(cases, o.write_params_dir);
+        return 0;
+    }
+    const External ext = o.external_path.empty() ? External() : read_external(o.external_path);
 
     // mcplay methods whose presets the scene API does not know are skipped, one line each.
     std::vector<std::string> methods;
@@ -588,7 +692,7 @@ int main(int argc, char** argv) {
         for (const std::string& g : o.gsl) {
             Cell cell;
             cell.method = "gsl_" + g;
-            cell.gsl = true;
+            cell.tool = "gsl";
             for (int rep = 0; rep < o.reps; ++rep) {
                 gsl_rng_set(rng, o.seed + uint64_t(rep));
                 cell.reps.push_back(run_gsl(g, cs.params, o.n, rng));
@@ -612,6 +716,7 @@ int main(int argc, char** argv) {
             }
             Cell cell;
             cell.method = m;
+            cell.tool = "mcplay";
             Workspace ws;
             for (int rep = 0; rep < o.reps; ++rep) {
                 Pcg32 prng(hash_combine(hash_combine(o.seed, ci), uint64_t(rep)),
@@ -627,11 +732,20 @@ int main(int argc, char** argv) {
             }
             cr.cells.push_back(cell);
         }
+        if (auto it = ext.by_case.find(cs.name); it != ext.by_case.end())
+            for (const auto& [method, reps] : it->second) {
+                Cell cell;
+                cell.method = method;
+                cell.tool = ext.tool_of_method.at(method);
+                cell.reps = reps;
+                cr.cells.push_back(cell);
+            }
         for (Cell& cell : cr.cells) summarize(cell, cs.exact, o.n);
-        cr.best_gsl = best_of(cr.cells, true);
-        cr.best_mcplay = best_of(cr.cells, false);
-        if (cr.best_gsl >= 0 && cr.best_mcplay >= 0)
-            cr.ratio = cr.cells[size_t(cr.best_mcplay)].eff / cr.cells[size_t(cr.best_gsl)].eff;
+        cr.best_other = best_of(cr.cells, false);
+        cr.best_mcplay = best_of(cr.cells, true);
+        if (cr.best_other >= 0 && cr.best_mcplay >= 0)
+            cr.ratio = cr.cells[size_t(cr.best_mcplay)].eff / cr.cells[size_t(cr.best_other)].eff;
+        cr.ratio_sig = best_eff_sig(cr.cells, true) / best_eff_sig(cr.cells, false);
 
         // Table for this case.
         std::printf("== %s: exact %.15e  [%s]\n", cs.label.c_str(), cs.exact, cs.source.c_str());
@@ -653,7 +767,7 @@ int main(int argc, char** argv) {
                          {"d", cs.params.dim()},
                          {"exact", jnum(cs.exact)},
                          {"method", c.method},
-                         {"tool", c.gsl ? "gsl" : "mcplay"},
+                         {"tool", c.tool},
                          {"N", o.n},
                          {"R", c.reps.size()},
                          {"rel_rmse", jnum(c.rel_rmse)},
@@ -662,6 +776,7 @@ int main(int argc, char** argv) {
                          {"cov2", c.cov2},
                          {"t_med", jnum(c.t_med)},
                          {"eff", jnum(c.eff)},
+                         {"eff_sig", jnum(c.eff_sig)},
                          {"calls_over_N", jnum(c.calls_frac)},
                          {"sigma_zero", c.sigma_zero},
                          {"sigma_nonfinite", c.sigma_nonfinite},
@@ -683,10 +798,10 @@ int main(int argc, char** argv) {
                       {"status", e.status}});
             }
         }
-        if (cr.best_gsl >= 0 && cr.best_mcplay >= 0) {
-            const Cell& g = cr.cells[size_t(cr.best_gsl)];
+        if (cr.best_other >= 0 && cr.best_mcplay >= 0) {
+            const Cell& g = cr.cells[size_t(cr.best_other)];
             const Cell& m = cr.cells[size_t(cr.best_mcplay)];
-            std::printf("   best GSL %s (eff %s), best mcplay %s (eff %s): mcplay/GSL %s\n\n",
+            std::printf("   best other %s (eff %s), best mcplay %s (eff %s): mcplay/other %s\n\n",
                         g.method.c_str(), fmt_e(g.eff, 1).c_str(), m.method.c_str(),
                         fmt_e(m.eff, 1).c_str(), fmt_e(cr.ratio, 1).c_str());
         } else
@@ -695,46 +810,52 @@ int main(int argc, char** argv) {
               {"case", cs.label},
               {"family", cs.family},
               {"d", cs.params.dim()},
-              {"best_gsl",
-               cr.best_gsl >= 0 ? Json(cr.cells[size_t(cr.best_gsl)].method) : Json(nullptr)},
+              {"best_other",
+               cr.best_other >= 0 ? Json(cr.cells[size_t(cr.best_other)].method) : Json(nullptr)},
               {"best_mcplay",
                cr.best_mcplay >= 0 ? Json(cr.cells[size_t(cr.best_mcplay)].method) : Json(nullptr)},
-              {"eff_ratio_mcplay_over_gsl", jnum(cr.ratio)}});
+              {"eff_ratio_mcplay_over_other", jnum(cr.ratio)},
+              {"eff_sig_ratio_mcplay_over_other", jnum(cr.ratio_sig)}});
         std::fflush(stdout);
         results.push_back(cr);
     }
     gsl_rng_free(rng);
 
-    // Summary: best GSL against best mcplay per case.
-    std::printf("== summary: best GSL method vs best mcplay method per case (efficiency "
+    // Summary: best of the other tools against best mcplay per case.
+    std::printf("== summary: best other method (GSL%s) vs best mcplay method per case (efficiency "
                 "1/(rel_rmse^2 t_med));\n"
                 "   after sig/rmse: '!' over-confident error bars (sig/rmse < 0.5 or cov2 < 70%%), "
                 "'^' pessimistic "
-                "ones (sig/rmse > 2)\n");
-    std::printf("   %-28s %-12s %9s %8s  %-16s %9s %8s  %10s\n", "case", "best GSL", "eff",
-                "sig/rmse", "best mcplay", "eff", "sig/rmse", "mcplay/GSL");
+                "ones (sig/rmse > 2);\n"
+                "   by_sigma: the same ratio from eff_sig, best honest cell of each side\n",
+                o.external_path.empty() ? "" : " and --external");
+    std::printf("   %-28s %-16s %9s %8s  %-16s %9s %8s  %11s %9s\n", "case", "best other", "eff",
+                "sig/rmse", "best mcplay", "eff", "sig/rmse", "mcplay/other", "by_sigma");
     double log_sum = 0.0;
-    int compared = 0, ahead = 0;
+    int compared = 0, ahead = 0, ahead_sig = 0;
     for (const CaseResult& cr : results) {
-        if (cr.best_gsl < 0 || cr.best_mcplay < 0) {
+        if (cr.best_other < 0 || cr.best_mcplay < 0) {
             std::printf("   %-28s (no comparison)\n", cr.c->label.c_str());
             continue;
         }
-        const Cell& g = cr.cells[size_t(cr.best_gsl)];
+        const Cell& g = cr.cells[size_t(cr.best_other)];
         const Cell& m = cr.cells[size_t(cr.best_mcplay)];
-        std::printf("   %-28s %-12s %9s %7s%s  %-16s %9s %7s%s  %10s\n", cr.c->label.c_str(),
+        std::printf("   %-28s %-16s %9s %7s%s  %-16s %9s %7s%s  %11s %9s\n", cr.c->label.c_str(),
                     g.method.c_str(), fmt_e(g.eff, 1).c_str(), fmt_f(g.sig_rmse, "%.2f").c_str(),
                     mark(g), m.method.c_str(), fmt_e(m.eff, 1).c_str(),
-                    fmt_f(m.sig_rmse, "%.2f").c_str(), mark(m), fmt_e(cr.ratio, 1).c_str());
+                    fmt_f(m.sig_rmse, "%.2f").c_str(), mark(m), fmt_e(cr.ratio, 1).c_str(),
+                    fmt_e(cr.ratio_sig, 1).c_str());
         if (std::isfinite(cr.ratio) && cr.ratio > 0) {
             log_sum += std::log(cr.ratio);
             ++compared;
             if (cr.ratio > 1.0) ++ahead;
         }
+        if (cr.ratio_sig > 1.0) ++ahead_sig;
     }
     const double geomean = compared ? std::exp(log_sum / compared) : kNaN;
-    std::printf("   geometric mean of mcplay/GSL: %s over %d cases; mcplay ahead on %d of %zu\n",
-                fmt_e(geomean, 2).c_str(), compared, ahead, results.size());
+    std::printf("   geometric mean of mcplay/other: %s over %d cases; mcplay ahead on %d of %zu "
+                "(by_sigma: on %d)\n",
+                fmt_e(geomean, 2).c_str(), compared, ahead, results.size(), ahead_sig);
 
     // Error bars that cannot be taken at face value, mcplay's and GSL's.
     int flagged = 0;
@@ -764,7 +885,8 @@ int main(int argc, char** argv) {
           {"cases", results.size()},
           {"compared", compared},
           {"mcplay_ahead", ahead},
-          {"geomean_eff_ratio_mcplay_over_gsl", jnum(geomean)},
+          {"geomean_eff_ratio_mcplay_over_other", jnum(geomean)},
+          {"mcplay_ahead_by_sigma", ahead_sig},
           {"overconfident_cells", flagged},
           {"seconds", total}});
     if (json) std::fclose(json);
