@@ -101,6 +101,8 @@ int mcp_study_plan(const char* scene_json, const char* options_json, char** plan
     return MCP_OK;
 }
 
+} // extern "C"
+
 namespace {
 
 /// An MIS estimator's weight for each technique over the grid xs (q_k = c_k p_k; the optimal
@@ -128,6 +130,8 @@ mcp::Json mis_weight_curves(const mcp::EstimatorSpec& spec, const mcp::Domain& d
 }
 
 } // namespace
+
+extern "C" {
 
 int mcp_study_samples(const char* scene_json, const char* options_json, char** samples_json) {
     if (!samples_json) return fail(MCP_ERROR_ARGUMENT, "mcp_study_samples: samples_json is NULL");
