@@ -75,6 +75,18 @@ std::vector<double> smooth_table() {
     return v;
 }
 
+/// A Cauchy-shaped peak: 49 of the 64 bins hold less than 1/64 of the mass, so many guide
+/// cells hold several bin edges and the block loops' one guided step leaves points to the
+/// full walk.
+std::vector<double> peaked_table() {
+    std::vector<double> v(64);
+    for (int i = 0; i < 64; ++i) {
+        const double z = (i - 19) / 3.0;
+        v[size_t(i)] = 1.0 / (1.0 + z * z);
+    }
+    return v;
+}
+
 const std::vector<Case>& cases() {
     static const std::vector<Case> all = [] {
         const double h = 0.5 * kPi;
@@ -118,6 +130,7 @@ const std::vector<Case>& cases() {
         c.push_back(analytic("cosine_omega2_to_zero", make_cosine(0.0, 0.5 * h, 2.0, 0.0), true));
         c.push_back(analytic("cosine_omega0p5_off_centre", make_cosine(1.0, 3.0, 0.5, 0.5), false));
         c.push_back(tabulated("tabulated_64", 0.0, 1.0, smooth_table(), true));
+        c.push_back(tabulated("tabulated_peaked", 0.0, 1.0, peaked_table(), true));
         c.push_back(tabulated("tabulated_zero_bins", -1.0, 3.0, {0, 1, 0, 0, 2, 0, 3, 0}, false));
         c.push_back(tabulated("tabulated_single_bin", -1.0, 1.0, {0, 0, 0, 5, 0, 0, 0}, false));
         c.push_back(tabulated("tabulated_huge_values", 0.0, 4.0, {1e300, 3e300, 0.0, 2e300}, true));
@@ -755,6 +768,34 @@ TEST(Tabulated2D, BlockEqualsScalar) {
         ASSERT_EQ(x[i], xs);
         ASSERT_EQ(y[i], ys);
         ASSERT_EQ(pdf[i], ps);
+    }
+}
+
+// The same on a peaked table, where the block loops' guided step often does not settle the bin.
+TEST(Tabulated2D, BlockEqualsScalarOnAPeakedTable) {
+    std::vector<double> values;
+    for (int iy = 0; iy < 24; ++iy)
+        for (int ix = 0; ix < 32; ++ix) {
+            const double zx = ((ix + 0.5) / 32 - 0.7) / 0.04, zy = ((iy + 0.5) / 24 - 0.2) / 0.05;
+            values.push_back(std::exp(-0.5 * (zx * zx + zy * zy)));
+        }
+    auto made = make_tabulated_2d(0, 1, 0, 1, 32, 24, values);
+    ASSERT_TRUE(made.ok()) << made.error;
+    Pcg32 rng(811u, 6u);
+    const size_t n = 5000;
+    std::vector<double> u1(n), u2(n), x(n), y(n), pdf(n);
+    for (size_t i = 0; i < n; ++i) {
+        u1[i] = rng.next_double();
+        u2[i] = rng.next_double();
+    }
+    made.value.sample_block(u1.data(), u2.data(), x.data(), y.data(), pdf.data(), n);
+    for (size_t i = 0; i < n; ++i) {
+        double xs, ys, ps;
+        made.value.sample(u1[i], u2[i], &xs, &ys, &ps);
+        ASSERT_EQ(x[i], xs) << "u1=" << u1[i] << " u2=" << u2[i];
+        ASSERT_EQ(y[i], ys) << "u1=" << u1[i] << " u2=" << u2[i];
+        ASSERT_EQ(pdf[i], ps) << "u1=" << u1[i] << " u2=" << u2[i];
+        ASSERT_GT(ps, 0.0);
     }
 }
 

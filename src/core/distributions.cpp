@@ -304,7 +304,8 @@ struct CosineK : CosinePdfK {
 // probability (its cdf entries are equal), then interpolates linearly inside it. The bin is found
 // from a guide table [ChenAsau74]: guide[g] is the bin of u = g / n, and the search walks forward
 // from guide[floor(u n)], about two comparisons on average whatever the table's shape (a binary
-// search takes log2(n) unpredictable branches).
+// search takes log2(n) unpredictable branches). Block loops take one step of that walk without
+// a branch and send the few points it does not settle to the full walk in a second pass.
 struct TabulatedK {
     double a, b, width, scale; // width = (b - a) / n, scale = n / (b - a)
     const double* func;
@@ -318,16 +319,39 @@ struct TabulatedK {
         while (cdf_edges[i + 1] <= u) ++i;     // ends at i = n - 1 at the latest: cdf[n] = 1 > u
         return i;
     }
+    /// bin_of_u's walk cut to one step, branch-free: the guide's bin for u's cell, or the next
+    /// one if u is past its upper edge. *settled says whether that is u's bin; it is not when
+    /// the cell holds several edges past the guide's bin (bins of mass below 1/n) or u n
+    /// rounded up onto the next cell.
+    size_t guided_bin(double u, bool* settled) const {
+        const double scaled = u * static_cast<double>(n);
+        size_t i = guide[scaled < static_cast<double>(n) ? floor_to_index(scaled) : n - 1];
+        i += static_cast<size_t>(u >= cdf_edges[i + 1]); // never past n - 1: cdf[n] = 1 > u
+        *settled = cdf_edges[i] <= u && u < cdf_edges[i + 1];
+        return i;
+    }
     static double clamp_u(double u) { return u > 0.0 ? std::min(u, kOneMinusEpsilon) : 0.0; }
+    /// u's place in bin i, cdf[i] <= u < cdf[i + 1].
+    double place(double u, size_t i) const {
+        const double lo = cdf_edges[i];
+        const double t = (u - lo) / (cdf_edges[i + 1] - lo);
+        return clamp(a + (static_cast<double>(i) + t) * width, a, b);
+    }
+    /// sample_in_bin for a point guided_bin may not have settled: bin *bin, found by
+    /// guided_bin, stands if it is u's and holds x; otherwise the full walk and the repair.
+    double settle(double u, double x, size_t* bin) const {
+        const double v = clamp_u(u);
+        const size_t i = *bin;
+        if (cdf_edges[i] <= v && v < cdf_edges[i + 1] && holds(x, i)) return x;
+        x = sample_in_bin(u, bin);
+        return holds(x, *bin) ? x : step_into_bin(x, *bin);
+    }
     /// The point of bin *bin at u's place in it; rounding may leave it on a neighbouring bin's
     /// edge, which holds() detects and step_into_bin() repairs.
     double sample_in_bin(double u, size_t* bin) const {
         u = clamp_u(u);
-        const size_t i = bin_of_u(u);
-        const double lo = cdf_edges[i];
-        const double t = (u - lo) / (cdf_edges[i + 1] - lo);
-        *bin = i;
-        return clamp(a + (static_cast<double>(i) + t) * width, a, b);
+        *bin = bin_of_u(u);
+        return place(u, *bin);
     }
     /// bin_of(x) == i, by comparisons only (no conversion, no branch).
     bool holds(double x, size_t i) const {
@@ -340,21 +364,24 @@ struct TabulatedK {
         return holds(x, i) ? x : step_into_bin(x, i);
     }
     /// sample() and its density for a block. The loop has no branch on the point and no call
-    /// (V8 compiles a loop with either to code 2x slower): it counts the points that rounding
-    /// left outside their bin, and a second pass, rarely taken, repairs them.
+    /// (V8 compiles a loop with either to code 2x slower): it counts the points that
+    /// guided_bin did not settle or rounding left outside their bin, and a second pass settles
+    /// them; the results are sample()'s, point by point.
     void sample_block(const double* u, double* x, double* pdf_out, size_t* bins, size_t m) const {
-        size_t misplaced = 0;
+        size_t unsettled = 0;
         for (size_t k = 0; k < m; ++k) {
-            size_t i;
-            x[k] = sample_in_bin(u[k], &i);
+            bool settled;
+            const double v = clamp_u(u[k]);
+            const size_t i = guided_bin(v, &settled);
+            x[k] = place(v, i);
             pdf_out[k] = func[i];
             bins[k] = i;
-            misplaced += !holds(x[k], i);
+            unsettled += !(settled && holds(x[k], i));
         }
-        if (misplaced == 0) return;
+        if (unsettled == 0) return;
         for (size_t k = 0; k < m; ++k) {
-            const size_t i = bin_of_u(clamp_u(u[k]));
-            if (!holds(x[k], i)) x[k] = step_into_bin(x[k], i);
+            x[k] = settle(u[k], x[k], &bins[k]);
+            pdf_out[k] = func[bins[k]];
         }
     }
     // Rounding can carry x onto a neighbouring bin's edge; step back into bin i (the factory
@@ -730,16 +757,19 @@ void TabulatedDistribution2D::sample_block(const double* u1, const double* u2, d
     for (size_t start = 0; start < n; start += kBlockSize) {
         const size_t m = std::min(kBlockSize, n - start);
         marginal.sample_block(u2 + start, y + start, row_density, row_of, m);
-        size_t misplaced = 0;
+        size_t unsettled = 0;
         for (size_t k = 0; k < m; ++k) {
             const TabulatedK row = Distribution1DFactory::tabulated(conditional_[row_of[k]]);
-            x[start + k] = row.sample_in_bin(u1[start + k], &column_of[k]);
-            misplaced += !row.holds(x[start + k], column_of[k]);
+            bool settled;
+            const double v = TabulatedK::clamp_u(u1[start + k]);
+            const size_t i = row.guided_bin(v, &settled);
+            x[start + k] = row.place(v, i);
+            column_of[k] = i;
+            unsettled += !(settled && row.holds(x[start + k], i));
         }
-        for (size_t k = 0; k < m && misplaced > 0; ++k) {
+        for (size_t k = 0; k < m && unsettled > 0; ++k) {
             const TabulatedK row = Distribution1DFactory::tabulated(conditional_[row_of[k]]);
-            if (!row.holds(x[start + k], column_of[k]))
-                x[start + k] = row.step_into_bin(x[start + k], column_of[k]);
+            x[start + k] = row.settle(u1[start + k], x[start + k], &column_of[k]);
         }
         for (size_t k = 0; k < m; ++k) // pdf(x, y): both lie in the box
             pdf_out[start + k] = values_[row_of[k] * size_t(nx_) + column_of[k]] / total_;
