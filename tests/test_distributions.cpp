@@ -752,10 +752,11 @@ TEST(Tabulated2D, InvertAndSampleAreInverses) {
     }
 }
 
-TEST(Tabulated2D, BlockEqualsScalar) {
-    TabulatedDistribution2D t = table_2d();
-    Pcg32 rng(808u, 6u);
-    const size_t n = 2000;
+namespace {
+
+/// sample_block equals sample() point by point (bit for bit) on n random pairs (u1, u2).
+void expect_block_equals_scalar(const TabulatedDistribution2D& t, uint64_t seed, size_t n) {
+    Pcg32 rng(seed, 6u);
     std::vector<double> u1(n), u2(n), x(n), y(n), pdf(n);
     for (size_t i = 0; i < n; ++i) {
         u1[i] = rng.next_double();
@@ -765,10 +766,17 @@ TEST(Tabulated2D, BlockEqualsScalar) {
     for (size_t i = 0; i < n; ++i) {
         double xs, ys, ps;
         t.sample(u1[i], u2[i], &xs, &ys, &ps);
-        ASSERT_EQ(x[i], xs);
-        ASSERT_EQ(y[i], ys);
-        ASSERT_EQ(pdf[i], ps);
+        ASSERT_EQ(x[i], xs) << "u1=" << u1[i] << " u2=" << u2[i];
+        ASSERT_EQ(y[i], ys) << "u1=" << u1[i] << " u2=" << u2[i];
+        ASSERT_EQ(pdf[i], ps) << "u1=" << u1[i] << " u2=" << u2[i];
+        ASSERT_GT(ps, 0.0);
     }
+}
+
+} // namespace
+
+TEST(Tabulated2D, BlockEqualsScalar) {
+    expect_block_equals_scalar(table_2d(), 808u, 2000);
 }
 
 // The same on a peaked table, where the block loops' guided step often does not settle the bin.
@@ -781,22 +789,7 @@ TEST(Tabulated2D, BlockEqualsScalarOnAPeakedTable) {
         }
     auto made = make_tabulated_2d(0, 1, 0, 1, 32, 24, values);
     ASSERT_TRUE(made.ok()) << made.error;
-    Pcg32 rng(811u, 6u);
-    const size_t n = 5000;
-    std::vector<double> u1(n), u2(n), x(n), y(n), pdf(n);
-    for (size_t i = 0; i < n; ++i) {
-        u1[i] = rng.next_double();
-        u2[i] = rng.next_double();
-    }
-    made.value.sample_block(u1.data(), u2.data(), x.data(), y.data(), pdf.data(), n);
-    for (size_t i = 0; i < n; ++i) {
-        double xs, ys, ps;
-        made.value.sample(u1[i], u2[i], &xs, &ys, &ps);
-        ASSERT_EQ(x[i], xs) << "u1=" << u1[i] << " u2=" << u2[i];
-        ASSERT_EQ(y[i], ys) << "u1=" << u1[i] << " u2=" << u2[i];
-        ASSERT_EQ(pdf[i], ps) << "u1=" << u1[i] << " u2=" << u2[i];
-        ASSERT_GT(ps, 0.0);
-    }
+    expect_block_equals_scalar(made.value, 811u, 5000);
 }
 
 TEST(Tabulated2D, SingleRowAndColumn) {
