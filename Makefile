@@ -54,6 +54,7 @@ help:
 	@echo "make test   install what is missing, build native + wasm, run every test suite"
 	@echo "make bench  samples per second natively and in wasm under Node, and their ratio; then bench-genz"
 	@echo "make bench-genz  mcplay beside GSL plain/MISER/VEGAS on Genz's families (GENZ_ARGS=--quick: 15 s)"
+	@echo "make bench-flags  the flags judged both ways: false alarms where intervals covered, confident wrong answers"
 	@echo "make bench-qmc  mcplay's randomized QMC beside QMCPy's and scipy's on Genz 1, 4, 5 (pip venv in build/)"
 	@echo "make format clang-format every C++ source"
 	@echo "make test-sanitize  the native ctest suite under ASan + UBSan ($(BUILD_ASAN); part of make test)"
@@ -138,6 +139,7 @@ bench: build build-wasm site
 	bash bench/run_bench.sh $(BUILD)/mcplay_bench "$(NODE_RUN) --no-liftoff $(BUILD_WASM)/mcplay_bench.js"
 	node web/e2e/first_plot.bench.mjs $(SITE) exp_1d 5
 	$(MAKE) --no-print-directory bench-genz
+	$(MAKE) --no-print-directory bench-flags
 
 # ---------------------------------------------------------------------------
 # GSL's plain, MISER and VEGAS beside mcplay's estimators on Genz's six families
@@ -166,6 +168,25 @@ bench-genz: deps deps-gsl $(BUILD)/CMakeCache.txt
 	cmake --build $(BUILD) -j $(JOBS) --target mcplay_api
 	$(MAKE) --no-print-directory $(BUILD)/genz_compare
 	set -o pipefail; $(BUILD)/genz_compare --json $(GENZ_JSON) $(GENZ_ARGS) | tee $(BUILD)/genz_compare.txt
+
+# ---------------------------------------------------------------------------
+# The flags judged both ways (docs/benchmarks.md): bench/calibrate.cpp runs studies through the
+# C API on Genz cases with the project's own random parameters and on every integration scene,
+# and reports the share of flagged cells where every interval covered and the confident wrong
+# answers. `make bench-flags FLAGS_ARGS=--quick` for a look in seconds.
+.PHONY: bench-flags
+FLAGS_ARGS ?=
+
+$(BUILD)/calibrate: bench/calibrate.cpp $(BUILD)/libmcplay_api.a $(BUILD)/libmcplay_core.a \
+		$(wildcard src/*/*.h)
+	g++ -O2 -std=c++17 -ffp-contract=off -Wall -Wextra -Isrc -I$(BUILD)/deps_include \
+	  bench/calibrate.cpp $(BUILD)/libmcplay_api.a $(BUILD)/libmcplay_core.a -pthread -o $@
+
+bench-flags: deps $(BUILD)/CMakeCache.txt
+	cmake --build $(BUILD) -j $(JOBS) --target mcplay_api
+	$(MAKE) --no-print-directory $(BUILD)/calibrate
+	set -o pipefail; $(BUILD)/calibrate --scenes scenes --json $(BUILD)/calibrate.jsonl $(FLAGS_ARGS) \
+	  2>/dev/null | tee $(BUILD)/calibrate.txt
 
 # ---------------------------------------------------------------------------
 # Randomized QMC beside QMCPy's and scipy's (docs/benchmarks.md): genz_compare writes the

@@ -1,0 +1,351 @@
+// calibrate: mcplay's flags judged both ways on a battery of integrals with exact values
+// (docs/benchmarks.md). A flag that fires where every interval covered teaches users to
+// ignore flags; an estimate far off with no flag is a confident wrong answer.
+//
+//   calibrate [--quick] [--reps R] [--n-min N] [--n-max N] [--param-seeds 1,2,3]
+//             [--dims 2,4,8] [--scenes DIR] [--json FILE] [--list N]
+//
+// The battery: Genz's six families [Genz84] at d = 2, 4, 8 with the project's own random
+// parameters (genz_random, seeds 1..3), each run with every uniform-density preset, and every
+// integration scene of DIR (default scenes/) that states an exact value, with its own
+// estimators and with each preset that applies to its domain (a user can pick any). Each is a
+// study through the C API, as the CLI and the page run it (N = n_min, 2 n_min, ..., n_max;
+// R replicates), so the flags are the ones users see.
+//
+// Per cell (case, estimator, N) of R replicates, with t = t_0.975(run dof) / 1.96 widening the
+// normal multiples for a run's few degrees of freedom:
+//   fine     every replicate within 3 t of its own standard error of the exact value
+//            (an exact estimator, se = 0 and the error at round-off, is fine)
+//   flagged  the level, or the estimator as a whole, carries a warning
+//   false-flag rate = flagged fine cells / fine cells            (target <= 5%, issue 13)
+//   confident wrong = replicates beyond 5 t standard errors in unflagged cells   (target 0)
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "api/json_read.h"
+#include "api/mcplay.h"
+#include "core/special.h"
+#include "integrands/genz.h"
+
+using namespace mcp;
+
+namespace {
+
+const char* const kPresets[] = {"uniform", "stratified", "latin_hypercube", "sobol",      "halton",
+                                "lattice", "vegas",      "vegas_sobol",     "vegas_plus", "miser"};
+
+struct Options {
+    int reps = 10;
+    uint64_t n_min = 1024, n_max = 65536, seed = 2026;
+    std::vector<int> dims{2, 4, 8};
+    std::vector<uint64_t> param_seeds{1, 2, 3};
+    std::string scenes_dir = "scenes", json_path;
+    int list = 20; // confident wrong answers and flag codes listed
+};
+
+[[noreturn]] void usage(const std::string& msg) {
+    if (!msg.empty()) std::fprintf(stderr, "calibrate: %s\n", msg.c_str());
+    std::fprintf(stderr, "usage: calibrate [--quick] [--reps R] [--n-min N] [--n-max N]\n"
+                         "         [--param-seeds 1,2,3] [--dims 2,4,8] [--scenes DIR]\n"
+                         "         [--json FILE] [--list N]\n");
+    std::exit(2);
+}
+
+std::vector<uint64_t> parse_list(const std::string& s, const char* what, uint64_t lo, uint64_t hi) {
+    std::vector<uint64_t> out;
+    std::stringstream ss(s);
+    std::string item;
+    while (std::getline(ss, item, ',')) {
+        char* end = nullptr;
+        const unsigned long long v = std::strtoull(item.c_str(), &end, 10);
+        if (item.empty() || !end || *end || v < lo || v > hi)
+            usage(std::string(what) + ": '" + item + "' is not a whole number in " +
+                  std::to_string(lo) + ".." + std::to_string(hi));
+        out.push_back(v);
+    }
+    if (out.empty()) usage(std::string(what) + ": empty list");
+    return out;
+}
+
+Options parse_options(int argc, char** argv) {
+    Options o;
+    for (int i = 1; i < argc; ++i) {
+        const std::string a = argv[i];
+        auto value = [&]() -> std::string {
+            if (i + 1 >= argc) usage(a + " needs a value");
+            return argv[++i];
+        };
+        auto one = [&](const char* what, uint64_t lo, uint64_t hi) {
+            return parse_list(value(), what, lo, hi).front();
+        };
+        if (a == "--quick") {
+            o.reps = 6;
+            o.n_max = 4096;
+            o.param_seeds = {1};
+        } else if (a == "--reps")
+            o.reps = int(one("--reps", 4, 1000));
+        else if (a == "--n-min")
+            o.n_min = one("--n-min", 16, uint64_t(1) << 24);
+        else if (a == "--n-max")
+            o.n_max = one("--n-max", 16, uint64_t(1) << 24);
+        else if (a == "--param-seeds")
+            o.param_seeds = parse_list(value(), "--param-seeds", 1, 1000000);
+        else if (a == "--dims") {
+            o.dims.clear();
+            for (uint64_t d : parse_list(value(), "--dims", 1, 64)) o.dims.push_back(int(d));
+        } else if (a == "--scenes")
+            o.scenes_dir = value();
+        else if (a == "--json")
+            o.json_path = value();
+        else if (a == "--list")
+            o.list = int(one("--list", 0, 100000));
+        else if (a == "-h" || a == "--help")
+            usage("");
+        else
+            usage("unknown argument '" + a + "'");
+    }
+    if (o.n_max < o.n_min) usage("--n-max must be at least --n-min");
+    return o;
+}
+
+struct Case {
+    std::string name;
+    Json scene;
+    Json options; // mcp_study_run options (estimators for the Genz cases)
+};
+
+std::vector<Case> genz_cases(const Options& o) {
+    std::vector<Case> cases;
+    Json presets = Json::array();
+    for (const char* p : kPresets) presets.push_back(p);
+    for (int fam = 0; fam < 6; ++fam)
+        for (int d : o.dims)
+            for (uint64_t seed : o.param_seeds) {
+                const GenzParams g = genz_random(GenzFamily(fam), d, seed);
+                Case c;
+                c.name = std::string(genz_family_name(GenzFamily(fam))) + "_d" + std::to_string(d) +
+                         "_s" + std::to_string(seed);
+                c.scene = {{"name", c.name},
+                           {"integrand",
+                            {{"type", genz_family_name(GenzFamily(fam))}, {"a", g.a}, {"u", g.u}}},
+                           {"exact", genz_exact(g)},
+                           {"estimators", presets}};
+                cases.push_back(c);
+            }
+    return cases;
+}
+
+std::vector<Case> scene_cases(const Options& o) {
+    namespace fs = std::filesystem;
+    std::vector<fs::path> files;
+    std::error_code ec;
+    for (const auto& e : fs::directory_iterator(o.scenes_dir, ec))
+        if (e.path().extension() == ".json") files.push_back(e.path());
+    if (ec) usage("--scenes " + o.scenes_dir + ": " + ec.message());
+    std::sort(files.begin(), files.end());
+    std::vector<Case> cases;
+    for (const fs::path& p : files) {
+        std::ifstream in(p);
+        std::stringstream ss;
+        ss << in.rdbuf();
+        Made<Json> j = parse_json(ss.str().c_str(), p.string().c_str());
+        // Integration scenes; render scenes (a "render" field) are the renderer's, with their
+        // own references. A scene without an exact value (stated or known to mcplay) is dropped
+        // after the study with its own estimators.
+        if (!j.ok() || !j.value.is_object() || j.value.contains("render")) continue;
+        cases.push_back(Case{p.stem().string(), j.value, Json::object()});
+        for (const char* preset : kPresets)
+            cases.push_back(
+                Case{p.stem().string() + "+" + preset, j.value, {{"estimators", {preset}}}});
+    }
+    return cases;
+}
+
+double number_or_nan(const Json& v) {
+    return v.is_number() ? v.get<double>() : std::nan("");
+}
+
+struct Tally {
+    long fine = 0, fine_flagged = 0, cells = 0, runs = 0, confident_wrong = 0;
+    std::map<std::string, long> false_flag_codes; // codes on fine cells
+};
+
+struct Wrong {
+    std::string where;
+    double z;
+};
+
+// Judges every level of every estimator of one study result.
+void judge(const std::string& case_name, const Json& result, double exact, Tally* t,
+           std::vector<Wrong>* wrong) {
+    for (const Json& e : result["estimators"]) {
+        std::vector<std::string> estimator_codes;
+        for (const Json& w : e["warnings"]) estimator_codes.push_back(w.value("code", "?"));
+        for (const Json& l : e["levels"]) {
+            std::vector<std::string> codes = estimator_codes;
+            for (const Json& w : l["warnings"]) codes.push_back(w.value("code", "?"));
+            const double dof = number_or_nan(l["run_dof"]);
+            const double widen =
+                dof >= 1.0 ? student_t_quantile(0.975, std::min(dof, 1e6)) / 1.959963985 : 1.0;
+            const Json& est = l["replicates"]["estimate"];
+            const Json& se = l["replicates"]["std_error"];
+            bool fine = true;
+            std::vector<double> misses;
+            for (size_t i = 0; i < est.size() && i < se.size(); ++i) {
+                const double x = number_or_nan(est[i]), s = number_or_nan(se[i]);
+                const double err = std::fabs(x - exact);
+                const double roundoff = 1e-12 * std::max(std::fabs(exact), std::fabs(x));
+                ++t->runs;
+                if (!(err <= 3.0 * widen * s + roundoff)) fine = false;
+                if (!(err <= 5.0 * widen * s + roundoff))
+                    misses.push_back(s > 0.0 ? err / s : INFINITY);
+            }
+            ++t->cells;
+            if (fine) {
+                ++t->fine;
+                if (!codes.empty()) {
+                    ++t->fine_flagged;
+                    std::sort(codes.begin(), codes.end());
+                    codes.erase(std::unique(codes.begin(), codes.end()), codes.end());
+                    for (const std::string& c : codes) ++t->false_flag_codes[c];
+                }
+            }
+            if (codes.empty())
+                for (double z : misses) {
+                    ++t->confident_wrong;
+                    wrong->push_back(Wrong{case_name + " " + e.value("name", "?") +
+                                               " N=" + std::to_string(l.value("n", 0ull)),
+                                           z});
+                }
+        }
+    }
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+    const Options o = parse_options(argc, argv);
+    const auto t0 = std::chrono::steady_clock::now();
+    std::vector<Case> cases = genz_cases(o);
+    const size_t genz_count = cases.size();
+    for (Case& c : scene_cases(o)) cases.push_back(std::move(c));
+    std::printf("calibrate: %zu studies (%zu Genz cases; %zu on the scenes of %s, with their own "
+                "estimators and each preset), N = %llu..%llu, R = %d\n",
+                cases.size(), genz_count, cases.size() - genz_count, o.scenes_dir.c_str(),
+                (unsigned long long)o.n_min, (unsigned long long)o.n_max, o.reps);
+    std::FILE* json = o.json_path.empty() ? nullptr : std::fopen(o.json_path.c_str(), "w");
+    if (!o.json_path.empty() && !json) usage("--json: cannot write " + o.json_path);
+
+    Tally genz, scenes;
+    std::vector<Wrong> wrong;
+    // Presets a scene does not take (a domain MISER cannot split, ...): count, first reason.
+    std::map<std::string, std::pair<int, std::string>> not_applicable;
+    std::set<std::string> no_exact; // scenes dropped, by the name before "+preset"
+    for (size_t ci = 0; ci < cases.size(); ++ci) {
+        const Case& c = cases[ci];
+        const std::string base = c.name.substr(0, c.name.find('+'));
+        if (no_exact.count(base)) continue;
+        Json options = c.options;
+        options["n_min"] = o.n_min;
+        options["n_max"] = o.n_max;
+        options["reps"] = o.reps;
+        options["seed"] = o.seed + ci;
+        options["threads"] = 0;
+        char* out = nullptr;
+        const int status =
+            mcp_study_run(c.scene.dump().c_str(), options.dump().c_str(), nullptr, nullptr, &out);
+        if (status == MCP_ERROR_SCENE && c.options.contains("estimators")) {
+            auto& [count, reason] = not_applicable[c.options["estimators"][0].get<std::string>()];
+            if (count++ == 0) reason = c.name + ": " + mcp_last_error();
+            mcp_free(out);
+            continue;
+        }
+        if (status != MCP_OK) {
+            std::printf("  %s: error %d: %s\n", c.name.c_str(), status, mcp_last_error());
+            mcp_free(out);
+            continue;
+        }
+        Made<Json> r = parse_json(out, c.name.c_str());
+        mcp_free(out);
+        if (!r.ok()) {
+            std::printf("  %s: result is not JSON: %s\n", c.name.c_str(), r.error.c_str());
+            continue;
+        }
+        const Json& scene = r.value["scene"];
+        if (!scene.contains("exact") || !scene["exact"].is_number()) {
+            std::printf("  %s: no exact value, skipped\n", c.name.c_str());
+            no_exact.insert(base);
+            continue;
+        }
+        const double exact = scene["exact"].get<double>();
+        Tally& t = ci < genz_count ? genz : scenes;
+        const size_t before = wrong.size();
+        judge(c.name, r.value, exact, &t, &wrong);
+        if (json)
+            std::fprintf(json, "%s\n",
+                         Json({{"case", c.name}, {"confident_wrong", wrong.size() - before}})
+                             .dump()
+                             .c_str());
+        std::fprintf(stderr, "[%zu/%zu] %s\n", ci + 1, cases.size(), c.name.c_str());
+    }
+
+    if (!not_applicable.empty()) {
+        std::printf("presets skipped on scenes that do not take them:\n");
+        for (const auto& [k, v] : not_applicable)
+            std::printf("  %-16s %3d scenes (first: %s)\n", k.c_str(), v.first, v.second.c_str());
+    }
+    auto report = [&](const char* label, const Tally& t) {
+        const double rate = t.fine ? double(t.fine_flagged) / double(t.fine) : 0.0;
+        std::printf("%-7s cells %6ld  fine %6ld  flagged among fine %6ld (%.1f%%)  confident wrong "
+                    "%ld of %ld runs\n",
+                    label, t.cells, t.fine, t.fine_flagged, 100.0 * rate, t.confident_wrong,
+                    t.runs);
+    };
+    std::printf("\n");
+    report("genz", genz);
+    report("scenes", scenes);
+    Tally all = genz;
+    all.cells += scenes.cells;
+    all.fine += scenes.fine;
+    all.fine_flagged += scenes.fine_flagged;
+    all.confident_wrong += scenes.confident_wrong;
+    all.runs += scenes.runs;
+    for (const auto& [k, v] : scenes.false_flag_codes) all.false_flag_codes[k] += v;
+    report("all", all);
+    std::printf("\nflag codes on fine cells (cells carrying each):\n");
+    std::vector<std::pair<long, std::string>> codes;
+    for (const auto& [k, v] : all.false_flag_codes) codes.push_back({v, k});
+    std::sort(codes.rbegin(), codes.rend());
+    for (const auto& [v, k] : codes) std::printf("  %-24s %6ld\n", k.c_str(), v);
+    std::printf("\nconfident wrong answers (|error| / se; first %d):\n", o.list);
+    std::sort(wrong.begin(), wrong.end(), [](const Wrong& a, const Wrong& b) { return a.z > b.z; });
+    for (size_t i = 0; i < wrong.size() && int(i) < o.list; ++i)
+        std::printf("  %-60s %10.3g\n", wrong[i].where.c_str(), wrong[i].z);
+    if (wrong.empty()) std::printf("  none\n");
+    const double secs =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    std::printf("\ntotal wall time %.0f s\n", secs);
+    if (json) {
+        std::fprintf(json, "%s\n",
+                     Json({{"kind", "summary"},
+                           {"cells", all.cells},
+                           {"fine", all.fine},
+                           {"fine_flagged", all.fine_flagged},
+                           {"confident_wrong", all.confident_wrong},
+                           {"runs", all.runs}})
+                         .dump()
+                         .c_str());
+        std::fclose(json);
+    }
+    return 0;
+}
