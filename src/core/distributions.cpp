@@ -335,7 +335,7 @@ struct TabulatedK {
     double place(double u, size_t i) const {
         const double lo = cdf_edges[i];
         const double t = (u - lo) / (cdf_edges[i + 1] - lo);
-        return clamp(a + (static_cast<double>(i) + t) * width, a, b);
+        return clamp(a + (index_to_double(static_cast<uint32_t>(i)) + t) * width, a, b);
     }
     /// sample_in_bin for a point guided_bin may not have settled: bin *bin, found by
     /// guided_bin, stands if it is u's and holds x; otherwise the full walk and the repair.
@@ -355,7 +355,7 @@ struct TabulatedK {
     }
     /// bin_of(x) == i, by comparisons only (no conversion, no branch).
     bool holds(double x, size_t i) const {
-        const double r = (x - a) * scale, fi = static_cast<double>(i);
+        const double r = (x - a) * scale, fi = index_to_double(static_cast<uint32_t>(i));
         return (i == 0 || r >= fi) && (i + 1 == n || r < fi + 1.0);
     }
     double sample(double u) const {

