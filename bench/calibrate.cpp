@@ -16,7 +16,8 @@
 // normal multiples for a run's few degrees of freedom:
 //   fine     every replicate within 3 t of its own standard error of the exact value
 //            (an exact estimator, se = 0 and the error at round-off, is fine)
-//   flagged  the level, or the estimator as a whole, carries a warning
+//   flagged  the level, or the estimator as a whole, carries a flag of severity error or
+//            warning (info is worth knowing, not an alarm)
 //   false-flag rate = flagged fine cells / fine cells            (target <= 5%, issue 13)
 //   confident wrong = replicates beyond 5 t standard errors in unflagged cells   (target 0)
 #include <algorithm>
@@ -189,11 +190,17 @@ struct Wrong {
 void judge(const std::string& case_name, const Json& result, double exact, Tally* t,
            std::vector<Wrong>* wrong) {
     for (const Json& e : result["estimators"]) {
+        // Alarms only: a flag of severity info says nothing is wrong.
+        auto alarms = [](const Json& warnings, std::vector<std::string>* codes) {
+            for (const Json& w : warnings)
+                if (w.value("severity", "warning") != "info")
+                    codes->push_back(w.value("code", "?"));
+        };
         std::vector<std::string> estimator_codes;
-        for (const Json& w : e["warnings"]) estimator_codes.push_back(w.value("code", "?"));
+        alarms(e["warnings"], &estimator_codes);
         for (const Json& l : e["levels"]) {
             std::vector<std::string> codes = estimator_codes;
-            for (const Json& w : l["warnings"]) codes.push_back(w.value("code", "?"));
+            alarms(l["warnings"], &codes);
             const double dof = number_or_nan(l["run_dof"]);
             const double widen =
                 dof >= 1.0 ? student_t_quantile(0.975, std::min(dof, 1e6)) / 1.959963985 : 1.0;

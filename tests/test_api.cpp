@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
+#include <sstream>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -427,6 +429,37 @@ TEST(Api, EveryNaNSampleGivesNullsAndOneWarning) {
         EXPECT_EQ(l["warnings"][0]["code"], "no_estimate");
     }
     EXPECT_TRUE(o.result["estimators"][0]["warnings"].empty());
+}
+
+// Every warning has a severity, and each list puts errors first, then warnings, then info:
+// is_zero_pdf's estimators carry pdf_support (an error) beside tail flags.
+TEST(Api, WarningsCarryASeverityMostSevereFirst) {
+    std::ifstream in(std::string(MCPLAY_SOURCE_DIR) + "/scenes/is_zero_pdf.json");
+    std::stringstream ss;
+    ss << in.rdbuf();
+    Outcome o = run(ss.str(), R"j({"n_min": 256, "n_max": 2048, "reps": 8})j");
+    ASSERT_EQ(o.status, MCP_OK) << o.error;
+    int errors = 0;
+    auto check = [&](const json& warnings) {
+        int last = -1;
+        for (const json& w : warnings) {
+            ASSERT_TRUE(w.contains("severity")) << w.dump();
+            const std::string s = w["severity"];
+            const int rank = s == "error" ? 0 : s == "warning" ? 1 : s == "info" ? 2 : -1;
+            ASSERT_GE(rank, 0) << w.dump();
+            EXPECT_GE(rank, last) << warnings.dump();
+            last = rank;
+            errors += rank == 0;
+        }
+    };
+    for (const json& e : o.result["estimators"]) {
+        check(e["warnings"]);
+        for (const json& l : e["levels"]) check(l["warnings"]);
+    }
+    EXPECT_GT(errors, 0);
+    Outcome t = format(o.result.dump(), "table");
+    ASSERT_EQ(t.status, MCP_OK) << t.error;
+    EXPECT_NE(t.result.get<std::string>().find("  ERROR   pdf_support: "), std::string::npos);
 }
 
 TEST(Api, ErrorMessagesStayOnOneLine) {

@@ -111,3 +111,39 @@ TEST(Diagnostics, ErrorBarsThatUnderstateTheSpreadAreFlagged) {
             EXPECT_FALSE(has(level_flags(level), FlagCode::ErrorBarsUnderstate))
                 << e.spec.name << " N=" << level.n;
 }
+
+// Severities (issue 13): what is wrong is an error, what cannot be trusted at this N a warning,
+// what is only worth knowing info; a raised flag carries its code's severity.
+TEST(Diagnostics, EveryFlagHasTheSeverityOfWhatItSays) {
+    for (FlagCode c :
+         {FlagCode::NoEstimate, FlagCode::NonfiniteEstimate, FlagCode::NonfiniteVariance,
+          FlagCode::ZeroErrorBar, FlagCode::NonfiniteSamples, FlagCode::ZeroPdfSamples,
+          FlagCode::ExactOutsideCi, FlagCode::PdfSupport, FlagCode::IterationsDisagree,
+          FlagCode::ErrorBarsUnderstate, FlagCode::PixelErrorBars})
+        EXPECT_EQ(default_severity(c), Severity::Error) << flag_code_name(c);
+    for (FlagCode c : {FlagCode::DominantSample, FlagCode::LowEss, FlagCode::HeavyTail,
+                       FlagCode::LevelDrift, FlagCode::SlowConvergence})
+        EXPECT_EQ(default_severity(c), Severity::Warning) << flag_code_name(c);
+    for (FlagCode c : {FlagCode::HeavyTail4, FlagCode::Float32Accumulator,
+                       FlagCode::BelowReferenceNoise, FlagCode::ReferenceNoise})
+        EXPECT_EQ(default_severity(c), Severity::Info) << flag_code_name(c);
+    EXPECT_STREQ(severity_name(Severity::Error), "error");
+    EXPECT_STREQ(severity_name(Severity::Warning), "warning");
+    EXPECT_STREQ(severity_name(Severity::Info), "info");
+
+    // Raised by a real study: x^-0.9 under uniform sampling (infinite variance: a warning) and
+    // a pdf that misses part of f (biased: an error).
+    StudyResult s = study("singular_power_0.9",
+                          Json{{"n_min", 1024}, {"n_max", 4096}, {"reps", 8}, {"seed", 3}});
+    for (const Flag& f : estimator_flags(named(s, "uniform"), s.settings))
+        EXPECT_EQ(f.severity, default_severity(f.code)) << flag_code_name(f.code);
+    StudyResult z = study("is_zero_pdf", Json{{"n_min", 256}, {"n_max", 1024}, {"reps", 8}});
+    int support = 0;
+    for (const EstimatorStudy& e : z.estimators)
+        for (const Flag& f : estimator_flags(e, z.settings))
+            if (f.code == FlagCode::PdfSupport) {
+                EXPECT_EQ(f.severity, Severity::Error);
+                ++support;
+            }
+    EXPECT_GT(support, 0);
+}

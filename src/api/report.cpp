@@ -1,5 +1,6 @@
 // Study results as JSON (docs/result-schema.md), as a human table and as CSV. The table
 // and CSV are rendered from the JSON, so any client holding a result can format it.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -13,9 +14,25 @@ Json num(double x) {
     return std::isfinite(x) ? Json(x) : Json(nullptr);
 }
 
-// A warning: a stable code (for clients that filter or group) and a sentence for people.
-Json warning(const char* code, const std::string& message) {
-    return Json{{"code", code}, {"message", message}};
+// A warning: a stable code (for clients that filter or group), its severity and a sentence for
+// people.
+Json warning(const char* code, Severity severity, const std::string& message) {
+    return Json{{"code", code}, {"severity", severity_name(severity)}, {"message", message}};
+}
+
+Json flag_warning(const Flag& flag, const std::string& message) {
+    return warning(flag_code_name(flag.code), flag.severity, message);
+}
+
+void sort_by_severity(Json& warnings) {
+    if (!warnings.is_array()) return;
+    auto rank = [](const Json& w) {
+        const auto it = w.find("severity");
+        const std::string s = it != w.end() && it->is_string() ? it->get<std::string>() : "";
+        return s == "error" ? 0 : s == "warning" ? 1 : 2;
+    };
+    std::stable_sort(warnings.begin(), warnings.end(),
+                     [&](const Json& a, const Json& b) { return rank(a) < rank(b); });
 }
 
 std::string fmt(const char* f, double x) {
@@ -39,71 +56,71 @@ Json diagnostics_to_json(const RunDiagnostics& d) {
 
 Json level_warning(const Flag& f, const LevelStats& l) {
     const std::string at_n = " at N = " + std::to_string(l.n);
-    const char* code = flag_code_name(f.code);
     switch (f.code) {
     case FlagCode::NoEstimate:
-        return warning(code, f.count == f.of
-                                 ? std::string("every sample was NaN or infinite: no estimate")
-                                 : "every sample was NaN or infinite in " +
-                                       std::to_string(f.count) + " of " + std::to_string(f.of) +
-                                       " replicates" + at_n + ": no estimate at this N");
+        return flag_warning(f, f.count == f.of
+                                   ? std::string("every sample was NaN or infinite: no estimate")
+                                   : "every sample was NaN or infinite in " +
+                                         std::to_string(f.count) + " of " + std::to_string(f.of) +
+                                         " replicates" + at_n + ": no estimate at this N");
     case FlagCode::NonfiniteEstimate:
-        return warning(code, "the mean of the replicates is not a finite number" + at_n +
-                                 " (the sum of the weights overflowed): no estimate");
+        return flag_warning(f, "the mean of the replicates is not a finite number" + at_n +
+                                   " (the sum of the weights overflowed): no estimate");
     case FlagCode::NonfiniteVariance:
-        return warning(code, "the variance across replicates is not a finite number >= 0" + at_n +
-                                 ": no error bar");
+        return flag_warning(f, "the variance across replicates is not a finite number >= 0" + at_n +
+                                   ": no error bar");
     case FlagCode::ZeroErrorBar:
-        return warning(code, std::to_string(f.count) + " of " + std::to_string(f.of) +
-                                 " replicates reported a standard error of 0" + at_n +
-                                 " although the replicates differ (standard deviation " +
-                                 fmt("%.3g", f.value) +
-                                 "): their error bars are wrong (too few samples to see f vary)");
+        return flag_warning(f, std::to_string(f.count) + " of " + std::to_string(f.of) +
+                                   " replicates reported a standard error of 0" + at_n +
+                                   " although the replicates differ (standard deviation " +
+                                   fmt("%.3g", f.value) +
+                                   "): their error bars are wrong (too few samples to see f vary)");
     case FlagCode::ErrorBarsUnderstate:
-        return warning(code, "the " + std::to_string(f.of) + " replicates" + at_n + " spread " +
-                                 fmt("%.3g", std::sqrt(f.value)) +
-                                 " times more than their own standard errors say (F test, p = " +
-                                 fmt("%.2g", f.p_value) +
-                                 "): the error bars are too small (too few strata, "
-                                 "randomizations or points saw how f varies)");
+        return flag_warning(f, "the " + std::to_string(f.of) + " replicates" + at_n + " spread " +
+                                   fmt("%.3g", std::sqrt(f.value)) +
+                                   " times more than their own standard errors say (F test, p = " +
+                                   fmt("%.2g", f.p_value) +
+                                   "): the error bars are too small (too few strata, "
+                                   "randomizations or points saw how f varies)");
     case FlagCode::NonfiniteSamples:
-        return warning(code, std::to_string(f.count) +
-                                 " sample(s) with NaN/Inf f/p dropped: the estimate is biased");
+        return flag_warning(f, std::to_string(f.count) +
+                                   " sample(s) with NaN/Inf f/p dropped: the estimate is biased");
     case FlagCode::ZeroPdfSamples:
-        return warning(code, std::to_string(f.count) +
-                                 " sample(s) with f != 0 where p = 0: the pdf misses part of the "
-                                 "integrand, the estimate is biased");
+        return flag_warning(f, std::to_string(f.count) +
+                                   " sample(s) with f != 0 where p = 0: the pdf misses part of the "
+                                   "integrand, the estimate is biased");
     case FlagCode::DominantSample:
-        return warning(code, "one sample carried " +
-                                 std::to_string(static_cast<int>(100 * f.value + 0.5)) +
-                                 "% of a run's sum" + at_n + ": the error bar is not trustworthy");
+        return flag_warning(
+            f, "one sample carried " + std::to_string(static_cast<int>(100 * f.value + 0.5)) +
+                   "% of a run's sum" + at_n + ": the error bar is not trustworthy");
     case FlagCode::LowEss:
-        return warning(code, "effective sample size " + fmt("%.1f", f.value) + " of " +
-                                 std::to_string(l.n) + at_n +
-                                 ": the estimate rests on a few samples (narrow peak, small "
-                                 "support or huge weights), its error bar is unreliable");
+        return flag_warning(f, "effective sample size " + fmt("%.1f", f.value) + " of " +
+                                   std::to_string(l.n) + at_n +
+                                   ": the estimate rests on a few samples (narrow peak, small "
+                                   "support or huge weights), its error bar is unreliable");
     case FlagCode::ExactOutsideCi:
-        return warning(
-            code, "the mean of " + std::to_string(f.of) + " replicates misses the exact value by " +
-                      (std::isfinite(f.value) ? fmt("%.1f", f.value) + " standard errors"
-                                              : std::string("a margin with zero spread")) +
-                      at_n + ": the estimator is biased or its error bars are wrong");
+        return flag_warning(
+            f, "the mean of " + std::to_string(f.of) + " replicates misses the exact value by " +
+                   (std::isfinite(f.value) ? fmt("%.1f", f.value) + " standard errors"
+                                           : std::string("a margin with zero spread")) +
+                   at_n + ": the estimator is biased or its error bars are wrong");
     case FlagCode::IterationsDisagree:
-        return warning(code, "the iterations of the runs disagree beyond their error bars" + at_n +
-                                 " (chi2 = " + fmt("%.1f", f.value) + " for " +
-                                 std::to_string(f.dof) + " degrees of freedom over " +
-                                 std::to_string(f.of) +
-                                 " replicates, p = " + fmt("%.2g", f.p_value) +
-                                 "): the weighted average and its error bar are not "
-                                 "trustworthy (the map was still changing, or the integrand "
-                                 "has a feature the iterations saw differently)");
-    default: return warning(code, "");
+        return flag_warning(f, "the iterations of the runs disagree beyond their error bars" +
+                                   at_n + " (chi2 = " + fmt("%.1f", f.value) + " for " +
+                                   std::to_string(f.dof) + " degrees of freedom over " +
+                                   std::to_string(f.of) +
+                                   " replicates, p = " + fmt("%.2g", f.p_value) +
+                                   "): the weighted average and its error bar are not "
+                                   "trustworthy (the map was still changing, or the integrand "
+                                   "has a feature the iterations saw differently)");
+    default: return flag_warning(f, "");
     }
 }
 
 Json warnings_for(const LevelStats& l) {
     Json w = Json::array();
     for (const Flag& f : level_flags(l)) w.push_back(level_warning(f, l));
+    sort_by_severity(w);
     return w;
 }
 
@@ -114,15 +131,14 @@ Json tail_warning(const Flag& f, uint64_t pooled, const TailWording& words) {
                               std::to_string(pooled) + " " + words.unit + " at " + words.n_name +
                               " = " + std::to_string(f.n) + ")";
     if (f.code == FlagCode::HeavyTail)
-        return warning("heavy_tail", std::string(words.what) + " are heavy-tailed: tail index " +
-                                         fmt("%.2f", f.value) + " +/- " + fmt("%.2f", f.se) +
-                                         where + ", and below 2 " + words.variance +
-                                         " is infinite: the error bars are not trustworthy");
-    return warning("heavy_tail_4", std::string(words.what) + " have a heavy tail: tail index " +
-                                       fmt("%.2f", f.value) + where + " is below 4, so " +
-                                       words.variance +
-                                       " is finite but its estimate is unreliable and the error "
-                                       "bars may be too small");
+        return flag_warning(f, std::string(words.what) + " are heavy-tailed: tail index " +
+                                   fmt("%.2f", f.value) + " +/- " + fmt("%.2f", f.se) + where +
+                                   ", and below 2 " + words.variance +
+                                   " is infinite: the error bars are not trustworthy");
+    return flag_warning(f, std::string(words.what) + " have a heavy tail: tail index " +
+                               fmt("%.2f", f.value) + where + " is below 4, so " + words.variance +
+                               " is finite but its estimate is unreliable and the error "
+                               "bars may be too small");
 }
 
 void add_tail_warnings(Json& w, const LevelStats& deepest, uint64_t pooled,
@@ -141,47 +157,47 @@ Json estimator_warnings(const EstimatorStudy& e, const StudySettings& s) {
     }
     const SupportCheck& sc = e.support;
     for (const Flag& f : estimator_flags(e, s)) {
-        const char* code = flag_code_name(f.code);
         switch (f.code) {
         case FlagCode::PdfSupport:
             if (sc.method == "quadrature")
-                w.push_back(warning(
-                    code, std::isfinite(sc.missed_mass)
-                              ? "the pdf is zero on " + fmt("%.3g", 100.0 * sc.zero_measure) +
-                                    "% of the domain, where the integral of |f| is " +
-                                    fmt("%.6g", sc.missed_mass) + " (" +
-                                    fmt("%.3g", 100.0 * sc.missed_fraction) +
-                                    "% of the integral of |f|, by quadrature): the estimator "
-                                    "never samples there and is biased"
-                              : "the pdf is zero on " + fmt("%.3g", 100.0 * sc.zero_measure) +
-                                    "% of the domain, where |f| is not finite or not "
-                                    "integrable: the estimator never samples there and is "
-                                    "biased"));
+                w.push_back(flag_warning(
+                    f, std::isfinite(sc.missed_mass)
+                           ? "the pdf is zero on " + fmt("%.3g", 100.0 * sc.zero_measure) +
+                                 "% of the domain, where the integral of |f| is " +
+                                 fmt("%.6g", sc.missed_mass) + " (" +
+                                 fmt("%.3g", 100.0 * sc.missed_fraction) +
+                                 "% of the integral of |f|, by quadrature): the estimator "
+                                 "never samples there and is biased"
+                           : "the pdf is zero on " + fmt("%.3g", 100.0 * sc.zero_measure) +
+                                 "% of the domain, where |f| is not finite or not "
+                                 "integrable: the estimator never samples there and is "
+                                 "biased"));
             else
-                w.push_back(warning(code, "the pdf is zero at " + std::to_string(sc.missed) +
-                                              " of " + std::to_string(sc.f_nonzero) +
-                                              " probe points where f != 0 (" +
-                                              fmt("%.3g", 100.0 * sc.missed_fraction) +
-                                              "% of |f|): the estimator never samples there and "
-                                              "is biased"));
+                w.push_back(flag_warning(f, "the pdf is zero at " + std::to_string(sc.missed) +
+                                                " of " + std::to_string(sc.f_nonzero) +
+                                                " probe points where f != 0 (" +
+                                                fmt("%.3g", 100.0 * sc.missed_fraction) +
+                                                "% of |f|): the estimator never samples there and "
+                                                "is biased"));
             break;
         case FlagCode::LevelDrift:
             w.push_back(
-                warning(code, "the means at different N disagree beyond their error bars "
-                              "(chi2 = " +
-                                  fmt("%.1f", f.value) + " for " + std::to_string(f.dof) +
-                                  " degrees of freedom, p = " + fmt("%.2g", f.p_value) +
-                                  "): the error bars understate the error (heavy tails, too "
-                                  "few samples, or bias)"));
+                flag_warning(f, "the means at different N disagree beyond their error bars "
+                                "(chi2 = " +
+                                    fmt("%.1f", f.value) + " for " + std::to_string(f.dof) +
+                                    " degrees of freedom, p = " + fmt("%.2g", f.p_value) +
+                                    "): the error bars understate the error (heavy tails, too "
+                                    "few samples, or bias)"));
             break;
         case FlagCode::Float32Accumulator:
-            w.push_back(warning(code, "float32 accumulation (teaching mode): the estimates are "
-                                      "naive single-precision sums and stall or drift at large "
-                                      "N"));
+            w.push_back(flag_warning(f, "float32 accumulation (teaching mode): the estimates are "
+                                        "naive single-precision sums and stall or drift at large "
+                                        "N"));
             break;
         default: break; // the tail flags are worded above
         }
     }
+    sort_by_severity(w);
     return w;
 }
 
@@ -413,6 +429,19 @@ void comparison_table(std::ostringstream& out, const Json& ests, const Compariso
 } // namespace
 
 // Render studies: relative MSE against spp, with the image's mean luminance for the bias.
+/// Warnings as lines, most severe first: "  ERROR   code: message" (WARNING, info).
+void print_warnings(std::ostringstream& out, Json warnings) {
+    sort_by_severity(warnings);
+    for (const Json& w : warnings) {
+        const std::string severity = jstr(w, "severity");
+        const std::string label = severity == "error"     ? "ERROR"
+                                  : severity == "warning" ? "WARNING"
+                                  : severity == "info"    ? "info"
+                                                          : "note";
+        out << "  " << padr(label, 8) << jstr(w, "code") << ": " << jstr(w, "message") << "\n";
+    }
+}
+
 std::string format_render_table(const Json& r) {
     std::ostringstream out;
     const Json& scene = get(r, "scene");
@@ -430,7 +459,7 @@ std::string format_render_table(const Json& r) {
         << " images per spp, seed " << fmt("%.0f", jnum(settings, "seed")) << ", "
         << fmt("%.0f", jnum(settings, "threads")) << " thread(s), "
         << fmt("%.2f", jnum(r, "wall_time_s")) << " s\n";
-    for (const Json& w : list(scene, "warnings")) out << "  NOTE: " << jstr(w, "message") << "\n";
+    print_warnings(out, list(scene, "warnings"));
     if (jbool(r, "cancelled")) out << "  (cancelled: partial result)\n";
     for (const Json& e : list(r, "estimators")) {
         out << "\n"
@@ -457,12 +486,11 @@ std::string format_render_table(const Json& r) {
             out << "  fitted order: none";
         if (!jstr(fit, "note").empty()) out << " (" << jstr(fit, "note") << ")";
         out << ";  " << fmt("%.3g", jnum(e, "rays_per_second")) << " rays/s\n";
-        for (const Json& w : list(e, "warnings"))
-            out << "  WARNING: " << jstr(w, "message") << "\n";
+        Json shown = list(e, "warnings");
         const Json& levels = list(e, "levels");
         if (!levels.empty())
-            for (const Json& w : list(levels.back(), "warnings"))
-                out << "  WARNING: " << jstr(w, "message") << "\n";
+            for (const Json& w : list(levels.back(), "warnings")) shown.push_back(w);
+        print_warnings(out, shown);
     }
     // Equal-time comparison at the largest spp: which estimator buys the least error per
     // second of rendering.
@@ -503,10 +531,10 @@ std::string format_table(const Json& r) {
         out << padl("N", 9) << padl("mean", 17) << padl("variance", 13) << padl("rel.err", 10);
         if (has_exact) out << padl("rmse", 11) << padl("bias/se", 9) << padl("cover", 7);
         out << padl("time/est", 11) << padl("efficiency", 12) << "\n";
-        for (const Json& w : list(e, "warnings"))
-            out << "  WARNING: " << jstr(w, "message") << "\n";
-        // Level warnings repeat from N to N: the table shows each code once, at the largest N.
-        std::vector<std::string> codes, messages;
+        // Level warnings repeat from N to N: the table shows each code once, at the largest N,
+        // after the estimator's own.
+        Json shown = list(e, "warnings"), level_shown = Json::array();
+        std::vector<std::string> codes;
         for (const Json& l : list(e, "levels")) {
             // A negative variance (a hand-edited result) is shown as "-" like a missing one.
             const double mean = jnum(l, "mean"), raw_var = jnum(l, "variance");
@@ -525,13 +553,13 @@ std::string format_table(const Json& r) {
                 << padl(fmt("%.3e", jnum(l, "efficiency")), 12) << "\n";
             for (const Json& w : list(l, "warnings")) {
                 const std::string code = jstr(w, "code");
-                size_t at = 0;
-                while (at < codes.size() && codes[at] != code) ++at;
+                const size_t at = static_cast<size_t>(std::find(codes.begin(), codes.end(), code) -
+                                                      codes.begin());
                 if (at == codes.size()) {
                     codes.push_back(code);
-                    messages.push_back("");
-                }
-                messages[at] = jstr(w, "message");
+                    level_shown.push_back(w);
+                } else
+                    level_shown[at] = w;
             }
         }
         const Json& fit = get(e, "fit");
@@ -542,7 +570,8 @@ std::string format_table(const Json& r) {
             out << "  fitted order: none";
         if (!jstr(fit, "note").empty()) out << " (" << jstr(fit, "note") << ")";
         out << "\n";
-        for (const std::string& m : messages) out << "  WARNING: " << m << "\n";
+        for (const Json& w : level_shown) shown.push_back(w);
+        print_warnings(out, shown);
     }
 
     // Equal-N and equal-time comparison at the largest N every estimator reached.

@@ -44,8 +44,13 @@ Json progress_to_json(const StudyResult& partial, size_t level_index);
 
 /// A JSON number, or null when x is not finite (JSON has no NaN).
 Json num(double x);
-/// A warning object: a stable code and a sentence, {"code", "message"}.
-Json warning(const char* code, const std::string& message);
+/// A warning object: a stable code, how much it matters and a sentence,
+/// {"code", "severity", "message"} (severity "error", "warning" or "info", diagnostics.h).
+Json warning(const char* code, Severity severity, const std::string& message);
+/// The warning of a raised flag: its code and severity, and the sentence that words it.
+Json flag_warning(const Flag& flag, const std::string& message);
+/// Orders an array of warnings by severity, errors first, keeping the order within one.
+void sort_by_severity(Json& warnings);
 /// One number formatted printf-style ("-" when it is not finite).
 std::string fmt(const char* f, double x);
 

@@ -32,11 +32,45 @@ const char* flag_code_name(FlagCode code) {
     return "?";
 }
 
+const char* severity_name(Severity severity) {
+    switch (severity) {
+    case Severity::Error: return "error";
+    case Severity::Warning: return "warning";
+    case Severity::Info: return "info";
+    }
+    return "?";
+}
+
+Severity default_severity(FlagCode code) {
+    switch (code) {
+    case FlagCode::NoEstimate:
+    case FlagCode::NonfiniteEstimate:
+    case FlagCode::NonfiniteVariance:
+    case FlagCode::ZeroErrorBar:
+    case FlagCode::NonfiniteSamples:
+    case FlagCode::ZeroPdfSamples:
+    case FlagCode::ExactOutsideCi:
+    case FlagCode::PdfSupport:
+    case FlagCode::IterationsDisagree:
+    case FlagCode::ErrorBarsUnderstate:
+    case FlagCode::PixelErrorBars: return Severity::Error;
+    case FlagCode::DominantSample:
+    case FlagCode::LowEss:
+    case FlagCode::HeavyTail:
+    case FlagCode::LevelDrift:
+    case FlagCode::SlowConvergence: return Severity::Warning;
+    case FlagCode::HeavyTail4:
+    case FlagCode::Float32Accumulator:
+    case FlagCode::BelowReferenceNoise:
+    case FlagCode::ReferenceNoise: return Severity::Info;
+    }
+    return Severity::Warning;
+}
+
 std::vector<Flag> level_flags(const LevelStats& l) {
     std::vector<Flag> flags;
     auto raise = [&](FlagCode code) -> Flag& {
-        flags.push_back(Flag{});
-        flags.back().code = code;
+        flags.push_back(Flag(code));
         flags.back().n = l.n;
         return flags.back();
     };
@@ -135,20 +169,17 @@ std::vector<Flag> level_flags(const LevelStats& l) {
 std::vector<Flag> tail_flags(const LevelStats& deepest) {
     std::vector<Flag> flags;
     if (!std::isfinite(deepest.tail_index) || deepest.tail_k <= 0) return flags;
-    Flag f;
+    const double alpha = deepest.tail_index;
+    const double se = alpha / std::sqrt(static_cast<double>(deepest.tail_k));
+    const bool infinite_variance = alpha < kHeavyTailAlpha + 2.0 * se;
+    if (!infinite_variance && !(alpha < kHeavyTail4Alpha)) return flags;
+    Flag f(infinite_variance ? FlagCode::HeavyTail : FlagCode::HeavyTail4);
     f.n = deepest.n;
-    f.value = deepest.tail_index;
-    f.se = deepest.tail_index / std::sqrt(static_cast<double>(deepest.tail_k));
+    f.value = alpha;
+    f.se = se;
     f.count = static_cast<uint64_t>(deepest.tail_k);
-    if (f.value < kHeavyTailAlpha + 2.0 * f.se) {
-        f.code = FlagCode::HeavyTail;
-        f.threshold = kHeavyTailAlpha;
-        flags.push_back(f);
-    } else if (f.value < kHeavyTail4Alpha) {
-        f.code = FlagCode::HeavyTail4;
-        f.threshold = kHeavyTail4Alpha;
-        flags.push_back(f);
-    }
+    f.threshold = infinite_variance ? kHeavyTailAlpha : kHeavyTail4Alpha;
+    flags.push_back(f);
     return flags;
 }
 
@@ -157,8 +188,7 @@ std::vector<Flag> estimator_flags(const EstimatorStudy& e, const StudySettings& 
     if (!e.levels.empty()) flags = tail_flags(e.levels.back());
     const SupportCheck& sc = e.support;
     if (sc.flagged) {
-        Flag f;
-        f.code = FlagCode::PdfSupport;
+        Flag f(FlagCode::PdfSupport);
         f.value = sc.missed_fraction;
         f.threshold = kSupportTolerance;
         f.count = sc.missed;
@@ -166,8 +196,7 @@ std::vector<Flag> estimator_flags(const EstimatorStudy& e, const StudySettings& 
         flags.push_back(f);
     }
     if (e.consistency.dof > 0 && e.consistency.p_value < kLevelDriftP) {
-        Flag f;
-        f.code = FlagCode::LevelDrift;
+        Flag f(FlagCode::LevelDrift);
         f.value = e.consistency.chi2;
         f.dof = e.consistency.dof;
         f.p_value = e.consistency.p_value;
@@ -175,9 +204,7 @@ std::vector<Flag> estimator_flags(const EstimatorStudy& e, const StudySettings& 
         flags.push_back(f);
     }
     if (settings.accumulator == Accumulator::Float32) {
-        Flag f;
-        f.code = FlagCode::Float32Accumulator;
-        flags.push_back(f);
+        flags.push_back(Flag(FlagCode::Float32Accumulator));
     }
     return flags;
 }

@@ -38,9 +38,26 @@ enum class FlagCode {
 /// The stable code of a flag in results ("no_estimate", "heavy_tail", ...).
 const char* flag_code_name(FlagCode code);
 
-/// One raised flag and its evidence. Fields a flag does not use stay NaN / 0.
+/// How much a flag matters, most first:
+/// - Error: the estimate or its error bar is wrong (samples dropped, mass the pdf misses, an
+///   exact value far outside the interval, error bars the replicates contradict);
+/// - Warning: the error bar cannot be trusted at this N (evidence of infinite variance, too
+///   few effective samples, drift across N);
+/// - Info: worth knowing, nothing is wrong (a finite-variance heavy tail, teaching modes).
+enum class Severity { Error, Warning, Info };
+
+/// "error", "warning", "info".
+const char* severity_name(Severity severity);
+
+/// The severity of a code when its evidence says nothing more.
+Severity default_severity(FlagCode code);
+
+/// One raised flag and its evidence. Fields a flag does not use stay NaN / 0. Built from its
+/// code, with the code's default severity.
 struct Flag {
-    FlagCode code = FlagCode::NoEstimate;
+    explicit Flag(FlagCode c) : code(c), severity(default_severity(c)) {}
+    FlagCode code;
+    Severity severity;
     uint64_t n = 0; ///< the level's N (0 for an estimator-wide flag)
     double value = std::numeric_limits<double>::quiet_NaN();     ///< the statistic
     double se = std::numeric_limits<double>::quiet_NaN();        ///< its standard error

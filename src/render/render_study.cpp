@@ -101,8 +101,7 @@ bool below_reference_noise(const LevelStats& level, double floor) {
 std::vector<Flag> render_level_flags(const LevelStats& level, double floor) {
     std::vector<Flag> flags;
     if (below_reference_noise(level, floor)) {
-        Flag f;
-        f.code = FlagCode::BelowReferenceNoise;
+        Flag f(FlagCode::BelowReferenceNoise);
         f.n = level.n;
         f.value = level.variance;
         f.threshold = floor;
@@ -117,8 +116,7 @@ std::vector<Flag> render_flags(const RenderEstimatorStudy& s, double floor) {
     size_t below = 0;
     for (const LevelStats& l : s.levels) below += below_reference_noise(l, floor) ? 1 : 0;
     if (below > 0) {
-        Flag f;
-        f.code = FlagCode::ReferenceNoise;
+        Flag f(FlagCode::ReferenceNoise);
         f.count = below;
         f.of = s.levels.size();
         f.threshold = floor;
@@ -127,16 +125,14 @@ std::vector<Flag> render_flags(const RenderEstimatorStudy& s, double floor) {
     const LevelStats& deepest = s.levels.back();
     for (const Flag& f : tail_flags(deepest)) flags.push_back(f);
     if (s.fit.valid && s.fit.order > -1.0 + 3.0 * s.fit.order_se && s.fit.order > -0.8) {
-        Flag f;
-        f.code = FlagCode::SlowConvergence;
+        Flag f(FlagCode::SlowConvergence);
         f.value = s.fit.order;
         f.se = s.fit.order_se;
         f.threshold = -1.0;
         flags.push_back(f);
     }
     if (deepest.coverage < 0.85 && deepest.n >= 16) {
-        Flag f;
-        f.code = FlagCode::PixelErrorBars;
+        Flag f(FlagCode::PixelErrorBars);
         f.n = deepest.n;
         f.value = deepest.coverage;
         f.threshold = 0.85;

@@ -60,8 +60,8 @@ Json render_warnings(const RenderEstimatorStudy& s, double floor) {
     for (const Flag& f : render_flags(s, floor)) {
         switch (f.code) {
         case FlagCode::ReferenceNoise:
-            w.push_back(warning(flag_code_name(f.code),
-                                std::to_string(f.count) + " of " + std::to_string(f.of) +
+            w.push_back(
+                flag_warning(f, std::to_string(f.count) + " of " + std::to_string(f.of) +
                                     " spp level(s) have a relative MSE below the reference's "
                                     "own noise (floor " +
                                     fmt("%.3e", f.threshold) +
@@ -73,15 +73,15 @@ Json render_warnings(const RenderEstimatorStudy& s, double floor) {
             w.push_back(tail_warning(f, s.levels.back().diagnostics.nonzero, tail_words));
             break;
         case FlagCode::SlowConvergence:
-            w.push_back(warning(flag_code_name(f.code),
-                                "relative MSE falls as spp^" + fmt("%.2f", f.value) + " +/- " +
+            w.push_back(
+                flag_warning(f, "relative MSE falls as spp^" + fmt("%.2f", f.value) + " +/- " +
                                     fmt("%.2f", f.se) +
                                     ", slower than 1/spp: infinite variance, bias against the "
                                     "reference, or a reference too noisy for this spp"));
             break;
         case FlagCode::PixelErrorBars:
-            w.push_back(warning(flag_code_name(f.code),
-                                "only " + fmt("%.1f", 100.0 * f.value) +
+            w.push_back(
+                flag_warning(f, "only " + fmt("%.1f", 100.0 * f.value) +
                                     "% of the pixels' own 95% error bars cover the reference at "
                                     "spp = " +
                                     std::to_string(f.n) +
@@ -90,6 +90,7 @@ Json render_warnings(const RenderEstimatorStudy& s, double floor) {
         default: break;
         }
     }
+    sort_by_severity(w);
     return w;
 }
 
@@ -101,13 +102,12 @@ Json render_level_to_json(const LevelStats& l, double floor) {
     const std::vector<Flag> flags = render_level_flags(l, floor);
     j["below_reference_noise"] = !flags.empty();
     for (const Flag& f : flags)
-        j["warnings"].push_back(warning(
-            flag_code_name(f.code),
-            "relative MSE " + fmt("%.3e", f.value) + " at spp = " + std::to_string(f.n) + " is " +
-                (f.value < 0.0 ? "negative" : "below") +
-                " the reference's own noise (relative-MSE floor " + fmt("%.3e", f.threshold) +
-                "): it measures the reference, not the estimator; use a reference with more "
-                "spp"));
+        j["warnings"].push_back(flag_warning(
+            f, "relative MSE " + fmt("%.3e", f.value) + " at spp = " + std::to_string(f.n) +
+                   " is " + (f.value < 0.0 ? "negative" : "below") +
+                   " the reference's own noise (relative-MSE floor " + fmt("%.3e", f.threshold) +
+                   "): it measures the reference, not the estimator; use a reference with more "
+                   "spp"));
     return j;
 }
 
@@ -230,16 +230,17 @@ Json scene_to_json(const Loaded& l) {
     const Scene& sc = *r.scene;
     const AccelStats& a = l.scene.accel.stats();
     Json warnings = Json::array();
-    for (const std::string& w : r.warnings) warnings.push_back(warning("gltf", w));
+    for (const std::string& w : r.warnings)
+        warnings.push_back(warning("gltf", Severity::Warning, w));
     const LightSet& lights = l.scene.lights_uniform;
     if (size_t n = lights.degenerate())
-        warnings.push_back(warning("degenerate_lights",
+        warnings.push_back(warning("degenerate_lights", Severity::Info,
                                    std::to_string(n) +
                                        " emissive triangle(s) have zero area: they can neither be "
                                        "hit nor sampled and are left out of the lights"));
     if (lights.empty())
-        warnings.push_back(
-            warning("no_lights", "the scene has no emissive surface: every image is black"));
+        warnings.push_back(warning("no_lights", Severity::Warning,
+                                   "the scene has no emissive surface: every image is black"));
     Json materials = Json::array();
     for (const Material& m : sc.materials)
         materials.push_back(Json{{"name", m.name},
@@ -358,7 +359,7 @@ bool check_study(const RenderRequest& r, std::string* error) {
 
 /// The warning of a result whose reference is black (relative MSE undefined, null).
 Json black_reference_warning() {
-    return warning("black_reference",
+    return warning("black_reference", Severity::Warning,
                    "the reference image is black (mean luminance 0): relative MSE is undefined "
                    "and reported as null");
 }
@@ -476,15 +477,17 @@ int mcp_render_image(const char* scene_json, const char* options_json, char** re
               {"max_sample_share", num(d.max_sample_share)}};
     Json warnings = Json::array();
     if (d.discarded_nonfinite)
-        warnings.push_back(warning("nonfinite", std::to_string(d.discarded_nonfinite) +
-                                                    " sample(s) with NaN/Inf radiance were "
-                                                    "discarded: the image is biased there"));
+        warnings.push_back(warning("nonfinite", Severity::Error,
+                                   std::to_string(d.discarded_nonfinite) +
+                                       " sample(s) with NaN/Inf radiance were "
+                                       "discarded: the image is biased there"));
     // Penumbrae legitimately have pixels where one sample of many sees the light; a share of
     // the image above 1% is fireflies.
     if (d.dominated_pixels * 100 > image.pixel_count())
-        warnings.push_back(warning("fireflies", std::to_string(d.dominated_pixels) +
-                                                    " pixel(s) owe more than half their value "
-                                                    "to one sample (fireflies)"));
+        warnings.push_back(warning("fireflies", Severity::Warning,
+                                   std::to_string(d.dominated_pixels) +
+                                       " pixel(s) owe more than half their value "
+                                       "to one sample (fireflies)"));
     Json images = Json::object();
     if (png) images["png"] = base64_encode(encode_png(image, r.exposure));
     if (hdr) images["hdr"] = base64_encode(encode_hdr(image));

@@ -3,7 +3,7 @@
 // flagged cells sit next to the warning that concerns them (low_ess by the effective sample
 // size, heavy_tail by the tail index, level_drift by the consistency test, ...). A pure render
 // of the state, text only (never HTML from data).
-import { collectWarnings, fitText, fmt } from './series.js';
+import { collectWarnings, fitText, fmt, severityOf } from './series.js';
 import { colorAt } from './palette.js';
 import { el } from './dom.js';
 
@@ -45,8 +45,14 @@ function columnsOf(run) {
 }
 
 
+/** The severity label that leads every warning: ERROR, WARNING or info. */
+function severityLabel(w) {
+  const s = severityOf(w);
+  return el('span', { className: `severity severity-${s}` }, s === 'info' ? 'info' : s.toUpperCase());
+}
+
 function badge(w) {
-  return el('span', { className: 'badge', title: w.message }, w.code);
+  return el('span', { className: `badge badge-${severityOf(w)}`, title: `${severityOf(w)}: ${w.message}` }, w.code);
 }
 
 let lastSig = null;
@@ -61,8 +67,9 @@ export function renderReport(state, dom) {
 
   const warnings = collectWarnings(run.records, run.order);
   dom.diagnostics.replaceChildren(...warnings.map((w) => el('li', {
-    dataset: { estimator: w.estimator, code: w.code, scope: w.scope },
+    dataset: { estimator: w.estimator, code: w.code, scope: w.scope, severity: w.severity },
   },
+  severityLabel(w), ' ',
   el('strong', {}, w.estimator), ' ',
   el('code', {}, w.code), ' ',
   w.message,
@@ -115,12 +122,12 @@ function estimatorTable(r, run, isOpen) {
     for (const w of l.warnings || []) (flagged[LEVEL_COLUMN[w.code] || 'n'] ??= []).push(w);
     rows.push(el('tr', { dataset: { n: String(l.n) } }, ...columns.map(([key, , get]) => {
       const ws = flagged[key];
-      return el('td', ws ? { className: 'flag', title: ws.map((w) => `${w.code}: ${w.message}`).join('\n') } : {},
+      return el('td', ws ? { className: 'flag', title: ws.map((w) => `${severityOf(w)} ${w.code}: ${w.message}`).join('\n') } : {},
         ws ? `⚠ ${get(l)}` : get(l));
     })));
     for (const w of l.warnings || []) {
       rows.push(el('tr', { className: 'warn-row' }, el('td', { colSpan: columns.length },
-        el('code', {}, w.code), ` ${run.kind === 'render' ? 'spp' : 'N'} = ${l.n}: ${w.message}`)));
+        severityLabel(w), ' ', el('code', {}, w.code), ` ${run.kind === 'render' ? 'spp' : 'N'} = ${l.n}: ${w.message}`)));
     }
   }
   const details = el('details', { dataset: { for: r.name } }, summary,

@@ -330,21 +330,30 @@ export function coverageSeries(records, order, xs = null) {
 // ---------------------------------------------------------------------------------------------
 // Diagnostics and text
 
+/** Severities most severe first; a warning without one (an older result) counts as "warning". */
+export const SEVERITIES = ['error', 'warning', 'info'];
+export function severityOf(w) {
+  return SEVERITIES.includes(w && w.severity) ? w.severity : 'warning';
+}
+
 /**
  * Every warning of the records, grouped by (estimator, scope, code): estimator-level flags
- * once, level flags with the list of N where they were raised and the message of the first.
+ * once, level flags with the list of N where they were raised and the message of the first;
+ * errors first, then warnings, then info (in record order within a severity).
  */
 export function collectWarnings(records, order) {
   const out = [];
   for (const name of order) {
     const r = records[name];
     if (!r) continue;
-    for (const w of r.warnings || []) out.push({ estimator: name, scope: 'estimator', code: w.code, message: w.message, n: [] });
+    for (const w of r.warnings || []) {
+      out.push({ estimator: name, scope: 'estimator', severity: severityOf(w), code: w.code, message: w.message, n: [] });
+    }
     const byCode = new Map();
     for (const l of r.levels) {
       for (const w of l.warnings || []) {
         if (!byCode.has(w.code)) {
-          const item = { estimator: name, scope: 'level', code: w.code, message: w.message, n: [] };
+          const item = { estimator: name, scope: 'level', severity: severityOf(w), code: w.code, message: w.message, n: [] };
           byCode.set(w.code, item);
           out.push(item);
         }
@@ -352,7 +361,8 @@ export function collectWarnings(records, order) {
       }
     }
   }
-  return out;
+  const rank = (w) => SEVERITIES.indexOf(w.severity);
+  return out.map((w, i) => [w, i]).sort((a, b) => rank(a[0]) - rank(b[0]) || a[1] - b[1]).map(([w]) => w);
 }
 
 /** x with 3 decimals exactly as C's printf("%.3f") writes it (ties to even, -0.000 kept). */
