@@ -179,6 +179,9 @@ double number_or_nan(const Json& v) {
 struct Tally {
     long fine = 0, fine_flagged = 0, cells = 0, runs = 0, confident_wrong = 0;
     std::map<std::string, long> false_flag_codes; // codes on fine cells
+    // Codes that are a cell's only alarm where a replicate missed by more than 5 t standard
+    // errors: without them those misses would be confident wrong answers.
+    std::map<std::string, long> sole_alarm_on_miss;
 };
 
 struct Wrong {
@@ -226,6 +229,13 @@ void judge(const std::string& case_name, const Json& result, double exact, Tally
                     codes.erase(std::unique(codes.begin(), codes.end()), codes.end());
                     for (const std::string& c : codes) ++t->false_flag_codes[c];
                 }
+            }
+            {
+                std::vector<std::string> distinct = codes;
+                std::sort(distinct.begin(), distinct.end());
+                distinct.erase(std::unique(distinct.begin(), distinct.end()), distinct.end());
+                if (distinct.size() == 1 && !misses.empty())
+                    ++t->sole_alarm_on_miss[distinct.front()];
             }
             if (codes.empty())
                 for (double z : misses) {
@@ -328,12 +338,20 @@ int main(int argc, char** argv) {
     all.confident_wrong += scenes.confident_wrong;
     all.runs += scenes.runs;
     for (const auto& [k, v] : scenes.false_flag_codes) all.false_flag_codes[k] += v;
+    for (const auto& [k, v] : scenes.sole_alarm_on_miss) all.sole_alarm_on_miss[k] += v;
     report("all", all);
-    std::printf("\nflag codes on fine cells (cells carrying each):\n");
+    std::printf("\nalarms on fine cells (cells carrying each), and cells with a miss beyond 5 t "
+                "standard errors\nwhere it is the only alarm (without it they would be "
+                "confident wrong answers):\n");
     std::vector<std::pair<long, std::string>> codes;
     for (const auto& [k, v] : all.false_flag_codes) codes.push_back({v, k});
+    for (const auto& [k, v] : all.sole_alarm_on_miss)
+        if (!all.false_flag_codes.count(k)) codes.push_back({0, k});
     std::sort(codes.rbegin(), codes.rend());
-    for (const auto& [v, k] : codes) std::printf("  %-24s %6ld\n", k.c_str(), v);
+    std::printf("  %-24s %10s %10s\n", "code", "on fine", "sole alarm");
+    for (const auto& [v, k] : codes)
+        std::printf("  %-24s %10ld %10ld\n", k.c_str(), v,
+                    all.sole_alarm_on_miss.count(k) ? all.sole_alarm_on_miss.at(k) : 0L);
     std::printf("\nconfident wrong answers (|error| / se; first %d):\n", o.list);
     std::sort(wrong.begin(), wrong.end(), [](const Wrong& a, const Wrong& b) { return a.z > b.z; });
     for (size_t i = 0; i < wrong.size() && int(i) < o.list; ++i)
