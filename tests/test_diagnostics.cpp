@@ -3,10 +3,14 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <sstream>
 
 #include "api/scene.h"
+#include "core/rng.h"
+#include "core/special.h"
+#include "core/stats.h"
 #include "estimators/diagnostics.h"
 
 using namespace mcp;
@@ -146,4 +150,47 @@ TEST(Diagnostics, EveryFlagHasTheSeverityOfWhatItSays) {
                 ++support;
             }
     EXPECT_GT(support, 0);
+}
+
+namespace {
+
+/// A ladder of 7 levels whose means are averages of R normal replicates around `truth` (plus
+/// `shift` standard deviations on level 3), with the standard errors those replicates give.
+std::vector<LevelStats> normal_ladder(Pcg32& rng, int reps, double shift) {
+    std::vector<LevelStats> levels(7);
+    for (size_t k = 0; k < levels.size(); ++k) {
+        const double sigma = 1.0 / std::sqrt(double(uint64_t(1) << k)); // as for N = 2^k
+        RunningMoments m;
+        for (int r = 0; r < reps; ++r) {
+            // Box-Muller from two 53-bit uniforms
+            const double u1 = 1.0 - rng.next_double(), u2 = rng.next_double();
+            const double z = std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * kPi * u2);
+            m.add(1.0 + sigma * (z + (k == 3 ? shift / std::sqrt(double(reps)) : 0.0)));
+        }
+        levels[k].reps = reps;
+        levels[k].mean = m.mean();
+        levels[k].std_error = std::sqrt(m.variance() / reps);
+        levels[k].estimates_spread = true;
+    }
+    return levels;
+}
+
+} // namespace
+
+// The level-consistency test (level_drift) both ways: on ladders whose levels agree, R = 10
+// replicates each, p < 1e-3 must be as rare as 1e-3 says (t-distributed z's summed as if normal
+// fired on 1.7% of them); a level shifted by 10 of its standard errors must be caught (6 is
+// within what t with 9 degrees of freedom allows once in a few thousand).
+TEST(Diagnostics, LevelDriftIsRareOnConsistentLaddersAndCatchesAShift) {
+    Pcg32 rng(2026, 13);
+    const int ladders = 4000;
+    int false_alarms = 0;
+    for (int i = 0; i < ladders; ++i)
+        false_alarms += level_consistency(normal_ladder(rng, 10, 0.0)).p_value < kLevelDriftP;
+    // Expected 4 at p = 1e-3; 14 is about 5 binomial standard deviations above that.
+    EXPECT_LE(false_alarms, 14) << "of " << ladders;
+    int caught = 0;
+    for (int i = 0; i < 200; ++i)
+        caught += level_consistency(normal_ladder(rng, 10, 10.0)).p_value < kLevelDriftP;
+    EXPECT_GE(caught, 150) << "of 200";
 }

@@ -39,6 +39,20 @@ TEST(Special, StudentTQuantileMatchesCdfByQuadrature) {
     }
 }
 
+TEST(Special, StudentTTailClosedForms) {
+    // nu = 1 (Cauchy): P(T > t) = 1/2 - atan(t) / pi; nu = 2: 1/2 - t / (2 sqrt(2 + t^2)).
+    for (double t : {-3.0, -0.5, 0.0, 0.7, 2.0, 40.0}) {
+        EXPECT_NEAR(student_t_sf(t, 1), 0.5 - std::atan(t) / kPi, 1e-13) << t;
+        EXPECT_NEAR(student_t_sf(t, 2), 0.5 - t / (2.0 * std::sqrt(2.0 + t * t)), 1e-13) << t;
+    }
+    // Large nu tends to the normal tail; the tail at the 97.5% quantile is 2.5%.
+    EXPECT_NEAR(student_t_sf(3.0, 1e7), 1.0 - normal_cdf(3.0), 1e-7);
+    for (double nu : {3.0, 9.0, 31.0})
+        EXPECT_NEAR(student_t_sf(student_t_quantile(0.975, nu), nu), 0.025, 1e-3) << nu;
+    EXPECT_EQ(student_t_sf(INFINITY, 9), 0.0);
+    EXPECT_EQ(student_t_sf(-INFINITY, 9), 1.0);
+}
+
 TEST(Special, IncompleteGammaIdentities) {
     // P(1, x) = 1 - e^-x; chi-square with 2 dof has survival e^(-x/2).
     for (double x : {0.01, 0.5, 1.0, 3.0, 10.0, 50.0}) {

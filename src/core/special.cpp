@@ -189,6 +189,13 @@ double beta_regularized(double a, double b, double x) {
     return 1.0 - front * beta_continued_fraction(b, a, 1.0 - x) / b;
 }
 
+double student_t_sf(double t, double nu) {
+    if (std::isnan(t)) return t;
+    if (std::isinf(t)) return t > 0.0 ? 0.0 : 1.0;
+    const double half_tail = 0.5 * beta_regularized(0.5 * nu, 0.5, nu / (nu + t * t));
+    return t >= 0.0 ? half_tail : 1.0 - half_tail;
+}
+
 double f_sf(double f, double d1, double d2) {
     if (!(f > 0.0)) return 1.0;
     if (std::isinf(f)) return 0.0;

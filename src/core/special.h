@@ -36,6 +36,10 @@ double chi_square_quantile(double p, double k);
 /// fraction [NR07, 6.4] (on the side where it converges fast).
 double beta_regularized(double a, double b, double x);
 
+/// Upper tail probability of Student's t with nu > 0 degrees of freedom, P(T > t):
+/// (1/2) I_{nu / (nu + t^2)}(nu / 2, 1 / 2) for t >= 0 [AS64, 26.7.1], by symmetry below.
+double student_t_sf(double t, double nu);
+
 /// Upper tail probability of Snedecor's F distribution with (d1, d2) degrees of freedom:
 /// P(F > f) = I_{d2 / (d2 + d1 f)}(d2 / 2, d1 / 2).
 double f_sf(double f, double d1, double d2);
