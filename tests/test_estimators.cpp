@@ -274,11 +274,16 @@ std::set<std::string> warning_codes(const EstimatorStudy& e, const LevelStats& l
     wrapper.settings = settings;
     wrapper.estimators.push_back(e);
     Json j = study_to_json(wrapper);
+    // Alarms only: a flag of severity info says nothing is wrong.
     std::set<std::string> codes;
-    for (const Json& w : j["estimators"][0]["warnings"]) codes.insert(w["code"].get<std::string>());
+    auto alarms = [&](const Json& warnings) {
+        for (const Json& w : warnings)
+            if (w["severity"] != "info") codes.insert(w["code"].get<std::string>());
+    };
+    alarms(j["estimators"][0]["warnings"]);
     const Json level =
         level_to_json(l); // kept alive: a range-for over a temporary's member dangles
-    for (const Json& w : level["warnings"]) codes.insert(w["code"].get<std::string>());
+    alarms(level["warnings"]);
     return codes;
 }
 
