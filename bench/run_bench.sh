@@ -12,9 +12,21 @@ echo "  wasm under node --no-liftoff: steady-state optimised code, as a browser 
 echo "machine: $(nproc) cores, $(uname -m), $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //')"
 $native scenes $((1 << 22)) --accumulation >"$tmp/native"
 $wasm scenes $((1 << 22)) --accumulation >"$tmp/wasm"
+# The estimator cases again, native and wasm in turn, case by case (ROUNDS more times): both
+# sides of a ratio then see the same machine load, and each figure is the best of its rounds.
+rounds=${ROUNDS:-2}
+cases=$(grep ^BENCH "$tmp/native" | awk '{print $2}' | grep -v '^render/\|^eval/\|^pcg32\|hand_loop' |
+        cut -d/ -f2 | sort -u)
+for ((r = 0; r < rounds; ++r)); do
+    for c in $cases; do
+        $native scenes $((1 << 22)) --only "$c" | grep -v pcg32 >>"$tmp/native"
+        $wasm scenes $((1 << 22)) --only "$c" | grep -v pcg32 >>"$tmp/wasm"
+    done
+done
+best() { grep ^BENCH "$1" | awk '{ if ($3 > b[$2]) b[$2] = $3 } END { for (k in b) print k, b[k] }' | sort; }
+echo "  (estimator cases: best of the full run and $rounds more rounds, native and wasm in turn)"
 printf '%-44s %14s %14s %8s\n' case native wasm native/wasm
-join <(grep ^BENCH "$tmp/native" | awk '{print $2, $3}' | sort) \
-     <(grep ^BENCH "$tmp/wasm" | awk '{print $2, $3}' | sort) |
+join <(best "$tmp/native") <(best "$tmp/wasm") |
     awk '{ printf "%-44s %14.3e %14.3e %7.2fx\n", $1, $2, $3, $2 / $3 }'
 echo
 echo "expression vs the same integrand compiled in C++ (evaluations per second; target ratio <= 3):"
