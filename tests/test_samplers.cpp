@@ -135,6 +135,38 @@ TEST(Samplers, BlockSizeDoesNotChangePoints) {
     }
 }
 
+// Stratified blocks that start anywhere (mid-cell with two points per cell, mid-row of the
+// grid) give the points sample_coordinate gives, and every cell holds its two points.
+TEST(Samplers, StratifiedBlocksStartingMidCellAgreeWithRandomAccess) {
+    SamplerOptions options;
+    options.per_stratum = 2;
+    for (int dim : {1, 2, 3}) {
+        const uint64_t n = 2 * 210; // 210 cells: grids 210, 14 x 15, 5 x 6 x 7
+        Pcg32 rng(5, 3);
+        const SamplerPlan plan = make_sampler_plan(SamplerKind::Stratified, dim, n, rng, options);
+        PointBlock u;
+        u.reset(dim, 13);
+        std::vector<int> per_cell(n / 2, 0);
+        for (uint64_t first = 0; first < n; first += 13) {
+            const size_t count = static_cast<size_t>(std::min<uint64_t>(13, n - first));
+            generate_block(plan, first, count, u);
+            for (size_t i = 0; i < count; ++i) {
+                uint64_t cell = 0;
+                for (int j = 0; j < dim; ++j) {
+                    const double x = u.coord(j)[i];
+                    ASSERT_EQ(x, sample_coordinate(plan, first + i, j))
+                        << "dim " << dim << " point " << first + i << " axis " << j;
+                    const uint64_t k = plan.strata[static_cast<size_t>(j)];
+                    cell = cell * k + static_cast<uint64_t>(x * static_cast<double>(k));
+                }
+                EXPECT_EQ(cell, (first + i) / 2) << "dim " << dim << " point " << first + i;
+                ++per_cell[static_cast<size_t>(cell)];
+            }
+        }
+        for (int c : per_cell) EXPECT_EQ(c, 2);
+    }
+}
+
 // A point is addressed by (plan, index, dimension): blocks generated backwards, one point at a
 // time, and sample_coordinate all give the points of the forward run, bit for bit.
 TEST(Samplers, PointsAreAddressableInAnyOrder) {

@@ -232,21 +232,32 @@ void generate_block(const SamplerPlan& plan, uint64_t first, size_t count, Point
         // Cell index in mixed radix, last axis fastest: cell = ((c_0 k_1 + c_1) k_2 + c_2)...
         // Consecutive indices are neighbouring cells, which the collapsed-strata variance
         // estimate relies on (pairs 2m, 2m+1).
-        // An odometer over the cells: the digits of the block's first cell once (divisions),
-        // then one increment per cell (no division per sample).
+        // Two passes: the jitter in draw order (point-major), then axis by axis the cell
+        // offset, with an odometer digit per axis that steps every `stride` points (the
+        // block's first cell once by division, then no division by the strata per sample).
+        for (size_t i = 0; i < count; ++i)
+            for (int j = 0; j < d; ++j) u.coord(j)[i] = rng.next_double();
         uint64_t digits[64];
-        uint64_t within = first % plan.per_stratum;
         cell_digits(plan, first / plan.per_stratum, digits);
-        for (size_t i = 0; i < count; ++i) {
-            for (int j = 0; j < d; ++j)
-                u.coord(j)[i] = stratified_coordinate(plan, digits, j, rng.next_double());
-            if (++within == plan.per_stratum) {
-                within = 0;
-                for (int j = d - 1; j >= 0; --j) {
-                    if (++digits[j] < plan.strata[static_cast<size_t>(j)]) break;
-                    digits[j] = 0;
+        uint64_t stride = plan.per_stratum;         // points per step of axis j's digit
+        uint64_t within = first % plan.per_stratum; // points of the first cell already past
+        for (int j = d - 1; j >= 0; --j) {
+            const uint64_t k = plan.strata[static_cast<size_t>(j)];
+            const double kd = u63_to_double(k);
+            double digit = u63_to_double(digits[j]); // integers, exact in a double
+            uint64_t left = stride - within;         // points until the digit steps
+            double* x = u.coord(j);
+            for (size_t i = 0; i < count; ++i) {
+                x[i] = below_one((digit + x[i]) / kd);
+                if (--left == 0) {
+                    left = stride;
+                    digit = digit + 1.0 < kd ? digit + 1.0 : 0.0;
                 }
             }
+            // The next axis steps when this one wraps: its first step is after the points
+            // remaining in this digit's current run of k values.
+            within += digits[j] * stride;
+            stride *= k;
         }
         break;
     }

@@ -14,11 +14,11 @@ namespace mcp {
 class NeumaierSum {
   public:
     void add(double x) {
-        double t = sum_ + x;
-        if (std::fabs(sum_) >= std::fabs(x))
-            comp_ += (sum_ - t) + x;
-        else
-            comp_ += (x - t) + sum_;
+        // Branch-free: the larger-magnitude term loses the low bits [Neumaier74].
+        const double t = sum_ + x;
+        const bool sum_larger = std::fabs(sum_) >= std::fabs(x);
+        const double big = sum_larger ? sum_ : x, small = sum_larger ? x : sum_;
+        comp_ += (big - t) + small;
         sum_ = t;
     }
     double value() const { return sum_ + comp_; }
