@@ -3,7 +3,7 @@
 // ignore flags; an estimate far off with no flag is a confident wrong answer.
 //
 //   calibrate [--quick] [--reps R] [--n-min N] [--n-max N] [--param-seeds 1,2,3]
-//             [--dims 2,4,8] [--scenes DIR] [--json FILE] [--list N]
+//             [--dims 2,4,8] [--scenes DIR] [--json FILE] [--cells FILE] [--list N]
 //
 // The battery: Genz's six families [Genz84] at d = 2, 4, 8 with the project's own random
 // parameters (genz_random, seeds 1..3), each run with every uniform-density preset, and every
@@ -50,7 +50,7 @@ struct Options {
     uint64_t n_min = 1024, n_max = 65536, seed = 2026;
     std::vector<int> dims{2, 4, 8};
     std::vector<uint64_t> param_seeds{1, 2, 3};
-    std::string scenes_dir = "scenes", json_path;
+    std::string scenes_dir = "scenes", json_path, cells_path;
     int list = 20; // confident wrong answers and flag codes listed
 };
 
@@ -58,7 +58,7 @@ struct Options {
     if (!msg.empty()) std::fprintf(stderr, "calibrate: %s\n", msg.c_str());
     std::fprintf(stderr, "usage: calibrate [--quick] [--reps R] [--n-min N] [--n-max N]\n"
                          "         [--param-seeds 1,2,3] [--dims 2,4,8] [--scenes DIR]\n"
-                         "         [--json FILE] [--list N]\n");
+                         "         [--json FILE] [--cells FILE] [--list N]\n");
     std::exit(2);
 }
 
@@ -108,6 +108,8 @@ Options parse_options(int argc, char** argv) {
             o.scenes_dir = value();
         else if (a == "--json")
             o.json_path = value();
+        else if (a == "--cells")
+            o.cells_path = value();
         else if (a == "--list")
             o.list = int(one("--list", 0, 100000));
         else if (a == "-h" || a == "--help")
@@ -190,8 +192,10 @@ struct Wrong {
 };
 
 // Judges every level of every estimator of one study result.
+// cells (if not null) gets one JSON line per cell: the verdict, the alarms and the level's
+// statistics, for studying what separates the misses from the fine cells.
 void judge(const std::string& case_name, const Json& result, double exact, Tally* t,
-           std::vector<Wrong>* wrong) {
+           std::vector<Wrong>* wrong, std::FILE* cells) {
     for (const Json& e : result["estimators"]) {
         // Alarms only: a flag of severity info says nothing is wrong.
         auto alarms = [](const Json& warnings, std::vector<std::string>* codes) {
@@ -221,6 +225,19 @@ void judge(const std::string& case_name, const Json& result, double exact, Tally
                     misses.push_back(s > 0.0 ? err / s : INFINITY);
             }
             ++t->cells;
+            if (cells) {
+                Json line = {{"case", case_name},
+                             {"estimator", e.value("name", "?")},
+                             {"n", l.value("n", 0ull)},
+                             {"fine", fine},
+                             {"misses", misses.size()},
+                             {"alarms", codes},
+                             {"exact", exact},
+                             {"widen", widen},
+                             {"level", l}};
+                line["level"].erase("warnings");
+                std::fprintf(cells, "%s\n", line.dump().c_str());
+            }
             if (fine) {
                 ++t->fine;
                 if (!codes.empty()) {
@@ -262,6 +279,8 @@ int main(int argc, char** argv) {
                 (unsigned long long)o.n_min, (unsigned long long)o.n_max, o.reps);
     std::FILE* json = o.json_path.empty() ? nullptr : std::fopen(o.json_path.c_str(), "w");
     if (!o.json_path.empty() && !json) usage("--json: cannot write " + o.json_path);
+    std::FILE* cells = o.cells_path.empty() ? nullptr : std::fopen(o.cells_path.c_str(), "w");
+    if (!o.cells_path.empty() && !cells) usage("--cells: cannot write " + o.cells_path);
 
     Tally genz, scenes;
     std::vector<Wrong> wrong;
@@ -307,7 +326,7 @@ int main(int argc, char** argv) {
         const double exact = scene["exact"].get<double>();
         Tally& t = ci < genz_count ? genz : scenes;
         const size_t before = wrong.size();
-        judge(c.name, r.value, exact, &t, &wrong);
+        judge(c.name, r.value, exact, &t, &wrong, cells);
         if (json)
             std::fprintf(json, "%s\n",
                          Json({{"case", c.name}, {"confident_wrong", wrong.size() - before}})
@@ -372,5 +391,6 @@ int main(int argc, char** argv) {
                          .c_str());
         std::fclose(json);
     }
+    if (cells) std::fclose(cells);
     return 0;
 }

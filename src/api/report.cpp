@@ -49,7 +49,8 @@ Json diagnostics_to_json(const RunDiagnostics& d) {
     return Json{{"nonfinite", d.nonfinite},
                 {"zero_pdf", d.zero_pdf},
                 {"nonzero", d.nonzero},
-                {"max_weight_share", num(d.max_weight_share)}};
+                {"max_weight_share", num(d.max_weight_share)},
+                {"weight_skewness", num(d.weights.skewness())}};
 }
 
 // Plain-language sentences for the flags the core raises (estimators/diagnostics.h).
@@ -89,10 +90,23 @@ Json level_warning(const Flag& f, const LevelStats& l) {
         return flag_warning(f, std::to_string(f.count) +
                                    " sample(s) with f != 0 where p = 0: the pdf misses part of the "
                                    "integrand, the estimate is biased");
-    case FlagCode::DominantSample:
+    case FlagCode::SkewedWeights: {
+        const std::string rule = "the weights are skewed (skewness " + fmt("%.3g", f.value) +
+                                 " over all runs)" + at_n +
+                                 ", and a normal error bar needs N "
+                                 "above 25 x skewness^2 = " +
+                                 fmt("%.3g", f.threshold) + " (Cochran's rule)";
+        if (f.severity == Severity::Info)
+            return flag_warning(f, rule + ": the intervals may cover a few percent less than "
+                                          "95% until then");
         return flag_warning(
-            f, "one sample carried " + std::to_string(static_cast<int>(100 * f.value + 0.5)) +
-                   "% of a run's sum" + at_n + ": the error bar is not trustworthy");
+            f, rule +
+                   (std::isfinite(f.se) && f.se > kErrorBarSpread
+                        ? "; the runs' error bars differ by a factor " + fmt("%.2g", f.se)
+                        : std::string()) +
+                   ": runs that missed the rare large weights have estimates and error bars "
+                   "both too small, so the error bar is not trustworthy at this N");
+    }
     case FlagCode::LowEss:
         return flag_warning(f, "effective sample size " + fmt("%.1f", f.value) + " of " +
                                    std::to_string(l.n) + at_n +
@@ -130,6 +144,13 @@ Json tail_warning(const Flag& f, uint64_t pooled, const TailWording& words) {
     const std::string where = " (from the " + std::to_string(f.count) + " largest of " +
                               std::to_string(pooled) + " " + words.unit + " at " + words.n_name +
                               " = " + std::to_string(f.n) + ")";
+    if (f.code == FlagCode::HeavyTail && f.severity == Severity::Info)
+        return flag_warning(f, std::string(words.what) + " look heavy-tailed: tail index " +
+                                   fmt("%.2f", f.value) + " +/- " + fmt("%.2f", f.se) + where +
+                                   ", but they are bounded (f bounded, the density bounded "
+                                   "below), so every moment is finite: a pre-asymptotic tail "
+                                   "that fades as N grows (skewed_weights says from which N "
+                                   "the error bars hold)");
     if (f.code == FlagCode::HeavyTail)
         return flag_warning(f, std::string(words.what) + " are heavy-tailed: tail index " +
                                    fmt("%.2f", f.value) + " +/- " + fmt("%.2f", f.se) + where +
@@ -142,8 +163,8 @@ Json tail_warning(const Flag& f, uint64_t pooled, const TailWording& words) {
 }
 
 void add_tail_warnings(Json& w, const LevelStats& deepest, uint64_t pooled,
-                       const TailWording& words) {
-    for (const Flag& f : tail_flags(deepest)) w.push_back(tail_warning(f, pooled, words));
+                       const TailWording& words, bool bounded) {
+    for (const Flag& f : tail_flags(deepest, bounded)) w.push_back(tail_warning(f, pooled, words));
 }
 
 namespace {
@@ -153,7 +174,8 @@ Json estimator_warnings(const EstimatorStudy& e, const StudySettings& s) {
     if (!e.levels.empty()) {
         const LevelStats& deepest = e.levels.back();
         add_tail_warnings(w, deepest, deepest.n * static_cast<uint64_t>(deepest.reps),
-                          TailWording{"the weights f/p", "weights", "N", "the variance"});
+                          TailWording{"the weights f/p", "weights", "N", "the variance"},
+                          e.weights_bounded);
     }
     const SupportCheck& sc = e.support;
     for (const Flag& f : estimator_flags(e, s)) {

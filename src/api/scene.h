@@ -63,9 +63,9 @@ struct TailWording {
     const char* variance;
 };
 /// Appends the `heavy_tail` / `heavy_tail_4` warnings for the tail index of a study's deepest
-/// level, estimated from `pooled` values.
+/// level, estimated from `pooled` values (`bounded` weights: heavy_tail is info).
 void add_tail_warnings(Json& warnings, const LevelStats& deepest, uint64_t pooled,
-                       const TailWording& words);
+                       const TailWording& words, bool bounded);
 /// The sentence of one heavy_tail / heavy_tail_4 flag (estimators/diagnostics.h).
 Json tail_warning(const Flag& flag, uint64_t pooled, const TailWording& words);
 

@@ -6,27 +6,40 @@
 
 namespace mcp {
 
+namespace {
+// Moments (n, mean, m2, m3) of b merged into a: the pairwise update of Chan, Golub and LeVeque
+// for m2 and Pebay's for m3 (the third moment first: it uses a's old m2) [Chan79, Pebay08].
+void merge_moments(double& mean_a, double& m2_a, double& m3_a, double na, double mean_b,
+                   double m2_b, double m3_b, double nb) {
+    const double n = na + nb, delta = mean_b - mean_a;
+    m3_a += m3_b + delta * delta * delta * na * nb * (na - nb) / (n * n) +
+            3.0 * delta * (na * m2_b - nb * m2_a) / n;
+    m2_a += m2_b + delta * delta * na * nb / n;
+    mean_a += delta * nb / n;
+}
+} // namespace
+
 void RunningMoments::add_block(const double* x, size_t n) {
     if (n == 0) return;
     double block_sum = 0.0;
     for (size_t i = 0; i < n; ++i) block_sum += x[i];
     const double block_mean = block_sum / static_cast<double>(n);
-    double m2 = 0.0, correction = 0.0;
+    double m2 = 0.0, m3 = 0.0, correction = 0.0;
     for (size_t i = 0; i < n; ++i) {
         const double d = x[i] - block_mean;
-        m2 += d * d;
+        const double d2 = d * d;
+        m2 += d2;
+        m3 += d2 * d;
         correction += d;
     }
-    // Corrected two-pass formula: removes the rounding error of block_mean [Chan79, eq. 1.7].
-    m2 -= correction * correction / static_cast<double>(n);
+    const double nb = static_cast<double>(n);
+    // Corrected two-pass formulas: about the block's mean block_mean + c/n rather than the
+    // rounded block_mean [Chan79, eq. 1.7]; for the cubes sum (d - c/n)^3 expanded.
+    const double c_n = correction / nb;
+    m3 += -3.0 * c_n * m2 + 2.0 * c_n * c_n * correction;
+    m2 -= correction * c_n;
     for (size_t i = 0; i < n; ++i) sum_.add(x[i]);
-    // Chan's merge of (n_, mean_, m2_) with the block (n, block_mean + correction/n, m2).
-    const double na = static_cast<double>(n_), nb = static_cast<double>(n);
-    const double mean_b = block_mean + correction / nb;
-    const double delta = mean_b - mean_;
-    const double total = na + nb;
-    m2_ += m2 + delta * delta * na * nb / total;
-    mean_ += delta * nb / total;
+    merge_moments(mean_, m2_, m3_, static_cast<double>(n_), block_mean + c_n, m2, m3, nb);
     n_ += n;
 }
 
@@ -36,13 +49,15 @@ void RunningMoments::merge(const RunningMoments& o) {
         *this = o;
         return;
     }
-    double na = static_cast<double>(n_), nb = static_cast<double>(o.n_);
-    double delta = o.mean_ - mean_;
-    double n = na + nb;
-    m2_ += o.m2_ + delta * delta * na * nb / n;
-    mean_ += delta * nb / n;
+    merge_moments(mean_, m2_, m3_, static_cast<double>(n_), o.mean_, o.m2_, o.m3_,
+                  static_cast<double>(o.n_));
     n_ += o.n_;
     sum_.add(o.sum_.value());
+}
+
+double RunningMoments::skewness() const {
+    if (n_ < 2 || !(m2_ > 0.0)) return 0.0;
+    return std::sqrt(static_cast<double>(n_)) * m3_ / (m2_ * std::sqrt(m2_));
 }
 
 LineFit fit_line(const std::vector<double>& x, const std::vector<double>& y) {

@@ -28,22 +28,27 @@ class NeumaierSum {
     double comp_ = 0.0;
 };
 
-/// Running mean and variance by Welford's update [Welford62]; the mean is also kept as a
-/// compensated sum so that 1e9 and more terms lose no digits. Never E[x^2] - E[x]^2.
+/// Running mean, variance and third central moment by Welford's update [Welford62] and its
+/// extension to higher moments [Pebay08]; the mean is also kept as a compensated sum so that 1e9
+/// and more terms lose no digits. Never E[x^2] - E[x]^2.
 class RunningMoments {
   public:
     void add(double x) {
         ++n_;
         sum_.add(x);
-        double delta = x - mean_;
-        mean_ += delta / static_cast<double>(n_);
-        m2_ += delta * (x - mean_);
+        const double n = static_cast<double>(n_);
+        const double delta = x - mean_, delta_n = delta / n;
+        const double term = delta * delta_n * (n - 1.0);
+        // Third moment first: it uses the old m2 [Pebay08, eq. 2.1 with one value].
+        m3_ += term * delta_n * (n - 2.0) - 3.0 * delta_n * m2_;
+        mean_ += delta_n;
+        m2_ += term;
     }
     /// Adds a block of values: a compensated sum for the mean, a two-pass sum of squared
     /// deviations about the block mean, merged by Chan's formula (one division per block
     /// instead of one per value, and loops the compiler can vectorise).
     void add_block(const double* x, size_t n);
-    /// Parallel combination of two sets of moments [Chan79].
+    /// Parallel combination of two sets of moments [Chan79, Pebay08].
     void merge(const RunningMoments& o);
 
     uint64_t count() const { return n_; }
@@ -53,12 +58,16 @@ class RunningMoments {
     /// Unbiased sample variance, 1/(n-1) sum (x - mean)^2.
     double variance() const { return n_ > 1 ? m2_ / static_cast<double>(n_ - 1) : 0.0; }
     double sum_squared_deviations() const { return m2_; }
+    double sum_cubed_deviations() const { return m3_; }
+    /// Sample skewness g1 = sqrt(n) m3 / m2^(3/2) (0 without spread).
+    double skewness() const;
 
   private:
     uint64_t n_ = 0;
     NeumaierSum sum_;
     double mean_ = 0.0;
     double m2_ = 0.0;
+    double m3_ = 0.0; ///< sum of cubed deviations from the mean
 };
 
 /// A sum of independent estimates, as stratified sampling, MISER's leaves and multi-sample MIS

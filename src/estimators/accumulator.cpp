@@ -228,6 +228,7 @@ RunResult WeightAccumulator::finish(double scale) const {
     const double total_abs = abs_sum_.value();
     result.diagnostics.max_weight_share = total_abs > 0.0 ? max_abs_ / total_abs : 0.0;
     result.diagnostics.nonzero = nonzero_;
+    result.diagnostics.weights = moments_;
     // Effective sample size [Kish65]: how many equal weights would carry the same information.
     const double sum_sq =
         moments_.sum_squared_deviations() + nd * moments_.mean() * moments_.mean();

@@ -14,7 +14,7 @@ const char* flag_code_name(FlagCode code) {
     case FlagCode::ZeroErrorBar: return "zero_error_bar";
     case FlagCode::NonfiniteSamples: return "nonfinite";
     case FlagCode::ZeroPdfSamples: return "zero_pdf_samples";
-    case FlagCode::DominantSample: return "dominant_sample";
+    case FlagCode::SkewedWeights: return "skewed_weights";
     case FlagCode::LowEss: return "low_ess";
     case FlagCode::ExactOutsideCi: return "exact_outside_ci";
     case FlagCode::HeavyTail: return "heavy_tail";
@@ -54,7 +54,7 @@ Severity default_severity(FlagCode code) {
     case FlagCode::IterationsDisagree:
     case FlagCode::ErrorBarsUnderstate:
     case FlagCode::PixelErrorBars: return Severity::Error;
-    case FlagCode::DominantSample:
+    case FlagCode::SkewedWeights:
     case FlagCode::LowEss:
     case FlagCode::HeavyTail:
     case FlagCode::LevelDrift:
@@ -66,6 +66,21 @@ Severity default_severity(FlagCode code) {
     }
     return Severity::Warning;
 }
+
+namespace {
+// max se / min se over the runs with a finite, positive error bar (NaN with fewer than two).
+double error_bar_spread(const std::vector<double>& se) {
+    double lo = std::numeric_limits<double>::infinity(), hi = 0.0;
+    int count = 0;
+    for (double s : se)
+        if (std::isfinite(s) && s > 0.0) {
+            lo = std::min(lo, s);
+            hi = std::max(hi, s);
+            ++count;
+        }
+    return count >= 2 ? hi / lo : std::numeric_limits<double>::quiet_NaN();
+}
+} // namespace
 
 std::vector<Flag> level_flags(const LevelStats& l) {
     std::vector<Flag> flags;
@@ -124,12 +139,27 @@ std::vector<Flag> level_flags(const LevelStats& l) {
         f.count = d.zero_pdf;
         f.of = l.n * reps;
     }
-    // One sample carrying a large share of a big sum: the variance estimate is dominated by
-    // rare large weights (heavy tail, possibly infinite variance).
-    if (l.n >= kDominantSampleMinN && d.max_weight_share > kDominantSampleShare) {
-        Flag& f = raise(FlagCode::DominantSample);
-        f.value = d.max_weight_share;
-        f.threshold = kDominantSampleShare;
+    // Weights so skewed that their mean is not yet near normal at this N: the t interval's
+    // coverage fails first in the tail the skew points away from (runs that missed the rare
+    // large weights have estimates and error bars both too small). Cochran's rule: the normal
+    // approximation holds for N > 25 g1^2, where the mean's own skewness g1 / sqrt(N) is below
+    // 0.2 [Cochran77, section 2.15]; g1 is the skewness of the weights pooled over the R runs
+    // (R N values reach further into the tail than one run).
+    //  - a warning from a mean's skewness of 0.4 (N < 25 g1^2 / 4);
+    //  - between 0.2 and 0.4 a warning when the runs' own error bars disagree by more than a
+    //    factor 2 (their variance estimates are unstable: some are off by 40% or more), else
+    //    info, with the N from which the rule holds.
+    const double g1 = d.weights.skewness();
+    const double rule_n = kSkewnessRule * g1 * g1;
+    if (std::isfinite(g1) && static_cast<double>(l.n) < rule_n) {
+        const bool strongly_skewed = static_cast<double>(l.n) < rule_n / 4.0;
+        const double spread = error_bar_spread(l.run_std_errors);
+        Flag& f = raise(FlagCode::SkewedWeights);
+        f.value = g1;
+        f.threshold = rule_n; // the N from which the rule holds
+        f.se = spread;
+        const bool unsettled = !(spread <= kErrorBarSpread); // NaN (fewer than 2 runs) too
+        f.severity = strongly_skewed || unsettled ? Severity::Warning : Severity::Info;
     }
     // Kish's effective sample size: when a handful of samples carry the sum (a narrow peak
     // barely hit, a few huge weights), the estimate and its error bar rest on those few.
@@ -166,7 +196,7 @@ std::vector<Flag> level_flags(const LevelStats& l) {
     return flags;
 }
 
-std::vector<Flag> tail_flags(const LevelStats& deepest) {
+std::vector<Flag> tail_flags(const LevelStats& deepest, bool bounded) {
     std::vector<Flag> flags;
     if (!std::isfinite(deepest.tail_index) || deepest.tail_k <= 0) return flags;
     const double alpha = deepest.tail_index;
@@ -179,13 +209,14 @@ std::vector<Flag> tail_flags(const LevelStats& deepest) {
     f.se = se;
     f.count = static_cast<uint64_t>(deepest.tail_k);
     f.threshold = infinite_variance ? kHeavyTailAlpha : kHeavyTail4Alpha;
+    if (bounded) f.severity = Severity::Info;
     flags.push_back(f);
     return flags;
 }
 
 std::vector<Flag> estimator_flags(const EstimatorStudy& e, const StudySettings& settings) {
     std::vector<Flag> flags;
-    if (!e.levels.empty()) flags = tail_flags(e.levels.back());
+    if (!e.levels.empty()) flags = tail_flags(e.levels.back(), e.weights_bounded);
     const SupportCheck& sc = e.support;
     if (sc.flagged) {
         Flag f(FlagCode::PdfSupport);

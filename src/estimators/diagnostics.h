@@ -18,7 +18,7 @@ enum class FlagCode {
     ZeroErrorBar,        ///< runs reported se = 0 although the replicates differ
     NonfiniteSamples,    ///< samples with NaN/Inf f/p were dropped (biased)
     ZeroPdfSamples,      ///< samples with f != 0 where p = 0 were dropped (biased)
-    DominantSample,      ///< one sample carried a large share of a run's sum
+    SkewedWeights,       ///< the weights too skewed for a normal error bar at this N
     LowEss,              ///< Kish's effective sample size is a handful
     ExactOutsideCi,      ///< the replicates' mean misses the exact value
     HeavyTail,           ///< tail index within 2 standard errors of 2 (or below)
@@ -68,9 +68,9 @@ struct Flag {
 };
 
 // Thresholds (see the functions' comments for why).
-constexpr uint64_t kDominantSampleMinN = 1024; ///< below this N one sample may carry a lot
-constexpr double kDominantSampleShare = 0.05;  ///< max |w| / sum |w| above this flags
-constexpr double kLowEss = 10.0;               ///< mean ESS below this (and below N/4) flags
+constexpr double kSkewnessRule = 25.0;  ///< skewed_weights below N = 25 g1^2 [Cochran77]
+constexpr double kErrorBarSpread = 2.0; ///< runs' max se / min se above this: unsettled
+constexpr double kLowEss = 10.0;        ///< mean ESS below this (and below N/4) flags
 constexpr double kLowEssShare = 0.25;
 constexpr double kExactOutsideZ = 5.0;  ///< |mean - exact| beyond this many standard errors
 constexpr double kLevelDriftP = 1e-3;   ///< chi-square p-value below this flags
@@ -78,8 +78,10 @@ constexpr double kHeavyTailAlpha = 2.0; ///< infinite variance below this tail i
 constexpr double kHeavyTail4Alpha = 4.0;
 
 /// The flags of one level, from its replicates' statistics: no estimate (then nothing else),
-/// a non-finite mean or variance, wrong zero error bars, dropped samples, a dominant sample
-/// (N >= 1024 and a share > 5%), a low effective sample size (< 10 and < N/4), and, with the
+/// a non-finite mean or variance, wrong zero error bars, dropped samples, weights too skewed
+/// for the normal approximation at this N (N < 25 g1^2: a warning below a quarter of that or
+/// when the runs' error bars differ by more than a factor 2, else info), a low effective sample
+/// size (< 10 and < N/4), and, with the
 /// exact value known, a mean more than 5 standard errors (+ 1e-12 relative) away from it;
 /// for iteration averages, iterations that disagree: the chi^2 summed over the runs has
 /// p < 1e-3 (pooled, so that the 1 run in 100 with p < 0.01 by chance raises nothing).
@@ -87,8 +89,10 @@ std::vector<Flag> level_flags(const LevelStats& level);
 
 /// Hill's tail index alpha, P(|x| > t) ~ t^-alpha, read at the deepest level (the pooled sample
 /// reaches furthest into the tail): heavy_tail when alpha = 2 is within two standard errors
-/// (alpha / sqrt(k)) or above alpha, heavy_tail_4 when alpha < 4 [Hill75].
-std::vector<Flag> tail_flags(const LevelStats& deepest);
+/// (alpha / sqrt(k)) or above alpha, heavy_tail_4 when alpha < 4 [Hill75]. With `bounded`
+/// weights (every moment finite) heavy_tail is info: a pre-asymptotic tail, whose effect on the
+/// error bars skewed_weights judges, with the N from which they hold.
+std::vector<Flag> tail_flags(const LevelStats& deepest, bool bounded = false);
 
 /// The flags of an estimator over the whole study: the tail index at the deepest level, the
 /// support check, the consistency of the level means (p < 1e-3), float32 accumulation.

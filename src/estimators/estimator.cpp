@@ -18,6 +18,7 @@ void RunDiagnostics::merge(const RunDiagnostics& o) {
     zero_pdf += o.zero_pdf;
     nonzero += o.nonzero;
     max_weight_share = std::fmax(max_weight_share, o.max_weight_share);
+    weights.merge(o.weights);
 }
 
 const char* error_method_name(ErrorMethod m) {

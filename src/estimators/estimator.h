@@ -20,6 +20,9 @@ struct RunDiagnostics {
     uint64_t nonzero = 0;          ///< samples with f/p != 0 (few: a narrow peak was missed)
     double max_weight_share = 0.0; ///< max |w_i| / sum |w_i|: near 1 means one sample rules
     double ess = 0.0;              ///< Kish's effective sample size (sum |w|)^2 / sum w^2
+    /// The weights' moments (mean, variance, third moment), pooled when runs merge: their
+    /// skewness says from which N the normal approximation behind an error bar holds.
+    RunningMoments weights;
     void merge(const RunDiagnostics& o);
 };
 

@@ -336,6 +336,22 @@ void proposal_pdf_block(const Proposal& p, const Domain& d, const PointBlock& x,
     }
 }
 
+namespace {
+// A density bounded below on its domain: the uniform ones (the cosine-weighted hemisphere
+// vanishes at the horizon; importance densities may vanish anywhere).
+bool density_bounded_below(const Proposal& p) {
+    return !p.importance && p.kind != ProposalKind::CosineHemisphere &&
+           p.kind != ProposalKind::Product1D && p.kind != ProposalKind::Tabulated2D;
+}
+} // namespace
+
+bool weights_bounded(const Problem& problem, const EstimatorSpec& spec) {
+    if (!integrand_bounded(problem.integrand) || spec.control_variates) return false;
+    for (const Proposal* p : proposals_of(spec))
+        if (density_bounded_below(*p)) return true; // MIS: the mixture is at least c_k p_k
+    return false;
+}
+
 std::vector<const Proposal*> proposals_of(const EstimatorSpec& spec) {
     std::vector<const Proposal*> out;
     if (!spec.mis) {

@@ -166,6 +166,14 @@ struct EstimatorSpec {
     SamplerOptions sampler_options() const { return {per_stratum, randomization, randomizations}; }
 };
 
+/// Whether the weights f/p of an estimator are bounded by what the problem and the estimator
+/// say: f bounded (integrand_bounded) and the sampling density bounded below on the domain (a
+/// uniform density, MISER's uniform boxes, a VEGAS map's piecewise-constant density over the
+/// uniform one, or MIS with a uniform technique among its mixture). Control variates and the
+/// other importance densities (which may vanish where f does not) are not known to be.
+/// Bounded weights have every moment finite: a heavy-looking tail is pre-asymptotic.
+bool weights_bounded(const Problem& problem, const EstimatorSpec& spec);
+
 /// The proposals an estimator draws from: its one proposal, or its MIS techniques.
 std::vector<const Proposal*> proposals_of(const EstimatorSpec& spec);
 

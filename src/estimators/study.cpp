@@ -688,6 +688,7 @@ StudyResult run_study(const Problem& problem, const std::vector<EstimatorSpec>& 
         es.spec = spec;
         es.error_method = error_method_for(spec);
         es.support = check_support(problem, spec, kSupportProbes, settings.seed);
+        es.weights_bounded = weights_bounded(problem, spec);
         result.estimators.push_back(es);
     }
     const std::vector<uint64_t> ladder = n_ladder(settings.n_min, settings.n_max);

@@ -191,6 +191,9 @@ struct EstimatorStudy {
     LevelConsistency consistency;
     ErrorMethod error_method = ErrorMethod::Iid;
     SupportCheck support;
+    /// The weights are bounded by what the problem and estimator say (weights_bounded): every
+    /// moment is finite, and a heavy-looking tail is pre-asymptotic.
+    bool weights_bounded = false;
     std::vector<LevelStats> levels;
     ConvergenceFit fit;
 };

@@ -181,6 +181,22 @@ double evaluate_point(const Integrand& f, const double* x) {
     return out;
 }
 
+bool integrand_bounded(const Integrand& f) {
+    switch (f.kind) {
+    case IntegrandKind::Constant:
+    case IntegrandKind::Exponential:
+    case IntegrandKind::Gaussian:
+    case IntegrandKind::IndicatorBall:
+    case IntegrandKind::Genz: return true; // Genz's six families are bounded on [0,1]^d [Genz84]
+    case IntegrandKind::Monomial:
+        for (double p : f.coeffs)
+            if (p < 0.0) return false;
+        return true;
+    case IntegrandKind::Expression: return false;
+    }
+    return false;
+}
+
 double ball_volume(int dim, double r) {
     return std::pow(kPi, 0.5 * dim) * std::pow(r, dim) / std::tgamma(0.5 * dim + 1.0);
 }

@@ -58,6 +58,10 @@ double evaluate_point(const Integrand& f, const double* x);
 std::optional<double> exact_integral_over_box(const Integrand& f, const std::vector<double>& lo,
                                               const std::vector<double>& hi);
 
+/// Whether |f| is bounded on any bounded domain by what its kind and parameters say: every
+/// kind but an expression (unknown) and a monomial with a negative power (a singularity).
+bool integrand_bounded(const Integrand& f);
+
 /// Volume of the d-dimensional ball of radius r: pi^(d/2) r^d / Gamma(d/2 + 1).
 double ball_volume(int dim, double r);
 

@@ -9,7 +9,7 @@ import { el } from './dom.js';
 
 /** Which column (level codes) or summary item (estimator codes) a warning concerns. */
 const LEVEL_COLUMN = {
-  low_ess: 'ess', dominant_sample: 'share', nonfinite: 'mean', zero_pdf_samples: 'mean',
+  low_ess: 'ess', skewed_weights: 'share', nonfinite: 'mean', zero_pdf_samples: 'mean',
   exact_outside_ci: 'mean',
 };
 const ESTIMATOR_ITEM = {

@@ -279,7 +279,7 @@ test('a cancelled run exports the streamed levels as a result', () => {
 test('warnings grouped per estimator and code, level flags with their N, errors first', () => {
   const a = record('a', [16, 32, 64], { warnings: [{ code: 'heavy_tail', severity: 'warning', message: 'tail index 1.4' }] });
   a.levels[0].warnings = [{ code: 'low_ess', severity: 'warning', message: 'ess 2 at N = 16' }];
-  a.levels[1].warnings = [{ code: 'low_ess', severity: 'warning', message: 'ess 3 at N = 32' }, { code: 'dominant_sample', message: 'one sample' }];
+  a.levels[1].warnings = [{ code: 'low_ess', severity: 'warning', message: 'ess 3 at N = 32' }, { code: 'skewed_weights', message: 'skewness 40' }];
   const b = record('b', [16], { warnings: [{ code: 'heavy_tail_4', severity: 'info', message: 'tail index 3' }] });
   b.levels[0].warnings = [{ code: 'exact_outside_ci', severity: 'error', message: 'misses' }];
   const w = collectWarnings({ a, b }, ['a', 'b']);
@@ -288,7 +288,7 @@ test('warnings grouped per estimator and code, level flags with their N, errors 
     { estimator: 'a', scope: 'estimator', severity: 'warning', code: 'heavy_tail', message: 'tail index 1.4', n: [] },
     { estimator: 'a', scope: 'level', severity: 'warning', code: 'low_ess', message: 'ess 2 at N = 16', n: [16, 32] },
     // no severity (a result from before severities): shown as a warning
-    { estimator: 'a', scope: 'level', severity: 'warning', code: 'dominant_sample', message: 'one sample', n: [32] },
+    { estimator: 'a', scope: 'level', severity: 'warning', code: 'skewed_weights', message: 'skewness 40', n: [32] },
     { estimator: 'b', scope: 'estimator', severity: 'info', code: 'heavy_tail_4', message: 'tail index 3', n: [] },
   ]);
 });
