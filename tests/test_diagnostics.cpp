@@ -243,6 +243,29 @@ TEST(Diagnostics, BoundedPeaksAreSkewedNotInfiniteVariance) {
     EXPECT_EQ(tail->severity, Severity::Warning);
 }
 
+// An exact estimator (f/p constant: the matched pdf of a peak of width 1e-8, stratified points
+// on disk_quarter) is recognised at every N and raises nothing: its spread, skewness and tail
+// are round-off. Points that never see f (uniform on the peak: every estimate 0) are not exact:
+// they keep their alarms.
+TEST(Diagnostics, ExactEstimatorsAreRecognisedAndQuiet) {
+    StudyResult s =
+        study("stiff_peak_1e-8", Json{{"n_min", 16}, {"n_max", 4096}, {"reps", 16}, {"seed", 4}});
+    const EstimatorStudy& matched = named(s, "importance_matched");
+    for (const LevelStats& l : matched.levels) {
+        EXPECT_TRUE(l.exact_to_roundoff) << l.n;
+        EXPECT_TRUE(level_flags(l).empty()) << l.n;
+    }
+    EXPECT_TRUE(estimator_flags(matched, s.settings).empty());
+    const EstimatorStudy& uniform = named(s, "uniform");
+    for (const LevelStats& l : uniform.levels) EXPECT_FALSE(l.exact_to_roundoff) << l.n;
+    EXPECT_FALSE(level_flags(uniform.levels.back()).empty());
+
+    StudyResult d = study("disk_quarter", Json{{"n_min", 16}, {"n_max", 1024}, {"reps", 8}});
+    for (const LevelStats& l : named(d, "stratified_concentric").levels)
+        EXPECT_TRUE(l.exact_to_roundoff) << l.n;
+    for (const LevelStats& l : named(d, "uniform").levels) EXPECT_FALSE(l.exact_to_roundoff) << l.n;
+}
+
 namespace {
 
 /// A ladder of 7 levels whose means are averages of R normal replicates around `truth` (plus

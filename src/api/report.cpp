@@ -295,6 +295,7 @@ Json level_to_json(const LevelStats& l) {
            {"ess", num(l.ess_mean)},
            {"no_estimate_runs", l.no_estimate_runs},
            {"zero_error_runs", l.zero_error_runs},
+           {"exact_to_roundoff", l.exact_to_roundoff},
            {"warnings", warnings_for(l)}};
     // A variance below 0 is not a variance: null, like NaN (warnings_for flags both).
     if (!(l.variance >= 0.0)) j["variance"] = j["variance_ci95"] = j["std_error"] = nullptr;
@@ -567,8 +568,14 @@ std::string format_table(const Json& r) {
                 << padl(ref != 0.0 ? fmt("%.2e", std::sqrt(var) / std::fabs(ref)) : "-", 10);
             if (has_exact) {
                 const double se = jnum(l, "std_error"), bias = jnum(l, "bias");
+                const bool exact_level = l.contains("exact_to_roundoff") &&
+                                         l["exact_to_roundoff"].is_boolean() &&
+                                         l["exact_to_roundoff"].get<bool>();
                 out << padl(fmt("%.3e", jnum(l, "rmse")), 11)
-                    << padl(se > 0 ? fmt("%+.2f", bias / se) : "-", 9)
+                    << padl(exact_level ? "exact"
+                            : se > 0    ? fmt("%+.2f", bias / se)
+                                        : "-",
+                            9)
                     << padl(fmt("%.2f", jnum(l, "coverage95")), 7);
             }
             out << padl(fmt("%.2e", jnum(l, "time_mean_s")), 11)

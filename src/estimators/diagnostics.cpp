@@ -151,7 +151,7 @@ std::vector<Flag> level_flags(const LevelStats& l) {
     //    info, with the N from which the rule holds.
     const double g1 = d.weights.skewness();
     const double rule_n = kSkewnessRule * g1 * g1;
-    if (std::isfinite(g1) && static_cast<double>(l.n) < rule_n) {
+    if (!l.exact_to_roundoff && std::isfinite(g1) && static_cast<double>(l.n) < rule_n) {
         const bool strongly_skewed = static_cast<double>(l.n) < rule_n / 4.0;
         const double spread = error_bar_spread(l.run_std_errors);
         Flag& f = raise(FlagCode::SkewedWeights);
@@ -163,7 +163,8 @@ std::vector<Flag> level_flags(const LevelStats& l) {
     }
     // Kish's effective sample size: when a handful of samples carry the sum (a narrow peak
     // barely hit, a few huge weights), the estimate and its error bar rest on those few.
-    if (l.ess_mean < kLowEss && l.ess_mean < kLowEssShare * static_cast<double>(l.n)) {
+    if (!l.exact_to_roundoff && l.ess_mean < kLowEss &&
+        l.ess_mean < kLowEssShare * static_cast<double>(l.n)) {
         Flag& f = raise(FlagCode::LowEss);
         f.value = l.ess_mean;
         f.threshold = kLowEss;
@@ -198,7 +199,8 @@ std::vector<Flag> level_flags(const LevelStats& l) {
 
 std::vector<Flag> tail_flags(const LevelStats& deepest, bool bounded) {
     std::vector<Flag> flags;
-    if (!std::isfinite(deepest.tail_index) || deepest.tail_k <= 0) return flags;
+    if (!std::isfinite(deepest.tail_index) || deepest.tail_k <= 0 || deepest.exact_to_roundoff)
+        return flags;
     const double alpha = deepest.tail_index;
     const double se = alpha / std::sqrt(static_cast<double>(deepest.tail_k));
     const bool infinite_variance = alpha < kHeavyTailAlpha + 2.0 * se;

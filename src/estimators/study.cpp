@@ -519,6 +519,8 @@ LevelStats summarise_level(const std::vector<RunResult>& runs, const Problem& pr
     }
     const double roundoff = 64.0 * 2.220446049250313e-16 * std::fabs(s.mean);
     s.estimates_spread = std::isfinite(s.variance) && s.variance > roundoff * roundoff;
+    s.exact_to_roundoff = !s.estimates_spread && std::isfinite(s.mean) && s.mean != 0.0 &&
+                          s.diagnostics.nonfinite == 0 && s.diagnostics.zero_pdf == 0;
     if (s.no_estimate_runs > 0) {
         // No estimate: nothing derived from the (dropped) samples means anything.
         const double nan = std::numeric_limits<double>::quiet_NaN();
@@ -559,7 +561,7 @@ ConvergenceFit fit_power_law(const std::vector<FitPoint>& points, LevelMeasure m
 
 ConvergenceFit fit_convergence(const std::vector<LevelStats>& levels) {
     std::vector<FitPoint> points;
-    int skipped = 0, missing = 0;
+    int skipped = 0, missing = 0, exact_levels = 0;
     for (const LevelStats& l : levels) {
         if (!std::isfinite(l.mean) || !std::isfinite(l.variance) || l.variance < 0.0) {
             ++missing; // no estimate at this N (every sample NaN/Inf, or an overflow)
@@ -568,6 +570,7 @@ ConvergenceFit fit_convergence(const std::vector<LevelStats>& levels) {
         // A variance at the round-off level of the mean (an exact estimator such as a pdf
         // proportional to f) carries no convergence information.
         const double roundoff = 64.0 * 2.220446049250313e-16 * std::fabs(l.mean);
+        exact_levels += l.exact_to_roundoff ? 1 : 0;
         if (l.variance > roundoff * roundoff && std::isfinite(l.variance)) {
             const double sd_log = l.reps > 1 ? std::sqrt(trigamma(0.5 * (l.reps - 1))) : 0.0;
             points.push_back({l.n, l.variance, sd_log});
@@ -583,7 +586,11 @@ ConvergenceFit fit_convergence(const std::vector<LevelStats>& levels) {
                     " level(s) without an estimate left out";
     if (points.size() < 3) {
         if (points.empty() && skipped && !missing)
-            fit.note = "variance is zero at every N (an exact estimator?)";
+            fit.note = exact_levels == skipped
+                           ? "exact to round-off at every N (f/p constant): nothing to fit"
+                           : "variance is zero at every N, but not from an exact estimator "
+                             "(the replicates agree on 0, or dropped samples): the samples saw "
+                             "nothing of f, no fit";
         else if (points.empty() && missing && !skipped)
             fit.note = "no estimate at any N: no fit";
         else

@@ -103,6 +103,11 @@ struct LevelStats {
     int zero_error_runs = 0; ///< runs whose own standard error is 0 (to round-off, 64 eps |I_N|)
     bool estimates_spread = false; ///< the replicates differ beyond round-off (variance >
                                    ///< (64 eps |mean|)^2): a zero error bar is then wrong
+    /// An exact estimator at this N: the replicates agree to round-off (not estimates_spread)
+    /// on a non-zero, finite mean with no dropped sample (f/p constant, as a matched importance
+    /// density or an area by its own uniform density gives). Its z-scores, skewness and tail
+    /// are round-off: no statistical flag applies, and tables show "exact".
+    bool exact_to_roundoff = false;
     std::vector<double> estimates, run_std_errors; ///< per replicate
 };
 

@@ -454,7 +454,9 @@ function renderCalibration(state, run, records) {
     ...cs.series.map((s) => {
       const parts = [];
       if (s.total) parts.push({ text: `${(100 * s.within2 / s.total).toFixed(0)}% within ±1.96 (${s.total} z)`, className: 'fit' });
+      else if (s.exactRuns) parts.push({ text: 'exact to round-off: no z', className: 'fit' });
       else parts.push('no replicates yet');
+      if (s.total && s.exactRuns) parts.push({ text: `${s.exactRuns} runs exact to round-off (no z)`, className: 'fit' });
       if (s.below + s.above) parts.push({ text: `${s.below + s.above} beyond ±5`, className: 'badge' });
       if (s.zeroSe) parts.push({ text: `${s.zeroSe} with a zero error bar`, className: 'badge' });
       return { name: s.name, color: colorOf(run, s.name), parts };

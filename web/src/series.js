@@ -235,16 +235,23 @@ export function timeSeries(records, order) {
  * z = (estimate - reference) / std_error of every replicate of `levels` (all of them, or the
  * one with n === which). The reference is the exact value, or when it is unknown each level's
  * mean of its replicates. Replicates with a zero or missing error bar are counted in zeroSe
- * (a zero error bar with a wrong estimate is the confident wrong answer), not in z.
+ * (a zero error bar with a wrong estimate is the confident wrong answer), not in z. Levels exact
+ * to round-off (exact_to_roundoff: f/p constant) are counted in exactRuns, not in z: their z is
+ * round-off over round-off.
  */
 export function zScores(levels, exact = null, which = 'all') {
   const useExact = exact !== null && exact !== undefined && Number.isFinite(exact);
   const z = [];
   let zeroSe = 0;
+  let exactRuns = 0;
   for (const l of levels) {
     if (which !== 'all' && l.n !== which) continue;
     const rep = l.replicates;
     if (!rep) continue;
+    if (l.exact_to_roundoff === true) {
+      exactRuns += rep.estimate.length;
+      continue;
+    }
     const ref = useExact ? exact : l.mean;
     for (let i = 0; i < rep.estimate.length; i++) {
       const est = rep.estimate[i];
@@ -254,7 +261,7 @@ export function zScores(levels, exact = null, which = 'all') {
       else zeroSe++;
     }
   }
-  return { z, zeroSe, reference: useExact ? 'exact' : 'mean' };
+  return { z, zeroSe, exactRuns, reference: useExact ? 'exact' : 'mean' };
 }
 
 /**
@@ -303,7 +310,7 @@ export function calibrationSeries(records, order, exact = null, which = 'all',
     const bins = h.counts.length;
     const y = x.map((v) => (h.total ? h.density[Math.min(bins - 1, Math.floor((v - lo) / width + 1e-9))] : null));
     return {
-      name, y, total: h.total, below: h.below, above: h.above, zeroSe: zs.zeroSe,
+      name, y, total: h.total, below: h.below, above: h.above, zeroSe: zs.zeroSe, exactRuns: zs.exactRuns,
       reference: zs.reference, within2: zs.z.filter((v) => Math.abs(v) <= 1.96).length,
     };
   });

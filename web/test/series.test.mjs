@@ -154,6 +154,11 @@ test('z-scores against the exact value, or each level\'s mean when it is unknown
   const mean = zScores(levels, null, 16);
   assert.deepEqual(mean.z, [-1, 1, 1.5]);
   assert.equal(mean.reference, 'mean');
+  // A level exact to round-off gives no z (round-off over round-off), only a count.
+  const exact = [lvl(64, { mean: 2, exact_to_roundoff: true, replicates: { estimate: [2, 2, 2], std_error: [1e-16, 2e-16, 1e-16] } }), ...levels];
+  const withExact = zScores(exact, 2);
+  assert.deepEqual(withExact.z, all.z);
+  assert.equal(withExact.exactRuns, 3);
 });
 
 test('histogram: counts per bin, a density that integrates to the share inside, outliers apart', () => {
