@@ -155,16 +155,18 @@ TEST(Diagnostics, EveryFlagHasTheSeverityOfWhatItSays) {
 
 namespace {
 
-// A level of R = 10 runs at N whose pooled weights are k ones among m values (the rest zeros):
-// skewness (1 - 2p) / sqrt(p (1 - p)) with p = k / m; the runs' error bars 1 and `spread`.
-LevelStats skewed_level(uint64_t n, int k, int m, double spread) {
+// A level of R = 10 runs at N whose R N pooled weights are k ones in every m values (the rest
+// zeros): skewness (1 - 2p) / sqrt(p (1 - p)) with p = k / m; the runs' error bars 1 and
+// `spread`. The weights are the error bar's units.
+LevelStats skewed_level(uint64_t n, uint64_t k, uint64_t m, double spread) {
     LevelStats l;
     l.n = n;
     l.reps = 10;
     l.mean = 0.0;
     l.variance = 1.0;
     l.estimates_spread = true;
-    for (int i = 0; i < m; ++i) l.diagnostics.weights.add(i < k ? 1.0 : 0.0);
+    for (uint64_t i = 0; i < 10 * n; ++i) l.diagnostics.weights.add(i % m < k ? 1.0 : 0.0);
+    l.diagnostics.error_units = l.diagnostics.weights;
     l.run_std_errors.assign(10, 1.0);
     l.run_std_errors[3] = spread;
     l.ess_mean = static_cast<double>(n);
@@ -180,28 +182,48 @@ std::optional<Flag> find(const std::vector<Flag>& flags, FlagCode code) {
 
 } // namespace
 
-// Cochran's rule both ways on levels built to order: one weight in 1000 non-zero has skewness
-// 31.5 and needs N > 25 x 31.5^2 = 24800. Below a quarter of that, a warning; between a quarter
+// Cochran's rule both ways on levels built to order: one weight in 1024 non-zero has skewness
+// 32.0 and needs N > 25 x 32.0^2 = 25570. Below a quarter of that, a warning; between a quarter
 // and the whole, a warning only when the runs' error bars differ by more than a factor 2, else
 // info with the N from which the rule holds; above it, nothing. Weights with one in ten
 // non-zero (skewness 2.67, N > 178) raise nothing at N = 1024.
 TEST(Diagnostics, SkewedWeightsFollowCochransRule) {
-    const double g1 = (1.0 - 2e-3) / std::sqrt(1e-3 * (1.0 - 1e-3));
+    const double p = 1.0 / 1024.0, g1 = (1.0 - 2.0 * p) / std::sqrt(p * (1.0 - p));
     std::optional<Flag> f =
-        find(level_flags(skewed_level(4096, 1, 1000, 1.1)), FlagCode::SkewedWeights);
+        find(level_flags(skewed_level(4096, 1, 1024, 1.1)), FlagCode::SkewedWeights);
     ASSERT_TRUE(f.has_value());
     EXPECT_EQ(f->severity, Severity::Warning);
     EXPECT_NEAR(f->value, g1, 1e-9);
     EXPECT_NEAR(f->threshold, 25.0 * g1 * g1, 1e-6);
-    f = find(level_flags(skewed_level(16384, 1, 1000, 1.1)), FlagCode::SkewedWeights);
+    f = find(level_flags(skewed_level(16384, 1, 1024, 1.1)), FlagCode::SkewedWeights);
     ASSERT_TRUE(f.has_value());
     EXPECT_EQ(f->severity, Severity::Info);
-    f = find(level_flags(skewed_level(16384, 1, 1000, 2.5)), FlagCode::SkewedWeights);
+    f = find(level_flags(skewed_level(16384, 1, 1024, 2.5)), FlagCode::SkewedWeights);
     ASSERT_TRUE(f.has_value());
     EXPECT_EQ(f->severity, Severity::Warning);
     EXPECT_NEAR(f->se, 2.5, 1e-12);
-    EXPECT_FALSE(find(level_flags(skewed_level(32768, 1, 1000, 2.5)), FlagCode::SkewedWeights));
+    EXPECT_FALSE(find(level_flags(skewed_level(32768, 1, 1024, 2.5)), FlagCode::SkewedWeights));
     EXPECT_FALSE(find(level_flags(skewed_level(1024, 1, 10, 1.1)), FlagCode::SkewedWeights));
+}
+
+// The runs' own error bars: flagged when they differ by more than a factor 4 and Bartlett's test
+// says more than their degrees of freedom allow (one of ten runs' se 5 times the others', 1000
+// dof each); not for the same spread at 1 dof each (such error bars vary that much by chance),
+// nor for error bars that agree to 10%.
+TEST(Diagnostics, UnstableErrorBarsNeedBothASpreadAndBartlettsTest) {
+    LevelStats l = skewed_level(1024, 1, 2, 1.0); // symmetric weights: no skewness flag
+    l.run_dofs.assign(10, 1000);
+    l.run_std_errors = {1.0, 1.02, 0.98, 1.01, 0.99, 1.0, 1.03, 0.97, 1.0, 5.0};
+    std::optional<Flag> f = find(level_flags(l), FlagCode::ErrorBarsUnstable);
+    ASSERT_TRUE(f.has_value());
+    EXPECT_EQ(f->severity, Severity::Warning);
+    EXPECT_NEAR(f->value, 5.0 / 0.97, 1e-12);
+    EXPECT_LT(f->p_value, 1e-3);
+    l.run_dofs.assign(10, 1);
+    EXPECT_FALSE(find(level_flags(l), FlagCode::ErrorBarsUnstable));
+    l.run_dofs.assign(10, 1000);
+    l.run_std_errors.back() = 1.1;
+    EXPECT_FALSE(find(level_flags(l), FlagCode::ErrorBarsUnstable));
 }
 
 // From real studies: Genz's corner peak in d = 2 (c = 75 per axis; f bounded by 1, skewness

@@ -50,7 +50,8 @@ Json diagnostics_to_json(const RunDiagnostics& d) {
                 {"zero_pdf", d.zero_pdf},
                 {"nonzero", d.nonzero},
                 {"max_weight_share", num(d.max_weight_share)},
-                {"weight_skewness", num(d.weights.skewness())}};
+                {"weight_skewness", num(d.weights.skewness())},
+                {"error_unit_skewness", num(d.error_units.skewness())}};
 }
 
 // Plain-language sentences for the flags the core raises (estimators/diagnostics.h).
@@ -91,22 +92,39 @@ Json level_warning(const Flag& f, const LevelStats& l) {
                                    " sample(s) with f != 0 where p = 0: the pdf misses part of the "
                                    "integrand, the estimate is biased");
     case FlagCode::SkewedWeights: {
-        const std::string rule = "the weights are skewed (skewness " + fmt("%.3g", f.value) +
-                                 " over all runs)" + at_n +
-                                 ", and a normal error bar needs N "
-                                 "above 25 x skewness^2 = " +
-                                 fmt("%.3g", f.threshold) + " (Cochran's rule)";
+        // The units: the weights (count = N), or each run's K batch means (randomized QMC).
+        const bool batches = f.count != l.n;
+        const std::string skew = "(skewness " + fmt("%.3g", f.value) + " over all runs)" + at_n;
+        const std::string rule =
+            batches
+                ? "the " + std::to_string(f.count) + " batch means of each run are skewed " + skew +
+                      ", and a t error bar from them needs more than 25 x skewness^2 = " +
+                      fmt("%.3g", f.threshold) + " of them (Cochran's rule)"
+                : "the weights are skewed " + skew +
+                      ", and a normal error bar needs N above 25 x skewness^2 = " +
+                      fmt("%.3g", f.threshold) + " (Cochran's rule)";
         if (f.severity == Severity::Info)
             return flag_warning(f, rule + ": the intervals may cover a few percent less than "
                                           "95% until then");
-        return flag_warning(
-            f, rule +
-                   (std::isfinite(f.se) && f.se > kErrorBarSpread
-                        ? "; the runs' error bars differ by a factor " + fmt("%.2g", f.se)
-                        : std::string()) +
-                   ": runs that missed the rare large weights have estimates and error bars "
-                   "both too small, so the error bar is not trustworthy at this N");
+        const std::string spread =
+            std::isfinite(f.se) && f.se > kErrorBarSpread
+                ? "; the runs' error bars differ by a factor " + fmt("%.2g", f.se)
+                : std::string();
+        const std::string why =
+            batches ? "a run whose randomizations missed a rare feature has an estimate and an "
+                      "error bar both too small"
+                    : "runs that missed the rare large weights have estimates and error bars "
+                      "both too small";
+        return flag_warning(f, rule + spread + ": " + why +
+                                   ", so the error bar is not trustworthy at this N");
     }
+    case FlagCode::ErrorBarsUnstable:
+        return flag_warning(f, "the replicates' own error bars differ by a factor " +
+                                   fmt("%.3g", f.value) + at_n +
+                                   " (Bartlett's test, p = " + fmt("%.2g", f.p_value) +
+                                   "): some runs saw a feature (a sliver of a step, a rare peak) "
+                                   "that others missed, and those others' error bars are far too "
+                                   "small");
     case FlagCode::LowEss:
         return flag_warning(f, "effective sample size " + fmt("%.1f", f.value) + " of " +
                                    std::to_string(l.n) + at_n +

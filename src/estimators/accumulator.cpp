@@ -175,6 +175,7 @@ RunResult WeightAccumulator::finish(double scale) const {
     const double nd = static_cast<double>(n);
     double mean = float32_ ? static_cast<double>(float_sum_) / nd : moments_.mean();
     double variance_of_mean = std::numeric_limits<double>::quiet_NaN();
+    RunningMoments units = moments_; // what the error bar is the spread of
     switch (method_) {
     case ErrorMethod::CollapsedStrata:
     case ErrorMethod::PairedStrata:
@@ -209,6 +210,7 @@ RunResult WeightAccumulator::finish(double scale) const {
             batch_means.add(batch_sums_[k].value() / size);
         }
         if (!float32_) mean = batch_means.mean();
+        units = batch_means;
         if (batches > 1) {
             variance_of_mean = batch_means.variance() / static_cast<double>(batches);
             result.dof = interval_dof(batches - 1);
@@ -229,6 +231,7 @@ RunResult WeightAccumulator::finish(double scale) const {
     result.diagnostics.max_weight_share = total_abs > 0.0 ? max_abs_ / total_abs : 0.0;
     result.diagnostics.nonzero = nonzero_;
     result.diagnostics.weights = moments_;
+    result.diagnostics.error_units = units;
     // Effective sample size [Kish65]: how many equal weights would carry the same information.
     const double sum_sq =
         moments_.sum_squared_deviations() + nd * moments_.mean() * moments_.mean();

@@ -1,5 +1,6 @@
 #include "estimators/diagnostics.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/special.h"
@@ -23,6 +24,7 @@ const char* flag_code_name(FlagCode code) {
     case FlagCode::LevelDrift: return "level_drift";
     case FlagCode::IterationsDisagree: return "iterations_disagree";
     case FlagCode::ErrorBarsUnderstate: return "error_bars_understate";
+    case FlagCode::ErrorBarsUnstable: return "error_bars_unstable";
     case FlagCode::Float32Accumulator: return "float32_accumulator";
     case FlagCode::BelowReferenceNoise: return "below_reference_noise";
     case FlagCode::ReferenceNoise: return "reference_noise";
@@ -55,6 +57,7 @@ Severity default_severity(FlagCode code) {
     case FlagCode::ErrorBarsUnderstate:
     case FlagCode::PixelErrorBars: return Severity::Error;
     case FlagCode::SkewedWeights:
+    case FlagCode::ErrorBarsUnstable:
     case FlagCode::LowEss:
     case FlagCode::HeavyTail:
     case FlagCode::LevelDrift:
@@ -79,6 +82,27 @@ double error_bar_spread(const std::vector<double>& se) {
             ++count;
         }
     return count >= 2 ? hi / lo : std::numeric_limits<double>::quiet_NaN();
+}
+// Bartlett's test that the runs' error bars estimate one variance: each run's se^2 with its
+// degrees of freedom nu_i; T = [(sum nu) ln(pooled) - sum nu_i ln se_i^2] / C is chi^2 with
+// k - 1 degrees of freedom for normal data, C = 1 + (sum 1/nu_i - 1/sum nu) / (3 (k - 1))
+// [Bartlett37]. Its p-value (NaN with fewer than two usable runs).
+double bartlett_p(const std::vector<double>& se, const std::vector<int>& dofs) {
+    double nu_sum = 0.0, pooled = 0.0, log_sum = 0.0, inv_sum = 0.0;
+    int k = 0;
+    for (size_t i = 0; i < se.size() && i < dofs.size(); ++i) {
+        const double s = se[i], nu = static_cast<double>(dofs[i]);
+        if (!(std::isfinite(s) && s > 0.0 && nu >= 1.0)) continue;
+        nu_sum += nu;
+        pooled += nu * s * s;
+        log_sum += nu * std::log(s * s);
+        inv_sum += 1.0 / nu;
+        ++k;
+    }
+    if (k < 2) return std::numeric_limits<double>::quiet_NaN();
+    const double c = 1.0 + (inv_sum - 1.0 / nu_sum) / (3.0 * (k - 1));
+    const double t = (nu_sum * std::log(pooled / nu_sum) - log_sum) / c;
+    return chi_square_sf(std::max(t, 0.0), static_cast<double>(k - 1));
 }
 } // namespace
 
@@ -128,6 +152,21 @@ std::vector<Flag> level_flags(const LevelStats& l) {
             f.of = reps;
         }
     }
+    // The runs' own error bars disagree with each other far beyond what their degrees of
+    // freedom allow (Bartlett's test), by more than a factor kUnstableSpread: some runs saw a
+    // feature (a sliver of a step, a rare peak) that others missed entirely, and those others'
+    // error bars are far too small, though the mean of the se^2 may match the spread.
+    if (!l.exact_to_roundoff && l.reps >= 2) {
+        const double spread = error_bar_spread(l.run_std_errors);
+        const double p = bartlett_p(l.run_std_errors, l.run_dofs);
+        if (spread > kUnstableSpread && p < kLevelDriftP) {
+            Flag& f = raise(FlagCode::ErrorBarsUnstable);
+            f.value = spread;
+            f.threshold = kUnstableSpread;
+            f.p_value = p;
+            f.of = reps;
+        }
+    }
     const RunDiagnostics& d = l.diagnostics;
     if (d.nonfinite) {
         Flag& f = raise(FlagCode::NonfiniteSamples);
@@ -144,19 +183,24 @@ std::vector<Flag> level_flags(const LevelStats& l) {
     // large weights have estimates and error bars both too small). Cochran's rule: the normal
     // approximation holds for N > 25 g1^2, where the mean's own skewness g1 / sqrt(N) is below
     // 0.2 [Cochran77, section 2.15]; g1 is the skewness of the weights pooled over the R runs
-    // (R N values reach further into the tail than one run).
+    // (R N values reach further into the tail than one run). For randomized QMC the error bar is
+    // the spread of each run's K batch means: the rule is then on them, K > 25 g1^2.
     //  - a warning from a mean's skewness of 0.4 (N < 25 g1^2 / 4);
     //  - between 0.2 and 0.4 a warning when the runs' own error bars disagree by more than a
     //    factor 2 (their variance estimates are unstable: some are off by 40% or more), else
     //    info, with the N from which the rule holds.
-    const double g1 = d.weights.skewness();
+    // The units are the weights, or for K randomizations the K batch means of each run.
+    const double g1 = d.error_units.skewness();
     const double rule_n = kSkewnessRule * g1 * g1;
-    if (!l.exact_to_roundoff && std::isfinite(g1) && static_cast<double>(l.n) < rule_n) {
-        const bool strongly_skewed = static_cast<double>(l.n) < rule_n / 4.0;
+    const double units_per_run =
+        l.reps > 0 ? static_cast<double>(d.error_units.count()) / static_cast<double>(l.reps) : 0.0;
+    if (!l.exact_to_roundoff && std::isfinite(g1) && units_per_run < rule_n) {
+        const bool strongly_skewed = units_per_run < rule_n / 4.0;
         const double spread = error_bar_spread(l.run_std_errors);
         Flag& f = raise(FlagCode::SkewedWeights);
         f.value = g1;
-        f.threshold = rule_n; // the N from which the rule holds
+        f.threshold = rule_n; // the number of units per run from which the rule holds
+        f.count = static_cast<uint64_t>(units_per_run + 0.5);
         f.se = spread;
         const bool unsettled = !(spread <= kErrorBarSpread); // NaN (fewer than 2 runs) too
         f.severity = strongly_skewed || unsettled ? Severity::Warning : Severity::Info;

@@ -28,6 +28,7 @@ enum class FlagCode {
     Float32Accumulator,  ///< naive single-precision sums (teaching mode)
     IterationsDisagree,  ///< an iteration average's iterations disagree beyond their error bars
     ErrorBarsUnderstate, ///< the replicates spread more than their own error bars allow
+    ErrorBarsUnstable,   ///< the replicates' own error bars disagree far beyond their dof
     // Render studies (render/render_study.h: render_flags).
     BelowReferenceNoise, ///< a level's relative MSE is below the reference's own noise
     ReferenceNoise,      ///< some levels lie below the reference's noise (left out of the fit)
@@ -70,7 +71,11 @@ struct Flag {
 // Thresholds (see the functions' comments for why).
 constexpr double kSkewnessRule = 25.0;  ///< skewed_weights below N = 25 g1^2 [Cochran77]
 constexpr double kErrorBarSpread = 2.0; ///< runs' max se / min se above this: unsettled
-constexpr double kLowEss = 10.0;        ///< mean ESS below this (and below N/4) flags
+/// error_bars_unstable: runs' max se / min se above this (some run's error bar is off by a
+/// factor 2 or more from the others' middle: enough to show a 2.5-SE error as 5 SE), and
+/// Bartlett's test at p < kLevelDriftP.
+constexpr double kUnstableSpread = 4.0;
+constexpr double kLowEss = 10.0; ///< mean ESS below this (and below N/4) flags
 constexpr double kLowEssShare = 0.25;
 constexpr double kExactOutsideZ = 5.0;  ///< |mean - exact| beyond this many standard errors
 constexpr double kLevelDriftP = 1e-3;   ///< chi-square p-value below this flags

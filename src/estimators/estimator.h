@@ -23,6 +23,9 @@ struct RunDiagnostics {
     /// The weights' moments (mean, variance, third moment), pooled when runs merge: their
     /// skewness says from which N the normal approximation behind an error bar holds.
     RunningMoments weights;
+    /// The values whose spread is the run's error bar, pooled when runs merge: the weights, or
+    /// for K randomizations the K batch means. Cochran's rule reads their skewness.
+    RunningMoments error_units;
     void merge(const RunDiagnostics& o);
 };
 

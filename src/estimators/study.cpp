@@ -465,6 +465,7 @@ LevelStats summarise_level(const std::vector<RunResult>& runs, const Problem& pr
         s.diagnostics.merge(r.diagnostics);
         s.estimates.push_back(r.estimate);
         s.run_std_errors.push_back(r.std_error);
+        s.run_dofs.push_back(r.dof);
         if (std::isfinite(r.std_error)) {
             se.add(r.std_error);
             se2.add(r.std_error * r.std_error);

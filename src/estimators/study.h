@@ -109,6 +109,7 @@ struct LevelStats {
     /// are round-off: no statistical flag applies, and tables show "exact".
     bool exact_to_roundoff = false;
     std::vector<double> estimates, run_std_errors; ///< per replicate
+    std::vector<int> run_dofs; ///< per replicate: the degrees of freedom of its error bar
 };
 
 struct ConvergenceFit {
