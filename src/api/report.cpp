@@ -118,6 +118,12 @@ Json level_warning(const Flag& f, const LevelStats& l) {
         return flag_warning(f, rule + spread + ": " + why +
                                    ", so the error bar is not trustworthy at this N");
     }
+    case FlagCode::ConservativeErrorBars:
+        return flag_warning(f, "conservative error bars" + at_n + ": the " + std::to_string(f.of) +
+                                   " replicates spread " + fmt("%.3g", f.value) +
+                                   " times less than their own error bars say (F test, p = " +
+                                   fmt("%.2g", f.p_value) +
+                                   "): the intervals cover, and are wider than they need be");
     case FlagCode::ErrorBarsUnstable:
         return flag_warning(f, "the replicates' own error bars differ by a factor " +
                                    fmt("%.3g", f.value) + at_n +
@@ -228,6 +234,14 @@ Json estimator_warnings(const EstimatorStudy& e, const StudySettings& s) {
                                     " degrees of freedom, p = " + fmt("%.2g", f.p_value) +
                                     "): the error bars understate the error (heavy tails, too "
                                     "few samples, or bias)"));
+            break;
+        case FlagCode::BiasDominates:
+            w.push_back(flag_warning(
+                f, "from N = " + std::to_string(f.n) + " on the bias (" + fmt("%.3g", f.value) +
+                       " at the largest N, " + fmt("%.0f", 100.0 * f.threshold) +
+                       "% of the MSE) is larger than the spread of an estimate: the MSE stops "
+                       "falling with N, and its fitted order describes the bias, not the "
+                       "estimator's variance"));
             break;
         case FlagCode::Float32Accumulator:
             w.push_back(flag_warning(f, "float32 accumulation (teaching mode): the estimates are "
@@ -407,6 +421,7 @@ Json study_to_json(const StudyResult& r) {
         for (const LevelStats& l : e.levels) levels.push_back(level_to_json(l));
         j["levels"] = levels;
         j["fit"] = fit_to_json(e.fit);
+        j["mse_fit"] = fit_to_json(e.mse_fit);
         estimators.push_back(j);
     }
     return Json{{"version", kResultSchemaVersion},
@@ -428,6 +443,7 @@ Json progress_to_json(const StudyResult& partial, size_t level_index) {
             n = e.levels[level_index].n;
         }
         j["fit"] = fit_to_json(e.fit);
+        j["mse_fit"] = fit_to_json(e.mse_fit);
         estimators.push_back(j);
     }
     return Json{{"version", kResultSchemaVersion},
@@ -616,6 +632,10 @@ std::string format_table(const Json& r) {
         else
             out << "  fitted order: none";
         if (!jstr(fit, "note").empty()) out << " (" << jstr(fit, "note") << ")";
+        const Json& mse_fit = get(e, "mse_fit");
+        if (jbool(mse_fit, "valid"))
+            out << "; MSE ~ N^(" << fmt("%.3f", jnum(mse_fit, "order")) << " +/- "
+                << fmt("%.3f", jnum(mse_fit, "order_se")) << ")";
         out << "\n";
         for (const Json& w : level_shown) shown.push_back(w);
         print_warnings(out, shown);

@@ -25,6 +25,8 @@ const char* flag_code_name(FlagCode code) {
     case FlagCode::IterationsDisagree: return "iterations_disagree";
     case FlagCode::ErrorBarsUnderstate: return "error_bars_understate";
     case FlagCode::ErrorBarsUnstable: return "error_bars_unstable";
+    case FlagCode::BiasDominates: return "bias_dominates";
+    case FlagCode::ConservativeErrorBars: return "conservative_error_bars";
     case FlagCode::Float32Accumulator: return "float32_accumulator";
     case FlagCode::BelowReferenceNoise: return "below_reference_noise";
     case FlagCode::ReferenceNoise: return "reference_noise";
@@ -63,6 +65,8 @@ Severity default_severity(FlagCode code) {
     case FlagCode::LevelDrift:
     case FlagCode::SlowConvergence: return Severity::Warning;
     case FlagCode::HeavyTail4:
+    case FlagCode::BiasDominates:
+    case FlagCode::ConservativeErrorBars:
     case FlagCode::Float32Accumulator:
     case FlagCode::BelowReferenceNoise:
     case FlagCode::ReferenceNoise: return Severity::Info;
@@ -148,6 +152,18 @@ std::vector<Flag> level_flags(const LevelStats& l) {
             f.value = ratio;
             f.dof = l.reps - 1;
             f.p_value = p;
+            f.threshold = kLevelDriftP;
+            f.of = reps;
+        }
+        // Far below (the lower tail at p < 1e-3): the error bars are conservative, e.g. the
+        // collapsed-strata bound of a stratified run on a smooth integrand (worth knowing: the
+        // intervals are right, only wider than they need be).
+        const double p_low = 1.0 - p;
+        if (ratio < 1.0 && p_low < kLevelDriftP) {
+            Flag& f = raise(FlagCode::ConservativeErrorBars);
+            f.value = std::sqrt(1.0 / ratio); // how many times too wide
+            f.dof = l.reps - 1;
+            f.p_value = p_low;
             f.threshold = kLevelDriftP;
             f.of = reps;
         }
@@ -278,6 +294,25 @@ std::vector<Flag> estimator_flags(const EstimatorStudy& e, const StudySettings& 
         f.dof = e.consistency.dof;
         f.p_value = e.consistency.p_value;
         f.threshold = kLevelDriftP;
+        flags.push_back(f);
+    }
+    // A bias that dominates the MSE from some N on: the MSE stops falling with the variance.
+    size_t first = e.levels.size();
+    while (first > 0) {
+        const LevelStats& l = e.levels[first - 1];
+        const bool dominated = l.has_exact && !l.exact_to_roundoff && std::isfinite(l.bias) &&
+                               std::isfinite(l.variance) && l.bias * l.bias > l.variance &&
+                               std::fabs(l.bias) > 3.0 * l.std_error;
+        if (!dominated) break;
+        --first;
+    }
+    if (first < e.levels.size()) {
+        const LevelStats& deepest = e.levels.back();
+        Flag f(FlagCode::BiasDominates);
+        f.n = e.levels[first].n;
+        f.value = deepest.bias;
+        f.se = deepest.std_error;
+        f.threshold = deepest.mse > 0.0 ? deepest.bias * deepest.bias / deepest.mse : 1.0;
         flags.push_back(f);
     }
     if (settings.accumulator == Accumulator::Float32) {

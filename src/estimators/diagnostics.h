@@ -12,23 +12,25 @@
 namespace mcp {
 
 enum class FlagCode {
-    NoEstimate,          ///< every sample of some run was NaN/Inf
-    NonfiniteEstimate,   ///< the mean of the replicates overflowed
-    NonfiniteVariance,   ///< the variance across replicates is not a finite number >= 0
-    ZeroErrorBar,        ///< runs reported se = 0 although the replicates differ
-    NonfiniteSamples,    ///< samples with NaN/Inf f/p were dropped (biased)
-    ZeroPdfSamples,      ///< samples with f != 0 where p = 0 were dropped (biased)
-    SkewedWeights,       ///< the weights too skewed for a normal error bar at this N
-    LowEss,              ///< Kish's effective sample size is a handful
-    ExactOutsideCi,      ///< the replicates' mean misses the exact value
-    HeavyTail,           ///< tail index within 2 standard errors of 2 (or below)
-    HeavyTail4,          ///< tail index below 4
-    PdfSupport,          ///< the pdf is zero where f is not
-    LevelDrift,          ///< the level means disagree beyond their error bars
-    Float32Accumulator,  ///< naive single-precision sums (teaching mode)
-    IterationsDisagree,  ///< an iteration average's iterations disagree beyond their error bars
-    ErrorBarsUnderstate, ///< the replicates spread more than their own error bars allow
-    ErrorBarsUnstable,   ///< the replicates' own error bars disagree far beyond their dof
+    NoEstimate,            ///< every sample of some run was NaN/Inf
+    NonfiniteEstimate,     ///< the mean of the replicates overflowed
+    NonfiniteVariance,     ///< the variance across replicates is not a finite number >= 0
+    ZeroErrorBar,          ///< runs reported se = 0 although the replicates differ
+    NonfiniteSamples,      ///< samples with NaN/Inf f/p were dropped (biased)
+    ZeroPdfSamples,        ///< samples with f != 0 where p = 0 were dropped (biased)
+    SkewedWeights,         ///< the weights too skewed for a normal error bar at this N
+    LowEss,                ///< Kish's effective sample size is a handful
+    ExactOutsideCi,        ///< the replicates' mean misses the exact value
+    HeavyTail,             ///< tail index within 2 standard errors of 2 (or below)
+    HeavyTail4,            ///< tail index below 4
+    PdfSupport,            ///< the pdf is zero where f is not
+    LevelDrift,            ///< the level means disagree beyond their error bars
+    Float32Accumulator,    ///< naive single-precision sums (teaching mode)
+    IterationsDisagree,    ///< an iteration average's iterations disagree beyond their error bars
+    ErrorBarsUnderstate,   ///< the replicates spread more than their own error bars allow
+    ErrorBarsUnstable,     ///< the replicates' own error bars disagree far beyond their dof
+    BiasDominates,         ///< from some N on the bias, not the variance, makes the MSE
+    ConservativeErrorBars, ///< the replicates spread far less than their error bars say
     // Render studies (render/render_study.h: render_flags).
     BelowReferenceNoise, ///< a level's relative MSE is below the reference's own noise
     ReferenceNoise,      ///< some levels lie below the reference's noise (left out of the fit)
@@ -100,7 +102,9 @@ std::vector<Flag> level_flags(const LevelStats& level);
 std::vector<Flag> tail_flags(const LevelStats& deepest, bool bounded = false);
 
 /// The flags of an estimator over the whole study: the tail index at the deepest level, the
-/// support check, the consistency of the level means (p < 1e-3), float32 accumulation.
+/// support check, the consistency of the level means (p < 1e-3), float32 accumulation, and
+/// with an exact value a bias that dominates the MSE from some N to the largest (bias^2 above
+/// the variance of one estimate and |bias| beyond 3 of its standard errors at every such N).
 std::vector<Flag> estimator_flags(const EstimatorStudy& e, const StudySettings& settings);
 
 } // namespace mcp

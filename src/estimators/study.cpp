@@ -537,7 +537,12 @@ LevelStats summarise_level(const std::vector<RunResult>& runs, const Problem& pr
 }
 
 const char* level_measure_name(LevelMeasure m) {
-    return m == LevelMeasure::RelativeMse ? "relative_mse" : "variance";
+    switch (m) {
+    case LevelMeasure::Variance: return "variance";
+    case LevelMeasure::Mse: return "mse";
+    case LevelMeasure::RelativeMse: return "relative_mse";
+    }
+    return "variance";
 }
 
 ConvergenceFit fit_power_law(const std::vector<FitPoint>& points, LevelMeasure measure) {
@@ -557,6 +562,22 @@ ConvergenceFit fit_power_law(const std::vector<FitPoint>& points, LevelMeasure m
     fit.order = line.slope;
     fit.intercept = line.intercept;
     fit.order_se = line.slope_se;
+    return fit;
+}
+
+ConvergenceFit fit_mse(const std::vector<LevelStats>& levels) {
+    std::vector<FitPoint> points;
+    for (const LevelStats& l : levels) {
+        if (!l.has_exact || !std::isfinite(l.mse) || l.exact_to_roundoff) continue;
+        const double roundoff = 64.0 * 2.220446049250313e-16 * std::fabs(l.mean);
+        if (!(l.mse > roundoff * roundoff)) continue;
+        // R squared errors: a chi-square of R degrees of freedom when the bias is 0 (a
+        // non-central one, narrower in log, when it is not).
+        const double sd_log = l.reps > 0 ? std::sqrt(trigamma(0.5 * l.reps)) : 0.0;
+        points.push_back({l.n, l.mse, sd_log});
+    }
+    ConvergenceFit fit = fit_power_law(points, LevelMeasure::Mse);
+    if (points.size() < 3) fit.note = "fewer than 3 levels with an MSE above round-off: no fit";
     return fit;
 }
 
@@ -714,6 +735,7 @@ StudyResult run_study(const Problem& problem, const std::vector<EstimatorSpec>& 
             EstimatorStudy& es = result.estimators[e];
             es.levels.push_back(summarise_level(level_runs, problem));
             es.fit = fit_convergence(es.levels);
+            es.mse_fit = fit_mse(es.levels);
             es.consistency = level_consistency(es.levels);
         }
         result.wall_seconds =

@@ -56,9 +56,10 @@ std::vector<uint64_t> n_ladder(uint64_t n_min, uint64_t n_max);
 /// measure.
 enum class LevelMeasure {
     Variance,    ///< integrals: the variance of the estimate across replicates
+    Mse,         ///< integrals with an exact value: the replicates' mean squared error
     RelativeMse, ///< renders: the images' relative MSE against the reference (render_study.h)
 };
-/// "variance", "relative_mse".
+/// "variance", "mse", "relative_mse".
 const char* level_measure_name(LevelMeasure m);
 
 struct LevelStats {
@@ -141,6 +142,10 @@ ConvergenceFit fit_power_law(const std::vector<FitPoint>& points, LevelMeasure m
 /// replicates, variance psi'((R-1)/2) [trigamma], so the weights are equal and the slope's
 /// standard error is the larger of the residual estimate and that noise.
 ConvergenceFit fit_convergence(const std::vector<LevelStats>& levels);
+/// With an exact value: the order of the MSE (bias^2 + variance) against N, from the levels
+/// with an MSE above round-off; sd of log MSE from R replicates as for a variance. A flat MSE
+/// under a falling variance is a bias that dominates (bias_dominates).
+ConvergenceFit fit_mse(const std::vector<LevelStats>& levels);
 
 /// Does the proposal cover the integrand's support? Checked once per estimator: where f != 0
 /// but p = 0 the estimator cannot sample, and is biased by the integral over that region,
@@ -201,7 +206,8 @@ struct EstimatorStudy {
     /// moment is finite, and a heavy-looking tail is pre-asymptotic.
     bool weights_bounded = false;
     std::vector<LevelStats> levels;
-    ConvergenceFit fit;
+    ConvergenceFit fit;     ///< of the variance
+    ConvergenceFit mse_fit; ///< of the MSE, with an exact value (else not valid)
 };
 
 struct StudyResult {

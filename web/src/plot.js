@@ -333,7 +333,11 @@ function renderVariance(state, run, records) {
       name: s.name,
       color: colorOf(run, s.name),
       parts: [
-        render ? `order of ${names.error}` : vs.quantity === 'mse' ? 'order of variance' : 'order',
+        // The plotted MSE's own order, then the variance's (a flat MSE under a falling
+        // variance is a bias: bias_dominates says from which N).
+        ...(vs.quantity === 'mse' && !render
+          ? ['order of MSE', { text: fitText(r.mse_fit), className: 'fit' }] : []),
+        render ? `order of ${names.error}` : vs.quantity === 'mse' ? 'of variance' : 'order of variance',
         { fit: fitText(r.fit), name: s.name },
         ...(r.warnings || []).map((w) => ({ warning: w })),
       ],
