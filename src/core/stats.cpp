@@ -56,8 +56,13 @@ void RunningMoments::merge(const RunningMoments& o) {
 }
 
 double RunningMoments::skewness() const {
-    if (n_ < 2 || !(m2_ > 0.0)) return 0.0;
-    return std::sqrt(static_cast<double>(n_)) * m3_ / (m2_ * std::sqrt(m2_));
+    // Values that agree to round-off (their spread within 64 eps of the mean, as an exact
+    // estimator's weights): the skewness of the rounding, which differs between platforms'
+    // libm, means nothing.
+    const double n = static_cast<double>(n_);
+    const double roundoff = 64.0 * 2.220446049250313e-16 * std::fabs(mean_);
+    if (n_ < 2 || !(m2_ > n * roundoff * roundoff)) return 0.0;
+    return std::sqrt(n) * m3_ / (m2_ * std::sqrt(m2_));
 }
 
 LineFit fit_line(const std::vector<double>& x, const std::vector<double>& y) {

@@ -59,7 +59,7 @@ class RunningMoments {
     double variance() const { return n_ > 1 ? m2_ / static_cast<double>(n_ - 1) : 0.0; }
     double sum_squared_deviations() const { return m2_; }
     double sum_cubed_deviations() const { return m3_; }
-    /// Sample skewness g1 = sqrt(n) m3 / m2^(3/2) (0 without spread).
+    /// Sample skewness g1 = sqrt(n) m3 / m2^(3/2) (0 without spread beyond round-off).
     double skewness() const;
 
   private:
