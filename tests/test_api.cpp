@@ -139,6 +139,44 @@ TEST(Api, BadScenesGiveScenesErrorsNamingTheField) {
     }
 }
 
+// Stopping at a requested accuracy through the API: "kind": "stopping", one answer per
+// replicate with its half-width, target, reason and cost; every run of x^2 under stratified
+// sampling meets 1e-3 relative and lies within it; bad tolerances are named.
+TEST(Api, StoppingAtARequestedAccuracy) {
+    Outcome o = run(kSmall, R"({"rel_tol": 1e-3, "reps": 8, "estimators": ["stratified"]})");
+    ASSERT_EQ(o.status, MCP_OK) << o.error;
+    EXPECT_EQ(o.result["kind"], "stopping");
+    EXPECT_EQ(o.result["stopping"]["rel_tol"], 1e-3);
+    const json& e = o.result["estimators"][0];
+    EXPECT_EQ(e["name"], "stratified");
+    ASSERT_EQ(e["runs"].size(), 8u);
+    EXPECT_EQ(e["met"], 8);
+    EXPECT_EQ(e["within_tolerance"], 8);
+    for (const json& r : e["runs"]) {
+        EXPECT_TRUE(r["met"].get<bool>());
+        EXPECT_EQ(r["reason"], "tolerance_met");
+        EXPECT_LE(r["half_width"].get<double>(), r["target"].get<double>());
+        EXPECT_GE(r["steps"].size(), 2u);
+        EXPECT_GT(r["evaluations"].get<uint64_t>(), r["n"].get<uint64_t>());
+    }
+    // A budget that ends first: reported unmet, with a warning naming it.
+    o = run(kSmall, R"({"rel_tol": 1e-9, "n_max": 256, "reps": 2})");
+    ASSERT_EQ(o.status, MCP_OK) << o.error;
+    EXPECT_EQ(o.result["estimators"][0]["met"], 0);
+    EXPECT_EQ(o.result["estimators"][0]["warnings"][0]["code"], "tolerance_not_met");
+    EXPECT_NE(
+        o.result["estimators"][0]["warnings"][0]["message"].get<std::string>().find("n_max = 256"),
+        std::string::npos);
+    for (const char* bad : {R"({"rel_tol": -1})", R"({"abs_tol": "small"})",
+                            R"({"max_seconds": 5})", R"({"rel_tol": 0.1, "max_seconds": -1})"}) {
+        o = run(kSmall, bad);
+        EXPECT_NE(o.status, MCP_OK) << bad;
+        EXPECT_TRUE(o.error.find("tol") != std::string::npos ||
+                    o.error.find("max_seconds") != std::string::npos)
+            << bad << ": " << o.error;
+    }
+}
+
 TEST(Api, BadOptions) {
     // A bad value in the options is a bad argument, not a bad scene.
     Outcome o = run(kSmall, R"({"estimators": ["nope"]})");

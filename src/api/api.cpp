@@ -8,6 +8,7 @@
 #include "api/boundary.h"
 #include "api/mcplay.h"
 #include "api/scene.h"
+#include "estimators/stopping.h"
 
 using mcp::boundary::copy_out;
 using mcp::boundary::dump;
@@ -55,6 +56,15 @@ int mcp_study_run(const char* scene_json, const char* options_json, mcp_progress
     mcp::SceneRequest req;
     if (int st = load_request(scene_json, options_json, &req)) return st;
 
+    if (req.settings.stopping()) {
+        // Stopping at a requested accuracy: no N ladder, so no per-level progress.
+        const mcp::StoppingStudy st =
+            mcp::run_stopping_study(req.problem, req.estimators, req.settings);
+        *result_json = copy_out(dump(mcp::stopping_to_json(st)));
+        if (!*result_json) return fail(MCP_ERROR_INTERNAL, "out of memory writing the result");
+        g_last_error.clear();
+        return MCP_OK;
+    }
     mcp::StudyProgress on_level;
     if (progress) {
         on_level = [&](const mcp::StudyResult& partial, size_t level) {

@@ -3,10 +3,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
+#include <map>
 #include <sstream>
 
 #include "api/scene.h"
 #include "estimators/diagnostics.h"
+#include "estimators/stopping.h"
 
 namespace mcp {
 
@@ -397,16 +400,123 @@ Json estimator_header(const EstimatorStudy& e, const StudySettings& s) {
 
 } // namespace
 
+namespace {
+Json scene_to_json(const Problem& p) {
+    return Json{{"name", p.name},
+                {"description", p.description},
+                {"domain", domain_kind_name(p.domain.kind)},
+                {"domain_text", p.domain.describe()},
+                {"dimension", p.domain.point_dim()},
+                {"integrand", describe_integrand(p.integrand)},
+                {"quantity", p.quantity == Quantity::Mean ? "mean" : "integral"},
+                {"exact", p.exact ? num(*p.exact) : Json(nullptr)}};
+}
+
+double median_of(std::vector<double> v) {
+    if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
+    std::sort(v.begin(), v.end());
+    const size_t m = v.size() / 2;
+    return v.size() % 2 ? v[m] : 0.5 * (v[m - 1] + v[m]);
+}
+} // namespace
+
+Json stopping_to_json(const StoppingStudy& st) {
+    const Problem& p = st.problem;
+    const StudySettings& set = st.settings;
+    Json estimators = Json::array();
+    for (size_t e = 0; e < st.specs.size(); ++e) {
+        EstimatorStudy header;
+        header.spec = st.specs[e];
+        header.error_method = error_method_for(st.specs[e]);
+        Json j = estimator_header(header, set);
+        Json runs = Json::array();
+        std::vector<double> seconds, evaluations;
+        int met = 0, within = 0;
+        std::map<std::string, int> unmet;
+        for (const StoppingResult& r : st.runs[e]) {
+            Json steps = Json::array();
+            for (const StoppingStep& s : r.steps)
+                steps.push_back({{"n", s.n},
+                                 {"estimate", num(s.estimate)},
+                                 {"std_error", num(s.std_error)},
+                                 {"half_width", num(s.half_width)},
+                                 {"dof", s.dof},
+                                 {"trusted", s.trusted}});
+            Json run{{"estimate", num(r.answer.estimate)},
+                     {"std_error", num(r.answer.std_error)},
+                     {"half_width", num(r.half_width)},
+                     {"target", num(r.target)},
+                     {"met", r.met},
+                     {"reason", stop_reason_name(r.reason)},
+                     {"n", r.answer.n},
+                     {"evaluations", r.evaluations},
+                     {"seconds", num(r.seconds)},
+                     {"steps", steps}};
+            if (p.exact) {
+                const double tol = std::fmax(set.abs_tol, set.rel_tol * std::fabs(*p.exact));
+                const bool in = std::fabs(r.answer.estimate - *p.exact) <= tol;
+                run["within_tolerance"] = in;
+                within += in;
+            }
+            met += r.met;
+            if (!r.met) ++unmet[stop_reason_name(r.reason)];
+            seconds.push_back(r.seconds);
+            evaluations.push_back(static_cast<double>(r.evaluations));
+            runs.push_back(run);
+        }
+        j["runs"] = runs;
+        j["met"] = met;
+        j["within_tolerance"] = p.exact ? Json(within) : Json(nullptr);
+        j["evaluations_median"] = num(median_of(evaluations));
+        j["seconds_median"] = num(median_of(seconds));
+        j["seconds_min"] = seconds.empty() ? Json(nullptr)
+                                           : num(*std::min_element(seconds.begin(), seconds.end()));
+        j["seconds_max"] = seconds.empty() ? Json(nullptr)
+                                           : num(*std::max_element(seconds.begin(), seconds.end()));
+        Json warnings = Json::array();
+        for (const auto& [reason, count] : unmet) {
+            const std::string why =
+                reason == "no_error_bar"
+                    ? "the estimator has no error bar (a point set without randomization), so "
+                      "no tolerance can be judged"
+                : reason == "n_max"
+                    ? "n_max = " + std::to_string(set.n_max) + " was reached first"
+                    : "the time budget (max_seconds = " + fmt("%.3g", set.max_seconds) +
+                          ") ended first";
+            warnings.push_back(Json{{"code", "tolerance_not_met"},
+                                    {"severity", reason == "no_error_bar" ? "error" : "warning"},
+                                    {"message", std::to_string(count) + " of " +
+                                                    std::to_string(st.runs[e].size()) +
+                                                    " runs did not meet the tolerance: " + why}});
+        }
+        j["warnings"] = warnings;
+        estimators.push_back(j);
+    }
+    Json settings{
+        {"n_min", set.n_min},
+        {"n_max", set.n_max},
+        {"reps", set.reps},
+        {"seed", set.seed},
+        {"accumulator", set.accumulator == Accumulator::Float32 ? "float32" : "compensated"},
+        {"threads", 1}};
+    return Json{{"version", kResultSchemaVersion},
+                {"mcplay", MCPLAY_VERSION},
+                {"kind", "stopping"},
+                {"scene", scene_to_json(p)},
+                {"settings", settings},
+                {"stopping",
+                 {{"rel_tol", num(set.rel_tol)},
+                  {"abs_tol", num(set.abs_tol)},
+                  {"max_seconds", set.max_seconds > 0.0 ? num(set.max_seconds) : Json(nullptr)},
+                  {"rule", "95% half-width <= max(abs_tol, rel_tol |estimate|) at N, predicted by "
+                           "the independent run at N/2, the two agreeing, and N > 25 skewness^2"}}},
+                {"wall_time_s", num(st.wall_seconds)},
+                {"estimators", estimators}};
+}
+
 Json study_to_json(const StudyResult& r) {
     const Problem& p = r.problem;
-    Json scene{{"name", p.name},
-               {"description", p.description},
-               {"domain", domain_kind_name(p.domain.kind)},
-               {"domain_text", p.domain.describe()},
-               {"dimension", p.domain.point_dim()},
-               {"integrand", describe_integrand(p.integrand)},
-               {"quantity", p.quantity == Quantity::Mean ? "mean" : "integral"},
-               {"exact", p.exact ? num(*p.exact) : Json(nullptr)}};
+    Json scene = scene_to_json(p);
     Json settings{
         {"n_min", r.settings.n_min},
         {"n_max", r.settings.n_max},
@@ -558,8 +668,63 @@ std::string format_render_table(const Json& r) {
     return out.str();
 }
 
+namespace {
+// Stopping studies: per estimator, how often the tolerance was met, the answers' spread, and
+// the evaluations and seconds it took (median and range over the replicates).
+std::string format_stopping_table(const Json& r) {
+    std::ostringstream out;
+    const Json& scene = get(r, "scene");
+    const Json& settings = get(r, "settings");
+    const Json& stop = get(r, "stopping");
+    const double exact = jnum(scene, "exact");
+    const bool has_exact = std::isfinite(exact);
+    out << "mcplay " << jstr(r, "mcplay") << "  scene " << jstr(scene, "name") << "\n  "
+        << jstr(scene, "quantity") << " of f = " << jstr(scene, "integrand") << " over "
+        << jstr(scene, "domain_text") << "\n  exact "
+        << (has_exact ? fmt("%.12g", exact) : std::string("unknown")) << "   stopping at ";
+    if (jnum(stop, "rel_tol") > 0.0) out << "rel_tol " << fmt("%.3g", jnum(stop, "rel_tol"));
+    if (jnum(stop, "abs_tol") > 0.0)
+        out << (jnum(stop, "rel_tol") > 0.0 ? " or " : "") << "abs_tol "
+            << fmt("%.3g", jnum(stop, "abs_tol"));
+    out << " (95% half-width), N from " << fmt("%.0f", jnum(settings, "n_min")) << " doubling to "
+        << fmt("%.0f", jnum(settings, "n_max"));
+    if (std::isfinite(jnum(stop, "max_seconds")))
+        out << ", at most " << fmt("%.3g", jnum(stop, "max_seconds")) << " s per estimate";
+    out << ", " << fmt("%.0f", jnum(settings, "reps")) << " replicates, seed "
+        << fmt("%.0f", jnum(settings, "seed")) << "\n  rule: " << jstr(stop, "rule") << "\n\n";
+    out << padr("estimator", 24) << padl("met", 8) << padl("within", 8) << padl("estimate", 17)
+        << padl("+/- (95%)", 12) << padl("evals (median)", 16) << padl("s (median)", 12)
+        << padl("s (min-max)", 20) << "\n";
+    Json shown = Json::array();
+    for (const Json& e : list(r, "estimators")) {
+        const Json& runs = list(e, "runs");
+        const std::string of = "/" + std::to_string(runs.size());
+        const Json first = runs.empty() ? Json::object() : runs.front();
+        out << padr(jstr(e, "name"), 24) << padl(fmt("%.0f", jnum(e, "met")) + of, 8)
+            << padl(has_exact ? fmt("%.0f", jnum(e, "within_tolerance")) + of : "-", 8)
+            << padl(fmt("%.10g", jnum(first, "estimate")), 17)
+            << padl(fmt("%.3g", jnum(first, "half_width")), 12)
+            << padl(fmt("%.0f", jnum(e, "evaluations_median")), 16)
+            << padl(fmt("%.3g", jnum(e, "seconds_median")), 12)
+            << padl(fmt("%.3g", jnum(e, "seconds_min")) + "-" + fmt("%.3g", jnum(e, "seconds_max")),
+                    20)
+            << "\n";
+        for (const Json& w : list(e, "warnings")) {
+            Json named = w;
+            named["message"] = jstr(e, "name") + ": " + jstr(w, "message");
+            shown.push_back(named);
+        }
+    }
+    out << "  (estimate and +/-: the first replicate's answer; met: runs whose rule was satisfied; "
+           "within: answers within the tolerance of the exact value)\n";
+    print_warnings(out, shown);
+    return out.str();
+}
+} // namespace
+
 std::string format_table(const Json& r) {
     if (jstr(r, "kind") == "render") return format_render_table(r);
+    if (jstr(r, "kind") == "stopping") return format_stopping_table(r);
     std::ostringstream out;
     const Json& scene = get(r, "scene");
     const Json& settings = get(r, "settings");
@@ -649,7 +814,46 @@ std::string format_table(const Json& r) {
     return out.str();
 }
 
+namespace {
+// A number at full precision, empty for null and NaN (which JSON holds as null).
+std::string csv_number(const Json& v) {
+    if (!v.is_number()) return "";
+    std::ostringstream s;
+    s.precision(17);
+    s << v.get<double>();
+    return s.str();
+}
+
+std::string csv_quoted(const std::string& s) {
+    std::string q = "\"";
+    for (char ch : s) q += ch == '"' ? std::string("\"\"") : std::string(1, ch);
+    return q + "\"";
+}
+
+// Stopping studies: one row per run.
+std::string format_stopping_csv(const Json& r) {
+    const auto cell = csv_number;
+    std::ostringstream out;
+    out << "estimator,replicate,estimate,std_error,half_width,target,met,reason,n,evaluations,"
+           "seconds,within_tolerance\n";
+    for (const Json& e : list(r, "estimators")) {
+        int k = 0;
+        for (const Json& run : list(e, "runs")) {
+            const Json& within = get(run, "within_tolerance");
+            out << csv_quoted(jstr(e, "name")) << "," << k++ << "," << cell(get(run, "estimate"))
+                << "," << cell(get(run, "std_error")) << "," << cell(get(run, "half_width")) << ","
+                << cell(get(run, "target")) << "," << (jbool(run, "met") ? "true" : "false") << ","
+                << jstr(run, "reason") << "," << cell(get(run, "n")) << ","
+                << cell(get(run, "evaluations")) << "," << cell(get(run, "seconds")) << ","
+                << (within.is_boolean() ? (within.get<bool>() ? "true" : "false") : "") << "\n";
+        }
+    }
+    return out.str();
+}
+} // namespace
+
 std::string format_csv(const Json& r) {
+    if (jstr(r, "kind") == "stopping") return format_stopping_csv(r);
     std::ostringstream out;
     out.precision(17);
     out << "scene,estimator,sampler,pdf,n,reps,mean,variance,variance_lo,variance_hi,std_error,ci_"
@@ -657,20 +861,8 @@ std::string format_csv(const Json& r) {
            "ci_hi,exact,bias,mse,rmse,coverage95,mean_run_std_error,time_mean_s,efficiency,"
            "nonfinite,zero_pdf,max_weight_share\n";
     const Json& scene = get(r, "scene");
-    auto cell = [](const Json& v) -> std::string {
-        if (v.is_number()) {
-            std::ostringstream s;
-            s.precision(17);
-            s << v.get<double>();
-            return s.str();
-        }
-        return "";
-    };
-    auto quoted = [](const std::string& s) {
-        std::string q = "\"";
-        for (char ch : s) q += ch == '"' ? std::string("\"\"") : std::string(1, ch);
-        return q + "\"";
-    };
+    const auto cell = csv_number;
+    const auto quoted = csv_quoted;
     // Spreads that are negative are not spreads: empty cells, like missing numbers.
     auto spread = [&](const Json& v) -> std::string {
         return v.is_number() && v.get<double>() < 0.0 ? std::string() : cell(v);

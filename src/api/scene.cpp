@@ -3,6 +3,7 @@
 // every error names the JSON path of the offending field and what was expected.
 #include "api/scene.h"
 #include "api/json_read.h"
+#include "estimators/stopping.h"
 
 #include <algorithm>
 #include <cmath>
@@ -1126,7 +1127,7 @@ Made<SceneRequest> build_request(const Json& scene, const Json& options) {
     if (!check_keys(c, scene, path,
                     {"name", "description", "domain", "integrand", "f", "quantity", "exact",
                      "estimators", "n_min", "n_max", "reps", "seed", "threads", "accumulator",
-                     "notes"}))
+                     "rel_tol", "abs_tol", "max_seconds", "notes"}))
         return made_error<SceneRequest>(c.error);
     Problem& pr = req.problem;
     pr.name = "scene";
@@ -1221,13 +1222,20 @@ Made<SceneRequest> build_request(const Json& scene, const Json& options) {
         !get_count(c, scene, "n_max", path, &s.n_max) ||
         !get_count(c, scene, "reps", path, &reps) || !get_count(c, scene, "seed", path, &s.seed) ||
         !get_count(c, scene, "threads", path, &threads) ||
-        !parse_accumulator(c, scene, path, &s.accumulator))
+        !parse_accumulator(c, scene, path, &s.accumulator) ||
+        !get_number(c, scene, "rel_tol", path, &s.rel_tol) ||
+        !get_number(c, scene, "abs_tol", path, &s.abs_tol) ||
+        !get_number(c, scene, "max_seconds", path, &s.max_seconds))
         return made_error<SceneRequest>(c.error);
 
     req.estimators = all;
     if (!options.is_null()) {
         if (!check_keys(c, options, "options",
-                        {"estimators", "n_min", "n_max", "reps", "seed", "threads"}) ||
+                        {"estimators", "n_min", "n_max", "reps", "seed", "threads", "rel_tol",
+                         "abs_tol", "max_seconds"}) ||
+            !get_number(c, options, "rel_tol", "options", &s.rel_tol) ||
+            !get_number(c, options, "abs_tol", "options", &s.abs_tol) ||
+            !get_number(c, options, "max_seconds", "options", &s.max_seconds) ||
             !get_count(c, options, "n_min", "options", &s.n_min) ||
             !get_count(c, options, "n_max", "options", &s.n_max) ||
             !get_count(c, options, "reps", "options", &reps) ||
@@ -1299,6 +1307,25 @@ Made<SceneRequest> build_request(const Json& scene, const Json& options) {
             from_options = from_options || (options.is_object() && find(options, key) &&
                                             bad.find(key) != std::string::npos);
         return made_error<SceneRequest>((from_options ? "options: " : "scene: ") + bad);
+    }
+    // Stopping at a requested accuracy: the tolerances and the time budget. N may double to
+    // 2^24 (or the scene's n_max, if larger: a scene's n_max is its ladder's) unless the options
+    // set n_max.
+    if (s.stopping() && !(options.is_object() && find(options, "n_max")))
+        s.n_max = std::max(s.n_max, kStoppingDefaultNMax);
+    if (s.stopping() || s.abs_tol != 0.0 || s.rel_tol != 0.0 || s.max_seconds != 0.0) {
+        const bool from_options =
+            options.is_object() &&
+            (find(options, "rel_tol") || find(options, "abs_tol") || find(options, "max_seconds"));
+        const char* who = from_options ? "options: " : "scene: ";
+        if (!(s.max_seconds >= 0.0) || !std::isfinite(s.max_seconds))
+            return made_error<SceneRequest>(std::string(who) +
+                                            "max_seconds: must be a finite number >= 0");
+        if (!s.stopping() && s.max_seconds > 0.0)
+            return made_error<SceneRequest>(std::string(who) +
+                                            "max_seconds: applies with rel_tol or abs_tol only");
+        const std::string bad_tol = check_stopping(tolerance_of(s), budget_of(s));
+        if (!bad_tol.empty()) return made_error<SceneRequest>(who + bad_tol);
     }
     // The whole study's size, before any work (a run of 2^36 points is refused, not begun).
     const std::string too_big = check_study_size(s, req.estimators.size());

@@ -38,6 +38,10 @@ const std::vector<EstimatorPreset>& estimator_presets();
 constexpr int kResultSchemaVersion = 1;
 
 Json study_to_json(const StudyResult& result);
+struct StoppingStudy;
+/// A stopping study (estimators/stopping.h) as JSON: "kind": "stopping", per estimator its runs
+/// (answer, half-width, target, met, reason, evaluations, seconds, the doublings) and summary.
+Json stopping_to_json(const StoppingStudy& study);
 Json level_to_json(const LevelStats& level);
 Json fit_to_json(const ConvergenceFit& fit);
 Json progress_to_json(const StudyResult& partial, size_t level_index);

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -49,6 +50,12 @@ const char* kUsage =
     "  --reps R             independent replicates per N (>= 2; default 32)\n"
     "  --seed S             random seed (default 1); same seed, same numbers\n"
     "  --threads T          worker threads (0 = all cores; results do not depend on T)\n"
+    "  --rel-tol X          stop at a requested accuracy instead of the N ladder: double N\n"
+    "                       from --n-min until the 95% error bar is within X |estimate|\n"
+    "                       (and the run at N/2 agrees), for each of --reps replicates\n"
+    "  --abs-tol X          the same with an absolute tolerance (with both: the larger)\n"
+    "  --max-seconds S      with a tolerance: give up an estimate after about S seconds\n"
+    "                       (--n-max is the other budget)\n"
     "  --format F           table (default), json or csv\n"
     "  --out FILE           write the result to FILE instead of standard output\n"
     "  --quiet              no progress lines on standard error\n"
@@ -411,6 +418,15 @@ int cmd_run(const std::vector<std::string>& args) {
             unsigned long long x = 0;
             if (!parse_count(v, &x))
                 return usage_error(a + ": expected a whole number >= 0, got '" + v + "'");
+            std::string key = a.substr(2);
+            std::replace(key.begin(), key.end(), '-', '_');
+            options[key] = x;
+        } else if (a == "--rel-tol" || a == "--abs-tol" || a == "--max-seconds") {
+            if (!value(&v)) return usage_error(a + " needs a value");
+            char* end = nullptr;
+            const double x = std::strtod(v.c_str(), &end);
+            if (v.empty() || *end != '\0' || !std::isfinite(x) || x <= 0.0)
+                return usage_error(a + ": expected a number > 0, got '" + v + "'");
             std::string key = a.substr(2);
             std::replace(key.begin(), key.end(), '-', '_');
             options[key] = x;

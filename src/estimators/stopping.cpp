@@ -1,5 +1,6 @@
 #include "estimators/stopping.h"
 
+#include <chrono>
 #include <cmath>
 
 #include "core/special.h"
@@ -96,6 +97,39 @@ StoppingResult run_to_tolerance(const Problem& problem, const EstimatorSpec& spe
             return out;
         }
     }
+}
+
+Tolerance tolerance_of(const StudySettings& settings) {
+    return Tolerance{settings.abs_tol, settings.rel_tol};
+}
+
+StoppingBudget budget_of(const StudySettings& settings) {
+    StoppingBudget b;
+    b.n_start = settings.n_min;
+    b.n_max = settings.n_max;
+    if (settings.max_seconds > 0.0) b.max_seconds = settings.max_seconds;
+    return b;
+}
+
+StoppingStudy run_stopping_study(const Problem& problem, const std::vector<EstimatorSpec>& specs,
+                                 const StudySettings& settings) {
+    const auto start = std::chrono::steady_clock::now();
+    StoppingStudy s;
+    s.problem = problem;
+    s.settings = settings;
+    s.specs = specs;
+    Workspace ws;
+    for (const EstimatorSpec& spec : specs) {
+        std::vector<StoppingResult> runs;
+        for (int r = 0; r < settings.reps; ++r)
+            runs.push_back(run_to_tolerance(problem, spec, tolerance_of(settings),
+                                            budget_of(settings), settings.seed, r, ws,
+                                            settings.accumulator));
+        s.runs.push_back(std::move(runs));
+    }
+    s.wall_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return s;
 }
 
 } // namespace mcp

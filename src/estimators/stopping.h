@@ -25,6 +25,7 @@
 #include "estimators/block_driver.h"
 #include "estimators/estimator.h"
 #include "estimators/problem.h"
+#include "estimators/study.h"
 
 namespace mcp {
 
@@ -34,6 +35,9 @@ struct Tolerance {
     double abs = 0.0;
     double rel = 0.0;
 };
+
+/// The largest N of a stopping run when nothing else says (the study ladder's default is 65536).
+constexpr uint64_t kStoppingDefaultNMax = uint64_t(1) << 24;
 
 /// Where doubling starts and what ends it.
 struct StoppingBudget {
@@ -77,5 +81,22 @@ StoppingResult run_to_tolerance(const Problem& problem, const EstimatorSpec& spe
                                 const Tolerance& tol, const StoppingBudget& budget, uint64_t seed,
                                 int replicate, Workspace& ws,
                                 Accumulator accumulator = Accumulator::Compensated);
+
+/// Every estimator run to the tolerance `settings.reps` times (replicate r from its own
+/// streams), one estimate at a time on one thread, so that each one's seconds are its own.
+struct StoppingStudy {
+    Problem problem;
+    StudySettings settings;
+    std::vector<EstimatorSpec> specs;
+    std::vector<std::vector<StoppingResult>> runs; ///< per estimator, per replicate
+    double wall_seconds = 0.0;
+};
+
+/// The tolerance and budget of study settings (settings.stopping() must hold).
+Tolerance tolerance_of(const StudySettings& settings);
+StoppingBudget budget_of(const StudySettings& settings);
+
+StoppingStudy run_stopping_study(const Problem& problem, const std::vector<EstimatorSpec>& specs,
+                                 const StudySettings& settings);
 
 } // namespace mcp

@@ -30,6 +30,11 @@ struct StudySettings {
     uint64_t seed = 1;
     int threads = 0; ///< 0: all hardware threads
     Accumulator accumulator = Accumulator::Compensated;
+    /// Stopping at a requested accuracy (estimators/stopping.h) instead of the N ladder: either
+    /// tolerance > 0 asks for it; N then doubles from n_min to at most n_max, each estimate for
+    /// at most max_seconds (0: no limit).
+    double abs_tol = 0.0, rel_tol = 0.0, max_seconds = 0.0;
+    bool stopping() const { return abs_tol > 0.0 || rel_tol > 0.0; }
 };
 
 /// Checks the settings; returns an error message naming the setting, or "".
