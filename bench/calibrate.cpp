@@ -4,6 +4,7 @@
 //
 //   calibrate [--quick] [--reps R] [--n-min N] [--n-max N] [--param-seeds 1,2,3]
 //             [--dims 2,4,8] [--scenes DIR] [--json FILE] [--cells FILE] [--list N]
+//             [--stopping REL [--stop-n-max N] [--max-seconds S]]
 //
 // The battery: Genz's six families [Genz84] at d = 2, 4, 8 with the project's own random
 // parameters (genz_random, seeds 1..3), each run with every uniform-density preset, and every
@@ -52,13 +53,17 @@ struct Options {
     std::vector<uint64_t> param_seeds{1, 2, 3};
     std::string scenes_dir = "scenes", json_path, cells_path;
     int list = 20; // confident wrong answers and flag codes listed
+    // --stopping REL: the stopping rule's battery instead of the flags' (n_max, seconds: budget)
+    double stop_rel = 0.0, stop_seconds = 2.0;
+    uint64_t stop_n_max = uint64_t(1) << 22;
 };
 
 [[noreturn]] void usage(const std::string& msg) {
     if (!msg.empty()) std::fprintf(stderr, "calibrate: %s\n", msg.c_str());
     std::fprintf(stderr, "usage: calibrate [--quick] [--reps R] [--n-min N] [--n-max N]\n"
                          "         [--param-seeds 1,2,3] [--dims 2,4,8] [--scenes DIR]\n"
-                         "         [--json FILE] [--cells FILE] [--list N]\n");
+                         "         [--json FILE] [--cells FILE] [--list N]\n"
+                         "         [--stopping REL [--stop-n-max N] [--max-seconds S]]\n");
     std::exit(2);
 }
 
@@ -108,7 +113,21 @@ Options parse_options(int argc, char** argv) {
             o.scenes_dir = value();
         else if (a == "--json")
             o.json_path = value();
-        else if (a == "--cells")
+        else if (a == "--stopping") {
+            const std::string v = value();
+            char* end = nullptr;
+            o.stop_rel = std::strtod(v.c_str(), &end);
+            if (v.empty() || *end || !(o.stop_rel > 0.0) || !(o.stop_rel < 1.0))
+                usage("--stopping: expected a relative tolerance in (0, 1)");
+        } else if (a == "--stop-n-max")
+            o.stop_n_max = one("--stop-n-max", 16, uint64_t(1) << 30);
+        else if (a == "--max-seconds") {
+            const std::string v = value();
+            char* end = nullptr;
+            o.stop_seconds = std::strtod(v.c_str(), &end);
+            if (v.empty() || *end || !(o.stop_seconds > 0.0) || !std::isfinite(o.stop_seconds))
+                usage("--max-seconds: expected a number of seconds > 0");
+        } else if (a == "--cells")
             o.cells_path = value();
         else if (a == "--list")
             o.list = int(one("--list", 0, 100000));
@@ -267,8 +286,92 @@ void judge(const std::string& case_name, const Json& result, double exact, Tally
 
 } // namespace
 
+// --stopping REL: every case run to a relative tolerance (each preset, R replicates), and the
+// promise judged: among the runs that met the tolerance, the share whose answer lies within it
+// of the exact value (target >= 95%), with its Wilson 95% interval; runs a budget ended are
+// counted apart.
+int stopping_battery(const Options& o, const std::vector<Case>& cases) {
+    std::printf("calibrate --stopping: %zu studies, rel_tol %.3g, n_min %llu, n_max %llu, "
+                "max_seconds %.3g, R = %d\n",
+                cases.size(), o.stop_rel, (unsigned long long)o.n_min,
+                (unsigned long long)o.stop_n_max, o.stop_seconds, o.reps);
+    long runs = 0, met = 0, within = 0, unmet_within = 0;
+    std::map<std::string, std::pair<long, long>> by_estimator; // met, within
+    struct Miss {
+        std::string where;
+        long within, met;
+    };
+    std::vector<Miss> worst;
+    for (size_t ci = 0; ci < cases.size(); ++ci) {
+        const Case& c = cases[ci];
+        Json options = c.options;
+        options["n_min"] = o.n_min;
+        options["n_max"] = o.stop_n_max;
+        options["reps"] = o.reps;
+        options["seed"] = o.seed + ci;
+        options["rel_tol"] = o.stop_rel;
+        options["max_seconds"] = o.stop_seconds;
+        char* out = nullptr;
+        const int status =
+            mcp_study_run(c.scene.dump().c_str(), options.dump().c_str(), nullptr, nullptr, &out);
+        Made<Json> r = status == MCP_OK ? parse_json(out, c.name.c_str()) : Made<Json>();
+        mcp_free(out);
+        std::fprintf(stderr, "[%zu/%zu] %s\n", ci + 1, cases.size(), c.name.c_str());
+        if (status != MCP_OK || !r.ok() || !r.value["scene"]["exact"].is_number()) continue;
+        for (const Json& e : r.value["estimators"]) {
+            long case_met = 0, case_within = 0;
+            for (const Json& run : e["runs"]) {
+                ++runs;
+                const bool in = run.value("within_tolerance", false);
+                if (run.value("met", false)) {
+                    ++case_met;
+                    case_within += in;
+                } else
+                    unmet_within += in;
+            }
+            met += case_met;
+            within += case_within;
+            auto& [m, w] = by_estimator[e.value("name", "?")];
+            m += case_met;
+            w += case_within;
+            if (case_met > case_within)
+                worst.push_back(Miss{c.name + " " + e.value("name", "?"), case_within, case_met});
+        }
+    }
+    // Wilson's score interval for a binomial proportion [Wilson27].
+    auto wilson = [](long k, long n) {
+        const double z = 1.959963985, p = n ? double(k) / double(n) : 0.0, nn = double(n);
+        const double centre = (p + z * z / (2 * nn)) / (1 + z * z / nn);
+        const double half = z * std::sqrt(p * (1 - p) / nn + z * z / (4 * nn * nn)) / (1 + z * z / nn);
+        return std::pair<double, double>(centre - half, centre + half);
+    };
+    const auto [lo, hi] = wilson(within, met);
+    std::printf("\nruns %ld, met the tolerance %ld (%.1f%%); of those, within it of the exact value "
+                "%ld = %.2f%% (95%% interval %.2f-%.2f%%; target >= 95%%)\n",
+                runs, met, 100.0 * met / std::max(runs, 1L), within,
+                100.0 * within / std::max(met, 1L), 100.0 * lo, 100.0 * hi);
+    std::printf("runs a budget ended: %ld (their answers within the tolerance anyway: %ld)\n",
+                runs - met, unmet_within);
+    std::printf("\nper estimator (met, within):\n");
+    for (const auto& [name, mw] : by_estimator)
+        std::printf("  %-28s %6ld %6ld  %.1f%%\n", name.c_str(), mw.first, mw.second,
+                    mw.first ? 100.0 * mw.second / mw.first : 0.0);
+    std::sort(worst.begin(), worst.end(), [](const Miss& a, const Miss& b) {
+        return double(a.within) / a.met < double(b.within) / b.met;
+    });
+    std::printf("\ncases whose met runs missed the tolerance (within / met; first %d):\n", o.list);
+    for (size_t i = 0; i < worst.size() && i < size_t(o.list); ++i)
+        std::printf("  %-60s %ld / %ld\n", worst[i].where.c_str(), worst[i].within, worst[i].met);
+    return 0;
+}
+
 int main(int argc, char** argv) {
     const Options o = parse_options(argc, argv);
+    if (o.stop_rel > 0.0) {
+        std::vector<Case> all = genz_cases(o);
+        for (Case& c : scene_cases(o)) all.push_back(std::move(c));
+        return stopping_battery(o, all);
+    }
     const auto t0 = std::chrono::steady_clock::now();
     std::vector<Case> cases = genz_cases(o);
     const size_t genz_count = cases.size();
