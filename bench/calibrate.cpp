@@ -342,14 +342,16 @@ int stopping_battery(const Options& o, const std::vector<Case>& cases) {
     auto wilson = [](long k, long n) {
         const double z = 1.959963985, p = n ? double(k) / double(n) : 0.0, nn = double(n);
         const double centre = (p + z * z / (2 * nn)) / (1 + z * z / nn);
-        const double half = z * std::sqrt(p * (1 - p) / nn + z * z / (4 * nn * nn)) / (1 + z * z / nn);
+        const double half =
+            z * std::sqrt(p * (1 - p) / nn + z * z / (4 * nn * nn)) / (1 + z * z / nn);
         return std::pair<double, double>(centre - half, centre + half);
     };
     const auto [lo, hi] = wilson(within, met);
-    std::printf("\nruns %ld, met the tolerance %ld (%.1f%%); of those, within it of the exact value "
-                "%ld = %.2f%% (95%% interval %.2f-%.2f%%; target >= 95%%)\n",
-                runs, met, 100.0 * met / std::max(runs, 1L), within,
-                100.0 * within / std::max(met, 1L), 100.0 * lo, 100.0 * hi);
+    std::printf(
+        "\nruns %ld, met the tolerance %ld (%.1f%%); of those, within it of the exact value "
+        "%ld = %.2f%% (95%% interval %.2f-%.2f%%; target >= 95%%)\n",
+        runs, met, 100.0 * met / std::max(runs, 1L), within, 100.0 * within / std::max(met, 1L),
+        100.0 * lo, 100.0 * hi);
     std::printf("runs a budget ended: %ld (their answers within the tolerance anyway: %ld)\n",
                 runs - met, unmet_within);
     std::printf("\nper estimator (met, within):\n");
