@@ -79,6 +79,12 @@ const handlers = {
       }
     }
     const result = core.runStudy(scene, options, onLevel);
+    // A scene with rel_tol or abs_tol asks for stopping at a requested accuracy: a result
+    // without an N ladder, which the page's plots cannot show yet (the CLI's table does).
+    if (result && result.kind === 'stopping') {
+      throw new Error('this scene asks to stop at a requested accuracy (rel_tol or abs_tol), which '
+        + 'the page does not show yet: remove those fields, or run mcplay run SCENE --rel-tol X');
+    }
     reply(id, MSG.RESULT, { result });
   },
   async [MSG.IMAGE](core, id, { scene, options }) {
