@@ -96,7 +96,7 @@ Json level_warning(const Flag& f, const LevelStats& l) {
                                    "integrand, the estimate is biased");
     case FlagCode::SkewedWeights: {
         // The units: the weights (count = N), or each run's K batch means (randomized QMC).
-        const bool batches = f.count != l.n;
+        const bool batches = f.dof > 0;
         const std::string skew = "(skewness " + fmt("%.3g", f.value) + " over all runs)" + at_n;
         const std::string rule =
             batches

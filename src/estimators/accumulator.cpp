@@ -232,6 +232,7 @@ RunResult WeightAccumulator::finish(double scale) const {
     result.diagnostics.nonzero = nonzero_;
     result.diagnostics.weights = moments_;
     result.diagnostics.error_units = units;
+    result.diagnostics.batch_units = method_ == ErrorMethod::Randomizations;
     // Effective sample size [Kish65]: how many equal weights would carry the same information.
     const double sum_sq =
         moments_.sum_squared_deviations() + nd * moments_.mean() * moments_.mean();

@@ -82,8 +82,7 @@ class ControlVariateEstimator final : public EstimatorAlgorithm {
     }
 
     RunResult result() const override {
-        const double scale =
-            quantity_scale(problem_);
+        const double scale = quantity_scale(problem_);
         RunResult r = accumulator_.finish(scale);
         r.n = plan_.total;
         r.diagnostics.nonfinite += dropped_g_;

@@ -217,6 +217,7 @@ std::vector<Flag> level_flags(const LevelStats& l) {
         f.value = g1;
         f.threshold = rule_n; // the number of units per run from which the rule holds
         f.count = static_cast<uint64_t>(units_per_run + 0.5);
+        f.dof = d.batch_units ? static_cast<int>(f.count) : 0; // K batch means, or weights
         f.se = spread;
         const bool unsettled = !(spread <= kErrorBarSpread); // NaN (fewer than 2 runs) too
         f.severity = strongly_skewed || unsettled ? Severity::Warning : Severity::Info;

@@ -20,6 +20,7 @@ void RunDiagnostics::merge(const RunDiagnostics& o) {
     max_weight_share = std::fmax(max_weight_share, o.max_weight_share);
     weights.merge(o.weights);
     error_units.merge(o.error_units);
+    batch_units = batch_units || o.batch_units;
 }
 
 const char* error_method_name(ErrorMethod m) {

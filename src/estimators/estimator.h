@@ -26,6 +26,7 @@ struct RunDiagnostics {
     /// The values whose spread is the run's error bar, pooled when runs merge: the weights, or
     /// for K randomizations the K batch means. Cochran's rule reads their skewness.
     RunningMoments error_units;
+    bool batch_units = false; ///< error_units are batch means (randomized QMC), not weights
     void merge(const RunDiagnostics& o);
 };
 

@@ -54,8 +54,7 @@ class MiserEstimator final : public EstimatorAlgorithm {
         // Depth first: a region is probed and cut, or sampled as a leaf, before the next.
         region(std::vector<double>(static_cast<size_t>(dim_), 0.0),
                std::vector<double>(static_cast<size_t>(dim_), 1.0), total_, 0);
-        const double unit =
-            quantity_scale(problem_);
+        const double unit = quantity_scale(problem_);
         result_ = accumulator_.finish(unit);
         result_.estimate = unit * strata_.estimate();
         result_.std_error = strata_.has_variance() ? unit * std::sqrt(strata_.variance())
