@@ -117,6 +117,18 @@ TEST(Stopping, BudgetsEndItUnmetAndAPointSetWithoutErrorBarCannotBeRun) {
     EXPECT_EQ(t.reason, StopReason::TimeBudget);
     EXPECT_EQ(t.steps.size(), 1u);
 
+    // Points that never see f (a peak of width 1e-8 under uniform points) give 0 +- 0 at every
+    // N: not an answer within an absolute tolerance of 1e-9, whatever its error bar says.
+    SceneRequest peak = request(scene_file("stiff_peak_1e-8"));
+    budget.n_max = 16384;
+    budget.max_seconds = 10.0;
+    const StoppingResult unseen = run_to_tolerance(peak.problem, peak.estimators.front(),
+                                                   Tolerance{1e-9, 0.0}, budget, 1, 0, ws);
+    EXPECT_EQ(peak.estimators.front().name, "uniform");
+    EXPECT_EQ(unseen.answer.estimate, 0.0);
+    EXPECT_FALSE(unseen.met);
+    EXPECT_EQ(unseen.reason, StopReason::NMax);
+
     Json sobol = scene_file("exp_1d");
     sobol["estimators"] =
         Json::array({{{"name", "net"}, {"sampler", "sobol"}, {"randomization", "none"}}});

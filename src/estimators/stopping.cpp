@@ -41,10 +41,14 @@ double t95(int dof) {
 // Condition 4: Cochran's rule on the run's weights (N of them). For randomized QMC the error bar
 // is the spread of only K batch means, whose skewness one run cannot estimate (its sampling
 // sd, sqrt(6 / K), is 0.6 for K = 16); the weights' rule is the conservative stand-in.
+// Also the low_ess rule: a run whose sum rests on a handful of weights, or on none (every weight
+// 0: no point saw f, and 0 +- 0 says nothing), is not evidence.
 bool error_bar_trusted(const RunResult& r) {
     const RunningMoments& u = r.diagnostics.weights;
     const double g1 = u.skewness();
-    return std::isfinite(g1) && static_cast<double>(u.count()) >= kSkewnessRule * g1 * g1;
+    const double n = static_cast<double>(u.count());
+    const bool enough = r.diagnostics.ess >= std::fmin(kLowEss, kLowEssShare * n);
+    return enough && std::isfinite(g1) && n >= kSkewnessRule * g1 * g1;
 }
 
 } // namespace

@@ -9,7 +9,8 @@
 //     Monte Carlo, conservative for faster estimators) meets the tolerance too;
 //  3. the two runs agree: |I_N - I_{N/2}| <= t_0.975 sqrt(se_N^2 + se_{N/2}^2);
 //  4. the run's error bar can be trusted at its size: Cochran's rule on its weights,
-//     N > 25 g1^2 [Cochran77] (the rule of the skewed_weights flag).
+//     N > 25 g1^2 [Cochran77] (the rule of the skewed_weights flag), and an effective sample
+//     size of at least min(10, N/4) (the low_ess rule: not 0 +- 0 from points that never saw f).
 // Every N is a fresh run with its own replicate stream, so the evidence at N/2 is independent of
 // the answer at N; the answer is the run at N, and the cost is at most twice its evaluations.
 // Any estimator with an error bar can be run this way (fixed, RQMC, VEGAS, MISER, MIS, control
