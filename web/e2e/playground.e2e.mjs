@@ -264,6 +264,43 @@ test('Cancel stops a long run promptly', async () => {
   await page.screenshot({ path: join(shots, 'cancelled.png') });
 });
 
+test('the race to a target accuracy: every estimator reaches it at the N the CLI reaches, and a verdict', async () => {
+  const estimators = ['uniform', 'stratified', 'importance'];
+  await configure('exp_1d', estimators, { nMin: 16, nMax: 4096, reps: 8, seed: 3 });
+  await page.fill('#race-rel', '1e-3');
+  await page.fill('#race-abs', '');
+  await page.fill('#race-runs', '6');
+  await page.fill('#race-seconds', '5');
+  const t0 = Date.now();
+  await page.click('#race-start');
+  await page.waitForFunction(() => window.mcplayDebug.state().race.status === 'done', null, { timeout: 60000 });
+  console.log(`# race finished in the page in ${Date.now() - t0} ms`);
+  await page.locator('#race-card').screenshot({ path: join(shots, 'race.png') });
+  const race = (await page.evaluate(() => window.mcplayDebug.state())).race;
+  const out = execFileSync(native, ['run', join('scenes', 'exp_1d.json'), '--estimators', estimators.join(','),
+    '--n-min', '16', '--reps', '6', '--seed', '3', '--rel-tol', '1e-3', '--max-seconds', '5', '--format', 'json',
+    '--quiet'], { encoding: 'utf8' });
+  const cli = JSON.parse(out);
+  assert.equal(cli.kind, 'stopping');
+  for (const name of estimators) {
+    const mine = race.result.estimators.find((e) => e.name === name);
+    const theirs = cli.estimators.find((e) => e.name === name);
+    assert.ok(mine, `${name}: no race result in the page`);
+    assert.equal(mine.runs.length, 6);
+    // The same streams: each run stops at the same N with the same estimate (the budget is far).
+    assert.deepEqual(mine.runs.map((r) => r.n), theirs.runs.map((r) => r.n), `${name}: N per run`);
+    mine.runs.forEach((r, i) => {
+      assert.ok(r.met, `${name} run ${i}: ${r.reason}`);
+      assert.ok(Math.abs(r.estimate - theirs.runs[i].estimate) <= 1e-9 * Math.abs(r.estimate), `${name} run ${i}`);
+    });
+  }
+  const verdict = await page.textContent('#race-verdict');
+  assert.match(verdict, /Target: relative 0\.001/);
+  assert.match(verdict, /(reaches the target first|No significant difference)/);
+  const rows = await page.$$eval('#race-table tbody tr', (trs) => trs.map((tr) => tr.querySelector('th').textContent.trim()));
+  assert.deepEqual(rows.slice().sort(), estimators.slice().sort(), 'one row per estimator');
+});
+
 test('the integration page never downloads the render module', () => {
   // A control that the list holds the workers' requests: the integration module itself.
   assert.ok(requested.some((u) => u.endsWith('/mcplay_web.wasm')), `mcplay_web.wasm not among ${requested.length} requests`);

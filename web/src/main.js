@@ -26,6 +26,8 @@ import { renderImages } from './images.js';
 import { mountControls, syncControls } from './ui/controls.js';
 import { mountCustom, syncCustom } from './ui/custom.js';
 import { mountExports, syncExports } from './ui/exports.js';
+import { mountRace, syncRace } from './ui/race.js';
+import { raceOptions, withoutStopping } from './race.js';
 
 const WORKER_URL = new URL('./worker.js', import.meta.url);
 const MAX_WORKERS = 16;
@@ -59,6 +61,7 @@ initPlots({
 mountControls(store);
 mountCustom(store);
 mountExports(store);
+mountRace(store);
 
 // Plots and tables are drawn in an animation frame, and at most every RUNNING_RENDER_MS while
 // a study runs: on a machine whose cores all run workers, the page's drawing takes time from
@@ -98,6 +101,7 @@ store.subscribe((state) => {
   syncControls(state);
   syncCustom(state);
   syncExports(state);
+  syncRace(state);
   // When a run ends, its final plots and fitted orders are drawn before anything else happens,
   // so that whatever reads "done" in #status also finds the final numbers; otherwise later.
   const ended = lastStatus === 'running' && state.run.status !== 'running';
@@ -132,7 +136,13 @@ store.subscribe((state, action) => {
       startRun();
       break;
     case 'run/cancel':
-      stopRunners();
+      if (!p.stopped) stopRunners();
+      break;
+    case 'race/request':
+      startRace();
+      break;
+    case 'race/cancel':
+      if (!p.stopped) stopRunners();
       break;
     case 'export/request':
       exportResult(p).catch((e) => dispatch({ type: 'notice', payload: { message: `export failed: ${e.message}` } }));
@@ -321,6 +331,10 @@ function startRun() {
     return;
   }
   if (activeRun !== null) stopRunners();
+  if (s.race.status === 'running') {
+    stopRunners(); // the runners are shared: a run ends a race
+    dispatch({ type: 'race/cancel', payload: { now: performance.now(), stopped: true } });
+  }
   const names = s.selected.slice();
   const groups = splitEstimators(names, CORES);
   const workers = runnersFor(groups.length);
@@ -346,7 +360,8 @@ function startRun() {
   // compete with the first, shortest levels, whose timings are the most fragile.
   renderHeavy();
   groups.forEach((group, i) => {
-    workers[i].request(MSG.RUN, { scene: s.scene, options: studyOptions(kind, settings, group), warmup: true }, (type, payload) => {
+    // A scene's own rel_tol / abs_tol (stopping) belong to the race: the run is an N ladder.
+    workers[i].request(MSG.RUN, { scene: withoutStopping(s.scene), options: studyOptions(kind, settings, group), warmup: true }, (type, payload) => {
       if (type === MSG.LEVEL) dispatch({ type: 'run/level', payload: { id, level: payload.level } });
     }).then(({ result }) => {
       dispatch({ type: 'run/partial', payload: { id, result, now: performance.now() } });
@@ -355,6 +370,49 @@ function startRun() {
       if (activeRun === id) stopRunners();
       dispatch({ type: 'run/error', payload: { id, message: e && e.message ? e.message : String(e) } });
     });
+  });
+}
+
+/**
+ * The race to a requested accuracy: one stopping study per selected estimator (its runs one
+ * after another on one worker, so their seconds are their own), spread over the run workers;
+ * each answer is shown as it comes. The runners are shared with the N-ladder run, which a race
+ * ends (and the reverse).
+ */
+function startRace() {
+  const s = store.getState();
+  const blocker = runBlocker(s);
+  if (blocker) {
+    dispatch({ type: 'notice', payload: { message: blocker } });
+    return;
+  }
+  if (kindOf(s.sceneInfo) === KIND.RENDER) return; // the card is hidden for render scenes
+  const parsed = raceOptions(s.race.inputs);
+  if (!parsed.ok) return; // the card shows why
+  if (s.run.status === 'running') {
+    stopRunners();
+    dispatch({ type: 'run/cancel', payload: { now: performance.now(), stopped: true } });
+  } else if (s.race.status === 'running') {
+    stopRunners();
+  }
+  const names = s.selected.slice();
+  const workers = runnersFor(Math.min(CORES, names.length));
+  const id = s.race.id + 1;
+  dispatch({
+    type: 'race/start',
+    payload: { id, order: names, options: parsed.options, sceneName: s.sceneInfo.name,
+      exact: s.sceneInfo.exact ?? null, startedAt: performance.now() },
+  });
+  const scene = withoutStopping(s.scene);
+  names.forEach((name, i) => {
+    const options = { ...parsed.options, n_min: s.params.n_min, seed: s.params.seed, estimators: [name] };
+    workers[i % workers.length].request(MSG.RUN, { scene, options, warmup: true })
+      .then(({ result }) => dispatch({ type: 'race/part', payload: { id, result, now: performance.now() } }))
+      .catch((e) => {
+        if (e && e.cancelled) return;
+        if (store.getState().race.id === id) stopRunners();
+        dispatch({ type: 'race/error', payload: { id, message: `${name}: ${e && e.message ? e.message : String(e)}` } });
+      });
   });
 }
 

@@ -6,7 +6,9 @@
 //   load     {}                             ready     {version}
 //   validate {scene}                        validated {info}          (core.sceneInfo)
 //   run      {scene, options, warmup?}      level     {level}  x N    (after each N)
-//                                           result    {result}        (core.runStudy)
+//                                           result    {result}        (core.runStudy; with
+//                                                     options.rel_tol / abs_tol a stopping
+//                                                     result: no level replies before it)
 //   image    {scene, options}               imaged    {image}         (render scenes only:
 //                                                                      renderCore.renderImage)
 //   format   {result, format}               formatted {text}          (core.format)

@@ -2,6 +2,7 @@
 // is the only code changing the state, and the pure helpers that put the comparison in the URL
 // and read it back. No DOM, no workers: web/test/state.test.mjs runs it under Node.
 import { applyLevel, ladder, mergeResults, progressOf, samplesSummary } from './series.js';
+import { RACE_DEFAULTS, sceneTolerance } from './race.js';
 
 /** Bounds of the core (docs/scene-format.md) and of the page's first run. */
 export const LIMITS = Object.freeze({
@@ -392,6 +393,35 @@ export function initialState() {
     samples: emptySamples(256),
     // render scenes: a quick image of the scene ({key, status, png, spp, estimator, message})
     scenePreview: null,
+    race: emptyRace({ ...RACE_DEFAULTS }),
+  };
+}
+
+/** The race to a requested accuracy (race.js): the card's inputs (text, as typed) and the
+ *  stopping result of each estimator as its worker answers (one request per estimator). */
+function emptyRace(inputs, id = 0) {
+  return {
+    inputs,
+    id,
+    status: 'idle',         // idle | running | done | cancelled | error
+    message: '',
+    order: [],              // estimator names raced, in the scene's order
+    parts: {},              // name -> the estimator of its stopping result
+    stopping: null,         // the tolerance and budget the core used (result.stopping)
+    options: null,          // {rel_tol?, abs_tol?, reps, max_seconds} sent
+    sceneName: null,
+    exact: null,
+    startedAt: null,
+    elapsed: null,
+  };
+}
+
+/** The race's parts as one stopping result (the C API's shape, estimators in the scene's order). */
+export function raceResult(race) {
+  return {
+    kind: 'stopping',
+    stopping: race.stopping,
+    estimators: race.order.filter((n) => race.parts[n]).map((n) => race.parts[n]),
   };
 }
 
@@ -474,6 +504,7 @@ export function reducer(state, action) {
         run: state.version ? { ...emptyRun('ready'), id: state.run.id } : state.run,
         samples: emptySamples(state.samples.n),
         scenePreview: null,
+        race: emptyRace(state.race.inputs, state.race.id),
       };
     }
     case 'scene/loaded': {
@@ -507,6 +538,7 @@ export function reducer(state, action) {
         run: state.version && !keep ? { ...emptyRun('ready'), id: state.run.id } : state.run,
         samples: keep ? state.samples : emptySamples(state.samples.n),
         scenePreview: null,
+        race: keep ? state.race : emptyRace(raceInputsFor(state.race.inputs, p.scene), state.race.id),
       };
     }
     case 'scene/failed':
@@ -578,6 +610,46 @@ export function reducer(state, action) {
       if (!state.scenePreview || p.key !== state.scenePreview.key) return state;
       return { ...state, scenePreview: { ...state.scenePreview, status: 'error', message: p.message } };
 
+    case 'race/edit':
+      if (!Object.prototype.hasOwnProperty.call(RACE_DEFAULTS, p.field)) return state;
+      return { ...state, race: { ...state.race, inputs: { ...state.race.inputs, [p.field]: String(p.value) } } };
+    case 'race/request':
+      return state;
+    case 'race/start':
+      // {id, order, options, sceneName, exact, startedAt}
+      return {
+        ...state,
+        race: {
+          ...emptyRace(state.race.inputs, p.id),
+          status: 'running',
+          order: p.order.slice(),
+          options: p.options,
+          sceneName: p.sceneName,
+          exact: p.exact ?? null,
+          startedAt: p.startedAt,
+        },
+      };
+    case 'race/part': {
+      // {id, result: a stopping result of one estimator, now}
+      const r = state.race;
+      if (p.id !== r.id || r.status !== 'running') return state;
+      const parts = { ...r.parts };
+      for (const e of p.result.estimators || []) parts[e.name] = e;
+      const done = r.order.every((n) => parts[n]);
+      return {
+        ...state,
+        race: {
+          ...r, parts, stopping: r.stopping || p.result.stopping || null,
+          ...(done ? { status: 'done', elapsed: p.now - r.startedAt } : {}),
+        },
+      };
+    }
+    case 'race/cancel':
+      if (state.race.status !== 'running') return state;
+      return { ...state, race: { ...state.race, status: 'cancelled', elapsed: p.now - state.race.startedAt } };
+    case 'race/error':
+      if (p.id !== state.race.id) return state;
+      return { ...state, race: { ...state.race, status: 'error', message: p.message } };
     case 'run/request':
       return state;
     case 'run/start': {
@@ -652,6 +724,13 @@ export function reducer(state, action) {
   }
 }
 
+/** The race's inputs for a newly loaded scene: the scene's own rel_tol / abs_tol when it has
+ *  them (a scene that asks for stopping), else the inputs as they were. */
+function raceInputsFor(inputs, scene) {
+  const t = sceneTolerance(scene);
+  return t.relTol || t.absTol ? { ...inputs, ...t } : inputs;
+}
+
 /** The #status text of a state. */
 export function statusText(state) {
   const r = state.run;
@@ -714,6 +793,9 @@ export function debugSnapshot(state) {
       return rest;
     }),
     result: r.result,
+    // the race to a requested accuracy: its status and the stopping result so far
+    race: { status: state.race.status, message: state.race.message, inputs: { ...state.race.inputs },
+      order: state.race.order.slice(), result: raceResult(state.race) },
     // the sample points drawn: per estimator the number of points, its strata; weights: n, zeros
     samples: samplesDebug(state.samples),
   };

@@ -6,7 +6,7 @@ import assert from 'node:assert/strict';
 import {
   stateToQuery, queryToState, sceneDefaults, parseWhole, paramError, reducer, initialState,
   createStore, runBlocker, statusText, buildCustomScene, customError, debugSnapshot, DEFAULTS, CUSTOM,
-  KIND, kindOf, normalizeInfo, runSettings, studyOptions, studyNames, RENDER_LIMITS,
+  KIND, kindOf, normalizeInfo, runSettings, studyOptions, studyNames, RENDER_LIMITS, raceResult,
 } from '../src/state.js';
 
 const SCENE_DEFAULTS = { scene: 'disk_quarter', estimators: null, n_min: 16, n_max: 65536, reps: 32, seed: 1 };
@@ -387,4 +387,35 @@ test('choosing a render scene shows it at once from the manifest, with its size'
   assert.equal(reducer(s, { type: 'preview/loaded', payload: { key: 1, png: 'old' } }), s);
   s = reducer(s, { type: 'preview/loaded', payload: { key: 2, png: 'P', spp: 16, estimator: 'bsdf' } });
   assert.deepEqual([s.scenePreview.status, s.scenePreview.png], ['ready', 'P']);
+});
+
+test('the race: inputs, one part per estimator, done when all are in; a new scene clears it', () => {
+  let s = initialState();
+  s = reducer(s, { type: 'core/ready', payload: { version: '0.1.0' } });
+  const info = { estimators: ['uniform', 'stratified'], n_min: 16, n_max: 4096 };
+  s = reducer(s, { type: 'scene/loaded', payload: { sceneId: 'exp_1d', scene: {}, info } });
+  assert.equal(s.race.inputs.relTol, '1e-3');
+  s = reducer(s, { type: 'race/edit', payload: { field: 'relTol', value: '1e-2' } });
+  assert.equal(s.race.inputs.relTol, '1e-2');
+  assert.equal(reducer(s, { type: 'race/edit', payload: { field: 'bogus', value: 1 } }), s, 'unknown fields are refused');
+
+  s = reducer(s, { type: 'race/start', payload: { id: 1, order: ['uniform', 'stratified'], options: { rel_tol: 0.01, reps: 2, max_seconds: 1 }, sceneName: 'exp_1d', exact: 1.7, startedAt: 0 } });
+  assert.equal(s.race.status, 'running');
+  const part = (name) => ({ kind: 'stopping', stopping: { rel_tol: 0.01 }, estimators: [{ name, runs: [] }] });
+  assert.equal(reducer(s, { type: 'race/part', payload: { id: 0, result: part('uniform'), now: 5 } }), s, 'an older race is ignored');
+  s = reducer(s, { type: 'race/part', payload: { id: 1, result: part('stratified'), now: 5 } });
+  assert.equal(s.race.status, 'running');
+  assert.deepEqual(raceResult(s.race).estimators.map((e) => e.name), ['stratified']);
+  s = reducer(s, { type: 'race/part', payload: { id: 1, result: part('uniform'), now: 9 } });
+  assert.equal(s.race.status, 'done');
+  assert.equal(s.race.elapsed, 9);
+  assert.deepEqual(raceResult(s.race).estimators.map((e) => e.name), ['uniform', 'stratified'], 'in the scene order');
+  assert.equal(debugSnapshot(s).race.status, 'done');
+
+  // a scene that asks for stopping fills the tolerance; the race's result is gone
+  s = reducer(s, { type: 'scene/loaded', payload: { sceneId: 'other', scene: { abs_tol: 1e-4 }, info } });
+  assert.equal(s.race.status, 'idle');
+  assert.deepEqual(s.race.order, []);
+  assert.equal(s.race.inputs.absTol, '0.0001');
+  assert.equal(s.race.inputs.relTol, '');
 });
