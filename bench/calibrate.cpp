@@ -21,6 +21,14 @@
 //            warning (info is worth knowing, not an alarm)
 //   false-flag rate = flagged fine cells / fine cells            (target <= 5%, issue 13)
 //   confident wrong = replicates beyond 5 t standard errors in unflagged cells   (target 0)
+//
+// A cell of R = 10 replicates is "fine" by luck as well: an estimator whose intervals cover 80%
+// of the time gives ten covering intervals in one cell of nine. --recheck K judges the flags on
+// fine cells by what they claim (the error bar cannot be trusted at this N): K flagged and K
+// unflagged fine cells, evenly spread over the battery, are run again at the same N with
+// --recheck-reps replicates (default 100) and new seeds; a cell's alarm is borne out when that
+// run finds its error bars wrong: two or more replicates beyond 3 t standard errors (honest
+// intervals: P = 3% with 100 replicates) or 95% coverage at most 88 of 100 (P = 1%).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -52,7 +60,8 @@ struct Options {
     std::vector<int> dims{2, 4, 8};
     std::vector<uint64_t> param_seeds{1, 2, 3};
     std::string scenes_dir = "scenes", json_path, cells_path;
-    int list = 20; // confident wrong answers and flag codes listed
+    int recheck = 0, recheck_reps = 100; // --recheck K: fine cells run again, per kind
+    int list = 20;                       // confident wrong answers and flag codes listed
     // --stopping REL: the stopping rule's battery instead of the flags' (n_max, seconds: budget)
     double stop_rel = 0.0, stop_seconds = 2.0;
     uint64_t stop_n_max = uint64_t(1) << 22;
@@ -63,7 +72,8 @@ struct Options {
     std::fprintf(stderr, "usage: calibrate [--quick] [--reps R] [--n-min N] [--n-max N]\n"
                          "         [--param-seeds 1,2,3] [--dims 2,4,8] [--scenes DIR]\n"
                          "         [--json FILE] [--cells FILE] [--list N]\n"
-                         "         [--stopping REL [--stop-n-max N] [--max-seconds S]]\n");
+                         "         [--stopping REL [--stop-n-max N] [--max-seconds S]]\n"
+                         "         [--recheck K [--recheck-reps R]]\n");
     std::exit(2);
 }
 
@@ -129,6 +139,10 @@ Options parse_options(int argc, char** argv) {
                 usage("--max-seconds: expected a number of seconds > 0");
         } else if (a == "--cells")
             o.cells_path = value();
+        else if (a == "--recheck")
+            o.recheck = int(one("--recheck", 0, 100000));
+        else if (a == "--recheck-reps")
+            o.recheck_reps = int(one("--recheck-reps", 20, 10000));
         else if (a == "--list")
             o.list = int(one("--list", 0, 100000));
         else if (a == "-h" || a == "--help")
@@ -210,11 +224,20 @@ struct Wrong {
     double z;
 };
 
+/// A fine cell, for --recheck: where it is and whether it carried an alarm.
+struct FineCell {
+    size_t case_index = 0;
+    std::string estimator;
+    uint64_t n = 0;
+    bool flagged = false;
+};
+
 // Judges every level of every estimator of one study result.
 // cells (if not null) gets one JSON line per cell: the verdict, the alarms and the level's
 // statistics, for studying what separates the misses from the fine cells.
-void judge(const std::string& case_name, const Json& result, double exact, Tally* t,
-           std::vector<Wrong>* wrong, std::FILE* cells) {
+void judge(const std::string& case_name, size_t case_index, const Json& result, double exact,
+           Tally* t, std::vector<Wrong>* wrong, std::vector<FineCell>* fine_cells,
+           std::FILE* cells) {
     for (const Json& e : result["estimators"]) {
         // Alarms only: a flag of severity info says nothing is wrong.
         auto alarms = [](const Json& warnings, std::vector<std::string>* codes) {
@@ -257,6 +280,9 @@ void judge(const std::string& case_name, const Json& result, double exact, Tally
                 line["level"].erase("warnings");
                 std::fprintf(cells, "%s\n", line.dump().c_str());
             }
+            if (fine)
+                fine_cells->push_back(
+                    FineCell{case_index, e.value("name", "?"), l.value("n", 0ull), !codes.empty()});
             if (fine) {
                 ++t->fine;
                 if (!codes.empty()) {
@@ -281,6 +307,75 @@ void judge(const std::string& case_name, const Json& result, double exact, Tally
                                            z});
                 }
         }
+    }
+}
+
+/// Runs one fine cell again with o.recheck_reps replicates and new seeds; true when its error
+/// bars prove wrong there (see the header: >= 2 beyond 3 t se, or 95% coverage <= 88%).
+/// `beyond3` and `covered` get the counts, `reps` the replicates judged.
+bool recheck_cell(const Options& o, const Case& c, const FineCell& cell, uint64_t seed,
+                  long* beyond3, long* covered, long* reps) {
+    Json options = {{"estimators", {cell.estimator}}, {"n_min", cell.n}, {"n_max", cell.n},
+                    {"reps", o.recheck_reps},         {"seed", seed},    {"threads", 0}};
+    char* out = nullptr;
+    const int status =
+        mcp_study_run(c.scene.dump().c_str(), options.dump().c_str(), nullptr, nullptr, &out);
+    Made<Json> r =
+        status == MCP_OK ? parse_json(out, c.name.c_str()) : made_error<Json>("the study failed");
+    mcp_free(out);
+    if (status != MCP_OK || !r.ok()) {
+        std::printf("  recheck %s %s N=%llu: %s\n", c.name.c_str(), cell.estimator.c_str(),
+                    (unsigned long long)cell.n, status != MCP_OK ? mcp_last_error() : "not JSON");
+        return false;
+    }
+    const double exact = number_or_nan(r.value["scene"]["exact"]);
+    const Json& l = r.value["estimators"][0]["levels"][0];
+    const double dof = number_or_nan(l["run_dof"]);
+    const double t975 = dof >= 1.0 ? student_t_quantile(0.975, std::min(dof, 1e6)) : 1.959963985;
+    const double widen = t975 / 1.959963985;
+    const Json& est = l["replicates"]["estimate"];
+    const Json& se = l["replicates"]["std_error"];
+    long b = 0, cov = 0, n = 0;
+    for (size_t i = 0; i < est.size() && i < se.size(); ++i) {
+        const double x = number_or_nan(est[i]), s = number_or_nan(se[i]);
+        const double err = std::fabs(x - exact);
+        const double roundoff = 1e-12 * std::max(std::fabs(exact), std::fabs(x));
+        ++n;
+        if (!(err <= 3.0 * widen * s + roundoff)) ++b;
+        if (err <= t975 * s + roundoff) ++cov;
+    }
+    *beyond3 += b;
+    *covered += cov;
+    *reps += n;
+    return b >= 2 || double(cov) <= 0.88 * double(n);
+}
+
+/// --recheck K: K flagged and K unflagged fine cells, evenly spaced over the battery, run again.
+void recheck_fine_cells(const Options& o, const std::vector<Case>& cases,
+                        const std::vector<FineCell>& fine_cells) {
+    std::printf("\nrecheck: fine cells run again at the same N with %d replicates and new seeds; "
+                "an alarm is\nborne out when the new run finds the error bars wrong (>= 2 "
+                "beyond 3 t se, or 95%% coverage <= 88%%)\n",
+                o.recheck_reps);
+    std::printf("  %-16s %6s %12s %14s %14s\n", "fine cells", "cells", "wrong there",
+                "beyond 3 t se", "95% coverage");
+    for (const bool flagged : {true, false}) {
+        std::vector<const FineCell*> pool;
+        for (const FineCell& f : fine_cells)
+            if (f.flagged == flagged) pool.push_back(&f);
+        const size_t k = std::min<size_t>(size_t(o.recheck), pool.size());
+        long wrong_there = 0, beyond3 = 0, covered = 0, reps = 0;
+        for (size_t j = 0; j < k; ++j) {
+            const FineCell& cell = *pool[j * pool.size() / k];
+            const uint64_t seed = o.seed + 1000003 * (j + 1) + (flagged ? 7 : 0);
+            if (recheck_cell(o, cases[cell.case_index], cell, seed, &beyond3, &covered, &reps))
+                ++wrong_there;
+        }
+        std::printf("  %-16s %6zu %5ld (%4.1f%%) %7ld (%4.2f%%) %13.1f%%\n",
+                    flagged ? "with an alarm" : "without", k, wrong_there,
+                    k ? 100.0 * double(wrong_there) / double(k) : 0.0, beyond3,
+                    reps ? 100.0 * double(beyond3) / double(reps) : 0.0,
+                    reps ? 100.0 * double(covered) / double(reps) : 0.0);
     }
 }
 
@@ -389,6 +484,7 @@ int main(int argc, char** argv) {
 
     Tally genz, scenes;
     std::vector<Wrong> wrong;
+    std::vector<FineCell> fine_cells;
     // Presets a scene does not take (a domain MISER cannot split, ...): count, first reason.
     std::map<std::string, std::pair<int, std::string>> not_applicable;
     std::set<std::string> no_exact; // scenes dropped, by the name before "+preset"
@@ -431,7 +527,7 @@ int main(int argc, char** argv) {
         const double exact = scene["exact"].get<double>();
         Tally& t = ci < genz_count ? genz : scenes;
         const size_t before = wrong.size();
-        judge(c.name, r.value, exact, &t, &wrong, cells);
+        judge(c.name, ci, r.value, exact, &t, &wrong, &fine_cells, cells);
         if (json)
             std::fprintf(json, "%s\n",
                          Json({{"case", c.name}, {"confident_wrong", wrong.size() - before}})
@@ -481,6 +577,7 @@ int main(int argc, char** argv) {
     for (size_t i = 0; i < wrong.size() && int(i) < o.list; ++i)
         std::printf("  %-60s %10.3g\n", wrong[i].where.c_str(), wrong[i].z);
     if (wrong.empty()) std::printf("  none\n");
+    if (o.recheck > 0) recheck_fine_cells(o, cases, fine_cells);
     const double secs =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     std::printf("\ntotal wall time %.0f s\n", secs);
