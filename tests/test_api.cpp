@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
 
@@ -341,6 +342,22 @@ TEST(Api, SceneInfoAndCatalog) {
     mcp_free(out);
     EXPECT_EQ(info["name"], "small");
     EXPECT_EQ(info["estimators"], json({"uniform", "stratified"}));
+    // Each estimator's method (what the page explains), the scene's own and the presets it
+    // does not list alike.
+    std::map<std::string, std::string> method;
+    for (const json& d : info["estimator_details"]) method[d["name"]] = d["method"];
+    EXPECT_EQ(method["uniform"], "uniform");
+    EXPECT_EQ(method["stratified"], "stratified");
+    EXPECT_EQ(method["sobol"], "rqmc");
+    EXPECT_EQ(method["vegas_plus"], "vegas_plus");
+    EXPECT_EQ(method["miser"], "miser");
+    const char* importance = R"J({"f": "exp(x)", "estimators": [{"name": "is", "pdf": "1 + x"},
+        {"name": "mis", "proposals": ["uniform", "1 + x"]}]})J";
+    ASSERT_EQ(mcp_scene_info(importance, &out), MCP_OK) << mcp_last_error();
+    info = json::parse(out);
+    mcp_free(out);
+    EXPECT_EQ(info["estimator_details"][0]["method"], "importance");
+    EXPECT_EQ(info["estimator_details"][1]["method"], "mis");
     ASSERT_EQ(mcp_catalog(&out), MCP_OK);
     json cat = json::parse(out);
     mcp_free(out);

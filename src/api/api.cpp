@@ -320,14 +320,31 @@ int mcp_scene_info(const char* scene_json, char** info_json) {
     mcp::Made<mcp::SceneRequest> req = mcp::build_request(scene.value, mcp::Json());
     if (!req.ok()) return mcp::boundary::request_error(req.error);
     const mcp::Problem& p = req.value.problem;
-    mcp::Json names = mcp::Json::array(), more = mcp::Json::array();
-    for (const mcp::EstimatorSpec& e : req.value.estimators) names.push_back(e.name);
+    mcp::Json names = mcp::Json::array(), more = mcp::Json::array(), details = mcp::Json::array();
+    for (const mcp::EstimatorSpec& e : req.value.estimators) {
+        names.push_back(e.name);
+        details.push_back({{"name", e.name},
+                           {"method", mcp::estimator_method(e)},
+                           {"sampler", mcp::sampler_name(e.sampler)},
+                           {"pdf", mcp::describe_sampling(e)}});
+    }
     // The uniform-density presets the scene does not list: options.estimators can run them too.
     for (const mcp::EstimatorPreset& preset : mcp::estimator_presets()) {
         bool listed = false;
         for (const mcp::EstimatorSpec& e : req.value.estimators)
             listed = listed || e.name == preset.name;
-        if (!listed && !preset.needs_pdf) more.push_back(preset.name);
+        if (listed || preset.needs_pdf) continue;
+        more.push_back(preset.name);
+        // its method, from the estimator the preset builds on this scene's domain
+        mcp::Made<mcp::SceneRequest> one =
+            mcp::build_request(scene.value, mcp::Json{{"estimators", {preset.name}}});
+        if (one.ok() && one.value.estimators.size() == 1) {
+            const mcp::EstimatorSpec& e = one.value.estimators.front();
+            details.push_back({{"name", e.name},
+                               {"method", mcp::estimator_method(e)},
+                               {"sampler", mcp::sampler_name(e.sampler)},
+                               {"pdf", mcp::describe_sampling(e)}});
+        }
     }
     mcp::Json info{{"name", p.name},
                    {"description", p.description},
@@ -336,6 +353,7 @@ int mcp_scene_info(const char* scene_json, char** info_json) {
                    {"exact", p.exact ? mcp::Json(*p.exact) : mcp::Json(nullptr)},
                    {"estimators", names},
                    {"more_estimators", more},
+                   {"estimator_details", details},
                    {"n_min", req.value.settings.n_min},
                    {"n_max", req.value.settings.n_max},
                    {"reps", req.value.settings.reps},

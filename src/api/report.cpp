@@ -369,6 +369,7 @@ namespace {
 Json estimator_header(const EstimatorStudy& e, const StudySettings& s) {
     return Json{
         {"name", e.spec.name},
+        {"method", estimator_method(e.spec)},
         {"sampler", sampler_name(e.spec.sampler)},
         {"samples_per_stratum", e.spec.per_stratum},
         {"pdf", describe_sampling(e.spec)},

@@ -391,4 +391,18 @@ std::string describe_sampling(const EstimatorSpec& spec) {
     return s + ")";
 }
 
+const char* estimator_method(const EstimatorSpec& spec) {
+    if (spec.control_variates) return "control_variates";
+    if (spec.mis) return "mis";
+    if (spec.miser) return "miser";
+    if (spec.vegas) return spec.vegas_options.stratify ? "vegas_plus" : "vegas";
+    if (is_qmc(spec.sampler)) return spec.randomization == QmcRandomization::None ? "qmc" : "rqmc";
+    const bool importance = spec.proposal.importance;
+    switch (spec.sampler) {
+    case SamplerKind::Stratified: return importance ? "stratified_importance" : "stratified";
+    case SamplerKind::LatinHypercube: return "latin_hypercube";
+    default: return importance ? "importance" : "uniform";
+    }
+}
+
 } // namespace mcp

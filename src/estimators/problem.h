@@ -186,4 +186,10 @@ void sampling_density_block(const EstimatorSpec& spec, const Domain& domain, con
 /// The density as a report names it: the proposal's, or "mis(balance: a 0.5, b 0.5)".
 std::string describe_sampling(const EstimatorSpec& spec);
 
+/// The method an estimator is an instance of, for explaining it: "uniform", "importance",
+/// "stratified", "stratified_importance", "latin_hypercube", "rqmc" (randomized quasi-Monte
+/// Carlo), "qmc" (no randomization), "vegas", "vegas_plus", "miser", "mis" or
+/// "control_variates" (the outermost idea when several combine).
+const char* estimator_method(const EstimatorSpec& spec);
+
 } // namespace mcp
