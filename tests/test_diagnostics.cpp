@@ -208,6 +208,27 @@ TEST(Diagnostics, SkewedWeightsFollowCochransRule) {
     EXPECT_FALSE(find(level_flags(skewed_level(1024, 1, 10, 1.1)), FlagCode::SkewedWeights));
 }
 
+// Randomized QMC: the rule reads the K batch means, and the weights' skewness over sqrt(N/K)
+// when that is larger. K = 16 batch means of 128 points that look symmetric, from weights with
+// one point in 128 non-zero (skewness 11.3: a batch mean holds about one hit, skewness 1.0, and
+// needs K > 25): flagged. The same batch means from weights with one point in 4 non-zero
+// (skewness 1.15, 0.10 per batch mean): not flagged.
+TEST(Diagnostics, BatchMeansAreJudgedByTheWeightsTheyAverage) {
+    auto rqmc_level = [](uint64_t m) {
+        LevelStats l = skewed_level(2048, 1, m, 1.1);
+        l.diagnostics.batch_units = true;
+        l.diagnostics.error_units = RunningMoments();
+        for (int i = 0; i < 10 * 16; ++i) l.diagnostics.error_units.add(i % 2 ? 1.0 : -1.0);
+        return l;
+    };
+    const std::optional<Flag> f = find(level_flags(rqmc_level(128)), FlagCode::SkewedWeights);
+    ASSERT_TRUE(f.has_value());
+    EXPECT_EQ(f->count, 16u); // batch means per run
+    EXPECT_NEAR(f->value, (126.0 / 128.0) / std::sqrt(127.0 / 128.0 / 128.0) / std::sqrt(128.0),
+                1e-9);
+    EXPECT_FALSE(find(level_flags(rqmc_level(4)), FlagCode::SkewedWeights));
+}
+
 // The runs' own error bars: flagged when they differ by more than a factor 4 and Bartlett's test
 // says more than their degrees of freedom allow (one of ten runs' se 5 times the others', 1000
 // dof each); not for the same spread at 1 dof each (such error bars vary that much by chance),

@@ -205,11 +205,20 @@ std::vector<Flag> level_flags(const LevelStats& l) {
     //  - between 0.2 and 0.4 a warning when the runs' own error bars disagree by more than a
     //    factor 2 (their variance estimates are unstable: some are off by 40% or more), else
     //    info, with the N from which the rule holds.
-    // The units are the weights, or for K randomizations the K batch means of each run.
-    const double g1 = d.error_units.skewness();
-    const double rule_n = kSkewnessRule * g1 * g1;
+    // The units are the weights, or for K randomizations the K batch means of each run. A batch
+    // mean averages m = N/K points; where the points barely see f (skewed weights) it is close
+    // to a mean of m independent weights, whose skewness is g1_w / sqrt(m) [Cochran77, 2.15],
+    // and the K R batch means pooled here may not yet show it (a rare hit in one batch of one
+    // run): the larger of the two is taken.
     const double units_per_run =
         l.reps > 0 ? static_cast<double>(d.error_units.count()) / static_cast<double>(l.reps) : 0.0;
+    double g1 = d.error_units.skewness();
+    if (d.batch_units && units_per_run > 0.0 && std::isfinite(g1)) {
+        const double per_unit = static_cast<double>(l.n) / units_per_run;
+        const double from_weights = std::fabs(d.weights.skewness()) / std::sqrt(per_unit);
+        if (std::isfinite(from_weights) && from_weights > std::fabs(g1)) g1 = from_weights;
+    }
+    const double rule_n = kSkewnessRule * g1 * g1;
     if (!l.exact_to_roundoff && std::isfinite(g1) && units_per_run < rule_n) {
         const bool strongly_skewed = units_per_run < rule_n / 4.0;
         const double spread = error_bar_spread(l.run_std_errors);
