@@ -237,6 +237,8 @@ test('multiple importance sampling: a study of the heuristics and each technique
 });
 
 test('a malformed expression is reported inline at its position', async () => {
+  // the form is folded until opened (the teaching path comes first)
+  if (!(await page.evaluate(() => document.getElementById('custom').open))) await page.click('#custom-title');
   await page.fill('#custom-f', 'sin(');
   await page.click('#custom-apply');
   await page.waitForFunction(() => (document.querySelector('#custom-error')?.textContent ?? '').length > 0, null,

@@ -23,6 +23,7 @@ import { MSG } from './protocol.js';
 import { initPlots, renderPlots, plotPng } from './plot.js';
 import { renderReport } from './report.js';
 import { renderImages } from './images.js';
+import { renderExplain } from './ui/explain.js';
 import { mountControls, syncControls } from './ui/controls.js';
 import { mountCustom, syncCustom } from './ui/custom.js';
 import { mountExports, syncExports } from './ui/exports.js';
@@ -77,6 +78,7 @@ function renderHeavy() {
     renderPlots(s);
     renderReport(s, reportDom);
     renderImages(s, imagesDom);
+    renderExplain(s);
   } catch (e) {
     console.error('render failed', e);
   }

@@ -159,6 +159,28 @@ function labelHook(items) {
   };
 }
 
+/** Marks the levels that are exact to round-off (no point on a log axis): a row of squares in
+ *  the series' colour along the bottom of the plot, one row per such estimator (the legend
+ *  says which). */
+function exactHook(rows) {
+  return (u) => {
+    if (!rows.length) return;
+    const ctx = u.ctx;
+    const px = uPlot.pxRatio || 1;
+    ctx.save();
+    rows.forEach(({ color, exactAt }, r) => {
+      const y = u.bbox.top + u.bbox.height - (7 + 11 * r) * px;
+      ctx.fillStyle = color;
+      exactAt.forEach((isExact, i) => {
+        if (!isExact) return;
+        const x = u.valToPos(u.data[0][i], 'x', true);
+        ctx.fillRect(x - 3.5 * px, y - 3.5 * px, 7 * px, 7 * px);
+      });
+    });
+    ctx.restore();
+  };
+}
+
 // ---------------------------------------------------------------------------------------------
 // Legends (plain DOM; text only, never HTML from data)
 
@@ -273,6 +295,8 @@ export function renderPlots(state) {
   renderCoverage(state, run, records);
 }
 
+let exactRows = [];
+
 function renderVariance(state, run, records) {
   const render = isRender(run);
   const names = runLabels(run);
@@ -305,6 +329,8 @@ function renderVariance(state, run, records) {
   });
   const values = vs.series.flatMap((s) => [...s.y, ...s.lo, ...s.hi]);
   const yRange = log10Range(values);
+  // Exact levels, drawn as a labelled row along the bottom (the hook reads the latest rows).
+  exactRows = vs.series.filter((s) => s.exactAt.some(Boolean)).map((s) => ({ color: colorOf(run, s.name), exactAt: s.exactAt }));
   const xRange = vs.x.length > 1 ? [vs.x[0], vs.x[vs.x.length - 1]] : [vs.x[0] / 2, vs.x[0] * 2];
   const quantity = render ? names.errorAxis || names.error
     : vs.quantity === 'mse' ? 'MSE of the estimate' : 'variance of the estimate';
@@ -324,7 +350,7 @@ function renderVariance(state, run, records) {
     series,
     bands,
     cursor: { drag: { x: false, y: false } },
-    hooks: { drawAxes: [minorLogGrid], draw: [(u) => labelHook(refItems)(u)] },
+    hooks: { drawAxes: [minorLogGrid], draw: [(u) => labelHook(refItems)(u), (u) => exactHook(exactRows)(u)] },
   }), data, { xRange, yRange });
 
   setLegend('variance', dom['legend-variance'], vs.series.map((s) => {
@@ -335,10 +361,11 @@ function renderVariance(state, run, records) {
       parts: [
         // The plotted MSE's own order, then the variance's (a flat MSE under a falling
         // variance is a bias: bias_dominates says from which N).
-        ...(vs.quantity === 'mse' && !render
+        ...(vs.quantity === 'mse' && !render && !s.exact
           ? ['order of MSE', { text: fitText(r.mse_fit), className: 'fit' }] : []),
-        render ? `order of ${names.error}` : vs.quantity === 'mse' ? 'of variance' : 'order of variance',
-        { fit: fitText(r.fit), name: s.name },
+        ...(s.exact ? [{ fit: 'exact: zero variance at every N (■ along the bottom)', name: s.name }] : [
+          render ? `order of ${names.error}` : vs.quantity === 'mse' ? 'of variance' : 'order of variance',
+          { fit: fitText(r.fit), name: s.name }]),
         ...(r.warnings || []).map((w) => ({ warning: w })),
       ],
     };

@@ -116,6 +116,8 @@ function unionSorted(values) {
  * value. Values that cannot sit on a log axis (0, null) are null. `xs` (optional) fixes the x
  * values, e.g. the whole N ladder of a run that is still going.
  */
+// Each series also has exactAt (per x: that level is exact to round-off, so y is null there) and
+// exact (every level so far is).
 export function varianceSeries(records, order, exact = null, xs = null) {
   const useMse = exact !== null && exact !== undefined && Number.isFinite(exact);
   const named = order.filter((n) => records[n]);
@@ -125,9 +127,13 @@ export function varianceSeries(records, order, exact = null, xs = null) {
     const y = [];
     const lo = [];
     const hi = [];
+    const exactAt = [];
     for (const n of x) {
       const l = byN.get(n);
-      if (!l) {
+      exactAt.push(Boolean(l && l.exact_to_roundoff === true));
+      if (!l || l.exact_to_roundoff === true) {
+        // an exact level (variance zero up to round-off) has no point on a log axis: the plot
+        // marks it apart
         y.push(null); lo.push(null); hi.push(null);
         continue;
       }
@@ -139,7 +145,9 @@ export function varianceSeries(records, order, exact = null, xs = null) {
       lo.push(ci ? positive(ci[0] * scale) : null);
       hi.push(ci ? positive(ci[1] * scale) : null);
     }
-    return { name, y, lo, hi, fit: records[name].fit || null };
+    const levels = records[name].levels;
+    const exact = levels.length > 0 && levels.every((l) => l.exact_to_roundoff === true);
+    return { name, y, lo, hi, exactAt, exact, fit: records[name].fit || null };
   });
   return { quantity: useMse ? 'mse' : 'variance', x, series };
 }

@@ -4,10 +4,11 @@
 // OUT/index.html, style.css, src/** (the page's modules), core.js, render_core.js,
 // vendor/uPlot.esm.js + uPlot.min.css (+ its LICENSE) from web/node_modules/uplot/dist,
 // mcplay_web.mjs + .wasm and mcplay_render_web.mjs + .wasm from WASM_DIR, scenes/*.json and
-// scenes/manifest.json ([{file, name, description, kind, dimension, estimators, n_min, n_max}],
-// render scenes also {reps, width, height}; read from the scene files themselves; the page asks
-// the core, sceneInfo, for the rest). Integration scenes come first in the manifest (the page
-// opens the first one, and only render scenes load the render module).
+// scenes/manifest.json ([{file, name, description, kind, dimension, estimators, n_min, n_max,
+// group, look}], render scenes also {reps, width, height}; read from the scene files themselves;
+// the page asks the core, sceneInfo, for the rest), in the order of the teaching path
+// web/tour.json, which gives each scene its group and what to look for. Its first scene is an
+// integral (the page opens it, and only render scenes load the render module).
 // Render scenes (a "render" object) are copied with their "gltf" replaced by the glTF itself,
 // inline, its external buffers and images turned into data: URIs (a .glb becomes the same
 // JSON with its binary chunk as buffer 0), since the wasm module cannot read the site's files.
@@ -87,6 +88,34 @@ export function isRenderScene(scene) {
 function estimatorName(e) {
   if (typeof e === 'string') return e;
   return e && (e.name ?? e.strategy);
+}
+
+/**
+ * The manifest in the order of the teaching path (web/tour.json): each entry gets its group's
+ * title (`group`) and what to look for in it (`look`). Throws, naming them, when a scene is in
+ * no group, in two, or when the tour names a scene that does not exist: the path and the folder
+ * must agree.
+ */
+export function orderByTour(manifest, tour) {
+  const byName = new Map(manifest.map((m) => [m.name, m]));
+  const seen = new Set();
+  const out = [];
+  const problems = [];
+  for (const group of (tour && tour.groups) || []) {
+    for (const stop of group.scenes || []) {
+      const m = byName.get(stop.name);
+      if (!m) problems.push(`the tour names '${stop.name}', which is not a scene`);
+      else if (seen.has(stop.name)) problems.push(`the tour names '${stop.name}' twice`);
+      else {
+        seen.add(stop.name);
+        out.push({ ...m, group: group.title, look: stop.look || '' });
+      }
+    }
+  }
+  const missing = manifest.filter((m) => !seen.has(m.name)).map((m) => m.name);
+  if (missing.length) problems.push(`scenes in no group of the tour: ${missing.join(', ')}`);
+  if (problems.length) throw new Error(problems.join('; '));
+  return out;
 }
 
 export function manifestEntry(file, scene) {
@@ -252,8 +281,15 @@ function main() {
       copy(path.join(scenesDir, file), path.join(OUT, 'scenes', file));
     }
   }
-  // Integration scenes first (the page opens the first scene), each kind in file order.
-  manifest.sort((a, b) => (a.kind === 'render') - (b.kind === 'render'));
+  // The teaching path's order (web/tour.json); the page opens the first scene, an integral.
+  let ordered;
+  try {
+    ordered = orderByTour(manifest, JSON.parse(fs.readFileSync(need(path.join(WEB, 'tour.json'), 'part of the repository'), 'utf8')));
+  } catch (e) {
+    fail(`web/tour.json: ${e.message}`);
+  }
+  manifest.splice(0, manifest.length, ...ordered);
+  if (manifest[0].kind === 'render') fail('web/tour.json: the first scene must be an integral (the page opens it)');
   const names = new Set();
   for (const m of manifest) {
     if (names.has(m.name)) fail(`two scenes are named '${m.name}'`);

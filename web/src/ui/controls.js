@@ -98,6 +98,26 @@ function option(value, text) {
   return o;
 }
 
+/** The scene list: one group per stop of the teaching path (the manifest's `group`, in its
+ *  order), then the custom problem; a manifest without groups is split by kind. */
+function sceneOptions(scenes) {
+  const optgroup = (label, items) => {
+    const g = document.createElement('optgroup');
+    g.label = label;
+    g.append(...items);
+    return g;
+  };
+  const label = (s) => (kindOf(s) === KIND.RENDER ? `${s.name}  (render)` : `${s.name}  (${s.dimension ?? '?'}D)`);
+  const groups = new Map();
+  for (const s of scenes) {
+    const title = s.group || (kindOf(s) === KIND.RENDER ? 'Render scenes (glTF)' : 'Integrals');
+    if (!groups.has(title)) groups.set(title, []);
+    groups.get(title).push(option(s.name, label(s)));
+  }
+  return [...[...groups].map(([title, items]) => optgroup(title, items)),
+    optgroup('Your own integral', [option(CUSTOM, 'custom: f and p typed below')])];
+}
+
 export function syncControls(state) {
   const sn = $('samples-n');
   if (sn && Number(sn.value) !== state.samples.n) sn.value = String(state.samples.n);
@@ -106,19 +126,7 @@ export function syncControls(state) {
   const select = $('scene');
   if (sSig !== scenesSig) {
     scenesSig = sSig;
-    const integrals = state.scenes.filter((s) => kindOf(s) !== KIND.RENDER);
-    const renders = state.scenes.filter((s) => kindOf(s) === KIND.RENDER);
-    const group = (label, items) => {
-      const g = document.createElement('optgroup');
-      g.label = label;
-      g.append(...items);
-      return g;
-    };
-    const items = [...integrals.map((s) => option(s.name, `${s.name}  (${s.dimension ?? '?'}D)`)),
-      option(CUSTOM, 'custom: f and p typed below')];
-    select.replaceChildren(...(renders.length
-      ? [group('Integrals', items), group('Render scenes (glTF)', renders.map((s) => option(s.name, `${s.name}  (render)`)))]
-      : items));
+    select.replaceChildren(...sceneOptions(state.scenes));
   }
   if (state.sceneId && select.value !== state.sceneId) select.value = state.sceneId;
 
@@ -126,6 +134,11 @@ export function syncControls(state) {
   const kind = kindOf(info);
   showKind(kind);
   $('scene-description').textContent = info ? info.description || '' : '';
+  // The custom problem's form opens when it is the problem shown or holds an error.
+  if ((state.sceneId === CUSTOM || state.custom.error) && !$('custom').open) $('custom').open = true;
+  const entry = state.scenes.find((sc) => sc.name === state.sceneId);
+  $('scene-look').textContent = entry && entry.look ? entry.look : '';
+  $('scene-look-block').hidden = !(entry && entry.look);
   $('scene-facts').textContent = sceneFacts(info);
 
   // Estimators

@@ -1,0 +1,32 @@
+// Tests of web/src/explain.js: every method the core names has an explanation, and the orders
+// follow the dimension where they depend on it.
+import { test } from 'node:test';
+import assert from 'node:assert/strict';
+import { explainEstimator, EXPLAINED } from '../src/explain.js';
+
+// The methods of src/estimators/problem.cpp estimator_method.
+const CORE_METHODS = ['uniform', 'importance', 'stratified', 'stratified_importance', 'latin_hypercube', 'rqmc',
+  'qmc', 'vegas', 'vegas_plus', 'miser', 'mis', 'control_variates'];
+
+test('every method the core names is explained, with a formula, an order and what to look for', () => {
+  assert.deepEqual([...EXPLAINED].sort(), [...CORE_METHODS].sort());
+  for (const method of CORE_METHODS) {
+    const x = explainEstimator({ name: 'e', method, pdf: 'uniform' }, 2);
+    assert.ok(x.title && x.formula && x.order && x.look, method);
+    assert.match(x.formula, /I_N|map|bisect|VEGAS/, `${method}: ${x.formula}`);
+  }
+});
+
+test('stratified orders follow the dimension: N^-(1+2/d) smooth, N^-(1+1/d) across an edge', () => {
+  assert.match(explainEstimator({ method: 'stratified' }, 1).order, /N\^−3 for smooth f, N\^−2 across/);
+  assert.match(explainEstimator({ method: 'stratified' }, 2).order, /N\^−2 for smooth f, N\^−1\.5 across/);
+  assert.match(explainEstimator({ method: 'stratified_importance' }, 4).order, /N\^−1\.5 for smooth f, N\^−1\.25 across/);
+  assert.match(explainEstimator({ method: 'stratified' }, null).order, /1\+2\/d/);
+});
+
+test('an unknown method gets a generic text, not an exception', () => {
+  const x = explainEstimator({ name: 'x', method: 'teleport', pdf: 'p' });
+  assert.equal(x.title, 'teleport');
+  assert.equal(x.density, 'p');
+  assert.equal(explainEstimator(null).title, 'Estimator');
+});
