@@ -69,7 +69,8 @@ const char* kUsage =
     "                       sampler (run and render; sobol needs a power-of-two spp)\n"
     "  render writes one image: --out FILE (.png tone-mapped sRGB, .hdr linear Radiance),\n"
     "  --error-out FILE (false-colour relative error against the reference, PNG),\n"
-    "  --estimator NAME (default the scene's first), --spp N (default the scene's spp_max),\n"
+    "  --estimator NAME (default the scene's best: MIS with the power heuristic, or path\n"
+    "  tracing with MIS for a path scene), --spp N (default the scene's spp_max),\n"
     "  --seed S, --threads T, --format json (print the result JSON instead of a summary)\n"
     "\n"
     "exit codes: 0 ok, 1 runtime error, 2 bad arguments, 3 bad scene\n";

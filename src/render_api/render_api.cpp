@@ -404,7 +404,12 @@ int mcp_render_image(const char* scene_json, const char* options_json, char** re
             begin_call("mcp_render_image", result_json, scene_json, options_json, &l, &options))
         return st;
     const RenderRequest& r = *l.request;
-    RenderEstimator est = r.estimators.front();
+    // Without options.estimator, the scene's best estimator: the reference's (MIS with the power
+    // heuristic, or path tracing with MIS for a path scene), with the scene's pixel sampler; a
+    // scene's list may well start with a teaching baseline (uniform hemisphere sampling).
+    RenderEstimator est = r.reference.estimator;
+    est.name = strategy_name(est.strategy);
+    est.pixel_sampler = r.estimators.front().pixel_sampler;
     if (auto it = options.find("estimator"); it != options.end()) {
         bool found = false;
         if (it->is_string())
