@@ -71,6 +71,26 @@ TEST(SceneParsing, UnknownEstimatorNamesAreRefused) {
                   kPresets + ")");
 }
 
+// A typed density that goes negative is an error at its field, not silently |p| (what the page's
+// custom problem did with p = x - 0.5); a density that is zero everywhere too. The integrand's
+// own shape is tabulated as |f|, the best density, and stays accepted where f changes sign.
+TEST(SceneParsing, TypedDensitiesMustBeNonNegativeAndNotZero) {
+    const std::string negative =
+        error_of(R"J({"f": "exp(x)", "estimators": [{"name": "is", "pdf": "x - 0.5"}]})J");
+    EXPECT_EQ(negative.rfind("scene.estimators[0].pdf.shape: a density must be >= 0", 0), 0u)
+        << negative;
+    EXPECT_NE(negative.find("write abs(...)"), std::string::npos);
+    const std::string zero =
+        error_of(R"J({"f": "exp(x)", "estimators": [{"name": "is", "pdf": "0 * x"}]})J");
+    EXPECT_EQ(zero.rfind("scene.estimators[0].pdf.shape: the density is 0 at every one", 0), 0u)
+        << zero;
+    EXPECT_TRUE(build(R"J({"f": "sin(6*x)", "estimators": [{"name": "is", "pdf":
+        {"type": "tabulated", "bins": 32, "shape": "integrand"}}]})J")
+                    .ok());
+    EXPECT_TRUE(
+        build(R"J({"f": "exp(x)", "estimators": [{"name": "is", "pdf": "abs(x - 0.5)"}]})J").ok());
+}
+
 TEST(SceneParsing, PresetsAreNotRedefined) {
     EXPECT_EQ(
         error_of(R"({"f": "x", "estimators": [{"name": "uniform", "sampler": "stratified"}]})"),

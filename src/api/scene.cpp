@@ -404,7 +404,11 @@ bool table_values(Ctx& c, const Json& j, const std::string& path, const Problem&
                                              "than the limit of " +
                                              std::to_string(kMaxTabulationPoints));
     Integrand f;
-    if (shape->is_string() && shape->get<std::string>() == "integrand") {
+    // The integrand's shape is tabulated as |f| (the density proportional to |f| is the best one
+    // [Owen13, 9.1]); a shape the user gives is a density and must not be negative: silently
+    // taking |p| would sample from something else than what was typed.
+    const bool from_integrand = shape->is_string() && shape->get<std::string>() == "integrand";
+    if (from_integrand) {
         if (problem.integrand.dim != dim)
             return c.fail(sub(path, "shape"), "the integrand has " +
                                                   std::to_string(problem.integrand.dim) +
@@ -419,8 +423,9 @@ bool table_values(Ctx& c, const Json& j, const std::string& path, const Problem&
     PointBlock block;
     block.reset(dim, kBlockSize);
     std::vector<double> v(kBlockSize);
-    size_t bad = 0;
+    size_t bad = 0, negative = 0;
     double bad_x = 0.0, bad_y = 0.0, bad_value = 0.0;
+    double neg_x = 0.0, neg_y = 0.0, neg_value = 0.0;
     for (size_t first = 0; first < total; first += kBlockSize) {
         block.n = std::min(kBlockSize, total - first);
         for (size_t i = 0; i < block.n; ++i) {
@@ -444,6 +449,11 @@ bool table_values(Ctx& c, const Json& j, const std::string& path, const Problem&
                 }
                 continue;
             }
+            if (v[i] < 0.0 && !from_integrand && negative++ == 0) {
+                neg_x = block.coord(0)[i];
+                neg_y = dim == 2 ? block.coord(1)[i] : 0.0;
+                neg_value = v[i];
+            }
             (*values)[(first + i) / sub_count] += a;
         }
     }
@@ -457,6 +467,22 @@ bool table_values(Ctx& c, const Json& j, const std::string& path, const Problem&
                                : "x = " + number_text(bad_x)) +
                           "); a pdf shape must be finite on the whole domain");
     }
+    auto where = [dim](double x, double y) {
+        return dim == 2 ? "(x, y) = (" + number_text(x) + ", " + number_text(y) + ")"
+                        : "x = " + number_text(x);
+    };
+    if (negative > 0)
+        return c.fail(sub(path, "shape"),
+                      "a density must be >= 0, and this one is negative at " +
+                          std::to_string(negative) + " of " + std::to_string(total) +
+                          " tabulation points (first " + number_text(neg_value) + " at " +
+                          where(neg_x, neg_y) + "); write abs(...) if |p| is meant");
+    bool all_zero = true;
+    for (double value : *values) all_zero = all_zero && value == 0.0;
+    if (all_zero)
+        return c.fail(sub(path, "shape"), "the density is 0 at every one of the " +
+                                              std::to_string(total) +
+                                              " tabulation points: it samples nothing");
     for (double& value : *values) value /= static_cast<double>(sub_count);
     return true;
 }
