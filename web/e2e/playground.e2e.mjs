@@ -252,6 +252,40 @@ test('a malformed expression is reported inline at its position', async () => {
     { timeout: 10000 });
 });
 
+test('the custom problem: a negative p is refused at the p field; an exact value gives MSE and coverage', async () => {
+  if (!(await page.evaluate(() => document.getElementById('custom').open))) await page.click('#custom-title');
+  await page.fill('#custom-f', 'x*x');
+  await page.fill('#custom-p', 'x - 0.5');
+  await page.fill('#custom-exact', '');
+  await page.click('#custom-apply');
+  await page.waitForFunction(() => (document.querySelector('#custom-error')?.textContent ?? '').length > 0, null,
+    { timeout: 10000 });
+  assert.match(await page.textContent('#custom-error'), /a density must be >= 0/);
+  assert.equal(await page.getAttribute('#custom-p', 'aria-invalid'), 'true');
+  assert.equal(await page.getAttribute('#custom-f', 'aria-invalid'), 'false');
+
+  await page.fill('#n-max', '1024');
+  await page.fill('#reps', '8');
+  await page.fill('#custom-p', 'x + 0.1');
+  await page.fill('#custom-exact', '0.3333333333333333');
+  await page.click('#custom-apply');
+  await page.waitForFunction(() => window.mcplayDebug.state().sceneInfo?.name === 'custom'
+    && window.mcplayDebug.state().sceneInfo.exact !== null, null, { timeout: 10000 });
+  const settings = (await page.evaluate(() => window.mcplayDebug.state())).params;
+  assert.deepEqual([settings.n_max, settings.reps], [1024, 8], 'the settings chosen are kept');
+  await page.click('#run');
+  await page.waitForFunction(() => document.querySelector('#status')?.textContent.startsWith('done'), null,
+    { timeout: 60000 });
+  const s = await page.evaluate(() => window.mcplayDebug.state());
+  assert.ok(Math.abs(s.run.exact - 1 / 3) < 1e-15);
+  assert.equal(s.run.errorName, 'mse');
+  assert.match(await page.textContent('#variance-title'), /MSE against N/);
+  const uniform = s.estimators.find((e) => e.name === 'uniform');
+  assert.ok(uniform.levels.every((l) => typeof l.coverage95 === 'number'), 'coverage with the exact value');
+  assert.match(s.query, /exact=0\.3333333333333333/);
+  await page.screenshot({ path: join(shots, 'custom_exact.png') });
+});
+
 test('Cancel stops a long run promptly', async () => {
   await configure('exp_1d', ['uniform', 'stratified'], { nMin: 16, nMax: 1 << 26, reps: 64, seed: 1 });
   await page.click('#run');

@@ -14,7 +14,7 @@
 // and their PNGs (options.previews), shown by images.js as the levels come in.
 import {
   createStore, reducer, initialState, queryToState, stateToQuery, sceneDefaults, runBlocker,
-  debugSnapshot, buildCustomScene, customError, CUSTOM, WEIGHT_SAMPLES, KIND, kindOf, normalizeInfo,
+  debugSnapshot, buildCustomScene, customError, parseExact, CUSTOM, WEIGHT_SAMPLES, KIND, kindOf, normalizeInfo,
   runSettings, studyOptions,
 } from './state.js';
 import { splitEstimators, partialResult } from './series.js';
@@ -302,7 +302,12 @@ store.subscribe((state, action) => {
 /** Builds the custom scene from f and p and has the core validate it (in the worker). */
 async function applyCustom(fromUrl = null) {
   const token = ++sceneToken;
-  const { f, p } = store.getState().custom;
+  const { f, p, exact: exactText } = store.getState().custom;
+  const exact = parseExact(exactText);
+  if (exactText.trim() && exact === null) {
+    dispatch({ type: 'custom/error', payload: { field: 'exact', message: `exact value: '${exactText.trim()}' is not a number (leave it empty if unknown)`, position: null } });
+    return false;
+  }
   if (!f.trim()) {
     dispatch({ type: 'custom/error', payload: { field: 'f', message: 'scene.f: type an expression for f (then press "Use this problem")', position: null } });
     $('custom-f').focus();
@@ -311,12 +316,12 @@ async function applyCustom(fromUrl = null) {
   try {
     // The dimension f implies (the unit cube of its highest variable), then the whole scene.
     const first = await service.request(MSG.VALIDATE, { scene: { f } });
-    const scene = buildCustomScene(f, p, first.info.dimension);
+    const scene = buildCustomScene(f, p, first.info.dimension, exact);
     const info = normalizeInfo((await service.request(MSG.VALIDATE, { scene })).info);
     if (token !== sceneToken) return false;
     dispatch({
       type: 'scene/loaded',
-      payload: { sceneId: CUSTOM, scene, info, custom: { f, p }, ...(fromUrl ? paramsFromUrl(fromUrl, info) : {}) },
+      payload: { sceneId: CUSTOM, scene, info, custom: { f, p, exact: exactText.trim() }, ...(fromUrl ? paramsFromUrl(fromUrl, info) : {}) },
     });
     return true;
   } catch (e) {
@@ -506,6 +511,7 @@ async function start() {
   if (q.scene === CUSTOM) {
     dispatch({ type: 'custom/edit', payload: { field: 'f', value: q.f } });
     dispatch({ type: 'custom/edit', payload: { field: 'p', value: q.p } });
+    dispatch({ type: 'custom/edit', payload: { field: 'exact', value: q.exact || '' } });
     ok = await applyCustom({ search });
   }
   if (!ok) {

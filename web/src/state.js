@@ -42,12 +42,13 @@ export const DEFAULTS = Object.freeze({
   seed: 1,
   f: '',
   p: '',
+  exact: '',
 });
 
 export const CUSTOM = 'custom';
 
 /** The URL keys, in the order stateToQuery writes them (width and height: render scenes). */
-export const QUERY_KEYS = Object.freeze(['scene', 'estimators', 'n_min', 'n_max', 'reps', 'seed', 'width', 'height', 'f', 'p']);
+export const QUERY_KEYS = Object.freeze(['scene', 'estimators', 'n_min', 'n_max', 'reps', 'seed', 'width', 'height', 'f', 'p', 'exact']);
 
 const NAME_RE = /^[A-Za-z0-9_.-]{1,100}$/;
 
@@ -121,6 +122,7 @@ export function stateToQuery(state) {
   if (c.scene === CUSTOM) {
     add('f', c.f);
     add('p', c.p);
+    add('exact', c.exact);
   }
   return parts.length ? `?${parts.join('&')}` : '';
 }
@@ -137,6 +139,7 @@ function comparisonOf(state) {
       height: render ? state.params.height : null,
       f: state.custom.applied ? state.custom.applied.f : state.custom.f,
       p: state.custom.applied ? state.custom.applied.p : state.custom.p,
+      exact: state.custom.applied ? state.custom.applied.exact ?? '' : state.custom.exact,
     };
   }
   return { ...DEFAULTS, ...state };
@@ -192,9 +195,21 @@ export function queryToState(search, defaults = {}, kind = KIND.INTEGRAL) {
     const raw = get(k);
     if (raw !== null && raw.length <= LIMITS.exprLength && !raw.includes('\0')) out[k] = raw.trim();
   }
+  const exact = get('exact');
+  if (exact !== null && parseExact(exact) !== null) out.exact = exact.trim();
   if (out.f) out.scene = CUSTOM;
   else if (out.scene === CUSTOM) out.scene = d.scene === CUSTOM ? null : d.scene;
   return out;
+}
+
+/** The custom problem's exact value from its text: a finite number, or null ('' or anything
+ *  else; the page says why for a non-empty text that is not one). */
+export function parseExact(text) {
+  if (typeof text !== 'string') return null;
+  const t = text.trim();
+  if (!/^[+-]?(\d+\.?\d*|\.\d+)(e[+-]?\d+)?$/i.test(t)) return null;
+  const v = Number(t);
+  return Number.isFinite(v) ? v : null;
 }
 
 /** The scene's own N range, n_max capped for a fast first run (the issue's defaults); for a
@@ -312,7 +327,7 @@ export function studyNames(kind, exactKnown = false) {
  * from a density proportional to p when p is given. Nothing is evaluated here: the core parses
  * both expressions when it validates the scene.
  */
-export function buildCustomScene(f, p = '', dimension = 1) {
+export function buildCustomScene(f, p = '', dimension = 1, exact = null) {
   const d = Number.isSafeInteger(dimension) && dimension >= 1 ? dimension : 1;
   const fx = String(f).trim();
   const px = String(p || '').trim();
@@ -324,6 +339,8 @@ export function buildCustomScene(f, p = '', dimension = 1) {
     estimators: ['uniform', 'stratified', 'latin_hypercube'],
   };
   if (px) scene.estimators.push({ name: 'importance', pdf: px }, { name: 'stratified_importance', pdf: px });
+  // A typed exact value gives the problem MSE, bias and coverage (the core checks it is finite).
+  if (typeof exact === 'number' && Number.isFinite(exact)) scene.exact = exact;
   return scene;
 }
 
@@ -339,7 +356,8 @@ export function customError(payload) {
     const m = /: at position (\d+): /.exec(message);
     if (m) position = Number(m[1]);
   }
-  return { field: /^scene\.estimators\[\d+\]\.pdf/.test(path) ? 'p' : 'f', message, position };
+  const field = /^scene\.estimators\[\d+\]\.pdf/.test(path) ? 'p' : /^scene\.exact/.test(path) ? 'exact' : 'f';
+  return { field, message, position };
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -386,7 +404,7 @@ export function initialState() {
     // width, height: the image of a render scene (null until one is chosen)
     params: { n_min: DEFAULTS.n_min, n_max: DEFAULTS.n_max, reps: DEFAULTS.reps, seed: DEFAULTS.seed, width: null, height: null },
     paramErrors: {},        // key -> message for an input that holds no valid value
-    custom: { f: '', p: '', error: null, pending: false, applied: null },
+    custom: { f: '', p: '', exact: '', error: null, pending: false, applied: null },
     calibration: 'all',     // the histogram's level: 'all' (pooled) or an N
     notice: '',             // last export / scene-loading message
     run: emptyRun('loading'),
@@ -518,8 +536,12 @@ export function reducer(state, action) {
       selected = orderedSelection(available, selected);
       if (!selected.length && !keep) selected = byDefault.slice();
       let params;
+      // "Use this problem" keeps the N range, replicates and seed chosen (from an integral)
+      const keepSettings = p.sceneId === CUSTOM && state.sceneInfo && kindOf(state.sceneInfo) !== KIND.RENDER
+        && hasLadder(state.params.n_min, state.params.n_max) && state.params.n_min <= state.params.n_max;
       if (keep) params = state.params;
       else if (p.params) params = { ...state.params, ...p.params };
+      else if (keepSettings) params = state.params;
       else params = { ...state.params, ...sceneDefaults(p.info) };
       const custom = p.sceneId === CUSTOM
         ? { ...state.custom, error: null, pending: false, applied: p.custom || state.custom.applied }
@@ -771,7 +793,7 @@ export function debugSnapshot(state) {
     selected: state.selected.slice(),
     params: { ...state.params },
     query: stateToQuery(state),
-    custom: { f: state.custom.f, p: state.custom.p, error: state.custom.error },
+    custom: { f: state.custom.f, p: state.custom.p, exact: state.custom.exact, error: state.custom.error },
     kind: kindOf(state.sceneInfo),
     scenePreview: state.scenePreview ? { status: state.scenePreview.status, spp: state.scenePreview.spp, message: state.scenePreview.message } : null,
     run: {

@@ -6,7 +6,7 @@ import assert from 'node:assert/strict';
 import {
   stateToQuery, queryToState, sceneDefaults, parseWhole, paramError, reducer, initialState,
   createStore, runBlocker, statusText, buildCustomScene, customError, debugSnapshot, DEFAULTS, CUSTOM,
-  KIND, kindOf, normalizeInfo, runSettings, studyOptions, studyNames, RENDER_LIMITS, raceResult,
+  KIND, kindOf, normalizeInfo, runSettings, studyOptions, studyNames, RENDER_LIMITS, raceResult, parseExact,
 } from '../src/state.js';
 
 const SCENE_DEFAULTS = { scene: 'disk_quarter', estimators: null, n_min: 16, n_max: 65536, reps: 32, seed: 1 };
@@ -14,7 +14,7 @@ const SCENE_DEFAULTS = { scene: 'disk_quarter', estimators: null, n_min: 16, n_m
 test('a comparison survives the round trip through the URL', () => {
   const c = {
     scene: 'disk_third', estimators: ['uniform', 'stratified_polar'], n_min: 32, n_max: 4096, reps: 64,
-    seed: 12345678901, f: '', p: '',
+    seed: 12345678901, f: '', p: '', exact: '',
   };
   const q = stateToQuery(c);
   assert.equal(q, '?scene=disk_third&estimators=uniform,stratified_polar&n_min=32&n_max=4096&reps=64&seed=12345678901');
@@ -24,7 +24,7 @@ test('a comparison survives the round trip through the URL', () => {
 test('custom f and p survive the round trip, whatever characters they hold', () => {
   const c = {
     scene: CUSTOM, estimators: ['uniform', 'importance'], n_min: 16, n_max: 1024, reps: 8, seed: 0,
-    f: 'exp(-(x-0.5)^2/0.01) + pow(x, 2)*1e-3 & #?=%', p: 'abs(x - 1/2)^-0.5 + 0.05',
+    f: 'exp(-(x-0.5)^2/0.01) + pow(x, 2)*1e-3 & #?=%', p: 'abs(x - 1/2)^-0.5 + 0.05', exact: '-1.5e-3',
   };
   const q = stateToQuery(c);
   assert.doesNotMatch(q, /[ #]/, 'spaces and # are escaped');
@@ -289,7 +289,7 @@ test('render defaults: the scene\'s spp range (capped), replicates and size clam
 });
 
 test('a render comparison survives the URL; width and height only for render scenes, in their range', () => {
-  const c = { scene: 'quad_light_floor', estimators: ['bsdf'], n_min: 1, n_max: 8, reps: 4, seed: 3, width: 16, height: 32, f: '', p: '' };
+  const c = { scene: 'quad_light_floor', estimators: ['bsdf'], n_min: 1, n_max: 8, reps: 4, seed: 3, width: 16, height: 32, f: '', p: '', exact: '' };
   const q = stateToQuery(c);
   assert.equal(q, '?scene=quad_light_floor&estimators=bsdf&n_min=1&n_max=8&reps=4&seed=3&width=16&height=32');
   const d = { scene: 'quad_light_floor', estimators: null, n_min: 1, n_max: 64, reps: 4, seed: 1, width: 48, height: 48 };
@@ -418,4 +418,25 @@ test('the race: inputs, one part per estimator, done when all are in; a new scen
   assert.deepEqual(s.race.order, []);
   assert.equal(s.race.inputs.absTol, '0.0001');
   assert.equal(s.race.inputs.relTol, '');
+});
+
+test('the custom problem: an exact value goes into the scene and the URL; "Use this problem" keeps the settings', () => {
+  assert.equal(parseExact(' 0.25 '), 0.25);
+  assert.equal(parseExact('-1e-3'), -1e-3);
+  for (const bad of ['', 'pi', '1/3', '1e999', 'NaN']) assert.equal(parseExact(bad), null, bad);
+  assert.equal(buildCustomScene('x', '', 1, 0.5).exact, 0.5);
+  assert.equal('exact' in buildCustomScene('x', '', 1, null), false);
+  // a bad exact value in a link is dropped, not used
+  assert.equal(queryToState('?f=x&exact=abc', SCENE_DEFAULTS).exact, '');
+  assert.equal(customError({ message: 'scene.exact: expected a number, got a string' }).field, 'exact');
+
+  let s = initialState();
+  s = reducer(s, { type: 'core/ready', payload: { version: '0.1.0' } });
+  s = reducer(s, { type: 'scene/loaded', payload: { sceneId: 'exp_1d', scene: {}, info: { estimators: ['uniform'], n_min: 16, n_max: 4096 } } });
+  s = reducer(s, { type: 'param/set', payload: { key: 'n_max', value: '1024' } });
+  s = reducer(s, { type: 'param/set', payload: { key: 'reps', value: '8' } });
+  s = reducer(s, { type: 'scene/loaded', payload: { sceneId: CUSTOM, scene: { f: 'x', exact: 0.5 }, info: { estimators: ['uniform'], n_min: 16, n_max: 65536, exact: 0.5 }, custom: { f: 'x', p: '', exact: '0.5' } } });
+  assert.equal(s.params.n_max, 1024, 'n_max kept');
+  assert.equal(s.params.reps, 8, 'reps kept');
+  assert.match(stateToQuery(s), /&f=x&exact=0\.5$/);
 });

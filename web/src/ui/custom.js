@@ -1,4 +1,4 @@
-// The custom problem: f and p typed as expressions. Events only dispatch (edit, apply); the
+// The custom problem: f and p typed as expressions, and its exact value if known. Events only dispatch (edit, apply); the
 // scene is built and validated by the core in a worker (main.js). sync(state) shows the core's
 // parse error inline: the message in #custom-error, the offending field marked invalid, and
 // the expression repeated under it with the reported position highlighted.
@@ -6,7 +6,7 @@ const $ = (id) => document.getElementById(id);
 
 export function mountCustom(store) {
   const { dispatch } = store;
-  for (const field of ['f', 'p']) {
+  for (const field of ['f', 'p', 'exact']) {
     const input = $(`custom-${field}`);
     input.addEventListener('input', () => dispatch({ type: 'custom/edit', payload: { field, value: input.value } }));
     // Enter applies the problem (instead of submitting the form, which would start a run).
@@ -33,7 +33,7 @@ let shownError = null;
 
 export function syncCustom(state) {
   const c = state.custom;
-  for (const field of ['f', 'p']) {
+  for (const field of ['f', 'p', 'exact']) {
     const input = $(`custom-${field}`);
     if (document.activeElement !== input && input.value !== c[field]) input.value = c[field];
   }
@@ -42,6 +42,7 @@ export function syncCustom(state) {
   if (err === shownError) return;
   shownError = err;
   $('custom-error').textContent = err ? err.message : '';
+  $('custom-exact').setAttribute('aria-invalid', String(Boolean(err && err.field === 'exact')));
   for (const field of ['f', 'p']) {
     const input = $(`custom-${field}`);
     const pre = $(`custom-${field}-mark`);
