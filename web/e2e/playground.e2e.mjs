@@ -337,6 +337,21 @@ test('the race to a target accuracy: every estimator reaches it at the N the CLI
   assert.deepEqual(rows.slice().sort(), estimators.slice().sort(), 'one row per estimator');
 });
 
+test('a shared link: its invalid values are named, and Run is offered', async () => {
+  await page.goto(`${url}?scene=exp_1d&n_min=abc&reps=1&estimators=uniform,bogus`);
+  await page.waitForFunction(() => window.mcplayDebug !== undefined);
+  await page.evaluate(() => window.mcplayDebug.ready);
+  const notice = await page.textContent('#notice');
+  assert.match(notice, /n_min=abc is not a whole number/);
+  assert.match(notice, /reps=1 is not a whole number/);
+  assert.match(notice, /'bogus' is not an estimator of this scene/);
+  assert.match(notice, /Press Run to draw this link's plots/);
+  assert.equal(await page.evaluate(() => document.activeElement?.id), 'run');
+  const s = await page.evaluate(() => window.mcplayDebug.state());
+  assert.deepEqual(s.selected, ['uniform']);
+  assert.equal(s.params.reps, 32);
+});
+
 test('the integration page never downloads the render module', () => {
   // A control that the list holds the workers' requests: the integration module itself.
   assert.ok(requested.some((u) => u.endsWith('/mcplay_web.wasm')), `mcplay_web.wasm not among ${requested.length} requests`);

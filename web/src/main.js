@@ -15,7 +15,7 @@
 import {
   createStore, reducer, initialState, queryToState, stateToQuery, sceneDefaults, runBlocker,
   debugSnapshot, buildCustomScene, customError, parseExact, CUSTOM, WEIGHT_SAMPLES, KIND, kindOf, normalizeInfo,
-  runSettings, studyOptions,
+  runSettings, studyOptions, urlProblems,
 } from './state.js';
 import { splitEstimators, partialResult } from './series.js';
 import { CoreWorker } from './client.js';
@@ -524,6 +524,14 @@ async function start() {
     if (ok && !customFailed && q.scene && !known) {
       dispatch({ type: 'notice', payload: { message: `unknown scene '${q.scene}' in the link: showing ${scenes[0].name}` } });
     }
+  }
+  // A shared link: name what it asked for that could not be used, and offer to run it.
+  if (ok && new URLSearchParams(search).has('scene') && store.getState().sceneId === q.scene) {
+    const st = store.getState();
+    const problems = urlProblems(search, st.sceneInfo ? st.sceneInfo.estimators : null, kindOf(st.sceneInfo));
+    const what = problems.length ? `The link's ${problems.join('; ')}: the defaults are used instead. ` : '';
+    dispatch({ type: 'notice', payload: { message: `${what}Press Run to draw this link's plots.` } });
+    document.getElementById('run').focus({ preventScroll: true });
   }
   urlReady = true;
   writeUrl(store.getState());

@@ -212,6 +212,43 @@ export function parseExact(text) {
   return Number.isFinite(v) ? v : null;
 }
 
+/**
+ * What a link asked for that cannot be used, one message per value, for a notice (queryToState
+ * replaces each by its default): numbers that are not whole or out of range, an N range without
+ * a power of two, estimator names the scene does not have (`available`), an exact value that is
+ * not a number. Unknown keys (a tracker's, say) are not the page's and are not reported.
+ */
+export function urlProblems(search, available = null, kind = KIND.INTEGRAL) {
+  let q;
+  try {
+    q = new URLSearchParams(typeof search === 'string' ? search : '');
+  } catch {
+    return ['the link could not be read'];
+  }
+  const out = [];
+  const rules = paramRules(kind);
+  const shown = (v) => (v.length > 24 ? `${v.slice(0, 24)}…` : v);
+  for (const k of ['n_min', 'n_max', 'reps', 'seed', ...(kind === KIND.RENDER ? ['width', 'height'] : [])]) {
+    const raw = q.get(k);
+    if (raw === null) continue;
+    const [lo, hi] = rules[k];
+    if (parseWhole(raw, lo, hi) === null) out.push(`${paramLabel(k, kind)}=${shown(raw)} is not a whole number in ${lo}..${hi}`);
+  }
+  const a = parseWhole(q.get('n_min') ?? '', ...rules.n_min);
+  const b = parseWhole(q.get('n_max') ?? '', ...rules.n_max);
+  if (a !== null && b !== null && (a > b || !hasLadder(a, b))) {
+    out.push(`n_min=${a} and n_max=${b} hold no power of two`);
+  }
+  const est = q.get('estimators');
+  if (est !== null && Array.isArray(available)) {
+    const unknown = est.split(',').map((n) => n.trim()).filter((n) => n && !available.includes(n));
+    if (unknown.length) out.push(`${unknown.map((n) => `'${shown(n)}'`).join(', ')} ${unknown.length > 1 ? 'are not estimators' : 'is not an estimator'} of this scene`);
+  }
+  const exact = q.get('exact');
+  if (exact !== null && exact.trim() && parseExact(exact) === null) out.push(`exact=${shown(exact)} is not a number`);
+  return out;
+}
+
 /** The scene's own N range, n_max capped for a fast first run (the issue's defaults); for a
  *  render scene its spp range (spp_max capped), replicates and image size (clamped to the
  *  page's limits). */

@@ -6,7 +6,7 @@ import assert from 'node:assert/strict';
 import {
   stateToQuery, queryToState, sceneDefaults, parseWhole, paramError, reducer, initialState,
   createStore, runBlocker, statusText, buildCustomScene, customError, debugSnapshot, DEFAULTS, CUSTOM,
-  KIND, kindOf, normalizeInfo, runSettings, studyOptions, studyNames, RENDER_LIMITS, raceResult, parseExact,
+  KIND, kindOf, normalizeInfo, runSettings, studyOptions, studyNames, RENDER_LIMITS, raceResult, parseExact, urlProblems,
 } from '../src/state.js';
 
 const SCENE_DEFAULTS = { scene: 'disk_quarter', estimators: null, n_min: 16, n_max: 65536, reps: 32, seed: 1 };
@@ -439,4 +439,19 @@ test('the custom problem: an exact value goes into the scene and the URL; "Use t
   assert.equal(s.params.n_max, 1024, 'n_max kept');
   assert.equal(s.params.reps, 8, 'reps kept');
   assert.match(stateToQuery(s), /&f=x&exact=0\.5$/);
+});
+
+test('urlProblems names every value of a link that cannot be used, and nothing else', () => {
+  const available = ['uniform', 'stratified'];
+  assert.deepEqual(urlProblems('?scene=exp_1d&n_min=16&n_max=1024&reps=8&estimators=uniform', available), []);
+  assert.deepEqual(urlProblems('?scene=exp_1d&utm_source=x', available), [], 'foreign keys are not the page\'s');
+  const p = urlProblems('?n_min=abc&reps=1&estimators=uniform,bogus&exact=pi', available);
+  assert.deepEqual(p, [
+    'n_min=abc is not a whole number in 1..68719476736',
+    'reps=1 is not a whole number in 2..100000',
+    "'bogus' is not an estimator of this scene",
+    'exact=pi is not a number',
+  ]);
+  assert.deepEqual(urlProblems('?n_min=17&n_max=31'), ['n_min=17 and n_max=31 hold no power of two']);
+  assert.deepEqual(urlProblems('?n_max=2048&width=9', null, KIND.RENDER), ['width=9 is not a whole number in 16..256']);
 });
