@@ -3,7 +3,7 @@
 // flagged cells sit next to the warning that concerns them (low_ess by the effective sample
 // size, heavy_tail by the tail index, level_drift by the consistency test, ...). A pure render
 // of the state, text only (never HTML from data).
-import { collectWarnings, fitText, fmt, severityOf } from './series.js';
+import { collectWarnings, fitText, fmt, severityOf, flagTitle, nText } from './series.js';
 import { colorAt } from './palette.js';
 import { el } from './dom.js';
 
@@ -70,10 +70,11 @@ export function renderReport(state, dom) {
     dataset: { estimator: w.estimator, code: w.code, scope: w.scope, severity: w.severity },
   },
   severityLabel(w), ' ',
-  el('strong', {}, w.estimator), ' ',
-  el('code', {}, w.code), ' ',
-  w.message,
-  w.scope === 'level' && w.n.length ? el('span', { className: 'muted' }, ` (at N = ${w.n.join(', ')})`) : null)));
+  el('strong', {}, w.estimator), ': ',
+  el('span', { className: 'flag-title' }, flagTitle(w.code)),
+  w.scope === 'level' && w.n.length ? el('span', {}, ` (${nText(w.n, run.ladder, run.kind === 'render' ? 'spp' : 'N')})`) : null,
+  ' ', el('code', { className: 'flag-code' }, w.code),
+  el('div', { className: 'flag-detail' }, w.message))));
   const hasRecords = run.order.some((n) => run.records[n]);
   dom.diagnosticsEmpty.textContent = !hasRecords ? 'Run a study to see its diagnostics.' : 'No warnings.';
   dom.diagnosticsEmpty.hidden = warnings.length > 0;

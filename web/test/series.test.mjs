@@ -481,3 +481,17 @@ test('a cancelled render run exports its streamed levels with the render names',
   // an integration run's export is unchanged: no kind
   assert.equal('kind' in partialResult({ ...run, kind: 'integral' }, { name: 'q' }), false);
 });
+
+test('nText collapses the N of a diagnostic; flagTitle says each code in words', async () => {
+  const { nText, flagTitle, FLAG_TITLES } = await import('../src/series.js');
+  const steps = [16, 32, 64, 128, 256];
+  assert.equal(nText([16, 32, 64, 128, 256], steps), 'every N, 16 … 256');
+  assert.equal(nText([32, 64, 128], steps), 'N = 32 … 128 (3 levels)');
+  assert.equal(nText([16, 64], steps), 'N = 16, 64');
+  assert.equal(nText([64], steps), 'N = 64');
+  assert.equal(nText([1, 2, 4], [1, 2, 4], 'spp'), 'every spp, 1 … 4');
+  assert.equal(nText([], steps), '');
+  assert.match(flagTitle('skewed_weights'), /not yet trustworthy/);
+  assert.equal(flagTitle('made_up'), 'made_up');
+  for (const [code, title] of Object.entries(FLAG_TITLES)) assert.ok(title.length > 10, code);
+});
