@@ -316,6 +316,7 @@ Json level_to_json(const LevelStats& l) {
            // this many degrees of freedom (0: no error bar).
            {"run_dof", l.run_dof},
            {"time_mean_s", num(l.time_mean)},
+           {"time_std_s", num(l.time_std)}, // over the replicates: the timing's own noise
            {"time_total_s", num(l.time_total)},
            // Adaptive estimators: the share of the calls and the seconds per estimate spent
            // training or probing (in n and time_mean_s too; 0 for fixed estimators).

@@ -430,7 +430,7 @@ LevelStats summarise_level(const std::vector<RunResult>& runs, const Problem& pr
     s.n = runs[0].n;
     s.run_dof = runs[0].dof;
     const double run_quantile = interval_quantile(s.run_dof);
-    RunningMoments est, se;
+    RunningMoments est, se, times;
     NeumaierSum sq_err, time, training_time;
     double training_share = 0.0;
     int covered = 0, se_count = 0;
@@ -459,6 +459,7 @@ LevelStats summarise_level(const std::vector<RunResult>& runs, const Problem& pr
         nonzero += static_cast<double>(r.diagnostics.nonzero);
         est.add(r.estimate);
         time.add(r.seconds);
+        times.add(r.seconds);
         training_time.add(r.training_seconds);
         training_share +=
             r.n > 0 ? static_cast<double>(r.training_n) / static_cast<double>(r.n) : 0.0;
@@ -505,6 +506,7 @@ LevelStats summarise_level(const std::vector<RunResult>& runs, const Problem& pr
     s.run_dof_total = run_dof_sum;
     s.time_total = time.value();
     s.time_mean = s.time_total / R;
+    s.time_std = std::sqrt(times.variance());
     s.training_time_mean = training_time.value() / R;
     s.training_share = training_share / R;
     s.efficiency = s.variance > 0.0 && s.time_mean > 0.0 ? 1.0 / (s.variance * s.time_mean)

@@ -87,6 +87,7 @@ struct LevelStats {
     double run_dof_total = 0.0;     ///< the runs' error-bar degrees of freedom, summed
     int run_dof = 0;                ///< degrees of freedom of the runs' error bars (RunResult::dof)
     double time_mean = 0.0;         ///< seconds per estimate
+    double time_std = 0.0;          ///< their standard deviation over the replicates
     double time_total = 0.0;
     /// Adaptive estimators: mean share of the calls and mean seconds per estimate spent
     /// training (VEGAS) or probing (MISER), included in n and time_mean.

@@ -4,7 +4,7 @@
 // A chart is rebuilt when its set of series changes and otherwise gets setData.
 import uPlot from '../vendor/uPlot.esm.js';
 import {
-  varianceSeries, anchorOf, referenceLines, timeSeries, calibrationSeries, coverageSeries,
+  varianceSeries, anchorOf, referenceLines, timeSeries, calibrationSeries, coverageSeries, equalTimeVerdict,
   decadeRange, fitText, fmt, curveOverlay, misWeightCurves, weightBins, weightHistogram, domainView, mapFor, mappedGrid,
 } from './series.js';
 import { colorAt, withAlpha } from './palette.js';
@@ -443,6 +443,10 @@ function renderTime(state, run, records) {
     parts: [s.slope === null ? '' : { text: `error ∝ t^${s.slope.toFixed(2)}`, className: 'fit' },
       s.trainingShare === null ? '' : { text: `training: ${Math.round(100 * s.trainingShare)}% of the time (dashed: without it)`, className: 'fit' }],
   })));
+  // The equal-time statement, once the run is over (integrals: render studies have their own
+  // efficiency in the tables).
+  const verdict = run.status === 'running' || isRender(run) ? null : equalTimeVerdict(records, run.order, run.exact);
+  setText('time-verdict', verdict ? verdict.text : '');
 }
 
 function renderCalibration(state, run, records) {

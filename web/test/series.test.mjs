@@ -495,3 +495,24 @@ test('nText collapses the N of a diagnostic; flagTitle says each code in words',
   assert.equal(flagTitle('made_up'), 'made_up');
   for (const [code, title] of Object.entries(FLAG_TITLES)) assert.ok(title.length > 10, code);
 });
+
+test('equalTimeVerdict: a winner only when the efficiencies differ beyond their uncertainty', async () => {
+  const { equalTimeVerdict } = await import('../src/series.js');
+  // variance and its chi-square interval, time and its spread over 32 replicates
+  const level = (variance, time, over = {}) => ({
+    n: 4096, reps: 32, variance, variance_ci95: [variance * 0.65, variance * 1.7], time_mean_s: time, time_std_s: time * 0.1, ...over,
+  });
+  const rec = (name, l) => ({ name, levels: [l], fit: null, warnings: [] });
+  const clear = equalTimeVerdict({ a: rec('a', level(1e-4, 1e-3)), b: rec('b', level(1e-6, 1e-3)) }, ['a', 'b']);
+  assert.equal(clear.winner, 'b');
+  assert.match(clear.text, /^Equal-time winner .*: b, 100× as efficient as the next, a \(z = /);
+  const close = equalTimeVerdict({ a: rec('a', level(1e-4, 1e-3)), b: rec('b', level(1.2e-4, 0.9e-3)) }, ['a', 'b']);
+  assert.equal(close.winner, null);
+  assert.match(close.text, /^No significant difference at equal time between/);
+  const exact = equalTimeVerdict({ a: rec('a', level(1e-4, 1e-3)), e: rec('e', level(0, 1e-3, { exact_to_roundoff: true })) }, ['a', 'e']);
+  assert.equal(exact.winner, 'e');
+  assert.match(exact.text, /e is exact/);
+  // with the exact value known, the MSE is what counts (a biased estimator's MSE is not its variance)
+  const biased = equalTimeVerdict({ a: rec('a', level(1e-4, 1e-3, { mse: 1e-4 })), b: rec('b', level(1e-6, 1e-3, { mse: 1e-2 })) }, ['a', 'b'], 1.0);
+  assert.equal(biased.winner, 'a');
+});
