@@ -38,11 +38,13 @@ function nTicks(u, splits) {
   const shown = splits.filter((v) => typeof v === 'number' && v > 0);
   const every = shown.length * 42 > width ? (shown.length * 21 > width ? 4 : 2) : 1;
   const last = Math.round(Math.log2(shown[shown.length - 1] || 1));
+  // One notation per axis: plain numbers while the largest fits in 6 digits, else 2^k for all.
+  const powers = 2 ** last > 999999;
   return splits.map((v) => {
     if (typeof v !== 'number' || !(v > 0)) return '';
     const k = Math.round(Math.log2(v));
     if (Math.abs(v - 2 ** k) > 1e-6 * v || (last - k) % every !== 0) return '';
-    return v <= 65536 ? String(v) : `2${sup(k)}`;
+    return powers ? `2${sup(k)}` : String(v);
   });
 }
 
