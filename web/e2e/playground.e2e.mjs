@@ -145,6 +145,23 @@ test('a study in the page plots every level and agrees with the CLI', async () =
   assert.ok(fits.stratified_polar.order < -1.3, `stratified order ${fits.stratified_polar.order} is not below -1.3`);
 });
 
+test('legends: a click hides an estimator in every plot, Shift+click isolates one', async () => {
+  // the study of the test above (disk_third: uniform, stratified_polar)
+  const entry = (name) => page.locator(`#legend-variance li[data-series="${name}"]`);
+  await entry('uniform').click();
+  assert.deepEqual(await page.evaluate(() => window.mcplayDebug.hidden()), ['uniform']);
+  assert.match(await entry('uniform').getAttribute('class'), /off/);
+  assert.match(await page.locator('#legend-coverage li[data-series="uniform"]').getAttribute('class'), /off/,
+    'every legend follows');
+  await entry('uniform').click();
+  assert.deepEqual(await page.evaluate(() => window.mcplayDebug.hidden()), []);
+  await entry('stratified_polar').click({ modifiers: ['Shift'] });
+  assert.deepEqual(await page.evaluate(() => window.mcplayDebug.hidden()), ['uniform']);
+  await page.locator('#legend-variance').screenshot({ path: join(shots, 'legend_isolated.png') });
+  await entry('stratified_polar').click({ modifiers: ['Shift'] });
+  assert.deepEqual(await page.evaluate(() => window.mcplayDebug.hidden()), []);
+});
+
 test('the sample points, the 1D overlay and the weights are drawn', async () => {
   await configure('disk_third', ['stratified_polar'], { nMin: 16, nMax: 1024, reps: 16, seed: 1 });
   await page.click('#run');

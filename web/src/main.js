@@ -20,7 +20,7 @@ import {
 import { splitEstimators, partialResult } from './series.js';
 import { CoreWorker } from './client.js';
 import { MSG } from './protocol.js';
-import { initPlots, renderPlots, plotPng } from './plot.js';
+import { initPlots, renderPlots, plotPng, hiddenEstimators } from './plot.js';
 import { renderReport } from './report.js';
 import { renderImages } from './images.js';
 import { renderExplain } from './ui/explain.js';
@@ -551,5 +551,6 @@ ready.catch(() => {});
 // Read-only hook for tests: a structured-cloneable snapshot and a promise of the first scene.
 window.mcplayDebug = Object.freeze({
   state: () => structuredClone(debugSnapshot(store.getState())),
+  hidden: () => hiddenEstimators(),
   ready,
 });

@@ -84,7 +84,56 @@ function draw(key, el, sig, makeOpts, data, ranges) {
     Object.assign(c, ranges);
     c.u.setData(data);
   }
+  applyHidden(c);
   return c;
+}
+
+// Estimators the reader hid by clicking their legend entry (every plot follows).
+const hiddenSeries = new Set();
+
+/** Shows or hides each series of a chart by the estimator it belongs to: its label is the
+ *  estimator's name, or the name and a suffix ("uniform 95% high"). */
+function applyHidden(c) {
+  if (!c || !c.u) return;
+  c.u.series.forEach((ser, i) => {
+    if (i === 0 || typeof ser.label !== 'string') return;
+    let hide = false;
+    for (const name of hiddenSeries) if (ser.label === name || ser.label.startsWith(`${name} `)) hide = true;
+    if (Boolean(ser.show) === hide) c.u.setSeries(i, { show: !hide });
+  });
+}
+
+/**
+ * A click on an estimator's legend entry hides it in every plot (or shows it again); with Shift
+ * or Alt, it isolates it (every other estimator hidden), and the same again shows them all.
+ */
+function onLegendClick(e) {
+  const li = e.target.closest('li[data-series]');
+  if (!li) return;
+  const name = li.dataset.series;
+  const all = [...new Set([...document.querySelectorAll('.legend li[data-series]')].map((x) => x.dataset.series))];
+  if (e.shiftKey || e.altKey) {
+    const isolated = all.every((n) => (n === name) !== hiddenSeries.has(n));
+    hiddenSeries.clear();
+    if (!isolated) for (const n of all) if (n !== name) hiddenSeries.add(n);
+  } else if (hiddenSeries.has(name)) {
+    hiddenSeries.delete(name);
+  } else {
+    hiddenSeries.add(name);
+  }
+  for (const item of document.querySelectorAll('.legend li[data-series]')) {
+    item.classList.toggle('off', hiddenSeries.has(item.dataset.series));
+    item.setAttribute('aria-pressed', String(!hiddenSeries.has(item.dataset.series)));
+  }
+  for (const c of Object.values(charts)) {
+    applyHidden(c);
+    if (c && c.u) c.u.redraw(false);
+  }
+}
+
+/** The estimators hidden in the plots (for tests: window.mcplayDebug). */
+export function hiddenEstimators() {
+  return [...hiddenSeries];
 }
 
 function logX(c, base = 2) {
@@ -204,7 +253,11 @@ function setLegend(key, ul, items) {
   const sig = JSON.stringify(items);
   if (legendSigs[key] === sig && ul.childElementCount === items.length) return;
   legendSigs[key] = sig;
-  ul.replaceChildren(...items.map((it) => el('li', { dataset: it.data || {} },
+  ul.replaceChildren(...items.map((it) => el('li', {
+    dataset: { ...(it.data || {}), ...(it.ref ? {} : { series: it.name }) },
+    ...(it.ref ? {} : { className: hiddenSeries.has(it.name) ? 'off' : '', tabIndex: 0, role: 'button',
+      title: 'click: hide or show in every plot; Shift+click: show only this one' }),
+  },
     swatch(it.color, it.dashed),
     el('span', { className: it.ref ? 'name ref' : 'name' }, it.name),
     ...(it.parts || []).map((p) => (typeof p === 'string' ? p : p.fit !== undefined
@@ -226,6 +279,16 @@ export function initPlots(elements) {
       }
     });
     for (const k of ['variance', 'time', 'calibration', 'coverage', 'overlay', 'misweights', 'weights']) if (dom[k]) ro.observe(dom[k]);
+  }
+  for (const [k, ul] of Object.entries(dom)) {
+    if (!k.startsWith('legend-') || !ul) continue;
+    ul.addEventListener('click', onLegendClick);
+    ul.addEventListener('keydown', (e) => {
+      if (e.key === 'Enter' || e.key === ' ') {
+        e.preventDefault();
+        onLegendClick(e);
+      }
+    });
   }
 }
 
@@ -384,7 +447,8 @@ function pathsInOrder(getPaths) {
     ctx.beginPath();
     ctx.rect(u.bbox.left, u.bbox.top, u.bbox.width, u.bbox.height);
     ctx.clip();
-    for (const { color, points, dash = null } of getPaths()) {
+    for (const { name, color, points, dash = null } of getPaths()) {
+      if (hiddenSeries.has(name)) continue;
       ctx.strokeStyle = color;
       ctx.lineWidth = (dash ? 1.5 : 2) * px;
       ctx.setLineDash(dash ? dash.map((v) => v * px) : []);
@@ -409,11 +473,11 @@ function renderTime(state, run, records) {
     const color = colorOf(run, s.name);
     return { label: s.name, stroke: color, width: 2, paths: noLine, points: { show: true, size: 7, fill: color } };
   })];
-  const lines = ts.series.map((s) => ({ color: colorOf(run, s.name), points: s.points.map(([t, e]) => [t, lg(e)]) }));
+  const lines = ts.series.map((s) => ({ name: s.name, color: colorOf(run, s.name), points: s.points.map(([t, e]) => [t, lg(e)]) }));
   // Adaptive estimators: dashed, the error at the time spent estimating only; the gap to the
   // solid line is what training (VEGAS) or probing (MISER) cost.
   for (const s of ts.series) {
-    if (s.estimating.length) lines.push({ color: colorOf(run, s.name), dash: [6, 4], points: s.estimating.map(([t, e]) => [t, lg(e)]) });
+    if (s.estimating.length) lines.push({ name: s.name, color: colorOf(run, s.name), dash: [6, 4], points: s.estimating.map(([t, e]) => [t, lg(e)]) });
   }
   const render = isRender(run);
   const names = runLabels(run);
