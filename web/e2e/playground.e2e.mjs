@@ -160,6 +160,13 @@ test('legends: a click hides an estimator in every plot, Shift+click isolates on
   await page.locator('#legend-variance').screenshot({ path: join(shots, 'legend_isolated.png') });
   await entry('stratified_polar').click({ modifiers: ['Shift'] });
   assert.deepEqual(await page.evaluate(() => window.mcplayDebug.hidden()), []);
+  // hovering reads the values under the cursor
+  const box = await page.locator('#plot-variance .u-over').boundingBox();
+  await page.mouse.move(box.x + box.width * 0.5, box.y + box.height * 0.5);
+  await page.waitForFunction(() => /stratified_polar: /.test(document.querySelector('#plot-variance .readout')?.textContent ?? ''),
+    null, { timeout: 5000 });
+  assert.match(await page.textContent('#plot-variance .readout'), /^N = \d+\nuniform: [\d.e-]+\nstratified_polar: /);
+  await page.mouse.move(0, 0);
 });
 
 test('the sample points, the 1D overlay and the weights are drawn', async () => {

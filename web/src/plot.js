@@ -78,7 +78,8 @@ function draw(key, el, sig, makeOpts, data, ranges) {
     el.replaceChildren();
     c = { sig, el, ...ranges };
     const opts = makeOpts(c);
-    c.u = new uPlot({ ...plotSize(el), legend: { show: false }, padding: [14, 36, 0, 0], ...opts }, data, el);
+    const hooks = { ...(opts.hooks || {}), setCursor: [...((opts.hooks && opts.hooks.setCursor) || []), readout(key)] };
+    c.u = new uPlot({ ...plotSize(el), legend: { show: false }, padding: [14, 36, 0, 0], ...opts, hooks }, data, el);
     charts[key] = c;
   } else {
     Object.assign(c, ranges);
@@ -86,6 +87,40 @@ function draw(key, el, sig, makeOpts, data, ranges) {
   }
   applyHidden(c);
   return c;
+}
+
+// Plots whose y values are log10 of what they show (see lg below).
+const LOG10_Y = new Set(['variance', 'time']);
+
+/** The hover readout of a chart: the x under the cursor and each shown estimator's value there
+ *  (bands, references and hidden series left out), in a box in the plot's corner. */
+function readout(key) {
+  return (u) => {
+    let box = u.root.querySelector('.readout');
+    if (!box) {
+      box = el('div', { className: 'readout', role: 'status' });
+      u.root.querySelector('.u-over').after(box);
+    }
+    const i = u.cursor.idx;
+    if (i === null || i === undefined || u.cursor.left < 0) {
+      box.hidden = true;
+      return;
+    }
+    const x = u.data[0][i];
+    const lines = [];
+    u.series.forEach((ser, k) => {
+      if (k === 0 || !ser.show || typeof ser.label !== 'string' || / 95% |^N|^spp|normal|exact/.test(ser.label)) return;
+      const v = u.data[k][i];
+      if (v === null || v === undefined || !Number.isFinite(v)) return;
+      lines.push(`${ser.label}: ${fmt(LOG10_Y.has(key) ? 10 ** v : v, 3)}`);
+    });
+    if (!lines.length) {
+      box.hidden = true;
+      return;
+    }
+    box.hidden = false;
+    box.textContent = `${key === 'time' ? 't' : key === 'calibration' ? 'z' : 'N'} = ${fmt(x, 4)}\n${lines.join('\n')}`;
+  };
 }
 
 // Estimators the reader hid by clicking their legend entry (every plot follows).
