@@ -5,7 +5,7 @@
 // downloads the render module, then runs a small render study (quad_light_floor) and checks its
 // fitted orders against the CLI and its images; saves screenshots.
 import { spawn, execFileSync } from 'node:child_process';
-import { mkdtempSync, mkdirSync, rmSync } from 'node:fs';
+import { mkdtempSync, mkdirSync, rmSync, readFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join, resolve, dirname } from 'node:path';
 import { fileURLToPath } from 'node:url';
@@ -167,6 +167,19 @@ test('legends: a click hides an estimator in every plot, Shift+click isolates on
     null, { timeout: 5000 });
   assert.match(await page.textContent('#plot-variance .readout'), /^N = \d+\nuniform: [\d.e-]+\nstratified_polar: /);
   await page.mouse.move(0, 0);
+});
+
+test('exports: a plot PNG and the sample points as CSV, named after the scene', async () => {
+  const [png] = await Promise.all([page.waitForEvent('download'), page.click('button[data-png="variance"]')]);
+  assert.match(png.suggestedFilename(), /^mcplay-disk_third-N16-4096-R32-seed1-variance\.png$/);
+  const pngBytes = readFileSync(await png.path());
+  assert.equal(pngBytes.subarray(1, 4).toString(), 'PNG');
+  await page.waitForFunction(() => !document.querySelector('#export-samples').disabled, null, { timeout: 10000 });
+  const [csv] = await Promise.all([page.waitForEvent('download'), page.click('#export-samples')]);
+  assert.match(csv.suggestedFilename(), /^mcplay-disk_third-samples-n\d+-seed1\.csv$/);
+  const text = readFileSync(await csv.path(), 'utf8');
+  assert.match(text, /^estimator,i,u1,u2,x1,x2,f,density,weight\n/);
+  assert.ok(text.trim().split('\n').length > 100);
 });
 
 test('the sample points, the 1D overlay and the weights are drawn', async () => {

@@ -17,7 +17,7 @@ import {
   debugSnapshot, buildCustomScene, customError, parseExact, CUSTOM, WEIGHT_SAMPLES, KIND, kindOf, normalizeInfo,
   runSettings, studyOptions, urlProblems,
 } from './state.js';
-import { splitEstimators, partialResult } from './series.js';
+import { splitEstimators, partialResult, samplesCsv } from './series.js';
 import { CoreWorker } from './client.js';
 import { MSG } from './protocol.js';
 import { initPlots, renderPlots, plotPng, hiddenEstimators } from './plot.js';
@@ -450,8 +450,15 @@ function fileStem(s) {
 
 async function exportResult({ format, plot }) {
   const s = store.getState();
+  if (format === 'samples') {
+    const text = samplesCsv(s.samples.data);
+    if (!text) throw new Error('no sample points yet');
+    const scene = String(s.sceneInfo && s.sceneInfo.name ? s.sceneInfo.name : s.sceneId || 'scene').replace(/[^\w.-]+/g, '_');
+    downloadText(`mcplay-${scene}-samples-n${s.samples.n}-seed${s.params.seed}.csv`, text, 'text/csv');
+    return;
+  }
   if (format === 'png') {
-    const url = plotPng(plot);
+    const url = plotPng(plot, `${s.run.sceneName || s.sceneId}: ${s.run.order.filter((n) => !hiddenEstimators().includes(n)).join(', ')}`);
     if (!url) throw new Error(`the ${plot} plot is empty`);
     download(`${fileStem(s)}-${plot}.png`, url);
     return;

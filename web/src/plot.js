@@ -1075,14 +1075,14 @@ function renderWeights(state, weights) {
  * The chart `key` as a PNG data URL: the canvas (axes and series) on white, with the plot's
  * title above and its legend lines below. null when the chart is not drawn.
  */
-export function plotPng(key) {
+export function plotPng(key, subtitle = '') {
   const c = charts[key];
   if (!c || !c.u) return null;
   const src = c.u.ctx.canvas;
   const px = src.width / c.u.width || 1;
   const legendItems = [...(dom[`legend-${key}`] ? dom[`legend-${key}`].children : [])];
   const line = 18 * px;
-  const head = 28 * px;
+  const head = (subtitle ? 46 : 28) * px;
   const out = document.createElement('canvas');
   out.width = src.width;
   out.height = head + src.height + (legendItems.length ? legendItems.length * line + 10 * px : 0);
@@ -1093,7 +1093,12 @@ export function plotPng(key) {
   ctx.font = `bold ${14 * px}px "DejaVu Sans", sans-serif`;
   ctx.textBaseline = 'middle';
   const title = document.getElementById(`${key}-title`);
-  ctx.fillText(title ? title.textContent : key, 10 * px, head / 2);
+  ctx.fillText(title ? title.textContent : key, 10 * px, 14 * px);
+  if (subtitle) {
+    // the scene and the estimators shown: a PNG names what it plots
+    ctx.font = `${12 * px}px "DejaVu Sans", sans-serif`;
+    ctx.fillText(subtitle, 10 * px, 34 * px, out.width - 20 * px);
+  }
   ctx.drawImage(src, 0, head);
   ctx.font = `${12 * px}px "DejaVu Sans", sans-serif`;
   legendItems.forEach((li, i) => {

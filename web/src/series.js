@@ -739,6 +739,34 @@ export function weightHistogram(weights, bins) {
   };
 }
 
+/**
+ * The sample points of a samples answer as CSV: one row per point of each estimator, with its
+ * index, the unit-cube point u, the domain point x, f(x), the density p(x) and the weight f/p
+ * (empty where the answer has no such array). Numbers as JavaScript writes them (round trip).
+ */
+export function samplesCsv(samples) {
+  if (!samples || !Array.isArray(samples.estimators)) return '';
+  const dimOf = (a) => (Array.isArray(a) ? a.length : 0);
+  const du = Math.max(0, ...samples.estimators.map((e) => dimOf(e.u)));
+  const dx = Math.max(0, ...samples.estimators.map((e) => dimOf(e.x)));
+  const head = ['estimator', 'i', ...Array.from({ length: du }, (_, k) => `u${k + 1}`),
+    ...Array.from({ length: dx }, (_, k) => `x${k + 1}`), 'f', 'density', 'weight'];
+  const cell = (v) => (v === null || v === undefined ? '' : String(v));
+  const rows = [head.join(',')];
+  for (const e of samples.estimators) {
+    const n = Math.max(dimOf(e.u) ? e.u[0].length : 0, dimOf(e.x) ? e.x[0].length : 0,
+      Array.isArray(e.weight) ? e.weight.length : 0);
+    const name = /[",\n]/.test(e.name) ? `"${e.name.replace(/"/g, '""')}"` : e.name;
+    for (let i = 0; i < n; ++i) {
+      rows.push([name, i,
+        ...Array.from({ length: du }, (_, k) => cell(e.u && e.u[k] ? e.u[k][i] : null)),
+        ...Array.from({ length: dx }, (_, k) => cell(e.x && e.x[k] ? e.x[k][i] : null)),
+        cell(e.f ? e.f[i] : null), cell(e.density ? e.density[i] : null), cell(e.weight ? e.weight[i] : null)].join(','));
+    }
+  }
+  return `${rows.join('\n')}\n`;
+}
+
 /** What the scatter shows of each estimator of a samples answer (for mcplayDebug and the notes). */
 export function samplesSummary(samples) {
   if (!samples) return null;

@@ -516,3 +516,17 @@ test('equalTimeVerdict: a winner only when the efficiencies differ beyond their 
   const biased = equalTimeVerdict({ a: rec('a', level(1e-4, 1e-3, { mse: 1e-4 })), b: rec('b', level(1e-6, 1e-3, { mse: 1e-2 })) }, ['a', 'b'], 1.0);
   assert.equal(biased.winner, 'a');
 });
+
+test('samplesCsv: one row per point, u and x per coordinate, f, density and weight', async () => {
+  const { samplesCsv } = await import('../src/series.js');
+  const samples = { n: 2, estimators: [
+    { name: 'uniform', u: [[0.1, 0.6], [0.2, 0.7]], x: [[0.1, 0.6], [0.2, 0.7]], f: [1, 2], density: [1, 1], weight: [1, 2] },
+    { name: 'is,odd', u: [[0.5, 0.25]], x: [[0.5, 0.25]], f: [3, 4], density: [2, 0.5], weight: [1.5, 8] },
+  ] };
+  const lines = samplesCsv(samples).trim().split('\n');
+  assert.equal(lines[0], 'estimator,i,u1,u2,x1,x2,f,density,weight');
+  assert.equal(lines[1], 'uniform,0,0.1,0.2,0.1,0.2,1,1,1');
+  assert.equal(lines[3], '"is,odd",0,0.5,,0.5,,3,2,1.5');
+  assert.equal(lines.length, 5);
+  assert.equal(samplesCsv(null), '');
+});

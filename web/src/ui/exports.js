@@ -7,6 +7,7 @@ export function mountExports(store) {
   $('export-csv').addEventListener('click', () => dispatch({ type: 'export/request', payload: { format: 'csv' } }));
   $('export-json').addEventListener('click', () => dispatch({ type: 'export/request', payload: { format: 'json' } }));
   $('copy-link').addEventListener('click', () => dispatch({ type: 'link/copy' }));
+  $('export-samples').addEventListener('click', () => dispatch({ type: 'export/request', payload: { format: 'samples' } }));
   for (const b of document.querySelectorAll('button[data-png]')) {
     b.addEventListener('click', () => dispatch({ type: 'export/request', payload: { format: 'png', plot: b.dataset.png } }));
   }
@@ -18,4 +19,5 @@ export function syncExports(state) {
   $('export-csv').disabled = !has;
   $('export-json').disabled = !has;
   for (const b of document.querySelectorAll('button[data-png]')) b.disabled = !has;
+  $('export-samples').disabled = !state.samples.data;
 }
