@@ -389,6 +389,27 @@ test('a shared link: its invalid values are named, and Run is offered', async ()
   assert.equal(s.params.reps, 32);
 });
 
+test('a phone: Run on the first screen, and Run brings the first plot into view', async () => {
+  const phone = await context.newPage();
+  try {
+    await phone.setViewportSize({ width: 390, height: 844 });
+    await phone.goto(`${url}?scene=exp_1d&n_max=1024&reps=8`);
+    await phone.evaluate(() => window.mcplayDebug.ready);
+    const run = await phone.locator('#run').boundingBox();
+    assert.ok(run && run.y >= 0 && run.y + run.height <= 844, `Run at y = ${run && run.y}`);
+    assert.ok(run.height >= 24 && run.width >= 24);
+    const box = await phone.locator('input[data-estimator="uniform"]').boundingBox();
+    assert.ok(box.width >= 20 && box.height >= 20, `checkbox ${box.width}x${box.height}`);
+    await phone.click('#run');
+    await phone.waitForFunction(() => document.querySelector('#status')?.textContent.startsWith('done'), null, { timeout: 60000 });
+    const plot = await phone.locator('#plot-variance').boundingBox();
+    assert.ok(plot.y < 844 && plot.y + 100 > 0, `the first plot at y = ${plot.y}`);
+    await phone.screenshot({ path: join(shots, 'phone.png') });
+  } finally {
+    await phone.close();
+  }
+});
+
 test('the integration page never downloads the render module', () => {
   // A control that the list holds the workers' requests: the integration module itself.
   assert.ok(requested.some((u) => u.endsWith('/mcplay_web.wasm')), `mcplay_web.wasm not among ${requested.length} requests`);

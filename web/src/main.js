@@ -366,6 +366,10 @@ function startRun() {
   // Draw the run's empty plots before the workers start, so that creating the charts does not
   // compete with the first, shortest levels, whose timings are the most fragile.
   renderHeavy();
+  // On a phone the plots are below the controls: bring the first one into view.
+  if (window.matchMedia && window.matchMedia('(max-width: 699px)').matches) {
+    document.getElementById('plot-variance').closest('figure').scrollIntoView({ block: 'start' });
+  }
   groups.forEach((group, i) => {
     // A scene's own rel_tol / abs_tol (stopping) belong to the race: the run is an N ladder.
     workers[i].request(MSG.RUN, { scene: withoutStopping(s.scene), options: studyOptions(kind, settings, group), warmup: true }, (type, payload) => {
