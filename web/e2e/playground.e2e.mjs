@@ -410,6 +410,18 @@ test('a phone: Run on the first screen, and Run brings the first plot into view'
   }
 });
 
+test('accessibility: axe-core finds no serious or critical WCAG 2 A/AA violation after a study', async () => {
+  await page.goto(`${url}?scene=exp_1d&n_max=1024&reps=8`);
+  await page.evaluate(() => window.mcplayDebug.ready);
+  await page.click('#run');
+  await page.waitForFunction(() => document.querySelector('#status')?.textContent.startsWith('done'), null, { timeout: 60000 });
+  await page.addScriptTag({ path: join(here, '..', 'node_modules', 'axe-core', 'axe.min.js') });
+  const result = await page.evaluate(() => window.axe.run(document, { runOnly: { type: 'tag', values: ['wcag2a', 'wcag2aa'] } }));
+  const serious = result.violations.filter((v) => v.impact === 'serious' || v.impact === 'critical');
+  assert.deepEqual(serious.map((v) => `${v.id}: ${v.help} (${v.nodes.map((n) => n.target.join(' ')).slice(0, 3).join('; ')})`), []);
+  console.log(`# axe: ${result.passes.length} rules passed, ${result.violations.length} minor or moderate violations`);
+});
+
 test('the integration page never downloads the render module', () => {
   // A control that the list holds the workers' requests: the integration module itself.
   assert.ok(requested.some((u) => u.endsWith('/mcplay_web.wasm')), `mcplay_web.wasm not among ${requested.length} requests`);

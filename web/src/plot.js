@@ -158,7 +158,8 @@ function onLegendClick(e) {
   }
   for (const item of document.querySelectorAll('.legend li[data-series]')) {
     item.classList.toggle('off', hiddenSeries.has(item.dataset.series));
-    item.setAttribute('aria-pressed', String(!hiddenSeries.has(item.dataset.series)));
+    const b = item.querySelector('button.toggle');
+    if (b) b.setAttribute('aria-pressed', String(!hiddenSeries.has(item.dataset.series)));
   }
   for (const c of Object.values(charts)) {
     applyHidden(c);
@@ -288,13 +289,19 @@ function setLegend(key, ul, items) {
   const sig = JSON.stringify(items);
   if (legendSigs[key] === sig && ul.childElementCount === items.length) return;
   legendSigs[key] = sig;
+  // An estimator's entry: its name is a toggle button (hide or show it in every plot).
+  const nameOf = (it) => {
+    if (it.ref) return el('span', { className: 'name ref' }, it.name);
+    const b = el('button', { type: 'button', className: 'name toggle', title: 'click: hide or show in every plot; Shift+click: show only this one' }, it.name);
+    b.setAttribute('aria-pressed', String(!hiddenSeries.has(it.name)));
+    return b;
+  };
   ul.replaceChildren(...items.map((it) => el('li', {
     dataset: { ...(it.data || {}), ...(it.ref ? {} : { series: it.name }) },
-    ...(it.ref ? {} : { className: hiddenSeries.has(it.name) ? 'off' : '', tabIndex: 0, role: 'button',
-      title: 'click: hide or show in every plot; Shift+click: show only this one' }),
+    ...(it.ref ? {} : { className: hiddenSeries.has(it.name) ? 'off' : '' }),
   },
     swatch(it.color, it.dashed),
-    el('span', { className: it.ref ? 'name ref' : 'name' }, it.name),
+    nameOf(it),
     ...(it.parts || []).map((p) => (typeof p === 'string' ? p : p.fit !== undefined
       ? el('span', { className: 'fit', dataset: { fit: p.name } }, p.fit)
       : p.warning ? badge(p.warning) : el('span', { className: p.className || '' }, p.text))))));
@@ -317,13 +324,7 @@ export function initPlots(elements) {
   }
   for (const [k, ul] of Object.entries(dom)) {
     if (!k.startsWith('legend-') || !ul) continue;
-    ul.addEventListener('click', onLegendClick);
-    ul.addEventListener('keydown', (e) => {
-      if (e.key === 'Enter' || e.key === ' ') {
-        e.preventDefault();
-        onLegendClick(e);
-      }
-    });
+    ul.addEventListener('click', onLegendClick); // the name buttons take Enter and Space
   }
 }
 
