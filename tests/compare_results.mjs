@@ -7,7 +7,7 @@
 import { readFileSync } from 'node:fs';
 
 const [a, b] = process.argv.slice(2).map((f) => JSON.parse(readFileSync(f, 'utf8')));
-const ignored = new Set(['time_mean_s', 'time_std_s', 'time_total_s', 'training_time_mean_s', 'efficiency', 'wall_time_s', 'threads',
+const ignored = new Set(['time_mean_s', 'time_std_s', 'time_median_s', 'time_median_ci95_s', 'time_total_s', 'training_time_mean_s', 'efficiency', 'wall_time_s', 'threads',
   'rays_per_second', 'seconds', 'file']);
 let worst = 0, worstPath = '', worstDerived = 0, worstDerivedPath = '', mismatches = [];
 const scaleOf = (r) => {

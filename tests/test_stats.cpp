@@ -117,3 +117,22 @@ TEST(Stats, WeightedLineFit) {
     EXPECT_EQ(h.slope, u.slope);
     EXPECT_EQ(h.slope_se, u.slope_se);
 }
+
+// The median's order-statistic interval [DavidNagaraja03, 7.1]: for n = 10, [x_(2), x_(9)] at
+// level 1 - 2 * 11/1024; for n = 5 the whole range, at its own level 1 - 2/32; unsorted input.
+TEST(Stats, MedianIntervalFromOrderStatistics) {
+    std::vector<double> ten{10, 9, 8, 7, 6, 5, 4, 3, 2, 1};
+    const MedianInterval m = median_interval(ten);
+    EXPECT_DOUBLE_EQ(m.median, 5.5);
+    EXPECT_DOUBLE_EQ(m.lo, 2.0);
+    EXPECT_DOUBLE_EQ(m.hi, 9.0);
+    EXPECT_NEAR(m.level, 1.0 - 22.0 / 1024.0, 1e-15);
+    std::vector<double> five{3, 1, 5, 2, 4};
+    const MedianInterval s = median_interval(five);
+    EXPECT_DOUBLE_EQ(s.median, 3.0);
+    EXPECT_DOUBLE_EQ(s.lo, 1.0);
+    EXPECT_DOUBLE_EQ(s.hi, 5.0);
+    EXPECT_NEAR(s.level, 1.0 - 2.0 / 32.0, 1e-15);
+    std::vector<double> none;
+    EXPECT_EQ(median_interval(none).level, 0.0);
+}

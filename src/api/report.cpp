@@ -317,6 +317,8 @@ Json level_to_json(const LevelStats& l) {
            {"run_dof", l.run_dof},
            {"time_mean_s", num(l.time_mean)},
            {"time_std_s", num(l.time_std)}, // over the replicates: the timing's own noise
+           {"time_median_s", num(l.time_median)},
+           {"time_median_ci95_s", {num(l.time_median_lo), num(l.time_median_hi)}},
            {"time_total_s", num(l.time_total)},
            // Adaptive estimators: the share of the calls and the seconds per estimate spent
            // training or probing (in n and time_mean_s too; 0 for fixed estimators).

@@ -173,4 +173,29 @@ void allocate_largest_remainders(uint64_t points, const std::vector<double>& sha
     for (size_t k = 0; given < points; k = (k + 1) % n, ++given) ++(*counts)[remainders[k].second];
 }
 
+MedianInterval median_interval(std::vector<double>& values, double level) {
+    MedianInterval m;
+    const size_t n = values.size();
+    if (n == 0) return m;
+    std::sort(values.begin(), values.end());
+    m.median = n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+    // P(B <= k) for B ~ Binomial(n, 1/2), term by term in logs (n may be large).
+    const double log_half_n = -static_cast<double>(n) * std::log(2.0);
+    double log_term = log_half_n; // log P(B = 0)
+    double cdf = std::exp(log_term);
+    size_t j = 1;
+    m.level = 1.0 - 2.0 * cdf;
+    for (size_t k = 1; 2 * k < n; ++k) {
+        log_term += std::log(static_cast<double>(n - k + 1) / static_cast<double>(k));
+        cdf += std::exp(log_term);
+        const double cover = 1.0 - 2.0 * cdf;
+        if (cover < level) break;
+        j = k + 1;
+        m.level = cover;
+    }
+    m.lo = values[j - 1];
+    m.hi = values[n - j];
+    return m;
+}
+
 } // namespace mcp

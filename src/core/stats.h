@@ -120,4 +120,14 @@ LineFit fit_line(const std::vector<double>& x, const std::vector<double>& y);
 LineFit fit_weighted_line(const std::vector<double>& x, const std::vector<double>& y,
                           const std::vector<double>& sd);
 
+/// The median of n values and its distribution-free confidence interval from order statistics
+/// [DavidNagaraja03, 7.1]: [x_(j), x_(n+1-j)] covers the median with probability
+/// 1 - 2 P(B < j), B ~ Binomial(n, 1/2); j is the largest with that at least `level`, or 1 (the
+/// whole range, with its own lower level) when n is too small. Sorts `values`.
+struct MedianInterval {
+    double median = 0.0, lo = 0.0, hi = 0.0;
+    double level = 0.0; ///< the interval's exact coverage
+};
+MedianInterval median_interval(std::vector<double>& values, double level = 0.95);
+
 } // namespace mcp

@@ -431,6 +431,8 @@ LevelStats summarise_level(const std::vector<RunResult>& runs, const Problem& pr
     s.run_dof = runs[0].dof;
     const double run_quantile = interval_quantile(s.run_dof);
     RunningMoments est, se, times;
+    std::vector<double> seconds;
+    seconds.reserve(runs.size());
     NeumaierSum sq_err, time, training_time;
     double training_share = 0.0;
     int covered = 0, se_count = 0;
@@ -460,6 +462,7 @@ LevelStats summarise_level(const std::vector<RunResult>& runs, const Problem& pr
         est.add(r.estimate);
         time.add(r.seconds);
         times.add(r.seconds);
+        seconds.push_back(r.seconds);
         training_time.add(r.training_seconds);
         training_share +=
             r.n > 0 ? static_cast<double>(r.training_n) / static_cast<double>(r.n) : 0.0;
@@ -507,6 +510,11 @@ LevelStats summarise_level(const std::vector<RunResult>& runs, const Problem& pr
     s.time_total = time.value();
     s.time_mean = s.time_total / R;
     s.time_std = std::sqrt(times.variance());
+    // The median and its 95% interval: robust to the replicate that a busy machine delayed.
+    const MedianInterval mi = median_interval(seconds);
+    s.time_median = mi.median;
+    s.time_median_lo = mi.lo;
+    s.time_median_hi = mi.hi;
     s.training_time_mean = training_time.value() / R;
     s.training_share = training_share / R;
     s.efficiency = s.variance > 0.0 && s.time_mean > 0.0 ? 1.0 / (s.variance * s.time_mean)

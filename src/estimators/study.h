@@ -88,6 +88,8 @@ struct LevelStats {
     int run_dof = 0;                ///< degrees of freedom of the runs' error bars (RunResult::dof)
     double time_mean = 0.0;         ///< seconds per estimate
     double time_std = 0.0;          ///< their standard deviation over the replicates
+    double time_median = 0.0;       ///< the replicates' median seconds per estimate
+    double time_median_lo = 0.0, time_median_hi = 0.0; ///< its 95% interval (order statistics)
     double time_total = 0.0;
     /// Adaptive estimators: mean share of the calls and mean seconds per estimate spent
     /// training (VEGAS) or probing (MISER), included in n and time_mean.

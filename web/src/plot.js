@@ -483,8 +483,22 @@ function pathsInOrder(getPaths) {
     ctx.beginPath();
     ctx.rect(u.bbox.left, u.bbox.top, u.bbox.width, u.bbox.height);
     ctx.clip();
-    for (const { name, color, points, dash = null } of getPaths()) {
+    for (const { name, color, points, dash = null, whiskers = [] } of getPaths()) {
       if (hiddenSeries.has(name)) continue;
+      // each point's timing interval (95%, over the replicates), with end caps
+      ctx.strokeStyle = color;
+      ctx.lineWidth = 1 * px;
+      ctx.setLineDash([]);
+      for (const [lo, hi, y] of whiskers) {
+        const cy = u.valToPos(y, 'y', true);
+        const x0 = u.valToPos(lo, 'x', true);
+        const x1 = u.valToPos(hi, 'x', true);
+        ctx.beginPath();
+        ctx.moveTo(x0, cy); ctx.lineTo(x1, cy);
+        ctx.moveTo(x0, cy - 3 * px); ctx.lineTo(x0, cy + 3 * px);
+        ctx.moveTo(x1, cy - 3 * px); ctx.lineTo(x1, cy + 3 * px);
+        ctx.stroke();
+      }
       ctx.strokeStyle = color;
       ctx.lineWidth = (dash ? 1.5 : 2) * px;
       ctx.setLineDash(dash ? dash.map((v) => v * px) : []);
@@ -509,7 +523,10 @@ function renderTime(state, run, records) {
     const color = colorOf(run, s.name);
     return { label: s.name, stroke: color, width: 2, paths: noLine, points: { show: true, size: 7, fill: color } };
   })];
-  const lines = ts.series.map((s) => ({ name: s.name, color: colorOf(run, s.name), points: s.points.map(([t, e]) => [t, lg(e)]) }));
+  const lines = ts.series.map((s) => ({
+    name: s.name, color: colorOf(run, s.name), points: s.points.map(([t, e]) => [t, lg(e)]),
+    whiskers: s.whiskers.map(([lo, hi, e]) => [lo, hi, lg(e)]),
+  }));
   // Adaptive estimators: dashed, the error at the time spent estimating only; the gap to the
   // solid line is what training (VEGAS) or probing (MISER) cost.
   for (const s of ts.series) {

@@ -213,10 +213,28 @@ export function fitSlope(xs, ys) {
  * pairs) and `trainingShare` (the mean share of the time spent training or probing; null for
  * the others).
  */
+/** The seconds per estimate a level is plotted at: the replicates' median (robust to the one
+ *  that a busy machine delayed), or their mean when the level has no median. */
+export function timeOf(l) {
+  return positive(l.time_median_s) !== null ? l.time_median_s : l.time_mean_s;
+}
+
+/** The 95% interval of timeOf(l): the median's order-statistic interval, else the mean's t-free
+ *  normal interval from time_std_s; null when neither is known. */
+export function timeInterval(l) {
+  const ci = l.time_median_ci95_s;
+  if (Array.isArray(ci) && positive(ci[0]) !== null && positive(ci[1]) !== null) return [ci[0], ci[1]];
+  if (positive(l.time_std_s) !== null && (l.reps || 0) > 1 && positive(l.time_mean_s) !== null) {
+    const h = 1.959963984540054 * l.time_std_s / Math.sqrt(l.reps);
+    return [Math.max(l.time_mean_s - h, l.time_mean_s * 1e-3), l.time_mean_s + h];
+  }
+  return null;
+}
+
 export function timeSeries(records, order) {
   const named = order.filter((n) => records[n]);
   const pts = named.map((name) => records[name].levels
-    .map((l) => [positive(l.time_mean_s), positive(l.error)])
+    .map((l) => [positive(timeOf(l)), positive(l.error)])
     .filter(([t, e]) => t !== null && e !== null));
   const x = unionSorted(pts.flat().map(([t]) => t));
   const index = new Map(x.map((t, i) => [t, i]));
@@ -226,21 +244,24 @@ export function timeSeries(records, order) {
     const fit = fitSlope(pts[k].map((p) => p[0]), pts[k].map((p) => p[1]));
     // Adaptive estimators: the same errors at the time spent estimating only (training or
     // probing left out), and the mean share of the time that training took.
-    const levels = records[name].levels.filter((l) => positive(l.time_mean_s) !== null && positive(l.error) !== null);
+    const levels = records[name].levels.filter((l) => positive(timeOf(l)) !== null && positive(l.error) !== null);
     const trained = levels.filter((l) => l.training_time_mean_s > 0 && l.training_time_mean_s < l.time_mean_s);
-    const estimating = trained.map((l) => [l.time_mean_s - l.training_time_mean_s, l.error]);
+    const estimating = trained.map((l) => [timeOf(l) * (1 - l.training_time_mean_s / l.time_mean_s), l.error]);
     const trainingShare = trained.length
       ? trained.reduce((a, l) => a + l.training_time_mean_s / l.time_mean_s, 0) / trained.length : null;
-    return { name, y, points: pts[k], slope: fit ? fit.slope : null, estimating, trainingShare };
+    // The timing's own uncertainty: the 95% interval of the median seconds over the replicates.
+    const whiskers = levels.map((l) => timeInterval(l)).map((ci, i) => (ci ? [ci[0], ci[1], levels[i].error] : null))
+      .filter(Boolean);
+    return { name, y, points: pts[k], slope: fit ? fit.slope : null, estimating, trainingShare, whiskers };
   });
   return { x, series };
 }
 
 /**
  * Who wins at equal time: the efficiency 1 / (error² × seconds) of each estimator at the
- * largest N it reached (the MSE when the exact value is known, else the variance), with its
- * uncertainty in log space from the error's chi-square interval (variance_ci95) and the timing's
- * spread over the replicates (time_std_s / sqrt(reps)). The most efficient is named only when a
+ * largest N it reached (the MSE when the exact value is known, else the variance; the median
+ * seconds), with its uncertainty in log space from the error's chi-square interval
+ * (variance_ci95) and the timing's (timeInterval). The most efficient is named only when a
  * z test on the log efficiencies separates it from the next (|z| > 1.96); an estimator exact to
  * round-off wins at any time. Returns {text, ranked: [{name, efficiency, lo, hi, n}], winner}.
  */
@@ -258,13 +279,13 @@ export function equalTimeVerdict(records, order, exact = null) {
     }
     const v = l.variance;
     const q = useMse && positive(l.mse) !== null ? l.mse : v;
-    const t = l.time_mean_s;
+    const t = timeOf(l);
     if (positive(q) === null || positive(t) === null) continue;
     const ci = l.variance_ci95;
     const seLogQ = ci && positive(ci[0]) !== null && positive(ci[1]) !== null
       ? (Math.log(ci[1]) - Math.log(ci[0])) / (2 * 1.959963984540054) : null;
-    const reps = l.reps || (l.replicates ? l.replicates.estimate.length : 0);
-    const seLogT = positive(l.time_std_s) !== null && reps > 1 ? l.time_std_s / Math.sqrt(reps) / t : 0;
+    const tci = timeInterval(l);
+    const seLogT = tci ? (Math.log(tci[1]) - Math.log(tci[0])) / (2 * 1.959963984540054) : 0;
     const logE = -Math.log(q) - Math.log(t);
     const se = seLogQ === null ? null : Math.sqrt(seLogQ * seLogQ + seLogT * seLogT);
     rows.push({ name, n: l.n, efficiency: Math.exp(logE), logE, se,
