@@ -169,6 +169,27 @@ test('legends: a click hides an estimator in every plot, Shift+click isolates on
   await page.mouse.move(0, 0);
 });
 
+test('compare two runs: a kept run is drawn dashed beside the next one of the same scene', async () => {
+  await page.click('#keep-run');
+  assert.equal((await page.evaluate(() => window.mcplayDebug.state())).kept.label, 'N 16..4096, 32 reps, seed 1');
+  await page.fill('#n-max', '1024');
+  await page.fill('#reps', '16');
+  await page.click('#run');
+  await page.waitForFunction(() => document.querySelector('#status')?.textContent.startsWith('done'), null,
+    { timeout: 60000 });
+  const names = await page.$$eval('#legend-variance li[data-series]', (lis) => lis.map((li) => li.dataset.series));
+  assert.deepEqual(names, ['uniform', 'stratified_polar', 'uniform (kept)', 'stratified_polar (kept)']);
+  assert.match(await page.textContent('#legend-variance'), /N 16\.\.4096, 32 reps, seed 1: order -/);
+  await page.locator('#variance-title >> xpath=../..').screenshot({ path: join(shots, 'compare_runs.png') });
+  await page.click('#keep-run'); // clears
+  assert.equal((await page.evaluate(() => window.mcplayDebug.state())).kept, null);
+  // back to the settings of the test above, for the exports below
+  await configure('disk_third', ['uniform', 'stratified_polar'], { nMin: 16, nMax: 4096, reps: 32, seed: 1 });
+  await page.click('#run');
+  await page.waitForFunction(() => document.querySelector('#status')?.textContent.startsWith('done'), null,
+    { timeout: 60000 });
+});
+
 test('exports: a plot PNG and the sample points as CSV, named after the scene', async () => {
   const [png] = await Promise.all([page.waitForEvent('download'), page.click('button[data-png="variance"]')]);
   assert.match(png.suggestedFilename(), /^mcplay-disk_third-N16-4096-R32-seed1-variance\.png$/);

@@ -8,6 +8,7 @@ import {
   decadeRange, fitText, fmt, curveOverlay, misWeightCurves, weightBins, weightHistogram, domainView, mapFor, mappedGrid,
 } from './series.js';
 import { colorAt, withAlpha } from './palette.js';
+import { keptFor } from './state.js';
 import { el } from './dom.js';
 
 const FONT = '12px "DejaVu Sans", system-ui, sans-serif';
@@ -402,7 +403,10 @@ function renderVariance(state, run, records) {
   const render = isRender(run);
   const names = runLabels(run);
   // A render level's variance is its relative MSE against the reference (mse is the same number).
-  const vs = varianceSeries(records, run.order, render ? null : run.exact, run.ladder);
+  // With a run kept for comparison (same scene), the x axis spans both ladders.
+  const kept = keptFor(state);
+  const xs = kept ? [...new Set([...run.ladder, ...kept.ladder])].sort((a, b) => a - b) : run.ladder;
+  const vs = varianceSeries(records, run.order, render ? null : run.exact, xs);
   const anchor = anchorOf(vs.x, vs.series);
   const orders = render ? [1] : [1, 2, 3];
   const refs = referenceLines(vs.x, anchor, orders);
@@ -420,6 +424,14 @@ function renderVariance(state, run, records) {
     );
     bands.push({ series: [yi + 1, yi + 2], fill: withAlpha(color, 0.14) });
   });
+  // The kept run's variance, dashed and lighter.
+  const keptSeries = kept ? varianceSeries(kept.records, kept.order, render ? null : kept.exact, vs.x).series : [];
+  keptSeries.forEach((s) => {
+    const color = colorOf(run, s.name);
+    data.push(lgAll(s.y));
+    series.push({ label: `${s.name} (kept)`, stroke: withAlpha(color, 0.7), width: 1.5, dash: [5, 4],
+      points: { show: true, size: 4, fill: '#fff' } });
+  });
   // Three reference series always (all null until there is a first point), so the chart keeps
   // its series while the levels stream in.
   const refItems = [];
@@ -428,7 +440,7 @@ function renderVariance(state, run, records) {
     data.push(refs[i] ? lgAll(refs[i].y) : vs.x.map(() => null));
     series.push({ label, stroke: '#8a8f96', width: 1, dash: [6, 5], points: { show: false } });
   });
-  const values = vs.series.flatMap((s) => [...s.y, ...s.lo, ...s.hi]);
+  const values = [...vs.series.flatMap((s) => [...s.y, ...s.lo, ...s.hi]), ...keptSeries.flatMap((s) => s.y)];
   const yRange = log10Range(values);
   // Exact levels, drawn as a labelled row along the bottom (the hook reads the latest rows).
   exactRows = vs.series.filter((s) => s.exactAt.some(Boolean)).map((s) => ({ color: colorOf(run, s.name), exactAt: s.exactAt }));
@@ -441,7 +453,8 @@ function renderVariance(state, run, records) {
       : vs.quantity === 'mse' ? 'MSE against N (exact value known)' : 'Variance against N';
   }
   setText('variance-note', VARIANCE_NOTE[render ? 'render' : 'integral']);
-  const sig = JSON.stringify([vs.quantity, run.order, run.colors, run.kind, names.nAxis, quantity]);
+  const sig = JSON.stringify([vs.quantity, run.order, run.colors, run.kind, names.nAxis, quantity,
+    keptSeries.map((k) => k.name)]);
   draw('variance', dom.variance, sig, (c) => ({
     scales: { x: logX(c, 2), y: log10Y(c) },
     axes: [
@@ -470,7 +483,12 @@ function renderVariance(state, run, records) {
         ...(r.warnings || []).map((w) => ({ warning: w })),
       ],
     };
-  }));
+  }).concat(keptSeries.map((k) => ({
+    name: `${k.name} (kept)`,
+    color: withAlpha(colorOf(run, k.name), 0.7),
+    dashed: true,
+    parts: [{ text: `${kept.label}: order ${fitText(k.fit)}`, className: 'fit' }],
+  }))));
 }
 
 /** Joins each series' points in the order of N (time is not monotone in N: uPlot's own

@@ -449,6 +449,8 @@ export function initialState() {
     // render scenes: a quick image of the scene ({key, status, png, spp, estimator, message})
     scenePreview: null,
     race: emptyRace({ ...RACE_DEFAULTS }),
+    // a finished run kept for comparison: drawn dashed beside the next runs of the same scene
+    kept: null,
   };
 }
 
@@ -669,6 +671,20 @@ export function reducer(state, action) {
       if (!state.scenePreview || p.key !== state.scenePreview.key) return state;
       return { ...state, scenePreview: { ...state.scenePreview, status: 'error', message: p.message } };
 
+    case 'compare/keep': {
+      // {label}: the current run, finished, kept with what it was run with
+      const r = state.run;
+      if (r.status !== 'done' || !r.order.some((n) => r.records[n])) return state;
+      return {
+        ...state,
+        kept: {
+          sceneId: state.sceneId, label: p.label || keptLabel(r), order: r.order.slice(),
+          records: r.records, ladder: r.ladder.slice(), exact: r.exact, kind: r.kind,
+        },
+      };
+    }
+    case 'compare/clear':
+      return { ...state, kept: null };
     case 'race/edit':
       if (!Object.prototype.hasOwnProperty.call(RACE_DEFAULTS, p.field)) return state;
       return { ...state, race: { ...state.race, inputs: { ...state.race.inputs, [p.field]: String(p.value) } } };
@@ -790,6 +806,17 @@ function raceInputsFor(inputs, scene) {
   return t.relTol || t.absTol ? { ...inputs, ...t } : inputs;
 }
 
+/** How a kept run is named: its settings, e.g. "N 16..65536, 32 reps, seed 1". */
+export function keptLabel(run) {
+  const st = run.settings || {};
+  return `${run.kind === KIND.RENDER ? 'spp' : 'N'} ${st.n_min}..${st.n_max}, ${st.reps} reps, seed ${st.seed}`;
+}
+
+/** The kept run, when it belongs to the scene shown (a kept run of another problem is not drawn). */
+export function keptFor(state) {
+  return state.kept && state.kept.sceneId === state.sceneId ? state.kept : null;
+}
+
 /** The #status text of a state. */
 export function statusText(state) {
   const r = state.run;
@@ -853,6 +880,7 @@ export function debugSnapshot(state) {
     }),
     result: r.result,
     // the race to a requested accuracy: its status and the stopping result so far
+    kept: state.kept ? { sceneId: state.kept.sceneId, label: state.kept.label, order: state.kept.order.slice() } : null,
     race: { status: state.race.status, message: state.race.message, inputs: { ...state.race.inputs },
       order: state.race.order.slice(), result: raceResult(state.race) },
     // the sample points drawn: per estimator the number of points, its strata; weights: n, zeros

@@ -455,3 +455,21 @@ test('urlProblems names every value of a link that cannot be used, and nothing e
   assert.deepEqual(urlProblems('?n_min=17&n_max=31'), ['n_min=17 and n_max=31 hold no power of two']);
   assert.deepEqual(urlProblems('?n_max=2048&width=9', null, KIND.RENDER), ['width=9 is not a whole number in 16..256']);
 });
+
+test('a finished run kept for comparison belongs to its scene', async () => {
+  const { keptFor, keptLabel } = await import('../src/state.js');
+  let s = initialState();
+  s = reducer(s, { type: 'core/ready', payload: { version: '0.1.0' } });
+  s = reducer(s, { type: 'scene/loaded', payload: { sceneId: 'exp_1d', scene: {}, info: { estimators: ['uniform'], n_min: 16, n_max: 64 } } });
+  s = reducer(s, { type: 'run/start', payload: { id: 1, workers: 1, settings: { n_min: 16, n_max: 64, reps: 4, seed: 1 }, order: ['uniform'], exact: 1, sceneName: 'exp_1d', startedAt: 0 } });
+  assert.equal(reducer(s, { type: 'compare/keep', payload: {} }), s, 'a running study cannot be kept');
+  s = reducer(s, { type: 'run/partial', payload: { id: 1, now: 5, result: { estimators: [{ name: 'uniform', levels: [{ n: 16 }], warnings: [] }] } } });
+  assert.equal(s.run.status, 'done');
+  s = reducer(s, { type: 'compare/keep', payload: {} });
+  assert.equal(keptFor(s).label, 'N 16..64, 4 reps, seed 1');
+  assert.equal(keptLabel(s.run), 'N 16..64, 4 reps, seed 1');
+  s = reducer(s, { type: 'scene/loaded', payload: { sceneId: 'disk_third', scene: {}, info: { estimators: ['uniform'], n_min: 16, n_max: 64 } } });
+  assert.equal(keptFor(s), null, 'not drawn on another scene');
+  s = reducer(s, { type: 'compare/clear' });
+  assert.equal(s.kept, null);
+});
