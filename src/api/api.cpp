@@ -321,12 +321,15 @@ int mcp_scene_info(const char* scene_json, char** info_json) {
     if (!req.ok()) return mcp::boundary::request_error(req.error);
     const mcp::Problem& p = req.value.problem;
     mcp::Json names = mcp::Json::array(), more = mcp::Json::array(), details = mcp::Json::array();
+    auto detail = [](const mcp::EstimatorSpec& e) {
+        return mcp::Json{{"name", e.name},
+                         {"method", mcp::estimator_method(e)},
+                         {"sampler", mcp::sampler_name(e.sampler)},
+                         {"pdf", mcp::describe_sampling(e)}};
+    };
     for (const mcp::EstimatorSpec& e : req.value.estimators) {
         names.push_back(e.name);
-        details.push_back({{"name", e.name},
-                           {"method", mcp::estimator_method(e)},
-                           {"sampler", mcp::sampler_name(e.sampler)},
-                           {"pdf", mcp::describe_sampling(e)}});
+        details.push_back(detail(e));
     }
     // The uniform-density presets the scene does not list: options.estimators can run them too.
     for (const mcp::EstimatorPreset& preset : mcp::estimator_presets()) {
@@ -335,16 +338,10 @@ int mcp_scene_info(const char* scene_json, char** info_json) {
             listed = listed || e.name == preset.name;
         if (listed || preset.needs_pdf) continue;
         more.push_back(preset.name);
-        // its method, from the estimator the preset builds on this scene's domain
-        mcp::Made<mcp::SceneRequest> one =
-            mcp::build_request(scene.value, mcp::Json{{"estimators", {preset.name}}});
-        if (one.ok() && one.value.estimators.size() == 1) {
-            const mcp::EstimatorSpec& e = one.value.estimators.front();
-            details.push_back({{"name", e.name},
-                               {"method", mcp::estimator_method(e)},
-                               {"sampler", mcp::sampler_name(e.sampler)},
-                               {"pdf", mcp::describe_sampling(e)}});
-        }
+        // its method, from the estimator the preset gives on this scene's problem (the scene is
+        // not built again: its own tabulated pdfs may cost millions of evaluations)
+        const mcp::Made<mcp::EstimatorSpec> e = mcp::preset_estimator(p, preset.name);
+        if (e.ok()) details.push_back(detail(e.value));
     }
     mcp::Json info{{"name", p.name},
                    {"description", p.description},

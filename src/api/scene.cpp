@@ -1146,6 +1146,14 @@ const std::vector<EstimatorPreset>& estimator_presets() {
     return presets;
 }
 
+Made<EstimatorSpec> preset_estimator(const Problem& problem, const std::string& name) {
+    Ctx c;
+    EstimatorSpec spec;
+    if (!parse_estimator(c, Json(name), "estimator", problem, &spec))
+        return made_error<EstimatorSpec>(c.error);
+    return Made<EstimatorSpec>{spec, ""};
+}
+
 Made<SceneRequest> build_request(const Json& scene, const Json& options) {
     Ctx c;
     SceneRequest req;

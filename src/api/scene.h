@@ -34,6 +34,9 @@ struct EstimatorPreset {
     bool vegas = false; ///< trains a VEGAS map first
 };
 const std::vector<EstimatorPreset>& estimator_presets();
+/// The estimator a preset name gives on a problem (as options.estimators would run it),
+/// without building the scene again; an error when it does not apply.
+Made<EstimatorSpec> preset_estimator(const Problem& problem, const std::string& name);
 
 constexpr int kResultSchemaVersion = 1;
 
