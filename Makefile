@@ -108,8 +108,8 @@ test-web-core: build build-wasm deps-web
 	MCPLAY_WASM_DIR=$(BUILD_WASM) MCPLAY_NATIVE=$(BUILD)/mcplay node --test web/test/
 
 # The playground: page, wasm module, uPlot and the scenes with their manifest.
-site: build-wasm deps-web
-	node web/tools/build-site.mjs $(SITE) $(BUILD_WASM)
+site: build build-wasm deps-web
+	node web/tools/build-site.mjs $(SITE) $(BUILD_WASM) $(BUILD)/mcplay
 
 # The page in headless Chromium, checked against the native CLI; screenshots in build/e2e.
 test-e2e: build site
@@ -137,7 +137,7 @@ cli: build
 
 bench: build build-wasm site
 	bash bench/run_bench.sh $(BUILD)/mcplay_bench "$(NODE_RUN) --no-liftoff $(BUILD_WASM)/mcplay_bench.js"
-	node web/e2e/first_plot.bench.mjs $(SITE) exp_1d 5
+	node web/e2e/first_plot.bench.mjs $(SITE) all 3
 	$(MAKE) --no-print-directory bench-genz
 	$(MAKE) --no-print-directory bench-flags
 

@@ -143,5 +143,17 @@ printf '{"render": {"gltf": "quad_light_floor.gltf", "spp_max": 4, "estimators":
 cp scenes/quad_light_floor.gltf "$tmp/own/"
 check render-sobol-reference-spp 3 "scene.render.reference.spp: the 'sobol' pixel sampler needs a power-of-two spp, got 100" -- run "$tmp/own/sobol_ref.json" --no-cache
 
+# References made once: `reference` writes one, and the cache it fills serves the next run.
+check reference-write 0 'quad_light_floor: reference 8x6 at [0-9]+ spp \(mis_power, rendered\)' -- reference quad_light_floor --width 8 --height 6 --out "$tmp/q.mcref" --cache "$tmp/refcache"
+if [ "$(head -c 8 "$tmp/q.mcref")" != "MCREF02" ]; then
+    echo "FAIL reference-write: $tmp/q.mcref does not start with the magic"; failed=$((failed + 1))
+fi
+check reference-cached 0 '\(mis_power, cache\)' -- reference quad_light_floor --width 8 --height 6 --out "$tmp/q2.mcref" --cache "$tmp/refcache"
+if ! cmp -s "$tmp/q.mcref" "$tmp/q2.mcref"; then
+    echo "FAIL reference-cached: the cached reference differs from the rendered one"; failed=$((failed + 1))
+fi
+check reference-no-out 2 'reference needs --out' -- reference quad_light_floor
+check reference-integral 2 'reference is for render scenes' -- reference exp_1d --out "$tmp/x.mcref"
+
 echo "$passed passed, $failed failed"
 [ "$failed" = 0 ]

@@ -534,9 +534,10 @@ TEST(RenderHonesty, ReferenceCacheReaderChecksEverything) {
     im.spp = 64;
     im.rgb.assign(18, 0.5);
     im.variance.assign(18, 0.01);
-    ASSERT_TRUE(write_reference_cache(file, im));
+    const uint64_t key = 0x1234abcd5678ef90ull;
+    ASSERT_TRUE(write_reference_cache(file, im, key));
     RenderImage back;
-    ASSERT_TRUE(read_reference_cache(file, &back));
+    ASSERT_TRUE(read_reference_cache(file, key, &back));
     EXPECT_EQ(back.rgb, im.rgb);
     EXPECT_EQ(back.variance, im.variance);
     EXPECT_EQ(back.spp, 64u);
@@ -548,14 +549,14 @@ TEST(RenderHonesty, ReferenceCacheReaderChecksEverything) {
         }
         RenderImage x;
         x.width = 7;
-        bool ok = read_reference_cache(file, &x);
+        bool ok = read_reference_cache(file, key, &x);
         EXPECT_EQ(x.width, 7); // untouched
         return !ok;
     };
     auto with_header = [&](int64_t w, int64_t h, int64_t spp) {
         std::string b = good;
         int64_t head[3] = {w, h, spp};
-        b.replace(8, sizeof head, reinterpret_cast<const char*>(head), sizeof head);
+        b.replace(16, sizeof head, reinterpret_cast<const char*>(head), sizeof head);
         return b;
     };
     EXPECT_TRUE(rejected(good.substr(0, good.size() - 1))); // truncated
@@ -566,10 +567,157 @@ TEST(RenderHonesty, ReferenceCacheReaderChecksEverything) {
     EXPECT_TRUE(rejected(with_header(3, 2, 0)));            // no spp
     std::string inf = good;
     double big = INFINITY;
-    std::memcpy(&inf[32], &big, sizeof big);
+    std::memcpy(&inf[40], &big, sizeof big);
     EXPECT_TRUE(rejected(inf)); // an infinite mean
+    EXPECT_TRUE(rejected(good.substr(0, 8) + std::string(8, 'k') + good.substr(16))); // other key
     RenderImage x;
-    EXPECT_FALSE(read_reference_cache(dir, &x)); // a directory
+    EXPECT_FALSE(read_reference_cache(dir, key, &x)); // a directory
+}
+
+// Base64 as RFC 4648 defines it, both ways, and nothing else decoded.
+TEST(RenderHonesty, Base64RoundTripsAndRefusesWhatIsNotBase64) {
+    for (const std::string& bytes : {std::string(), std::string("f"), std::string("fo"),
+                                     std::string("foo"), std::string("foob"),
+                                     std::string("\0\xff\x10\x80", 4)}) {
+        std::string back = "x";
+        ASSERT_TRUE(base64_decode(base64_encode(bytes), &back)) << base64_encode(bytes);
+        EXPECT_EQ(back, bytes);
+    }
+    std::string out;
+    EXPECT_TRUE(base64_decode("Zm9vYg==", &out));
+    EXPECT_EQ(out, "foob");
+    for (const char* bad : {"Zm9", "Zm9v!A==", "Zg===", "====", "Z===", "Zm=v", "Zm9v\n"})
+        EXPECT_FALSE(base64_decode(bad, &out)) << bad;
+}
+
+/// The reference of `scene` under `options` through mcp_render_reference (with progress lines
+/// kept in `lines` when given).
+Call reference_call(const json& scene, const json& options,
+                    std::vector<json>* lines = nullptr) {
+    char* out = nullptr;
+    Call c;
+    auto on_line = [](const char* text, void* user) {
+        static_cast<std::vector<json>*>(user)->push_back(json::parse(text));
+        return 0;
+    };
+    c.status = mcp_render_reference(scene.dump().c_str(), options.dump().c_str(),
+                                    lines ? +on_line : nullptr, lines, &out);
+    if (c.status != MCP_OK) c.error = mcp_last_error();
+    if (out) c.result = json::parse(out);
+    mcp_free(out);
+    return c;
+}
+
+// A reference made once (mcplay reference; the site ships them for its scenes) gives a study
+// exactly the result it would have rendered itself; one made for another image size is not
+// used and the result says so; bytes that are not a reference are an error naming the option.
+// The study's seed never changes the reference: its own seed does.
+TEST(RenderHonesty, SuppliedReferencesAreUsedOnlyForTheirOwnSettings) {
+    json scene = quad_scene([](json&) {});
+    json options = kTiny;
+    options["reference"]["spp"] = 64;
+    options["width"] = 6;
+    options["height"] = 5;
+    std::vector<json> lines;
+    Call ref = reference_call(scene, options, &lines);
+    ASSERT_EQ(ref.status, MCP_OK) << ref.error;
+    EXPECT_EQ(ref.result["kind"], "render_reference");
+    EXPECT_EQ(ref.result["source"], "rendered");
+    EXPECT_EQ(ref.result["spp"], 64);
+    ASSERT_FALSE(lines.empty());
+    for (const json& l : lines) EXPECT_EQ(l["kind"], "render_reference") << l.dump();
+    EXPECT_EQ(lines.back()["rows"], 5);
+    EXPECT_LE(lines.back()["rows_done"].get<int>(), 5);
+
+    Call rendered = study_text(scene, options);
+    ASSERT_EQ(rendered.status, MCP_OK) << rendered.error;
+    json with = options;
+    with["reference_data"] = ref.result["reference_data"];
+    Call supplied = study_text(scene, with);
+    ASSERT_EQ(supplied.status, MCP_OK) << supplied.error;
+    EXPECT_EQ(supplied.result["scene"]["reference"]["source"], "supplied");
+    for (size_t e = 0; e < 2; ++e)
+        for (size_t k = 0; k < 2; ++k)
+            EXPECT_EQ(supplied.result["estimators"][e]["levels"][k]["relative_mse"],
+                      rendered.result["estimators"][e]["levels"][k]["relative_mse"]);
+
+    // The plan knows it will not render the reference.
+    char* plan = nullptr;
+    ASSERT_EQ(mcp_render_study_plan(scene.dump().c_str(), with.dump().c_str(), &plan), MCP_OK);
+    EXPECT_EQ(json::parse(plan)["reference"]["source"], "supplied");
+    mcp_free(plan);
+
+    // Another study seed: the same reference (its floor is a property of the reference alone).
+    json seeded = with;
+    seeded["seed"] = 99;
+    Call other_seed = study_text(scene, seeded);
+    ASSERT_EQ(other_seed.status, MCP_OK) << other_seed.error;
+    EXPECT_EQ(other_seed.result["scene"]["reference"]["source"], "supplied");
+    EXPECT_EQ(other_seed.result["scene"]["reference"]["relative_mse_floor"],
+              rendered.result["scene"]["reference"]["relative_mse_floor"]);
+    // The reference's own seed, another image size: rendered again, and said so.
+    for (auto edit : {+[](json& o) { o["reference"]["seed"] = 7; },
+                      +[](json& o) { o["width"] = 7; }}) {
+        json changed = with;
+        edit(changed);
+        Call c = study_text(scene, changed);
+        ASSERT_EQ(c.status, MCP_OK) << c.error;
+        EXPECT_EQ(c.result["scene"]["reference"]["source"], "rendered");
+        EXPECT_TRUE(c.result["scene"]["reference"]["supplied"].get<std::string>().find(
+                        "not used") == 0);
+    }
+    // Not base64, base64 of something else, and the right key with a wrong length.
+    std::string bytes;
+    ASSERT_TRUE(base64_decode(ref.result["reference_data"].get<std::string>(), &bytes));
+    for (const std::string& bad : {std::string("not base64!"), base64_encode("MCREF01\nshort"),
+                                   base64_encode(bytes.substr(0, bytes.size() - 8))}) {
+        json b = options;
+        b["reference_data"] = bad;
+        Call c = study_text(scene, b);
+        EXPECT_NE(c.status, MCP_OK);
+        EXPECT_NE(c.error.find("options.reference_data"), std::string::npos) << c.error;
+    }
+}
+
+// The default reference's spp follows the scene's spp_max, not a study's smaller one (so that a
+// shorter study keeps the scene's cached or shipped reference); a study of more than a quarter
+// of it gets 16 x its own spp_max.
+TEST(RenderHonesty, DefaultReferenceSppFollowsTheScene) {
+    json scene = quad_scene([](json&) {});
+    scene["render"]["spp_max"] = 16;
+    auto reference_spp = [&](const json& options) {
+        char* out = nullptr;
+        EXPECT_EQ(mcp_render_scene_info(scene.dump().c_str(), options.dump().c_str(), &out), MCP_OK)
+            << mcp_last_error();
+        uint64_t spp = json::parse(out)["reference"]["spp"];
+        mcp_free(out);
+        return spp;
+    };
+    EXPECT_EQ(reference_spp(json::object()), 256u);
+    EXPECT_EQ(reference_spp(json{{"spp_max", 2}}), 256u);
+    EXPECT_EQ(reference_spp(json{{"spp_max", 64}}), 256u);
+    EXPECT_EQ(reference_spp(json{{"spp_max", 128}}), 2048u);
+}
+
+// A progress callback that returns non-zero while the reference renders cancels the study
+// before any level, with MCP_ERROR_CANCELLED.
+TEST(RenderHonesty, ReferenceProgressCanCancel) {
+    json scene = quad_scene([](json&) {});
+    json options = kTiny;
+    options["height"] = 40;
+    options["reference"]["spp"] = 256;
+    int calls = 0;
+    auto stop = [](const char* text, void* user) {
+        json line = json::parse(text);
+        EXPECT_EQ(line["kind"], "render_reference") << text;
+        return ++*static_cast<int*>(user) >= 2 ? 1 : 0;
+    };
+    char* out = nullptr;
+    int status = mcp_render_study_run(scene.dump().c_str(), options.dump().c_str(), +stop, &calls,
+                                      &out);
+    EXPECT_EQ(status, MCP_ERROR_CANCELLED);
+    EXPECT_EQ(calls, 2);
+    mcp_free(out);
 }
 
 // Radiance HDR references: truncated data, a bad size line, sizes over the limits and

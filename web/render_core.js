@@ -72,10 +72,21 @@ function makeRenderCore(M) {
    * ...} or null. onLevel(progress) gets {kind: "render", level_index, n, estimators: [{...,
    * level, fit, preview_png?, error_png?}]} after each spp; returning exactly `true` cancels
    * (the result then has cancelled: true). An exception thrown by onLevel cancels the study
-   * and is rethrown. Failures throw McplayError.
+   * and is rethrown. onReference(progress), when given, gets {kind: "render_reference",
+   * rows_done, rows} while the study renders its reference (at most one per percent; none when
+   * options.reference_data or the cache gives it); returning exactly `true` cancels too.
+   * Failures throw McplayError.
    */
-  function runStudy(scene, options = null, onLevel = null) {
-    return b.study('runStudy', M._mcp_render_study_run, 'mcp_render_study_run', scene, options, onLevel);
+  function runStudy(scene, options = null, onLevel = null, onReference = null) {
+    if (onReference !== null && typeof onReference !== 'function') {
+      throw new McplayError(Status.ARGUMENT, 'runStudy: onReference must be a function or null');
+    }
+    const route = onReference === null ? onLevel
+      : (p) => (p && p.kind === 'render_reference' ? onReference(p) : typeof onLevel === 'function' ? onLevel(p) : undefined);
+    const levelsOnly = typeof onLevel === 'function'
+      ? (p) => (p && p.kind === 'render_reference' ? undefined : onLevel(p)) : onLevel;
+    return b.study('runStudy', M._mcp_render_study_run, 'mcp_render_study_run', scene, options,
+      onReference === null ? levelsOnly : route);
   }
 
   /**

@@ -37,6 +37,7 @@ const char* kUsage =
     "  mcplay list [--scenes DIR]\n"
     "  mcplay run SCENE [options]\n"
     "  mcplay render SCENE [--estimator NAME] [--spp N] --out FILE [render options]\n"
+    "  mcplay reference SCENE --out FILE.mcref [--width W] [--height H] [--threads T]\n"
     "  mcplay --help | --version\n"
     "\n"
     "SCENE is a scene JSON file, or the name of one in the scenes directory\n"
@@ -72,6 +73,10 @@ const char* kUsage =
     "  --estimator NAME (default the scene's best: MIS with the power heuristic, or path\n"
     "  tracing with MIS for a path scene), --spp N (default the scene's spp_max),\n"
     "  --seed S, --threads T, --format json (print the result JSON instead of a summary)\n"
+    "  reference renders (or takes from the cache) the scene's reference image alone and\n"
+    "  writes it to --out: a study given it (options.reference_data) renders none, if it was\n"
+    "  made from the same glTF, name, image size and reference settings (the site ships\n"
+    "  its scenes' references this way)\n"
     "\n"
     "exit codes: 0 ok, 1 runtime error, 2 bad arguments, 3 bad scene\n";
 
@@ -360,7 +365,15 @@ int cmd_list(const std::vector<std::string>& args) {
 
 int progress_line(const char* level_json, void*) {
     nlohmann::json j = nlohmann::json::parse(level_json, nullptr, false);
-    if (!j.is_discarded()) std::fprintf(stderr, "mcplay: N = %s done\n", j["n"].dump().c_str());
+    if (j.is_discarded()) return 0;
+    if (j["kind"] == "render_reference") {
+        // A reference being rendered: one line per tenth of its rows.
+        const int done = j["rows_done"].get<int>(), rows = std::max(1, j["rows"].get<int>());
+        if ((10 * done) / rows != (10 * (done - 1)) / rows)
+            std::fprintf(stderr, "mcplay: reference %d%% rendered\n", 100 * done / rows);
+        return 0;
+    }
+    std::fprintf(stderr, "mcplay: N = %s done\n", j["n"].dump().c_str());
     return 0;
 }
 
@@ -665,6 +678,89 @@ int cmd_render(const std::vector<std::string>& args) {
     return kExitOk;
 }
 
+int cmd_reference(const std::vector<std::string>& args) {
+    std::string scene_arg, out_path, dir_arg, cache_arg, format = "summary";
+    bool no_cache = false, quiet = false;
+    nlohmann::json options = nlohmann::json::object();
+    for (size_t i = 0; i < args.size(); ++i) {
+        const std::string& a = args[i];
+        std::string v;
+        auto value = [&](std::string* out) {
+            if (i + 1 >= args.size() || args[i + 1].rfind("--", 0) == 0) return false;
+            *out = args[++i];
+            return true;
+        };
+        if (a == "--width" || a == "--height" || a == "--threads") {
+            if (!value(&v)) return usage_error(a + " needs a value");
+            unsigned long long x = 0;
+            if (!parse_count(v, &x))
+                return usage_error(a + ": expected a whole number, got '" + v + "'");
+            options[a.substr(2)] = x;
+        } else if (a == "--out") {
+            if (!value(&out_path)) return usage_error("--out needs a file name");
+        } else if (a == "--scenes") {
+            if (!value(&dir_arg)) return usage_error("--scenes needs a directory");
+        } else if (a == "--cache") {
+            if (!value(&cache_arg)) return usage_error("--cache needs a directory");
+        } else if (a == "--no-cache") {
+            no_cache = true;
+        } else if (a == "--quiet") {
+            quiet = true;
+        } else if (a == "--format") {
+            if (!value(&format) || (format != "json" && format != "summary"))
+                return usage_error("--format: expected json or summary");
+        } else if (a.rfind("-", 0) == 0) {
+            return usage_error("unknown option '" + a + "'");
+        } else if (scene_arg.empty()) {
+            scene_arg = a;
+        } else {
+            return usage_error("reference takes one scene, got '" + scene_arg + "' and '" + a +
+                               "'");
+        }
+    }
+    if (scene_arg.empty()) return usage_error("reference needs a scene file or name");
+    if (out_path.empty()) return usage_error("reference needs --out FILE.mcref");
+    std::string path, text, error;
+    if (!load_scene(scene_arg, dir_arg, &path, &text)) return kExitScene;
+    if (!is_render_scene_text(text))
+        return usage_error("reference is for render scenes; '" + scene_arg + "' is an integral");
+    OutputFile out_file{out_path};
+    if (!out_file.check(&error)) return usage_error("--out: " + error);
+    options["base_dir"] = dirname_of(path);
+    if (!no_cache) {
+        std::string dir = cache_dir(cache_arg);
+        if (!dir.empty()) options["cache_dir"] = dir;
+    }
+    const bool show_progress = !quiet && isatty(fileno(stderr));
+    char* result = nullptr;
+    int status = mcp_render_reference(text.c_str(), options.dump().c_str(),
+                                      show_progress ? progress_line : nullptr, nullptr, &result);
+    if (status != MCP_OK) {
+        std::fprintf(stderr, "mcplay: %s: %s\n", mcp::boundary::one_line(path).c_str(),
+                     mcp_last_error());
+        out_file.discard();
+        return exit_code(status);
+    }
+    nlohmann::json j = nlohmann::json::parse(result, nullptr, false);
+    mcp_free(result);
+    if (j.is_discarded()) return kExitRuntime;
+    if (!write_file(out_path, base64_decode(j["reference_data"].get<std::string>()))) {
+        std::fprintf(stderr, "mcplay: cannot write '%s'\n", out_path.c_str());
+        return kExitRuntime;
+    }
+    j.erase("reference_data");
+    if (format == "json") {
+        std::printf("%s\n", j.dump(2).c_str());
+        return kExitOk;
+    }
+    std::printf("%s: reference %dx%d at %s spp (%s, %s), mean luminance %s\n",
+                j["scene"].get<std::string>().c_str(), j["width"].get<int>(),
+                j["height"].get<int>(), j["spp"].dump().c_str(),
+                j["estimator"]["strategy"].get<std::string>().c_str(),
+                j["source"].get<std::string>().c_str(), j["mean_luminance"].dump().c_str());
+    return kExitOk;
+}
+
 } // namespace
 
 int main(int argc, char** argv) {
@@ -691,5 +787,6 @@ int main(int argc, char** argv) {
     if (cmd == "list") return cmd_list(rest);
     if (cmd == "run") return cmd_run(rest);
     if (cmd == "render") return cmd_render(rest);
+    if (cmd == "reference") return cmd_reference(rest);
     return usage_error("unknown command '" + cmd + "'");
 }

@@ -11,24 +11,6 @@ namespace mcp {
 
 namespace {
 
-double mean_luminance(const RenderImage& image, double* se) {
-    size_t n = image.pixel_count();
-    double dn = n ? double(n) : 1.0;
-    double sum = 0.0, var = 0.0;
-    for (size_t p = 0; p < n; ++p) {
-        Vec3 c(image.rgb[p * 3], image.rgb[p * 3 + 1], image.rgb[p * 3 + 2]);
-        Vec3 v(image.variance[p * 3], image.variance[p * 3 + 1], image.variance[p * 3 + 2]);
-        // Each term divided first: no overflow for radiances up to the largest double.
-        if (std::isfinite(luminance(c))) sum += luminance(c) / dn;
-        // Channels of one pixel share their samples; the luminance variance is bounded by
-        // (sum_c w_c sd_c)^2, which is what an error bar may honestly claim without the
-        // covariances.
-        double sd = 0.2126 * std::sqrt(v.x) + 0.7152 * std::sqrt(v.y) + 0.0722 * std::sqrt(v.z);
-        if (std::isfinite(sd)) var += (sd / dn) * (sd / dn);
-    }
-    if (se) *se = std::sqrt(var);
-    return sum;
-}
 
 /// The reference's mean luminance, the scale every pixel is divided by before squaring
 /// (so that neither 1e-200 nor 1e300 radiances underflow or overflow), or 0 when the
@@ -78,6 +60,25 @@ ImageError image_error(const RenderImage& image, const RenderImage& reference) {
     e.coverage = counted ? double(covered) / double(counted) : NAN;
     e.mean_luminance = mean_luminance(image, &e.mean_luminance_se);
     return e;
+}
+
+double mean_luminance(const RenderImage& image, double* se) {
+    size_t n = image.pixel_count();
+    double dn = n ? double(n) : 1.0;
+    double sum = 0.0, var = 0.0;
+    for (size_t p = 0; p < n; ++p) {
+        Vec3 c(image.rgb[p * 3], image.rgb[p * 3 + 1], image.rgb[p * 3 + 2]);
+        Vec3 v(image.variance[p * 3], image.variance[p * 3 + 1], image.variance[p * 3 + 2]);
+        // Each term divided first: no overflow for radiances up to the largest double.
+        if (std::isfinite(luminance(c))) sum += luminance(c) / dn;
+        // Channels of one pixel share their samples; the luminance variance is bounded by
+        // (sum_c w_c sd_c)^2, which is what an error bar may honestly claim without the
+        // covariances.
+        double sd = 0.2126 * std::sqrt(v.x) + 0.7152 * std::sqrt(v.y) + 0.0722 * std::sqrt(v.z);
+        if (std::isfinite(sd)) var += (sd / dn) * (sd / dn);
+    }
+    if (se) *se = std::sqrt(var);
+    return sum;
 }
 
 double relative_mse_floor(const RenderImage& reference) {

@@ -51,6 +51,10 @@ struct ImageError {
 };
 ImageError image_error(const RenderImage& image, const RenderImage& reference);
 
+/// The image's mean luminance, and when `se` is given its standard error from the pixels'
+/// variances.
+double mean_luminance(const RenderImage& image, double* se = nullptr);
+
 /// The relative-MSE floor of a reference (see the header comment): 0 for a noiseless
 /// reference (an HDR file), NaN for a black one.
 double relative_mse_floor(const RenderImage& reference);

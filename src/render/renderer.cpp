@@ -25,13 +25,29 @@ void push_top(std::vector<double>& heap, double x) {
     }
 }
 
+/// How far an image is, shared by its workers.
+struct RowProgress {
+    std::atomic<int> rows_done{0};
+    std::atomic<bool> stop{false}; ///< the progress callback asked to cancel
+};
+
 /// Renders rows first_row, first_row + step, ... into the image.
 void render_rows(const RenderScene& rs, const RenderEstimator& est, const RenderSettings& st,
-                 int first_row, int step, RenderImage& image, RenderDiagnostics& diag) {
+                 int first_row, int step, RenderImage& image, RenderDiagnostics& diag,
+                 RowProgress& progress) {
     PixelSampler sampler;
     sampler.configure(est.pixel_sampler, st.spp, st.width, st.height, st.stream);
     for (int y = first_row; y < st.height; y += step) {
         if (st.cancel && st.cancel->load(std::memory_order_relaxed)) return;
+        if (progress.stop.load(std::memory_order_relaxed)) return;
+        if (y > first_row) {
+            const int done = progress.rows_done.fetch_add(1) + 1;
+            // Only the calling thread (worker 0) reports, so the callback needs no lock.
+            if (first_row == 0 && st.progress && !st.progress(done, st.height)) {
+                progress.stop = true;
+                return;
+            }
+        }
         for (int x = 0; x < st.width; ++x) {
             size_t pixel = size_t(y) * size_t(st.width) + size_t(x);
             sampler.start_pixel(x, y);
@@ -77,6 +93,7 @@ void render_rows(const RenderScene& rs, const RenderEstimator& est, const Render
             }
         }
     }
+    progress.rows_done.fetch_add(1);
 }
 
 } // namespace
@@ -116,12 +133,13 @@ RenderImage render_image(const RenderScene& rs, const RenderEstimator& est,
     threads = 1; // one worker renders every row
 #endif
     std::vector<RenderDiagnostics> diags(static_cast<size_t>(threads));
+    RowProgress progress;
     run_workers(threads, [&](int t) {
-        render_rows(rs, est, settings, t, threads, image, diags[size_t(t)]);
+        render_rows(rs, est, settings, t, threads, image, diags[size_t(t)], progress);
     });
     for (const auto& d : diags) image.diagnostics.merge(d);
     std::sort(image.diagnostics.top.begin(), image.diagnostics.top.end(), std::greater<double>());
-    image.cancelled = settings.cancel && settings.cancel->load();
+    image.cancelled = (settings.cancel && settings.cancel->load()) || progress.stop.load();
     image.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return image;
 }

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <atomic>
+#include <functional>
 #include <cstdint>
 #include <vector>
 
@@ -19,6 +20,9 @@ struct RenderSettings {
     int threads = 1;     ///< worker threads (1 where the build has none)
     bool jitter_pixels = true; ///< false: every sample's camera ray passes through the pixel centre
     const std::atomic<bool>* cancel = nullptr; ///< checked once per row
+    /// Told the rows done so far (of `height`) after each row the calling thread renders, on
+    /// that thread; returning false cancels. For long renders (a reference) that show progress.
+    std::function<bool(int rows_done, int rows)> progress;
 };
 
 /// Problems found while rendering, summed over the image.

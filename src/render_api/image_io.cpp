@@ -52,7 +52,7 @@ Vec3 error_ramp(double t) {
     return kStops[i] * (1.0 - f) + kStops[i + 1] * f;
 }
 
-constexpr char kCacheMagic[8] = {'M', 'C', 'R', 'E', 'F', '0', '1', '\n'};
+constexpr char kCacheMagic[8] = {'M', 'C', 'R', 'E', 'F', '0', '2', '\n'};
 
 } // namespace
 
@@ -252,33 +252,39 @@ bool decode_hdr(const std::string& bytes, RenderImage* out, std::string* error) 
     return true;
 }
 
-bool write_reference_cache(const std::string& path, const RenderImage& image) {
-    std::string tmp = path + ".tmp";
-    {
-        std::ofstream out(tmp, std::ios::binary);
-        if (!out) return false;
-        int64_t header[3] = {image.width, image.height, int64_t(image.spp)};
-        out.write(kCacheMagic, sizeof kCacheMagic);
-        out.write(reinterpret_cast<const char*>(header), sizeof header);
-        out.write(reinterpret_cast<const char*>(image.rgb.data()),
-                  std::streamsize(image.rgb.size() * sizeof(double)));
-        out.write(reinterpret_cast<const char*>(image.variance.data()),
-                  std::streamsize(image.variance.size() * sizeof(double)));
-        if (!out) return false;
-    }
-    return std::rename(tmp.c_str(), path.c_str()) == 0; // atomic: no half-written cache
+std::string encode_reference(const RenderImage& image, uint64_t key) {
+    const int64_t header[3] = {image.width, image.height, int64_t(image.spp)};
+    std::string out(kCacheMagic, sizeof kCacheMagic);
+    out.append(reinterpret_cast<const char*>(&key), sizeof key);
+    out.append(reinterpret_cast<const char*>(header), sizeof header);
+    out.append(reinterpret_cast<const char*>(image.rgb.data()), image.rgb.size() * sizeof(double));
+    out.append(reinterpret_cast<const char*>(image.variance.data()),
+               image.variance.size() * sizeof(double));
+    return out;
 }
 
-bool read_reference_cache(const std::string& path, RenderImage* image) {
-    // A regular file of bounded size, read whole; anything that is not exactly what
-    // write_reference_cache writes is ignored (the caller renders the reference again).
-    std::string bytes, error;
-    if (!read_regular_file(path, kMaxCacheFileBytes, &bytes, &error)) return false;
+namespace {
+constexpr size_t kReferenceHead = sizeof kCacheMagic + sizeof(uint64_t) + 3 * sizeof(int64_t);
+} // namespace
+
+bool is_encoded_reference(const std::string& bytes) {
+    return bytes.size() >= kReferenceHead &&
+           std::memcmp(bytes.data(), kCacheMagic, sizeof kCacheMagic) == 0;
+}
+
+uint64_t encoded_reference_key(const std::string& bytes) {
+    uint64_t key = 0;
+    if (is_encoded_reference(bytes))
+        std::memcpy(&key, bytes.data() + sizeof kCacheMagic, sizeof key);
+    return key;
+}
+
+bool decode_reference(const std::string& bytes, uint64_t key, RenderImage* image) {
+    constexpr size_t kHead = kReferenceHead;
+    // Made for another scene, size or reference estimator: not this reference.
+    if (!is_encoded_reference(bytes) || encoded_reference_key(bytes) != key) return false;
     int64_t header[3];
-    constexpr size_t kHead = sizeof kCacheMagic + sizeof header;
-    if (bytes.size() < kHead || std::memcmp(bytes.data(), kCacheMagic, sizeof kCacheMagic) != 0)
-        return false;
-    std::memcpy(header, bytes.data() + sizeof kCacheMagic, sizeof header);
+    std::memcpy(header, bytes.data() + sizeof kCacheMagic + sizeof key, sizeof header);
     if (!image_size_ok(header[0], header[1]) || header[2] < 1) return false;
     size_t n = size_t(header[0]) * size_t(header[1]) * 3;
     if (bytes.size() != kHead + 2 * n * sizeof(double)) return false;
@@ -297,6 +303,26 @@ bool read_reference_cache(const std::string& path, RenderImage* image) {
             return false;
     *image = std::move(im);
     return true;
+}
+
+bool write_reference_cache(const std::string& path, const RenderImage& image, uint64_t key) {
+    std::string tmp = path + ".tmp";
+    {
+        std::ofstream out(tmp, std::ios::binary);
+        if (!out) return false;
+        const std::string bytes = encode_reference(image, key);
+        out.write(bytes.data(), std::streamsize(bytes.size()));
+        if (!out) return false;
+    }
+    return std::rename(tmp.c_str(), path.c_str()) == 0; // atomic: no half-written cache
+}
+
+bool read_reference_cache(const std::string& path, uint64_t key, RenderImage* image) {
+    // A regular file of bounded size, read whole; anything that is not exactly what
+    // write_reference_cache writes is ignored (the caller renders the reference again).
+    std::string bytes, error;
+    if (!read_regular_file(path, kMaxCacheFileBytes, &bytes, &error)) return false;
+    return decode_reference(bytes, key, image);
 }
 
 std::string base64_encode(const std::string& bytes) {
@@ -319,6 +345,38 @@ std::string base64_encode(const std::string& bytes) {
         out += '=';
     }
     return out;
+}
+
+bool base64_decode(const std::string& text, std::string* bytes) {
+    // RFC 4648 section 4, padded: a length that is a multiple of 4, '=' only at the end.
+    if (text.size() % 4 != 0) return false;
+    auto value = [](char c) -> int {
+        if (c >= 'A' && c <= 'Z') return c - 'A';
+        if (c >= 'a' && c <= 'z') return c - 'a' + 26;
+        if (c >= '0' && c <= '9') return c - '0' + 52;
+        if (c == '+') return 62;
+        if (c == '/') return 63;
+        return -1;
+    };
+    // Padding: '=' in the last one or two places of the last group only.
+    size_t pad = 0;
+    if (!text.empty() && text.back() == '=') pad = text[text.size() - 2] == '=' ? 2 : 1;
+    std::string out;
+    out.reserve(text.size() / 4 * 3);
+    for (size_t i = 0; i < text.size(); i += 4) {
+        const size_t used = i + 4 == text.size() ? 4 - pad : 4; // characters carrying data
+        uint32_t v = 0;
+        for (size_t k = 0; k < 4; ++k) {
+            const int d = k < used ? value(text[i + k]) : 0;
+            if (d < 0) return false;
+            v = (v << 6) | uint32_t(d);
+        }
+        out += char((v >> 16) & 255);
+        if (used > 2) out += char((v >> 8) & 255);
+        if (used > 3) out += char(v & 255);
+    }
+    *bytes = std::move(out);
+    return true;
 }
 
 } // namespace mcp

@@ -27,14 +27,29 @@ constexpr uint64_t kMaxReferencePixels = uint64_t(1) << 22; ///< 2048 x 2048
 /// content) when any fails, e.g. "the HDR data ends after 3 of 8 scanlines".
 bool decode_hdr(const std::string& bytes, RenderImage* out, std::string* error);
 
-/// The reference cache: a small binary file with the means and their variances as doubles.
-bool write_reference_cache(const std::string& path, const RenderImage& image);
-/// Reads a cache file written by write_reference_cache: a regular file of at most
-/// kMaxCacheFileBytes (api/files.h), with the magic, sizes within the limits above, spp >= 1,
-/// exactly the bytes those sizes need, and no infinite mean or negative variance. Anything
-/// else is ignored (false, `image` untouched): the caller renders the reference again.
-bool read_reference_cache(const std::string& path, RenderImage* image);
+/// A reference image as bytes (the cache file, and what options.reference_data carries): the
+/// magic "MCREF02\n", `key` (the hash of everything the reference was rendered from, see
+/// reference_key in render_api.cpp), width, height and spp as int64, then the means and their
+/// variances as doubles, native (little-endian) byte order.
+std::string encode_reference(const RenderImage& image, uint64_t key);
+/// Reads what encode_reference wrote: the magic, the same `key`, sizes within the limits above,
+/// spp >= 1, exactly the bytes those sizes need, and no infinite mean or negative variance.
+/// Anything else is refused (false, `image` untouched).
+bool decode_reference(const std::string& bytes, uint64_t key, RenderImage* image);
+/// Do the bytes start like encode_reference's (the magic and a whole header)?
+bool is_encoded_reference(const std::string& bytes);
+/// The key encode_reference stored (bytes accepted by is_encoded_reference).
+uint64_t encoded_reference_key(const std::string& bytes);
+
+/// The reference cache: encode_reference's bytes in a file, written whole or not at all.
+bool write_reference_cache(const std::string& path, const RenderImage& image, uint64_t key);
+/// Reads a cache file: a regular file of at most kMaxCacheFileBytes (api/files.h) that
+/// decode_reference accepts. Anything else is ignored (false, `image` untouched): the caller
+/// renders the reference again.
+bool read_reference_cache(const std::string& path, uint64_t key, RenderImage* image);
 
 std::string base64_encode(const std::string& bytes);
+/// Standard padded base64 (RFC 4648); false on any other character, length or padding.
+bool base64_decode(const std::string& text, std::string* bytes);
 
 } // namespace mcp

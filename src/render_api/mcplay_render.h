@@ -7,7 +7,9 @@
  * NULL): base_dir (folder that a relative glTF path is resolved against), cache_dir (where
  * high-spp references are cached; none when absent), and overrides of the scene's render
  * settings: width, height, spp_min, spp_max, reps, seed, threads, estimators, reference,
- * jitter_pixels, exposure, accel. */
+ * jitter_pixels, exposure, accel, and reference_data (a reference made earlier: the
+ * reference_data of mcp_render_reference, used when it was made from the same glTF, scene name,
+ * image size and reference settings, else rendered again and said so). */
 #ifndef MCPLAY_RENDER_H
 #define MCPLAY_RENDER_H
 
@@ -19,11 +21,22 @@ extern "C" {
 
 /* Convergence study: every estimator at spp = spp_min..spp_max (powers of two), reps
  * images each, measured by relative MSE against the reference (docs/result-schema.md,
- * "Render studies"). progress gets one JSON line per completed spp level (non-zero return
- * cancels). Options also take previews (true: PNGs of each estimator's last image and of
+ * "Render studies"). progress gets one JSON line per completed spp level, and before them,
+ * while a reference is rendered, lines {"kind": "render_reference", "rows_done", "rows"}
+ * (non-zero return cancels). Options also take previews (true: PNGs of each estimator's last image and of
  * the reference, base64, in the result). */
 int mcp_render_study_run(const char* scene_json, const char* options_json, mcp_progress_fn progress,
                          void* user, char** result_json);
+
+/* The study's reference image alone, obtained as a study obtains it (options.reference_data,
+ * the cache, or rendered and then cached; an error for a scene whose reference is a file):
+ * {"version", "kind": "render_reference", "scene", "source", "estimator", "spp", "seed",
+ * "seconds" (when rendered), "width", "height", "mean_luminance", "relative_mse_floor",
+ * "reference_data": the image, its variances and the key of what it was made from, base64}.
+ * progress gets {"kind": "render_reference", "rows_done", "rows"} lines while it renders, as
+ * mcp_render_study_run does before its levels (non-zero return cancels: no result). */
+int mcp_render_reference(const char* scene_json, const char* options_json,
+                         mcp_progress_fn progress, void* user, char** result_json);
 
 /* What a study of the same scene and options would cost, before any of it is rendered:
  * validates like mcp_render_study_run (the same errors), then times a pilot (each estimator

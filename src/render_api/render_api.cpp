@@ -2,8 +2,10 @@
 // the integration API; every failure is a status code plus mcp_last_error.
 #include "render_api/mcplay_render.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 
 #include "api/boundary.h"
 #include "api/files.h"
@@ -19,7 +21,7 @@ namespace mcp {
 
 namespace {
 
-constexpr int kReferenceCacheVersion = 2;
+constexpr int kReferenceCacheVersion = 3;
 
 /// Work and memory bounds, checked before anything is rendered: samples of a whole call
 /// (every image of the study and the reference), and bytes of the images held at once
@@ -157,13 +159,11 @@ std::string hex(uint64_t x) {
     return buf;
 }
 
-/// The reference image: read from the scene's HDR file, from the cache, or rendered (and
-/// then cached). `source` says which.
-/// Where a rendered reference is cached ("" without a cache folder). The file name is a hash
-/// of the glTF, the scene's name and every setting alone: nothing of the scene's text reaches
-/// the path.
-std::string reference_cache_file(const RenderRequest& r) {
-    if (r.cache_dir.empty()) return "";
+/// The hash of everything a rendered reference depends on: the glTF, the scene's name, the
+/// image size, the reference's estimator, spp and seed, and the renderer's version. It names
+/// the cache file and is stored in it (and in a supplied reference): nothing of the scene's
+/// text reaches a path.
+uint64_t reference_key(const RenderRequest& r) {
     const RenderStudySettings& s = r.settings;
     const RenderEstimator& e = r.reference.estimator;
     uint64_t key = hash_combine(r.gltf_hash, uint64_t(kReferenceCacheVersion));
@@ -171,12 +171,25 @@ std::string reference_cache_file(const RenderRequest& r) {
     for (uint64_t v :
          {uint64_t(s.width), uint64_t(s.height), uint64_t(s.jitter_pixels), uint64_t(e.strategy),
           uint64_t(e.light_selection), uint64_t(e.light_sampling), uint64_t(e.pixel_sampler),
-          uint64_t(e.max_depth), uint64_t(e.rr_depth), r.reference.spp, s.seed})
+          uint64_t(e.max_depth), uint64_t(e.rr_depth), r.reference.spp, r.reference.seed})
         key = hash_combine(key, v);
-    return r.cache_dir + "/" + hex(key) + ".mcref";
+    return key;
 }
 
-bool obtain_reference(const Loaded& l, RenderImage* ref, Json* info, std::string* error) {
+/// Where a rendered reference is cached ("" without a cache folder).
+std::string reference_cache_file(const RenderRequest& r) {
+    if (r.cache_dir.empty()) return "";
+    return r.cache_dir + "/" + hex(reference_key(r)) + ".mcref";
+}
+
+/// Called with the rows of the reference rendered so far and the image's rows; false cancels.
+using ReferenceProgress = std::function<bool(int rows_done, int rows)>;
+
+/// The reference image: read from the scene's HDR file, taken from options.reference_data
+/// when it was made from the same scene and settings, read from the cache, or rendered (and
+/// then cached). `source` says which; a supplied reference that is not used says why.
+bool obtain_reference(const Loaded& l, RenderImage* ref, Json* info, std::string* error,
+                      const ReferenceProgress& progress = nullptr) {
     const RenderRequest& r = *l.request;
     const RenderStudySettings& s = r.settings;
     if (!r.reference.file.empty()) {
@@ -201,10 +214,26 @@ bool obtain_reference(const Loaded& l, RenderImage* ref, Json* info, std::string
         return true;
     }
     const RenderEstimator& e = r.reference.estimator;
+    const uint64_t key = reference_key(r);
+    *info = Json{{"estimator", estimator_to_json(e)}, {"spp", r.reference.spp},
+                 {"seed", r.reference.seed}};
+    if (!r.supplied_reference.empty()) {
+        if (encoded_reference_key(r.supplied_reference) != key) {
+            (*info)["supplied"] = "not used: it was made from another scene, image size, "
+                                  "reference estimator, spp or seed, or by another version";
+        } else if (!decode_reference(r.supplied_reference, key, ref) || ref->width != s.width ||
+                   ref->height != s.height || ref->spp != r.reference.spp) {
+            *error = "options.reference_data: a corrupt reference image (its sizes, length or "
+                     "values are not what mcplay writes)";
+            return false;
+        } else {
+            (*info)["source"] = "supplied";
+            return true;
+        }
+    }
     const std::string cache_file = reference_cache_file(r);
-    *info = Json{{"estimator", estimator_to_json(e)}, {"spp", r.reference.spp}};
-    if (!cache_file.empty() && read_reference_cache(cache_file, ref) && ref->width == s.width &&
-        ref->height == s.height && ref->spp == r.reference.spp) {
+    if (!cache_file.empty() && read_reference_cache(cache_file, key, ref) &&
+        ref->width == s.width && ref->height == s.height && ref->spp == r.reference.spp) {
         (*info)["source"] = "cache";
         (*info)["file"] = cache_file;
         return true;
@@ -213,16 +242,40 @@ bool obtain_reference(const Loaded& l, RenderImage* ref, Json* info, std::string
     rs.width = s.width;
     rs.height = s.height;
     rs.spp = r.reference.spp;
-    // Its own stream: no study image shares random numbers with the reference.
-    rs.stream = replicate_stream(s.seed, "reference", r.reference.spp, -1);
+    // Its own stream, from its own seed: no study image shares random numbers with it, and a
+    // study's seed does not change it.
+    rs.stream = replicate_stream(r.reference.seed, "reference", r.reference.spp, -1);
     rs.threads = resolve_threads(s.threads);
     rs.jitter_pixels = s.jitter_pixels;
+    rs.progress = progress;
     *ref = render_image(l.scene, e, rs);
+    if (ref->cancelled) {
+        *error = "cancelled while rendering the reference";
+        return false;
+    }
     (*info)["source"] = "rendered";
     (*info)["seconds"] = num(ref->seconds);
-    if (!cache_file.empty() && write_reference_cache(cache_file, *ref))
+    if (!cache_file.empty() && write_reference_cache(cache_file, *ref, key))
         (*info)["file"] = cache_file;
     return true;
+}
+
+/// The progress lines of a reference being rendered, {"kind": "render_reference", "rows_done",
+/// "rows"}, at most one per percent; sets *cancelled when the callback asks to stop.
+ReferenceProgress reference_progress(mcp_progress_fn progress, void* user, bool* cancelled) {
+    if (!progress) return nullptr;
+    return [progress, user, cancelled, last = -1](int rows_done, int rows) mutable {
+        const int percent = int(100.0 * rows_done / std::max(1, rows));
+        if (percent == last) return true;
+        last = percent;
+        const std::string text = dump(Json{{"version", kResultSchemaVersion},
+                                           {"kind", "render_reference"},
+                                           {"rows_done", rows_done},
+                                           {"rows", rows}});
+        if (progress(text.c_str(), user) == 0) return true;
+        *cancelled = true;
+        return false;
+    };
 }
 
 Json scene_to_json(const Loaded& l) {
@@ -569,6 +622,9 @@ int mcp_render_study_plan(const char* scene_json, const char* options_json, char
     std::string source = "rendered";
     if (!r.reference.file.empty())
         source = "file";
+    else if (!r.supplied_reference.empty() &&
+             encoded_reference_key(r.supplied_reference) == reference_key(r))
+        source = "supplied"; // its content is checked when the study reads it
     else if (!cache_file.empty() && is_regular_file(cache_file))
         source = "cache"; // its content is checked when the study reads it
     Json reference{{"source", source}, {"spp", r.reference.spp}};
@@ -611,7 +667,10 @@ int mcp_render_study_run(const char* scene_json, const char* options_json, mcp_p
     if (!check_study(r, &err)) return fail(MCP_ERROR_SCENE, err);
     RenderImage reference;
     Json ref_info;
-    if (!obtain_reference(l, &reference, &ref_info, &err)) return fail(MCP_ERROR_SCENE, err);
+    bool cancelled = false;
+    if (!obtain_reference(l, &reference, &ref_info, &err,
+                          reference_progress(progress, user, &cancelled)))
+        return fail(cancelled ? MCP_ERROR_CANCELLED : MCP_ERROR_SCENE, err);
     const double floor = relative_mse_floor(reference);
     int threads = resolve_threads(r.settings.threads);
     RenderStudyProgress on_level;
@@ -660,6 +719,41 @@ int mcp_render_study_run(const char* scene_json, const char* options_json, mcp_p
     *result_json = copy_out(dump(j));
     if (!*result_json) return fail(MCP_ERROR_INTERNAL, "out of memory writing the result");
     if (result.cancelled) return fail(MCP_ERROR_CANCELLED, "study cancelled by the caller");
+    return boundary::succeed();
+}
+
+int mcp_render_reference(const char* scene_json, const char* options_json,
+                         mcp_progress_fn progress, void* user, char** result_json) {
+    using namespace mcp;
+    Loaded l;
+    Json options;
+    if (int st = begin_call("mcp_render_reference", result_json, scene_json, options_json, &l,
+                            &options))
+        return st;
+    const RenderRequest& r = *l.request;
+    if (!r.reference.file.empty())
+        return fail(MCP_ERROR_ARGUMENT, "scene.render.reference.file: this scene's reference is "
+                                        "an image file; there is none to render");
+    std::string err;
+    if (!check_work(r, 0.0, 1, true, &err)) return fail(MCP_ERROR_SCENE, err);
+    RenderImage reference;
+    Json info;
+    bool cancelled = false;
+    if (!obtain_reference(l, &reference, &info, &err,
+                          reference_progress(progress, user, &cancelled)))
+        return fail(cancelled ? MCP_ERROR_CANCELLED : MCP_ERROR_SCENE, err);
+    const RenderStudySettings& s = r.settings;
+    info["version"] = kResultSchemaVersion;
+    info["kind"] = "render_reference";
+    info["mcplay"] = mcp_version();
+    info["scene"] = r.name;
+    info["width"] = s.width;
+    info["height"] = s.height;
+    info["mean_luminance"] = num(mean_luminance(reference));
+    info["relative_mse_floor"] = num(relative_mse_floor(reference));
+    info["reference_data"] = base64_encode(encode_reference(reference, reference_key(r)));
+    *result_json = copy_out(dump(info));
+    if (!*result_json) return fail(MCP_ERROR_INTERNAL, "out of memory writing the reference");
     return boundary::succeed();
 }
 

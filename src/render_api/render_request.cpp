@@ -6,6 +6,7 @@
 #include "api/scene.h" // parse_json
 #include "core/rng.h"
 #include "render_api/gltf_scene.h"
+#include "render_api/image_io.h"
 
 namespace mcp {
 
@@ -113,10 +114,11 @@ bool resolve_scene_file(Ctx& c, const std::string& field, const std::string& roo
 
 bool parse_reference(Ctx& c, const Json& j, const std::string& path, const std::string& root,
                      const std::string& from, ReferenceSpec* out) {
-    if (!check_keys(c, j, path, {"estimator", "spp", "file"})) return false;
+    if (!check_keys(c, j, path, {"estimator", "spp", "seed", "file"})) return false;
     if (const Json* e = find(j, "estimator"))
         if (!parse_estimator(c, *e, sub(path, "estimator"), &out->estimator)) return false;
-    if (!get_count(c, j, "spp", path, &out->spp)) return false;
+    if (!get_count(c, j, "spp", path, &out->spp) || !get_count(c, j, "seed", path, &out->seed))
+        return false;
     if (out->spp < 1 || out->spp > kMaxSpp)
         return c.fail(sub(path, "spp"), "must be in 1.." + std::to_string(kMaxSpp));
     std::string file;
@@ -215,12 +217,26 @@ Made<std::shared_ptr<RenderRequest>> build_render_request(const Json& scene, con
     if (!check_keys(c, opts, "options",
                     {"base_dir", "cache_dir", "width", "height", "spp_min", "spp_max", "reps",
                      "seed", "threads", "estimators", "reference", "jitter_pixels", "exposure",
-                     "accel", "estimator", "spp", "outputs", "previews", "pixel_sampler"}))
+                     "accel", "estimator", "spp", "outputs", "previews", "pixel_sampler",
+                     "reference_data"}))
         return error();
-    std::string base_dir = ".";
+    std::string base_dir = ".", reference_data;
     if (!get_string(c, opts, "base_dir", "options", &base_dir) ||
-        !get_string(c, opts, "cache_dir", "options", &r->cache_dir))
+        !get_string(c, opts, "cache_dir", "options", &r->cache_dir) ||
+        !get_string(c, opts, "reference_data", "options", &reference_data))
         return error();
+    if (!reference_data.empty()) {
+        // Bounded before it is decoded: at most a cache file's size, in base64.
+        if (reference_data.size() > (kMaxCacheFileBytes + 2) / 3 * 4)
+            return made_error<std::shared_ptr<RenderRequest>>(
+                "options.reference_data: longer than a reference of at most " +
+                std::to_string(kMaxCacheFileBytes >> 20) + " MiB");
+        if (!base64_decode(reference_data, &r->supplied_reference) ||
+            !is_encoded_reference(r->supplied_reference))
+            return made_error<std::shared_ptr<RenderRequest>>(
+                "options.reference_data: not a reference image made by mcplay (base64 of what "
+                "`mcplay reference` writes)");
+    }
 
     // The glTF: a path relative to the scene file, or the glTF JSON itself inline.
     const Json* gltf = find(render, "gltf");
@@ -271,8 +287,9 @@ Made<std::shared_ptr<RenderRequest>> build_render_request(const Json& scene, con
             !parse_settings(c, extras, ep, r.get()))
             return error();
     }
-    if (!parse_settings(c, render, rp, r.get()) || !parse_settings(c, opts, "options", r.get()))
-        return error();
+    if (!parse_settings(c, render, rp, r.get())) return error();
+    const uint64_t scene_spp_max = r->settings.spp_max;
+    if (!parse_settings(c, opts, "options", r.get())) return error();
 
     // Estimators: the scene's list (or the glTF's, or every direct-lighting strategy), then
     // the options'.
@@ -331,7 +348,12 @@ Made<std::shared_ptr<RenderRequest>> build_render_request(const Json& scene, con
                                           : RadianceStrategy::MisPower;
     r->reference.estimator.max_depth = first.max_depth;
     r->reference.estimator.rr_depth = first.rr_depth;
-    r->reference.spp = std::max<uint64_t>(256, 16 * r->settings.spp_max);
+    // Its spp: 16 x the scene's spp_max (at least 256), so that a study of fewer spp keeps the
+    // scene's reference (cached, or shipped by the site); a study that asks more than a quarter
+    // of that (kReferenceSppRatio) gets 16 x its own spp_max.
+    r->reference.spp = std::max<uint64_t>(256, 16 * scene_spp_max);
+    if (r->settings.spp_max > r->reference.spp / 4)
+        r->reference.spp = std::max<uint64_t>(256, 16 * r->settings.spp_max);
     // Reference files: the glTF's extras name them relative to the glTF, the scene and the
     // options relative to the scene's folder.
     const std::string gltf_dir = r->gltf_path.empty() ? root : dirname_of(r->gltf_path);

@@ -15,7 +15,8 @@ namespace mcp {
 struct ReferenceSpec {
     RenderEstimator estimator;
     uint64_t spp = 1024;
-    std::string file; ///< a Radiance .hdr file instead of a render ("" = render it)
+    uint64_t seed = 0; ///< its own: a study's seed changes the estimators' images, never it
+    std::string file;  ///< a Radiance .hdr file instead of a render ("" = render it)
 };
 
 struct RenderRequest {
@@ -30,6 +31,9 @@ struct RenderRequest {
     AccelKind accel = AccelKind::Auto;
     double exposure = 0.0; ///< stops, for PNG output
     std::string cache_dir; ///< where high-spp references are cached ("" = no cache)
+    /// options.reference_data decoded: a reference made earlier (encode_reference), used when
+    /// it was made from the same scene and settings ("" = none).
+    std::string supplied_reference;
 };
 
 /// Does this scene JSON describe a render scene (it has a "render" object)?

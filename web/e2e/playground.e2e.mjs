@@ -502,5 +502,38 @@ test('a render scene: relative MSE against spp, fitted orders as the CLI, and th
   assert.equal(sizes.length, 1 + 2 * estimators.length);
   for (const im of sizes) assert.deepEqual([im.drawn, im.w, im.h], ['true', 16, 16], JSON.stringify(im));
   assert.equal(state.images.reference, true);
+  // Not the site's size: the study rendered its own reference, and its progress moved.
+  assert.equal(state.run.referenceShipped, false);
+  assert.equal(state.run.referenceSource, 'rendered');
+  assert.ok(state.run.referenceRows && state.run.referenceRows.rows === 16 && state.run.referenceRows.done >= 1,
+    `reference progress: ${JSON.stringify(state.run.referenceRows)}`);
   await page.screenshot({ path: join(shots, 'render_quad_light_floor.png'), fullPage: true });
+});
+
+// A bundled render scene at its own size: the reference the site ships is used (the page
+// renders none), so the first level comes at once (timed in `make bench`, asserted here only as
+// "appears"); the study's numbers are the CLI's against the reference it renders itself.
+test('a bundled render scene uses the reference shipped with the site', async () => {
+  const estimators = ['light_area', 'mis_power'];
+  await configure('cornell_box', estimators, { nMin: 1, nMax: 4, reps: 2, seed: 3 });
+  await page.click('#run');
+  await page.waitForFunction(() => document.querySelector('#status')?.textContent.startsWith('done'), null,
+    { timeout: 60000 });
+  assert.ok(requested.some((u) => u.endsWith('/refs/cornell_box.mcref')),
+    'the shipped reference was not fetched');
+  const state = await page.evaluate(() => window.mcplayDebug.state());
+  assert.equal(state.run.referenceShipped, true);
+  assert.equal(state.run.referenceSource, 'supplied');
+  assert.equal(state.run.referenceRows, null, 'the page rendered a reference');
+  assert.match(await page.textContent('#render-images'), /shipped with the site/);
+  const info = state.sceneInfo;
+  const cli = cliRender('cornell_box', estimators, { nMin: 1, nMax: 4, reps: 2, seed: 3, width: info.width, height: info.height });
+  for (const name of estimators) {
+    const est = state.estimators.find((e) => e.name === name);
+    const native = cli.estimators.find((e) => e.name === name);
+    est.levels.forEach((l, i) => {
+      const n = native.levels[i];
+      assert.ok(Math.abs(l.variance - n.variance) <= 1e-6 * n.variance, `${name} spp ${l.n}: page ${l.variance} vs CLI ${n.variance}`);
+    });
+  }
 });

@@ -5,6 +5,7 @@
 // (options.previews). An <img> gets a new src only when its picture changed.
 import { colorAt } from './palette.js';
 import { el } from './dom.js';
+import { referenceText } from './state.js';
 
 const PNG = 'data:image/png;base64,';
 
@@ -90,11 +91,12 @@ export function renderImages(state, dom) {
   let waitText = '';
   if (refPng) {
     const r = run.result && run.result.scene && run.result.scene.reference;
-    info = r && r.spp ? ` ${r.spp} spp${r.estimator ? `, ${r.estimator.strategy}` : ''}` : '';
+    info = r && r.spp ? ` ${r.spp} spp${r.estimator ? `, ${r.estimator.strategy}` : ''}${r.source === 'supplied' ? ', shipped with the site' : ''}` : '';
   } else if (preview && preview.png) {
     info = ` ${preview.estimator}, ${preview.spp} spp`;
-    waitText = run.status === 'running' ? 'The study renders its reference first; it is shown here when the study ends.'
-      : 'Press Run: the study renders a reference at many spp and compares every image with it.';
+    const doing = referenceText(run);
+    waitText = run.status === 'running' ? `${doing[0].toUpperCase()}${doing.slice(1)}; it is shown here with the first level.`
+      : 'Press Run: the study compares every image with a reference rendered at many spp.';
   } else {
     waitText = preview && preview.status === 'error' ? `No image: ${preview.message}` : 'Rendering a quick image of the scene…';
   }

@@ -225,6 +225,30 @@ function stopRunners() {
   for (const w of runners) if (w.busy) w.restart();
 }
 
+// The site's own render scenes come with their reference, rendered when the site was built
+// (manifest entry.reference, refs/<name>.mcref): fetched once per scene, base64 for the C API's
+// options.reference_data. The core uses it only if it was made from the very scene and image
+// size of the study; otherwise the study renders its own and says so.
+const shippedReferences = new Map();
+
+function base64Of(bytes) {
+  let text = '';
+  for (let i = 0; i < bytes.length; i += 0x8000) text += String.fromCharCode(...bytes.subarray(i, i + 0x8000));
+  return btoa(text);
+}
+
+/** The shipped reference of a manifest entry (a promise of base64, or null without one). */
+function shippedReference(entry) {
+  if (!entry || typeof entry.reference !== 'string') return Promise.resolve(null);
+  if (!shippedReferences.has(entry.name)) {
+    shippedReferences.set(entry.name, fetch(entry.reference)
+      .then((r) => (r.ok ? r.arrayBuffer() : null))
+      .then((buf) => (buf ? base64Of(new Uint8Array(buf)) : null))
+      .catch(() => null));
+  }
+  return shippedReferences.get(entry.name);
+}
+
 async function fetchScene(entry) {
   const res = await fetch(`scenes/${encodeURIComponent(entry.file)}`);
   if (!res.ok) throw new Error(`scenes/${entry.file}: HTTP ${res.status}`);
@@ -242,6 +266,7 @@ async function loadScene(sceneId, fromUrl = null) {
   }
   try {
     const scene = await fetchScene(entry);
+    shippedReference(entry); // fetched while the reader looks at the scene
     const info = normalizeInfo((await service.request(MSG.VALIDATE, { scene })).info);
     if (token !== sceneToken) return false;
     dispatch({
@@ -348,11 +373,14 @@ function startRun() {
   const id = s.run.id + 1;
   const kind = kindOf(s.sceneInfo);
   const settings = runSettings(s);
+  const entry = kind === KIND.RENDER ? s.scenes.find((e) => e.name === s.sceneId) : null;
+  const shipped = Boolean(entry && entry.reference && settings.width === entry.width && settings.height === entry.height);
   dispatch({
     type: 'run/start',
     payload: {
       id,
       kind,
+      referenceShipped: shipped,
       workers: groups.length,
       settings,
       order: names,
@@ -370,17 +398,27 @@ function startRun() {
   if (window.matchMedia && window.matchMedia('(max-width: 699px)').matches) {
     document.getElementById('plot-variance').closest('figure').scrollIntoView({ block: 'start' });
   }
-  groups.forEach((group, i) => {
-    // A scene's own rel_tol / abs_tol (stopping) belong to the race: the run is an N ladder.
-    workers[i].request(MSG.RUN, { scene: withoutStopping(s.scene), options: studyOptions(kind, settings, group), warmup: true }, (type, payload) => {
-      if (type === MSG.LEVEL) dispatch({ type: 'run/level', payload: { id, level: payload.level } });
-    }).then(({ result }) => {
-      dispatch({ type: 'run/partial', payload: { id, result, now: performance.now() } });
-    }).catch((e) => {
-      if (e && e.cancelled) return;
-      if (activeRun === id) stopRunners();
-      dispatch({ type: 'run/error', payload: { id, message: e && e.message ? e.message : String(e) } });
+  (shipped ? shippedReference(entry) : Promise.resolve(null)).then((referenceData) => {
+    if (activeRun !== id) return;
+    groups.forEach((group, i) => {
+      const options = studyOptions(kind, settings, group);
+      if (referenceData) options.reference_data = referenceData;
+      startPart(workers[i], id, s.scene, options);
     });
+  });
+}
+
+/** One worker's part of run `id`: its estimators' study, each level sent on as it ends. */
+function startPart(worker, id, scene, options) {
+  // A scene's own rel_tol / abs_tol (stopping) belong to the race: the run is an N ladder.
+  worker.request(MSG.RUN, { scene: withoutStopping(scene), options, warmup: true }, (type, payload) => {
+    if (type === MSG.LEVEL) dispatch({ type: 'run/level', payload: { id, level: payload.level } });
+  }).then(({ result }) => {
+    dispatch({ type: 'run/partial', payload: { id, result, now: performance.now() } });
+  }).catch((e) => {
+    if (e && e.cancelled) return;
+    if (activeRun === id) stopRunners();
+    dispatch({ type: 'run/error', payload: { id, message: e && e.message ? e.message : String(e) } });
   });
 }
 

@@ -506,6 +506,8 @@ function emptyRun(status) {
     nName: 'N',             // what N is called (settings.n_name: 'spp' for render studies)
     errorName: 'variance',  // what the plotted error is (settings.error_name: 'relative_mse')
     referencePng: null,     // render studies: the reference image (base64 PNG), once known
+    referenceShipped: false, // render studies: the site's own reference was given to the study
+    referenceRows: null,    // render studies rendering their reference: {done, rows} so far
     exact: null,            // the scene's exact value (MSE instead of variance when known)
     sceneName: null,
     colors: null,           // name -> palette index (its position in the scene)
@@ -748,11 +750,27 @@ export function reducer(state, action) {
           kind,
           nName: names.nName,
           errorName: names.errorName,
+          referenceShipped: Boolean(p.referenceShipped),
         },
       };
     }
     case 'run/level': {
       if (p.id !== state.run.id || state.run.status !== 'running') return state;
+      if (p.level && p.level.kind === 'render_reference') {
+        // Rows of the reference rendered so far (every worker renders the same one): the
+        // progress bar shows them until the first level arrives.
+        const done = Math.max(p.level.rows_done, state.run.referenceRows ? state.run.referenceRows.done : 0);
+        const rows = p.level.rows;
+        const levelsDone = state.run.order.some((n) => state.run.records[n]);
+        return {
+          ...state,
+          run: {
+            ...state.run,
+            referenceRows: { done, rows },
+            progress: levelsDone ? state.run.progress : Math.min(1, done / Math.max(1, rows)),
+          },
+        };
+      }
       const records = applyLevel(state.run.records, p.level);
       return {
         ...state,
@@ -818,6 +836,14 @@ export function keptFor(state) {
 }
 
 /** The #status text of a state. */
+/** What a render study does before its first level: the reference, shipped or being rendered. */
+export function referenceText(run) {
+  if (run.referenceShipped) return 'the reference ships with the site';
+  const rows = run.referenceRows;
+  if (!rows) return 'rendering the reference first…';
+  return `rendering the reference: ${Math.floor((100 * rows.done) / Math.max(1, rows.rows))}% of its rows`;
+}
+
 export function statusText(state) {
   const r = state.run;
   if (r.status === 'error') return `error: ${r.message}`;
@@ -863,6 +889,8 @@ export function debugSnapshot(state) {
     run: {
       id: r.id, status: r.status, progress: r.progress, workers: r.workers, settings: r.settings, exact: r.exact,
       kind: r.kind, nName: r.nName, errorName: r.errorName,
+      referenceShipped: r.referenceShipped, referenceRows: r.referenceRows,
+      referenceSource: (r.result && r.result.scene && r.result.scene.reference && r.result.scene.reference.source) || null,
     },
     // render runs: which images the page has (the reference; per estimator its preview and error image)
     images: r.kind === KIND.RENDER ? {

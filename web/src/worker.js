@@ -65,7 +65,8 @@ const handlers = {
     if (isRenderScene(scene)) {
       const render = await renderCore();
       if (warmup) warmRender(render, scene, options || {});
-      reply(id, MSG.RESULT, { result: render.runStudy(scene, options, onLevel) });
+      // The rows of a reference being rendered go the same way as levels (kind "render_reference").
+      reply(id, MSG.RESULT, { result: render.runStudy(scene, options, onLevel, onLevel) });
       return;
     }
     if (warmup) {

@@ -8,6 +8,7 @@ import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { execFileSync } from 'node:child_process';
 import fs from 'node:fs';
+import os from 'node:os';
 import path from 'node:path';
 import { fileURLToPath, pathToFileURL } from 'node:url';
 
@@ -219,6 +220,53 @@ test('estimators have their own random streams: a study split over workers gives
   // ... and the same reference in every part
   assert.equal(parts[0].scene.reference.mean_luminance, all.scene.reference.mean_luminance);
   assert.equal(parts[1].scene.exact, all.scene.exact);
+});
+
+// The site's way to skip the reference: the native CLI renders it once (`mcplay reference`) from
+// the very scene file the page loads, and the wasm study takes it as options.reference_data. The
+// two builds must agree on the key (the glTF as JSON, the name, the size, the reference's
+// settings), and the study's numbers must be those of a study that rendered it itself.
+test('a reference rendered by the native CLI is taken by the wasm study; its progress otherwise', async () => {
+  const core = await getCore();
+  const dir = fs.mkdtempSync(path.join(os.tmpdir(), 'mcplay-ref-'));
+  try {
+    const sceneFile = path.join(dir, 'scene.json');
+    fs.writeFileSync(sceneFile, JSON.stringify({ ...SCENE, render: { ...SCENE.render, width: 8, height: 8 } }));
+    execFileSync(NATIVE, ['reference', sceneFile, '--out', path.join(dir, 'r.mcref'), '--no-cache', '--quiet']);
+    const referenceData = fs.readFileSync(path.join(dir, 'r.mcref')).toString('base64');
+    const rows = [];
+    const levels = [];
+    const rendered = core.runStudy(SCENE, SMALL, (p) => { levels.push(p.kind); }, (p) => { rows.push(p); });
+    assert.equal(rendered.scene.reference.source, 'rendered');
+    assert.ok(rows.length >= 2, `reference progress lines: ${rows.length}`);
+    for (const p of rows) {
+      assert.equal(p.kind, 'render_reference');
+      assert.equal(p.rows, 8);
+      assert.ok(p.rows_done >= 1 && p.rows_done <= 8);
+    }
+    assert.deepEqual(levels, ['render', 'render', 'render'], 'levels only through onLevel');
+    const rowsAgain = [];
+    const supplied = core.runStudy(SCENE, { ...SMALL, reference_data: referenceData }, null, (p) => { rowsAgain.push(p); });
+    assert.equal(supplied.scene.reference.source, 'supplied');
+    assert.equal(rowsAgain.length, 0, 'no reference to render');
+    // Native and wasm builds agree to rounding (libm, contraction), not bit for bit.
+    const close = (a, b, what) => assert.ok(Math.abs(a - b) <= 1e-9 * Math.abs(b), `${what}: ${a} vs ${b}`);
+    close(supplied.scene.reference.mean_luminance, rendered.scene.reference.mean_luminance, 'reference mean');
+    supplied.estimators.forEach((e, k) => e.levels.forEach((l, i) => {
+      const r = rendered.estimators[k].levels[i];
+      assert.equal(l.mean, r.mean, `${e.name} spp ${l.n}: the same images`);
+      close(l.variance, r.variance, `${e.name} spp ${l.n}: relative MSE`);
+    }));
+    // Another image size: not used, rendered, and said so.
+    const other = core.runStudy(SCENE, { ...SMALL, width: 6, reference_data: referenceData });
+    assert.equal(other.scene.reference.source, 'rendered');
+    assert.match(other.scene.reference.supplied, /^not used/);
+    // Returning true from onReference cancels before any level.
+    assert.throws(() => core.runStudy(SCENE, SMALL, null, () => true),
+      (e) => e instanceof McplayError && e.status === Status.CANCELLED);
+  } finally {
+    fs.rmSync(dir, { recursive: true, force: true });
+  }
 });
 
 test('onLevel returning true cancels; an exception in it propagates and the core keeps working', async () => {

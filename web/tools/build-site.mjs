@@ -1,21 +1,24 @@
 #!/usr/bin/env node
 // Assembles the playground into a static directory:
-//   node web/tools/build-site.mjs [OUT=build/site] [WASM_DIR=build-wasm]
+//   node web/tools/build-site.mjs [OUT=build/site] [WASM_DIR=build-wasm] [NATIVE=build/mcplay]
 // OUT/index.html, style.css, src/** (the page's modules), core.js, render_core.js,
 // vendor/uPlot.esm.js + uPlot.min.css (+ its LICENSE) from web/node_modules/uplot/dist,
 // mcplay_web.mjs + .wasm and mcplay_render_web.mjs + .wasm from WASM_DIR, scenes/*.json and
 // scenes/manifest.json ([{file, name, description, kind, dimension, estimators, n_min, n_max,
-// group, look}], render scenes also {reps, width, height}; read from the scene files themselves;
+// group, look}], render scenes also {reps, width, height, reference}; read from the scene files themselves;
 // the page asks the core, sceneInfo, for the rest), in the order of the teaching path
 // web/tour.json, which gives each scene its group and what to look for. Its first scene is an
 // integral (the page opens it, and only render scenes load the render module).
 // Render scenes (a "render" object) are copied with their "gltf" replaced by the glTF itself,
 // inline, its external buffers and images turned into data: URIs (a .glb becomes the same
-// JSON with its binary chunk as buffer 0), since the wasm module cannot read the site's files.
+// JSON with its binary chunk as buffer 0), since the wasm module cannot read the site's files,
+// and their reference images are rendered here by the native CLI into refs/<name>.mcref (the
+// page never renders a bundled scene's reference; see shipReference).
 // OUT and WASM_DIR default to build/site and build-wasm in the repository. Fails with a message
 // naming what is missing.
 import fs from 'node:fs';
 import path from 'node:path';
+import { spawnSync } from 'node:child_process';
 import { fileURLToPath } from 'node:url';
 
 const ROOT = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '..', '..');
@@ -24,6 +27,8 @@ const WEB = path.join(ROOT, 'web');
 const OUT = process.argv[2] ? path.resolve(process.argv[2]) : path.join(ROOT, 'build', 'site');
 const WASM_DIR = process.argv[3] ? path.resolve(process.argv[3]) : path.join(ROOT, 'build-wasm');
 const UPLOT = path.join(WEB, 'node_modules', 'uplot');
+const NATIVE = process.argv[4] ? path.resolve(process.argv[4]) : path.join(ROOT, 'build', 'mcplay');
+const REF_CACHE = path.join(ROOT, 'build', 'ref-cache');
 
 function fail(message) {
   console.error(`build-site: ${message}`);
@@ -200,8 +205,8 @@ export function inlineGltf(gltfPath) {
 
 /**
  * The scene as the site serves it: a render scene's "gltf" file name replaced by the glTF
- * object (inlineGltf), and a reference image file dropped (the browser renders the reference:
- * the wasm module reads no files). Returns {scene, notes}.
+ * object (inlineGltf), and a reference image file dropped (the wasm module reads no files: the
+ * site ships a rendered reference instead, shipReference). Returns {scene, notes}.
  */
 export function siteScene(scene, sceneDir) {
   if (!isRenderScene(scene) || !scene.render || typeof scene.render !== 'object') return { scene, notes: [] };
@@ -211,7 +216,7 @@ export function siteScene(scene, sceneDir) {
   if (render.reference && typeof render.reference === 'object' && 'file' in render.reference) {
     render.reference = { ...render.reference };
     delete render.reference.file;
-    notes.push('reference.file dropped: the page renders the reference instead');
+    notes.push('reference.file dropped: the site ships a rendered reference instead');
   }
   return { scene: { ...scene, render }, notes };
 }
@@ -230,7 +235,27 @@ function copyTree(from, to) {
   }
 }
 
+/**
+ * The reference of a site's render scene, rendered once here by the native CLI from the very
+ * scene file the page loads (`mcplay reference`; the result is keyed by the glTF, the name,
+ * the size and the reference's settings, so the page's study uses it only for exactly these),
+ * written to OUT/refs/<name>.mcref. References already rendered are kept in build/ref-cache.
+ * Returns the path the manifest gives the page.
+ */
+function shipReference(sceneFile, name) {
+  const rel = `refs/${name.replace(/[^A-Za-z0-9_.-]/g, '_')}.mcref`;
+  const out = path.join(OUT, rel);
+  fs.mkdirSync(path.dirname(out), { recursive: true });
+  const run = spawnSync(NATIVE, ['reference', sceneFile, '--out', out, '--cache', REF_CACHE, '--quiet'],
+    { encoding: 'utf8' });
+  if (run.status !== 0) fail(`${shown(sceneFile)}: the reference could not be rendered: ${(run.stderr || run.error || '').toString().trim()}`);
+  console.log(`build-site: ${run.stdout.trim()}`);
+  return rel;
+}
+
 function main() {
+  need(NATIVE, 'build the native CLI with `make build` (or pass its path as the third argument): it renders the render scenes\' references');
+  fs.mkdirSync(REF_CACHE, { recursive: true });
   const wasmFiles = ['mcplay_web.mjs', 'mcplay_web.wasm', 'mcplay_render_web.mjs', 'mcplay_render_web.wasm'].map((f) =>
     need(path.join(WASM_DIR, f), `build the wasm module with \`make build-wasm\` (or pass its directory as the second argument)`));
   const uplotFiles = ['uPlot.esm.js', 'uPlot.min.css'].map((f) =>
@@ -277,6 +302,7 @@ function main() {
       for (const note of site.notes) console.log(`build-site: scenes/${file}: ${note}`);
       fs.mkdirSync(path.join(OUT, 'scenes'), { recursive: true });
       fs.writeFileSync(path.join(OUT, 'scenes', file), `${JSON.stringify(site.scene)}\n`);
+      manifest[manifest.length - 1].reference = shipReference(path.join(OUT, 'scenes', file), manifest[manifest.length - 1].name);
     } else {
       copy(path.join(scenesDir, file), path.join(OUT, 'scenes', file));
     }

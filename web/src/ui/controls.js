@@ -3,7 +3,7 @@
 // state back into the controls (never into an input the user is typing in), and shows the
 // panels of the kind of problem chosen: render scenes hide the custom problem and the sample
 // points, and show the image size and the images.
-import { CUSTOM, KIND, kindOf, paramRules, runBlocker, statusText } from '../state.js';
+import { CUSTOM, KIND, kindOf, paramRules, referenceText, runBlocker, statusText } from '../state.js';
 import { colorAt } from '../palette.js';
 import { fmt } from '../series.js';
 import { renderFacts } from '../report.js';
@@ -194,7 +194,7 @@ export function syncControls(state) {
     info2 = `${run.order.length} estimator${run.order.length === 1 ? '' : 's'} on ${run.workers} worker${run.workers === 1 ? '' : 's'}${secs}`;
     if (run.settings && run.kind === KIND.RENDER) {
       info2 += ` · spp ${run.settings.n_min}..${run.settings.n_max}, ${run.settings.width}×${run.settings.height} px, ${run.settings.reps} reps, seed ${run.settings.seed}`;
-      if (run.status === 'running' && !run.order.some((n) => run.records[n])) info2 += ' · rendering the reference first…';
+      if (run.status === 'running' && !run.order.some((n) => run.records[n])) info2 += ` · ${referenceText(run)}`;
     } else if (run.settings) {
       info2 += ` · N ${run.settings.n_min}..${run.settings.n_max}, ${run.settings.reps} reps, seed ${run.settings.seed}`;
     }
