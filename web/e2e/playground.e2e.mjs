@@ -526,6 +526,29 @@ test('a bundled render scene uses the reference shipped with the site', async ()
   assert.equal(state.run.referenceSource, 'supplied');
   assert.equal(state.run.referenceRows, null, 'the page rendered a reference');
   assert.match(await page.textContent('#render-images'), /shipped with the site/);
+  // Images come before the plots, at least 256 px wide, one square per pixel.
+  const order = await page.evaluate(() => document.querySelector('#render-images-section')
+    .compareDocumentPosition(document.querySelector('#plot-variance')) & Node.DOCUMENT_POSITION_FOLLOWING);
+  assert.ok(order, 'the images are not above the plots');
+  const ref = page.locator('img[data-role="reference"]');
+  const box = await ref.boundingBox();
+  assert.ok(box.width >= 256, `reference shown ${box.width} px wide`);
+  assert.equal(await ref.evaluate((i) => getComputedStyle(i).imageRendering), 'pixelated');
+  // "Show": the error images only on request; a click enlarges an image, Escape closes it.
+  const error = page.locator('img[data-role="error"][data-estimator="mis_power"]');
+  assert.equal(await error.isVisible(), false);
+  await page.check('input[name="image-view"][value="both"]');
+  assert.equal(await error.isVisible(), true);
+  await page.click('img[data-role="preview"][data-estimator="mis_power"]');
+  const zoomed = page.locator('#zoom-image');
+  await zoomed.waitFor({ state: 'visible' });
+  const zbox = await zoomed.boundingBox();
+  assert.ok(zbox.width >= 1.5 * box.width, `enlarged to ${zbox.width} px from ${box.width}`);
+  assert.match(await page.textContent('#zoom-caption'), /mis_power.*48×48 px/);
+  await page.screenshot({ path: join(shots, 'render_zoom.png') });
+  await page.keyboard.press('Escape');
+  await zoomed.waitFor({ state: 'hidden' });
+  await page.check('input[name="image-view"][value="image"]');
   const info = state.sceneInfo;
   const cli = cliRender('cornell_box', estimators, { nMin: 1, nMax: 4, reps: 2, seed: 3, width: info.width, height: info.height });
   for (const name of estimators) {

@@ -30,7 +30,23 @@ function setImage(img, key, base64) {
 
 function picture(role, name, caption, alt) {
   const img = el('img', { alt, className: 'render-image', hidden: true, dataset: { role, estimator: name || '', drawn: 'false' } });
-  return el('figure', { className: 'render-figure' }, img, el('figcaption', { className: 'cap', dataset: { caption: role } }, caption));
+  // A button around it: a click (or Enter) enlarges the image (main.js opens #image-zoom).
+  const zoom = el('button', { type: 'button', className: 'zoom-button', title: 'enlarge', ariaLabel: `Enlarge: ${alt}` }, img);
+  return el('figure', { className: 'render-figure', dataset: { kind: role } }, zoom,
+    el('figcaption', { className: 'cap', dataset: { caption: role } }, caption));
+}
+
+/**
+ * The whole factor an image of w pixels is scaled up by: at least 256 px on screen (one square
+ * per pixel, no smoothing), never scaled down.
+ */
+export function imageScale(w) {
+  return Math.max(1, Math.ceil(256 / Math.max(1, w)));
+}
+
+/** The whole factor that fits a w x h image into a box of boxW x boxH pixels (at least 1). */
+export function zoomScale(w, h, boxW, boxH) {
+  return Math.max(1, Math.floor(Math.min(boxW / Math.max(1, w), boxH / Math.max(1, h))));
 }
 
 function colorOf(run, name) {
@@ -55,6 +71,39 @@ function layout(container, run, size) {
   container.style.setProperty('--image-width', `${size}px`);
 }
 
+/**
+ * The panel's own controls, wired once: "Show" (image, relative error or both per card: a data
+ * attribute the stylesheet reads; the pictures keep their sources) and the enlarged view (a
+ * click on an image opens #image-zoom with it at the largest whole factor that fits).
+ */
+export function mountImages(dom) {
+  const view = document.querySelector('.image-view');
+  if (view) {
+    view.addEventListener('change', (e) => {
+      if (e.target && e.target.name === 'image-view') dom.images.dataset.view = e.target.value;
+    });
+  }
+  const dialog = document.getElementById('image-zoom');
+  const big = document.getElementById('zoom-image');
+  const caption = document.getElementById('zoom-caption');
+  if (!dialog || !big) return;
+  dom.images.addEventListener('click', (e) => {
+    const button = e.target && e.target.closest ? e.target.closest('.zoom-button') : null;
+    const img = button && button.querySelector('img');
+    if (!img || !img.src || img.hidden) return;
+    big.src = img.src;
+    big.alt = img.alt;
+    const card = button.closest('.image-card');
+    const title = card && card.querySelector('h3') ? card.querySelector('h3').textContent.trim() : '';
+    const cap = button.closest('figure') && button.closest('figure').querySelector('figcaption');
+    caption.textContent = `${title}${cap && cap.textContent ? ` · ${cap.textContent}` : ''} · ${img.naturalWidth}×${img.naturalHeight} px`;
+    const k = zoomScale(img.naturalWidth, img.naturalHeight, window.innerWidth * 0.9, window.innerHeight * 0.8);
+    big.style.width = `${img.naturalWidth * k}px`;
+    if (typeof dialog.showModal === 'function') dialog.showModal();
+    else dialog.setAttribute('open', '');
+  });
+}
+
 /** Draws the images of state.run into dom.images (the #render-images grid). */
 export function renderImages(state, dom) {
   if (!dom.images) return;
@@ -70,8 +119,8 @@ export function renderImages(state, dom) {
   }
   const order = run.kind === 'render' ? run.order : [];
   const w = (run.kind === 'render' && run.settings && run.settings.width) || state.params.width || 64;
-  // Small images are scaled up by whole factors (pixelated), to about 200 px.
-  const size = w * Math.max(1, Math.min(8, Math.round(200 / w)));
+  // Small images are scaled up by whole factors (pixelated), to at least 256 px.
+  const size = w * imageScale(w);
   const sig = JSON.stringify([run.id, order, run.colors, size]);
   if (sig !== layoutSig) {
     layoutSig = sig;

@@ -22,7 +22,7 @@ import { CoreWorker } from './client.js';
 import { MSG } from './protocol.js';
 import { initPlots, renderPlots, plotPng, hiddenEstimators } from './plot.js';
 import { renderReport } from './report.js';
-import { renderImages } from './images.js';
+import { mountImages, renderImages } from './images.js';
 import { renderExplain } from './ui/explain.js';
 import { mountControls, syncControls } from './ui/controls.js';
 import { mountCustom, syncCustom } from './ui/custom.js';
@@ -49,6 +49,7 @@ let urlReady = false; // the URL is written only once the first scene is in
 
 const reportDom = { diagnostics: $('diagnostics'), diagnosticsEmpty: $('diagnostics-empty'), levels: $('levels') };
 const imagesDom = { images: $('render-images') };
+mountImages(imagesDom);
 initPlots({
   variance: $('plot-variance'), time: $('plot-time'), calibration: $('plot-calibration'), coverage: $('plot-coverage'),
   'legend-variance': $('legend-variance'), 'legend-time': $('legend-time'),

@@ -736,6 +736,8 @@ export function reducer(state, action) {
       return {
         ...state,
         calibration: 'all',
+        // a shared link's offer to run is done with; what it said about its values stays
+        notice: state.notice.replace(/\s*Press Run to draw this link's plots\.$/, ''),
         run: {
           ...emptyRun('running'),
           id: p.id,

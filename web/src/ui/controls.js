@@ -59,7 +59,7 @@ function showKind(kind) {
   $('n-min-label').textContent = render ? 'spp_min [samples per pixel]' : 'n_min [samples]';
   $('n-max-label').textContent = render ? 'spp_max [samples per pixel]' : 'n_max [samples]';
   $('ladder-note').textContent = render
-    ? 'spp runs over the powers of two in [spp_min, spp_max]: each estimator renders “replicates” images of width × height pixels at each spp, compared with a reference rendered first.'
+    ? 'spp runs over the powers of two in [spp_min, spp_max]: each estimator renders “replicates” images of width × height pixels at each spp, compared with a reference image at many more spp (the site ships its scenes\' references; another image size renders its own first).'
     : 'N runs over the powers of two in [n_min, n_max].';
   const calLabel = document.querySelector('label[for="calibration-level"]');
   if (calLabel) calLabel.textContent = render ? 'spp' : 'N';
