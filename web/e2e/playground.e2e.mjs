@@ -510,6 +510,29 @@ test('a render scene: relative MSE against spp, fitted orders as the CLI, and th
   await page.screenshot({ path: join(shots, 'render_quad_light_floor.png'), fullPage: true });
 });
 
+// A glTF file the reader opens: shown as "your file" in the scene list, kept out of the link,
+// its reference rendered by the study with progress that moves; a wrong choice is named.
+test('a glTF file opened in the page renders its reference with moving progress', async () => {
+  await page.setInputFiles('#gltf-file', join(here, '..', '..', 'scenes', 'exp_1d.json'));
+  await page.waitForFunction(() => document.querySelector('#gltf-error').textContent.length > 0);
+  assert.match(await page.textContent('#gltf-error'), /none of the chosen files is a \.gltf or \.glb/);
+  await page.setInputFiles('#gltf-file', join(here, '..', '..', 'scenes', 'quad_light_floor.gltf'));
+  await page.waitForFunction(() => window.mcplayDebug.state().scene === 'gltf-file' && !window.mcplayDebug.state().sceneInfo.provisional);
+  assert.equal(await page.textContent('#gltf-error'), '');
+  assert.match(await page.textContent('#scene option[value="gltf-file"]'), /your file: quad_light_floor\.gltf/);
+  await configure('quad_light_floor', ['light_area', 'mis_power'], { nMin: 1, nMax: 4, reps: 2, seed: 1, width: 32, height: 24 });
+  assert.equal(await page.evaluate(() => window.mcplayDebug.state().scene), 'gltf-file');
+  await page.click('#run');
+  await page.waitForFunction(() => document.querySelector('#status')?.textContent.startsWith('done'), null, { timeout: 60000 });
+  const state = await page.evaluate(() => window.mcplayDebug.state());
+  assert.equal(state.run.referenceShipped, false);
+  assert.equal(state.run.referenceSource, 'rendered');
+  assert.equal(state.run.referenceRows.rows, 24);
+  assert.ok(state.run.referenceRows.done >= 1);
+  assert.doesNotMatch(state.query, /scene=/, 'a link names the reader\'s file');
+  assert.deepEqual(state.estimators.map((e) => e.levels.length), [3, 3]);
+});
+
 // A bundled render scene at its own size: the reference the site ships is used (the page
 // renders none), so the first level comes at once (timed in `make bench`, asserted here only as
 // "appears"); the study's numbers are the CLI's against the reference it renders itself.

@@ -15,7 +15,7 @@
 import {
   createStore, reducer, initialState, queryToState, stateToQuery, sceneDefaults, runBlocker,
   debugSnapshot, buildCustomScene, customError, parseExact, CUSTOM, WEIGHT_SAMPLES, KIND, kindOf, normalizeInfo,
-  runSettings, studyOptions, urlProblems,
+  runSettings, studyOptions, urlProblems, USER_GLTF,
 } from './state.js';
 import { splitEstimators, partialResult, samplesCsv } from './series.js';
 import { CoreWorker } from './client.js';
@@ -23,6 +23,7 @@ import { MSG } from './protocol.js';
 import { initPlots, renderPlots, plotPng, hiddenEstimators } from './plot.js';
 import { renderReport } from './report.js';
 import { mountImages, renderImages } from './images.js';
+import { base64Of, checkGltfBytes, sceneFromFiles } from './gltf_files.js';
 import { renderExplain } from './ui/explain.js';
 import { mountControls, syncControls } from './ui/controls.js';
 import { mountCustom, syncCustom } from './ui/custom.js';
@@ -132,6 +133,9 @@ store.subscribe((state, action) => {
     case 'custom/apply':
       applyCustom();
       break;
+    case 'gltf/open':
+      openGltf(p.files);
+      break;
     case 'scene/loaded':
       if (state.run.status !== 'running') stopRunners(); // a run of the previous problem, if any
       break;
@@ -232,11 +236,6 @@ function stopRunners() {
 // size of the study; otherwise the study renders its own and says so.
 const shippedReferences = new Map();
 
-function base64Of(bytes) {
-  let text = '';
-  for (let i = 0; i < bytes.length; i += 0x8000) text += String.fromCharCode(...bytes.subarray(i, i + 0x8000));
-  return btoa(text);
-}
 
 /** The shipped reference of a manifest entry (a promise of base64, or null without one). */
 function shippedReference(entry) {
@@ -256,8 +255,34 @@ async function fetchScene(entry) {
   return res.json();
 }
 
+// A glTF scene the reader opened (web/src/gltf_files.js): kept here, shown as "your file" in
+// the scene list; its reference is rendered by the study (the progress bar follows its rows).
+let userScene = null;
+
+/** Reads the chosen files, builds their scene and loads it; errors go to #gltf-error. */
+async function openGltf(files) {
+  const token = ++sceneToken;
+  try {
+    checkGltfBytes(files.reduce((sum, f) => sum + f.size, 0)); // before anything is read
+    const read = await Promise.all(files.map(async (f) => ({ name: f.name, bytes: new Uint8Array(await f.arrayBuffer()) })));
+    const scene = sceneFromFiles(read);
+    const info = normalizeInfo((await service.request(MSG.VALIDATE, { scene })).info);
+    if (token !== sceneToken) return;
+    userScene = { scene, info, fileName: files.find((f) => /\.(gltf|glb)$/i.test(f.name)).name };
+    stopRunners();
+    dispatch({ type: 'scene/loaded', payload: { sceneId: USER_GLTF, ...userScene } });
+  } catch (e) {
+    if (token === sceneToken) dispatch({ type: 'gltf/error', payload: { message: e && e.message ? e.message : String(e) } });
+  }
+}
+
 /** Loads a scene of the manifest; `fromUrl` (first load) gives its estimators and settings. */
 async function loadScene(sceneId, fromUrl = null) {
+  if (sceneId === USER_GLTF && userScene) {
+    ++sceneToken;
+    dispatch({ type: 'scene/loaded', payload: { sceneId: USER_GLTF, ...userScene } });
+    return true;
+  }
   const token = ++sceneToken;
   const { scenes } = store.getState();
   const entry = scenes.find((s) => s.name === sceneId) || scenes[0];

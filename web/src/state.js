@@ -46,6 +46,8 @@ export const DEFAULTS = Object.freeze({
 });
 
 export const CUSTOM = 'custom';
+/** The scene id of a glTF file the reader opened in the page (never in a link: the file is theirs). */
+export const USER_GLTF = 'gltf-file';
 
 /** The URL keys, in the order stateToQuery writes them (width and height: render scenes). */
 export const QUERY_KEYS = Object.freeze(['scene', 'estimators', 'n_min', 'n_max', 'reps', 'seed', 'width', 'height', 'f', 'p', 'exact']);
@@ -116,6 +118,7 @@ export function stateToQuery(state) {
   const c = comparisonOf(state);
   const parts = [];
   const add = (k, v) => { if (v !== null && v !== undefined && v !== '') parts.push(`${k}=${enc(String(v))}`); };
+  if (c.scene === USER_GLTF) return ''; // a link cannot carry the reader's file
   add('scene', c.scene);
   if (Array.isArray(c.estimators)) add('estimators', c.estimators.join(','));
   for (const k of ['n_min', 'n_max', 'reps', 'seed', 'width', 'height']) add(k, c[k]);
@@ -442,6 +445,7 @@ export function initialState() {
     params: { n_min: DEFAULTS.n_min, n_max: DEFAULTS.n_max, reps: DEFAULTS.reps, seed: DEFAULTS.seed, width: null, height: null },
     paramErrors: {},        // key -> message for an input that holds no valid value
     custom: { f: '', p: '', exact: '', error: null, pending: false, applied: null },
+    userGltf: { name: null, error: null }, // a glTF file opened in the page (its file name), or why not
     calibration: 'all',     // the histogram's level: 'all' (pooled) or an N
     notice: '',             // last export / scene-loading message
     run: emptyRun('loading'),
@@ -543,7 +547,7 @@ export function reducer(state, action) {
       // range), from what the manifest says of it; core.sceneInfo completes it (scene/loaded)
       // and Run waits for that. Edits made meanwhile are kept.
       const entry = p.sceneId === CUSTOM ? null : state.scenes.find((sc) => sc.name === p.sceneId);
-      if (!entry) return { ...state, notice: '' };
+      if (!entry) return { ...state, notice: '', userGltf: { ...state.userGltf, error: null } };
       const info = {
         name: entry.name, description: entry.description, dimension: entry.dimension,
         estimators: entry.estimators.slice(), n_min: entry.n_min, n_max: entry.n_max, provisional: true,
@@ -592,6 +596,7 @@ export function reducer(state, action) {
         sceneId: p.sceneId,
         scene: p.scene,
         sceneInfo: p.info,
+        userGltf: p.sceneId === USER_GLTF ? { name: p.fileName || state.userGltf.name, error: null } : { ...state.userGltf, error: null },
         selected,
         params,
         paramErrors: keep ? state.paramErrors : {},
@@ -604,6 +609,8 @@ export function reducer(state, action) {
         race: keep ? state.race : emptyRace(raceInputsFor(state.race.inputs, p.scene), state.race.id),
       };
     }
+    case 'gltf/error':
+      return { ...state, userGltf: { ...state.userGltf, error: p.message } };
     case 'scene/failed':
       return { ...state, notice: p.message, custom: { ...state.custom, pending: false } };
     case 'estimator/set': {

@@ -3,7 +3,7 @@
 // state back into the controls (never into an input the user is typing in), and shows the
 // panels of the kind of problem chosen: render scenes hide the custom problem and the sample
 // points, and show the image size and the images.
-import { CUSTOM, KIND, kindOf, paramRules, referenceText, runBlocker, statusText } from '../state.js';
+import { CUSTOM, KIND, USER_GLTF, kindOf, paramRules, referenceText, runBlocker, statusText } from '../state.js';
 import { colorAt } from '../palette.js';
 import { fmt } from '../series.js';
 import { renderFacts } from '../report.js';
@@ -14,6 +14,11 @@ const PARAM_INPUTS = { n_min: 'n-min', n_max: 'n-max', reps: 'reps', seed: 'seed
 
 export function mountControls(store) {
   const { dispatch } = store;
+  $('gltf-file').addEventListener('change', (e) => {
+    const files = [...(e.target.files || [])];
+    if (files.length) dispatch({ type: 'gltf/open', payload: { files } });
+    e.target.value = ''; // the same files may be chosen again
+  });
   $('scene').addEventListener('change', (e) => {
     dispatch({ type: 'scene/request', payload: { sceneId: e.target.value } });
   });
@@ -100,7 +105,7 @@ function option(value, text) {
 
 /** The scene list: one group per stop of the teaching path (the manifest's `group`, in its
  *  order), then the custom problem; a manifest without groups is split by kind. */
-function sceneOptions(scenes) {
+function sceneOptions(scenes, userGltf) {
   const optgroup = (label, items) => {
     const g = document.createElement('optgroup');
     g.label = label;
@@ -115,19 +120,21 @@ function sceneOptions(scenes) {
     groups.get(title).push(option(s.name, label(s)));
   }
   return [...[...groups].map(([title, items]) => optgroup(title, items)),
-    optgroup('Your own integral', [option(CUSTOM, 'custom: f and p typed below')])];
+    optgroup('Your own integral', [option(CUSTOM, 'custom: f and p typed below')]),
+    ...(userGltf ? [optgroup('Your own glTF scene', [option(USER_GLTF, `your file: ${userGltf}`)])] : [])];
 }
 
 export function syncControls(state) {
   const sn = $('samples-n');
   if (sn && Number(sn.value) !== state.samples.n) sn.value = String(state.samples.n);
   // Scenes
-  const sSig = JSON.stringify(state.scenes.map((s) => s.name));
+  const sSig = JSON.stringify([state.scenes.map((s) => s.name), state.userGltf.name]);
   const select = $('scene');
   if (sSig !== scenesSig) {
     scenesSig = sSig;
-    select.replaceChildren(...sceneOptions(state.scenes));
+    select.replaceChildren(...sceneOptions(state.scenes, state.userGltf.name));
   }
+  $('gltf-error').textContent = state.userGltf.error || '';
   if (state.sceneId && select.value !== state.sceneId) select.value = state.sceneId;
 
   const info = state.sceneInfo;
