@@ -195,6 +195,12 @@ test('exports: a plot PNG and the sample points as CSV, named after the scene', 
   assert.match(png.suggestedFilename(), /^mcplay-disk_third-N16-4096-R32-seed1-variance\.png$/);
   const pngBytes = readFileSync(await png.path());
   assert.equal(pngBytes.subarray(1, 4).toString(), 'PNG');
+  // At twice the screen's resolution: the PNG is at least twice the plot's CSS width.
+  const cssWidth = await page.locator('#plot-variance canvas').first().evaluate((c) => c.getBoundingClientRect().width);
+  assert.ok(pngBytes.readUInt32BE(16) >= 2 * cssWidth - 2, `PNG ${pngBytes.readUInt32BE(16)} px wide for a ${cssWidth} px plot`);
+  // ... and the plot on screen is back at the device's resolution.
+  const back = await page.locator('#plot-variance canvas').first().evaluate((c) => c.width / c.getBoundingClientRect().width);
+  assert.ok(Math.abs(back - 1) < 0.02, `canvas at ${back}x after the export`);
   await page.waitForFunction(() => !document.querySelector('#export-samples').disabled, null, { timeout: 10000 });
   const [csv] = await Promise.all([page.waitForEvent('download'), page.click('#export-samples')]);
   assert.match(csv.suggestedFilename(), /^mcplay-disk_third-samples-n\d+-seed1\.csv$/);

@@ -17,7 +17,7 @@ import {
   debugSnapshot, buildCustomScene, customError, parseExact, CUSTOM, WEIGHT_SAMPLES, KIND, kindOf, normalizeInfo,
   runSettings, studyOptions, urlProblems, USER_GLTF,
 } from './state.js';
-import { splitEstimators, partialResult, samplesCsv } from './series.js';
+import { clockResolution, splitEstimators, partialResult, samplesCsv } from './series.js';
 import { CoreWorker } from './client.js';
 import { MSG } from './protocol.js';
 import { initPlots, renderPlots, plotPng, hiddenEstimators } from './plot.js';
@@ -526,7 +526,7 @@ async function exportResult({ format, plot }) {
     return;
   }
   if (format === 'png') {
-    const url = plotPng(plot, `${s.run.sceneName || s.sceneId}: ${s.run.order.filter((n) => !hiddenEstimators().includes(n)).join(', ')}`);
+    const url = await plotPng(plot, `${s.run.sceneName || s.sceneId}: ${s.run.order.filter((n) => !hiddenEstimators().includes(n)).join(', ')}`);
     if (!url) throw new Error(`the ${plot} plot is empty`);
     download(`${fileStem(s)}-${plot}.png`, url);
     return;
@@ -556,6 +556,7 @@ async function copyLink() {
 // Start-up: the core, the manifest, then the scene the URL names (or the first one).
 
 async function start() {
+  dispatch({ type: 'clock/measured', payload: { ms: clockResolution(() => performance.now()) } });
   service = new CoreWorker(WORKER_URL);
   const manifest = fetch('scenes/manifest.json').then((r) => {
     if (!r.ok) throw new Error(`scenes/manifest.json: HTTP ${r.status}`);

@@ -2,9 +2,12 @@
 // error against time per estimate, the z-score histogram and the coverage against N. A pure
 // render of the state: it reads state.run and writes only into the plot containers and legends.
 // A chart is rebuilt when its set of series changes and otherwise gets setData.
+// Before uPlot: it keeps uPlot's pixel-ratio listeners (exports at 2x).
+import { devicePixelRatioNow, withPixelRatio } from './pixel_ratio.js';
 import uPlot from '../vendor/uPlot.esm.js';
 import {
   varianceSeries, anchorOf, referenceLines, timeSeries, calibrationSeries, coverageSeries, equalTimeVerdict,
+  CLOCK_STEPS_FITTED,
   decadeRange, fitText, fmt, curveOverlay, misWeightCurves, weightBins, weightHistogram, domainView, mapFor, mappedGrid,
 } from './series.js';
 import { colorAt, withAlpha } from './palette.js';
@@ -533,8 +536,41 @@ function pathsInOrder(getPaths) {
   };
 }
 
+/** A duration in seconds, short: 0.1 ms, 25 us, 1.5 s. */
+function shortSeconds(t) {
+  if (t >= 1) return `${+t.toPrecision(2)} s`;
+  if (t >= 1e-3) return `${+(t * 1e3).toPrecision(2)} ms`;
+  return `${+(t * 1e6).toPrecision(2)} µs`;
+}
+
+/** Shades the times below `floor` seconds (too short for the clock) and says so. */
+function clockBandHook(floor, stepSeconds) {
+  return (u) => {
+    if (!(floor > 0)) return;
+    const x1 = u.valToPos(floor, 'x', true);
+    const x0 = u.bbox.left;
+    if (!(x1 > x0)) return;
+    const ctx = u.ctx;
+    const px = uPlot.pxRatio || 1;
+    ctx.save();
+    ctx.fillStyle = 'rgba(120, 128, 138, 0.10)';
+    ctx.fillRect(x0, u.bbox.top, Math.min(x1, u.bbox.left + u.bbox.width) - x0, u.bbox.height);
+    ctx.fillStyle = '#5a6470';
+    ctx.font = `${10 * px}px "DejaVu Sans", sans-serif`;
+    ctx.textBaseline = 'bottom';
+    ctx.textAlign = 'left';
+    const text = `under ${CLOCK_STEPS_FITTED} clock steps (${shortSeconds(stepSeconds)}): not fitted`;
+    ctx.fillText(text, x0 + 4 * px, u.bbox.top + u.bbox.height - 4 * px, Math.max(40 * px, x1 - x0 - 8 * px));
+    ctx.restore();
+  };
+}
+
 function renderTime(state, run, records) {
-  const ts = timeSeries(records, run.order);
+  // The page's clock (performance.now, which the wasm core times with) rounds to a step: times
+  // under CLOCK_STEPS_FITTED steps are drawn but not fitted.
+  const step = state.clockStep > 0 ? state.clockStep / 1000 : 0;
+  const floor = CLOCK_STEPS_FITTED * step;
+  const ts = timeSeries(records, run.order, floor);
   const data = [ts.x, ...ts.series.map((s) => lgAll(s.y))];
   const noLine = () => null;
   const series = [{}, ...ts.series.map((s) => {
@@ -571,13 +607,18 @@ function renderTime(state, run, records) {
       ],
       series,
       cursor: { drag: { x: false, y: false } },
-      hooks: { drawAxes: [minorLogGrid], draw: [(u) => pathsInOrder(() => charts.time.lines)(u)] },
-    }), data, { xRange, yRange, lines });
+      hooks: { drawAxes: [minorLogGrid, (u) => clockBandHook(charts.time.floor, charts.time.step)(u)],
+        draw: [(u) => pathsInOrder(() => charts.time.lines)(u)] },
+    }), data, { xRange, yRange, lines, floor, step });
   }
+  const slopeText = (s) => {
+    if (s.slope === null) return s.untimed ? 'no slope: too fast for the clock' : '';
+    return `error ∝ t^${s.slope.toFixed(2)}${s.untimed ? ` (fit at t ≥ ${shortSeconds(floor)})` : ''}`;
+  };
   setLegend('time', dom['legend-time'], ts.series.map((s) => ({
     name: s.name,
     color: colorOf(run, s.name),
-    parts: [s.slope === null ? '' : { text: `error ∝ t^${s.slope.toFixed(2)}`, className: 'fit' },
+    parts: [slopeText(s) ? { text: slopeText(s), className: 'fit' } : '',
       s.trainingShare === null ? '' : { text: `training: ${Math.round(100 * s.trainingShare)}% of the time (dashed: without it)`, className: 'fit' }],
   })));
   // The equal-time statement, once the run is over (integrals: render studies have their own
@@ -1111,7 +1152,18 @@ function renderWeights(state, weights) {
  * The chart `key` as a PNG data URL: the canvas (axes and series) on white, with the plot's
  * title above and its legend lines below. null when the chart is not drawn.
  */
-export function plotPng(key, subtitle = '') {
+/**
+ * The chart `key` as a PNG data URL at `scale` times the device's resolution (drawn again at that
+ * pixel ratio for the export, withPixelRatio), with its title, `subtitle` and legend; null
+ * for an empty chart.
+ */
+export async function plotPng(key, subtitle = '', scale = 2) {
+  const c = charts[key];
+  if (!c || !c.u) return null;
+  return withPixelRatio(scale * devicePixelRatioNow(), () => composePng(key, subtitle));
+}
+
+function composePng(key, subtitle) {
   const c = charts[key];
   if (!c || !c.u) return null;
   const src = c.u.ctx.canvas;

@@ -204,15 +204,6 @@ export function fitSlope(xs, ys) {
 // ---------------------------------------------------------------------------------------------
 // Error against time
 
-/**
- * The equal-time plot: per estimator the points (time_mean_s, error) of its levels (error =
- * RMSE when the exact value is known, else sqrt(variance)), on the sorted union of all times
- * (uPlot's aligned data; null where a series has no point), the points in the order of N
- * (`points`: [time, error] pairs, for joining them), and the least-squares slope of log error on
- * log time. Adaptive estimators also get `estimating` (the [time minus training time, error]
- * pairs) and `trainingShare` (the mean share of the time spent training or probing; null for
- * the others).
- */
 /** The seconds per estimate a level is plotted at: the replicates' median (robust to the one
  *  that a busy machine delayed), or their mean when the level has no median. */
 export function timeOf(l) {
@@ -231,7 +222,42 @@ export function timeInterval(l) {
   return null;
 }
 
-export function timeSeries(records, order) {
+/**
+ * The finest step of a clock (ms): the smallest positive difference between successive readings
+ * of `now`, watched for at most `budgetMs` (or `maxReadings` readings). Browsers coarsen performance.now() (to 5 us, or
+ * 100 us without cross-origin isolation), and the wasm core's timings are taken with it.
+ */
+export function clockResolution(now, budgetMs = 5, maxReadings = 1e6) {
+  const start = now();
+  let last = start;
+  let step = Infinity;
+  let seen = 0;
+  for (let k = 0; seen < 20 && k < maxReadings; ++k) {
+    const t = now();
+    if (t > last) {
+      step = Math.min(step, t - last);
+      last = t;
+      ++seen;
+    }
+    if (t - start > budgetMs) break;
+  }
+  return Number.isFinite(step) ? step : null;
+}
+
+/** Times under this many clock steps are not fitted: the clock's rounding is over 5% of them. */
+export const CLOCK_STEPS_FITTED = 20;
+
+/**
+ * The equal-time plot: per estimator the points (timeOf, error) of its levels (error =
+ * RMSE when the exact value is known, else sqrt(variance)), on the sorted union of all times
+ * (uPlot's aligned data; null where a series has no point), the points in the order of N
+ * (`points`: [time, error] pairs, for joining them), and the least-squares slope of log error on
+ * log time over the points at t >= clockFloor (`fitted` of them; `untimed` below it, where the
+ * clock's rounding bends the line). Adaptive estimators also get `estimating` (the [time minus training time, error]
+ * pairs) and `trainingShare` (the mean share of the time spent training or probing; null for
+ * the others).
+ */
+export function timeSeries(records, order, clockFloor = 0) {
   const named = order.filter((n) => records[n]);
   const pts = named.map((name) => records[name].levels
     .map((l) => [positive(timeOf(l)), positive(l.error)])
@@ -241,7 +267,10 @@ export function timeSeries(records, order) {
   const series = named.map((name, k) => {
     const y = new Array(x.length).fill(null);
     for (const [t, e] of pts[k]) y[index.get(t)] = e;
-    const fit = fitSlope(pts[k].map((p) => p[0]), pts[k].map((p) => p[1]));
+    // The slope over the points the clock can time (t >= clockFloor): below, its rounding
+    // would bend the line.
+    const timed = pts[k].filter(([t]) => t >= clockFloor);
+    const fit = fitSlope(timed.map((p) => p[0]), timed.map((p) => p[1]));
     // Adaptive estimators: the same errors at the time spent estimating only (training or
     // probing left out), and the mean share of the time that training took.
     const levels = records[name].levels.filter((l) => positive(timeOf(l)) !== null && positive(l.error) !== null);
@@ -252,7 +281,8 @@ export function timeSeries(records, order) {
     // The timing's own uncertainty: the 95% interval of the median seconds over the replicates.
     const whiskers = levels.map((l) => timeInterval(l)).map((ci, i) => (ci ? [ci[0], ci[1], levels[i].error] : null))
       .filter(Boolean);
-    return { name, y, points: pts[k], slope: fit ? fit.slope : null, estimating, trainingShare, whiskers };
+    return { name, y, points: pts[k], slope: fit ? fit.slope : null, fitted: timed.length,
+      untimed: pts[k].length - timed.length, estimating, trainingShare, whiskers };
   });
   return { x, series };
 }

@@ -446,6 +446,7 @@ export function initialState() {
     paramErrors: {},        // key -> message for an input that holds no valid value
     custom: { f: '', p: '', exact: '', error: null, pending: false, applied: null },
     userGltf: { name: null, error: null }, // a glTF file opened in the page (its file name), or why not
+    clockStep: null,        // ms: the step performance.now() rounds to here (times under 20 steps are not fitted)
     calibration: 'all',     // the histogram's level: 'all' (pooled) or an N
     notice: '',             // last export / scene-loading message
     run: emptyRun('loading'),
@@ -609,6 +610,8 @@ export function reducer(state, action) {
         race: keep ? state.race : emptyRace(raceInputsFor(state.race.inputs, p.scene), state.race.id),
       };
     }
+    case 'clock/measured':
+      return { ...state, clockStep: p.ms > 0 ? p.ms : null };
     case 'gltf/error':
       return { ...state, userGltf: { ...state.userGltf, error: p.message } };
     case 'scene/failed':

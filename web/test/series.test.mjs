@@ -5,7 +5,7 @@ import assert from 'node:assert/strict';
 
 import {
   ladder, applyLevel, progressOf, mergeResults, varianceSeries, anchorOf, referenceLines, fitSlope,
-  timeSeries, zScores, histogram, normalDensity, calibrationSeries, coverageSeries, collectWarnings,
+  timeSeries, clockResolution, CLOCK_STEPS_FITTED, zScores, histogram, normalDensity, calibrationSeries, coverageSeries, collectWarnings,
   fixed3, fitText, fmt, decadeRange, splitEstimators, partialResult,
 } from '../src/series.js';
 
@@ -535,4 +535,27 @@ test('samplesCsv: one row per point, u and x per coordinate, f, density and weig
   assert.equal(lines[3], '"is,odd",0,0.5,,0.5,,3,2,1.5');
   assert.equal(lines.length, 5);
   assert.equal(samplesCsv(null), '');
+});
+
+test('the clock step is the smallest advance of the clock, and times under 20 steps are not fitted', () => {
+  // A clock that rounds to 5 us (0.005 ms) and advances 1.3 us per reading.
+  let t = 0;
+  const coarse = () => { t += 0.0013; return Math.floor(t / 0.005) * 0.005; };
+  assert.ok(Math.abs(clockResolution(coarse) - 0.005) < 1e-12);
+  assert.equal(clockResolution(() => 7, 1), null, 'a clock that never moves');
+  // error = t^-0.5 above the floor; below it, quantized times that would bend the fit.
+  const floor = CLOCK_STEPS_FITTED * 5e-6;
+  const levels = [[5e-6, 1e-1], [5e-6, 5e-2], [1e-5, 3e-2], [2e-4, 2e-4 ** -0.5], [8e-4, 8e-4 ** -0.5], [3.2e-3, 3.2e-3 ** -0.5]]
+    .map(([s, e], i) => ({ n: 16 << i, time_median_s: s, error: e }));
+  const records = { a: { name: 'a', levels } };
+  const fitted = timeSeries(records, ['a'], floor).series[0];
+  assert.ok(Math.abs(fitted.slope + 0.5) < 1e-9, `slope ${fitted.slope}`);
+  assert.equal(fitted.fitted, 3);
+  assert.equal(fitted.untimed, 3);
+  assert.equal(fitted.points.length, 6, 'every point is still drawn');
+  const all = timeSeries(records, ['a']).series[0];
+  assert.ok(Math.abs(all.slope + 0.5) > 0.05, `without the floor the quantized points bend the slope: ${all.slope}`);
+  const none = timeSeries(records, ['a'], 1).series[0];
+  assert.equal(none.slope, null);
+  assert.equal(none.untimed, 6);
 });
