@@ -679,6 +679,38 @@ TEST(RenderHonesty, SuppliedReferencesAreUsedOnlyForTheirOwnSettings) {
     }
 }
 
+// The reference image itself as PNG and HDR through mcp_render_image (the page's image exports):
+// the supplied reference when it fits, decoded back to the same size; it goes alone.
+TEST(RenderHonesty, ReferenceImageExports) {
+    json scene = quad_scene([](json&) {});
+    json options = kTiny;
+    options["reference"]["spp"] = 32;
+    Call ref = reference_call(scene, options);
+    ASSERT_EQ(ref.status, MCP_OK) << ref.error;
+    json o = options;
+    o["reference_data"] = ref.result["reference_data"];
+    o["outputs"] = {"reference_png", "reference_hdr"};
+    char* out = nullptr;
+    ASSERT_EQ(mcp_render_image(scene.dump().c_str(), o.dump().c_str(), &out), MCP_OK)
+        << mcp_last_error();
+    json j = json::parse(out);
+    mcp_free(out);
+    EXPECT_EQ(j["reference"]["source"], "supplied");
+    std::string hdr, png;
+    ASSERT_TRUE(base64_decode(j["images"]["reference_hdr"].get<std::string>(), &hdr));
+    ASSERT_TRUE(base64_decode(j["images"]["reference_png"].get<std::string>(), &png));
+    EXPECT_EQ(png.substr(1, 3), "PNG");
+    RenderImage back;
+    std::string error;
+    ASSERT_TRUE(decode_hdr(hdr, &back, &error)) << error;
+    EXPECT_EQ(back.width, 4);
+    EXPECT_EQ(back.height, 4);
+    o["outputs"] = {"png", "reference_hdr"};
+    EXPECT_EQ(mcp_render_image(scene.dump().c_str(), o.dump().c_str(), &out), MCP_ERROR_ARGUMENT);
+    mcp_free(out);
+    EXPECT_NE(std::string(mcp_last_error()).find("go alone"), std::string::npos);
+}
+
 // The default reference's spp follows the scene's spp_max, not a study's smaller one (so that a
 // shorter study keeps the scene's cached or shipped reference); a study of more than a quarter
 // of it gets 16 x its own spp_max.

@@ -48,9 +48,11 @@ int mcp_render_reference(const char* scene_json, const char* options_json,
 int mcp_render_study_plan(const char* scene_json, const char* options_json, char** plan_json);
 
 /* One image: options.estimator (a name from the scene or an estimator object; default the
- * scene's first), options.spp (default spp_max), options.outputs (any of "png", "hdr",
- * "error_png"; default ["png"]; "error_png" renders or reads the reference). The result
- * carries the images base64-encoded, the diagnostics and the rays per second. */
+ * scene's best, the reference's), options.spp (default spp_max), options.outputs (any of "png",
+ * "hdr", "error_png"; default ["png"]; "error_png" renders or reads the reference). The result
+ * carries the images base64-encoded, the diagnostics and the rays per second. With the outputs
+ * "reference_png" and/or "reference_hdr" alone, the result is the study's reference image
+ * (options.reference_data, the cache, its file, or rendered) and its "reference" block. */
 int mcp_render_image(const char* scene_json, const char* options_json, char** result_json);
 
 /* What a render scene holds: triangles, lights, materials, camera, accelerator, loader

@@ -496,7 +496,7 @@ int mcp_render_image(const char* scene_json, const char* options_json, char** re
                     std::string(from_options ? "options" : "scene.render") + ".spp_max: " + why +
                         " (an image is rendered at spp_max unless spp is given)");
     }
-    bool png = true, hdr = false, error_png = false;
+    bool png = true, hdr = false, error_png = false, reference_png = false, reference_hdr = false;
     if (auto it = options.find("outputs"); it != options.end()) {
         png = false;
         if (!it->is_array()) return fail(MCP_ERROR_ARGUMENT, "options.outputs: expected an array");
@@ -508,10 +508,37 @@ int mcp_render_image(const char* scene_json, const char* options_json, char** re
                 hdr = true;
             else if (s == "error_png")
                 error_png = true;
+            else if (s == "reference_png")
+                reference_png = true;
+            else if (s == "reference_hdr")
+                reference_hdr = true;
             else
-                return fail(MCP_ERROR_ARGUMENT, "options.outputs: unknown output " + o.dump() +
-                                                    " (known: png, hdr, error_png)");
+                return fail(MCP_ERROR_ARGUMENT,
+                            "options.outputs: unknown output " + o.dump() +
+                                " (known: png, hdr, error_png, reference_png, reference_hdr)");
         }
+    }
+    if (reference_png || reference_hdr) {
+        // The study's reference image itself (from options.reference_data, the cache, a file,
+        // or rendered), as PNG and/or Radiance HDR; no estimator image is rendered with it.
+        if (png || hdr || error_png)
+            return fail(MCP_ERROR_ARGUMENT, "options.outputs: reference_png and reference_hdr go "
+                                            "alone (the reference image, no estimator's)");
+        std::string err;
+        if (!check_work(r, 0.0, 1, r.reference.file.empty(), &err))
+            return fail(MCP_ERROR_SCENE, err);
+        RenderImage ref;
+        Json info;
+        if (!obtain_reference(l, &ref, &info, &err)) return fail(MCP_ERROR_SCENE, err);
+        Json images = Json::object();
+        if (reference_png) images["reference_png"] = base64_encode(encode_png(ref, r.exposure));
+        if (reference_hdr) images["reference_hdr"] = base64_encode(encode_hdr(ref));
+        Json j{{"version", kResultSchemaVersion}, {"kind", "render_image"},
+               {"mcplay", mcp_version()},        {"scene", scene_to_json(l)},
+               {"reference", info},              {"images", images}};
+        *result_json = copy_out(dump(j));
+        if (!*result_json) return fail(MCP_ERROR_INTERNAL, "out of memory writing the result");
+        return boundary::succeed();
     }
     {
         std::string err;

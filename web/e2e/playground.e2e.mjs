@@ -578,6 +578,22 @@ test('a bundled render scene uses the reference shipped with the site', async ()
   await page.keyboard.press('Escape');
   await zoomed.waitFor({ state: 'hidden' });
   await page.check('input[name="image-view"][value="image"]');
+  // Image files: the reference as Radiance HDR (the shipped one), an estimator's image as PNG
+  // and as HDR (the same replicate-0 image, rendered again by the core).
+  const saved = async (selector) => {
+    const [d] = await Promise.all([page.waitForEvent('download'), page.click(selector)]);
+    return { name: d.suggestedFilename(), bytes: readFileSync(await d.path()) };
+  };
+  const refHdr = await saved('button[data-export-image="reference"][data-format="hdr"]');
+  assert.match(refHdr.name, /^mcplay-cornell_box-spp1-4-R2-seed3-48x48-reference-spp1024\.hdr$/);
+  assert.match(refHdr.bytes.subarray(0, 10).toString(), /^#\?RADIANCE/);
+  assert.match(refHdr.bytes.toString('latin1'), /-Y 48 \+X 48/);
+  const png = await saved('button[data-export-image="mis_power"][data-format="png"]');
+  assert.match(png.name, /-mis_power-spp4\.png$/);
+  assert.equal(png.bytes.subarray(1, 4).toString(), 'PNG');
+  const hdr = await saved('button[data-export-image="mis_power"][data-format="hdr"]');
+  assert.match(hdr.name, /-mis_power-spp4\.hdr$/);
+  assert.match(hdr.bytes.toString('latin1'), /-Y 48 \+X 48/);
   const info = state.sceneInfo;
   const cli = cliRender('cornell_box', estimators, { nMin: 1, nMax: 4, reps: 2, seed: 3, width: info.width, height: info.height });
   for (const name of estimators) {

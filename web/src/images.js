@@ -53,11 +53,24 @@ function colorOf(run, name) {
   return colorAt(run.colors && name in run.colors ? run.colors[name] : run.order.indexOf(name));
 }
 
+/** A card's downloads: its image as PNG (tone-mapped, as shown) and as Radiance HDR (linear). */
+function exports(which, label) {
+  const button = (format, text, title) => el('button', {
+    type: 'button', className: 'png', disabled: true, title, ariaLabel: `${title}: ${label}`,
+    dataset: { exportImage: which, format },
+  }, text);
+  return el('div', { className: 'image-exports' },
+    button('png', 'PNG', 'download the image as PNG (tone-mapped sRGB, as shown)'),
+    button('hdr', 'HDR', 'download the image as Radiance HDR (linear radiance)'),
+    which === 'reference' ? null : button('error', 'error PNG', 'download the relative-error image as PNG'));
+}
+
 /** The cards: the reference (or the scene's quick preview), then one per estimator of the run. */
 function layout(container, run, size) {
   const cards = [el('div', { className: 'image-card', dataset: { card: 'reference' } },
     el('h3', {}, el('span', { dataset: { title: 'reference' } }, 'Reference'), el('span', { className: 'muted small', dataset: { info: 'reference' } }, '')),
     el('div', { className: 'pair' }, picture('reference', '', 'reference image', 'reference image')),
+    exports('reference', 'the reference'),
     el('p', { className: 'cap', dataset: { wait: 'reference' } }, ''))];
   for (const name of run.order) {
     cards.push(el('div', { className: 'image-card', dataset: { card: name } },
@@ -65,7 +78,8 @@ function layout(container, run, size) {
         el('span', { className: 'muted small', dataset: { info: name } }, '')),
       el('div', { className: 'pair' },
         picture('preview', name, 'image (replicate 0)', `${name}: image of the latest level`),
-        picture('error', name, '|relative error|', `${name}: relative error against the reference`))));
+        picture('error', name, '|relative error|', `${name}: relative error against the reference`)),
+      exports(name, name)));
   }
   container.replaceChildren(...cards);
   container.style.setProperty('--image-width', `${size}px`);
@@ -76,7 +90,11 @@ function layout(container, run, size) {
  * attribute the stylesheet reads; the pictures keep their sources) and the enlarged view (a
  * click on an image opens #image-zoom with it at the largest whole factor that fits).
  */
-export function mountImages(dom) {
+export function mountImages(dom, onExport = () => {}) {
+  dom.images.addEventListener('click', (e) => {
+    const b = e.target && e.target.closest ? e.target.closest('button[data-export-image]') : null;
+    if (b && !b.disabled) onExport(b.dataset.exportImage, b.dataset.format);
+  });
   const view = document.querySelector('.image-view');
   if (view) {
     view.addEventListener('change', (e) => {
@@ -158,8 +176,18 @@ export function renderImages(state, dom) {
   const captionText = refPng ? 'the study\'s reference image' : preview && preview.png ? 'a quick image, not the reference' : '';
   if (caption && caption.textContent !== captionText) caption.textContent = captionText;
 
+  const enable = (which, format, on) => {
+    const b = q(`button[data-export-image="${CSS.escape(which)}"][data-format="${format}"]`);
+    if (b && b.disabled === on) b.disabled = !on;
+  };
+  // The reference's files once the study has it (a quick preview is not the reference).
+  enable('reference', 'png', Boolean(refPng));
+  enable('reference', 'hdr', Boolean(refPng) && run.status !== 'running');
   for (const name of order) {
     const r = run.records[name];
+    enable(name, 'png', Boolean(r && r.preview_png));
+    enable(name, 'hdr', Boolean(r && r.preview_png) && run.status !== 'running');
+    enable(name, 'error', Boolean(r && r.error_png));
     setImage(q(`img[data-role="preview"][data-estimator="${CSS.escape(name)}"]`), `preview:${name}`, r && r.preview_png);
     setImage(q(`img[data-role="error"][data-estimator="${CSS.escape(name)}"]`), `error:${name}`, r && r.error_png);
     const last = r && r.levels.length ? r.levels[r.levels.length - 1] : null;

@@ -50,7 +50,7 @@ let urlReady = false; // the URL is written only once the first scene is in
 
 const reportDom = { diagnostics: $('diagnostics'), diagnosticsEmpty: $('diagnostics-empty'), levels: $('levels') };
 const imagesDom = { images: $('render-images') };
-mountImages(imagesDom);
+mountImages(imagesDom, (image, as) => dispatch({ type: 'export/request', payload: { format: 'image', image, as } }));
 initPlots({
   variance: $('plot-variance'), time: $('plot-time'), calibration: $('plot-calibration'), coverage: $('plot-coverage'),
   'legend-variance': $('legend-variance'), 'legend-time': $('legend-time'),
@@ -516,8 +516,57 @@ function fileStem(s) {
   return `mcplay-${scene}-N${st.n_min}-${st.n_max}-R${st.reps}-seed${st.seed}`;
 }
 
-async function exportResult({ format, plot }) {
+/** Base64 to a blob URL of `type`. */
+function blobUrlOf(base64, type) {
+  const bin = atob(base64);
+  const bytes = new Uint8Array(bin.length);
+  for (let i = 0; i < bin.length; ++i) bytes[i] = bin.charCodeAt(i);
+  return URL.createObjectURL(new Blob([bytes], { type }));
+}
+
+/**
+ * A render study's image as a file: `image` is an estimator of the run or 'reference'; `as` is
+ * png (the picture shown), error (its relative-error picture) or hdr (linear Radiance, from the
+ * core: the same replicate-0 image again, or the reference the study used).
+ */
+async function exportImage(s, image, as) {
+  const r = s.run;
+  const last = image === 'reference' ? null : r.records[image] && r.records[image].levels.at(-1);
+  const ref = r.result && r.result.scene && r.result.scene.reference;
+  const name = image === 'reference' ? `reference-spp${ref && ref.spp ? ref.spp : ''}` : `${image}-spp${last ? last.n : ''}`;
+  const stem = `${fileStem(s)}-${name.replace(/[^\w.-]+/g, '_')}`;
+  const save = (base64, ext, type) => {
+    const url = blobUrlOf(base64, type);
+    download(`${stem}.${ext}`, url);
+    setTimeout(() => URL.revokeObjectURL(url), 10000);
+  };
+  if (as === 'png' || as === 'error') {
+    const png = image === 'reference' ? r.referencePng : r.records[image] && (as === 'png' ? r.records[image].preview_png : r.records[image].error_png);
+    if (!png) throw new Error(`no ${image} image yet`);
+    save(png, as === 'png' ? 'png' : 'error.png', 'image/png');
+    return;
+  }
+  const st = r.settings;
+  const options = { seed: st.seed, width: st.width, height: st.height };
+  if (image === 'reference') {
+    options.outputs = ['reference_hdr'];
+    const entry = s.scenes.find((e) => e.name === s.sceneId);
+    const data = r.referenceShipped ? await shippedReference(entry) : null;
+    if (data) options.reference_data = data;
+  } else {
+    if (!last) throw new Error(`no ${image} image yet`);
+    Object.assign(options, { estimator: image, spp: last.n, outputs: ['hdr'] });
+  }
+  const { image: out } = await service.request(MSG.IMAGE, { scene: s.scene, options });
+  save(out.images[image === 'reference' ? 'reference_hdr' : 'hdr'], 'hdr', 'image/vnd.radiance');
+}
+
+async function exportResult({ format, plot, image, as }) {
   const s = store.getState();
+  if (format === 'image') {
+    await exportImage(s, image, as);
+    return;
+  }
   if (format === 'samples') {
     const text = samplesCsv(s.samples.data);
     if (!text) throw new Error('no sample points yet');
