@@ -234,6 +234,30 @@ test('the sample points, the 1D overlay and the weights are drawn', async () => 
     && window.mcplayDebug.state().samples.curve === true, null, { timeout: 20000 });
   assert.ok(await page.$('#plot-overlay canvas'), 'no overlay chart');
   await page.screenshot({ path: join(shots, 'samples_gaussian_peak_1d.png'), fullPage: true });
+
+  // The replay: the first k points, and the running estimate of their weights with its interval
+  // for independent points; ▶ replay accumulates them up to all.
+  await page.fill('#samples-k', '10');
+  await page.waitForFunction(() => [...document.querySelectorAll('#plot-samples .sample-card')].every((c) => c.dataset.points === '10'));
+  assert.match(await page.textContent('#samples-k-out'), /^10 of 256 points$/);
+  const caption = await page.textContent('.sample-card[data-estimator="uniform"] .running .cap');
+  assert.match(caption, /first 10: -?[\d.e+-]+ ± [\d.e+-]+\. Independent points/);
+  await page.click('#samples-play');
+  await page.waitForFunction(() => [...document.querySelectorAll('#plot-samples .sample-card')].every((c) => c.dataset.points === '256'),
+    null, { timeout: 20000 });
+  await page.screenshot({ path: join(shots, 'samples_replay.png'), fullPage: false });
+});
+
+test('sample points of a 6D problem: any pair of axes as the projection', async () => {
+  await configure('genz_product_peak_6d', ['uniform', 'halton'], { nMin: 16, nMax: 256, reps: 4, seed: 1 });
+  await page.waitForFunction(() => window.mcplayDebug.state().samples.status === 'ready'
+    && document.querySelectorAll('#plot-samples .sample-card').length === 2, null, { timeout: 20000 });
+  assert.equal(await page.isVisible('#samples-axes-block'), true);
+  await page.selectOption('#samples-axis-a', '4');
+  await page.selectOption('#samples-axis-b', '5');
+  await page.waitForFunction(() => /axes 5 \(across\) and 6 \(up\) of 6/.test(document.querySelector('#plot-samples').textContent));
+  assert.match(await page.textContent('#plot-samples'), /x: x5, x6 \(axes 5 and 6 of 6\)/);
+  assert.match(await page.textContent('.sample-card[data-estimator="halton"] .running .cap'), /A designed set/);
 });
 
 test('randomized QMC: presets a scene does not list are offered; a sobol study agrees with the CLI', async () => {

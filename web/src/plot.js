@@ -7,7 +7,7 @@ import { devicePixelRatioNow, withPixelRatio } from './pixel_ratio.js';
 import uPlot from '../vendor/uPlot.esm.js';
 import {
   varianceSeries, anchorOf, referenceLines, timeSeries, calibrationSeries, coverageSeries, equalTimeVerdict,
-  CLOCK_STEPS_FITTED,
+  CLOCK_STEPS_FITTED, runningEstimate, replayIsEstimator,
   decadeRange, fitText, fmt, curveOverlay, misWeightCurves, weightBins, weightHistogram, domainView, mapFor, mappedGrid,
 } from './series.js';
 import { colorAt, withAlpha } from './palette.js';
@@ -330,6 +330,7 @@ export function initPlots(elements) {
     if (!k.startsWith('legend-') || !ul) continue;
     ul.addEventListener('click', onLegendClick); // the name buttons take Enter and Space
   }
+  mountSampleControls();
 }
 
 function colorOf(run, name) {
@@ -735,11 +736,83 @@ function sceneColor(state, name) {
   return colorAt(i < 0 ? 0 : i);
 }
 
+// The replay of the sample view (presentation only, like VEGAS's training slider): the first k
+// points of each set (null: all), and the pair of axes a set of d > 2 is projected on.
+const replay = { k: null, axes: [0, 1], timer: null, state: null };
+
+/** The sample view's own controls (#samples-k, #samples-play, the two axis selects), wired once. */
+function mountSampleControls() {
+  const $ = (id) => document.getElementById(id);
+  const slider = $('samples-k');
+  if (!slider) return;
+  const redraw = () => {
+    const st = replay.state;
+    if (st && st.samples.data) renderScatter(st, st.samples.data);
+  };
+  slider.addEventListener('input', () => {
+    clearInterval(replay.timer);
+    replay.k = Number(slider.value);
+    redraw();
+  });
+  $('samples-play').addEventListener('click', () => {
+    const st = replay.state;
+    if (!st || !st.samples.data) return;
+    clearInterval(replay.timer);
+    // k from 1 to n in about 60 steps spaced evenly in log k, so that the first points are seen
+    const n = st.samples.data.n;
+    const steps = [...new Set(Array.from({ length: 61 }, (_, i) => Math.max(1, Math.round(n ** (i / 60)))))];
+    let i = 0;
+    replay.k = steps[0];
+    redraw();
+    replay.timer = setInterval(() => {
+      i += 1;
+      replay.k = steps[Math.min(i, steps.length - 1)];
+      redraw();
+      if (i >= steps.length - 1) clearInterval(replay.timer);
+    }, 70);
+  });
+  for (const [id, at] of [['samples-axis-a', 0], ['samples-axis-b', 1]]) {
+    $(id).addEventListener('change', (e) => {
+      replay.axes = at === 0 ? [Number(e.target.value), replay.axes[1]] : [replay.axes[0], Number(e.target.value)];
+      redraw();
+    });
+  }
+}
+
+/** The replay controls of a new point set: k back to all, axes offered for d > 2. */
+function syncSampleControls(data) {
+  const $ = (id) => document.getElementById(id);
+  const slider = $('samples-k');
+  if (!slider) return;
+  const n = data ? data.n : 1;
+  slider.max = String(n);
+  slider.disabled = !data;
+  $('samples-play').disabled = !data;
+  const d = data ? data.dimension : 0;
+  $('samples-axes-block').hidden = !(d > 2);
+  if (d > 2) {
+    if (!(replay.axes[0] < d && replay.axes[1] < d)) replay.axes = [0, 1];
+    for (const [id, at] of [['samples-axis-a', 0], ['samples-axis-b', 1]]) {
+      const sel = $(id);
+      if (sel.options.length !== d) {
+        sel.replaceChildren(...Array.from({ length: d }, (_, k) => el('option', { value: String(k) }, `${at === 0 ? 'across' : 'up'}: axis ${k + 1}`)));
+      }
+      sel.value = String(replay.axes[at]);
+    }
+  }
+}
+
 function renderSampleViews(state) {
   if (!dom.samples) return;
+  replay.state = state;
   const smp = state.samples;
   const sig = [smp.data, smp.weights, smp.status, state.sceneInfo, smp.message];
   if (samplesDrawn && sig.every((v, i) => v === samplesDrawn[i])) return;
+  if (!samplesDrawn || samplesDrawn[0] !== smp.data) {
+    clearInterval(replay.timer);
+    replay.k = null;
+    syncSampleControls(smp.data);
+  }
   samplesDrawn = sig;
   dom.samples.classList.toggle('loading', smp.status === 'loading');
   if (smp.status === 'error') {
@@ -758,7 +831,8 @@ const PANEL = 240; // logical size of a scatter panel (CSS scales it to the card
 const PAD = { l: 38, r: 6, t: 6, b: 18 };
 
 /** A canvas of w x h logical pixels with a plot area mapping [xr] x [yr]; returns helpers. */
-function panel(w, h, xr, yr) {
+function panel(w, h, xr, yr, padLeft = PAD.l) {
+  const P = { ...PAD, l: padLeft };
   const px = window.devicePixelRatio || 1;
   const c = document.createElement('canvas');
   c.width = Math.round(w * px);
@@ -767,36 +841,36 @@ function panel(w, h, xr, yr) {
   ctx.scale(px, px);
   ctx.fillStyle = '#fff';
   ctx.fillRect(0, 0, w, h);
-  const iw = w - PAD.l - PAD.r;
-  const ih = h - PAD.t - PAD.b;
-  const X = (v) => PAD.l + ((v - xr[0]) / (xr[1] - xr[0] || 1)) * iw;
-  const Y = (v) => PAD.t + ih - ((v - yr[0]) / (yr[1] - yr[0] || 1)) * ih;
+  const iw = w - P.l - P.r;
+  const ih = h - P.t - P.b;
+  const X = (v) => P.l + ((v - xr[0]) / (xr[1] - xr[0] || 1)) * iw;
+  const Y = (v) => P.t + ih - ((v - yr[0]) / (yr[1] - yr[0] || 1)) * ih;
   const frame = () => {
     ctx.strokeStyle = '#b8c0c8';
     ctx.lineWidth = 1;
-    ctx.strokeRect(PAD.l + 0.5, PAD.t + 0.5, iw - 1, ih - 1);
+    ctx.strokeRect(P.l + 0.5, P.t + 0.5, iw - 1, ih - 1);
     ctx.fillStyle = '#5a6470';
     ctx.font = '10px "DejaVu Sans", sans-serif';
     ctx.textBaseline = 'top';
     ctx.textAlign = 'left';
-    ctx.fillText(fmt(xr[0], 3), PAD.l, PAD.t + ih + 3);
+    ctx.fillText(fmt(xr[0], 3), P.l, P.t + ih + 3);
     ctx.textAlign = 'right';
-    ctx.fillText(fmt(xr[1], 3), PAD.l + iw, PAD.t + ih + 3);
+    ctx.fillText(fmt(xr[1], 3), P.l + iw, P.t + ih + 3);
     ctx.textBaseline = 'bottom';
-    ctx.fillText(fmt(yr[0], 3), PAD.l - 3, PAD.t + ih);
+    ctx.fillText(fmt(yr[0], 3), P.l - 3, P.t + ih);
     ctx.textBaseline = 'top';
-    ctx.fillText(fmt(yr[1], 3), PAD.l - 3, PAD.t);
+    ctx.fillText(fmt(yr[1], 3), P.l - 3, P.t);
   };
   const clip = () => {
     ctx.beginPath();
-    ctx.rect(PAD.l, PAD.t, iw, ih);
+    ctx.rect(P.l, P.t, iw, ih);
     ctx.clip();
   };
   const clear = () => {
     ctx.fillStyle = '#fff';
     ctx.fillRect(0, 0, w, h);
   };
-  return { c, ctx, X, Y, frame, clip, clear, iw, ih };
+  return { c, ctx, X, Y, frame, clip, clear, iw, ih, pad: P };
 }
 
 function dots(ctx, xs, ys, X, Y, color, n) {
@@ -854,15 +928,15 @@ function mapLines(p, edges, axis) {
 }
 
 /** MISER's leaf boxes on the first two axes of the unit square (1D: their left edges). */
-function boxOutlines(p, boxes, d) {
+function boxOutlines(p, boxes, d, [a, b] = [0, 1]) {
   if (!boxes || !Array.isArray(boxes.lo)) return;
   const { ctx, X, Y } = p;
   ctx.strokeStyle = 'rgba(150, 80, 20, 0.5)';
   ctx.lineWidth = 1;
   ctx.beginPath();
-  boxes.lo.forEach((lo, b) => {
-    const hi = boxes.hi[b];
-    if (d >= 2) ctx.rect(X(lo[0]), Y(hi[1]), X(hi[0]) - X(lo[0]), Y(lo[1]) - Y(hi[1]));
+  boxes.lo.forEach((lo, i) => {
+    const hi = boxes.hi[i];
+    if (d >= 2) ctx.rect(X(lo[a]), Y(hi[b]), X(hi[a]) - X(lo[a]), Y(lo[b]) - Y(hi[b]));
     else {
       ctx.moveTo(X(lo[0]), Y(0));
       ctx.lineTo(X(lo[0]), Y(1));
@@ -893,33 +967,121 @@ function strataText(e, d) {
   return `strata ${shown} cells${per}${fine}`;
 }
 
+/**
+ * The running estimate of an estimator's first points (runningEstimate of its weights): the
+ * mean of the first j against j (log axis) with its 95% band, the exact value dashed, and the
+ * replay's k marked.
+ */
+function runningPanel(e, k, exact, color, band = true) {
+  const w = Array.isArray(e.weight) ? e.weight : [];
+  const n = w.length;
+  if (n < 2) return null;
+  const run = runningEstimate(w);
+  const shown = [...run.mean, ...run.lo, ...run.hi].filter(Number.isFinite);
+  if (exact !== null) shown.push(exact);
+  // the band's extremes at the first few points would flatten the rest: the range of j >= 4
+  const later = [...run.mean.slice(3), ...run.lo.slice(3), ...run.hi.slice(3)].filter(Number.isFinite);
+  const vals = later.length ? [...later, ...(exact !== null ? [exact] : [])] : shown;
+  let lo = Math.min(...vals);
+  let hi = Math.max(...vals);
+  if (!(hi > lo)) { lo -= 1; hi += 1; }
+  const pad = 0.05 * (hi - lo);
+  const p = panel(2 * PANEL, 110, [0, Math.log10(n)], [lo - pad, hi + pad], 58);
+  const X = (j) => p.X(Math.log10(j));
+  p.ctx.save();
+  p.clip();
+  p.ctx.fillStyle = withAlpha(color, band ? 0.16 : 0);
+  p.ctx.beginPath();
+  let started = false;
+  for (let j = 2; j <= n; ++j) {
+    if (!Number.isFinite(run.hi[j - 1])) continue;
+    if (!started) { p.ctx.moveTo(X(j), p.Y(run.hi[j - 1])); started = true; } else p.ctx.lineTo(X(j), p.Y(run.hi[j - 1]));
+  }
+  for (let j = n; j >= 2; --j) if (Number.isFinite(run.lo[j - 1])) p.ctx.lineTo(X(j), p.Y(run.lo[j - 1]));
+  p.ctx.closePath();
+  p.ctx.fill();
+  if (exact !== null) {
+    p.ctx.strokeStyle = '#1b1f24';
+    p.ctx.setLineDash([5, 4]);
+    p.ctx.beginPath();
+    p.ctx.moveTo(X(1), p.Y(exact));
+    p.ctx.lineTo(X(n), p.Y(exact));
+    p.ctx.stroke();
+    p.ctx.setLineDash([]);
+  }
+  p.ctx.strokeStyle = color;
+  p.ctx.lineWidth = 1.5;
+  p.ctx.beginPath();
+  for (let j = 1; j <= n; ++j) {
+    if (!Number.isFinite(run.mean[j - 1])) continue;
+    if (j === 1) p.ctx.moveTo(X(j), p.Y(run.mean[j - 1])); else p.ctx.lineTo(X(j), p.Y(run.mean[j - 1]));
+  }
+  p.ctx.stroke();
+  // the replay's k
+  p.ctx.strokeStyle = '#5a6470';
+  p.ctx.beginPath();
+  p.ctx.moveTo(Math.round(X(k)) + 0.5, p.Y(lo - pad));
+  p.ctx.lineTo(Math.round(X(k)) + 0.5, p.Y(hi + pad));
+  p.ctx.stroke();
+  p.ctx.restore();
+  p.frame();
+  // the x axis is log10 j: label its ends as point counts
+  const P = p.pad;
+  p.ctx.fillStyle = '#fff';
+  p.ctx.fillRect(P.l, p.ih + P.t + 1, p.iw, P.b - 1);
+  p.ctx.fillStyle = '#5a6470';
+  p.ctx.font = '10px "DejaVu Sans", sans-serif';
+  p.ctx.textBaseline = 'top';
+  p.ctx.textAlign = 'left';
+  p.ctx.fillText('1', P.l, P.t + p.ih + 3);
+  p.ctx.textAlign = 'right';
+  p.ctx.fillText(`${n} points (log)`, P.l + p.iw, P.t + p.ih + 3);
+  const at = run.mean[k - 1];
+  const half = Number.isFinite(run.hi[k - 1]) ? run.hi[k - 1] - at : null;
+  const text = `first ${k}: ${Number.isFinite(at) ? fmt(at, 5) : '—'}${half !== null && band ? ` ± ${fmt(half, 2)}` : ''}`;
+  return { canvas: p.c, text };
+}
+
 function renderScatter(state, data) {
   const d = data.dimension;
-  const view = domainView(data, state.scene && state.scene.domain);
+  const view = domainView(data, state.scene && state.scene.domain, replay.axes);
+  const [a, b] = d > 2 ? view.axes : [0, 1];
+  const k = Math.max(1, Math.min(data.n, replay.k ?? data.n));
+  const exact = state.sceneInfo && typeof state.sceneInfo.exact === 'number' ? state.sceneInfo.exact : null;
+  const out = document.getElementById('samples-k-out');
+  if (out) out.textContent = `${k} of ${data.n} points`;
+  const slider = document.getElementById('samples-k');
+  if (slider && Number(slider.value) !== k) slider.value = String(k);
   const mapped = {};
-  const cards = data.estimators.map((e) => {
-    const color = sceneColor(state, e.name);
+  const cards = data.estimators.map((full) => {
+    const color = sceneColor(state, full.name);
+    // the first k points (the replay); the strata, map and boxes are the whole set's
+    const first = (arr) => (Array.isArray(arr) ? arr.slice(0, k) : arr);
+    const e = { ...full, u: full.u.map(first), x: full.x.map(first), f: first(full.f), weight: first(full.weight) };
     const n = e.u[0] ? e.u[0].length : 0;
     // u space: the sampler's unit square (1D: u against the point's index)
     const pu = panel(PANEL, PANEL, [0, 1], [0, 1]);
-    const uy = d >= 2 ? e.u[1] : e.u[0].map((_, i) => (i + 0.5) / n);
+    const uy = d >= 2 ? e.u[b] : e.u[0].map((_, i) => (i + 0.5) / full.u[0].length);
     const drawU = (edges) => {
       pu.clear();
-      strataLines(pu, e.strata[0], 'x');
-      if (d >= 2) strataLines(pu, e.strata[1], 'y');
+      strataLines(pu, e.strata[a], 'x');
+      if (d >= 2) strataLines(pu, e.strata[b], 'y');
       if (edges) {
-        mapLines(pu, edges[0], 'x');
-        if (d >= 2 && edges[1]) mapLines(pu, edges[1], 'y');
+        mapLines(pu, edges[a], 'x');
+        if (d >= 2 && edges[b]) mapLines(pu, edges[b], 'y');
       }
-      if (e.boxes) boxOutlines(pu, e.boxes, d);
+      if (e.boxes) boxOutlines(pu, e.boxes, d, [a, b]);
       pu.frame();
       pu.ctx.save();
       pu.clip();
-      dots(pu.ctx, e.u[0], uy, pu.X, pu.Y, color, n);
+      dots(pu.ctx, e.u[a], uy, pu.X, pu.Y, color, full.u[0].length);
       pu.ctx.restore();
     };
     drawU(e.map_edges);
-    const training = mapTraining(e, drawU);
+    // the training history holds the map's first two axes only
+    const training = a === 0 && b === 1 ? mapTraining(e, drawU) : null;
+    // a designed set's spread is not the error of its first points' mean: no band
+    const running = runningPanel(full, k, exact, color, replayIsEstimator(full));
     // x space: the domain (1D: f at the points, with the curve of f)
     let px;
     if (d === 1) {
@@ -985,18 +1147,23 @@ function renderScatter(state, data) {
         px.ctx.stroke();
         mapped[e.name] = known.name;
       }
-      dots(px.ctx, e.x[view.axes[0]], e.x[view.axes[1]], px.X, px.Y, color, n);
+      dots(px.ctx, e.x[view.axes[0]], e.x[view.axes[1]], px.X, px.Y, color, full.u[0].length);
       px.ctx.restore();
       px.frame();
     }
-    const facts = `${e.sampler}; p: ${e.pdf}; ${strataText(e, d)}`;
+    const facts = `${e.sampler}; p: ${e.pdf}; ${strataText(full, d)}`;
+    const runningCap = running ? `${running.text}. ${replayIsEstimator(full)
+      ? 'Independent points: the mean of the first k is the estimate at N = k; shaded: its 95% interval.'
+      : `A designed set: only all ${full.u[0].length} points make the estimate (the first k are not a design of k points).`}` : '';
     return el('div', { className: 'sample-card', dataset: { estimator: e.name, points: String(n) } },
       el('h3', {}, swatch(color), e.name, el('span', { className: 'muted small' }, `${n} points`)),
       el('p', { className: 'facts' }, facts),
       training,
       el('div', { className: 'pair' },
-        el('div', {}, pu.c, el('p', { className: 'cap' }, d === 1 ? 'u (across) by point index (up)' : d > 2 ? 'u: first two axes' : 'u (unit square)')),
-        el('div', {}, px.c, el('p', { className: 'cap' }, d === 1 ? 'x (across), f(x) (up); grey: f' : `x: ${view.labels.join(', ')}${view.note ? ` (${view.note})` : ''}${mapped[e.name] ? `; strata through the ${mapped[e.name]} map` : ''}`))));
+        el('div', {}, pu.c, el('p', { className: 'cap' }, d === 1 ? 'u (across) by point index (up)' : d > 2 ? `u: axes ${a + 1} (across) and ${b + 1} (up) of ${d}` : 'u (unit square)')),
+        el('div', {}, px.c, el('p', { className: 'cap' }, d === 1 ? 'x (across), f(x) (up); grey: f' : `x: ${view.labels.join(', ')}${view.note ? ` (${view.note})` : ''}${mapped[e.name] ? `; strata through the ${mapped[e.name]} map` : ''}`))),
+      running ? el('div', { className: 'running', dataset: { k: String(k) } }, running.canvas,
+        el('p', { className: 'cap' }, `running estimate: ${runningCap}`)) : null);
   });
   dom.samples.replaceChildren(...cards);
   const adaptive = data.estimators.find((e) => e.run_n > data.n);
@@ -1141,7 +1308,8 @@ function renderWeights(state, weights) {
   setLegend('weights', dom['legend-weights'], hs.map(({ name, h }) => {
     const parts = [{ text: h.tail === null ? 'max|w| / mean|w| = —' : `max|w| / mean|w| = ${fmt(h.tail, 3)}`, className: 'fit' }];
     if (h.zeros) parts.push({ text: `${h.zeros} zero weights`, className: 'fit' });
-    if (h.below) parts.push({ text: `${h.below} below ${fmt(Number(`1e${bins.logEdges[0]}`), 2)}`, className: 'fit' });
+    // the first edge may be a fractional power of ten (4 bins per decade)
+    if (h.below) parts.push({ text: `${h.below} below ${fmt(10 ** bins.logEdges[0], 2)} (over 12 decades under the largest)`, className: 'fit' });
     if (h.negative) parts.push({ text: `${h.negative} negative`, className: 'fit' });
     if (h.nonFinite) parts.push({ text: `${h.nonFinite} not finite`, className: 'badge' });
     return { name, color: sceneColor(state, name), data: { weights: name, zeros: String(h.zeros) }, parts };

@@ -840,7 +840,48 @@ export function samplesSummary(samples) {
  * of the domain ({type: 'circle', cx, cy, r} | {type: 'polygon', points} | {type: 'rect'}), and
  * a note when it is a projection. `domain` is the scene's domain object, when known.
  */
-export function domainView(samples, domain = null) {
+/**
+ * The running estimate of a point sequence's weights (the mean of the first k, k = 1..n) with
+ * its 95% interval, mean +- 1.96 s / sqrt(k) from the first k's sample standard deviation
+ * (Welford's update [Welford62]; no interval at k = 1). For independent points (uniform or
+ * importance sampling) the mean at k is the estimator at N = k; for stratified, Latin
+ * hypercube and quasi-random sets only the whole set is (their first k points are not a
+ * design of k points, and their spread is not the error of the mean).
+ */
+export function runningEstimate(weights) {
+  const n = Array.isArray(weights) ? weights.length : 0;
+  const mean = new Array(n);
+  const lo = new Array(n);
+  const hi = new Array(n);
+  let m = 0;
+  let m2 = 0;
+  let k = 0;
+  for (let i = 0; i < n; ++i) {
+    const w = Number(weights[i]);
+    if (!Number.isFinite(w)) {
+      mean[i] = lo[i] = hi[i] = null;
+      continue;
+    }
+    k += 1;
+    const d = w - m;
+    m += d / k;
+    m2 += d * (w - m);
+    mean[i] = m;
+    const h = k > 1 ? 1.959963984540054 * Math.sqrt(m2 / (k - 1) / k) : null;
+    lo[i] = h === null ? null : m - h;
+    hi[i] = h === null ? null : m + h;
+  }
+  return { mean, lo, hi };
+}
+
+/** Is the mean of the first k of an estimator's points its estimate at N = k (independent points)? */
+export function replayIsEstimator(e) {
+  const strata = Array.isArray(e.strata) ? e.strata : [];
+  return !(e.randomizations > 0) && !strata.some((c) => c > 1) && e.sampler !== 'latin_hypercube'
+    && !e.map_edges && !e.boxes;
+}
+
+export function domainView(samples, domain = null, pair = [0, 1]) {
   const type = samples.domain;
   const d = samples.dimension;
   const xs = samples.estimators.length ? samples.estimators[0].x : [];
@@ -878,8 +919,10 @@ export function domainView(samples, domain = null) {
       : samples.curve && samples.curve.x.length ? [samples.curve.x[0], samples.curve.x[samples.curve.x.length - 1]] : extent(0);
     return { axes: [0], labels: ['x', 'f(x)'], xRange: r, yRange: null, outline: { type: 'rect' }, note: '' };
   }
-  return { axes: [0, 1], labels: ['x1', 'x2'], xRange: extent(0), yRange: extent(1), outline: { type: 'rect' },
-    note: d > 2 ? `the first two of ${d} axes` : '' };
+  // A box of d > 2 axes: the projection on the chosen pair.
+  const [a, b] = d > 2 && pair[0] !== pair[1] && pair.every((k) => k >= 0 && k < d) ? pair : [0, 1];
+  return { axes: [a, b], labels: [`x${a + 1}`, `x${b + 1}`], xRange: extent(a), yRange: extent(b), outline: { type: 'rect' },
+    note: d > 2 ? `axes ${a + 1} and ${b + 1} of ${d}` : '' };
 }
 
 /**

@@ -5,7 +5,7 @@ import assert from 'node:assert/strict';
 
 import {
   ladder, applyLevel, progressOf, mergeResults, varianceSeries, anchorOf, referenceLines, fitSlope,
-  timeSeries, clockResolution, CLOCK_STEPS_FITTED, zScores, histogram, normalDensity, calibrationSeries, coverageSeries, collectWarnings,
+  timeSeries, clockResolution, runningEstimate, replayIsEstimator, CLOCK_STEPS_FITTED, zScores, histogram, normalDensity, calibrationSeries, coverageSeries, collectWarnings,
   fixed3, fitText, fmt, decadeRange, splitEstimators, partialResult,
 } from '../src/series.js';
 
@@ -412,7 +412,7 @@ test('samplesSummary and domainView', () => {
   assert.equal(s2.estimators[0].runN, 64);
   assert.equal(s2.estimators[1].boxes, 2);
   assert.deepEqual(domainView(smp).xRange, [0, 1]);
-  assert.match(domainView({ ...smp, dimension: 5 }).note, /first two of 5/);
+  assert.match(domainView({ ...smp, dimension: 5 }).note, /axes 1 and 2 of 5/);
   assert.equal(domainView({ ...smp, domain: 'disk' }, { center: [1, 0], radius: 2 }).outline.r, 2);
   assert.match(domainView({ ...smp, domain: 'hemisphere', dimension: 3 }).note, /projected/);
   assert.deepEqual(domainView({ ...smp, dimension: 1, curve: { x: [0.1, 0.9] } }, { type: 'interval', lower: -1, upper: 2 }).xRange, [-1, 2]);
@@ -558,4 +558,46 @@ test('the clock step is the smallest advance of the clock, and times under 20 st
   const none = timeSeries(records, ['a'], 1).series[0];
   assert.equal(none.slope, null);
   assert.equal(none.untimed, 6);
+});
+
+test('the running estimate is the mean of the first k weights, with a t-free 95% interval', () => {
+  const w = [3, 1, 2, 6, NaN, 4];
+  const r = runningEstimate(w);
+  assert.deepEqual(r.mean.slice(0, 4), [3, 2, 2, 3]);
+  assert.equal(r.lo[0], null, 'no interval from one point');
+  // k = 4: s^2 = ((0)^2 + (-2)^2 + (-1)^2 + 3^2) / 3 = 14/3 around the mean 3
+  assert.ok(Math.abs(r.hi[3] - (3 + 1.959963984540054 * Math.sqrt(14 / 3 / 4))) < 1e-12);
+  assert.equal(r.mean[4], null, 'a non-finite weight is skipped');
+  assert.equal(r.mean[5], 16 / 5);
+  // Coverage of the final interval over independent uniform sets (fixed seed): about 95%.
+  let seed = 12345;
+  const rand = () => ((seed = (seed * 1103515245 + 12345) % 2147483648) / 2147483648);
+  let covered = 0;
+  const sets = 400;
+  for (let s = 0; s < sets; ++s) {
+    const x = Array.from({ length: 256 }, () => Math.exp(rand()));
+    const e = runningEstimate(x);
+    if (e.lo[255] <= Math.E - 1 && Math.E - 1 <= e.hi[255]) covered += 1;
+  }
+  // binomial: 0.95 +- 4 standard errors of 400 sets
+  assert.ok(Math.abs(covered / sets - 0.95) < 4 * Math.sqrt(0.95 * 0.05 / sets), `${covered} of ${sets}`);
+});
+
+test('replaying the first k points is the estimator only for independent points', () => {
+  assert.equal(replayIsEstimator({ sampler: 'uniform', strata: [1] }), true);
+  assert.equal(replayIsEstimator({ sampler: 'uniform', strata: [] }), true);
+  assert.equal(replayIsEstimator({ sampler: 'stratified', strata: [16, 16] }), false);
+  assert.equal(replayIsEstimator({ sampler: 'latin_hypercube', strata: [] }), false);
+  assert.equal(replayIsEstimator({ sampler: 'sobol', strata: [], randomizations: 16 }), false);
+  assert.equal(replayIsEstimator({ sampler: 'vegas', strata: [], map_edges: [[0, 1]] }), false);
+});
+
+test('a box of d > 2 axes is shown on the chosen pair of axes', () => {
+  const samples = { domain: 'box', dimension: 4, estimators: [{ x: [[0.1], [0.2], [2.5], [0.4]] }] };
+  const v = domainView(samples, null, [2, 3]);
+  assert.deepEqual(v.axes, [2, 3]);
+  assert.deepEqual(v.labels, ['x3', 'x4']);
+  assert.match(v.note, /axes 3 and 4 of 4/);
+  assert.deepEqual(domainView(samples, null, [1, 1]).axes, [0, 1], 'a pair of one axis twice falls back');
+  assert.deepEqual(domainView(samples, null, [0, 9]).axes, [0, 1]);
 });
