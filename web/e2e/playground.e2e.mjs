@@ -260,6 +260,26 @@ test('sample points of a 6D problem: any pair of axes as the projection', async 
   assert.match(await page.textContent('.sample-card[data-estimator="halton"] .running .cap'), /A designed set/);
 });
 
+// The stiff case of zero variance two ways: a matched density is exact (drawn and labelled
+// as such), while uniform points that never hit the peak also have zero spread but are wrong,
+// and the page says so as an error instead of showing a confident answer.
+test('stiff_peak_1e-8: exact and zero-variance-but-wrong are told apart', async () => {
+  await configure('stiff_peak_1e-8', ['uniform', 'importance_matched'], { nMin: 16, nMax: 1024, reps: 8, seed: 1 });
+  await page.click('#run');
+  await page.waitForFunction(() => document.querySelector('#status')?.textContent.startsWith('done'), null, { timeout: 60000 });
+  const legend = async (name) => page.textContent(`#legend-variance li:has([data-series="${name}"]), #legend-variance li:has-text("${name}")`);
+  assert.match(await legend('importance_matched'), /exact: zero variance at every N/);
+  assert.doesNotMatch(await legend('uniform'), /exact: zero variance/);
+  assert.match(await legend('uniform'), /not from an exact estimator/);
+  const diagnostics = await page.textContent('#diagnostics');
+  assert.match(diagnostics, /uniform[\s\S]*The exact value is outside the replicates' interval/);
+  assert.doesNotMatch(diagnostics, /importance_matched: The exact value is outside/);
+  const state = await page.evaluate(() => window.mcplayDebug.state());
+  const uniform = state.estimators.find((e) => e.name === 'uniform');
+  assert.ok(uniform.levels.every((l) => l.variance === 0 && l.mse > 0), 'uniform: zero spread, nonzero error');
+  await page.screenshot({ path: join(shots, 'stiff_peak_zero_variance.png'), fullPage: true });
+});
+
 test('randomized QMC: presets a scene does not list are offered; a sobol study agrees with the CLI', async () => {
   await page.selectOption('#scene', 'sin_product_2d');
   await page.waitForFunction(() => {
