@@ -40,14 +40,21 @@ function decadeLabel(v) {
 function nTicks(u, splits) {
   const width = u.bbox.width / (uPlot.pxRatio || 1);
   const shown = splits.filter((v) => typeof v === 'number' && v > 0);
-  const every = shown.length * 42 > width ? (shown.length * 21 > width ? 4 : 2) : 1;
   const last = Math.round(Math.log2(shown[shown.length - 1] || 1));
   // One notation per axis: plain numbers while the largest fits in 6 digits, else 2^k for all.
   const powers = 2 ** last > 999999;
+  // Labels on every `every`-th split (counted from the last), as many as fit side by side
+  // (about 8.5 px a character of the axis font, and a gap).
+  const need = (powers ? 3 : String(2 ** last).length) * 8.5 + 10;
+  const step = width / Math.max(1, shown.length - 1);
+  let every = 1;
+  while (every * step < need && every < shown.length) every *= 2;
+  let i = shown.length;
   return splits.map((v) => {
     if (typeof v !== 'number' || !(v > 0)) return '';
+    i -= 1; // this split's position counted from the last
     const k = Math.round(Math.log2(v));
-    if (Math.abs(v - 2 ** k) > 1e-6 * v || (last - k) % every !== 0) return '';
+    if (Math.abs(v - 2 ** k) > 1e-6 * v || i % every !== 0) return '';
     return powers ? `2${sup(k)}` : String(v);
   });
 }
@@ -592,7 +599,10 @@ function renderTime(state, run, records) {
   const known = render || (run.exact !== null && run.exact !== undefined);
   const xRange = decadeRange([...ts.x, ...ts.series.flatMap((s) => s.estimating.map(([t]) => t))], [1e-6, 1]);
   const yRange = log10Range(ts.series.flatMap((s) => s.y));
-  const yLabel = render ? names.rootAxis || names.error : known ? 'RMSE (error against the exact value)' : 'error = sqrt(variance)';
+  // A short label where the plot is too short for the long one (a phone).
+  const roomy = !dom.time || dom.time.clientHeight === 0 || dom.time.clientHeight >= 340;
+  const yLabel = render ? names.rootAxis || names.error
+    : known ? (roomy ? 'RMSE (error against the exact value)' : 'RMSE') : (roomy ? 'error = sqrt(variance)' : 'sqrt(variance)');
   const sig = JSON.stringify([run.order, run.colors, known, yLabel, names.timeAxis]);
   const title = document.getElementById('time-title');
   if (title) title.textContent = render ? 'Error against time per image' : 'Error against run time';
