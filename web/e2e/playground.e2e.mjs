@@ -126,6 +126,12 @@ test('a study in the page plots every level and agrees with the CLI', async () =
     { timeout: 60000 });
   console.log(`# study finished in the page in ${Date.now() - t0} ms`);
   await page.screenshot({ path: join(shots, 'disk_third.png'), fullPage: true });
+  // Conservative error bars are said to be so where they show (z too narrow, coverage over 95%).
+  for (const id of ['#legend-calibration', '#legend-coverage']) {
+    const text = await page.textContent(id);
+    assert.match(text, /stratified_polar[^]*conservative error bars \(collapsed strata/, id);
+    assert.doesNotMatch(text.split('stratified_polar')[0], /conservative/, `${id}: uniform's bars are not conservative`);
+  }
 
   const state = await page.evaluate(() => window.mcplayDebug.state());
   const levels = 9; // 16 .. 4096

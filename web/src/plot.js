@@ -7,7 +7,7 @@ import { devicePixelRatioNow, withPixelRatio } from './pixel_ratio.js';
 import uPlot from '../vendor/uPlot.esm.js';
 import {
   varianceSeries, anchorOf, referenceLines, timeSeries, calibrationSeries, coverageSeries, equalTimeVerdict,
-  CLOCK_STEPS_FITTED, runningEstimate, replayIsEstimator,
+  CLOCK_STEPS_FITTED, runningEstimate, replayIsEstimator, conservativeErrorBars,
   decadeRange, fitText, fmt, curveOverlay, misWeightCurves, weightBins, weightHistogram, domainView, mapFor, mappedGrid,
 } from './series.js';
 import { colorAt, withAlpha } from './palette.js';
@@ -683,6 +683,8 @@ function renderCalibration(state, run, records) {
       if (s.total && s.exactRuns) parts.push({ text: `${s.exactRuns} runs exact to round-off (no z)`, className: 'fit' });
       if (s.below + s.above) parts.push({ text: `${s.below + s.above} beyond ±5`, className: 'badge' });
       if (s.zeroSe) parts.push({ text: `${s.zeroSe} with a zero error bar`, className: 'badge' });
+      const wide = conservativeErrorBars(records[s.name]);
+      if (wide) parts.push({ text: `${wide}: z narrower than N(0, 1) by design`, className: 'fit' });
       return { name: s.name, color: colorOf(run, s.name), parts };
     }),
   ]);
@@ -730,7 +732,8 @@ function renderCoverage(state, run, records) {
     return {
       name: s.name,
       color: colorOf(run, s.name),
-      parts: [{ text: last === undefined ? '—' : `${fmt(last, 3)} at the largest ${names.n}`, className: 'fit' }],
+      parts: [{ text: last === undefined ? '—' : `${fmt(last, 3)} at the largest ${names.n}`, className: 'fit' },
+        conservativeErrorBars(records[s.name]) ? { text: `${conservativeErrorBars(records[s.name])}: above 0.95 by design`, className: 'fit' } : ''],
     };
   }));
 }

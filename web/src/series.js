@@ -874,6 +874,19 @@ export function runningEstimate(weights) {
   return { mean, lo, hi };
 }
 
+/**
+ * Why an estimator's error bars are wider than its estimates' spread, by design, or null: the
+ * core's error_method (collapsed strata pair neighbouring cells [Cochran77, 5A.12]; the iid
+ * formula on a Latin hypercube or similar design overstates its variance). Their z-scores are
+ * narrower than N(0, 1) and their coverage above 95%: that is what conservative means.
+ */
+export function conservativeErrorBars(record) {
+  const m = record && record.error_method;
+  if (m === 'collapsed_strata') return 'conservative error bars (collapsed strata: neighbouring cells paired)';
+  if (m === 'iid_conservative') return 'conservative error bars (the iid formula, wider than this design\'s spread)';
+  return null;
+}
+
 /** Is the mean of the first k of an estimator's points its estimate at N = k (independent points)? */
 export function replayIsEstimator(e) {
   const strata = Array.isArray(e.strata) ? e.strata : [];

@@ -5,7 +5,7 @@ import assert from 'node:assert/strict';
 
 import {
   ladder, applyLevel, progressOf, mergeResults, varianceSeries, anchorOf, referenceLines, fitSlope,
-  timeSeries, clockResolution, runningEstimate, replayIsEstimator, CLOCK_STEPS_FITTED, zScores, histogram, normalDensity, calibrationSeries, coverageSeries, collectWarnings,
+  timeSeries, clockResolution, runningEstimate, replayIsEstimator, conservativeErrorBars, CLOCK_STEPS_FITTED, zScores, histogram, normalDensity, calibrationSeries, coverageSeries, collectWarnings,
   fixed3, fitText, fmt, decadeRange, splitEstimators, partialResult,
 } from '../src/series.js';
 
@@ -600,4 +600,11 @@ test('a box of d > 2 axes is shown on the chosen pair of axes', () => {
   assert.match(v.note, /axes 3 and 4 of 4/);
   assert.deepEqual(domainView(samples, null, [1, 1]).axes, [0, 1], 'a pair of one axis twice falls back');
   assert.deepEqual(domainView(samples, null, [0, 9]).axes, [0, 1]);
+});
+
+test('conservative error bars are named for the methods that make them so', () => {
+  assert.match(conservativeErrorBars({ error_method: 'collapsed_strata' }), /conservative error bars \(collapsed strata/);
+  assert.match(conservativeErrorBars({ error_method: 'iid_conservative' }), /conservative/);
+  for (const m of ['iid', 'paired_strata', 'randomizations', 'none', undefined]) assert.equal(conservativeErrorBars({ error_method: m }), null, m);
+  assert.equal(conservativeErrorBars(undefined), null);
 });
