@@ -512,7 +512,7 @@ function pathsInOrder(getPaths) {
     ctx.beginPath();
     ctx.rect(u.bbox.left, u.bbox.top, u.bbox.width, u.bbox.height);
     ctx.clip();
-    for (const { name, color, points, dash = null, whiskers = [] } of getPaths()) {
+    for (const { name, color, points, dash = null, whiskers = [], width = null, label = null } of getPaths()) {
       if (hiddenSeries.has(name)) continue;
       // each point's timing interval (95%, over the replicates), with end caps
       ctx.strokeStyle = color;
@@ -529,7 +529,7 @@ function pathsInOrder(getPaths) {
         ctx.stroke();
       }
       ctx.strokeStyle = color;
-      ctx.lineWidth = (dash ? 1.5 : 2) * px;
+      ctx.lineWidth = (width ?? (dash ? 1.5 : 2)) * px;
       ctx.setLineDash(dash ? dash.map((v) => v * px) : []);
       ctx.beginPath();
       points.forEach(([x, y], i) => {
@@ -539,6 +539,16 @@ function pathsInOrder(getPaths) {
         else ctx.lineTo(cx, cy);
       });
       ctx.stroke();
+      if (label && points.length) {
+        // a reference line's name at its end (inside the plot)
+        const [x, y] = points[points.length - 1];
+        ctx.setLineDash([]);
+        ctx.fillStyle = '#555';
+        ctx.font = `${11 * px}px "DejaVu Sans", sans-serif`;
+        ctx.textAlign = 'right';
+        ctx.textBaseline = 'bottom';
+        ctx.fillText(label, Math.min(u.valToPos(x, 'x', true), u.bbox.left + u.bbox.width) - 2 * px, u.valToPos(y, 'y', true) - 2 * px);
+      }
     }
     ctx.restore();
   };
@@ -589,6 +599,20 @@ function renderTime(state, run, records) {
     name: s.name, color: colorOf(run, s.name), points: s.points.map(([t, e]) => [t, lg(e)]),
     whiskers: s.whiskers.map(([lo, hi, e]) => [lo, hi, lg(e)]),
   }));
+  // Reference slopes, dashed grey, from the fastest timed point (at the largest error there) to
+  // the right edge: t^-1/2 (Monte Carlo when the cost grows like N) and t^-1.
+  const timed = ts.series.flatMap((s) => s.points).filter(([t]) => t >= floor);
+  if (timed.length) {
+    const t0 = Math.min(...timed.map(([t]) => t));
+    const e0 = Math.max(...timed.filter(([t]) => t === t0).map(([, e]) => e));
+    const tMax = Math.max(...ts.x);
+    if (tMax > t0) {
+      for (const [k, label] of [[0.5, 't⁻½'], [1, 't⁻¹']]) {
+        lines.unshift({ name: `reference ${label}`, color: '#8a8f96', dash: [6, 5], width: 1, label,
+          points: [[t0, lg(e0)], [tMax, lg(e0 * (tMax / t0) ** -k)]] });
+      }
+    }
+  }
   // Adaptive estimators: dashed, the error at the time spent estimating only; the gap to the
   // solid line is what training (VEGAS) or probing (MISER) cost.
   for (const s of ts.series) {
