@@ -277,6 +277,9 @@ test('stiff_peak_1e-8: exact and zero-variance-but-wrong are told apart', async 
   assert.match(await legend('importance_matched'), /exact: zero variance at every N/);
   assert.doesNotMatch(await legend('uniform'), /exact: zero variance/);
   assert.match(await legend('uniform'), /not from an exact estimator/);
+  // The error is beside the plot (a badge in the legend) and counted above the plots.
+  assert.ok(await page.$('#legend-variance .badge[data-severity="error"]:text("exact_outside_ci")'), 'no error badge in the variance legend');
+  assert.match(await page.textContent('#diagnostics-summary'), /Diagnostics: \d+ errors? \(uniform\)/);
   const diagnostics = await page.textContent('#diagnostics');
   assert.match(diagnostics, /uniform[\s\S]*The exact value is outside the replicates' interval/);
   assert.doesNotMatch(diagnostics, /importance_matched: The exact value is outside/);

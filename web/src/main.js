@@ -48,7 +48,7 @@ let urlReady = false; // the URL is written only once the first scene is in
 // ---------------------------------------------------------------------------------------------
 // Views
 
-const reportDom = { diagnostics: $('diagnostics'), diagnosticsEmpty: $('diagnostics-empty'), levels: $('levels') };
+const reportDom = { diagnostics: $('diagnostics'), diagnosticsEmpty: $('diagnostics-empty'), levels: $('levels'), summary: $('diagnostics-summary') };
 const imagesDom = { images: $('render-images') };
 mountImages(imagesDom, (image, as) => dispatch({ type: 'export/request', payload: { format: 'image', image, as } }));
 initPlots({

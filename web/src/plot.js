@@ -7,7 +7,7 @@ import { devicePixelRatioNow, withPixelRatio } from './pixel_ratio.js';
 import uPlot from '../vendor/uPlot.esm.js';
 import {
   varianceSeries, anchorOf, referenceLines, timeSeries, calibrationSeries, coverageSeries, equalTimeVerdict,
-  CLOCK_STEPS_FITTED, runningEstimate, replayIsEstimator, conservativeErrorBars,
+  CLOCK_STEPS_FITTED, runningEstimate, replayIsEstimator, conservativeErrorBars, severityOf, SEVERITIES,
   decadeRange, fitText, fmt, curveOverlay, misWeightCurves, weightBins, weightHistogram, domainView, mapFor, mappedGrid,
 } from './series.js';
 import { colorAt, withAlpha } from './palette.js';
@@ -291,7 +291,22 @@ function swatch(color, dashed = false) {
 }
 
 function badge(w) {
-  return el('span', { className: 'badge', title: w.message }, w.code);
+  const severity = severityOf(w);
+  return el('span', { className: `badge${severity === 'error' ? ' badge-error' : ''}`, title: w.message, dataset: { severity } }, w.code);
+}
+
+/** An estimator's level flags of severity error or warning (one per code) that its own
+ *  estimator-level warnings do not already say: shown beside the plot they concern. */
+function levelFlags(r) {
+  const own = new Set((r.warnings || []).map((w) => w.code));
+  const seen = new Map();
+  for (const l of r.levels || []) {
+    for (const w of l.warnings || []) {
+      const sev = severityOf(w);
+      if ((sev === 'error' || sev === 'warning') && !own.has(w.code) && !seen.has(w.code)) seen.set(w.code, w);
+    }
+  }
+  return [...seen.values()].sort((a, b) => SEVERITIES.indexOf(severityOf(a)) - SEVERITIES.indexOf(severityOf(b)));
 }
 
 const legendSigs = {};
@@ -491,6 +506,7 @@ function renderVariance(state, run, records) {
         ...(s.exact ? [{ fit: 'exact: zero variance at every N (■ along the bottom)', name: s.name }] : [
           render ? `order of ${names.error}` : vs.quantity === 'mse' ? 'of variance' : 'order of variance',
           { fit: fitText(r.fit), name: s.name }]),
+        ...levelFlags(r).map((w) => ({ warning: w })),
         ...(r.warnings || []).map((w) => ({ warning: w })),
       ],
     };

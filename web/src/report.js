@@ -78,6 +78,19 @@ export function renderReport(state, dom) {
   const hasRecords = run.order.some((n) => run.records[n]);
   dom.diagnosticsEmpty.textContent = !hasRecords ? 'Run a study to see its diagnostics.' : 'No warnings.';
   dom.diagnosticsEmpty.hidden = warnings.length > 0;
+  // Above the plots: how many errors and warnings, who has them, and a link down to them.
+  if (dom.summary) {
+    const count = (sev) => warnings.filter((w) => w.severity === sev);
+    const errors = count('error');
+    const warns = count('warning');
+    const who = (list) => [...new Set(list.map((w) => w.estimator))].join(', ');
+    const parts = [];
+    if (errors.length) parts.push(el('span', { className: 'sev sev-error' }, `${errors.length} error${errors.length > 1 ? 's' : ''}`), ` (${who(errors)})`);
+    if (warns.length) parts.push(parts.length ? '; ' : '', el('span', { className: 'sev sev-warning' }, `${warns.length} warning${warns.length > 1 ? 's' : ''}`), ` (${who(warns)})`);
+    dom.summary.replaceChildren(...(parts.length ? ['Diagnostics: ', ...parts, ' · ', el('a', { href: '#diagnostics-title' }, 'read them')] : []));
+    dom.summary.hidden = parts.length === 0;
+    dom.summary.dataset.errors = String(errors.length);
+  }
 
   // Keep the tables the reader opened open.
   const open = new Set([...dom.levels.querySelectorAll('details[open]')].map((d) => d.dataset.for));
