@@ -269,6 +269,39 @@ test('sample points of a 6D problem: any pair of axes as the projection', async 
 // The stiff case of zero variance two ways: a matched density is exact (drawn and labelled
 // as such), while uniform points that never hit the peak also have zero spread but are wrong,
 // and the page says so as an error instead of showing a confident answer.
+// disk_quarter: both stratified estimators are exact (the circle r = R/2 lies on stratum edges
+// for every power-of-two N). They are drawn and labelled as exact, not left out as "no fit".
+test('disk_quarter: exact estimators are drawn and labelled as exact', async () => {
+  const estimators = ['uniform', 'stratified_polar', 'stratified_concentric'];
+  await configure('disk_quarter', estimators, { nMin: 16, nMax: 1024, reps: 8, seed: 1 });
+  await page.click('#run');
+  await page.waitForFunction(() => document.querySelector('#status')?.textContent.startsWith('done'), null, { timeout: 60000 });
+  const legend = await page.textContent('#legend-variance');
+  for (const name of ['stratified_polar', 'stratified_concentric']) {
+    assert.match(legend, new RegExp(`${name}exact: zero variance at every N`), `${name} not labelled exact`);
+  }
+  assert.match(legend, /uniformorder of MSE/);
+  assert.match(await page.textContent('#legend-calibration'), /stratified_polarexact to round-off: no z/);
+  assert.match(await page.textContent('#time-verdict'), /exact/);
+  // The ■ row along the bottom: the exact estimators' colours are drawn in the bottom band.
+  const marked = await page.locator('#plot-variance canvas').first().evaluate((c) => {
+    const ctx = c.getContext('2d');
+    const row = ctx.getImageData(0, 0, c.width, c.height);
+    let colored = 0;
+    // the lowest 12% of the canvas above the x axis labels: count strongly coloured pixels
+    for (let y = Math.floor(c.height * 0.55); y < Math.floor(c.height * 0.9); ++y) {
+      for (let x = 0; x < c.width; ++x) {
+        const i = 4 * (y * c.width + x);
+        const [r, g, b] = [row.data[i], row.data[i + 1], row.data[i + 2]];
+        if (Math.max(r, g, b) - Math.min(r, g, b) > 80) colored += 1;
+      }
+    }
+    return colored;
+  });
+  assert.ok(marked > 50, `no exact markers drawn (${marked} coloured pixels)`);
+  await page.locator('#variance-title >> xpath=../..').screenshot({ path: join(shots, 'exact_disk_quarter.png') });
+});
+
 test('stiff_peak_1e-8: exact and zero-variance-but-wrong are told apart', async () => {
   await configure('stiff_peak_1e-8', ['uniform', 'importance_matched'], { nMin: 16, nMax: 1024, reps: 8, seed: 1 });
   await page.click('#run');
