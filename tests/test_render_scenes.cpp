@@ -576,9 +576,9 @@ TEST(RenderHonesty, ReferenceCacheReaderChecksEverything) {
 
 // Base64 as RFC 4648 defines it, both ways, and nothing else decoded.
 TEST(RenderHonesty, Base64RoundTripsAndRefusesWhatIsNotBase64) {
-    for (const std::string& bytes : {std::string(), std::string("f"), std::string("fo"),
-                                     std::string("foo"), std::string("foob"),
-                                     std::string("\0\xff\x10\x80", 4)}) {
+    for (const std::string& bytes :
+         {std::string(), std::string("f"), std::string("fo"), std::string("foo"),
+          std::string("foob"), std::string("\0\xff\x10\x80", 4)}) {
         std::string back = "x";
         ASSERT_TRUE(base64_decode(base64_encode(bytes), &back)) << base64_encode(bytes);
         EXPECT_EQ(back, bytes);
@@ -592,8 +592,7 @@ TEST(RenderHonesty, Base64RoundTripsAndRefusesWhatIsNotBase64) {
 
 /// The reference of `scene` under `options` through mcp_render_reference (with progress lines
 /// kept in `lines` when given).
-Call reference_call(const json& scene, const json& options,
-                    std::vector<json>* lines = nullptr) {
+Call reference_call(const json& scene, const json& options, std::vector<json>* lines = nullptr) {
     char* out = nullptr;
     Call c;
     auto on_line = [](const char* text, void* user) {
@@ -656,15 +655,15 @@ TEST(RenderHonesty, SuppliedReferencesAreUsedOnlyForTheirOwnSettings) {
     EXPECT_EQ(other_seed.result["scene"]["reference"]["relative_mse_floor"],
               rendered.result["scene"]["reference"]["relative_mse_floor"]);
     // The reference's own seed, another image size: rendered again, and said so.
-    for (auto edit : {+[](json& o) { o["reference"]["seed"] = 7; },
-                      +[](json& o) { o["width"] = 7; }}) {
+    for (auto edit :
+         {+[](json& o) { o["reference"]["seed"] = 7; }, +[](json& o) { o["width"] = 7; }}) {
         json changed = with;
         edit(changed);
         Call c = study_text(scene, changed);
         ASSERT_EQ(c.status, MCP_OK) << c.error;
         EXPECT_EQ(c.result["scene"]["reference"]["source"], "rendered");
-        EXPECT_TRUE(c.result["scene"]["reference"]["supplied"].get<std::string>().find(
-                        "not used") == 0);
+        EXPECT_TRUE(
+            c.result["scene"]["reference"]["supplied"].get<std::string>().find("not used") == 0);
     }
     // Not base64, base64 of something else, and the right key with a wrong length.
     std::string bytes;
@@ -745,8 +744,8 @@ TEST(RenderHonesty, ReferenceProgressCanCancel) {
         return ++*static_cast<int*>(user) >= 2 ? 1 : 0;
     };
     char* out = nullptr;
-    int status = mcp_render_study_run(scene.dump().c_str(), options.dump().c_str(), +stop, &calls,
-                                      &out);
+    int status =
+        mcp_render_study_run(scene.dump().c_str(), options.dump().c_str(), +stop, &calls, &out);
     EXPECT_EQ(status, MCP_ERROR_CANCELLED);
     EXPECT_EQ(calls, 2);
     mcp_free(out);

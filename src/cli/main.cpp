@@ -545,10 +545,18 @@ int cmd_run(const std::vector<std::string>& args) {
     return status == MCP_ERROR_CANCELLED ? kExitRuntime : rc;
 }
 
-int cmd_render(const std::vector<std::string>& args) {
+/// What `render` and `reference` are told: the scene, the files and the options the C API gets.
+struct ImageCommand {
     std::string scene_arg, out_path, error_path, dir_arg, cache_arg, format = "summary";
-    bool no_cache = false;
+    bool no_cache = false, quiet = false;
     nlohmann::json options = nlohmann::json::object();
+};
+
+/// Parses the arguments of `command` (render or reference): `counts` are its whole-number
+/// options (--spp, --width, ...), `render_only` adds --estimator, --pixel-sampler and
+/// --error-out. Returns -1 when the arguments are good, else the exit code of the usage error.
+int parse_image_command(const char* command, const std::vector<std::string>& args,
+                        const std::vector<std::string>& counts, bool render_only, ImageCommand* c) {
     for (size_t i = 0; i < args.size(); ++i) {
         const std::string& a = args[i];
         std::string v;
@@ -557,45 +565,60 @@ int cmd_render(const std::vector<std::string>& args) {
             *out = args[++i];
             return true;
         };
-        if (a == "--spp" || a == "--width" || a == "--height" || a == "--seed" ||
-            a == "--threads") {
+        if (std::find(counts.begin(), counts.end(), a) != counts.end()) {
             if (!value(&v)) return usage_error(a + " needs a value");
             unsigned long long x = 0;
             if (!parse_count(v, &x))
                 return usage_error(a + ": expected a whole number, got '" + v + "'");
-            options[a.substr(2)] = x;
-        } else if (a == "--estimator") {
+            c->options[a.substr(2)] = x;
+        } else if (render_only && a == "--estimator") {
             if (!value(&v)) return usage_error("--estimator needs a name");
-            options["estimator"] = v;
-        } else if (a == "--pixel-sampler") {
+            c->options["estimator"] = v;
+        } else if (render_only && a == "--pixel-sampler") {
             if (!value(&v))
                 return usage_error("--pixel-sampler needs independent, stratified or sobol");
             std::string why;
-            if (!pixel_sampler_option(v, &options, &why)) return usage_error(why);
+            if (!pixel_sampler_option(v, &c->options, &why)) return usage_error(why);
+        } else if (render_only && a == "--error-out") {
+            if (!value(&c->error_path)) return usage_error("--error-out needs a file name");
         } else if (a == "--out") {
-            if (!value(&out_path)) return usage_error("--out needs a file name");
-        } else if (a == "--error-out") {
-            if (!value(&error_path)) return usage_error("--error-out needs a file name");
+            if (!value(&c->out_path)) return usage_error("--out needs a file name");
         } else if (a == "--scenes") {
-            if (!value(&dir_arg)) return usage_error("--scenes needs a directory");
+            if (!value(&c->dir_arg)) return usage_error("--scenes needs a directory");
         } else if (a == "--cache") {
-            if (!value(&cache_arg)) return usage_error("--cache needs a directory");
+            if (!value(&c->cache_arg)) return usage_error("--cache needs a directory");
         } else if (a == "--no-cache") {
-            no_cache = true;
+            c->no_cache = true;
         } else if (a == "--quiet") {
-            // accepted as for run: a single render prints no progress lines anyway
+            c->quiet = true;
         } else if (a == "--format") {
-            if (!value(&format) || (format != "json" && format != "summary"))
+            if (!value(&c->format) || (c->format != "json" && c->format != "summary"))
                 return usage_error("--format: expected json or summary");
         } else if (a.rfind("-", 0) == 0) {
             return usage_error("unknown option '" + a + "'");
-        } else if (scene_arg.empty()) {
-            scene_arg = a;
+        } else if (c->scene_arg.empty()) {
+            c->scene_arg = a;
         } else {
-            return usage_error("render takes one scene, got '" + scene_arg + "' and '" + a + "'");
+            return usage_error(std::string(command) + " takes one scene, got '" + c->scene_arg +
+                               "' and '" + a + "'");
         }
     }
-    if (scene_arg.empty()) return usage_error("render needs a scene file or name");
+    if (c->scene_arg.empty())
+        return usage_error(std::string(command) + " needs a scene file or name");
+    return -1;
+}
+
+int cmd_render(const std::vector<std::string>& args) {
+    ImageCommand c;
+    if (int rc = parse_image_command(
+            "render", args, {"--spp", "--width", "--height", "--seed", "--threads"}, true, &c);
+        rc >= 0)
+        return rc;
+    // --quiet is accepted as for run: a single render prints no progress lines anyway
+    const std::string &scene_arg = c.scene_arg, &out_path = c.out_path, &error_path = c.error_path,
+                      &dir_arg = c.dir_arg, &cache_arg = c.cache_arg, &format = c.format;
+    const bool no_cache = c.no_cache;
+    nlohmann::json& options = c.options;
     if (out_path.empty() && error_path.empty() && format != "json")
         return usage_error("render needs --out FILE (.png or .hdr) or --error-out FILE");
     auto ends_with = [](const std::string& s, const char* suffix) {
@@ -679,46 +702,15 @@ int cmd_render(const std::vector<std::string>& args) {
 }
 
 int cmd_reference(const std::vector<std::string>& args) {
-    std::string scene_arg, out_path, dir_arg, cache_arg, format = "summary";
-    bool no_cache = false, quiet = false;
-    nlohmann::json options = nlohmann::json::object();
-    for (size_t i = 0; i < args.size(); ++i) {
-        const std::string& a = args[i];
-        std::string v;
-        auto value = [&](std::string* out) {
-            if (i + 1 >= args.size() || args[i + 1].rfind("--", 0) == 0) return false;
-            *out = args[++i];
-            return true;
-        };
-        if (a == "--width" || a == "--height" || a == "--threads") {
-            if (!value(&v)) return usage_error(a + " needs a value");
-            unsigned long long x = 0;
-            if (!parse_count(v, &x))
-                return usage_error(a + ": expected a whole number, got '" + v + "'");
-            options[a.substr(2)] = x;
-        } else if (a == "--out") {
-            if (!value(&out_path)) return usage_error("--out needs a file name");
-        } else if (a == "--scenes") {
-            if (!value(&dir_arg)) return usage_error("--scenes needs a directory");
-        } else if (a == "--cache") {
-            if (!value(&cache_arg)) return usage_error("--cache needs a directory");
-        } else if (a == "--no-cache") {
-            no_cache = true;
-        } else if (a == "--quiet") {
-            quiet = true;
-        } else if (a == "--format") {
-            if (!value(&format) || (format != "json" && format != "summary"))
-                return usage_error("--format: expected json or summary");
-        } else if (a.rfind("-", 0) == 0) {
-            return usage_error("unknown option '" + a + "'");
-        } else if (scene_arg.empty()) {
-            scene_arg = a;
-        } else {
-            return usage_error("reference takes one scene, got '" + scene_arg + "' and '" + a +
-                               "'");
-        }
-    }
-    if (scene_arg.empty()) return usage_error("reference needs a scene file or name");
+    ImageCommand c;
+    if (int rc =
+            parse_image_command("reference", args, {"--width", "--height", "--threads"}, false, &c);
+        rc >= 0)
+        return rc;
+    const std::string &scene_arg = c.scene_arg, &out_path = c.out_path, &dir_arg = c.dir_arg,
+                      &cache_arg = c.cache_arg, &format = c.format;
+    const bool no_cache = c.no_cache, quiet = c.quiet;
+    nlohmann::json& options = c.options;
     if (out_path.empty()) return usage_error("reference needs --out FILE.mcref");
     std::string path, text, error;
     if (!load_scene(scene_arg, dir_arg, &path, &text)) return kExitScene;

@@ -11,7 +11,6 @@ namespace mcp {
 
 namespace {
 
-
 /// The reference's mean luminance, the scale every pixel is divided by before squaring
 /// (so that neither 1e-200 nor 1e300 radiances underflow or overflow), or 0 when the
 /// reference is black (or has no finite positive mean): relative MSE is then undefined.

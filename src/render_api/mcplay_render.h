@@ -23,8 +23,8 @@ extern "C" {
  * images each, measured by relative MSE against the reference (docs/result-schema.md,
  * "Render studies"). progress gets one JSON line per completed spp level, and before them,
  * while a reference is rendered, lines {"kind": "render_reference", "rows_done", "rows"}
- * (non-zero return cancels). Options also take previews (true: PNGs of each estimator's last image and of
- * the reference, base64, in the result). */
+ * (non-zero return cancels). Options also take previews (true: PNGs of each estimator's last image
+ * and of the reference, base64, in the result). */
 int mcp_render_study_run(const char* scene_json, const char* options_json, mcp_progress_fn progress,
                          void* user, char** result_json);
 
@@ -35,8 +35,8 @@ int mcp_render_study_run(const char* scene_json, const char* options_json, mcp_p
  * "reference_data": the image, its variances and the key of what it was made from, base64}.
  * progress gets {"kind": "render_reference", "rows_done", "rows"} lines while it renders, as
  * mcp_render_study_run does before its levels (non-zero return cancels: no result). */
-int mcp_render_reference(const char* scene_json, const char* options_json,
-                         mcp_progress_fn progress, void* user, char** result_json);
+int mcp_render_reference(const char* scene_json, const char* options_json, mcp_progress_fn progress,
+                         void* user, char** result_json);
 
 /* What a study of the same scene and options would cost, before any of it is rendered:
  * validates like mcp_render_study_run (the same errors), then times a pilot (each estimator

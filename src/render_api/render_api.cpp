@@ -215,8 +215,8 @@ bool obtain_reference(const Loaded& l, RenderImage* ref, Json* info, std::string
     }
     const RenderEstimator& e = r.reference.estimator;
     const uint64_t key = reference_key(r);
-    *info = Json{{"estimator", estimator_to_json(e)}, {"spp", r.reference.spp},
-                 {"seed", r.reference.seed}};
+    *info = Json{
+        {"estimator", estimator_to_json(e)}, {"spp", r.reference.spp}, {"seed", r.reference.seed}};
     if (!r.supplied_reference.empty()) {
         if (encoded_reference_key(r.supplied_reference) != key) {
             (*info)["supplied"] = "not used: it was made from another scene, image size, "
@@ -276,6 +276,16 @@ ReferenceProgress reference_progress(mcp_progress_fn progress, void* user, bool*
         *cancelled = true;
         return false;
     };
+}
+
+/// obtain_reference for a C API call with a progress callback: MCP_OK, or the status to fail
+/// with (MCP_ERROR_CANCELLED when the callback stopped it, else MCP_ERROR_SCENE; `error` says).
+int obtain_reference_reporting(const Loaded& l, mcp_progress_fn progress, void* user,
+                               RenderImage* ref, Json* info, std::string* error) {
+    bool cancelled = false;
+    if (obtain_reference(l, ref, info, error, reference_progress(progress, user, &cancelled)))
+        return MCP_OK;
+    return cancelled ? MCP_ERROR_CANCELLED : MCP_ERROR_SCENE;
 }
 
 Json scene_to_json(const Loaded& l) {
@@ -533,9 +543,9 @@ int mcp_render_image(const char* scene_json, const char* options_json, char** re
         Json images = Json::object();
         if (reference_png) images["reference_png"] = base64_encode(encode_png(ref, r.exposure));
         if (reference_hdr) images["reference_hdr"] = base64_encode(encode_hdr(ref));
-        Json j{{"version", kResultSchemaVersion}, {"kind", "render_image"},
-               {"mcplay", mcp_version()},        {"scene", scene_to_json(l)},
-               {"reference", info},              {"images", images}};
+        Json j{
+            {"version", kResultSchemaVersion}, {"kind", "render_image"}, {"mcplay", mcp_version()},
+            {"scene", scene_to_json(l)},       {"reference", info},      {"images", images}};
         *result_json = copy_out(dump(j));
         if (!*result_json) return fail(MCP_ERROR_INTERNAL, "out of memory writing the result");
         return boundary::succeed();
@@ -694,10 +704,8 @@ int mcp_render_study_run(const char* scene_json, const char* options_json, mcp_p
     if (!check_study(r, &err)) return fail(MCP_ERROR_SCENE, err);
     RenderImage reference;
     Json ref_info;
-    bool cancelled = false;
-    if (!obtain_reference(l, &reference, &ref_info, &err,
-                          reference_progress(progress, user, &cancelled)))
-        return fail(cancelled ? MCP_ERROR_CANCELLED : MCP_ERROR_SCENE, err);
+    if (int st = obtain_reference_reporting(l, progress, user, &reference, &ref_info, &err))
+        return fail(st, err);
     const double floor = relative_mse_floor(reference);
     int threads = resolve_threads(r.settings.threads);
     RenderStudyProgress on_level;
@@ -749,13 +757,13 @@ int mcp_render_study_run(const char* scene_json, const char* options_json, mcp_p
     return boundary::succeed();
 }
 
-int mcp_render_reference(const char* scene_json, const char* options_json,
-                         mcp_progress_fn progress, void* user, char** result_json) {
+int mcp_render_reference(const char* scene_json, const char* options_json, mcp_progress_fn progress,
+                         void* user, char** result_json) {
     using namespace mcp;
     Loaded l;
     Json options;
-    if (int st = begin_call("mcp_render_reference", result_json, scene_json, options_json, &l,
-                            &options))
+    if (int st =
+            begin_call("mcp_render_reference", result_json, scene_json, options_json, &l, &options))
         return st;
     const RenderRequest& r = *l.request;
     if (!r.reference.file.empty())
@@ -765,10 +773,8 @@ int mcp_render_reference(const char* scene_json, const char* options_json,
     if (!check_work(r, 0.0, 1, true, &err)) return fail(MCP_ERROR_SCENE, err);
     RenderImage reference;
     Json info;
-    bool cancelled = false;
-    if (!obtain_reference(l, &reference, &info, &err,
-                          reference_progress(progress, user, &cancelled)))
-        return fail(cancelled ? MCP_ERROR_CANCELLED : MCP_ERROR_SCENE, err);
+    if (int st = obtain_reference_reporting(l, progress, user, &reference, &info, &err))
+        return fail(st, err);
     const RenderStudySettings& s = r.settings;
     info["version"] = kResultSchemaVersion;
     info["kind"] = "render_reference";

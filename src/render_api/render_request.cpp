@@ -215,10 +215,10 @@ Made<std::shared_ptr<RenderRequest>> build_render_request(const Json& scene, con
         return error();
     Json opts = options.is_null() ? Json::object() : options;
     if (!check_keys(c, opts, "options",
-                    {"base_dir", "cache_dir", "width", "height", "spp_min", "spp_max", "reps",
-                     "seed", "threads", "estimators", "reference", "jitter_pixels", "exposure",
-                     "accel", "estimator", "spp", "outputs", "previews", "pixel_sampler",
-                     "reference_data"}))
+                    {"base_dir",  "cache_dir",     "width",    "height",        "spp_min",
+                     "spp_max",   "reps",          "seed",     "threads",       "estimators",
+                     "reference", "jitter_pixels", "exposure", "accel",         "estimator",
+                     "spp",       "outputs",       "previews", "pixel_sampler", "reference_data"}))
         return error();
     std::string base_dir = ".", reference_data;
     if (!get_string(c, opts, "base_dir", "options", &base_dir) ||
