@@ -104,8 +104,12 @@ if [ "$(head -c 10 "$tmp/img.hdr")" = "#?RADIANCE" ]; then
 else
     echo "FAIL render-hdr: $tmp/img.hdr is not a Radiance HDR file"; failed=$((failed + 1))
 fi
+check render-pfm 0 'quad_light_floor: mis_power at 2 spp, 8x6' -- render quad_light_floor --spp 2 --out "$tmp/img.pfm" "${tiny[@]}"
+if [ "$(head -c 3 "$tmp/img.pfm")" != "$(printf 'PF\n')" ] || [ "$(stat -c %s "$tmp/img.pfm")" -ne $((12 + 8 * 6 * 12)) ]; then
+    echo "FAIL render-pfm: $tmp/img.pfm is not an 8x6 float RGB map"; failed=$((failed + 1))
+fi
 check render-no-out 2 'render needs --out FILE' -- render quad_light_floor
-check render-bad-ext 2 'must end in .png or .hdr' -- render quad_light_floor --out "$tmp/x.jpg"
+check render-bad-ext 2 'must end in .png, .hdr or .pfm' -- render quad_light_floor --out "$tmp/x.jpg"
 check render-bad-estimator 2 "unknown estimator 'lite'" -- render quad_light_floor --estimator lite --out "$tmp/x.png" "${tiny[@]}"
 check render-bad-spp 2 "--spp: expected a whole number" -- render quad_light_floor --spp many --out "$tmp/x.png"
 check render-width-on-integral 2 'for render scenes' -- run exp_1d --width 8

@@ -710,6 +710,33 @@ TEST(RenderHonesty, ReferenceImageExports) {
     EXPECT_NE(std::string(mcp_last_error()).find("go alone"), std::string::npos);
 }
 
+// PFM output: the header, then float32 RGB, little-endian, bottom row first.
+TEST(RenderHonesty, PfmIsFloatRgbBottomUp) {
+    RenderImage im;
+    im.width = 2;
+    im.height = 2;
+    im.rgb = {0.5, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 1e-9, 1e9, -0.25};
+    im.variance.assign(12, 0.0);
+    const std::string pfm = encode_pfm(im);
+    const std::string head = "PF\n2 2\n-1.0\n";
+    ASSERT_EQ(pfm.size(), head.size() + 12 * 4);
+    EXPECT_EQ(pfm.substr(0, head.size()), head);
+    auto at = [&](size_t k) { // the k-th float after the header
+        uint32_t u = 0;
+        for (int b = 0; b < 4; ++b)
+            u |= uint32_t(uint8_t(pfm[head.size() + 4 * k + size_t(b)])) << (8 * b);
+        float f;
+        std::memcpy(&f, &u, 4);
+        return f;
+    };
+    // bottom row (y = 1) first: pixels 2 and 3
+    EXPECT_EQ(at(0), 6.0f);
+    EXPECT_EQ(at(3), 1e-9f);
+    EXPECT_EQ(at(5), -0.25f);
+    EXPECT_EQ(at(6), 0.5f);
+    EXPECT_EQ(at(11), 5.0f);
+}
+
 // The default reference's spp follows the scene's spp_max, not a study's smaller one (so that a
 // shorter study keeps the scene's cached or shipped reference); a study of more than a quarter
 // of it gets 16 x its own spp_max.

@@ -68,7 +68,8 @@ const char* kUsage =
     "  --cache DIR | --no-cache  where high-spp references are kept\n"
     "  --pixel-sampler P    independent, stratified or sobol: every estimator's pixel\n"
     "                       sampler (run and render; sobol needs a power-of-two spp)\n"
-    "  render writes one image: --out FILE (.png tone-mapped sRGB, .hdr linear Radiance),\n"
+    "  render writes one image: --out FILE (.png tone-mapped sRGB, .hdr linear Radiance,\n"
+    "  .pfm linear float32),\n"
     "  --error-out FILE (false-colour relative error against the reference, PNG),\n"
     "  --estimator NAME (default the scene's best: MIS with the power heuristic, or path\n"
     "  tracing with MIS for a path scene), --spp N (default the scene's spp_max),\n"
@@ -631,8 +632,10 @@ int cmd_render(const std::vector<std::string>& args) {
             outputs.push_back("png");
         else if (ends_with(out_path, ".hdr"))
             outputs.push_back("hdr");
+        else if (ends_with(out_path, ".pfm"))
+            outputs.push_back("pfm");
         else
-            return usage_error("--out: the file name must end in .png or .hdr");
+            return usage_error("--out: the file name must end in .png, .hdr or .pfm");
     }
     if (!error_path.empty()) {
         if (!ends_with(error_path, ".png")) return usage_error("--error-out: must be a .png file");
@@ -666,7 +669,9 @@ int cmd_render(const std::vector<std::string>& args) {
     if (j.is_discarded()) return kExitRuntime;
     const nlohmann::json& images = j["images"];
     if (!out_path.empty()) {
-        const char* key = ends_with(out_path, ".png") ? "png" : "hdr";
+        const char* key = ends_with(out_path, ".png")   ? "png"
+                          : ends_with(out_path, ".hdr") ? "hdr"
+                                                        : "pfm";
         if (!write_file(out_path, base64_decode(images[key].get<std::string>()))) {
             std::fprintf(stderr, "mcplay: cannot write '%s'\n", out_path.c_str());
             return kExitRuntime;

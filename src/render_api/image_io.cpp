@@ -75,6 +75,29 @@ std::string encode_hdr(const RenderImage& image) {
     return out;
 }
 
+std::string encode_pfm(const RenderImage& image) {
+    // Portable Float Map: "PF", the size, a negative scale for little-endian, then the rows
+    // bottom to top as float32 RGB. NaN pixels (every sample discarded) stay NaN.
+    std::string out =
+        "PF\n" + std::to_string(image.width) + " " + std::to_string(image.height) + "\n-1.0\n";
+    out.reserve(out.size() + image.pixel_count() * 3 * sizeof(float));
+    for (int y = image.height - 1; y >= 0; --y) {
+        for (int x = 0; x < image.width; ++x) {
+            for (int c = 0; c < 3; ++c) {
+                const float v =
+                    float(image.rgb[(size_t(y) * size_t(image.width) + size_t(x)) * 3 + size_t(c)]);
+                // little-endian whatever the host: byte 0 is the least significant
+                uint8_t b[4];
+                uint32_t u;
+                std::memcpy(&u, &v, 4);
+                for (int k = 0; k < 4; ++k) b[k] = uint8_t(u >> (8 * k));
+                out.append(reinterpret_cast<const char*>(b), 4);
+            }
+        }
+    }
+    return out;
+}
+
 std::string encode_error_png(const RenderImage& image, const RenderImage& reference) {
     size_t n = std::min(image.pixel_count(), reference.pixel_count());
     double mean = 0.0;

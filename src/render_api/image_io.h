@@ -14,6 +14,8 @@ namespace mcp {
 std::string encode_png(const RenderImage& image, double exposure);
 /// Radiance RGBE .hdr of the linear pixel means [Ward91].
 std::string encode_hdr(const RenderImage& image);
+/// Linear float32 RGB as a Portable Float Map (little-endian): no 8-bit mantissa, for measuring.
+std::string encode_pfm(const RenderImage& image);
 /// False colour of the per-pixel relative error |I - R| / (R + eps) of luminance, on a log
 /// scale from 1e-3 (dark blue) to 1 and above (yellow); eps = 1e-2 of R's mean luminance.
 std::string encode_error_png(const RenderImage& image, const RenderImage& reference);

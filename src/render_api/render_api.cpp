@@ -506,7 +506,8 @@ int mcp_render_image(const char* scene_json, const char* options_json, char** re
                     std::string(from_options ? "options" : "scene.render") + ".spp_max: " + why +
                         " (an image is rendered at spp_max unless spp is given)");
     }
-    bool png = true, hdr = false, error_png = false, reference_png = false, reference_hdr = false;
+    bool png = true, hdr = false, pfm = false, error_png = false, reference_png = false,
+         reference_hdr = false;
     if (auto it = options.find("outputs"); it != options.end()) {
         png = false;
         if (!it->is_array()) return fail(MCP_ERROR_ARGUMENT, "options.outputs: expected an array");
@@ -516,6 +517,8 @@ int mcp_render_image(const char* scene_json, const char* options_json, char** re
                 png = true;
             else if (s == "hdr")
                 hdr = true;
+            else if (s == "pfm")
+                pfm = true;
             else if (s == "error_png")
                 error_png = true;
             else if (s == "reference_png")
@@ -525,13 +528,13 @@ int mcp_render_image(const char* scene_json, const char* options_json, char** re
             else
                 return fail(MCP_ERROR_ARGUMENT,
                             "options.outputs: unknown output " + o.dump() +
-                                " (known: png, hdr, error_png, reference_png, reference_hdr)");
+                                " (known: png, hdr, pfm, error_png, reference_png, reference_hdr)");
         }
     }
     if (reference_png || reference_hdr) {
         // The study's reference image itself (from options.reference_data, the cache, a file,
         // or rendered), as PNG and/or Radiance HDR; no estimator image is rendered with it.
-        if (png || hdr || error_png)
+        if (png || hdr || pfm || error_png)
             return fail(MCP_ERROR_ARGUMENT, "options.outputs: reference_png and reference_hdr go "
                                             "alone (the reference image, no estimator's)");
         std::string err;
@@ -586,6 +589,7 @@ int mcp_render_image(const char* scene_json, const char* options_json, char** re
     Json images = Json::object();
     if (png) images["png"] = base64_encode(encode_png(image, r.exposure));
     if (hdr) images["hdr"] = base64_encode(encode_hdr(image));
+    if (pfm) images["pfm"] = base64_encode(encode_pfm(image));
     Json j{{"version", kResultSchemaVersion},
            {"kind", "render_image"},
            {"mcplay", mcp_version()},
