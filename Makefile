@@ -44,7 +44,7 @@ DEP_PROBES := /usr/bin/cmake /usr/bin/g++ /usr/src/googletest/CMakeLists.txt \
 	/usr/include/tiny_gltf.h /usr/include/nlohmann/json.hpp /usr/bin/chromium
 
 .PHONY: all deps deps-web build build-wasm site test test-native test-wasm test-compare test-web-core \
-	test-e2e test-sanitize run cli bench format clean help fuzz fuzz-build fuzz-smoke deps-fuzz
+	test-e2e test-sanitize run cli bench bench-mitsuba format clean help fuzz fuzz-build fuzz-smoke deps-fuzz
 
 all: build
 
@@ -56,6 +56,7 @@ help:
 	@echo "make bench-genz  mcplay beside GSL plain/MISER/VEGAS on Genz's families (GENZ_ARGS=--quick: 15 s)"
 	@echo "make bench-flags  the flags judged both ways: false alarms where intervals covered, confident wrong answers"
 	@echo "make bench-qmc  mcplay's randomized QMC beside QMCPy's and scipy's on Genz 1, 4, 5 (pip venv in build/)"
+	@echo "make bench-mitsuba  the renderer beside Mitsuba 3.9.1 on three glTF scenes: time, relMSE, efficiency (ARGS=--quick)"
 	@echo "make format clang-format every C++ source"
 	@echo "make test-sanitize  the native ctest suite under ASan + UBSan ($(BUILD_ASAN); part of make test)"
 	@echo "make fuzz   libFuzzer targets, $(FUZZ_SECONDS) s each (FUZZ_TARGETS=\"$(FUZZ_TARGETS)\"); docs/fuzzing.md"
@@ -134,6 +135,19 @@ run: build site
 
 cli: build
 	./$(BUILD)/mcplay run $(SCENE) $(ARGS)
+
+# mcplay's renderer beside Mitsuba 3.9.1 on the same glTF scenes (not part of make test): installs
+# Debian's libllvm19 (drjit 1.5 needs LLVM >= 16) and Mitsuba into a virtual environment under
+# build/ with pip, then bench/mitsuba/bench_mitsuba.py (about 10 minutes on 2 cores).
+MITSUBA_VENV := $(BUILD)/mitsuba-venv
+LIBLLVM19 := /usr/lib/x86_64-linux-gnu/libLLVM.so.19.1
+bench-mitsuba: build
+	@[ -e $(LIBLLVM19) ] || { if [ "$$(id -u)" = 0 ]; then DEBIAN_FRONTEND=noninteractive apt-get install -y -q libllvm19; \
+	  else echo "bench-mitsuba: run as root, or: sudo apt-get install libllvm19"; exit 1; fi; }
+	@[ -x $(MITSUBA_VENV)/bin/python ] || python3 -m venv $(MITSUBA_VENV)
+	@$(MITSUBA_VENV)/bin/python -c "import mitsuba, numpy" 2>/dev/null || \
+	  $(MITSUBA_VENV)/bin/pip install -q mitsuba==3.9.1 drjit==1.5.0 numpy
+	DRJIT_LIBLLVM_PATH=$(LIBLLVM19) $(MITSUBA_VENV)/bin/python bench/mitsuba/bench_mitsuba.py --mcplay $(BUILD)/mcplay $(ARGS)
 
 bench: build build-wasm site
 	bash bench/run_bench.sh $(BUILD)/mcplay_bench "$(NODE_RUN) --no-liftoff $(BUILD_WASM)/mcplay_bench.js"

@@ -1,0 +1,335 @@
+#!/usr/bin/env python3
+"""mcplay's renderer beside Mitsuba 3 on the same glTF scenes: time per image, relative MSE
+and efficiency at 16, 64 and 256 spp, each renderer scored against its own converged reference.
+
+  build/mitsuba-venv/bin/python bench/mitsuba/bench_mitsuba.py [--mcplay build/mcplay]
+      [--spp 16,64,256] [--ref-spp 4096] [--threads 2] [--quick] [--out build/bench-mitsuba]
+
+`make bench-mitsuba` installs what it needs (Debian's libllvm19 for drjit 1.5, Mitsuba 3.9.1 in a
+virtual environment under build/) and runs this. Not part of `make test`.
+
+The Mitsuba scene is built here from the glTF file alone (our own reader: node transforms,
+triangles with flat face normals, the camera; Lambertian materials as `twosided(diffuse)`,
+metals as `roughconductor` GGX with alpha = roughness^2 and F = 1, emissive materials as one-sided
+`area` emitters). Strategies: light sampling (Mitsuba `direct` with emitter samples only; mcplay
+`light_solid_angle`), BSDF sampling (`direct` with BSDF samples only; mcplay `bsdf`), MIS (`direct`,
+one of each, power heuristic; mcplay `mis_power`) and path tracing (Mitsuba `path` with
+max_depth = mcplay's bounces + 1, the same Russian-roulette depth; mcplay `path`).
+
+Relative MSE of an image I against a reference R (two halves R1, R2 of different seeds, R their
+mean): mean over pixels and channels of ((I - R)^2 - v) / (R^2 + eps), v = (R1 - R2)^2 / 4 the
+unbiased variance of R's pixel (the reference's own noise is not counted as error), eps = 1e-2
+(mean luminance of R)^2 [RousselleKnausZwicker11]. Efficiency = 1 / (relative MSE x seconds).
+Seconds are render time only, the smaller of two runs (Mitsuba's after a first render of the same
+size compiled its kernels; mcplay's from its result JSON). The two renderers' references are
+also compared with each other (the same relative MSE), which says whether they render the same
+image.
+"""
+import argparse
+import base64
+import json
+import math
+import os
+import struct
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+ROOT = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..'))
+
+# scene, glTF, width, height, strategies (mcplay estimator name for each)
+SCENES = [
+    ('quad_light_floor', 'quad_light_floor.gltf', 320, 240, ['light', 'bsdf', 'mis']),
+    ('cornell_box', 'cornell_box.gltf', 128, 128, ['light', 'bsdf', 'mis', 'path']),
+    ('veach_mis', 'veach_mis.gltf', 320, 180, ['light', 'bsdf', 'mis']),
+]
+MCPLAY_ESTIMATOR = {'light': 'light_solid_angle', 'bsdf': 'bsdf', 'mis': 'mis_power', 'path': 'path'}
+PATH_BOUNCES, PATH_RR = 5, 3  # mcplay's path defaults (src/render/integrator.h)
+
+
+# --------------------------------------------------------------------------------------------
+# glTF, read for Mitsuba
+
+
+def quat_matrix(q):
+    x, y, z, w = q
+    return np.array([
+        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w), 0],
+        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w), 0],
+        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y), 0],
+        [0, 0, 0, 1]])
+
+
+def node_matrix(node):
+    if 'matrix' in node:
+        return np.array(node['matrix'], dtype=float).reshape(4, 4).T  # column-major
+    t = np.eye(4)
+    t[:3, 3] = node.get('translation', [0, 0, 0])
+    r = quat_matrix(node.get('rotation', [0, 0, 0, 1]))
+    s = np.diag(list(node.get('scale', [1, 1, 1])) + [1])
+    return t @ r @ s
+
+
+def buffer_bytes(gltf, i, folder):
+    uri = gltf['buffers'][i]['uri']
+    if uri.startswith('data:'):
+        return base64.b64decode(uri.split(',', 1)[1])
+    with open(os.path.join(folder, uri), 'rb') as f:
+        return f.read()
+
+
+def accessor(gltf, i, buffers):
+    a = gltf['accessors'][i]
+    view = gltf['bufferViews'][a['bufferView']]
+    data = buffers[view['buffer']]
+    comps = {'SCALAR': 1, 'VEC2': 2, 'VEC3': 3, 'VEC4': 4}[a['type']]
+    dtype = {5126: np.float32, 5125: np.uint32, 5123: np.uint16, 5121: np.uint8}[a['componentType']]
+    size = np.dtype(dtype).itemsize
+    stride = view.get('byteStride', comps * size)
+    start = view.get('byteOffset', 0) + a.get('byteOffset', 0)
+    rows = [np.frombuffer(data, dtype, comps, start + k * stride) for k in range(a['count'])]
+    return np.array(rows)
+
+
+def gltf_scene(path):
+    """Triangles in world space per primitive with its material, and the camera's matrix and yfov."""
+    with open(path) as f:
+        gltf = json.load(f)
+    folder = os.path.dirname(path)
+    buffers = [buffer_bytes(gltf, i, folder) for i in range(len(gltf.get('buffers', [])))]
+    prims, camera = [], None
+
+    def visit(n, parent):
+        node = gltf['nodes'][n]
+        m = parent @ node_matrix(node)
+        nonlocal camera
+        if 'camera' in node:
+            camera = (m, gltf['cameras'][node['camera']]['perspective']['yfov'])
+        if 'mesh' in node:
+            for p in gltf['meshes'][node['mesh']]['primitives']:
+                pos = accessor(gltf, p['attributes']['POSITION'], buffers).astype(float)
+                world = (m @ np.c_[pos, np.ones(len(pos))].T).T[:, :3]
+                idx = (accessor(gltf, p['indices'], buffers).reshape(-1, 3) if 'indices' in p
+                       else np.arange(len(pos)).reshape(-1, 3))
+                prims.append((world, idx.astype(np.int32), gltf['materials'][p.get('material', 0)]))
+        for c in node.get('children', []):
+            visit(c, m)
+
+    for n in gltf['scenes'][gltf.get('scene', 0)]['nodes']:
+        visit(n, np.eye(4))
+    return prims, camera
+
+
+def write_ply(path, vertices, faces):
+    with open(path, 'wb') as f:
+        f.write((f'ply\nformat binary_little_endian 1.0\nelement vertex {len(vertices)}\n'
+                 'property float x\nproperty float y\nproperty float z\n'
+                 f'element face {len(faces)}\nproperty list uchar int vertex_indices\nend_header\n').encode())
+        f.write(np.asarray(vertices, '<f4').tobytes())
+        for tri in faces:
+            f.write(struct.pack('<Biii', 3, *[int(v) for v in tri]))
+
+
+def mitsuba_scene(mi, gltf_path, width, height, folder):
+    prims, (cam, yfov) = gltf_scene(gltf_path)
+    scene = {'type': 'scene'}
+    for k, (v, f, mat) in enumerate(prims):
+        pbr = mat.get('pbrMetallicRoughness', {})
+        base = pbr.get('baseColorFactor', [1, 1, 1, 1])[:3]
+        if pbr.get('metallicFactor', 1) >= 0.5:
+            r = pbr.get('roughnessFactor', 1)
+            bsdf = {'type': 'roughconductor', 'distribution': 'ggx', 'alpha': r * r, 'material': 'none',
+                    'specular_reflectance': {'type': 'rgb', 'value': base}}
+        else:
+            bsdf = {'type': 'twosided', 'bsdf': {'type': 'diffuse', 'reflectance': {'type': 'rgb', 'value': base}}}
+        ply = os.path.join(folder, f'mesh{k}.ply')
+        write_ply(ply, v, f)
+        shape = {'type': 'ply', 'filename': ply, 'face_normals': True, 'bsdf': bsdf}
+        emissive = mat.get('emissiveFactor')
+        if emissive and max(emissive) > 0:
+            strength = mat.get('extensions', {}).get('KHR_materials_emissive_strength', {}).get('emissiveStrength', 1)
+            shape['emitter'] = {'type': 'area', 'radiance': {'type': 'rgb', 'value': [c * strength for c in emissive]}}
+        scene[f'shape{k}'] = shape
+    # glTF cameras look down -z with +x right; Mitsuba's look down +z with +x left
+    to_world = cam @ np.diag([-1, 1, -1, 1])
+    scene['sensor'] = {
+        'type': 'perspective', 'fov': math.degrees(yfov), 'fov_axis': 'y', 'near_clip': 1e-3,
+        'to_world': mi.ScalarTransform4f(to_world.tolist()),
+        'film': {'type': 'hdrfilm', 'width': width, 'height': height, 'rfilter': {'type': 'box'},
+                 'pixel_format': 'rgb'},
+        'sampler': {'type': 'independent'},
+    }
+    return scene
+
+
+MITSUBA_INTEGRATOR = {
+    'light': {'type': 'direct', 'emitter_samples': 1, 'bsdf_samples': 0},
+    'bsdf': {'type': 'direct', 'emitter_samples': 0, 'bsdf_samples': 1},
+    'mis': {'type': 'direct', 'emitter_samples': 1, 'bsdf_samples': 1},
+    'path': {'type': 'path', 'max_depth': PATH_BOUNCES + 1, 'rr_depth': PATH_RR + 1},
+}
+
+
+class Mitsuba:
+    def __init__(self, mi, gltf, width, height, folder):
+        self.mi = mi
+        self.base = mitsuba_scene(mi, gltf, width, height, folder)
+        self.scenes = {}
+
+    def scene(self, strategy):
+        if strategy not in self.scenes:
+            self.scenes[strategy] = self.mi.load_dict({**self.base, 'integrator': MITSUBA_INTEGRATOR[strategy]})
+        return self.scenes[strategy]
+
+    def render(self, strategy, spp, seed):
+        s = self.scene(strategy)
+        t0 = time.perf_counter()
+        img = self.mi.render(s, spp=spp, seed=seed)
+        img = np.array(img, dtype=np.float64)  # waits for the kernel
+        return img[:, :, :3], time.perf_counter() - t0
+
+
+# --------------------------------------------------------------------------------------------
+# mcplay, through its CLI
+
+
+def read_pfm(path):
+    with open(path, 'rb') as f:
+        assert f.readline().strip() == b'PF'
+        w, h = map(int, f.readline().split())
+        scale = float(f.readline())
+        data = np.frombuffer(f.read(), '<f4' if scale < 0 else '>f4').astype(np.float64)
+    return data.reshape(h, w, 3)[::-1]
+
+
+class Mcplay:
+    def __init__(self, exe, scene, width, height, threads, folder):
+        self.exe, self.scene, self.width, self.height = exe, scene, width, height
+        self.threads, self.folder = threads, folder
+
+    def render(self, strategy, spp, seed):
+        out = os.path.join(self.folder, 'mcplay.pfm')
+        cmd = [self.exe, 'render', self.scene, '--scenes', os.path.join(ROOT, 'scenes'),
+               '--estimator', MCPLAY_ESTIMATOR[strategy], '--spp', str(spp), '--seed', str(seed),
+               '--width', str(self.width), '--height', str(self.height), '--threads', str(self.threads),
+               '--out', out, '--format', 'json', '--no-cache']
+        if strategy == 'path':  # the path scene: the Cornell box's path estimators
+            cmd[2] = 'cornell_box_path'
+            cmd[6] = 'path_mis'
+        r = subprocess.run(cmd, check=True, capture_output=True, text=True)
+        return read_pfm(out), json.loads(r.stdout)['seconds']
+
+
+# --------------------------------------------------------------------------------------------
+# Scoring
+
+
+def luminance(img):
+    return 0.2126 * img[..., 0] + 0.7152 * img[..., 1] + 0.0722 * img[..., 2]
+
+
+def reference(renderer, strategy, spp):
+    """The converged reference as two halves of different seeds: (mean, per-pixel variance)."""
+    a, _ = renderer.render(strategy, spp // 2, 1_000_001)
+    b, _ = renderer.render(strategy, spp // 2, 2_000_003)
+    return (a + b) / 2, (a - b) ** 2 / 4
+
+
+def relative_mse(img, ref, ref_var):
+    eps = 1e-2 * np.mean(luminance(ref)) ** 2
+    ok = np.isfinite(img) & np.isfinite(ref)
+    return float(np.mean(np.where(ok, ((img - ref) ** 2 - ref_var) / (ref ** 2 + eps), 0.0)))
+
+
+def timed(renderer, strategy, spp, runs=2):
+    """The image of the first run and the smaller time of `runs` runs."""
+    img, best = None, math.inf
+    for k in range(runs):
+        im, s = renderer.render(strategy, spp, 7 + k)
+        if img is None:
+            img = im
+        best = min(best, s)
+    return img, best
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split('\n')[0])
+    ap.add_argument('--mcplay', default=os.path.join(ROOT, 'build', 'mcplay'))
+    ap.add_argument('--spp', default='16,64,256')
+    ap.add_argument('--ref-spp', type=int, default=4096)
+    ap.add_argument('--threads', type=int, default=2)
+    ap.add_argument('--quick', action='store_true', help='small images and references: a smoke test')
+    ap.add_argument('--scenes', default=','.join(s[0] for s in SCENES))
+    args = ap.parse_args()
+    spps = [int(s) for s in args.spp.split(',')]
+    os.environ.setdefault('DRJIT_NUM_THREADS', str(args.threads))
+    import mitsuba as mi
+    variant = os.environ.get('MI_VARIANT', 'llvm_ad_rgb')
+    try:
+        mi.set_variant(variant)
+    except Exception as e:  # drjit without a usable LLVM
+        sys.exit(f'bench-mitsuba: Mitsuba variant {variant} is not usable ({e}); '
+                 'llvm variants need DRJIT_LIBLLVM_PATH pointing at LLVM >= 16 (Debian libllvm19)')
+    import drjit as dr
+    dr.set_thread_count(args.threads)
+    print(f'mcplay {subprocess.run([args.mcplay, "--version"], capture_output=True, text=True).stdout.strip()}'
+          f' beside Mitsuba {mi.__version__} ({variant}), {args.threads} threads; '
+          f'spp {spps}, references {args.ref_spp} spp (two halves)')
+    rows = []
+    with tempfile.TemporaryDirectory() as folder:
+        for name, gltf, w, h, strategies in SCENES:
+            if name not in args.scenes.split(','):
+                continue
+            if args.quick:
+                w, h = w // 4, h // 4
+            mit = Mitsuba(mi, os.path.join(ROOT, 'scenes', gltf), w, h, folder)
+            mcp = Mcplay(args.mcplay, name, w, h, args.threads, folder)
+            cache = {}  # the references of this scene, per reference strategy
+            for strategy in strategies:
+                ref_strategy = 'path' if strategy == 'path' else 'mis'
+                if ref_strategy not in cache:
+                    refs = {}
+                    for label, r in (('mcplay', mcp), ('mitsuba', mit)):
+                        t0 = time.perf_counter()
+                        refs[label] = reference(r, ref_strategy, args.ref_spp)
+                        print(f'  {name} {label} reference ({ref_strategy}, {args.ref_spp} spp): '
+                              f'{time.perf_counter() - t0:.1f} s', file=sys.stderr)
+                    cache[ref_strategy] = refs
+                refs = cache[ref_strategy]
+                between = relative_mse(refs['mcplay'][0], refs['mitsuba'][0], refs['mitsuba'][1])
+                mit.render(strategy, spps[0], 3)  # compiles Mitsuba's kernels for this size
+                for spp in spps:
+                    row = {'scene': name, 'strategy': strategy, 'spp': spp, 'refs_rel_mse': between}
+                    for label, r in (('mcplay', mcp), ('mitsuba', mit)):
+                        img, s = timed(r, strategy, spp)
+                        rel = relative_mse(img, *refs[label])
+                        row[label] = {'seconds': s, 'rel_mse': rel,
+                                      'efficiency': 1 / (rel * s) if rel > 0 and s > 0 else None}
+                    eff = [row[k]['efficiency'] for k in ('mcplay', 'mitsuba')]
+                    row['time_ratio'] = row['mcplay']['seconds'] / row['mitsuba']['seconds']
+                    row['efficiency_ratio'] = eff[0] / eff[1] if None not in eff else None
+                    rows.append(row)
+                    print(f"{name:16} {strategy:5} {spp:4} spp  mcplay {row['mcplay']['seconds']:7.3f} s "
+                          f"relMSE {row['mcplay']['rel_mse']:.3e}  |  Mitsuba {row['mitsuba']['seconds']:7.3f} s "
+                          f"relMSE {row['mitsuba']['rel_mse']:.3e}  |  time x{row['time_ratio']:.2f}  "
+                          f"efficiency x{row['efficiency_ratio']:.2f}", flush=True)
+    out = os.path.join(ROOT, 'build', 'bench-mitsuba.json')
+    with open(out, 'w') as f:
+        json.dump(rows, f, indent=1)
+    ratios = sorted(r['efficiency_ratio'] for r in rows if r['efficiency_ratio'])
+    times = sorted(r['time_ratio'] for r in rows)
+    if ratios:
+        print(f'efficiency mcplay / Mitsuba over {len(ratios)} cells: median {ratios[len(ratios) // 2]:.2f}, '
+              f'range {ratios[0]:.2f} .. {ratios[-1]:.2f}; mcplay ahead in {sum(r >= 1 for r in ratios)}; '
+              f'time per image mcplay / Mitsuba: median {times[len(times) // 2]:.2f}')
+    for name in sorted({r['scene'] for r in rows}):
+        print(f'references, mcplay against Mitsuba, {name}: relative MSE '
+              + ', '.join(f"{r['strategy']} {r['refs_rel_mse']:.2e}" for r in rows if r['scene'] == name and r['spp'] == spps[0]))
+    print(f'figures: {out}')
+
+
+if __name__ == '__main__':
+    main()
