@@ -107,35 +107,46 @@ std::vector<uint64_t> stratification_grid(uint64_t n, int dim) {
 namespace {
 
 // One keyed bijection of [0, 2^bits): each step (xor with a constant, multiplication by an
-// odd number, xorshift to the right, addition) is invertible modulo 2^bits.
-inline uint64_t bijection(uint64_t x, uint64_t mask, int bits, uint64_t key) {
+// odd number, xorshift to the right, addition) is invertible modulo 2^bits. `rk` are its four
+// round keys, mix64(key + round).
+inline uint64_t bijection(uint64_t x, uint64_t mask, int bits, const uint64_t* rk) {
     int shift = bits > 1 ? bits / 2 : 1;
     for (int round = 0; round < 4; ++round) {
-        uint64_t rk = mix64(key + static_cast<uint64_t>(round));
-        x ^= rk & mask;
-        x = (x * (rk | 1u)) & mask;
+        x ^= rk[round] & mask;
+        x = (x * (rk[round] | 1u)) & mask;
         x ^= x >> shift;
         x = (x * 0x9e3779b97f4a7c15ULL) & mask; // odd multiplier: a bijection mod 2^bits
         x ^= x >> (shift > 1 ? shift - 1 : 1);
-        x = (x + (rk >> 32)) & mask;
+        x = (x + (rk[round] >> 32)) & mask;
     }
     return x;
 }
 
 } // namespace
 
-uint64_t permute_index(uint64_t index, uint64_t n, uint64_t key) {
-    if (n <= 1) return 0;
-    int bits = 0;
-    while ((uint64_t(1) << bits) < n) ++bits;
-    uint64_t mask = bits >= 64 ? ~uint64_t(0) : (uint64_t(1) << bits) - 1;
+IndexPermutation index_permutation(uint64_t n, uint64_t key) {
+    IndexPermutation p;
+    p.n = n;
+    while (p.bits < 64 && (uint64_t(1) << p.bits) < n) ++p.bits;
+    p.mask = p.bits >= 64 ? ~uint64_t(0) : (uint64_t(1) << p.bits) - 1;
+    for (int round = 0; round < 4; ++round) p.round_key[round] = mix64(key + uint64_t(round));
+    return p;
+}
+
+uint64_t permute_index(uint64_t index, const IndexPermutation& p) {
+    if (p.n <= 1) return 0;
     // Cycle walking: apply the bijection until the value falls back inside [0, n). The
     // orbit of an index < n returns to [0, n), so this is a permutation of [0, n).
     uint64_t x = index;
     do {
-        x = bijection(x, mask, bits, key);
-    } while (x >= n);
+        x = bijection(x, p.mask, p.bits, p.round_key);
+    } while (x >= p.n);
     return x;
+}
+
+uint64_t permute_index(uint64_t index, uint64_t n, uint64_t key) {
+    if (n <= 1) return 0;
+    return permute_index(index, index_permutation(n, key));
 }
 
 SamplerPlan make_sampler_plan(SamplerKind kind, int dim, uint64_t n, Pcg32& rng,

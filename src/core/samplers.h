@@ -63,6 +63,16 @@ std::vector<uint64_t> stratification_grid(uint64_t n, int dim);
 /// enclosing power-of-two range [Kensler13, Black02]; O(1) memory, any n >= 1.
 uint64_t permute_index(uint64_t index, uint64_t n, uint64_t key);
 
+/// permute_index's permutation of [0, n) for one key, prepared once (its round keys and the
+/// enclosing power of two) for many indices: a pixel's samples share one per dimension.
+struct IndexPermutation {
+    uint64_t n = 1, mask = 0, round_key[4] = {0, 0, 0, 0};
+    int bits = 0;
+};
+IndexPermutation index_permutation(uint64_t n, uint64_t key);
+/// The same value as permute_index(index, p.n, key) for the key `p` was prepared with.
+uint64_t permute_index(uint64_t index, const IndexPermutation& p);
+
 /// Everything a run needs to generate its points; built once per run.
 struct SamplerPlan {
     SamplerKind kind = SamplerKind::Independent;

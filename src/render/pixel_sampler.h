@@ -144,6 +144,7 @@ class PixelSampler {
     /// the stratum permutations); the Sobol' sampler keeps its Morton index.
     void start_pixel(int x, int y) {
         key_ = hash_combine(image_key_, uint64_t(y) * width_ + uint64_t(x));
+        prepared_ = 0; // the pixel's permutations are prepared on first use
         if (kind_ == PixelSamplerKind::Sobol)
             morton_ = pixel_sampler_detail::morton2(uint32_t(x), uint32_t(y));
         else
@@ -164,7 +165,7 @@ class PixelSampler {
         }
         if (kind_ == PixelSamplerKind::Independent || d >= kStratifiedDimensions || spp_ <= 1)
             return rng_.next_double();
-        uint64_t stratum = permute_index(index_, spp_, hash_combine(key_, uint64_t(d)));
+        uint64_t stratum = permute_index(index_, permutation(d));
         return clamp_open((static_cast<double>(stratum) + rng_.next_double()) /
                           static_cast<double>(spp_));
     }
@@ -185,7 +186,7 @@ class PixelSampler {
         double u1 = rng_.next_double();
         if (kind_ == PixelSamplerKind::Independent || d >= kStratifiedDimensions || spp_ <= 1)
             return Vec2(u0, u1);
-        uint64_t cell = permute_index(index_, spp_, hash_combine(key_, uint64_t(d)));
+        uint64_t cell = permute_index(index_, permutation(d));
         uint64_t cx = cell % grid_x_, cy = cell / grid_x_;
         return Vec2(clamp_open((static_cast<double>(cx) + u0) / static_cast<double>(grid_x_)),
                     clamp_open((static_cast<double>(cy) + u1) / static_cast<double>(grid_y_)));
@@ -219,6 +220,16 @@ class PixelSampler {
 
   private:
     static double clamp_open(double u) { return below_one(u); }
+
+    /// The stratified sampler's permutation of the pixel's spp samples in dimension d
+    /// (d < kStratifiedDimensions), keyed by the pixel and d, prepared once per pixel.
+    const IndexPermutation& permutation(int d) {
+        if (!((prepared_ >> d) & 1u)) {
+            permutations_[d] = index_permutation(spp_, hash_combine(key_, uint64_t(d)));
+            prepared_ |= uint32_t(1) << d;
+        }
+        return permutations_[d];
+    }
 
     /// The permuted global index of the current sample in the dimension keyed by dim_key:
     /// the Morton index with its base-4 digits through a nested random permutation (each
@@ -270,6 +281,9 @@ class PixelSampler {
     int sample_bits_ = 0, morton_bits_ = 0;
     int dimension_ = 0;
     Pcg32 rng_;
+    uint32_t prepared_ = 0; ///< bit d: permutations_[d] is this pixel's
+    static_assert(kStratifiedDimensions <= 32, "one bit of prepared_ per dimension");
+    IndexPermutation permutations_[kStratifiedDimensions];
 };
 
 } // namespace mcp

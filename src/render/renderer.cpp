@@ -37,6 +37,7 @@ void render_rows(const RenderScene& rs, const RenderEstimator& est, const Render
                  RowProgress& progress) {
     PixelSampler sampler;
     sampler.configure(est.pixel_sampler, st.spp, st.width, st.height, st.stream);
+    const CameraRays camera = camera_rays(rs.scene->camera, st.width, st.height);
     for (int y = first_row; y < st.height; y += step) {
         if (st.cancel && st.cancel->load(std::memory_order_relaxed)) return;
         if (progress.stop.load(std::memory_order_relaxed)) return;
@@ -60,8 +61,7 @@ void render_rows(const RenderScene& rs, const RenderEstimator& est, const Render
             for (uint64_t i = 0; i < st.spp; ++i) {
                 sampler.start_sample(i);
                 Vec2 jitter = st.jitter_pixels ? sampler.get_2d() : Vec2(0.5);
-                Ray ray =
-                    camera_ray(rs.scene->camera, st.width, st.height, x + jitter.x, y + jitter.y);
+                Ray ray = ray_through(camera, x + jitter.x, y + jitter.y);
                 RadianceSample rad = sample_radiance(rs, est, ray, sampler, counters);
                 Vec3 L = rad.total();
                 if (!std::isfinite(L.x) || !std::isfinite(L.y) || !std::isfinite(L.z)) {
@@ -108,15 +108,30 @@ void RenderDiagnostics::merge(const RenderDiagnostics& o) {
     for (double x : o.top) push_top(top, x);
 }
 
-Ray camera_ray(const Camera& camera, int width, int height, double x, double y) {
-    double tan_half = std::tan(0.5 * camera.yfov);
-    double aspect = double(width) / double(height);
-    double sx = (2.0 * x / width - 1.0) * tan_half * aspect;
-    double sy = (1.0 - 2.0 * y / height) * tan_half;
+CameraRays camera_rays(const Camera& camera, int width, int height) {
+    CameraRays c;
+    c.origin = camera.position;
+    c.forward = camera.forward;
+    c.right = camera.right;
+    c.up = camera.up;
+    c.tan_half = std::tan(0.5 * camera.yfov);
+    c.aspect = double(width) / double(height);
+    c.width = width;
+    c.height = height;
+    return c;
+}
+
+Ray ray_through(const CameraRays& c, double x, double y) {
+    double sx = (2.0 * x / c.width - 1.0) * c.tan_half * c.aspect;
+    double sy = (1.0 - 2.0 * y / c.height) * c.tan_half;
     Ray r;
-    r.origin = camera.position;
-    r.direction = glm::normalize(camera.forward + sx * camera.right + sy * camera.up);
+    r.origin = c.origin;
+    r.direction = glm::normalize(c.forward + sx * c.right + sy * c.up);
     return r;
+}
+
+Ray camera_ray(const Camera& camera, int width, int height, double x, double y) {
+    return ray_through(camera_rays(camera, width, height), x, y);
 }
 
 RenderImage render_image(const RenderScene& rs, const RenderEstimator& est,

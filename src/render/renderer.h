@@ -55,6 +55,15 @@ struct RenderImage {
 /// The camera ray through image position (x, y) in pixels from the top-left corner.
 Ray camera_ray(const Camera& camera, int width, int height, double x, double y);
 
+/// camera_ray's constants for one image (one tan per image, not per ray): ray_through gives
+/// the same rays, bit for bit.
+struct CameraRays {
+    Vec3 origin{0.0}, forward{0.0, 0.0, -1.0}, right{1.0, 0.0, 0.0}, up{0.0, 1.0, 0.0};
+    double tan_half = 1.0, aspect = 1.0, width = 1.0, height = 1.0;
+};
+CameraRays camera_rays(const Camera& camera, int width, int height);
+Ray ray_through(const CameraRays& c, double x, double y);
+
 RenderImage render_image(const RenderScene& rs, const RenderEstimator& est,
                          const RenderSettings& settings);
 
