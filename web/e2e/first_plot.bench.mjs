@@ -57,7 +57,8 @@ try {
         poll();
       }));
       times.push(ms);
-      if (!(await page.locator('#cancel').isDisabled())) await page.click('#cancel');
+      // the run may end on its own meanwhile: click Cancel only while it is enabled
+      await page.evaluate(() => { const b = document.querySelector('#cancel'); if (!b.disabled) b.click(); });
       await page.waitForFunction(() => /^(done|cancelled|error)/.test(document.querySelector('#status').textContent),
         null, { timeout: 120000 });
     }
