@@ -20,7 +20,8 @@ Relative MSE of an image I against a reference R (two halves R1, R2 of different
 mean): mean over pixels and channels of ((I - R)^2 - v) / (R^2 + eps), v = (R1 - R2)^2 / 4 the
 unbiased variance of R's pixel (the reference's own noise is not counted as error), eps = 1e-2
 (mean luminance of R)^2 [RousselleKnausZwicker11]. Efficiency = 1 / (relative MSE x seconds).
-Seconds are render time only, the smaller of two runs (Mitsuba's after a first render of the same
+With --images K the relative MSE is the mean over K images of different seeds. Seconds are
+render time only, the smallest of those runs (at least two) (Mitsuba's after a first render of the same
 size compiled its kernels; mcplay's from its result JSON). The two renderers' references are
 also compared with each other (the same relative MSE), which says whether they render the same
 image.
@@ -244,15 +245,16 @@ def relative_mse(img, ref, ref_var):
     return float(np.mean(np.where(ok, ((img - ref) ** 2 - ref_var) / (ref ** 2 + eps), 0.0)))
 
 
-def timed(renderer, strategy, spp, runs=2):
-    """The image of the first run and the smaller time of `runs` runs."""
-    img, best = None, math.inf
-    for k in range(runs):
+def scored(renderer, strategy, spp, ref, images):
+    """The mean relative MSE of `images` images of different seeds (one image's is noisy where
+    the weights are heavy-tailed) and the smallest time among them (at least two runs)."""
+    rels, best = [], math.inf
+    for k in range(max(images, 2)):
         im, s = renderer.render(strategy, spp, 7 + k)
-        if img is None:
-            img = im
+        if k < images:
+            rels.append(relative_mse(im, *ref))
         best = min(best, s)
-    return img, best
+    return float(np.mean(rels)), best
 
 
 def main():
@@ -261,6 +263,8 @@ def main():
     ap.add_argument('--spp', default='16,64,256')
     ap.add_argument('--ref-spp', type=int, default=4096)
     ap.add_argument('--threads', type=int, default=2)
+    ap.add_argument('--images', type=int, default=1,
+                    help='images per cell whose relative MSE is averaged (heavy-tailed cells need several)')
     ap.add_argument('--quick', action='store_true', help='small images and references: a smoke test')
     ap.add_argument('--scenes', default=','.join(s[0] for s in SCENES))
     args = ap.parse_args()
@@ -277,7 +281,7 @@ def main():
     dr.set_thread_count(args.threads)
     print(f'mcplay {subprocess.run([args.mcplay, "--version"], capture_output=True, text=True).stdout.strip()}'
           f' beside Mitsuba {mi.__version__} ({variant}), {args.threads} threads; '
-          f'spp {spps}, references {args.ref_spp} spp (two halves)')
+          f'spp {spps}, references {args.ref_spp} spp (two halves), {args.images} image(s) per cell')
     rows = []
     with tempfile.TemporaryDirectory() as folder:
         for name, gltf, w, h, strategies in SCENES:
@@ -304,8 +308,7 @@ def main():
                 for spp in spps:
                     row = {'scene': name, 'strategy': strategy, 'spp': spp, 'refs_rel_mse': between}
                     for label, r in (('mcplay', mcp), ('mitsuba', mit)):
-                        img, s = timed(r, strategy, spp)
-                        rel = relative_mse(img, *refs[label])
+                        rel, s = scored(r, strategy, spp, refs[label], args.images)
                         row[label] = {'seconds': s, 'rel_mse': rel,
                                       'efficiency': 1 / (rel * s) if rel > 0 and s > 0 else None}
                     eff = [row[k]['efficiency'] for k in ('mcplay', 'mitsuba')]
