@@ -62,7 +62,7 @@ const cli = [
   ['list_extra', ['list', 'extra'], "list: unexpected argument 'extra'"],
   ['list_no_dir', ['list', '--scenes', '{T}/none'], "cannot open scenes directory"],
   ['render_no_out', ['render', 'render/ok.json'], 'render needs --out'],
-  ['render_out_txt', ['render', 'render/ok.json', '--out', '{T}/x.txt'], 'must end in .png or .hdr'],
+  ['render_out_txt', ['render', 'render/ok.json', '--out', '{T}/x.txt'], 'must end in .png, .hdr or .pfm'],
   ['render_error_jpg', ['render', 'render/ok.json', '--error-out', '{T}/x.jpg'], 'must be a .png file'],
   ['render_spp_zero', ['render', 'render/ok.json', '--spp', '0', '--out', '{T}/x.png'], 'options.spp'],
   ['render_spp_huge', ['render', 'render/ok.json', '--spp', '99999999', '--out', '{T}/x.png'], 'options.spp'],
