@@ -426,6 +426,7 @@ function startRun() {
   }
   (shipped ? shippedReference(entry) : Promise.resolve(null)).then((referenceData) => {
     if (activeRun !== id) return;
+    if (shipped && !referenceData) dispatch({ type: 'run/reference-unavailable', payload: { id } });
     groups.forEach((group, i) => {
       const options = studyOptions(kind, settings, group);
       if (referenceData) options.reference_data = referenceData;

@@ -794,6 +794,11 @@ export function reducer(state, action) {
         },
       };
     }
+    case 'run/reference-unavailable': {
+      // the shipped reference could not be fetched: the study renders its own
+      if (p.id !== state.run.id || state.run.status !== 'running') return state;
+      return { ...state, run: { ...state.run, referenceShipped: false } };
+    }
     case 'run/partial': {
       // one worker's complete result: its records become the result's estimators
       if (p.id !== state.run.id || state.run.status !== 'running') return state;
@@ -847,7 +852,6 @@ export function keptFor(state) {
   return state.kept && state.kept.sceneId === state.sceneId ? state.kept : null;
 }
 
-/** The #status text of a state. */
 /** What a render study does before its first level: the reference, shipped or being rendered. */
 export function referenceText(run) {
   if (run.referenceShipped) return 'the reference ships with the site';
@@ -856,6 +860,7 @@ export function referenceText(run) {
   return `rendering the reference: ${Math.floor((100 * rows.done) / Math.max(1, rows.rows))}% of its rows`;
 }
 
+/** The #status text of a state. */
 export function statusText(state) {
   const r = state.run;
   if (r.status === 'error') return `error: ${r.message}`;

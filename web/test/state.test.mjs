@@ -473,3 +473,17 @@ test('a finished run kept for comparison belongs to its scene', async () => {
   s = reducer(s, { type: 'compare/clear' });
   assert.equal(s.kept, null);
 });
+
+test('a shipped reference that cannot be fetched is no longer announced as shipped', async () => {
+  const { referenceText } = await import('../src/state.js');
+  let s = reducer(initialState(), { type: 'core/ready', payload: { version: '0.1.0' } });
+  const start = { id: 2, kind: KIND.RENDER, referenceShipped: true, workers: 1, settings: { n_min: 1, n_max: 4, reps: 2, seed: 1 }, order: ['mis'], startedAt: 0 };
+  s = reducer(s, { type: 'run/start', payload: start });
+  assert.equal(referenceText(s.run), 'the reference ships with the site');
+  assert.equal(reducer(s, { type: 'run/reference-unavailable', payload: { id: 1 } }), s, 'another run\'s message is ignored');
+  s = reducer(s, { type: 'run/reference-unavailable', payload: { id: 2 } });
+  assert.equal(s.run.referenceShipped, false);
+  assert.equal(referenceText(s.run), 'rendering the reference first…');
+  s = reducer(s, { type: 'run/level', payload: { id: 2, level: { kind: 'render_reference', rows_done: 30, rows: 120 } } });
+  assert.equal(referenceText(s.run), 'rendering the reference: 25% of its rows');
+});
