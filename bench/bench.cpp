@@ -216,6 +216,14 @@ void render_rays_per_second(const std::string& dir, const char* scene, const cha
     }
 }
 
+void render_cases(const std::string& dir) {
+    render_rays_per_second(dir, "cornell_box", "mis_power");
+    render_rays_per_second(dir, "cornell_box", "light_area");
+    render_rays_per_second(dir, "cornell_box_path", "path_mis");
+    render_rays_per_second(dir, "veach_mis", "mis_power");
+    render_rays_per_second(dir, "quad_light_floor", "mis_power");
+}
+
 } // namespace
 
 int main(int argc, char** argv) {
@@ -235,7 +243,9 @@ int main(int argc, char** argv) {
         {"disk_quarter", "stratified_concentric"},
         {"hemisphere_cos2", "cosine"},
     };
+    // --only NAME: one estimator case, or "render" for the render cases alone.
     const char* only = argc > 4 && std::string(argv[3]) == "--only" ? argv[4] : nullptr;
+    const bool render_only = only && std::string(only) == "render";
     for (auto& c : cases) {
         if (only && std::string(c[1]) != only) continue;
         SceneRequest req;
@@ -248,6 +258,10 @@ int main(int argc, char** argv) {
                 std::printf("BENCH %s/%s %.6e\n", c[0], c[1], samples_per_second(req, spec, n));
     }
 
+    if (render_only) {
+        render_cases(dir);
+        return 0;
+    }
     if (only) return 0;
     // run_estimate's overhead over the bare work of a uniform estimate.
     {
@@ -266,10 +280,7 @@ int main(int argc, char** argv) {
     std::printf("BENCH eval/expression_gaussian %.6e\n", e);
     std::printf("BENCH eval/compiled_gaussian %.6e\n", g);
     std::printf("RATIO compiled/expression %.2f\n", g / e);
-    render_rays_per_second(dir, "cornell_box", "mis_power");
-    render_rays_per_second(dir, "cornell_box", "light_area");
-    render_rays_per_second(dir, "cornell_box_path", "path_mis");
-    render_rays_per_second(dir, "veach_mis", "mis_power");
+    render_cases(dir);
     if (argc > 3 && std::string(argv[3]) == "--accumulation") accumulation_accuracy();
     return 0;
 }

@@ -1,43 +1,55 @@
 // Ray-scene intersection: the watertight ray-triangle test [Woop13], a binned-SAH BVH
-// [Wald07] flattened depth first, and its traversal with a robust slab test [Ize13].
+// [Wald07] collapsed to four children per node and flattened depth first, and its traversal,
+// which tests a node's four boxes at once in float SIMD [Wald08] with a slab test made
+// conservative as in [Ize13].
 //
 // Robustness, in order of where it matters:
-// - Triangle test: every vertex is translated and sheared into the ray's frame by the same
-//   arithmetic whichever triangle it belongs to, and the 2D edge function of an edge P->Q is
-//   an antisymmetric function of (P, Q) alone (a product difference, recomputed exactly from
-//   fma remainders when it rounds to 0), so two triangles sharing an edge see opposite signs
-//   and no ray slips between them [Woop13, sec. 3-4].
-// - Boxes: a hit accepted by the triangle test may lie outside the exact triangle by the
-//   rounding of its transformed vertices (a few ulps of |p - origin|). Node boxes are padded
-//   by 2^-32 of the scene's largest coordinate, and the slab test widens its far distances by
-//   a relative 2^-40 (far more than the 1 + 2 gamma_3 of [Ize13]), so a box never culls a
-//   hit its triangles would report: BVH and brute force return the same hits.
+// - Triangle test (double precision): every vertex is translated and sheared into the ray's
+//   frame by the same arithmetic whichever triangle it belongs to, and the 2D edge function of
+//   an edge P->Q is an antisymmetric function of (P, Q) alone (a product difference,
+//   recomputed exactly from fma remainders when it rounds to 0), so two triangles sharing an
+//   edge see opposite signs and no ray slips between them [Woop13, sec. 3-4].
+// - Boxes (float): a box must never cull a hit its triangles would report, whatever the
+//   rounding. Boxes and ray origins are taken relative to the centre c of the scene's bounds
+//   (in double), so float rounding is relative to the scene's radius R, not to how far it is
+//   from the coordinate origin. Each bound is padded by P = 2^-20 R (plus 2^-40 of the largest
+//   coordinate, for the double rounding of the triangle test) and then rounded outwards to
+//   float. On an axis k where the origin is within 8 R of c, rounding o_k - c_k to float
+//   moves the ray by at most 2^-24 |o_k - c_k| <= P/2, so the float ray still passes through
+//   the padded box wherever the double ray meets a triangle. On an axis where it is farther,
+//   the ray covers at least 7/8 of that distance before it reaches the box, so the rounding
+//   moves the plane distances by at most 2^-23 of the hit's t. The distances (b - o) inv
+//   carry a relative error of a few 2^-24 besides. The test absorbs both by accepting
+//   t_enter <= t_exit (1 + 2^-18) (the 1 + 2 gamma_3 of [Ize13], with room to spare). NaN
+//   from 0 * inf (origin on a plane, direction parallel to it) counts as inside.
 // - Ties: the closest hit prefers the lower mesh triangle id among hits at exactly the same
-//   t, so the answer does not depend on traversal order.
+//   t, so the answer does not depend on traversal order: BVH and brute force return the same
+//   hits, bit for bit.
 //
-// Timing (for the lead's benchmark): build once with Accelerator::build(scene.mesh), then
-// time a loop of N intersect() (or occluded()) calls over precomputed rays (e.g. camera
-// rays through jittered pixel positions plus cosine-distributed bounce rays from their hit
-// points), count hits so the loop is not optimised away, and report N / seconds. stats()
-// gives nodes, leaves, depth and bytes for the report. Per ray there is no allocation.
+// Timing: `make bench` times rays per second on the render scenes; stats() gives nodes,
+// leaves, depth and bytes. Per ray there is no allocation.
 #include "render/accel.h"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
+#include "render/simd4.h"
+
 namespace mcp {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-constexpr uint32_t kMaxDepth = 64;         // build guard; also the traversal stack size
-constexpr uint32_t kLeafTriangles = 2;     // nodes this small are always leaves
-constexpr uint32_t kMaxLeafTriangles = 16; // larger nodes split even when SAH says no
-constexpr int kBins = 16;                  // [Wald07] uses 8-32
-constexpr double kTraversalCost = 1.0;     // SAH cost of one node visit ...
-constexpr double kIntersectCost = 1.0;     // ... relative to one triangle test
-constexpr double kBoxPad = 0x1p-32;        // of the scene's largest coordinate
-constexpr double kFarScale = 1.0 + 0x1p-40;
+constexpr uint32_t kMaxDepth = 64;          // build guard; also the traversal stack size
+constexpr uint32_t kLeafTriangles = 2;      // nodes this small are always leaves
+constexpr uint32_t kMaxLeafTriangles = 16;  // larger nodes split even when SAH says no
+constexpr int kBins = 16;                   // [Wald07] uses 8-32
+constexpr double kTraversalCost = 1.0;      // SAH cost of one node visit ...
+constexpr double kIntersectCost = 1.0;      // ... relative to one triangle test
+constexpr double kBoxPad = 0x1p-20;         // of the scene's radius ...
+constexpr double kBoxPadAbsolute = 0x1p-40; // ... plus this of its largest coordinate
+constexpr float kFarScale = 1.0f + 0x1p-18f;
+constexpr uint32_t kStackSize = 4 * kMaxDepth; // a node pushes at most 4, pops 1, depth <= 64
 
 /// Everything about a ray that the triangle and box tests reuse [Woop13, sec. 3; Ize13].
 struct RayPrep {
@@ -45,7 +57,7 @@ struct RayPrep {
     int kx, ky, kz;      // axis permutation: kz is the largest |direction| component
     double sx, sy, sz;   // shear that maps the direction to (0, 0, 1)
     double inv[3];       // 1 / direction (+-inf for zero components)
-    int near[3], far[3]; // per axis, the index into Node::bounds of the entry / exit plane
+    int near[3], far[3]; // per axis, the row of Node4::bounds of the entry / exit plane
     double zero;         // 0, from memory: a literal 0 turns the first max into a branch
 };
 
@@ -130,31 +142,6 @@ inline bool watertight(const RayPrep& r, const Vec3* p, TriHit* h) {
     h->w = w;
     h->det = det;
     return true;
-}
-
-inline double max_keep(double x, double y) {
-    return x > y ? x : y;
-}
-inline double min_keep(double x, double y) {
-    return x < y ? x : y;
-}
-
-/// Slab test [KayKajiya86] with the conservative far distances of [Ize13]: true when the
-/// ray's [0, t_max] meets the box, with the entry distance in *t_enter. NaN from 0 * inf
-/// (origin on a plane, direction parallel to it) leaves the interval unchanged, i.e. counts
-/// as inside.
-inline bool box_hit(const double* b, const RayPrep& r, double t_max, double* t_enter) {
-    const double tx0 = (b[r.near[0]] - r.o[0]) * r.inv[0];
-    const double tx1 = (b[r.far[0]] - r.o[0]) * r.inv[0];
-    const double ty0 = (b[r.near[1]] - r.o[1]) * r.inv[1];
-    const double ty1 = (b[r.far[1]] - r.o[1]) * r.inv[1];
-    const double tz0 = (b[r.near[2]] - r.o[2]) * r.inv[2];
-    const double tz1 = (b[r.far[2]] - r.o[2]) * r.inv[2];
-    // x > y ? x : y keeps y when x is NaN (maxsd / minsd on x86, no branch).
-    const double t0 = max_keep(tz0, max_keep(ty0, max_keep(tx0, r.zero)));
-    const double t1 = min_keep(tz1, min_keep(ty1, min_keep(tx1, t_max)));
-    *t_enter = t0;
-    return t0 <= t1 * kFarScale;
 }
 
 // --- Build ------------------------------------------------------------------------------
@@ -264,6 +251,58 @@ SplitDecision decide(std::vector<Prim>& prims, uint32_t begin, uint32_t end, uin
     return {false, mid};
 }
 
+/// A node of the binary SAH tree, before it is collapsed to four children per node.
+struct BuildNode {
+    Box bounds;
+    uint32_t left = 0, right = 0;  // interior: children (build indices)
+    uint32_t first = 0, count = 0; // leaf: triangles [first, first + count) in leaf order
+};
+
+/// Binned-SAH binary tree over prims (reordered into leaf order); node 0 is the root.
+std::vector<BuildNode> build_binary(std::vector<Prim>& prims, uint32_t* depth_reached) {
+    const uint32_t n = static_cast<uint32_t>(prims.size());
+    std::vector<BuildNode> nodes;
+    nodes.reserve(2 * size_t(n) - 1);
+    struct Task {
+        uint32_t begin, end, depth, parent;
+        bool right;
+    };
+    std::vector<Task> tasks;
+    tasks.push_back({0, n, 0, 0, false});
+    while (!tasks.empty()) {
+        const Task task = tasks.back();
+        tasks.pop_back();
+        const uint32_t index = static_cast<uint32_t>(nodes.size());
+        nodes.emplace_back();
+        if (index > 0) (task.right ? nodes[task.parent].right : nodes[task.parent].left) = index;
+        Box bounds;
+        for (uint32_t i = task.begin; i < task.end; ++i) bounds.grow(prims[i].lo, prims[i].hi);
+        const SplitDecision split = decide(prims, task.begin, task.end, task.depth, bounds);
+        nodes[index].bounds = bounds;
+        *depth_reached = std::max(*depth_reached, task.depth);
+        if (split.leaf) {
+            nodes[index].first = task.begin;
+            nodes[index].count = task.end - task.begin;
+        } else {
+            tasks.push_back({split.mid, task.end, task.depth + 1, index, true});
+            tasks.push_back({task.begin, split.mid, task.depth + 1, index, false});
+        }
+    }
+    return nodes;
+}
+
+/// The largest float <= x and the smallest float >= x.
+float float_below(double x) {
+    float f = static_cast<float>(x);
+    return static_cast<double>(f) > x ? std::nextafter(f, -std::numeric_limits<float>::infinity())
+                                      : f;
+}
+float float_above(double x) {
+    float f = static_cast<float>(x);
+    return static_cast<double>(f) < x ? std::nextafter(f, std::numeric_limits<float>::infinity())
+                                      : f;
+}
+
 } // namespace
 
 bool intersect_triangle(const Ray& ray, const Vec3& p0, const Vec3& p1, const Vec3& p2, double* t,
@@ -315,37 +354,71 @@ void Accelerator::build(const Mesh& mesh, AccelKind kind) {
     stats_.kind = kind;
 
     if (kind == AccelKind::Bvh && n > 0) {
-        const double pad = kBoxPad * scale;
-        nodes_.reserve(2 * size_t(n) - 1);
+        const std::vector<BuildNode> tree = build_binary(prims, &stats_.build_depth);
+        double radius = 0.0;
+        for (int k = 0; k < 3; ++k) {
+            const Box& b = tree[0].bounds;
+            center_[k] = 0.5 * b.lo[k] + 0.5 * b.hi[k];
+            radius = std::max(radius, std::max(b.hi[k] - center_[k], center_[k] - b.lo[k]));
+        }
+        const double pad = kBoxPad * radius + kBoxPadAbsolute * scale;
+        // Collapse: each 4-wide node takes a binary node's children and keeps opening the
+        // interior child of largest surface area until it has four [Wald08, sec. 3].
+        nodes_.reserve(tree.size() / 2 + 1);
         struct Task {
-            uint32_t begin, end, depth, parent;
-            bool right;
+            uint32_t build, depth; // a binary interior node (or the root leaf) to emit
+            uint32_t parent, lane; // where its index goes (parent == UINT32_MAX: the root)
         };
         std::vector<Task> tasks;
-        tasks.push_back({0, n, 0, 0, false});
+        tasks.push_back({0, 0, UINT32_MAX, 0});
         while (!tasks.empty()) {
             const Task task = tasks.back();
             tasks.pop_back();
             const uint32_t index = static_cast<uint32_t>(nodes_.size());
             nodes_.emplace_back();
-            if (task.right) nodes_[task.parent].index = index;
-            Box bounds;
-            for (uint32_t i = task.begin; i < task.end; ++i) bounds.grow(prims[i].lo, prims[i].hi);
-            const SplitDecision split = decide(prims, task.begin, task.end, task.depth, bounds);
-            Node& node = nodes_[index];
-            for (int k = 0; k < 3; ++k) {
-                node.bounds[k] = bounds.lo[k] - pad;
-                node.bounds[k + 3] = bounds.hi[k] + pad;
-            }
+            if (task.parent != UINT32_MAX) nodes_[task.parent].child[task.lane] = index;
             stats_.max_depth = std::max(stats_.max_depth, task.depth);
-            if (split.leaf) {
-                node.index = task.begin;
-                node.count = task.end - task.begin;
-                ++stats_.leaves;
-            } else {
-                // Left child is popped next, so it lands right after its parent.
-                tasks.push_back({split.mid, task.end, task.depth + 1, index, true});
-                tasks.push_back({task.begin, split.mid, task.depth + 1, index, false});
+            uint32_t lanes[4] = {task.build, 0, 0, 0};
+            int used = 1;
+            const BuildNode& top = tree[task.build];
+            if (top.count == 0) lanes[0] = top.left, lanes[1] = top.right, used = 2;
+            while (used < 4) {
+                int open = -1;
+                double area = -1.0;
+                for (int l = 0; l < used; ++l) {
+                    const BuildNode& b = tree[lanes[l]];
+                    if (b.count == 0 && b.bounds.half_area() > area) {
+                        area = b.bounds.half_area();
+                        open = l;
+                    }
+                }
+                if (open < 0) break;
+                const BuildNode& b = tree[lanes[open]];
+                lanes[open] = b.left;
+                lanes[used++] = b.right;
+            }
+            Node4& node = nodes_[index];
+            for (int l = 0; l < 4; ++l) {
+                for (int k = 0; k < 3; ++k) {
+                    node.bounds[k][l] = std::numeric_limits<float>::infinity();
+                    node.bounds[k + 3][l] = -std::numeric_limits<float>::infinity();
+                }
+                node.child[l] = 0;
+                node.count[l] = 0;
+            }
+            for (int l = used - 1; l >= 0; --l) {
+                const BuildNode& b = tree[lanes[l]];
+                for (int k = 0; k < 3; ++k) {
+                    nodes_[index].bounds[k][l] = float_below(b.bounds.lo[k] - center_[k] - pad);
+                    nodes_[index].bounds[k + 3][l] = float_above(b.bounds.hi[k] - center_[k] + pad);
+                }
+                if (b.count > 0) {
+                    nodes_[index].child[l] = b.first;
+                    nodes_[index].count[l] = b.count;
+                    ++stats_.leaves;
+                } else {
+                    tasks.push_back({lanes[l], task.depth + 1, index, uint32_t(l)});
+                }
             }
         }
         nodes_.shrink_to_fit();
@@ -360,7 +433,7 @@ void Accelerator::build(const Mesh& mesh, AccelKind kind) {
         triangle_id_[i] = id;
         for (int k = 0; k < 3; ++k) vertices_[3 * size_t(i) + k] = mesh.vertex(id, k);
     }
-    stats_.bytes = nodes_.size() * sizeof(Node) + vertices_.size() * sizeof(Vec3) +
+    stats_.bytes = nodes_.size() * sizeof(Node4) + vertices_.size() * sizeof(Vec3) +
                    triangle_id_.size() * sizeof(uint32_t);
 }
 
@@ -392,52 +465,88 @@ template <bool kAnyHit> bool Accelerator::traverse(const Ray& ray, Hit* hit) con
             if (test(i)) return true;
         }
     } else {
-        // Children are tested at their parent; the nearer one is visited first, the other
-        // waits on the stack with its entry distance and is skipped if a hit got closer.
+        // The ray in float, relative to the scene's centre (see the file comment).
+        float o_rel[3];
+        for (int k = 0; k < 3; ++k) o_rel[k] = static_cast<float>(r.o[k] - center_[k]);
+        const F4 ox = f4_set1(o_rel[0]);
+        const F4 oy = f4_set1(o_rel[1]);
+        const F4 oz = f4_set1(o_rel[2]);
+        const F4 ix = f4_set1(static_cast<float>(r.inv[0]));
+        const F4 iy = f4_set1(static_cast<float>(r.inv[1]));
+        const F4 iz = f4_set1(static_cast<float>(r.inv[2]));
+        const F4 zero = f4_set1(0.0f), far_scale = f4_set1(kFarScale);
+        const int nx = r.near[0], ny = r.near[1], nz = r.near[2];
+        const int fx = r.far[0], fy = r.far[1], fz = r.far[2];
+
+        // Children met by the ray wait on the stack, nearest on top, with their entry
+        // distance; one is skipped when a hit got closer than its box.
         struct Pending {
-            uint32_t node;
-            double t_enter;
+            uint32_t child, count; // count 0: a node; else a leaf's triangles
+            float t_enter;
         };
-        Pending stack[kMaxDepth];
+        Pending stack[kStackSize];
         uint32_t top = 0, current = 0;
-        const Node* nodes = nodes_.data();
-        double t_root;
-        bool visit = box_hit(nodes[0].bounds, r, best_t, &t_root);
-        while (visit) {
-            const Node& node = nodes[current];
-            if (node.count == 0) {
-                uint32_t near = current + 1, far = node.index;
-                double t_near, t_far;
-                const bool hit_near = box_hit(nodes[near].bounds, r, best_t, &t_near);
-                const bool hit_far = box_hit(nodes[far].bounds, r, best_t, &t_far);
-                if (hit_near && hit_far) {
-                    if (t_far < t_near) {
-                        std::swap(near, far);
-                        std::swap(t_near, t_far);
+        for (;;) {
+            const Node4& node = nodes_[current];
+            const float t_max = static_cast<float>(best_t);
+            // Slab test of the four boxes [KayKajiya86]; max_keep / min_keep ignore NaN.
+            const F4 tx0 = (f4_load(node.bounds[nx]) - ox) * ix;
+            const F4 tx1 = (f4_load(node.bounds[fx]) - ox) * ix;
+            const F4 ty0 = (f4_load(node.bounds[ny]) - oy) * iy;
+            const F4 ty1 = (f4_load(node.bounds[fy]) - oy) * iy;
+            const F4 tz0 = (f4_load(node.bounds[nz]) - oz) * iz;
+            const F4 tz1 = (f4_load(node.bounds[fz]) - oz) * iz;
+            const F4 t0 = f4_max_keep(tz0, f4_max_keep(ty0, f4_max_keep(tx0, zero)));
+            const F4 t1 = f4_min_keep(tz1, f4_min_keep(ty1, f4_min_keep(tx1, f4_set1(t_max))));
+            int mask = f4_le_mask(t0, t1 * far_scale);
+            alignas(16) float t_enter[4];
+            f4_store(t_enter, t0);
+            // One interior child met: go straight down.
+            if ((mask & (mask - 1)) == 0 && mask != 0) {
+                const int l = __builtin_ctz(static_cast<unsigned>(mask));
+                if (node.count[l] == 0) {
+                    current = node.child[l];
+                    continue;
+                }
+            }
+            // Push the boxes met, farthest first (closest hit); an any-hit query tests the
+            // leaves met at once and pushes only the nodes.
+            const uint32_t base = top;
+            while (mask != 0) {
+                const int l = __builtin_ctz(static_cast<unsigned>(mask));
+                mask &= mask - 1;
+                const Pending p{node.child[l], node.count[l], t_enter[l]};
+                uint32_t at = top++;
+                if (kAnyHit) {
+                    if (p.count == 0) {
+                        stack[at] = p;
+                        continue;
                     }
-                    stack[top++] = {far, t_far};
-                    current = near;
+                    --top;
+                    for (uint32_t i = p.child; i < p.child + p.count; ++i) {
+                        if (test(i)) return true;
+                    }
                     continue;
                 }
-                if (hit_near | hit_far) {
-                    current = hit_near ? near : far;
-                    continue;
+                for (; at > base && stack[at - 1].t_enter < p.t_enter; --at)
+                    stack[at] = stack[at - 1];
+                stack[at] = p;
+            }
+            bool descend = false;
+            while (top > 0) {
+                const Pending p = stack[--top];
+                if (!kAnyHit && !(p.t_enter <= static_cast<float>(best_t) * kFarScale)) continue;
+                if (p.count == 0) {
+                    current = p.child;
+                    descend = true;
+                    break;
                 }
-            } else {
-                const uint32_t end = node.index + node.count;
-                for (uint32_t i = node.index; i < end; ++i) {
+                const uint32_t end = p.child + p.count;
+                for (uint32_t i = p.child; i < end; ++i) {
                     if (test(i)) return true;
                 }
             }
-            visit = false;
-            while (top > 0) {
-                const Pending& p = stack[--top];
-                if (p.t_enter <= best_t * kFarScale) {
-                    current = p.node;
-                    visit = true;
-                    break;
-                }
-            }
+            if (!descend) break;
         }
     }
     if (kAnyHit || !found) return false;

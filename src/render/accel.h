@@ -1,4 +1,5 @@
-// Ray-scene intersection: a bounding volume hierarchy built with binned SAH [Wald07], or a
+// Ray-scene intersection: a bounding volume hierarchy built with binned SAH [Wald07] and
+// collapsed to four children per node, whose boxes are tested four at a time [Wald08], or a
 // brute-force loop when the scene is too small for a BVH to pay, both on the watertight
 // ray-triangle test of [Woop13].
 #pragma once
@@ -20,8 +21,11 @@ enum class AccelKind { Auto, BruteForce, Bvh };
 
 struct AccelStats {
     AccelKind kind = AccelKind::BruteForce; ///< what was built (never Auto)
-    uint32_t nodes = 0, leaves = 0, max_depth = 0;
-    uint64_t bytes = 0; ///< memory of the structure
+    uint32_t nodes = 0;                     ///< 4-wide nodes
+    uint32_t leaves = 0;                    ///< leaves (runs of triangles)
+    uint32_t max_depth = 0;                 ///< of the 4-wide tree (root at 0)
+    uint32_t build_depth = 0; ///< of the binary SAH tree it was collapsed from (<= 64)
+    uint64_t bytes = 0;       ///< memory of the structure
 };
 
 class Accelerator {
@@ -43,21 +47,21 @@ class Accelerator {
     const AccelStats& stats() const { return stats_; }
 
   private:
-    /// Flattened depth-first BVH node (64 bytes): the left child of an interior node is the
-    /// next node, the right child is at `index`. Traversal tests both children's boxes at
-    /// their parent and visits the nearer first.
-    struct Node {
-        double bounds[6];   ///< lo.x, lo.y, lo.z, hi.x, hi.y, hi.z, padded outwards
-        uint32_t index = 0; ///< interior: right child; leaf: first triangle (leaf order)
-        uint32_t count = 0; ///< triangles of a leaf; 0 for an interior node
-        uint32_t unused[2] = {0, 0};
+    /// A 4-wide BVH node (128 bytes, two cache lines): its children's boxes as four lanes
+    /// of each bound, in float, rounded and padded outwards (see accel.cpp). Unused lanes
+    /// hold empty boxes (lo = +inf, hi = -inf), which no ray meets.
+    struct alignas(16) Node4 {
+        float bounds[6][4]; ///< lo.x, lo.y, lo.z, hi.x, hi.y, hi.z of each child
+        uint32_t child[4];  ///< interior child: node index; leaf: first triangle (leaf order)
+        uint32_t count[4];  ///< triangles of a leaf child; 0 for an interior child
     };
     template <bool kAnyHit> bool traverse(const Ray& ray, Hit* hit) const;
 
     AccelStats stats_;
-    std::vector<Node> nodes_;           // empty for brute force
-    std::vector<Vec3> vertices_;        // p0, p1, p2 of each triangle, in leaf order
-    std::vector<uint32_t> triangle_id_; // leaf order -> mesh triangle id
+    double center_[3] = {0.0, 0.0, 0.0}; // boxes and ray origins are relative to it
+    std::vector<Node4> nodes_;           // empty for brute force
+    std::vector<Vec3> vertices_;         // p0, p1, p2 of each triangle, in leaf order
+    std::vector<uint32_t> triangle_id_;  // leaf order -> mesh triangle id
 };
 
 } // namespace mcp

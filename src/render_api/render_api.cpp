@@ -326,9 +326,11 @@ Json scene_to_json(const Loaded& l) {
                 {"textures", sc.textures.size()},
                 {"accel",
                  {{"kind", a.kind == AccelKind::Bvh ? "bvh" : "brute_force"},
+                  {"width", 4},
                   {"nodes", a.nodes},
                   {"leaves", a.leaves},
                   {"max_depth", a.max_depth},
+                  {"build_depth", a.build_depth},
                   {"bytes", a.bytes}}},
                 {"warnings", warnings}};
 }
