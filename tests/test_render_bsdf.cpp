@@ -749,3 +749,59 @@ TEST(RenderBsdf, FiniteEverywhere) {
     }
     EXPECT_GT(valid, n / 2);
 }
+
+// The Lambertian shortcut a scene of diffuse materials uses gives the general BRDF's numbers,
+// bit for bit, including below the surface, at grazing angles and for black and out-of-range
+// colours; and it is taken only for metallic 0 and specular 0.
+TEST(RenderBsdf, LambertShortcutEqualsTheGeneralBrdf) {
+    Pcg32 rng(97u, 3u);
+    const Vec3 colours[] = {Vec3(0.8, 0.5, 0.2), Vec3(0.0), Vec3(1.7, -0.3, 0.4), Vec3(1e-300)};
+    int compared = 0;
+    for (const Vec3& c : colours) {
+        BsdfParams m;
+        m.base_color = c;
+        m.metallic = 0.0;
+        m.specular = 0.0;
+        m.roughness = rng.next_double();
+        ASSERT_TRUE(bsdf_is_lambertian(m));
+        for (int i = 0; i < 2000; ++i) {
+            const double z = i % 10 == 0 ? -0.3 : (i % 10 == 1 ? 1e-9 : rng.next_double());
+            const Vec3 wo = direction(z, 2.0 * kPi * rng.next_double());
+            const Vec3 wi = direction(i % 7 == 0 ? -rng.next_double() : rng.next_double(),
+                                      2.0 * kPi * rng.next_double());
+            double pdf_general = -1.0, pdf_lambert = -2.0;
+            const Vec3 f_general = bsdf_eval_pdf(m, wo, wi, &pdf_general);
+            const Vec3 f_lambert = lambert_eval_pdf(m, wo, wi, &pdf_lambert);
+            ASSERT_EQ(f_general.x, f_lambert.x);
+            ASSERT_EQ(f_general.y, f_lambert.y);
+            ASSERT_EQ(f_general.z, f_lambert.z);
+            ASSERT_EQ(pdf_general, pdf_lambert);
+            const Vec2 u = next_u(rng);
+            const BsdfSample g = bsdf_sample(m, wo, rng.next_double(), u);
+            const BsdfSample l = lambert_sample(m, wo, u);
+            // A black material's general sample may be "valid" with f = 0; both carry nothing.
+            const bool g_carries = g.valid && g.pdf > 0.0 && (g.f.x > 0 || g.f.y > 0 || g.f.z > 0);
+            const bool l_carries = l.valid && l.pdf > 0.0 && (l.f.x > 0 || l.f.y > 0 || l.f.z > 0);
+            ASSERT_EQ(g_carries, l_carries);
+            if (!g_carries) continue;
+            ++compared;
+            ASSERT_EQ(g.wi.x, l.wi.x);
+            ASSERT_EQ(g.wi.y, l.wi.y);
+            ASSERT_EQ(g.wi.z, l.wi.z);
+            ASSERT_EQ(g.f.x, l.f.x);
+            ASSERT_EQ(g.f.z, l.f.z);
+            ASSERT_EQ(g.pdf, l.pdf);
+            ASSERT_FALSE(l.delta);
+        }
+    }
+    EXPECT_GT(compared, 4000);
+    BsdfParams glossy;
+    glossy.metallic = 0.0;
+    glossy.specular = 1e-9; // a faint specular layer is not Lambertian
+    EXPECT_FALSE(bsdf_is_lambertian(glossy));
+    glossy.specular = 0.0;
+    glossy.metallic = 1e-9;
+    EXPECT_FALSE(bsdf_is_lambertian(glossy));
+    glossy.metallic = -2.0; // clamped to 0
+    EXPECT_TRUE(bsdf_is_lambertian(glossy));
+}

@@ -229,6 +229,33 @@ bool bsdf_has_delta(const BsdfParams& m) {
     return layer && roughness * roughness < kMirrorAlpha;
 }
 
+bool bsdf_is_lambertian(const BsdfParams& m) {
+    return clamp01(m.metallic) == 0.0 && clamp01(m.specular) == 0.0;
+}
+
+Vec3 lambert_eval_pdf(const BsdfParams& m, const Vec3& wo, const Vec3& wi, double* pdf) {
+    *pdf = 0.0;
+    if (!(wo.z > 0.0) || !(wi.z > 0.0)) return Vec3(0.0);
+    const Vec3 c(clamp01(m.base_color.x), clamp01(m.base_color.y), clamp01(m.base_color.z));
+    if (!(c.x > 0.0 || c.y > 0.0 || c.z > 0.0)) return Vec3(0.0); // no lobe: no density
+    *pdf = cosine_hemisphere_pdf(wi.z);
+    return c * kInvPi;
+}
+
+BsdfSample lambert_sample(const BsdfParams& m, const Vec3& wo, const Vec2& u) {
+    BsdfSample s;
+    if (!(wo.z > 0.0)) return s;
+    const Vec3 c(clamp01(m.base_color.x), clamp01(m.base_color.y), clamp01(m.base_color.z));
+    if (!(c.x > 0.0 || c.y > 0.0 || c.z > 0.0)) return s; // black: no direction carries light
+    const Vec3 wi = sample_cosine_hemisphere(u);
+    if (!(wi.z > 0.0)) return s;
+    s.wi = wi;
+    s.f = c * kInvPi;
+    s.pdf = cosine_hemisphere_pdf(wi.z);
+    s.valid = s.pdf > 0.0;
+    return s;
+}
+
 BsdfSample bsdf_sample(const BsdfParams& m, const Vec3& wo, double u_lobe, const Vec2& u) {
     BsdfSample s;
     if (!(wo.z > 0.0)) return s;

@@ -62,6 +62,16 @@ bool bsdf_has_delta(const BsdfParams& m);
 /// exactly 1 when c_diff = (1 - metallic) base is black (no diffuse lobe).
 double bsdf_specular_probability(const BsdfParams& m, const Vec3& wo);
 
+/// Is the BRDF of these parameters the pure Lambertian c / pi (metallic 0 and specular 0
+/// after clamping)? Such a material has no specular layer at all.
+bool bsdf_is_lambertian(const BsdfParams& m);
+/// The Lambertian BRDF c / pi (c = base colour clamped to [0, 1]) with the cosine density
+/// cos / pi, and its sampling: for parameters where bsdf_is_lambertian holds, the same
+/// numbers as bsdf_eval_pdf and bsdf_sample, which a scene of such materials uses without
+/// their Fresnel and GGX arithmetic (the choice number bsdf_sample would use is not needed).
+Vec3 lambert_eval_pdf(const BsdfParams& m, const Vec3& wo, const Vec3& wi, double* pdf);
+BsdfSample lambert_sample(const BsdfParams& m, const Vec3& wo, const Vec2& u);
+
 // The pieces, exposed for tests: GGX normal distribution D(h) [Walter07] (local h), Smith's
 // G1, the visible-normal density D_v(h) = G1(wo) max(0, wo.h) D(h) / wo.z [Heitz18], and
 // visible-normal sampling. wo must lie above the surface (wo.z > 0; otherwise the density is

@@ -38,6 +38,51 @@ double mis_weight(double p_this, double p_other, bool power) {
     return mcp::mis_weight(power ? kPower : kBalance, p_this, p_other);
 }
 
+/// material_at, with the texture lookup compiled in or left out (a scene without textures).
+template <bool kTextured> BsdfParams material_at_impl(const Scene& scene, const Hit& hit) {
+    const Mesh& mesh = scene.mesh;
+    BsdfParams b;
+    uint32_t mi = hit.triangle < mesh.material.size() ? mesh.material[hit.triangle] : 0;
+    if (mi >= scene.materials.size()) return b;
+    const Material& m = scene.materials[mi];
+    b.base_color = m.base_color;
+    b.metallic = m.metallic;
+    b.roughness = m.roughness;
+    b.specular = m.specular;
+    if (kTextured && m.base_color_texture >= 0 &&
+        size_t(m.base_color_texture) < scene.textures.size() && !mesh.uv.empty()) {
+        const Texture& t = scene.textures[size_t(m.base_color_texture)];
+        const auto& idx = mesh.index[hit.triangle];
+        double b0 = 1.0 - hit.b1 - hit.b2;
+        Vec2 uv = b0 * mesh.uv[idx[0]] + hit.b1 * mesh.uv[idx[1]] + hit.b2 * mesh.uv[idx[2]];
+        if (t.width > 0 && t.height > 0 && std::isfinite(uv.x) && std::isfinite(uv.y)) {
+            // Nearest texel, repeat wrapping (the glTF sampler default).
+            double fx = uv.x - std::floor(uv.x), fy = uv.y - std::floor(uv.y);
+            int x = std::min(t.width - 1, int(fx * t.width));
+            int y = std::min(t.height - 1, int(fy * t.height));
+            size_t k = (size_t(y) * size_t(t.width) + size_t(x)) * 3;
+            b.base_color *= Vec3(t.rgb[k], t.rgb[k + 1], t.rgb[k + 2]);
+        }
+    }
+    return b;
+}
+
+/// The surfaces of a scene as the integrator sees them, compiled for what the scene uses
+/// (SurfaceKernel, chosen once per render): every material Lambertian or not (no Fresnel or
+/// GGX arithmetic), textured or not (no texture lookup). Each gives the general code's
+/// numbers on the scenes it is chosen for, drawing the same random numbers.
+template <bool kLambertian, bool kTextured> struct Surfaces {
+    static BsdfParams at(const Scene& scene, const Hit& hit) {
+        return material_at_impl<kTextured>(scene, hit);
+    }
+    static Vec3 eval_pdf(const BsdfParams& m, const Vec3& wo, const Vec3& wi, double* pdf) {
+        return kLambertian ? lambert_eval_pdf(m, wo, wi, pdf) : bsdf_eval_pdf(m, wo, wi, pdf);
+    }
+    static BsdfSample sample(const BsdfParams& m, const Vec3& wo, double u_lobe, const Vec2& u) {
+        return kLambertian ? lambert_sample(m, wo, u) : bsdf_sample(m, wo, u_lobe, u);
+    }
+};
+
 /// A shading point: position, geometric normal turned towards the arriving ray, shading
 /// frame (interpolated normal on the same side), BRDF parameters and the outgoing direction
 /// in the shading frame.
@@ -49,7 +94,7 @@ struct ShadingPoint {
     uint32_t triangle = 0;
 };
 
-ShadingPoint shade(const Scene& scene, const Ray& ray, const Hit& hit) {
+template <class S> ShadingPoint shade(const Scene& scene, const Ray& ray, const Hit& hit) {
     const Mesh& mesh = scene.mesh;
     ShadingPoint sp;
     sp.triangle = hit.triangle;
@@ -73,7 +118,7 @@ ShadingPoint shade(const Scene& scene, const Ray& ray, const Hit& hit) {
     }
     sp.frame = Frame::from_normal(ns);
     sp.wo_local = sp.frame.to_local(wo);
-    sp.bsdf = material_at(scene, hit);
+    sp.bsdf = S::at(scene, hit);
     return sp;
 }
 
@@ -100,6 +145,7 @@ Ray spawn_ray(const ShadingPoint& sp, const Vec3& direction) {
 
 /// One light sample's contribution f Le cos / p, times its MIS weight against BSDF sampling
 /// when `mis` is set.
+template <class S>
 Vec3 light_sample_term(const RenderScene& rs, const LightSet& lights, LightSampling mode,
                        const ShadingPoint& sp, PixelSampler& sampler, SampleCounters& c, bool mis,
                        bool power) {
@@ -118,7 +164,7 @@ Vec3 light_sample_term(const RenderScene& rs, const LightSet& lights, LightSampl
     Vec3 wi_local = sp.frame.to_local(wi);
     if (wi_local.z <= 0.0) return Vec3(0.0);
     double bsdf_density = 0.0;
-    Vec3 f = bsdf_eval_pdf(sp.bsdf, sp.wo_local, wi_local, &bsdf_density);
+    Vec3 f = S::eval_pdf(sp.bsdf, sp.wo_local, wi_local, &bsdf_density);
     if (is_black(f)) return Vec3(0.0);
     if (!visible(rs, sp, ls.point, ls.normal, c)) return Vec3(0.0);
     double w = mis ? mis_weight(ls.pdf, bsdf_density, power) : 1.0;
@@ -145,6 +191,7 @@ DirectionResult trace_direction(const RenderScene& rs, const ShadingPoint& sp, c
 /// Direct lighting by sampling directions: wi from the uniform hemisphere, the cosine
 /// hemisphere or the BRDF, weighted f Le cos / p (times the MIS weight against light
 /// sampling when `mis` is set).
+template <class S>
 Vec3 direction_sample_term(const RenderScene& rs, const RenderEstimator& est,
                            const LightSet& lights, const ShadingPoint& sp, PixelSampler& sampler,
                            SampleCounters& c, bool mis, bool power) {
@@ -163,12 +210,13 @@ Vec3 direction_sample_term(const RenderScene& rs, const RenderEstimator& est,
             pdf = cosine_hemisphere_pdf(wi_local.z);
         }
         if (!(pdf > 0.0) || wi_local.z <= 0.0) return Vec3(0.0);
-        f = bsdf_eval(sp.bsdf, sp.wo_local, wi_local);
+        double unused_pdf;
+        f = S::eval_pdf(sp.bsdf, sp.wo_local, wi_local, &unused_pdf);
         break;
     }
     default: {
         ChoiceSample cs = sampler.get_choice_2d();
-        BsdfSample bs = bsdf_sample(sp.bsdf, sp.wo_local, cs.choice, cs.u);
+        BsdfSample bs = S::sample(sp.bsdf, sp.wo_local, cs.choice, cs.u);
         if (!bs.valid || !(bs.pdf > 0.0)) return Vec3(0.0);
         wi_local = bs.wi;
         f = bs.f;
@@ -193,6 +241,7 @@ Vec3 direction_sample_term(const RenderScene& rs, const RenderEstimator& est,
 
 /// The direct-lighting estimators: emission seen by the camera plus one estimate of the
 /// reflected direct light at the first hit.
+template <class S>
 RadianceSample direct_radiance(const RenderScene& rs, const RenderEstimator& est,
                                const Ray& camera_ray, PixelSampler& sampler, SampleCounters& c) {
     RadianceSample out;
@@ -202,18 +251,18 @@ RadianceSample direct_radiance(const RenderScene& rs, const RenderEstimator& est
     const Scene& scene = *rs.scene;
     Vec3 wo = -glm::normalize(camera_ray.direction);
     out.emitted = rs.lights_uniform.emitted(hit.triangle, wo);
-    ShadingPoint sp = shade(scene, camera_ray, hit);
+    ShadingPoint sp = shade<S>(scene, camera_ray, hit);
     if (sp.wo_local.z <= 0.0) return out;
     const LightSet& lights = rs.lights(est.light_selection);
     if (lights.empty()) return out;
     switch (est.strategy) {
     case RadianceStrategy::LightArea:
         out.reflected =
-            light_sample_term(rs, lights, LightSampling::Area, sp, sampler, c, false, false);
+            light_sample_term<S>(rs, lights, LightSampling::Area, sp, sampler, c, false, false);
         break;
     case RadianceStrategy::LightSolidAngle:
-        out.reflected =
-            light_sample_term(rs, lights, LightSampling::SolidAngle, sp, sampler, c, false, false);
+        out.reflected = light_sample_term<S>(rs, lights, LightSampling::SolidAngle, sp, sampler, c,
+                                             false, false);
         break;
     case RadianceStrategy::MisBalance:
     case RadianceStrategy::MisPower: {
@@ -221,13 +270,13 @@ RadianceSample direct_radiance(const RenderScene& rs, const RenderEstimator& est
         // Two statements: both terms draw from the sampler, and the order in which the
         // operands of + are evaluated is unspecified (g++ and clang differ).
         Vec3 from_light =
-            light_sample_term(rs, lights, est.light_sampling, sp, sampler, c, true, power);
-        Vec3 from_bsdf = direction_sample_term(rs, est, lights, sp, sampler, c, true, power);
+            light_sample_term<S>(rs, lights, est.light_sampling, sp, sampler, c, true, power);
+        Vec3 from_bsdf = direction_sample_term<S>(rs, est, lights, sp, sampler, c, true, power);
         out.reflected = from_light + from_bsdf;
         break;
     }
     default:
-        out.reflected = direction_sample_term(rs, est, lights, sp, sampler, c, false, false);
+        out.reflected = direction_sample_term<S>(rs, est, lights, sp, sampler, c, false, false);
         break;
     }
     return out;
@@ -237,6 +286,7 @@ RadianceSample direct_radiance(const RenderScene& rs, const RenderEstimator& est
 /// sample, weighted by the power heuristic, the BSDF sample continuing the path [Veach97, 9.2;
 /// PBR4, 13.4]. Russian roulette from rr_depth on survives with probability
 /// min(0.95, max throughput component), dividing the throughput by it (unbiased).
+template <class S>
 RadianceSample path_radiance(const RenderScene& rs, const RenderEstimator& est,
                              const Ray& camera_ray, PixelSampler& sampler, SampleCounters& c) {
     const Scene& scene = *rs.scene;
@@ -266,13 +316,13 @@ RadianceSample path_radiance(const RenderScene& rs, const RenderEstimator& est,
                 L += beta * Le * w;
         }
         if (depth >= est.max_depth) break;
-        ShadingPoint sp = shade(scene, ray, hit);
+        ShadingPoint sp = shade<S>(scene, ray, hit);
         if (sp.wo_local.z <= 0.0) break;
         if (!lights.empty())
             L += beta *
-                 light_sample_term(rs, lights, est.light_sampling, sp, sampler, c, true, true);
+                 light_sample_term<S>(rs, lights, est.light_sampling, sp, sampler, c, true, true);
         ChoiceSample cs = sampler.get_choice_2d();
-        BsdfSample bs = bsdf_sample(sp.bsdf, sp.wo_local, cs.choice, cs.u);
+        BsdfSample bs = S::sample(sp.bsdf, sp.wo_local, cs.choice, cs.u);
         if (!bs.valid || !(bs.pdf > 0.0) || is_black(bs.f)) break;
         Vec3 wi = sp.frame.to_world(bs.wi);
         if (glm::dot(wi, sp.ng) <= 0.0) break;
@@ -331,39 +381,67 @@ const LightSet& RenderScene::lights(LightSelection selection) const {
 }
 
 BsdfParams material_at(const Scene& scene, const Hit& hit) {
-    const Mesh& mesh = scene.mesh;
-    BsdfParams b;
-    uint32_t mi = hit.triangle < mesh.material.size() ? mesh.material[hit.triangle] : 0;
-    if (mi >= scene.materials.size()) return b;
-    const Material& m = scene.materials[mi];
-    b.base_color = m.base_color;
-    b.metallic = m.metallic;
-    b.roughness = m.roughness;
-    b.specular = m.specular;
-    if (m.base_color_texture >= 0 && size_t(m.base_color_texture) < scene.textures.size() &&
-        !mesh.uv.empty()) {
-        const Texture& t = scene.textures[size_t(m.base_color_texture)];
-        const auto& idx = mesh.index[hit.triangle];
-        double b0 = 1.0 - hit.b1 - hit.b2;
-        Vec2 uv = b0 * mesh.uv[idx[0]] + hit.b1 * mesh.uv[idx[1]] + hit.b2 * mesh.uv[idx[2]];
-        if (t.width > 0 && t.height > 0 && std::isfinite(uv.x) && std::isfinite(uv.y)) {
-            // Nearest texel, repeat wrapping (the glTF sampler default).
-            double fx = uv.x - std::floor(uv.x), fy = uv.y - std::floor(uv.y);
-            int x = std::min(t.width - 1, int(fx * t.width));
-            int y = std::min(t.height - 1, int(fy * t.height));
-            size_t k = (size_t(y) * size_t(t.width) + size_t(x)) * 3;
-            b.base_color *= Vec3(t.rgb[k], t.rgb[k + 1], t.rgb[k + 2]);
-        }
-    }
-    return b;
+    return material_at_impl<true>(scene, hit);
 }
+
+template <SurfaceKernel K>
+RadianceSample sample_radiance_with(const RenderScene& rs, const RenderEstimator& est,
+                                    const Ray& camera_ray, PixelSampler& sampler,
+                                    SampleCounters& counters) {
+    using S =
+        Surfaces<K == SurfaceKernel::Lambertian || K == SurfaceKernel::LambertianTextured,
+                 K == SurfaceKernel::GeneralTextured || K == SurfaceKernel::LambertianTextured>;
+    if (est.strategy == RadianceStrategy::Path)
+        return path_radiance<S>(rs, est, camera_ray, sampler, counters);
+    return direct_radiance<S>(rs, est, camera_ray, sampler, counters);
+}
+template RadianceSample
+sample_radiance_with<SurfaceKernel::GeneralTextured>(const RenderScene&, const RenderEstimator&,
+                                                     const Ray&, PixelSampler&, SampleCounters&);
+template RadianceSample sample_radiance_with<SurfaceKernel::General>(const RenderScene&,
+                                                                     const RenderEstimator&,
+                                                                     const Ray&, PixelSampler&,
+                                                                     SampleCounters&);
+template RadianceSample
+sample_radiance_with<SurfaceKernel::LambertianTextured>(const RenderScene&, const RenderEstimator&,
+                                                        const Ray&, PixelSampler&, SampleCounters&);
+template RadianceSample sample_radiance_with<SurfaceKernel::Lambertian>(const RenderScene&,
+                                                                        const RenderEstimator&,
+                                                                        const Ray&, PixelSampler&,
+                                                                        SampleCounters&);
 
 RadianceSample sample_radiance(const RenderScene& rs, const RenderEstimator& est,
                                const Ray& camera_ray, PixelSampler& sampler,
                                SampleCounters& counters) {
-    if (est.strategy == RadianceStrategy::Path)
-        return path_radiance(rs, est, camera_ray, sampler, counters);
-    return direct_radiance(rs, est, camera_ray, sampler, counters);
+    return sample_radiance_with<SurfaceKernel::GeneralTextured>(rs, est, camera_ray, sampler,
+                                                                counters);
+}
+
+SurfaceKernel surface_kernel(const Scene& scene) {
+    const Mesh& mesh = scene.mesh;
+    bool lambertian = true, textured = false;
+    for (const Material& m : scene.materials) {
+        BsdfParams p;
+        p.metallic = m.metallic;
+        p.specular = m.specular;
+        lambertian = lambertian && bsdf_is_lambertian(p);
+        textured = textured || m.base_color_texture >= 0;
+    }
+    textured = textured && !scene.textures.empty() && !mesh.uv.empty();
+    // A triangle without a valid material is shaded with the default (glTF) parameters.
+    for (uint32_t mi : mesh.material) lambertian = lambertian && mi < scene.materials.size();
+    if (mesh.material.size() < mesh.triangle_count()) lambertian = false;
+    if (lambertian) return textured ? SurfaceKernel::LambertianTextured : SurfaceKernel::Lambertian;
+    return textured ? SurfaceKernel::GeneralTextured : SurfaceKernel::General;
+}
+
+const char* surface_kernel_name(SurfaceKernel k) {
+    switch (k) {
+    case SurfaceKernel::Lambertian: return "lambertian";
+    case SurfaceKernel::LambertianTextured: return "lambertian_textured";
+    case SurfaceKernel::General: return "gltf";
+    default: return "gltf_textured";
+    }
 }
 
 } // namespace mcp

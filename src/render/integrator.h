@@ -89,10 +89,24 @@ struct RadianceSample {
 };
 
 /// Radiance carried towards the camera along `camera_ray` (one sample of the estimator),
-/// drawing its random numbers from `sampler`.
+/// drawing its random numbers from `sampler`: the general integrator, for any scene.
 RadianceSample sample_radiance(const RenderScene& rs, const RenderEstimator& est,
                                const Ray& camera_ray, PixelSampler& sampler,
                                SampleCounters& counters);
+
+/// The versions of the integrator compiled for what a scene's surfaces use, so that a scene
+/// does not pay for what it leaves out: GeneralTextured is sample_radiance itself; General
+/// leaves out texture lookups; Lambertian (every material metallic 0, specular 0) leaves out
+/// the Fresnel and GGX arithmetic as well. On the scenes surface_kernel picks them for, they
+/// give sample_radiance's numbers, drawing the same random numbers.
+enum class SurfaceKernel { GeneralTextured, General, LambertianTextured, Lambertian };
+/// The narrowest kernel that serves every surface of the scene (chosen once per render).
+SurfaceKernel surface_kernel(const Scene& scene);
+const char* surface_kernel_name(SurfaceKernel k);
+template <SurfaceKernel K>
+RadianceSample sample_radiance_with(const RenderScene& rs, const RenderEstimator& est,
+                                    const Ray& camera_ray, PixelSampler& sampler,
+                                    SampleCounters& counters);
 
 /// The BRDF parameters at a hit: the material's factors times its base colour texture.
 BsdfParams material_at(const Scene& scene, const Hit& hit);

@@ -31,7 +31,9 @@ struct RowProgress {
     std::atomic<bool> stop{false}; ///< the progress callback asked to cancel
 };
 
-/// Renders rows first_row, first_row + step, ... into the image.
+/// Renders rows first_row, first_row + step, ... into the image, with the integrator compiled
+/// for the scene's surfaces (kernel K).
+template <SurfaceKernel K>
 void render_rows(const RenderScene& rs, const RenderEstimator& est, const RenderSettings& st,
                  int first_row, int step, RenderImage& image, RenderDiagnostics& diag,
                  RowProgress& progress) {
@@ -62,7 +64,7 @@ void render_rows(const RenderScene& rs, const RenderEstimator& est, const Render
                 sampler.start_sample(i);
                 Vec2 jitter = st.jitter_pixels ? sampler.get_2d() : Vec2(0.5);
                 Ray ray = ray_through(camera, x + jitter.x, y + jitter.y);
-                RadianceSample rad = sample_radiance(rs, est, ray, sampler, counters);
+                RadianceSample rad = sample_radiance_with<K>(rs, est, ray, sampler, counters);
                 Vec3 L = rad.total();
                 if (!std::isfinite(L.x) || !std::isfinite(L.y) || !std::isfinite(L.z)) {
                     ++diag.discarded_nonfinite;
@@ -149,8 +151,19 @@ RenderImage render_image(const RenderScene& rs, const RenderEstimator& est,
 #endif
     std::vector<RenderDiagnostics> diags(static_cast<size_t>(threads));
     RowProgress progress;
+    const SurfaceKernel kernel =
+        settings.specialize ? surface_kernel(*rs.scene) : SurfaceKernel::GeneralTextured;
     run_workers(threads, [&](int t) {
-        render_rows(rs, est, settings, t, threads, image, diags[size_t(t)], progress);
+        auto rows = &render_rows<SurfaceKernel::GeneralTextured>;
+        switch (kernel) {
+        case SurfaceKernel::General: rows = &render_rows<SurfaceKernel::General>; break;
+        case SurfaceKernel::LambertianTextured:
+            rows = &render_rows<SurfaceKernel::LambertianTextured>;
+            break;
+        case SurfaceKernel::Lambertian: rows = &render_rows<SurfaceKernel::Lambertian>; break;
+        default: break;
+        }
+        rows(rs, est, settings, t, threads, image, diags[size_t(t)], progress);
     });
     for (const auto& d : diags) image.diagnostics.merge(d);
     std::sort(image.diagnostics.top.begin(), image.diagnostics.top.end(), std::greater<double>());

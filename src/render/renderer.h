@@ -19,6 +19,9 @@ struct RenderSettings {
     uint64_t stream = 1; ///< keys every pixel's random stream (seed, estimator, spp, replicate)
     int threads = 1;     ///< worker threads (1 where the build has none)
     bool jitter_pixels = true; ///< false: every sample's camera ray passes through the pixel centre
+    /// true: the integrator compiled for the scene's surfaces (surface_kernel); false: the
+    /// general one, whatever the scene (tests compare the two).
+    bool specialize = true;
     const std::atomic<bool>* cancel = nullptr; ///< checked once per row
     /// Told the rows done so far (of `height`) after each row the calling thread renders, on
     /// that thread; returning false cancels. For long renders (a reference) that show progress.

@@ -324,6 +324,7 @@ Json scene_to_json(const Loaded& l) {
                 {"light_power", num(l.scene.lights_uniform.total_power())},
                 {"materials", materials},
                 {"textures", sc.textures.size()},
+                {"surface_kernel", surface_kernel_name(surface_kernel(sc))},
                 {"accel",
                  {{"kind", a.kind == AccelKind::Bvh ? "bvh" : "brute_force"},
                   {"width", 4},
