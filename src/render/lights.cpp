@@ -24,7 +24,8 @@ struct SphericalTriangle {
     double alpha = 0.0;   ///< interior angle at A, or pi minus it when obtuse
     bool obtuse = false;  ///< alpha holds pi minus the angle (kept accurate near pi)
     double sin_half_c = 0.0, cos_half_c = 1.0; ///< of half the arc length AB
-    double arc_b = 0.0;                        ///< arc length AC
+    double sin_half_b = 0.0, cos_half_b = 1.0; ///< of half the arc length AC
+    double sin_b = 0.0, cos_b = 1.0;           ///< of the arc length AC
     double omega = 0.0;                        ///< solid angle
 };
 
@@ -69,7 +70,10 @@ void fill_spherical(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& e1,
     st->obtuse = cos_term < 0.0;
     st->alpha = std::atan2(la * std::fabs(det), std::fabs(cos_term));
     half_angle(glm::length(n_ab), glm::dot(a, b), la * lb, &st->sin_half_c, &st->cos_half_c);
-    st->arc_b = std::atan2(glm::length(n_ac), glm::dot(a, c));
+    half_angle(glm::length(n_ac), glm::dot(a, c), la * glm::length(c), &st->sin_half_b,
+               &st->cos_half_b);
+    st->sin_b = 2.0 * st->sin_half_b * st->cos_half_b;
+    st->cos_b = (st->cos_half_b - st->sin_half_b) * (st->cos_half_b + st->sin_half_b);
     st->A = a / la;
     st->B = b / lb;
     st->tangent_ac = glm::normalize(glm::cross(n_ac, st->A)); // (A x C) x A = C - (A.C) A
@@ -106,14 +110,29 @@ Vec3 sample_spherical(const SphericalTriangle& st, const Vec2& u) {
                                 : std::sin(std::fmax(0.0, st.alpha - half_area));
     double num = st.cos_half_c * std::sin(half_area);
     double den = st.sin_half_c * sin_rest;
-    double arc = std::fmin(2.0 * std::atan2(num, den), st.arc_b); // |AC'|
-    Vec3 c_hat = st.A * std::cos(arc) + st.tangent_ac * std::sin(arc);
+    // |AC'| = 2 atan2(num, den) (num >= 0), clamped to |AC|. Its cosine and sine follow from
+    // the half angle's by cos 2x = (d^2 - n^2) / (d^2 + n^2), sin 2x = 2 n d / (d^2 + n^2),
+    // and the clamp compares the half angles by a cross product: no trigonometric call.
+    double cos_arc = st.cos_b, sin_arc = st.sin_b;
+    if (num * st.cos_half_b - den * st.sin_half_b < 0.0) { // |AC'| / 2 < |AC| / 2
+        const double m = std::fmax(num, std::fabs(den));
+        const double n = m > 0.0 ? num / m : 0.0, d = m > 0.0 ? den / m : 1.0;
+        const double r2 = n * n + d * d;
+        cos_arc = (d - n) * (d + n) / r2;
+        sin_arc = 2.0 * n * d / r2;
+    }
+    Vec3 c_hat = st.A * cos_arc + st.tangent_ac * sin_arc;
     double s = 0.5 * glm::length(c_hat - st.B), k = 0.5 * glm::length(c_hat + st.B);
-    double theta = 2.0 * std::atan2(std::sqrt(u.y) * s, std::sqrt((1.0 - u.y) * s * s + k * k));
+    // theta = 2 atan2(y, x), y = sqrt(u2) s, x = sqrt((1 - u2) s^2 + k^2): again by the
+    // half-angle formulas, with x^2 + y^2 = s^2 + k^2.
+    const double x2 = (1.0 - u.y) * s * s + k * k, y2 = u.y * s * s, r2 = x2 + y2;
+    if (!(r2 > 0.0)) return st.B;
+    const double cos_theta = (x2 - y2) / r2;
+    const double sin_theta = 2.0 * std::sqrt(x2 * y2) / r2;
     Vec3 t = c_hat - st.B * glm::dot(c_hat, st.B);
     double lt = glm::length(t);
     if (!(lt > 0.0)) return st.B;
-    return st.B * std::cos(theta) + t * (std::sin(theta) / lt);
+    return st.B * cos_theta + t * (sin_theta / lt);
 }
 
 /// Solid-angle density of a uniform area sample at `point` seen from ref, per unit (1/A)
