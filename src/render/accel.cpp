@@ -409,12 +409,12 @@ void Accelerator::build(const Mesh& mesh, AccelKind kind) {
             for (int l = used - 1; l >= 0; --l) {
                 const BuildNode& b = tree[lanes[l]];
                 for (int k = 0; k < 3; ++k) {
-                    nodes_[index].bounds[k][l] = float_below(b.bounds.lo[k] - center_[k] - pad);
-                    nodes_[index].bounds[k + 3][l] = float_above(b.bounds.hi[k] - center_[k] + pad);
+                    node.bounds[k][l] = float_below(b.bounds.lo[k] - center_[k] - pad);
+                    node.bounds[k + 3][l] = float_above(b.bounds.hi[k] - center_[k] + pad);
                 }
                 if (b.count > 0) {
-                    nodes_[index].child[l] = b.first;
-                    nodes_[index].count[l] = b.count;
+                    node.child[l] = b.first;
+                    node.count[l] = b.count;
                     ++stats_.leaves;
                 } else {
                     tasks.push_back({lanes[l], task.depth + 1, index, uint32_t(l)});

@@ -395,20 +395,16 @@ RadianceSample sample_radiance_with(const RenderScene& rs, const RenderEstimator
         return path_radiance<S>(rs, est, camera_ray, sampler, counters);
     return direct_radiance<S>(rs, est, camera_ray, sampler, counters);
 }
-template RadianceSample
-sample_radiance_with<SurfaceKernel::GeneralTextured>(const RenderScene&, const RenderEstimator&,
-                                                     const Ray&, PixelSampler&, SampleCounters&);
-template RadianceSample sample_radiance_with<SurfaceKernel::General>(const RenderScene&,
-                                                                     const RenderEstimator&,
-                                                                     const Ray&, PixelSampler&,
-                                                                     SampleCounters&);
-template RadianceSample
-sample_radiance_with<SurfaceKernel::LambertianTextured>(const RenderScene&, const RenderEstimator&,
-                                                        const Ray&, PixelSampler&, SampleCounters&);
-template RadianceSample sample_radiance_with<SurfaceKernel::Lambertian>(const RenderScene&,
-                                                                        const RenderEstimator&,
-                                                                        const Ray&, PixelSampler&,
-                                                                        SampleCounters&);
+
+// The four versions, compiled here (the renderer picks one per image).
+#define MCP_SAMPLE_RADIANCE_WITH(K)                                                                \
+    template RadianceSample sample_radiance_with<SurfaceKernel::K>(                                \
+        const RenderScene&, const RenderEstimator&, const Ray&, PixelSampler&, SampleCounters&);
+MCP_SAMPLE_RADIANCE_WITH(GeneralTextured)
+MCP_SAMPLE_RADIANCE_WITH(General)
+MCP_SAMPLE_RADIANCE_WITH(LambertianTextured)
+MCP_SAMPLE_RADIANCE_WITH(Lambertian)
+#undef MCP_SAMPLE_RADIANCE_WITH
 
 RadianceSample sample_radiance(const RenderScene& rs, const RenderEstimator& est,
                                const Ray& camera_ray, PixelSampler& sampler,

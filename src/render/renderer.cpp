@@ -151,18 +151,19 @@ RenderImage render_image(const RenderScene& rs, const RenderEstimator& est,
 #endif
     std::vector<RenderDiagnostics> diags(static_cast<size_t>(threads));
     RowProgress progress;
+    // The integrator version for the scene's surfaces, chosen once for the whole image.
     const SurfaceKernel kernel =
         settings.specialize ? surface_kernel(*rs.scene) : SurfaceKernel::GeneralTextured;
+    auto rows = &render_rows<SurfaceKernel::GeneralTextured>;
+    switch (kernel) {
+    case SurfaceKernel::General: rows = &render_rows<SurfaceKernel::General>; break;
+    case SurfaceKernel::LambertianTextured:
+        rows = &render_rows<SurfaceKernel::LambertianTextured>;
+        break;
+    case SurfaceKernel::Lambertian: rows = &render_rows<SurfaceKernel::Lambertian>; break;
+    default: break;
+    }
     run_workers(threads, [&](int t) {
-        auto rows = &render_rows<SurfaceKernel::GeneralTextured>;
-        switch (kernel) {
-        case SurfaceKernel::General: rows = &render_rows<SurfaceKernel::General>; break;
-        case SurfaceKernel::LambertianTextured:
-            rows = &render_rows<SurfaceKernel::LambertianTextured>;
-            break;
-        case SurfaceKernel::Lambertian: rows = &render_rows<SurfaceKernel::Lambertian>; break;
-        default: break;
-        }
         rows(rs, est, settings, t, threads, image, diags[size_t(t)], progress);
     });
     for (const auto& d : diags) image.diagnostics.merge(d);
