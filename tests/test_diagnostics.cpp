@@ -129,7 +129,8 @@ TEST(Diagnostics, EveryFlagHasTheSeverityOfWhatItSays) {
           FlagCode::ErrorBarsUnderstate, FlagCode::PixelErrorBars})
         EXPECT_EQ(default_severity(c), Severity::Error) << flag_code_name(c);
     for (FlagCode c : {FlagCode::SkewedWeights, FlagCode::LowEss, FlagCode::HeavyTail,
-                       FlagCode::LevelDrift, FlagCode::SlowConvergence})
+                       FlagCode::LevelDrift, FlagCode::SlowConvergence,
+                       FlagCode::FewPixelErrors, FlagCode::RareLargeErrors})
         EXPECT_EQ(default_severity(c), Severity::Warning) << flag_code_name(c);
     for (FlagCode c : {FlagCode::HeavyTail4, FlagCode::Float32Accumulator,
                        FlagCode::BelowReferenceNoise, FlagCode::ReferenceNoise})

@@ -2,8 +2,10 @@
 // furnaces (closed emitting enclosures), thread invariance and convergence orders.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
+#include "core/rng.h"
 #include "core/special.h"
 #include "render/render_study.h"
 #include "render_scenes.h"
@@ -230,6 +232,83 @@ TEST(RenderError, ReferenceFloorHasItsClosedForm) {
     EXPECT_EQ(fit.measure, LevelMeasure::RelativeMse);
     EXPECT_EQ(fit.levels_used, 3);
     EXPECT_NEAR(fit.order, -1.0, 1e-12);
+}
+
+// Issue 15: a level's relative MSE resting on a few (pixel, image) errors is flagged, with
+// Kish's effective number of terms (sum t)^2 / sum t^2 [Kish65]; error spread over the image
+// gives hundreds, one rare large pixel error about one.
+RenderImage noisy_image(const RenderImage& ref, double sigma, uint64_t seed) {
+    RenderImage im = ref;
+    Pcg32 rng(seed, 7);
+    for (double& v : im.rgb) {
+        // Box-Muller: independent normal errors of standard deviation sigma on every channel.
+        const double u1 = rng.next_double(), u2 = rng.next_double();
+        v += sigma * std::sqrt(-2.0 * std::log(u1)) * std::cos(6.283185307179586 * u2);
+    }
+    std::fill(im.variance.begin(), im.variance.end(), sigma * sigma);
+    return im;
+}
+
+TEST(RenderError, FewPixelErrorsAreFlaggedAndSpreadErrorsAreNot) {
+    const RenderImage ref = flat_image(16, 16, 1.0, 0.0);
+    const int reps = 4;
+    std::vector<ImageSummary> spread, rare;
+    for (int r = 0; r < reps; ++r) {
+        RenderImage im = noisy_image(ref, 0.01, uint64_t(r + 1));
+        spread.push_back(summarise_image(im, ref));
+        if (r == 2) im.rgb[3 * (5 * 16 + 9) + 1] += 2.0; // pixel (9, 5), 200 sigma in green
+        rare.push_back(summarise_image(im, ref));
+    }
+    // Independent normal errors on three channels: a pixel's term is sigma^2 chi^2_3, whose
+    // Kish ratio E[t]^2 / E[t^2] is 9 / 15, so about 0.6 x 1024 terms; half of that allows a
+    // spread of the sample second moment far beyond its standard error (about 4%).
+    ErrorConcentration c;
+    LevelStats l = render_level_stats(spread, ref, &c);
+    EXPECT_GT(c.effective_terms, 0.5 * 0.6 * 16 * 16 * reps);
+    EXPECT_LT(c.effective_terms, 1.5 * 0.6 * 16 * 16 * reps);
+    EXPECT_TRUE(render_level_flags(l, c, 0.0).empty());
+    // One pixel 200 sigma off carries 4e4 sigma^2 of a total of about 3 x 1024 sigma^2: one
+    // effective term (1.17 for these totals), flagged, located, and the median image is the
+    // noise's, not the event's.
+    l = render_level_stats(rare, ref, &c);
+    EXPECT_LT(c.effective_terms, 1.3);
+    EXPECT_GT(c.effective_terms, 1.0);
+    EXPECT_EQ(c.worst_image, 2);
+    EXPECT_EQ(c.worst_x, 9);
+    EXPECT_EQ(c.worst_y, 5);
+    EXPECT_GT(c.worst_share, 0.9);
+    EXPECT_LT(c.median_rel_mse, 1.5 * 0.01 * 0.01 / 1.01); // sigma^2 / (R^2 + eps) per channel
+    EXPECT_GT(l.variance, 10.0 * c.median_rel_mse);
+    std::vector<Flag> flags = render_level_flags(l, c, 0.0);
+    ASSERT_EQ(flags.size(), 1u);
+    EXPECT_EQ(flags[0].code, FlagCode::FewPixelErrors);
+    EXPECT_EQ(flags[0].n, l.n);
+    // Exactly two equal pixel errors and nothing else: two effective terms.
+    std::vector<ImageSummary> two;
+    for (int r = 0; r < reps; ++r) {
+        RenderImage im = ref;
+        if (r < 2) im.rgb[3 * size_t(r)] += 0.5;
+        two.push_back(summarise_image(im, ref));
+    }
+    render_level_stats(two, ref, &c);
+    EXPECT_NEAR(c.effective_terms, 2.0, 1e-12);
+    // The study flag counts such levels and names the most concentrated one.
+    RenderEstimatorStudy s;
+    s.levels = {l, l};
+    s.levels[1].n = 2 * l.n;
+    ErrorConcentration spread_c;
+    render_level_stats(spread, ref, &spread_c);
+    s.concentration = {spread_c, c};
+    bool found = false;
+    for (const Flag& f : render_flags(s, 0.0))
+        if (f.code == FlagCode::RareLargeErrors) {
+            found = true;
+            EXPECT_EQ(f.count, 1u);
+            EXPECT_EQ(f.of, 2u);
+            EXPECT_EQ(f.n, 2 * l.n);
+            EXPECT_NEAR(f.value, 2.0, 1e-12);
+        }
+    EXPECT_TRUE(found);
 }
 
 } // namespace

@@ -32,6 +32,8 @@ const char* flag_code_name(FlagCode code) {
     case FlagCode::ReferenceNoise: return "reference_noise";
     case FlagCode::SlowConvergence: return "slow_convergence";
     case FlagCode::PixelErrorBars: return "pixel_error_bars";
+    case FlagCode::FewPixelErrors: return "few_pixel_errors";
+    case FlagCode::RareLargeErrors: return "rare_large_errors";
     }
     return "?";
 }
@@ -63,6 +65,8 @@ Severity default_severity(FlagCode code) {
     case FlagCode::LowEss:
     case FlagCode::HeavyTail:
     case FlagCode::LevelDrift:
+    case FlagCode::FewPixelErrors:
+    case FlagCode::RareLargeErrors:
     case FlagCode::SlowConvergence: return Severity::Warning;
     case FlagCode::HeavyTail4:
     case FlagCode::BiasDominates:

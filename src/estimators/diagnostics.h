@@ -36,6 +36,8 @@ enum class FlagCode {
     ReferenceNoise,      ///< some levels lie below the reference's noise (left out of the fit)
     SlowConvergence,     ///< relative MSE falls clearly slower than 1/spp
     PixelErrorBars,      ///< too few pixels' 95% intervals cover the reference
+    FewPixelErrors,      ///< a level's relative MSE rests on a few (pixel, image) errors
+    RareLargeErrors,     ///< some levels rest on a few pixel errors: rare large errors
 };
 
 /// The stable code of a flag in results ("no_estimate", "heavy_tail", ...).

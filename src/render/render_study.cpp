@@ -31,8 +31,11 @@ ImageError image_error(const RenderImage& image, const RenderImage& reference) {
     // [RousselleKnausZwicker11], evaluated on I / mean(R) and R / mean(R).
     double scale = reference_scale(reference);
     double sum = 0.0, sum_raw = 0.0;
+    double worst = -1.0, squares_raw = 0.0;
+    size_t worst_pixel = 0;
     uint64_t covered = 0, counted = 0;
     for (size_t p = 0; p < n; ++p) {
+        double pixel_raw = 0.0;
         for (int c = 0; c < 3; ++c) {
             size_t k = p * 3 + size_t(c);
             double d = image.rgb[k] - reference.rgb[k];
@@ -41,7 +44,7 @@ ImageError image_error(const RenderImage& image, const RenderImage& reference) {
                 double ds = d / scale, r = reference.rgb[k] / scale;
                 double vs = v_ref / scale / scale;
                 double denom = r * r + kRelEps;
-                sum_raw += ds * ds / denom;
+                pixel_raw += ds * ds / denom;
                 sum += (ds * ds - vs) / denom;
             }
             double v = image.variance[k];
@@ -50,8 +53,20 @@ ImageError image_error(const RenderImage& image, const RenderImage& reference) {
                 if (std::fabs(d) <= 1.959963984540054 * std::sqrt(v + v_ref)) ++covered;
             }
         }
+        sum_raw += pixel_raw;
+        squares_raw += pixel_raw * pixel_raw;
+        if (pixel_raw > worst) {
+            worst = pixel_raw;
+            worst_pixel = p;
+        }
     }
     double m = n ? double(3 * n) : 1.0;
+    if (scale > 0.0 && n > 0 && image.width > 0) {
+        e.worst_pixel_term = worst / m;
+        e.pixel_term_squares = squares_raw / m / m;
+        e.worst_x = int(worst_pixel % size_t(image.width));
+        e.worst_y = int(worst_pixel / size_t(image.width));
+    }
     // A black reference: relative error has no scale, the relative MSE is undefined (NaN,
     // null in JSON) rather than a triumphant 0.
     e.rel_mse = scale > 0.0 ? sum / m : NAN;
@@ -98,13 +113,25 @@ bool below_reference_noise(const LevelStats& level, double floor) {
     return std::isfinite(level.variance) && (level.variance < 0.0 || level.variance < floor);
 }
 
-std::vector<Flag> render_level_flags(const LevelStats& level, double floor) {
+bool few_error_terms(const ErrorConcentration& c) {
+    return c.effective_terms < kFewErrorTerms;
+}
+
+std::vector<Flag> render_level_flags(const LevelStats& level, const ErrorConcentration& c,
+                                     double floor) {
     std::vector<Flag> flags;
     if (below_reference_noise(level, floor)) {
         Flag f(FlagCode::BelowReferenceNoise);
         f.n = level.n;
         f.value = level.variance;
         f.threshold = floor;
+        flags.push_back(f);
+    }
+    if (few_error_terms(c)) {
+        Flag f(FlagCode::FewPixelErrors);
+        f.n = level.n;
+        f.value = c.effective_terms;
+        f.threshold = kFewErrorTerms;
         flags.push_back(f);
     }
     return flags;
@@ -120,6 +147,26 @@ std::vector<Flag> render_flags(const RenderEstimatorStudy& s, double floor) {
         f.count = below;
         f.of = s.levels.size();
         f.threshold = floor;
+        flags.push_back(f);
+    }
+    // Levels carried by a few (pixel, image) terms: the study's relative MSE is made by rare
+    // events, which the other levels may simply not have seen.
+    size_t concentrated = 0;
+    size_t worst = 0;
+    for (size_t i = 0; i < s.concentration.size() && i < s.levels.size(); ++i)
+        if (few_error_terms(s.concentration[i])) {
+            if (concentrated == 0 ||
+                s.concentration[i].effective_terms < s.concentration[worst].effective_terms)
+                worst = i;
+            ++concentrated;
+        }
+    if (concentrated > 0) {
+        Flag f(FlagCode::RareLargeErrors);
+        f.count = concentrated;
+        f.of = s.levels.size();
+        f.n = s.levels[worst].n;
+        f.value = s.concentration[worst].effective_terms;
+        f.threshold = kFewErrorTerms;
         flags.push_back(f);
     }
     const LevelStats& deepest = s.levels.back();
@@ -145,8 +192,44 @@ ImageSummary summarise_image(const RenderImage& image, const RenderImage& refere
     return ImageSummary{image_error(image, reference), image.diagnostics, image.seconds, image.spp};
 }
 
-LevelStats render_level_stats(const std::vector<ImageSummary>& images,
-                              const RenderImage& reference) {
+namespace {
+
+ErrorConcentration error_concentration(const std::vector<ImageSummary>& images) {
+    ErrorConcentration c;
+    c.images = int(images.size());
+    double total = 0.0, squares = 0.0;
+    std::vector<double> rel;
+    for (size_t r = 0; r < images.size(); ++r) {
+        const ImageError& e = images[r].error;
+        if (std::isfinite(e.rel_mse)) rel.push_back(e.rel_mse);
+        if (!std::isfinite(e.rel_mse_raw) || !std::isfinite(e.pixel_term_squares)) continue;
+        total += e.rel_mse_raw;
+        squares += e.pixel_term_squares;
+        if (c.worst_image < 0 ||
+            e.worst_pixel_term > images[size_t(c.worst_image)].error.worst_pixel_term) {
+            c.worst_image = int(r);
+            c.worst_x = e.worst_x;
+            c.worst_y = e.worst_y;
+        }
+    }
+    if (c.worst_image >= 0 && total > 0.0 && squares > 0.0) {
+        // [Kish65]: (sum t)^2 / sum t^2, each factor divided first (no overflow).
+        c.effective_terms = (total / std::sqrt(squares)) * (total / std::sqrt(squares));
+        c.worst_share = images[size_t(c.worst_image)].error.worst_pixel_term / total;
+    }
+    if (!rel.empty()) {
+        std::sort(rel.begin(), rel.end());
+        const size_t h = rel.size() / 2;
+        c.median_rel_mse = rel.size() % 2 ? rel[h] : 0.5 * (rel[h - 1] + rel[h]);
+    }
+    return c;
+}
+
+} // namespace
+
+LevelStats render_level_stats(const std::vector<ImageSummary>& images, const RenderImage& reference,
+                              ErrorConcentration* concentration) {
+    if (concentration) *concentration = error_concentration(images);
     LevelStats l;
     l.measure = LevelMeasure::RelativeMse;
     l.reps = int(images.size());
@@ -275,7 +358,9 @@ RenderStudyResult run_render_study(const RenderScene& rs,
             std::vector<ImageSummary> summaries;
             for (size_t r = 0; r < reps; ++r) summaries.push_back(images[e * reps + r].summary);
             if (reps > 0) s.preview = std::move(images[e * reps].preview);
-            s.levels.push_back(render_level_stats(summaries, reference));
+            ErrorConcentration c;
+            s.levels.push_back(render_level_stats(summaries, reference, &c));
+            s.concentration.push_back(c);
             s.fit = fit_render_convergence(s.levels, result.relative_mse_floor);
         }
         return !progress || progress(result, level);

@@ -21,6 +21,7 @@
 // (below_reference_noise), have no efficiency, and are left out of the fitted order.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -48,6 +49,12 @@ struct ImageError {
     double coverage = 0.0;    ///< share of pixels whose 95% interval covers the reference
     double mean_luminance = 0.0;
     double mean_luminance_se = 0.0;
+    /// The pixel with the largest raw term of the relative MSE (its three channels), and that
+    /// term in the units of rel_mse_raw (the image's rel_mse_raw sums every pixel's term);
+    /// the sum of the pixels' squared terms, in the same units squared.
+    double worst_pixel_term = 0.0;
+    double pixel_term_squares = 0.0;
+    int worst_x = -1, worst_y = -1;
 };
 ImageError image_error(const RenderImage& image, const RenderImage& reference);
 
@@ -62,11 +69,31 @@ double relative_mse_floor(const RenderImage& reference);
 /// Is the level's relative MSE negative or below the reference's floor?
 bool below_reference_noise(const LevelStats& level, double floor);
 
+/// How concentrated a level's relative MSE is. The level's raw relative MSE is a sum of
+/// (pixel, image) terms t; Kish's effective number of them, (sum t)^2 / sum t^2 [Kish65], is in
+/// the hundreds or more when the error is spread over an image, and a handful when a few rare
+/// events make it: a camera ray that hit a light from a dark pixel, a firefly. The level's
+/// number (and the interval from its images' spread) then rests on those few events, levels
+/// that saw none understate the error, and relative MSE can rise from one spp to the next.
+struct ErrorConcentration {
+    int images = 0;
+    double effective_terms = NAN; ///< Kish's effective number of (pixel, image) terms
+    int worst_image = -1, worst_x = -1, worst_y = -1; ///< the largest term
+    double worst_share = NAN;                         ///< its share of the level's raw sum
+    double median_rel_mse = NAN; ///< the median image's relative MSE: the typical image
+};
+
+/// A level whose relative MSE rests on fewer than kFewErrorTerms effective (pixel, image)
+/// terms (the integration studies' threshold for Kish's effective sample size, kLowEss).
+constexpr double kFewErrorTerms = kLowEss;
+bool few_error_terms(const ErrorConcentration& c);
+
 struct RenderEstimatorStudy {
     RenderEstimator estimator;
     std::vector<LevelStats> levels; ///< n = spp; see render_level_stats for the fields' meaning
-    ConvergenceFit fit;             ///< of relative MSE against spp
-    RenderImage preview;            ///< replicate 0 at the largest spp rendered
+    std::vector<ErrorConcentration> concentration; ///< one per level
+    ConvergenceFit fit;                            ///< of relative MSE against spp
+    RenderImage preview;                           ///< replicate 0 at the largest spp rendered
 };
 
 struct RenderStudyResult {
@@ -83,10 +110,12 @@ struct RenderStudyResult {
 /// reference_noise (levels below the reference's floor: count, of), the tail flags of the
 /// deepest level, slow_convergence (fitted order above -1 by more than 3 standard errors and
 /// above -0.8), pixel_error_bars (under 85% of the pixels' own 95% intervals cover the
-/// reference at the deepest spp, spp >= 16).
+/// reference at the deepest spp, spp >= 16), rare_large_errors (levels whose relative MSE rests
+/// on a few (pixel, image) terms: count, of; the most concentrated level's n and terms).
 std::vector<Flag> render_flags(const RenderEstimatorStudy& s, double floor);
-/// below_reference_noise for one level, or nothing.
-std::vector<Flag> render_level_flags(const LevelStats& level, double floor);
+/// below_reference_noise and few_pixel_errors for one level, or nothing.
+std::vector<Flag> render_level_flags(const LevelStats& level, const ErrorConcentration& c,
+                                     double floor);
 
 /// Summarises R replicate images of one level in the integration studies' terms:
 ///   variance, mse  relative MSE against the reference (mean over replicates), with a 95%
@@ -109,8 +138,9 @@ struct ImageSummary {
 };
 ImageSummary summarise_image(const RenderImage& image, const RenderImage& reference);
 
-LevelStats render_level_stats(const std::vector<ImageSummary>& images,
-                              const RenderImage& reference);
+/// With `concentration`, also where the level's relative MSE comes from.
+LevelStats render_level_stats(const std::vector<ImageSummary>& images, const RenderImage& reference,
+                              ErrorConcentration* concentration = nullptr);
 
 /// Fitted order of relative MSE against spp (fit_power_law, measure RelativeMse): weights from
 /// each level's replicate spread, the standard error inflated by the residuals. Levels below

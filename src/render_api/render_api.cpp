@@ -53,6 +53,12 @@ Json estimator_to_json(const RenderEstimator& e) {
     return j;
 }
 
+/// The error concentration of level i (a default, flagless one if the study has none).
+const ErrorConcentration& concentration_of(const RenderEstimatorStudy& s, size_t i) {
+    static const ErrorConcentration none;
+    return i < s.concentration.size() ? s.concentration[i] : none;
+}
+
 /// Warnings about an estimator over the whole study (the levels carry their own): the
 /// render flags of the core (render_study.h), worded.
 Json render_warnings(const RenderEstimatorStudy& s, double floor) {
@@ -81,6 +87,19 @@ Json render_warnings(const RenderEstimatorStudy& s, double floor) {
                                     ", slower than 1/spp: infinite variance, bias against the "
                                     "reference, or a reference too noisy for this spp"));
             break;
+        case FlagCode::RareLargeErrors:
+            w.push_back(flag_warning(
+                f, "in " + std::to_string(f.count) + " of " + std::to_string(f.of) +
+                       " spp level(s) the relative MSE rests on fewer than " +
+                       fmt("%.0f", f.threshold) + " (pixel, image) errors (" +
+                       fmt("%.1f", f.value) + " at spp = " + std::to_string(f.n) +
+                       "): the error is made by rare large pixel errors (a camera ray that "
+                       "hits a light from a dark pixel, a firefly). Levels that saw none "
+                       "understate it, so the relative MSE need not fall with spp and the "
+                       "fitted order is unreliable; more images per spp or more pixels average "
+                       "more of them, and each level's relative_mse_median shows the typical "
+                       "image"));
+            break;
         case FlagCode::PixelErrorBars:
             w.push_back(
                 flag_warning(f, "only " + fmt("%.1f", 100.0 * f.value) +
@@ -96,20 +115,41 @@ Json render_warnings(const RenderEstimatorStudy& s, double floor) {
     return w;
 }
 
-/// A level's JSON: relative_mse (null when undefined, see render_study.h), and a flag and a
-/// warning when it lies below the reference's relative-MSE floor.
-Json render_level_to_json(const LevelStats& l, double floor) {
+/// A level's JSON: relative_mse (null when undefined, see render_study.h), its median over the
+/// images and where its largest (pixel, image) term lies, and a flag and a warning when it lies
+/// below the reference's relative-MSE floor or one pixel of one image carries most of it.
+Json render_level_to_json(const LevelStats& l, const ErrorConcentration& c, double floor) {
     Json j = level_to_json(l);
     j["relative_mse"] = num(l.variance);
-    const std::vector<Flag> flags = render_level_flags(l, floor);
-    j["below_reference_noise"] = !flags.empty();
-    for (const Flag& f : flags)
-        j["warnings"].push_back(flag_warning(
-            f, "relative MSE " + fmt("%.3e", f.value) + " at spp = " + std::to_string(f.n) +
-                   " is " + (f.value < 0.0 ? "negative" : "below") +
-                   " the reference's own noise (relative-MSE floor " + fmt("%.3e", f.threshold) +
-                   "): it measures the reference, not the estimator; use a reference with more "
-                   "spp"));
+    j["relative_mse_median"] = num(c.median_rel_mse);
+    j["error_concentration"] = Json{{"effective_terms", num(c.effective_terms)},
+                                    {"worst_image", c.worst_image},
+                                    {"worst_x", c.worst_x},
+                                    {"worst_y", c.worst_y},
+                                    {"worst_share", num(c.worst_share)}};
+    j["below_reference_noise"] = false;
+    for (const Flag& f : render_level_flags(l, c, floor)) {
+        if (f.code == FlagCode::BelowReferenceNoise) {
+            j["below_reference_noise"] = true;
+            j["warnings"].push_back(flag_warning(
+                f, "relative MSE " + fmt("%.3e", f.value) + " at spp = " + std::to_string(f.n) +
+                       " is " + (f.value < 0.0 ? "negative" : "below") +
+                       " the reference's own noise (relative-MSE floor " +
+                       fmt("%.3e", f.threshold) +
+                       "): it measures the reference, not the estimator; use a reference with "
+                       "more spp"));
+        } else if (f.code == FlagCode::FewPixelErrors) {
+            j["warnings"].push_back(flag_warning(
+                f, "the relative MSE at spp = " + std::to_string(f.n) + " rests on about " +
+                       fmt("%.1f", f.value) + " (pixel, image) errors: pixel (" +
+                       std::to_string(c.worst_x) + ", " + std::to_string(c.worst_y) +
+                       ") of image " + std::to_string(c.worst_image + 1) + " of " +
+                       std::to_string(c.images) + " alone carries " +
+                       fmt("%.0f", 100.0 * c.worst_share) +
+                       "% (the median image's relative MSE is " + fmt("%.3e", c.median_rel_mse) +
+                       "): this level's number and interval rest on rare events"));
+        }
+    }
     return j;
 }
 
@@ -354,10 +394,11 @@ Json estimator_study_to_json(const RenderEstimatorStudy& s, bool previews, doubl
     j["warnings"] = render_warnings(s, floor);
     if (all_levels) {
         Json levels = Json::array();
-        for (const LevelStats& l : s.levels) levels.push_back(render_level_to_json(l, floor));
+        for (size_t i = 0; i < s.levels.size(); ++i)
+            levels.push_back(render_level_to_json(s.levels[i], concentration_of(s, i), floor));
         j["levels"] = levels;
     } else if (level < s.levels.size()) {
-        j["level"] = render_level_to_json(s.levels[level], floor);
+        j["level"] = render_level_to_json(s.levels[level], concentration_of(s, level), floor);
     }
     j["fit"] = fit_to_json(s.fit);
     const RenderDiagnostics& d = s.preview.diagnostics;

@@ -485,6 +485,8 @@ export const FLAG_TITLES = Object.freeze({
   reference_noise: 'The reference is noisy',
   slow_convergence: 'Slower convergence than an unbiased estimator\'s',
   pixel_error_bars: 'The pixels\' error bars cover too rarely',
+  few_pixel_errors: 'A few pixel errors make this level\'s error: it rests on rare events',
+  rare_large_errors: 'Rare large pixel errors make the error: levels that missed them understate it',
   tolerance_not_met: 'The requested accuracy was not reached',
 });
 
