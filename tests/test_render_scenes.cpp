@@ -3,6 +3,8 @@
 // than the worse of its parts, and bad render scene files get clear errors.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -465,6 +467,118 @@ Call study_text(const json& scene, json options) {
     if (out) c.result = json::parse(out);
     mcp_free(out);
     return c;
+}
+
+Call merge_text(const json& parts) {
+    char* out = nullptr;
+    Call c;
+    c.status = mcp_render_study_merge(parts.dump().c_str(), &out);
+    if (c.status != MCP_OK) c.error = mcp_last_error();
+    if (out) c.result = json::parse(out);
+    mcp_free(out);
+    return c;
+}
+
+// A study split over processes (the page's workers) by replicate: its parts, merged, are the
+// whole study, every level's numbers, the fit and the warnings bit for bit; only seconds (and
+// what divides by them) are each run's own. Parts that do not belong together are refused.
+TEST(RenderSplit, PartsMergeToTheWholeStudy) {
+    const json options{{"base_dir", kScenes},
+                       {"width", 16},
+                       {"height", 12},
+                       {"spp_min", 1},
+                       {"spp_max", 8},
+                       {"reps", 6},
+                       {"seed", 5},
+                       {"estimators", {"light_solid_angle", "bsdf"}},
+                       {"reference", {{"spp", 64}}}};
+    const std::string scene = read(kScenes + "/cornell_box.json");
+    auto run = [&](json o) {
+        char* out = nullptr;
+        Call c;
+        c.status = mcp_render_study_run(scene.c_str(), o.dump().c_str(), nullptr, nullptr, &out);
+        if (c.status != MCP_OK) c.error = mcp_last_error();
+        if (out) c.result = json::parse(out);
+        mcp_free(out);
+        return c;
+    };
+    const Call whole = run(options);
+    ASSERT_EQ(whole.status, MCP_OK) << whole.error;
+    EXPECT_FALSE(whole.result.contains("part"));
+    EXPECT_FALSE(whole.result["estimators"][0]["levels"][0].contains("images"));
+    const char* const kTimed[] = {"time_mean_s",        "time_std_s",   "time_median_s",
+                                  "time_median_ci95_s", "time_total_s", "efficiency"};
+    for (int k : {3, 4}) {
+        json parts = json::array();
+        for (int i = 0; i < k; ++i) {
+            json o = options;
+            o["part"] = i;
+            o["parts"] = k;
+            Call c = run(o);
+            ASSERT_EQ(c.status, MCP_OK) << c.error;
+            ASSERT_EQ(c.result["part"], (json{{"index", i}, {"of", k}}));
+            // replicates i, i + k, ... of every level
+            const json& images = c.result["estimators"][0]["levels"][0]["images"];
+            ASSERT_EQ(images.size(), size_t((6 - i + k - 1) / k));
+            EXPECT_EQ(images[0]["replicate"], i);
+            parts.push_back(c.result);
+        }
+        std::reverse(parts.begin(), parts.end()); // the order the parts come in is free
+        const Call merged = merge_text(json{{"parts", parts}});
+        ASSERT_EQ(merged.status, MCP_OK) << merged.error;
+        ASSERT_EQ(merged.result["estimators"].size(), whole.result["estimators"].size());
+        for (size_t e = 0; e < whole.result["estimators"].size(); ++e) {
+            json a = whole.result["estimators"][e], b = merged.result["estimators"][e];
+            EXPECT_EQ(a["fit"], b["fit"]) << k;
+            EXPECT_EQ(a["warnings"], b["warnings"]) << k;
+            ASSERT_EQ(a["levels"].size(), b["levels"].size());
+            for (size_t i = 0; i < a["levels"].size(); ++i) {
+                json la = a["levels"][i], lb = b["levels"][i];
+                for (const char* key : kTimed) {
+                    la.erase(key);
+                    lb.erase(key);
+                }
+                EXPECT_EQ(la, lb) << "parts " << k << ", estimator " << e << ", level " << i;
+            }
+        }
+        EXPECT_FALSE(merged.result.contains("part"));
+        EXPECT_EQ(merged.result["settings"]["reps"], 6);
+
+        // Refused: a part missing, a part twice, parts of different studies, not parts at all.
+        json missing = parts;
+        missing.erase(missing.begin());
+        Call bad = merge_text(json{{"parts", missing}});
+        EXPECT_EQ(bad.status, MCP_ERROR_ARGUMENT);
+        EXPECT_NE(bad.error.find("part.of"), std::string::npos) << bad.error;
+        json twice = parts;
+        twice[1] = twice[0];
+        bad = merge_text(json{{"parts", twice}});
+        EXPECT_EQ(bad.status, MCP_ERROR_ARGUMENT);
+        EXPECT_NE(bad.error.find("must be given once"), std::string::npos) << bad.error;
+        json other = parts;
+        other[0]["reference_summary"]["mean_luminance"] = 1.0;
+        bad = merge_text(json{{"parts", other}});
+        EXPECT_NE(bad.error.find("different references"), std::string::npos) << bad.error;
+        json broken = parts;
+        broken[0]["estimators"][0]["levels"][1]["images"][0]["top"] = json::array({-1.0});
+        bad = merge_text(json{{"parts", broken}});
+        EXPECT_EQ(bad.status, MCP_ERROR_ARGUMENT);
+        EXPECT_NE(bad.error.find("top[0]: expected a number >= 0"), std::string::npos) << bad.error;
+    }
+    Call bad = merge_text(json{{"parts", json::array({whole.result})}});
+    EXPECT_EQ(bad.status, MCP_ERROR_ARGUMENT);
+    EXPECT_NE(bad.error.find("not a part of a split study"), std::string::npos) << bad.error;
+    EXPECT_EQ(merge_text(json{{"parts", json::array()}}).status, MCP_ERROR_ARGUMENT);
+    EXPECT_EQ(merge_text(json::array()).status, MCP_ERROR_ARGUMENT);
+    json o = options;
+    o["parts"] = 7;
+    Call c = run(o);
+    EXPECT_EQ(c.status, MCP_ERROR_ARGUMENT);
+    EXPECT_EQ(c.error, "options.parts: must be in 1..reps = 6");
+    o["parts"] = 2;
+    o["part"] = 2;
+    c = run(o);
+    EXPECT_EQ(c.error, "options.part: must be in 0..parts - 1 = 1");
 }
 
 /// quad_light_floor with its glTF inline, edited by `edit`.

@@ -20,7 +20,7 @@ export { McplayError, Status };
 export const RENDER_WASM_FUNCTIONS = Object.freeze([
   '_malloc', '_free',
   '_mcp_version', '_mcp_last_error', '_mcp_render_study_run', '_mcp_render_study_plan', '_mcp_render_image',
-  '_mcp_render_scene_info', '_mcp_free',
+  '_mcp_render_scene_info', '_mcp_render_study_merge', '_mcp_free',
   '_mallinfo',
 ]);
 
@@ -100,7 +100,19 @@ function makeRenderCore(M) {
       [b.jsonText(scene, 'scene'), b.optionalJson(options, 'options')]);
   }
 
+  /**
+   * The parts of a study split over workers by replicate (mcp_render_study_merge): each part
+   * is runStudy's result with options {part: i, parts: K} (its levels carry their images);
+   * the merge is the whole study's result, levels, fit and warnings as one worker would give
+   * them. Parts cut short merge over the levels every part finished. Failures throw McplayError.
+   */
+  function mergeParts(parts) {
+    b.usable('mergeParts');
+    return b.callJson('mergeParts', M._mcp_render_study_merge, 'mcp_render_study_merge',
+      [b.jsonText({ parts }, 'parts')]);
+  }
+
   return Object.freeze({
-    version: b.version, sceneInfo, plan, runStudy, renderImage, heapStats: b.heapStats, dispose: b.dispose,
+    version: b.version, sceneInfo, plan, runStudy, renderImage, mergeParts, heapStats: b.heapStats, dispose: b.dispose,
   });
 }

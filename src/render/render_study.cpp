@@ -227,7 +227,20 @@ ErrorConcentration error_concentration(const std::vector<ImageSummary>& images) 
 
 } // namespace
 
+ReferenceSummary summarise_reference(const RenderImage& reference) {
+    ReferenceSummary r;
+    r.mean_luminance = mean_luminance(reference, &r.mean_luminance_se);
+    r.floor = relative_mse_floor(reference);
+    return r;
+}
+
 LevelStats render_level_stats(const std::vector<ImageSummary>& images, const RenderImage& reference,
+                              ErrorConcentration* concentration) {
+    return render_level_stats(images, summarise_reference(reference), concentration);
+}
+
+LevelStats render_level_stats(const std::vector<ImageSummary>& images,
+                              const ReferenceSummary& reference,
                               ErrorConcentration* concentration) {
     if (concentration) *concentration = error_concentration(images);
     LevelStats l;
@@ -235,8 +248,7 @@ LevelStats render_level_stats(const std::vector<ImageSummary>& images, const Ren
     l.reps = int(images.size());
     if (images.empty()) return l;
     l.n = images[0].spp;
-    double ref_se = 0.0;
-    double ref_mean = mean_luminance(reference, &ref_se);
+    const double ref_se = reference.mean_luminance_se, ref_mean = reference.mean_luminance;
     RunningMoments rel, lum;
     double coverage = 0.0, run_se = 0.0;
     RenderDiagnostics pooled;
@@ -273,10 +285,10 @@ LevelStats render_level_stats(const std::vector<ImageSummary>& images, const Ren
     l.time_mean = l.time_total / R;
     // Below the reference's noise the relative MSE measures the reference, not the estimator:
     // no efficiency (it would be arbitrarily large).
-    l.efficiency = l.variance > 0.0 && l.time_mean > 0.0 &&
-                           !below_reference_noise(l, relative_mse_floor(reference))
-                       ? 1.0 / (l.variance * l.time_mean)
-                       : NAN;
+    l.efficiency =
+        l.variance > 0.0 && l.time_mean > 0.0 && !below_reference_noise(l, reference.floor)
+            ? 1.0 / (l.variance * l.time_mean)
+            : NAN;
     l.diagnostics.nonfinite = pooled.discarded_nonfinite;
     l.diagnostics.nonzero = pooled.samples;
     l.diagnostics.max_weight_share = pooled.max_sample_share;
@@ -333,12 +345,16 @@ RenderStudyResult run_render_study(const RenderScene& rs,
     // per image are the wall time of one image as a user renders it. An image is summarised as
     // soon as it is rendered: a level keeps one image (replicate 0, the preview), not reps.
     struct Rendered {
+        bool rendered = false; ///< false: another part's replicate
         ImageSummary summary;
         RenderImage preview; ///< replicate 0 only
     };
+    const int parts = std::max(1, settings.parts);
+    const ReferenceSummary ref_summary = summarise_reference(reference);
     const std::vector<uint64_t> ladder = n_ladder(settings.spp_min, settings.spp_max);
     const size_t reps = static_cast<size_t>(settings.reps);
     auto run = [&](size_t e, uint64_t spp, int r, int) {
+        if (r % parts != settings.part) return Rendered{};
         RenderSettings rset;
         rset.width = settings.width;
         rset.height = settings.height;
@@ -347,8 +363,10 @@ RenderStudyResult run_render_study(const RenderScene& rs,
         rset.threads = result.threads_used;
         rset.jitter_pixels = settings.jitter_pixels;
         Rendered out;
+        out.rendered = true;
         RenderImage image = render_image(rs, estimators[e], rset);
         out.summary = summarise_image(image, reference);
+        out.summary.replicate = r;
         if (r == 0) out.preview = std::move(image);
         return out;
     };
@@ -356,11 +374,15 @@ RenderStudyResult run_render_study(const RenderScene& rs,
         for (size_t e = 0; e < estimators.size(); ++e) {
             RenderEstimatorStudy& s = result.estimators[e];
             std::vector<ImageSummary> summaries;
-            for (size_t r = 0; r < reps; ++r) summaries.push_back(images[e * reps + r].summary);
-            if (reps > 0) s.preview = std::move(images[e * reps].preview);
+            for (size_t r = 0; r < reps; ++r)
+                if (images[e * reps + r].rendered)
+                    summaries.push_back(images[e * reps + r].summary);
+            if (reps > 0 && images[e * reps].rendered)
+                s.preview = std::move(images[e * reps].preview);
             ErrorConcentration c;
-            s.levels.push_back(render_level_stats(summaries, reference, &c));
+            s.levels.push_back(render_level_stats(summaries, ref_summary, &c));
             s.concentration.push_back(c);
+            if (parts > 1) s.images.push_back(std::move(summaries));
             s.fit = fit_render_convergence(s.levels, result.relative_mse_floor);
         }
         return !progress || progress(result, level);

@@ -40,6 +40,11 @@ struct RenderStudySettings {
     uint64_t seed = 1;
     int threads = 0; ///< 0: all hardware threads
     bool jitter_pixels = true;
+    /// Part `part` of `parts` of a study split over processes (the page's workers): only the
+    /// replicates r with r % parts == part are rendered. Each image is the one the whole study
+    /// renders (its stream depends on r alone), so the parts' images, merged by replicate
+    /// (render_level_stats), give the whole study's levels.
+    int part = 0, parts = 1;
 };
 
 /// Error of one image against the reference.
@@ -57,6 +62,15 @@ struct ImageError {
     int worst_x = -1, worst_y = -1;
 };
 ImageError image_error(const RenderImage& image, const RenderImage& reference);
+
+/// What a level keeps of one image.
+struct ImageSummary {
+    ImageError error;
+    RenderDiagnostics diagnostics;
+    double seconds = 0.0;
+    uint64_t spp = 0;
+    int replicate = 0;
+};
 
 /// The image's mean luminance, and when `se` is given its standard error from the pixels'
 /// variances.
@@ -94,6 +108,8 @@ struct RenderEstimatorStudy {
     std::vector<ErrorConcentration> concentration; ///< one per level
     ConvergenceFit fit;                            ///< of relative MSE against spp
     RenderImage preview;                           ///< replicate 0 at the largest spp rendered
+    /// Each level's images, kept by a part of a study split over processes (for the merge).
+    std::vector<std::vector<ImageSummary>> images;
 };
 
 struct RenderStudyResult {
@@ -129,16 +145,19 @@ std::vector<Flag> render_level_flags(const LevelStats& level, const ErrorConcent
 ///   diagnostics    discarded samples (nonfinite), largest single-sample share of a pixel
 ///   tail_index     Hill's estimate on the luminance of the samples' reflected radiance, pooled
 ///                  over the image and the replicates
-/// What a level keeps of one image.
-struct ImageSummary {
-    ImageError error;
-    RenderDiagnostics diagnostics;
-    double seconds = 0.0;
-    uint64_t spp = 0;
+
+/// What a level needs of the reference: its mean luminance, that mean's standard error, and
+/// the relative-MSE floor (so that parts of a study can be merged without the image).
+struct ReferenceSummary {
+    double mean_luminance = 0.0, mean_luminance_se = 0.0, floor = 0.0;
 };
+ReferenceSummary summarise_reference(const RenderImage& reference);
 ImageSummary summarise_image(const RenderImage& image, const RenderImage& reference);
 
 /// With `concentration`, also where the level's relative MSE comes from.
+LevelStats render_level_stats(const std::vector<ImageSummary>& images,
+                              const ReferenceSummary& reference,
+                              ErrorConcentration* concentration = nullptr);
 LevelStats render_level_stats(const std::vector<ImageSummary>& images, const RenderImage& reference,
                               ErrorConcentration* concentration = nullptr);
 

@@ -28,6 +28,13 @@ extern "C" {
 int mcp_render_study_run(const char* scene_json, const char* options_json, mcp_progress_fn progress,
                          void* user, char** result_json);
 
+/* A study split over processes: each runs mcp_render_study_run with options.part = i of
+ * options.parts = K (the replicates r with r % K == i), and its result carries every level's
+ * images and "part": {"index", "of"}. parts_json is {"parts": [the K results]}; the merge is
+ * the whole study's result, levels, fit and warnings bit for bit as one process would give them
+ * (seconds are each image's own). Parts cut short merge over the levels all of them finished. */
+int mcp_render_study_merge(const char* parts_json, char** result_json);
+
 /* The study's reference image alone, obtained as a study obtains it (options.reference_data,
  * the cache, or rendered and then cached; an error for a scene whose reference is a file):
  * {"version", "kind": "render_reference", "scene", "source", "estimator", "spp", "seed",

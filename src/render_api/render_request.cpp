@@ -218,7 +218,8 @@ Made<std::shared_ptr<RenderRequest>> build_render_request(const Json& scene, con
                     {"base_dir",  "cache_dir",     "width",    "height",        "spp_min",
                      "spp_max",   "reps",          "seed",     "threads",       "estimators",
                      "reference", "jitter_pixels", "exposure", "accel",         "estimator",
-                     "spp",       "outputs",       "previews", "pixel_sampler", "reference_data"}))
+                     "spp",       "outputs",       "previews", "pixel_sampler", "reference_data",
+                     "part",      "parts"}))
         return error();
     std::string base_dir = ".", reference_data;
     if (!get_string(c, opts, "base_dir", "options", &base_dir) ||
@@ -290,6 +291,21 @@ Made<std::shared_ptr<RenderRequest>> build_render_request(const Json& scene, con
     if (!parse_settings(c, render, rp, r.get())) return error();
     const uint64_t scene_spp_max = r->settings.spp_max;
     if (!parse_settings(c, opts, "options", r.get())) return error();
+    // A part of a study split over processes (mcp_render_study_merge).
+    uint64_t part = 0, parts = 1;
+    if (!get_count(c, opts, "part", "options", &part) ||
+        !get_count(c, opts, "parts", "options", &parts))
+        return error();
+    if (parts < 1 || parts > uint64_t(r->settings.reps)) {
+        c.fail("options.parts", "must be in 1..reps = " + std::to_string(r->settings.reps));
+        return error();
+    }
+    if (part >= parts) {
+        c.fail("options.part", "must be in 0..parts - 1 = " + std::to_string(parts - 1));
+        return error();
+    }
+    r->settings.part = int(part);
+    r->settings.parts = int(parts);
 
     // Estimators: the scene's list (or the glTF's, or every direct-lighting strategy), then
     // the options'.
