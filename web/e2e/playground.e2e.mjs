@@ -625,6 +625,32 @@ test('a glTF file opened in the page renders its reference with moving progress'
   assert.deepEqual(state.estimators.map((e) => e.levels.length), [3, 3]);
 });
 
+// One estimator of a render scene uses every core: its replicates are split over the workers
+// (options.part / parts) and the service worker merges the parts; the numbers are the CLI's.
+test('one render estimator is split over the workers by replicate and merged as the CLI\'s study', async () => {
+  const settings = { nMin: 1, nMax: 8, reps: 4, seed: 2, width: 16, height: 16 };
+  await configure('quad_light_floor', ['mis_power'], settings);
+  await page.click('#run');
+  await page.waitForFunction(() => document.querySelector('#status')?.textContent.startsWith('done'), null,
+    { timeout: 60000 });
+  const cores = await page.evaluate(() => Math.min(8, navigator.hardwareConcurrency || 2));
+  const state = await page.evaluate(() => window.mcplayDebug.state());
+  assert.equal(state.run.threads, Math.min(cores, settings.reps), 'the estimator did not use every worker');
+  assert.equal(state.run.workers, 1);
+  const est = state.estimators.find((e) => e.name === 'mis_power');
+  const native = cliRender('quad_light_floor', ['mis_power'], settings).estimators[0];
+  assert.deepEqual(est.levels.map((l) => l.n), [1, 2, 4, 8]);
+  native.levels.forEach((l, i) => {
+    const got = est.levels[i].relative_mse;
+    // wasm and native share the code; their libm may differ in the last bit of a sin or cos
+    assert.ok(Math.abs(got - l.relative_mse) <= 1e-9 * Math.abs(l.relative_mse), `spp ${l.n}: page ${got} vs CLI ${l.relative_mse}`);
+  });
+  const text = await page.textContent('[data-fit="mis_power"]');
+  const shown = Number(text.match(/-?\d+\.\d{3}/)?.[0]);
+  assert.ok(Math.abs(shown - native.fit.order) <= 0.0015, `page ${shown} vs CLI ${native.fit.order}`);
+  assert.deepEqual(state.images.estimators.mis_power, { preview: true, error: true, n: 8 });
+});
+
 // A bundled render scene at its own size: the reference the site ships is used (the page
 // renders none), so the first level comes at once (timed in `make bench`, asserted here only as
 // "appears"); the study's numbers are the CLI's against the reference it renders itself.

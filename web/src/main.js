@@ -11,13 +11,16 @@
 // Render scenes (a "render" object; state.kindOf) go the same way: the workers hand them to the
 // render core, which they import only then (so a page showing integrals never downloads
 // mcplay_render_web.wasm); each run worker renders the same reference, its estimators' images
-// and their PNGs (options.previews), shown by images.js as the levels come in.
+// and their PNGs (options.previews), shown by images.js as the levels come in. With fewer
+// estimators than cores, each estimator's replicates are split over several workers
+// (series.splitRenderWork; options.part / parts), and the service worker merges the parts'
+// levels and results (MSG.MERGE, the render core's mergeParts) into what one worker would give.
 import {
   createStore, reducer, initialState, queryToState, stateToQuery, sceneDefaults, runBlocker,
   debugSnapshot, buildCustomScene, customError, parseExact, CUSTOM, WEIGHT_SAMPLES, KIND, kindOf, normalizeInfo,
   runSettings, studyOptions, urlProblems, USER_GLTF,
 } from './state.js';
-import { clockResolution, splitEstimators, partialResult, samplesCsv } from './series.js';
+import { clockResolution, splitEstimators, splitRenderWork, splitCollector, partialResult, samplesCsv } from './series.js';
 import { CoreWorker } from './client.js';
 import { MSG } from './protocol.js';
 import { initPlots, renderPlots, plotPng, hiddenEstimators } from './plot.js';
@@ -394,11 +397,15 @@ function startRun() {
     dispatch({ type: 'race/cancel', payload: { now: performance.now(), stopped: true } });
   }
   const names = s.selected.slice();
-  const groups = splitEstimators(names, CORES);
-  const workers = runnersFor(groups.length);
-  const id = s.run.id + 1;
   const kind = kindOf(s.sceneInfo);
   const settings = runSettings(s);
+  // Render studies of fewer estimators than cores split each estimator's replicates.
+  const groups = kind === KIND.RENDER
+    ? splitRenderWork(names, CORES, settings.reps)
+    : splitEstimators(names, CORES).map((estimators) => ({ estimators, part: 0, parts: 1 }));
+  const workers = runnersFor(groups.length);
+  const results = groups.filter((g) => g.part === 0).length;
+  const id = s.run.id + 1;
   const entry = kind === KIND.RENDER ? s.scenes.find((e) => e.name === s.sceneId) : null;
   const shipped = Boolean(entry && entry.reference && settings.width === entry.width && settings.height === entry.height);
   dispatch({
@@ -407,7 +414,8 @@ function startRun() {
       id,
       kind,
       referenceShipped: shipped,
-      workers: groups.length,
+      workers: results,
+      threads: groups.length,
       settings,
       order: names,
       exact: kind === KIND.RENDER ? null : s.sceneInfo.exact ?? null,
@@ -427,11 +435,57 @@ function startRun() {
   (shipped ? shippedReference(entry) : Promise.resolve(null)).then((referenceData) => {
     if (activeRun !== id) return;
     if (shipped && !referenceData) dispatch({ type: 'run/reference-unavailable', payload: { id } });
+    const collectors = new Map(); // one per estimator split by replicate
     groups.forEach((group, i) => {
-      const options = studyOptions(kind, settings, group);
+      const options = studyOptions(kind, settings, group.estimators);
       if (referenceData) options.reference_data = referenceData;
-      startPart(workers[i], id, s.scene, options);
+      if (group.parts === 1) {
+        startPart(workers[i], id, s.scene, options);
+        return;
+      }
+      const key = group.estimators.join('\n');
+      if (!collectors.has(key)) collectors.set(key, splitRun(id, group.parts));
+      startSplitPart(workers[i], id, s.scene, { ...options, part: group.part, parts: group.parts }, collectors.get(key), group.part);
     });
+  });
+}
+
+/** The collector of one estimator split over `parts` workers: merged levels and result go to
+ *  the store as an unsplit worker's would (the merges run in the service worker). */
+function splitRun(id, parts) {
+  const live = () => activeRun === id;
+  return splitCollector({
+    parts,
+    merge: (results) => service.request(MSG.MERGE, { parts: results }).then(({ result }) => result),
+    onLevel: (level) => {
+      if (live()) dispatch({ type: 'run/level', payload: { id, level } });
+    },
+    onResult: (result) => {
+      if (live()) dispatch({ type: 'run/partial', payload: { id, result, now: performance.now() } });
+    },
+    onError: (e) => {
+      if (!live()) return;
+      stopRunners();
+      dispatch({ type: 'run/error', payload: { id, message: e && e.message ? e.message : String(e) } });
+    },
+  });
+}
+
+/** One part of a split estimator's study: its lines and result go to the collector. */
+function startSplitPart(worker, id, scene, options, collector, part) {
+  worker.request(MSG.RUN, { scene: withoutStopping(scene), options, warmup: true }, (type, payload) => {
+    if (type !== MSG.LEVEL) return;
+    if (payload.level && payload.level.kind === 'render_reference') {
+      if (part === 0) dispatch({ type: 'run/level', payload: { id, level: payload.level } });
+      return;
+    }
+    collector.level(part, payload.level);
+  }).then(({ result }) => {
+    collector.result(part, result);
+  }).catch((e) => {
+    if (e && e.cancelled) return;
+    if (activeRun === id) stopRunners();
+    dispatch({ type: 'run/error', payload: { id, message: e && e.message ? e.message : String(e) } });
   });
 }
 

@@ -11,6 +11,9 @@
 //                                                     result: no level replies before it)
 //   image    {scene, options}               imaged    {image}         (render scenes only:
 //                                                                      renderCore.renderImage)
+//   merge    {parts}                        merged    {result}        (render studies split over
+//                                                                      workers by replicate:
+//                                                                      renderCore.mergeParts)
 //   format   {result, format}               formatted {text}          (core.format)
 //   samples  {scene, options, fields?}      sampled   {samples}       (core.samples; `fields`
 //                                                     keeps only those per-estimator arrays)
@@ -37,6 +40,8 @@ export const MSG = Object.freeze({
   SAMPLED: 'sampled',
   IMAGE: 'image',
   IMAGED: 'imaged',
+  MERGE: 'merge',
+  MERGED: 'merged',
   ERROR: 'error',
 });
 
@@ -48,6 +53,7 @@ export const FINAL_REPLY = Object.freeze({
   [MSG.FORMAT]: MSG.FORMATTED,
   [MSG.SAMPLES]: MSG.SAMPLED,
   [MSG.IMAGE]: MSG.IMAGED,
+  [MSG.MERGE]: MSG.MERGED,
 });
 
 /** True for a render scene (an object, or JSON text of one, with a "render" key), the test

@@ -503,7 +503,8 @@ function emptyRun(status) {
     status,                 // loading | ready | running | done | cancelled | error
     message: '',
     progress: 0,
-    workers: 0,
+    workers: 0,             // results the run waits for (one per estimator group)
+    threads: 0,             // workers it runs on (more when an estimator is split by replicate)
     startedAt: null,
     elapsed: null,
     settings: null,         // {n_min, n_max, reps, seed} (+ {width, height} for render scenes)
@@ -740,7 +741,8 @@ export function reducer(state, action) {
     case 'run/request':
       return state;
     case 'run/start': {
-      // {id, workers, settings, order, exact, sceneName, startedAt, kind?}
+      // {id, workers (results expected), threads? (workers running), settings, order, exact,
+      // sceneName, startedAt, kind?}
       const kind = p.kind === KIND.RENDER ? KIND.RENDER : KIND.INTEGRAL;
       const names = studyNames(kind, p.exact !== null && p.exact !== undefined);
       return {
@@ -752,6 +754,7 @@ export function reducer(state, action) {
           ...emptyRun('running'),
           id: p.id,
           workers: p.workers,
+          threads: p.threads || p.workers,
           startedAt: p.startedAt,
           settings: p.settings,
           exact: p.exact,
@@ -904,7 +907,7 @@ export function debugSnapshot(state) {
     kind: kindOf(state.sceneInfo),
     scenePreview: state.scenePreview ? { status: state.scenePreview.status, spp: state.scenePreview.spp, message: state.scenePreview.message } : null,
     run: {
-      id: r.id, status: r.status, progress: r.progress, workers: r.workers, settings: r.settings, exact: r.exact,
+      id: r.id, status: r.status, progress: r.progress, workers: r.workers, threads: r.threads, settings: r.settings, exact: r.exact,
       kind: r.kind, nName: r.nName, errorName: r.errorName,
       referenceShipped: r.referenceShipped, referenceRows: r.referenceRows,
       referenceSource: (r.result && r.result.scene && r.result.scene.reference && r.result.scene.reference.source) || null,

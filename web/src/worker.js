@@ -89,6 +89,10 @@ const handlers = {
     const render = await renderCore();
     reply(id, MSG.IMAGED, { image: render.renderImage(scene, options) });
   },
+  async [MSG.MERGE](core, id, { parts }) {
+    const render = await renderCore();
+    reply(id, MSG.MERGED, { result: render.mergeParts(parts) });
+  },
   [MSG.FORMAT](core, id, { result, format }) {
     reply(id, MSG.FORMATTED, { text: core.format(result, format) });
   },

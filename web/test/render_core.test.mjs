@@ -222,6 +222,24 @@ test('estimators have their own random streams: a study split over workers gives
   assert.equal(parts[1].scene.exact, all.scene.exact);
 });
 
+test('one estimator split over workers by replicate: the parts merge to the whole study', async () => {
+  const core = await getCore();
+  const options = { ...SMALL, reps: 5, estimators: ['light_area'] };
+  const whole = core.runStudy(SCENE, options);
+  const parts = [0, 1].map((part) => core.runStudy(SCENE, { ...options, part, parts: 2 }));
+  assert.deepEqual(parts.map((p) => p.part), [{ index: 0, of: 2 }, { index: 1, of: 2 }]);
+  assert.deepEqual(parts[1].estimators[0].levels[0].images.map((i) => i.replicate), [1, 3]);
+  const merged = core.mergeParts(parts);
+  const e = merged.estimators[0];
+  assert.deepEqual(withoutTimes(e.levels), withoutTimes(whole.estimators[0].levels));
+  assert.deepEqual(e.fit, whole.estimators[0].fit);
+  assert.deepEqual(e.warnings, whole.estimators[0].warnings);
+  assert.equal(merged.part, undefined);
+  assert.equal(merged.settings.threads, 2);
+  assertMcplayError(() => core.mergeParts([parts[0]]), Status.ARGUMENT, /part\.of.*is 2, but 1 parts were given/);
+  assertMcplayError(() => core.mergeParts([whole]), Status.ARGUMENT, /not a part of a split study/);
+});
+
 // The site's way to skip the reference: the native CLI renders it once (`mcplay reference`) from
 // the very scene file the page loads, and the wasm study takes it as options.reference_data. The
 // two builds must agree on the key (the glTF as JSON, the name, the size, the reference's

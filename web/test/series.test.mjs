@@ -6,7 +6,7 @@ import assert from 'node:assert/strict';
 import {
   ladder, applyLevel, progressOf, mergeResults, varianceSeries, anchorOf, referenceLines, fitSlope,
   timeSeries, clockResolution, runningEstimate, replayIsEstimator, conservativeErrorBars, CLOCK_STEPS_FITTED, zScores, histogram, normalDensity, calibrationSeries, coverageSeries, collectWarnings,
-  fixed3, fitText, fmt, decadeRange, splitEstimators, partialResult,
+  fixed3, fitText, fmt, decadeRange, splitEstimators, splitRenderWork, splitCollector, partialResult,
 } from '../src/series.js';
 
 // A level as the core reports it (docs/result-schema.md), with the fields the plots use.
@@ -272,6 +272,53 @@ test('splitting the estimators over workers: round robin, never an empty group',
   assert.deepEqual(splitEstimators([], 4), []);
   const names = ['u', 'v', 'w', 'x', 'y', 'z', 'q'];
   for (let k = 1; k <= 8; k++) assert.deepEqual(splitEstimators(names, k).flat().sort(), [...names].sort());
+});
+
+test('render work: groups of estimators while they fill the workers, else replicates split', () => {
+  assert.deepEqual(splitRenderWork(['a', 'b', 'c'], 2, 4), [
+    { estimators: ['a', 'c'], part: 0, parts: 1 }, { estimators: ['b'], part: 0, parts: 1 }]);
+  assert.deepEqual(splitRenderWork(['a'], 4, 8).map((g) => [g.estimators[0], g.part, g.parts]),
+    [['a', 0, 4], ['a', 1, 4], ['a', 2, 4], ['a', 3, 4]]);
+  // never more parts than replicates, and every estimator gets its share of the workers
+  assert.deepEqual(splitRenderWork(['a'], 8, 3).map((g) => g.part), [0, 1, 2]);
+  assert.deepEqual(splitRenderWork(['a', 'b'], 5, 4).map((g) => `${g.estimators[0]}${g.part}/${g.parts}`),
+    ['a0/2', 'a1/2', 'b0/2', 'b1/2']);
+  assert.equal(splitRenderWork(['a'], 1, 4)[0].parts, 1);
+});
+
+test('a split estimator\'s parts: whole levels in order once every part has them, then the result', async () => {
+  const merges = [];
+  const got = [];
+  // a fake merge: the levels' images concatenated, as the render core's merge gathers them
+  const merge = async (parts) => {
+    merges.push(parts);
+    await new Promise((r) => setTimeout(r, parts.length));
+    const e0 = parts[0].estimators[0];
+    return { ...parts[0], estimators: [{ ...e0, levels: e0.levels.map((l, i) => ({ n: l.n, images: parts.flatMap((p) => p.estimators[0].levels[i].images) })) }] };
+  };
+  const c = splitCollector({ parts: 2, merge, onLevel: (line) => got.push(['level', line]), onResult: (r) => got.push(['result', r]) });
+  const line = (part, index) => ({ kind: 'render', level_index: index, n: 2 ** index, part: { index: part, of: 2 },
+    estimators: [{ name: 'a', fit: {}, level: { n: 2 ** index, images: [`${part}:${index}`] } }] });
+  c.level(0, { kind: 'render_reference', rows_done: 1, rows: 8 }); // not a level
+  c.level(0, line(0, 0));
+  c.level(0, line(0, 1));
+  assert.equal(merges.length, 0); // part 1 has no level yet
+  c.level(1, line(1, 0));
+  c.level(1, line(1, 1));
+  c.result(1, { estimators: [{ name: 'a', levels: [] }], part: { index: 1, of: 2 } });
+  c.result(0, { estimators: [{ name: 'a', levels: [] }], part: { index: 0, of: 2 } });
+  await c.settled();
+  assert.deepEqual(got.map(([k, x]) => (k === 'level' ? `${k}${x.estimators[0].level.n}:${x.estimators[0].level.images}` : k)),
+    ['level1:0:0,1:0', 'level2:0:1,1:1', 'result']);
+  // each level's merge sees every level so far of every part, as a result with levels
+  assert.equal(merges[1][0].estimators[0].levels.length, 2);
+  assert.equal(merges[1][0].estimators[0].level, undefined);
+  const failed = [];
+  const bad = splitCollector({ parts: 1, merge: async () => { throw new Error('no'); }, onLevel: () => {}, onResult: () => {}, onError: (e) => failed.push(e.message) });
+  bad.level(0, line(0, 0));
+  bad.result(0, {});
+  await bad.settled();
+  assert.deepEqual(failed, ['no']);
 });
 
 test('a cancelled run exports the streamed levels as a result', () => {
