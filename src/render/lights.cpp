@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "core/special.h" // kPi
+#include "core/trig.h"
 
 namespace mcp {
 
@@ -21,8 +22,10 @@ namespace {
 struct SphericalTriangle {
     Vec3 A{0.0}, B{0.0};  ///< unit directions to vertices 0 and 1
     Vec3 tangent_ac{0.0}; ///< unit tangent at A of the arc towards C
-    double alpha = 0.0;   ///< interior angle at A, or pi minus it when obtuse
-    bool obtuse = false;  ///< alpha holds pi minus the angle (kept accurate near pi)
+    /// Sine and cosine of the interior angle alpha at A, or of pi minus it when obtuse (kept
+    /// accurate near pi).
+    double sin_alpha = 0.0, cos_alpha = 1.0;
+    bool obtuse = false;
     double sin_half_c = 0.0, cos_half_c = 1.0; ///< of half the arc length AB
     double sin_half_b = 0.0, cos_half_b = 1.0; ///< of half the arc length AC
     double sin_b = 0.0, cos_b = 1.0;           ///< of the arc length AC
@@ -68,7 +71,9 @@ void fill_spherical(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& e1,
     // since (a x e1) x (a x e2) = (a . (e1 x e2)) a. Near pi its supplement is kept instead.
     double cos_term = glm::dot(n_ab, n_ac);
     st->obtuse = cos_term < 0.0;
-    st->alpha = std::atan2(la * std::fabs(det), std::fabs(cos_term));
+    const double sa = la * std::fabs(det), ca = std::fabs(cos_term), ra = std::hypot(sa, ca);
+    st->sin_alpha = ra > 0.0 ? sa / ra : 0.0;
+    st->cos_alpha = ra > 0.0 ? ca / ra : 1.0;
     half_angle(glm::length(n_ab), glm::dot(a, b), la * lb, &st->sin_half_c, &st->cos_half_c);
     half_angle(glm::length(n_ac), glm::dot(a, c), la * glm::length(c), &st->sin_half_b,
                &st->cos_half_b);
@@ -104,11 +109,14 @@ bool setup_spherical(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& e1
 /// 1 - cos(theta) = u2 (1 - cos |BC'|), is solved as tan(theta/2) = sqrt(u2) s / sqrt((1 - u2) s^2
 /// + k^2) with s = |C' - B| / 2 and k = |C' + B| / 2 the sine and cosine of |BC'| / 2.
 Vec3 sample_spherical(const SphericalTriangle& st, const Vec2& u) {
-    double half_area = 0.5 * u.x * st.omega;
-    // sin(alpha - A'/2), clamped to alpha >= A'/2 (a sub-triangle fits in its lune).
-    double sin_rest = st.obtuse ? std::sin(std::fmin(kPi, st.alpha + half_area))
-                                : std::sin(std::fmax(0.0, st.alpha - half_area));
-    double num = st.cos_half_c * std::sin(half_area);
+    // A'/2 = u1 Omega / 2 in [0, pi], in turns for sincos_turns.
+    const SinCos h = sincos_turns(u.x * st.omega * (0.25 / kPi));
+    // sin(alpha - A'/2) by the difference formula (for an obtuse angle, stored as pi - alpha,
+    // sin(pi - alpha + A'/2) by the sum), clamped at 0 where A'/2 passes alpha: a sub-triangle
+    // fits in its lune, and past it the sine turns negative.
+    const double sin_rest = std::fmax(0.0, st.obtuse ? st.sin_alpha * h.cos + st.cos_alpha * h.sin
+                                                     : st.sin_alpha * h.cos - st.cos_alpha * h.sin);
+    double num = st.cos_half_c * h.sin;
     double den = st.sin_half_c * sin_rest;
     // |AC'| = 2 atan2(num, den) (num >= 0), clamped to |AC|. Its cosine and sine follow from
     // the half angle's by cos 2x = (d^2 - n^2) / (d^2 + n^2), sin 2x = 2 n d / (d^2 + n^2),
