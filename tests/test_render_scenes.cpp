@@ -565,6 +565,60 @@ TEST(RenderSplit, PartsMergeToTheWholeStudy) {
         EXPECT_EQ(bad.status, MCP_ERROR_ARGUMENT);
         EXPECT_NE(bad.error.find("top[0]: expected a number >= 0"), std::string::npos) << bad.error;
     }
+    // Every value of a part's JSON replaced by something else (calls from JavaScript may pass
+    // anything): an answer or a named error, never a crash. Previews are left out (size).
+    {
+        json o = options;
+        o["part"] = 0;
+        o["parts"] = 2;
+        json p0 = run(o).result, p1;
+        o["part"] = 1;
+        p1 = run(o).result;
+        for (json* p : {&p0, &p1})
+            for (json& e : (*p)["estimators"]) e["levels"] = json::array({e["levels"][0]});
+        // What the merge reads: the part, its reference summary, the estimators' names, the
+        // fields of an image (one element of its sample list), and the containers.
+        std::vector<std::string> keys = {"/part",
+                                         "/reference_summary",
+                                         "/estimators",
+                                         "/estimators/0",
+                                         "/estimators/0/levels",
+                                         "/estimators/0/levels/0",
+                                         "/estimators/0/levels/0/images",
+                                         "/estimators/0/levels/0/images/0",
+                                         "/settings"};
+        const json flat = p0.flatten();
+        for (auto it = flat.begin(); it != flat.end(); ++it) {
+            const std::string& key = it.key();
+            const bool read = key.rfind("/part", 0) == 0 ||
+                              key.rfind("/reference_summary", 0) == 0 ||
+                              key.rfind("/estimators/0/levels/0/images/0/", 0) == 0 ||
+                              key.substr(key.size() - 5) == "/name" || key == "/settings/threads" ||
+                              key == "/cancelled" || key == "/wall_time_s";
+            if (read &&
+                !(key.find("/top/") != std::string::npos && key.substr(key.size() - 2) != "/0"))
+                keys.push_back(key);
+        }
+        const json replacements[] = {nullptr, -1, 1e308, "x", json::array(), json::object(), 0};
+        int answered = 0, refused = 0;
+        for (const std::string& key : keys) {
+            for (const json& r : replacements) {
+                json f = p0;
+                f[json::json_pointer(key)] = r;
+                const Call c = merge_text(json{{"parts", {f, p1}}});
+                ASSERT_TRUE(c.status == MCP_OK || c.status == MCP_ERROR_ARGUMENT)
+                    << key << " = " << r.dump() << ": " << c.error;
+                if (c.status == MCP_OK) {
+                    ++answered;
+                } else {
+                    ++refused;
+                    EXPECT_FALSE(c.error.empty());
+                }
+            }
+        }
+        EXPECT_GT(answered, 0);
+        EXPECT_GT(refused, 0);
+    }
     Call bad = merge_text(json{{"parts", json::array({whole.result})}});
     EXPECT_EQ(bad.status, MCP_ERROR_ARGUMENT);
     EXPECT_NE(bad.error.find("not a part of a split study"), std::string::npos) << bad.error;

@@ -231,6 +231,8 @@ bool image_summary_from_json(Ctx& c, const Json& j, const std::string& path, Ima
         !read_number(c, j, "max_sample_share", path, &d.max_sample_share))
         return false;
     if (replicate >= 1024) return c.fail(sub(path, "replicate"), "must be in 0..1023");
+    if (im->spp < 1) return c.fail(sub(path, "spp"), "must be at least 1");
+    if (!(im->seconds >= 0.0)) return c.fail(sub(path, "seconds"), "expected a number >= 0");
     im->replicate = int(replicate);
     const Json* top = find(j, "top");
     if (!top || !top->is_array() || top->size() > kTopWeights)
