@@ -292,6 +292,19 @@ TEST(RenderError, FewPixelErrorsAreFlaggedAndSpreadErrorsAreNot) {
     }
     render_level_stats(two, ref, &c);
     EXPECT_NEAR(c.effective_terms, 2.0, 1e-12);
+    // A pixel error whose square is beyond the doubles (1e200 times the reference's mean):
+    // one term rules, and the other images do not hide it.
+    std::vector<ImageSummary> huge = spread;
+    {
+        RenderImage im = noisy_image(ref, 0.01, 9);
+        im.rgb[0] = 1e200;
+        huge[1] = summarise_image(im, ref);
+    }
+    ErrorConcentration hc;
+    render_level_stats(huge, ref, &hc);
+    EXPECT_EQ(hc.effective_terms, 1.0);
+    EXPECT_EQ(hc.worst_image, 1);
+    EXPECT_EQ(hc.worst_x, 0);
     // The study flag counts such levels and names the most concentrated one.
     RenderEstimatorStudy s;
     s.levels = {l, l};

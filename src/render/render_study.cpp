@@ -198,11 +198,22 @@ ErrorConcentration error_concentration(const std::vector<ImageSummary>& images) 
     ErrorConcentration c;
     c.images = int(images.size());
     double total = 0.0, squares = 0.0;
+    bool overflow = false; // a pixel's term, or its square, beyond the doubles: one term rules
     std::vector<double> rel;
     for (size_t r = 0; r < images.size(); ++r) {
         const ImageError& e = images[r].error;
         if (std::isfinite(e.rel_mse)) rel.push_back(e.rel_mse);
-        if (!std::isfinite(e.rel_mse_raw) || !std::isfinite(e.pixel_term_squares)) continue;
+        if (std::isnan(e.rel_mse_raw) || std::isnan(e.pixel_term_squares)) continue;
+        if (!std::isfinite(e.rel_mse_raw) || !std::isfinite(e.pixel_term_squares)) {
+            if (!overflow) {
+                c.worst_image = int(r);
+                c.worst_x = e.worst_x;
+                c.worst_y = e.worst_y;
+            }
+            overflow = true;
+            continue;
+        }
+        if (overflow) continue;
         total += e.rel_mse_raw;
         squares += e.pixel_term_squares;
         if (c.worst_image < 0 ||
@@ -212,7 +223,9 @@ ErrorConcentration error_concentration(const std::vector<ImageSummary>& images) 
             c.worst_y = e.worst_y;
         }
     }
-    if (c.worst_image >= 0 && total > 0.0 && squares > 0.0) {
+    if (overflow) {
+        c.effective_terms = 1.0;
+    } else if (c.worst_image >= 0 && total > 0.0 && squares > 0.0) {
         // [Kish65]: (sum t)^2 / sum t^2, each factor divided first (no overflow).
         c.effective_terms = (total / std::sqrt(squares)) * (total / std::sqrt(squares));
         c.worst_share = images[size_t(c.worst_image)].error.worst_pixel_term / total;
