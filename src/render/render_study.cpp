@@ -6,6 +6,7 @@
 
 #include "core/rng.h"
 #include "core/special.h"
+#include "core/stats.h"
 
 namespace mcp {
 
@@ -230,11 +231,7 @@ ErrorConcentration error_concentration(const std::vector<ImageSummary>& images) 
         c.effective_terms = (total / std::sqrt(squares)) * (total / std::sqrt(squares));
         c.worst_share = images[size_t(c.worst_image)].error.worst_pixel_term / total;
     }
-    if (!rel.empty()) {
-        std::sort(rel.begin(), rel.end());
-        const size_t h = rel.size() / 2;
-        c.median_rel_mse = rel.size() % 2 ? rel[h] : 0.5 * (rel[h - 1] + rel[h]);
-    }
+    if (!rel.empty()) c.median_rel_mse = median_interval(rel).median;
     return c;
 }
 
