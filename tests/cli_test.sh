@@ -159,5 +159,37 @@ fi
 check reference-no-out 2 'reference needs --out' -- reference quad_light_floor
 check reference-integral 2 'reference is for render scenes' -- reference exp_1d --out "$tmp/x.mcref"
 
+# A study split over runs (machines) by replicate: `run --part I/K --format json` writes the
+# parts, `merge` gives the whole study's numbers (seconds aside), as the table run prints.
+split=(quad_light_floor --n-min 1 --n-max 4 --reps 3 --estimators light_area,bsdf "${tiny[@]}" --quiet)
+for i in 0 1 2; do
+    check "split-part-$i" 0 '' -- run "${split[@]}" --part "$i/3" --format json --out "$tmp/part$i.json"
+done
+check merge-table 0 'fitted order: relative MSE ~ spp\^' -- merge "$tmp/part2.json" "$tmp/part0.json" "$tmp/part1.json"
+$mcplay merge "$tmp/part0.json" "$tmp/part1.json" "$tmp/part2.json" --format csv --out "$tmp/merged.csv" 2>/dev/null
+$mcplay run "${split[@]}" --format csv --out "$tmp/whole.csv" 2>/dev/null
+# the CSV without its timing columns (seconds, efficiency) must be the same
+# columns 20 and 21 of the CSV are time_mean_s and efficiency (checked on the header)
+strip_times() { cut -d, -f1-19,22- "$1"; }
+if [ "$(head -1 "$tmp/whole.csv" | cut -d, -f20-21)" != "time_mean_s,efficiency" ]; then
+    echo "FAIL merge-csv-columns: $(head -1 "$tmp/whole.csv")"; failed=$((failed + 1))
+fi
+if [ "$(strip_times "$tmp/merged.csv")" != "$(strip_times "$tmp/whole.csv")" ]; then
+    echo "FAIL merge-equals-whole: the merged parts differ from the whole study"; failed=$((failed + 1))
+else
+    passed=$((passed + 1))
+fi
+check merge-missing-part 2 'is 3, but 2 parts were given' -- merge "$tmp/part0.json" "$tmp/part1.json"
+check merge-twice 2 'must be given once' -- merge "$tmp/part0.json" "$tmp/part0.json" "$tmp/part2.json"
+check merge-not-json 2 'merged.csv: parse error at line 1' -- merge "$tmp/merged.csv"
+$mcplay run "${split[@]}" --format json --out "$tmp/whole.json" 2>/dev/null
+check merge-whole 2 'not a part of a split study' -- merge "$tmp/whole.json"
+check merge-nothing 2 'merge needs the JSON results of run --part' -- merge
+check merge-no-file 2 "cannot open '$tmp/none.json'" -- merge "$tmp/none.json"
+check part-bad 2 '--part: expected I/K' -- run quad_light_floor --part 3 --format json
+check part-table 2 '--part is for render scenes, with --format json' -- run quad_light_floor --part 0/2
+check part-integral 2 '--part is for render scenes' -- run exp_1d --part 0/2 --format json
+check part-too-many 2 'options.parts: must be in 1..reps = 3' -- run "${split[@]}" --part 0/4 --format json
+
 echo "$passed passed, $failed failed"
 [ "$failed" = 0 ]

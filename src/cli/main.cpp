@@ -38,6 +38,7 @@ const char* kUsage =
     "  mcplay run SCENE [options]\n"
     "  mcplay render SCENE [--estimator NAME] [--spp N] --out FILE [render options]\n"
     "  mcplay reference SCENE --out FILE.mcref [--width W] [--height H] [--threads T]\n"
+    "  mcplay merge PART.json... [--format F] [--out FILE]\n"
     "  mcplay --help | --version\n"
     "\n"
     "SCENE is a scene JSON file, or the name of one in the scenes directory\n"
@@ -68,6 +69,9 @@ const char* kUsage =
     "  --cache DIR | --no-cache  where high-spp references are kept\n"
     "  --pixel-sampler P    independent, stratified or sobol: every estimator's pixel\n"
     "                       sampler (run and render; sobol needs a power-of-two spp)\n"
+    "  --part I/K           render only replicates r with r % K == I (K <= reps), as JSON\n"
+    "                       for merge: K such runs (on K machines) merged give the whole\n"
+    "                       study's numbers; merge prints them like run\n"
     "  render writes one image: --out FILE (.png tone-mapped sRGB, .hdr linear Radiance,\n"
     "  .pfm linear float32),\n"
     "  --error-out FILE (false-colour relative error against the reference, PNG),\n"
@@ -403,6 +407,19 @@ void announce_long_study(const std::string& scene, const std::string& options, b
                  p["threads"].dump().c_str());
 }
 
+/// Writes a formatted result to `out_path`, or to standard output when it is empty.
+int write_output(const std::string& out_path, const char* formatted) {
+    if (out_path.empty()) {
+        std::fputs(formatted, stdout);
+        return kExitOk;
+    }
+    std::ofstream out(out_path, std::ios::binary);
+    out << formatted;
+    if (out) return kExitOk;
+    std::fprintf(stderr, "mcplay: cannot write '%s'\n", out_path.c_str());
+    return kExitRuntime;
+}
+
 int cmd_run(const std::vector<std::string>& args) {
     std::string scene_arg, format = "table", out_path, dir_arg, cache_arg;
     bool quiet = false, no_cache = false;
@@ -460,6 +477,14 @@ int cmd_run(const std::vector<std::string>& args) {
                 return usage_error("--pixel-sampler needs independent, stratified or sobol");
             std::string why;
             if (!pixel_sampler_option(v, &options, &why)) return usage_error(why);
+        } else if (a == "--part") {
+            const size_t slash = value(&v) ? v.find('/') : std::string::npos;
+            unsigned long long part = 0, parts = 0;
+            if (slash == std::string::npos || !parse_count(v.substr(0, slash), &part) ||
+                !parse_count(v.substr(slash + 1), &parts))
+                return usage_error("--part: expected I/K with whole numbers, e.g. 0/4");
+            options["part"] = part;
+            options["parts"] = parts;
         } else if (a == "--format") {
             if (!value(&v)) return usage_error("--format needs table, json or csv");
             if (v != "table" && v != "json" && v != "csv")
@@ -489,6 +514,8 @@ int cmd_run(const std::vector<std::string>& args) {
     if (!render_scene && (options.contains("width") || options.contains("height") ||
                           options.contains("pixel_sampler") || !cache_arg.empty()))
         return usage_error("--width, --height, --cache and --pixel-sampler are for render scenes");
+    if (options.contains("part") && (!render_scene || format != "json"))
+        return usage_error("--part is for render scenes, with --format json (the input of merge)");
     OutputFile out_file{out_path};
     if (!out_file.check(&error)) return usage_error("--out: " + error);
 
@@ -531,17 +558,7 @@ int cmd_run(const std::vector<std::string>& args) {
         return kExitRuntime;
     }
     mcp_free(result);
-    int rc = kExitOk;
-    if (out_path.empty()) {
-        std::fputs(formatted, stdout);
-    } else {
-        std::ofstream out(out_path, std::ios::binary);
-        out << formatted;
-        if (!out) {
-            std::fprintf(stderr, "mcplay: cannot write '%s'\n", out_path.c_str());
-            rc = kExitRuntime;
-        }
-    }
+    const int rc = write_output(out_path, formatted);
     mcp_free(formatted);
     return status == MCP_ERROR_CANCELLED ? kExitRuntime : rc;
 }
@@ -758,6 +775,76 @@ int cmd_reference(const std::vector<std::string>& args) {
     return kExitOk;
 }
 
+/// `mcplay merge PART.json...`: the parts of a render study run with --part, merged by the C API
+/// (mcp_render_study_merge) and printed as `run` prints a study.
+int cmd_merge(const std::vector<std::string>& args) {
+    std::string format = "table", out_path;
+    std::vector<std::string> files;
+    for (size_t i = 0; i < args.size(); ++i) {
+        const std::string& a = args[i];
+        if (a == "--format" || a == "--out") {
+            if (i + 1 >= args.size()) return usage_error(a + " needs a value");
+            const std::string& v = args[++i];
+            if (a == "--out") {
+                out_path = v;
+            } else if (v != "table" && v != "json" && v != "csv") {
+                return usage_error("--format: expected table, json or csv, got '" + v + "'");
+            } else {
+                format = v;
+            }
+        } else if (a == "--quiet") {
+            // nothing to report while merging
+        } else if (a.rfind("-", 0) == 0) {
+            return usage_error("unknown option '" + a + "'");
+        } else {
+            files.push_back(a);
+        }
+    }
+    if (files.empty()) return usage_error("merge needs the JSON results of run --part");
+    if (files.size() > 1024) return usage_error("merge: at most 1024 parts");
+    std::string text = "{\"parts\":[", error;
+    for (size_t i = 0; i < files.size(); ++i) {
+        std::string part;
+        if (!mcp::read_regular_file(files[i], mcp::kMaxJsonBytes / 4, &part, &error)) {
+            std::fprintf(stderr, "mcplay: %s\n", mcp::boundary::one_line(error).c_str());
+            return kExitUsage;
+        }
+        if (text.size() + part.size() > mcp::kMaxJsonBytes) {
+            std::fprintf(stderr, "mcplay: merge: the parts exceed %llu bytes together\n",
+                         static_cast<unsigned long long>(mcp::kMaxJsonBytes));
+            return kExitUsage;
+        }
+        // Each part checked on its own first, so that an error names its file.
+        const std::string why = mcp::check_json_text(part.c_str(), part.size());
+        if (!why.empty()) {
+            std::fprintf(stderr, "mcplay: %s: %s\n", mcp::boundary::one_line(files[i]).c_str(),
+                         why.c_str());
+            return kExitUsage;
+        }
+        text += (i ? "," : "") + part;
+    }
+    text += "]}";
+    OutputFile out_file{out_path};
+    if (!out_file.check(&error)) return usage_error("--out: " + error);
+    char* result = nullptr;
+    if (mcp_render_study_merge(text.c_str(), &result) != MCP_OK) {
+        std::fprintf(stderr, "mcplay: merge: %s\n", mcp_last_error());
+        out_file.discard();
+        return kExitUsage;
+    }
+    char* formatted = nullptr;
+    const int status = mcp_result_format(result, format.c_str(), &formatted);
+    mcp_free(result);
+    if (status != MCP_OK) {
+        std::fprintf(stderr, "mcplay: %s\n", mcp_last_error());
+        out_file.discard();
+        return kExitRuntime;
+    }
+    const int rc = write_output(out_path, formatted);
+    mcp_free(formatted);
+    return rc;
+}
+
 } // namespace
 
 int main(int argc, char** argv) {
@@ -785,5 +872,6 @@ int main(int argc, char** argv) {
     if (cmd == "run") return cmd_run(rest);
     if (cmd == "render") return cmd_render(rest);
     if (cmd == "reference") return cmd_reference(rest);
+    if (cmd == "merge") return cmd_merge(rest);
     return usage_error("unknown command '" + cmd + "'");
 }
