@@ -492,16 +492,8 @@ TEST(RenderSplit, PartsMergeToTheWholeStudy) {
                        {"seed", 5},
                        {"estimators", {"light_solid_angle", "bsdf"}},
                        {"reference", {{"spp", 64}}}};
-    const std::string scene = read(kScenes + "/cornell_box.json");
-    auto run = [&](json o) {
-        char* out = nullptr;
-        Call c;
-        c.status = mcp_render_study_run(scene.c_str(), o.dump().c_str(), nullptr, nullptr, &out);
-        if (c.status != MCP_OK) c.error = mcp_last_error();
-        if (out) c.result = json::parse(out);
-        mcp_free(out);
-        return c;
-    };
+    const json scene = json::parse(read(kScenes + "/cornell_box.json"));
+    auto run = [&](const json& o) { return study_text(scene, o); };
     const Call whole = run(options);
     ASSERT_EQ(whole.status, MCP_OK) << whole.error;
     EXPECT_FALSE(whole.result.contains("part"));
