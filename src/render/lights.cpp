@@ -48,6 +48,23 @@ bool spherical_applies(double det, double omega) {
     return det != 0.0 && omega >= kMinSphericalSolidAngle && omega <= kMaxSphericalSolidAngle;
 }
 
+/// (s, c) / |(s, c)| for s, c >= 0: the sine and cosine of the angle atan2(s, c), (0, 1) when
+/// both are 0. Scaled by the larger first, so that the squares neither overflow nor underflow
+/// (hypot's guarantee without its cost: one division, one square root and one more division).
+inline void unit_pair(double s, double c, double* sin_out, double* cos_out) {
+    const double m = std::fmax(s, c);
+    if (!(m > 0.0)) {
+        *sin_out = 0.0;
+        *cos_out = 1.0;
+        return;
+    }
+    const double inv_m = 1.0 / m;
+    const double a = s * inv_m, b = c * inv_m; // the larger is 1 to an ulp
+    const double inv_r = 1.0 / std::sqrt(a * a + b * b);
+    *sin_out = a * inv_r;
+    *cos_out = b * inv_r;
+}
+
 /// Sin and cos of half the angle between a and b, from |a x b| (computed accurately by the
 /// caller) and a . b, without the cancellation of |a||b| + a.b near antipodal directions:
 /// tan(c/2) = |a x b| / (|a||b| + a.b) = (|a||b| - a.b) / |a x b|.
@@ -55,9 +72,7 @@ void half_angle(double cross_len, double dot_ab, double len_ab, double* sin_half
                 double* cos_half) {
     double s = dot_ab >= 0.0 ? cross_len : len_ab - dot_ab;
     double c = dot_ab >= 0.0 ? len_ab + dot_ab : cross_len;
-    double r = std::hypot(s, c);
-    *sin_half = r > 0.0 ? s / r : 0.0;
-    *cos_half = r > 0.0 ? c / r : 1.0;
+    unit_pair(s, c, sin_half, cos_half);
 }
 
 /// Fills the map's parameters of the triangle with vertex vectors a, b, c, edges e1 = b - a,
@@ -71,9 +86,7 @@ void fill_spherical(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& e1,
     // since (a x e1) x (a x e2) = (a . (e1 x e2)) a. Near pi its supplement is kept instead.
     double cos_term = glm::dot(n_ab, n_ac);
     st->obtuse = cos_term < 0.0;
-    const double sa = la * std::fabs(det), ca = std::fabs(cos_term), ra = std::hypot(sa, ca);
-    st->sin_alpha = ra > 0.0 ? sa / ra : 0.0;
-    st->cos_alpha = ra > 0.0 ? ca / ra : 1.0;
+    unit_pair(la * std::fabs(det), std::fabs(cos_term), &st->sin_alpha, &st->cos_alpha);
     half_angle(glm::length(n_ab), glm::dot(a, b), la * lb, &st->sin_half_c, &st->cos_half_c);
     half_angle(glm::length(n_ac), glm::dot(a, c), la * glm::length(c), &st->sin_half_b,
                &st->cos_half_b);
@@ -84,11 +97,11 @@ void fill_spherical(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& e1,
     st->tangent_ac = glm::normalize(glm::cross(n_ac, st->A)); // (A x C) x A = C - (A.C) A
 }
 
-/// Sets up the spherical triangle; st->omega is always set, the rest only when the
-/// triangle is in the spherical regime (return value true).
+/// Sets up the spherical triangle (cross_normal = e1 x e2); st->omega is always set, the rest
+/// only when the triangle is in the spherical regime (return value true).
 bool setup_spherical(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& e1, const Vec3& e2,
-                     SphericalTriangle* st) {
-    double det = glm::dot(a, glm::cross(e1, e2));
+                     const Vec3& cross_normal, SphericalTriangle* st) {
+    double det = glm::dot(a, cross_normal);
     st->omega = solid_angle(a, b, c, det);
     if (!spherical_applies(det, st->omega)) return false;
     fill_spherical(a, b, c, e1, e2, det, st);
@@ -159,9 +172,8 @@ double area_to_solid_angle(const Vec3& ref, const Vec3& point, const Vec3& cross
 // --- Light set -------------------------------------------------------------------------
 
 void LightSet::build(const Scene& scene, LightSelection selection) {
-    scene_ = &scene;
     selection_ = selection;
-    triangles_.clear();
+    lights_.clear();
     selection_cdf_.clear();
     selection_pmf_.clear();
     const Mesh& mesh = scene.mesh;
@@ -188,8 +200,19 @@ void LightSet::build(const Scene& scene, LightSelection selection) {
             continue;
         }
         double l = std::max(0.0, luminance(le));
-        light_of_triangle_[t] = int32_t(triangles_.size());
-        triangles_.push_back(uint32_t(t));
+        light_of_triangle_[t] = int32_t(lights_.size());
+        Light light;
+        light.p0 = mesh.vertex(t, 0);
+        light.p1 = mesh.vertex(t, 1);
+        light.p2 = mesh.vertex(t, 2);
+        light.e1 = light.p1 - light.p0;
+        light.e2 = light.p2 - light.p0;
+        light.cross_normal = glm::cross(light.e1, light.e2);
+        light.unit_normal = glm::normalize(light.cross_normal);
+        light.emission = le;
+        light.double_sided = mat.double_sided;
+        light.triangle = uint32_t(t);
+        lights_.push_back(light);
         lum.push_back(l);
         area.push_back(a);
         sides.push_back(mat.double_sided ? 2.0 : 1.0);
@@ -199,9 +222,9 @@ void LightSet::build(const Scene& scene, LightSelection selection) {
     // Flux of a Lambertian emitter: pi L A per emitting side. The weights are taken relative
     // to the largest radiance and area, each factor in [0, 1], so they stay finite when the
     // power itself overflows a double.
-    std::vector<double> weight(triangles_.size(), 1.0);
+    std::vector<double> weight(lights_.size(), 1.0);
     double relative_power = 0.0;
-    for (size_t i = 0; i < triangles_.size(); ++i) {
+    for (size_t i = 0; i < lights_.size(); ++i) {
         double p = (max_lum > 0.0 ? lum[i] / max_lum : 0.0) * (area[i] / max_area) * sides[i];
         relative_power += p;
         if (selection == LightSelection::Area) weight[i] = area[i] / max_area;
@@ -209,7 +232,7 @@ void LightSet::build(const Scene& scene, LightSelection selection) {
     }
     total_power_ = relative_power > 0.0 ? max_lum * max_area * kPi * relative_power : 0.0;
     // One light, or uniform choice: no table (index and pmf are arithmetic).
-    if (triangles_.size() <= 1 || selection == LightSelection::Uniform) return;
+    if (lights_.size() <= 1 || selection == LightSelection::Uniform) return;
     double sum = 0.0;
     for (double w : weight) sum += w;
     if (!(sum > 0.0) || !std::isfinite(sum)) return; // no usable weights: uniform choice
@@ -234,13 +257,13 @@ double LightSet::total_power() const {
 }
 
 double LightSet::selection_pmf(int light) const {
-    if (light < 0 || size_t(light) >= triangles_.size()) return 0.0;
-    if (selection_pmf_.empty()) return 1.0 / double(triangles_.size());
+    if (light < 0 || size_t(light) >= lights_.size()) return 0.0;
+    if (selection_pmf_.empty()) return 1.0 / double(lights_.size());
     return selection_pmf_[size_t(light)];
 }
 
 int LightSet::select(double u_select, double* pmf) const {
-    size_t n = triangles_.size();
+    size_t n = lights_.size();
     size_t i;
     if (selection_cdf_.empty()) {
         i = std::min(n - 1, size_t(std::fmax(0.0, u_select) * double(n)));
@@ -258,21 +281,16 @@ int LightSet::select(double u_select, double* pmf) const {
 LightSample LightSet::sample(const Vec3& ref, double u_select, const Vec2& u,
                              LightSampling mode) const {
     LightSample s;
-    if (triangles_.empty()) return s;
+    if (lights_.empty()) return s;
     double pmf = 0.0;
-    int light = select(u_select, &pmf);
-    uint32_t tri = triangles_[size_t(light)];
-    const Mesh& mesh = scene_->mesh;
-    const Vec3& p0 = mesh.vertex(tri, 0);
-    const Vec3& p1 = mesh.vertex(tri, 1);
-    const Vec3& p2 = mesh.vertex(tri, 2);
-    Vec3 e1 = p1 - p0, e2 = p2 - p0;
-    Vec3 n = glm::cross(e1, e2);
+    const Light& light = lights_[size_t(select(u_select, &pmf))];
+    const Vec3 &p0 = light.p0, &p1 = light.p1, &p2 = light.p2;
+    const Vec3& n = light.cross_normal;
     double pdf = 0.0;
     Vec3 point;
     SphericalTriangle st;
     if (mode == LightSampling::SolidAngle &&
-        setup_spherical(p0 - ref, p1 - ref, p2 - ref, e1, e2, &st)) {
+        setup_spherical(p0 - ref, p1 - ref, p2 - ref, light.e1, light.e2, n, &st)) {
         Vec3 w = sample_spherical(st, u);
         // Where the direction meets the triangle's plane: (ref + t w - p0) . N = 0.
         double t = glm::dot(p0 - ref, n) / glm::dot(w, n);
@@ -286,10 +304,10 @@ LightSample LightSet::sample(const Vec3& ref, double u_select, const Vec2& u,
     }
     if (!(pdf > 0.0) || !std::isfinite(pdf)) return s;
     s.point = point;
-    s.normal = glm::normalize(n);
-    s.radiance = emitted(tri, glm::normalize(ref - point));
+    s.normal = light.unit_normal;
+    s.radiance = emitted_by(light, ref - point);
     s.pdf = pdf;
-    s.triangle = tri;
+    s.triangle = light.triangle;
     s.valid = true;
     return s;
 }
@@ -299,31 +317,21 @@ double LightSet::pdf(const Vec3& ref, uint32_t triangle, const Vec3& point,
     int light = light_index(triangle);
     if (light < 0) return 0.0;
     double pmf = selection_pmf(light);
-    const Mesh& mesh = scene_->mesh;
-    const Vec3& p0 = mesh.vertex(triangle, 0);
-    const Vec3& p1 = mesh.vertex(triangle, 1);
-    const Vec3& p2 = mesh.vertex(triangle, 2);
-    Vec3 e1 = p1 - p0, e2 = p2 - p0;
-    Vec3 n = glm::cross(e1, e2);
+    const Light& l = lights_[size_t(light)];
+    const Vec3& n = l.cross_normal;
     if (mode == LightSampling::SolidAngle) {
         // The same rule as sample: the same solid angle and the same regime test.
-        Vec3 a = p0 - ref;
+        Vec3 a = l.p0 - ref;
         double det = glm::dot(a, n);
-        double omega = solid_angle(a, p1 - ref, p2 - ref, det);
+        double omega = solid_angle(a, l.p1 - ref, l.p2 - ref, det);
         if (spherical_applies(det, omega)) return pmf / omega;
     }
     return pmf * area_to_solid_angle(ref, point, n);
 }
 
 Vec3 LightSet::emitted(uint32_t triangle, const Vec3& w) const {
-    if (scene_ == nullptr || triangle >= scene_->mesh.triangle_count()) return Vec3(0.0);
-    const Mesh& mesh = scene_->mesh;
-    uint32_t m = triangle < mesh.material.size() ? mesh.material[triangle] : 0u;
-    if (m >= scene_->materials.size()) return Vec3(0.0);
-    const Material& mat = scene_->materials[m];
-    if (!mat.is_emissive()) return Vec3(0.0);
-    if (mat.double_sided || glm::dot(w, mesh.cross_normal(triangle)) > 0.0) return mat.emission;
-    return Vec3(0.0);
+    const int light = light_index(triangle);
+    return light < 0 ? Vec3(0.0) : emitted_by(lights_[size_t(light)], w);
 }
 
 // --- Spherical triangles and polygons ------------------------------------------------------

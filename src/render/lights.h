@@ -33,8 +33,8 @@ class LightSet {
     /// valid distribution even when their power overflows (total_power() is then inf).
     void build(const Scene& scene, LightSelection selection);
 
-    bool empty() const { return triangles_.empty(); }
-    size_t size() const { return triangles_.size(); }
+    bool empty() const { return lights_.empty(); }
+    size_t size() const { return lights_.size(); }
     /// Emissive triangles left out because their area is zero.
     size_t degenerate() const { return degenerate_; }
     /// Emissive triangles left out because their emission or area is NaN or infinite.
@@ -50,19 +50,36 @@ class LightSet {
     /// `triangle` (0 when it does not emit), for multiple importance sampling.
     double pdf(const Vec3& ref, uint32_t triangle, const Vec3& point, LightSampling mode) const;
 
-    /// Radiance emitted by mesh triangle `triangle` towards direction `w` (unit, pointing away
-    /// from the light): its emission on the front side (both sides when double-sided), else 0.
+    /// Radiance emitted by mesh triangle `triangle` towards direction `w` (pointing away from
+    /// the light; its length does not matter): its emission on the front side (both sides when
+    /// double-sided), else 0. 0 for a triangle that is not a light, which includes emissive
+    /// triangles of zero area (never hit).
     Vec3 emitted(uint32_t triangle, const Vec3& w) const;
 
     /// Probability of choosing light number `light` (0 outside [0, size())).
     double selection_pmf(int light) const;
 
   private:
+    /// What sampling, pdf and emission need of one light, gathered once in build() so that a
+    /// sample reads one record instead of the mesh's index, position and material arrays.
+    struct Light {
+        Vec3 p0{0.0}, p1{0.0}, p2{0.0};
+        Vec3 e1{0.0}, e2{0.0};  ///< p1 - p0, p2 - p0
+        Vec3 cross_normal{0.0}; ///< e1 x e2: front side, length twice the area
+        Vec3 unit_normal{0.0};  ///< cross_normal normalised
+        Vec3 emission{0.0};     ///< radiance, linear RGB
+        bool double_sided = false;
+        uint32_t triangle = 0; ///< mesh triangle
+    };
     int select(double u_select, double* pmf) const;
+    /// The light's emission towards w (any length), or 0 from its back.
+    static Vec3 emitted_by(const Light& light, const Vec3& w) {
+        return light.double_sided || glm::dot(w, light.cross_normal) > 0.0 ? light.emission
+                                                                           : Vec3(0.0);
+    }
 
-    const Scene* scene_ = nullptr;
     LightSelection selection_ = LightSelection::Uniform;
-    std::vector<uint32_t> triangles_;        // light -> mesh triangle
+    std::vector<Light> lights_;              // light number -> its record
     std::vector<int32_t> light_of_triangle_; // mesh triangle -> light or -1
     std::vector<double> selection_cdf_;      // empty for one light and for uniform choice
     std::vector<double> selection_pmf_;      // likewise
