@@ -44,6 +44,59 @@ RenderSettings settings(int w, int h, uint64_t spp, uint64_t stream) {
     return s;
 }
 
+// The stratified pixel sampler: in every dimension a pixel's spp samples take each stratum
+// once (1D: [k/spp, (k+1)/spp); 2D: each cell of the grid), and the permutations that pair the
+// strata are uniform and independent between dimensions and pixels. Checked on the shuffled
+// tables (spp 8 and 12, a non-power of two) and on the hashed bijection beyond kTableMaxSpp.
+TEST(PixelSamplerStratified, EveryStratumOnceAndUniformPairing) {
+    using test::chi_square;
+    for (uint64_t spp : {uint64_t(8), uint64_t(12), PixelSampler::kTableMaxSpp + 5}) {
+        SCOPED_TRACE(spp);
+        PixelSampler s;
+        s.configure(PixelSamplerKind::Stratified, spp, 64, 64, 12345);
+        const auto grid = stratification_grid(spp, 2);
+        const int pixels = spp > 64 ? 4 : 4096;
+        // Stratum of sample 0 in dimension 0, jointly with its stratum in dimension 3: uniform
+        // on spp x spp cells under independent uniform permutations (for the small spp).
+        std::vector<double> joint(size_t(spp * spp), 0.0);
+        double fixed_points = 0.0; // of dimension 0's permutation, summed over pixels
+        for (int px = 0; px < pixels; ++px) {
+            s.start_pixel(px % 64, px / 64);
+            std::vector<int> seen_1d(spp, 0), seen_2d(spp, 0), seen_late(spp, 0);
+            for (uint64_t i = 0; i < spp; ++i) {
+                s.start_sample(i);
+                const auto k0 = uint64_t(s.get_1d() * double(spp));
+                const Vec2 u = s.get_2d(); // dimensions 1 and 2
+                const auto k3 = uint64_t(s.get_1d() * double(spp));
+                for (int skip = 4; skip < PixelSampler::kStratifiedDimensions - 1; ++skip)
+                    s.get_1d();
+                const auto k_late = uint64_t(s.get_1d() * double(spp)); // the last stratified
+                ASSERT_LT(k0, spp);
+                ASSERT_LT(k3, spp);
+                ASSERT_LT(k_late, spp);
+                ++seen_1d[k0];
+                ++seen_late[k_late];
+                ++seen_2d[uint64_t(u.y * double(grid[1])) * grid[0] +
+                          uint64_t(u.x * double(grid[0]))];
+                if (i == 0) joint[k0 * spp + k3] += 1.0;
+                if (k0 == i) fixed_points += 1.0;
+            }
+            for (uint64_t k = 0; k < spp; ++k) {
+                ASSERT_EQ(seen_1d[k], 1) << "pixel " << px << " stratum " << k;
+                ASSERT_EQ(seen_2d[k], 1) << "pixel " << px << " cell " << k;
+                ASSERT_EQ(seen_late[k], 1) << "pixel " << px << " stratum " << k;
+            }
+        }
+        if (spp > 64) continue;
+        const std::vector<double> expected(joint.size(), double(pixels) / double(spp * spp));
+        const auto chi = chi_square(joint, expected);
+        EXPECT_GT(chi.p_value, 1e-4) << "chi^2 " << chi.statistic << " on " << chi.dof << " dof";
+        // A uniform permutation has one fixed point on average, with variance 1 (a
+        // cyclic-only shuffle, Sattolo's, has none): within 5 standard errors over the pixels.
+        EXPECT_NEAR(fixed_points / pixels, 1.0, 5.0 / std::sqrt(double(pixels)));
+    }
+}
+
 // Floor radiance under the quad light: (albedo / pi) E with E = pi Le F from Lambert's
 // polygon formula at the point each pixel's centre ray hits. Every estimator, every pixel,
 // within its own error bar (z-threshold for a family-wise level of 1e-3 over all pixels).

@@ -3,8 +3,12 @@
 // - independent: independent uniforms from the pixel's own PCG32 stream.
 // - stratified: every 1D and 2D dimension of the path is stratified over the pixel's spp
 //   samples on its own and the strata of different dimensions are paired by keyed random
-//   permutations ("padding", as in pbrt's stratified sampler [PBR4, 8.5]; the permutations
-//   are those of the core's Latin hypercube sampler [Kensler13]).
+//   permutations ("padding", as in pbrt's stratified sampler [PBR4, 8.5]): for spp up to
+//   kTableMaxSpp each pixel and dimension shuffles a table of its spp strata once, by
+//   Fisher and Yates's shuffle in Durstenfeld's inside-out form [Knuth97, 3.4.2 algorithm P]
+//   with bounded draws [Lemire19] from a PCG32 stream keyed by the pixel and the dimension,
+//   so that a sample reads its stratum instead of hashing it; beyond, the keyed bijection of
+//   the core's Latin hypercube sampler [Kensler13] (O(1) memory).
 // - sobol: Owen-scrambled Sobol' points with the pixels decorrelated by a randomly permuted
 //   Morton (Z) order of the image, so that neighbouring pixels get complementary points and
 //   the error is spread as blue noise [AhmedWonka20; PBR4, 8.7]. Written from the papers'
@@ -117,6 +121,9 @@ class PixelSampler {
     /// Dimensions past this many per sample are independent in the stratified sampler (a
     /// path's deep bounces gain little from stratification). The Sobol' sampler has no limit.
     static constexpr int kStratifiedDimensions = 32;
+    /// The stratified sampler keeps shuffled tables of the strata up to this many spp
+    /// (kStratifiedDimensions x spp 16-bit entries: 256 KiB at most, allocated per image).
+    static constexpr uint64_t kTableMaxSpp = 4096;
 
     /// Plans an image of width x height pixels of `spp` samples, keyed by `image_key` (the
     /// image's stream); allocation happens here (once per image), not per pixel. The Sobol'
@@ -137,6 +144,10 @@ class PixelSampler {
         if (sample_bits_ > 32) sample_bits_ = 32;
         morton_bits_ = 2 * ceil_log2(uint64_t(side > 1 ? side : 1));
         if (morton_bits_ > 32) morton_bits_ = 32;
+        if (kind == PixelSamplerKind::Stratified && spp > 1 && spp <= kTableMaxSpp)
+            strata_.resize(size_t(kStratifiedDimensions) * size_t(spp));
+        else
+            strata_.clear();
     }
 
     /// Starts pixel (x, y). The independent and stratified samplers give it its own PCG32
@@ -165,7 +176,7 @@ class PixelSampler {
         }
         if (kind_ == PixelSamplerKind::Independent || d >= kStratifiedDimensions || spp_ <= 1)
             return rng_.next_double();
-        uint64_t stratum = permute_index(index_, permutation(d));
+        uint64_t stratum = stratum_of_sample(d);
         return clamp_open((static_cast<double>(stratum) + rng_.next_double()) /
                           static_cast<double>(spp_));
     }
@@ -186,7 +197,7 @@ class PixelSampler {
         double u1 = rng_.next_double();
         if (kind_ == PixelSamplerKind::Independent || d >= kStratifiedDimensions || spp_ <= 1)
             return Vec2(u0, u1);
-        uint64_t cell = permute_index(index_, permutation(d));
+        uint64_t cell = stratum_of_sample(d);
         uint64_t cx = cell % grid_x_, cy = cell / grid_x_;
         return Vec2(clamp_open((static_cast<double>(cx) + u0) / static_cast<double>(grid_x_)),
                     clamp_open((static_cast<double>(cy) + u1) / static_cast<double>(grid_y_)));
@@ -221,14 +232,30 @@ class PixelSampler {
   private:
     static double clamp_open(double u) { return below_one(u); }
 
-    /// The stratified sampler's permutation of the pixel's spp samples in dimension d
-    /// (d < kStratifiedDimensions), keyed by the pixel and d, prepared once per pixel.
-    const IndexPermutation& permutation(int d) {
-        if (!((prepared_ >> d) & 1u)) {
-            permutations_[d] = index_permutation(spp_, hash_combine(key_, uint64_t(d)));
-            prepared_ |= uint32_t(1) << d;
+    /// The stratum of the current sample in dimension d (d < kStratifiedDimensions) of the
+    /// stratified sampler: its index through the pixel's permutation of [0, spp) for d, keyed
+    /// by the pixel and d and prepared on the dimension's first use in the pixel.
+    uint64_t stratum_of_sample(int d) {
+        const bool prepared = (prepared_ >> d) & 1u;
+        prepared_ |= uint32_t(1) << d;
+        if (strata_.empty()) {
+            if (!prepared)
+                permutations_[d] = index_permutation(spp_, hash_combine(key_, uint64_t(d)));
+            return permute_index(index_, permutations_[d]);
         }
-        return permutations_[d];
+        uint16_t* row = strata_.data() + size_t(d) * size_t(spp_);
+        if (!prepared) {
+            // Inside-out shuffle: after step i, row[0..i] is a uniform permutation of 0..i.
+            const uint64_t key = hash_combine(key_, uint64_t(d));
+            Pcg32 shuffle;
+            shuffle.set_seed(mix64(key), key);
+            for (uint32_t i = 0; i < uint32_t(spp_); ++i) {
+                const uint32_t j = shuffle.next_below(i + 1);
+                row[i] = row[j];
+                row[j] = uint16_t(i);
+            }
+        }
+        return row[index_ < spp_ ? index_ : index_ % spp_];
     }
 
     /// The permuted global index of the current sample in the dimension keyed by dim_key:
@@ -283,7 +310,8 @@ class PixelSampler {
     Pcg32 rng_;
     uint32_t prepared_ = 0; ///< bit d: permutations_[d] is this pixel's
     static_assert(kStratifiedDimensions <= 32, "one bit of prepared_ per dimension");
-    IndexPermutation permutations_[kStratifiedDimensions];
+    IndexPermutation permutations_[kStratifiedDimensions]; ///< spp > kTableMaxSpp
+    std::vector<uint16_t> strata_; ///< row d: the pixel's shuffled strata of dimension d
 };
 
 } // namespace mcp
