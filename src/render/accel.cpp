@@ -62,8 +62,9 @@ struct RayPrep {
 };
 
 /// False for rays no triangle can be reported for: zero, infinite or NaN direction or
-/// origin, or t_max <= 0 / NaN.
-bool prepare(const Ray& ray, RayPrep* r) {
+/// origin, or t_max <= 0 / NaN. The box tests' reciprocals and plane rows (inv, near, far)
+/// are filled only when `boxes` is set (brute force needs only the shear).
+bool prepare(const Ray& ray, bool boxes, RayPrep* r) {
     const double d[3] = {ray.direction.x, ray.direction.y, ray.direction.z};
     const double* o = &ray.origin.x;
     // x - x is NaN exactly when x is infinite or NaN.
@@ -76,17 +77,19 @@ bool prepare(const Ray& ray, RayPrep* r) {
     int kx = kz == 2 ? 0 : kz + 1;
     int ky = kx == 2 ? 0 : kx + 1;
     if (d[kz] < 0.0) std::swap(kx, ky); // keeps the winding, hence the sign of the edges
-    for (int k = 0; k < 3; ++k) {
-        r->o[k] = o[k];
-        r->inv[k] = 1.0 / d[k]; // -0 gives -inf: the sign still orders the planes
-        const int neg = std::signbit(r->inv[k]) ? 1 : 0;
-        r->near[k] = k + 3 * neg;
-        r->far[k] = k + 3 - 3 * neg;
+    for (int k = 0; k < 3; ++k) r->o[k] = o[k];
+    if (boxes) {
+        for (int k = 0; k < 3; ++k) {
+            r->inv[k] = 1.0 / d[k]; // -0 gives -inf: the sign still orders the planes
+            const int neg = std::signbit(r->inv[k]) ? 1 : 0;
+            r->near[k] = k + 3 * neg;
+            r->far[k] = k + 3 - 3 * neg;
+        }
     }
     r->kx = kx;
     r->ky = ky;
     r->kz = kz;
-    r->sz = r->inv[kz];
+    r->sz = 1.0 / d[kz]; // the same division as inv[kz]
     r->sx = d[kx] * r->sz;
     r->sy = d[ky] * r->sz;
     r->zero = 0.0;
@@ -308,7 +311,7 @@ float float_above(double x) {
 bool intersect_triangle(const Ray& ray, const Vec3& p0, const Vec3& p1, const Vec3& p2, double* t,
                         double* b1, double* b2) {
     RayPrep r;
-    if (!prepare(ray, &r)) return false;
+    if (!prepare(ray, false, &r)) return false;
     const Vec3 p[3] = {p0, p1, p2};
     TriHit h;
     if (!watertight(r, p, &h) || !(h.t < ray.t_max)) return false;
@@ -439,7 +442,7 @@ void Accelerator::build(const Mesh& mesh, AccelKind kind) {
 
 template <bool kAnyHit> bool Accelerator::traverse(const Ray& ray, Hit* hit) const {
     RayPrep r;
-    if (triangle_id_.empty() || !prepare(ray, &r)) return false;
+    if (triangle_id_.empty() || !prepare(ray, !nodes_.empty(), &r)) return false;
     const Vec3* tri = vertices_.data();
     double best_t = ray.t_max;
     TriHit best_hit{0.0, 0.0, 0.0, 1.0};

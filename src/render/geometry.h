@@ -47,12 +47,18 @@ struct Frame {
     Vec3 to_world(const Vec3& v) const { return s * v.x + t * v.y + n * v.z; }
 };
 
+/// std::fmax without the library call it compiles to (without -ffast-math): the larger of a
+/// and b, or the other one when one is NaN.
+inline double fmax_inline(double a, double b) {
+    return (a > b || b != b) ? a : b;
+}
+
 /// Moves a surface point off its surface, to the side `direction` points to, by a distance
 /// that scales with the point's magnitude: a few thousand ulps of the largest coordinate,
 /// which exceeds the rounding error of a double-precision hit point and its watertight
 /// triangle test (the float-ulp version is [WaechterBinder19], Ray Tracing Gems ch. 6).
 inline Vec3 offset_ray_origin(const Vec3& p, const Vec3& geometric_normal, const Vec3& direction) {
-    double scale = std::fmax(std::fmax(std::fabs(p.x), std::fabs(p.y)), std::fabs(p.z));
+    double scale = fmax_inline(fmax_inline(std::fabs(p.x), std::fabs(p.y)), std::fabs(p.z));
     double eps = 0x1p-40 * (scale + 1.0); // ~1e-12 near the origin, relative beyond
     Vec3 offset = geometric_normal * eps;
     return glm::dot(direction, geometric_normal) < 0.0 ? p - offset : p + offset;

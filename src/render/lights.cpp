@@ -52,7 +52,7 @@ bool spherical_applies(double det, double omega) {
 /// both are 0. Scaled by the larger first, so that the squares neither overflow nor underflow
 /// (hypot's guarantee without its cost: one division, one square root and one more division).
 inline void unit_pair(double s, double c, double* sin_out, double* cos_out) {
-    const double m = std::fmax(s, c);
+    const double m = fmax_inline(s, c);
     if (!(m > 0.0)) {
         *sin_out = 0.0;
         *cos_out = 1.0;
@@ -127,8 +127,9 @@ Vec3 sample_spherical(const SphericalTriangle& st, const Vec2& u) {
     // sin(alpha - A'/2) by the difference formula (for an obtuse angle, stored as pi - alpha,
     // sin(pi - alpha + A'/2) by the sum), clamped at 0 where A'/2 passes alpha: a sub-triangle
     // fits in its lune, and past it the sine turns negative.
-    const double sin_rest = std::fmax(0.0, st.obtuse ? st.sin_alpha * h.cos + st.cos_alpha * h.sin
-                                                     : st.sin_alpha * h.cos - st.cos_alpha * h.sin);
+    const double sin_rest =
+        fmax_inline(0.0, st.obtuse ? st.sin_alpha * h.cos + st.cos_alpha * h.sin
+                                   : st.sin_alpha * h.cos - st.cos_alpha * h.sin);
     double num = st.cos_half_c * h.sin;
     double den = st.sin_half_c * sin_rest;
     // |AC'| = 2 atan2(num, den) (num >= 0), clamped to |AC|. Its cosine and sine follow from
@@ -136,7 +137,7 @@ Vec3 sample_spherical(const SphericalTriangle& st, const Vec2& u) {
     // and the clamp compares the half angles by a cross product: no trigonometric call.
     double cos_arc = st.cos_b, sin_arc = st.sin_b;
     if (num * st.cos_half_b - den * st.sin_half_b < 0.0) { // |AC'| / 2 < |AC| / 2
-        const double m = std::fmax(num, std::fabs(den));
+        const double m = fmax_inline(num, std::fabs(den));
         const double n = m > 0.0 ? num / m : 0.0, d = m > 0.0 ? den / m : 1.0;
         const double r2 = n * n + d * d;
         cos_arc = (d - n) * (d + n) / r2;
@@ -266,7 +267,7 @@ int LightSet::select(double u_select, double* pmf) const {
     size_t n = lights_.size();
     size_t i;
     if (selection_cdf_.empty()) {
-        i = std::min(n - 1, size_t(std::fmax(0.0, u_select) * double(n)));
+        i = std::min(n - 1, size_t(fmax_inline(0.0, u_select) * double(n)));
         *pmf = 1.0 / double(n);
     } else {
         // cdf[i] <= u < cdf[i + 1]: lights of zero weight span an empty interval.
