@@ -79,7 +79,10 @@ TEST(SobolPixelSampler, EachPixelsPointsFormANet) {
             PixelSampler s;
             s.configure(PixelSamplerKind::Sobol, spp, W, H, key);
             for (auto [x, y] : {std::pair{0, 0}, {12, 6}, {5, 3}, {6, 3}}) {
-                for (int skip : {0, 1, 3, 7}) {
+                // Requests prepared once per pixel, the last prepared one and two beyond.
+                for (int skip : {0, 1, 3, 7, PixelSampler::kSobolPreparedRequests - 2,
+                                 PixelSampler::kSobolPreparedRequests,
+                                 PixelSampler::kSobolPreparedRequests + 9}) {
                     std::vector<Vec2> pts = pixel_points(s, x, y, spp, skip);
                     EXPECT_EQ(net_defects(pts, m, 1), 0)
                         << "spp " << spp << " pixel " << x << "," << y << " after " << skip
@@ -96,6 +99,18 @@ TEST(SobolPixelSampler, EachPixelsPointsFormANet) {
                 for (int c : count) EXPECT_EQ(c, 1) << "1D, spp " << spp;
             }
         }
+    }
+}
+
+// Beyond the shuffled tables (spp > kTableMaxSpp) the sample permutation is the core's keyed
+// bijection: the pixel's points are still a net, prepared or not.
+TEST(SobolPixelSampler, PointsFormANetBeyondTheTables) {
+    const uint64_t spp = 2 * PixelSampler::kTableMaxSpp;
+    PixelSampler s;
+    s.configure(PixelSamplerKind::Sobol, spp, 5, 3, 42);
+    for (int skip : {0, 5, PixelSampler::kSobolPreparedRequests + 1}) {
+        EXPECT_EQ(net_defects(pixel_points(s, 3, 1, spp, skip), log2_exact(spp), 1), 0)
+            << "after " << skip << " 1D draws";
     }
 }
 

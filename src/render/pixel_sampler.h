@@ -121,8 +121,13 @@ class PixelSampler {
     /// Dimensions past this many per sample are independent in the stratified sampler (a
     /// path's deep bounces gain little from stratification). The Sobol' sampler has no limit.
     static constexpr int kStratifiedDimensions = 32;
-    /// The stratified sampler keeps shuffled tables of the strata up to this many spp
-    /// (kStratifiedDimensions x spp 16-bit entries: 256 KiB at most, allocated per image).
+    /// The Sobol' sampler prepares the first this many requests of a sample once per pixel
+    /// (their permuted Morton index, seeds, sample permutation and the Sobol' digits of the
+    /// index's pixel part); later requests are computed in full each time.
+    static constexpr int kSobolPreparedRequests = 64;
+    /// Both samplers keep shuffled tables of the sample permutations up to this many spp (a
+    /// row of spp 16-bit entries per dimension: 256 KiB stratified, 512 KiB Sobol' at most,
+    /// allocated per image); beyond, the core's keyed bijection.
     static constexpr uint64_t kTableMaxSpp = 4096;
 
     /// Plans an image of width x height pixels of `spp` samples, keyed by `image_key` (the
@@ -144,8 +149,11 @@ class PixelSampler {
         if (sample_bits_ > 32) sample_bits_ = 32;
         morton_bits_ = 2 * ceil_log2(uint64_t(side > 1 ? side : 1));
         if (morton_bits_ > 32) morton_bits_ = 32;
-        if (kind == PixelSamplerKind::Stratified && spp > 1 && spp <= kTableMaxSpp)
-            strata_.resize(size_t(kStratifiedDimensions) * size_t(spp));
+        const int rows = kind == PixelSamplerKind::Stratified ? kStratifiedDimensions
+                         : kind == PixelSamplerKind::Sobol    ? kSobolPreparedRequests
+                                                              : 0;
+        if (rows > 0 && spp > 1 && spp <= kTableMaxSpp)
+            strata_.resize(size_t(rows) * size_t(spp));
         else
             strata_.clear();
     }
@@ -170,9 +178,9 @@ class PixelSampler {
     double get_1d() {
         int d = dimension_++;
         if (kind_ == PixelSamplerKind::Sobol) {
-            uint64_t seeds = 0;
-            uint32_t index = sobol_index(d, &seeds);
-            return sobol_value(index, 0, seeds);
+            uint32_t v[1];
+            const uint64_t seeds = sobol_point(d, 1, v);
+            return sobol_value(v[0], 0, seeds);
         }
         if (kind_ == PixelSamplerKind::Independent || d >= kStratifiedDimensions || spp_ <= 1)
             return rng_.next_double();
@@ -187,10 +195,10 @@ class PixelSampler {
         int d = dimension_;
         dimension_ += 2;
         if (kind_ == PixelSamplerKind::Sobol) {
-            uint64_t seeds = 0;
-            uint32_t index = sobol_index(d, &seeds);
-            double u0 = sobol_value(index, 0, seeds);
-            double u1 = sobol_value(index, 1, seeds);
+            uint32_t v[2];
+            const uint64_t seeds = sobol_point(d, 2, v);
+            double u0 = sobol_value(v[0], 0, seeds);
+            double u1 = sobol_value(v[1], 1, seeds);
             return Vec2(u0, u1);
         }
         double u0 = rng_.next_double();
@@ -219,13 +227,13 @@ class PixelSampler {
         }
         int d = dimension_;
         dimension_ += 3;
-        uint64_t seeds = 0;
-        uint32_t index = sobol_index(d, &seeds);
+        uint32_t v[3];
+        const uint64_t seeds = sobol_point(d, 3, v);
         ChoiceSample c;
-        double u0 = sobol_value(index, 0, seeds);
-        double u1 = sobol_value(index, 1, seeds);
+        double u0 = sobol_value(v[0], 0, seeds);
+        double u1 = sobol_value(v[1], 1, seeds);
         c.u = Vec2(u0, u1);
-        c.choice = sobol_value(index, 2, seeds);
+        c.choice = sobol_value(v[2], 2, seeds);
         return c;
     }
 
@@ -237,66 +245,107 @@ class PixelSampler {
     /// by the pixel and d and prepared on the dimension's first use in the pixel.
     uint64_t stratum_of_sample(int d) {
         const bool prepared = (prepared_ >> d) & 1u;
-        prepared_ |= uint32_t(1) << d;
+        prepared_ |= uint64_t(1) << d;
         if (strata_.empty()) {
             if (!prepared)
                 permutations_[d] = index_permutation(spp_, hash_combine(key_, uint64_t(d)));
             return permute_index(index_, permutations_[d]);
         }
         uint16_t* row = strata_.data() + size_t(d) * size_t(spp_);
-        if (!prepared) {
-            // Inside-out shuffle: after step i, row[0..i] is a uniform permutation of 0..i.
-            const uint64_t key = hash_combine(key_, uint64_t(d));
-            Pcg32 shuffle;
-            shuffle.set_seed(mix64(key), key);
-            for (uint32_t i = 0; i < uint32_t(spp_); ++i) {
-                const uint32_t j = shuffle.next_below(i + 1);
-                row[i] = row[j];
-                row[j] = uint16_t(i);
-            }
-        }
+        if (!prepared) shuffle_row(row, hash_combine(key_, uint64_t(d)));
         return row[index_ < spp_ ? index_ : index_ % spp_];
     }
 
-    /// The permuted global index of the current sample in the dimension keyed by dim_key:
-    /// the Morton index with its base-4 digits through a nested random permutation (each
-    /// digit's permutation keyed by the dimension, the digit's position and the original
-    /// digits above it: a bijection that keeps aligned quads of pixels on aligned blocks of
-    /// indices), times 2^sample_bits, plus the sample index through a keyed random permutation
-    /// of [0, spp) (keyed by the dimension and the pixel: requests are paired at random
-    /// within the pixel, as for the stratified sampler).
-    uint64_t permuted_index(uint64_t dim_key) const {
+    /// Fills a table row with a uniform random permutation of [0, spp) keyed by `key`:
+    /// the inside-out shuffle, after whose step i row[0..i] is a uniform permutation of 0..i.
+    void shuffle_row(uint16_t* row, uint64_t key) const {
+        Pcg32 shuffle;
+        shuffle.set_seed(mix64(key), key);
+        for (uint32_t i = 0; i < uint32_t(spp_); ++i) {
+            const uint32_t j = shuffle.next_below(i + 1);
+            row[i] = row[j];
+            row[j] = uint16_t(i);
+        }
+    }
+
+    /// What the Sobol' sampler's request d needs of the pixel, the same for all its samples.
+    /// The request's global index is I = (M' << sample_bits) | s' with M' the Morton index
+    /// with its base-4 digits through a nested random permutation (each digit's permutation
+    /// keyed by the dimension, the digit's position and the original digits above it: a
+    /// bijection that keeps aligned quads of pixels on aligned blocks of indices) and s' the
+    /// sample index through a keyed random permutation of [0, spp) (keyed by the dimension and
+    /// the pixel: requests are paired at random within the pixel, as for the stratified
+    /// sampler). The Sobol' point takes I's low 32 bits; since the Gray code and the Sobol'
+    /// digits are linear over GF(2) and the two parts have disjoint bits, its digits are
+    /// sobol_u32(low 32 bits of M' << sample_bits) ^ sobol_u32(s'): the pixel's part is
+    /// computed once here.
+    struct SobolRequest {
+        uint64_t dim_key = 0; ///< hash of the image's key and d
+        uint64_t high = 0;    ///< M' << sample_bits
+        uint64_t seeds = 0;   ///< two 32-bit scrambling seeds, keyed by dim_key and high >> 32
+        uint32_t high_digits[3] = {0, 0, 0}; ///< sobol_u32(high, c), c = 0, 1, 2
+        IndexPermutation permutation;        ///< of the sample index, when there is no table
+    };
+
+    void prepare_sobol(int d, SobolRequest* r, uint16_t* row) const {
         using pixel_sampler_detail::kPerm4;
+        r->dim_key = hash_combine(image_key_, uint64_t(d));
         uint64_t morton = 0;
         for (int shift = morton_bits_ - 2; shift >= 0; shift -= 2) {
             const uint64_t higher = morton_ >> (shift + 2);
-            const uint64_t h = mix64(dim_key ^ ((higher << 6) | uint64_t(shift)));
+            const uint64_t h = mix64(r->dim_key ^ ((higher << 6) | uint64_t(shift)));
             const uint32_t p = uint32_t((uint64_t(uint32_t(h >> 32)) * 24u) >> 32);
             const uint32_t digit = uint32_t(morton_ >> shift) & 3u;
             morton |= uint64_t((kPerm4.p[p] >> (2 * digit)) & 3u) << shift;
         }
-        const uint64_t sample = index_ < spp_
-                                    ? permute_index(index_, spp_, hash_combine(dim_key, morton_))
-                                    : index_ & ((uint64_t(1) << sample_bits_) - 1);
-        return (morton << sample_bits_) | sample;
+        r->high = morton << sample_bits_;
+        // The sample part lies below bit 32 (sample_bits <= 32): the bits of I above 32 are
+        // the pixel's, so the seeds are too.
+        r->seeds = hash_combine(r->dim_key ^ 0x6f77656e5365656eULL, r->high >> 32); // "owenSeen"
+        for (int c = 0; c < 3; ++c) r->high_digits[c] = sobol_u32(uint32_t(r->high), c);
+        const uint64_t key = hash_combine(r->dim_key, morton_);
+        if (row != nullptr)
+            shuffle_row(row, key);
+        else
+            r->permutation = index_permutation(spp_, key);
     }
 
-    /// Dimension d's Sobol' index (low 32 bits of the permuted index) and its 64-bit seed
-    /// word (two 32-bit scrambling seeds, keyed by the image, d and the index's bits above 32).
-    uint32_t sobol_index(int d, uint64_t* seeds) const {
-        const uint64_t dim_key = hash_combine(image_key_, uint64_t(d));
-        const uint64_t p = permuted_index(dim_key);
-        *seeds = hash_combine(dim_key ^ 0x6f77656e5365656eULL, p >> 32); // "owenSeen"
-        return uint32_t(p);
+    /// The unscrambled Sobol' digits of coordinates 0..count-1 (count <= 3) of request d's
+    /// point for the current sample; returns the request's seeds.
+    uint64_t sobol_point(int d, int count, uint32_t* digits) {
+        SobolRequest unprepared;
+        const SobolRequest* r = &unprepared;
+        const uint16_t* row = nullptr;
+        if (d < kSobolPreparedRequests) {
+            uint16_t* own_row =
+                strata_.empty() ? nullptr : strata_.data() + size_t(d) * size_t(spp_);
+            if (!((prepared_ >> d) & 1u)) {
+                prepare_sobol(d, &sobol_requests_[d], own_row);
+                prepared_ |= uint64_t(1) << d;
+            }
+            r = &sobol_requests_[d];
+            row = own_row;
+        } else {
+            prepare_sobol(d, &unprepared, nullptr);
+        }
+        uint64_t sample;
+        if (index_ >= spp_)
+            sample = index_ & ((uint64_t(1) << sample_bits_) - 1);
+        else if (row != nullptr)
+            sample = row[index_];
+        else
+            sample = permute_index(index_, r->permutation);
+        for (int c = 0; c < count; ++c) digits[c] = r->high_digits[c] ^ sobol_u32(sample, c);
+        return r->seeds;
     }
 
-    /// Sobol' coordinate `sobol_dim` (0, 1 or 2) of point `index`, Owen-scrambled with a
-    /// 32-bit seed from `seeds` (its low half, its high half, a hash of it), with 21 fill bits
-    /// hashed from the scrambled digits and the coordinate: a value in (0, 1).
-    static double sobol_value(uint32_t index, int sobol_dim, uint64_t seeds) {
+    /// Sobol' coordinate `sobol_dim` (0, 1 or 2) of a point, from its digits, Owen-scrambled
+    /// with a 32-bit seed from `seeds` (its low half, its high half, a hash of it), with 21
+    /// fill bits hashed from the scrambled digits and the coordinate: a value in (0, 1).
+    static double sobol_value(uint32_t digits, int sobol_dim, uint64_t seeds) {
         const uint32_t seed =
             sobol_dim < 2 ? uint32_t(seeds >> (32 * sobol_dim)) : uint32_t(mix64(seeds));
-        const uint32_t v = owen_scramble_u32(sobol_u32(index, sobol_dim), seed);
+        const uint32_t v = owen_scramble_u32(digits, seed);
         const uint64_t fill = mix64(seeds ^ ((uint64_t(v) << 2) | uint64_t(sobol_dim))) >> 43;
         return bits53_to_unit((uint64_t(v) << 21) | fill);
     }
@@ -308,9 +357,11 @@ class PixelSampler {
     int sample_bits_ = 0, morton_bits_ = 0;
     int dimension_ = 0;
     Pcg32 rng_;
-    uint32_t prepared_ = 0; ///< bit d: permutations_[d] is this pixel's
-    static_assert(kStratifiedDimensions <= 32, "one bit of prepared_ per dimension");
+    uint64_t prepared_ = 0; ///< bit d: dimension (request) d is prepared for this pixel
+    static_assert(kStratifiedDimensions <= 64 && kSobolPreparedRequests <= 64,
+                  "one bit of prepared_ per dimension");
     IndexPermutation permutations_[kStratifiedDimensions]; ///< spp > kTableMaxSpp
+    SobolRequest sobol_requests_[kSobolPreparedRequests];
     std::vector<uint16_t> strata_; ///< row d: the pixel's shuffled strata of dimension d
 };
 
