@@ -50,7 +50,8 @@ RenderSettings settings(int w, int h, uint64_t spp, uint64_t stream) {
 // tables (spp 8 and 12, a non-power of two) and on the hashed bijection beyond kTableMaxSpp.
 TEST(PixelSamplerStratified, EveryStratumOnceAndUniformPairing) {
     using test::chi_square;
-    for (uint64_t spp : {uint64_t(8), uint64_t(12), PixelSampler::kTableMaxSpp + 5}) {
+    for (uint64_t spp :
+         {uint64_t(8), uint64_t(12), uint64_t(256), PixelSampler::kTableMaxSpp + 5}) {
         SCOPED_TRACE(spp);
         PixelSampler s;
         s.configure(PixelSamplerKind::Stratified, spp, 64, 64, 12345);

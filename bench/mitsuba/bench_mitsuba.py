@@ -3,7 +3,7 @@
 and efficiency at 16, 64 and 256 spp, each renderer scored against its own converged reference.
 
   build/mitsuba-venv/bin/python bench/mitsuba/bench_mitsuba.py [--mcplay build/mcplay]
-      [--spp 16,64,256] [--ref-spp 4096] [--threads 2] [--quick] [--out build/bench-mitsuba]
+      [--spp 16,64,256] [--ref-spp 4096] [--threads 2] [--quick] [--sobol]
 
 `make bench-mitsuba` installs what it needs (Debian's libllvm19 for drjit 1.5, Mitsuba 3.9.1 in a
 virtual environment under build/) and runs this. Not part of `make test`.
@@ -24,7 +24,9 @@ With --images K the relative MSE is the mean over K images of different seeds. S
 render time only, the smallest of those runs (at least two) (Mitsuba's after a first render of the same
 size compiled its kernels; mcplay's from its result JSON). The two renderers' references are
 also compared with each other (the same relative MSE), which says whether they render the same
-image.
+image. With --sobol, mcplay also renders every cell with its Owen-scrambled Sobol' pixel sampler
+(`--pixel-sampler sobol`; the default is stratified), scored against the same mcplay reference:
+one more column, and its own efficiency ratio against Mitsuba.
 """
 import argparse
 import base64
@@ -207,9 +209,9 @@ def read_pfm(path):
 
 
 class Mcplay:
-    def __init__(self, exe, scene, width, height, threads, folder):
+    def __init__(self, exe, scene, width, height, threads, folder, pixel_sampler=None):
         self.exe, self.scene, self.width, self.height = exe, scene, width, height
-        self.threads, self.folder = threads, folder
+        self.threads, self.folder, self.pixel_sampler = threads, folder, pixel_sampler
 
     def render(self, strategy, spp, seed):
         out = os.path.join(self.folder, 'mcplay.pfm')
@@ -217,6 +219,8 @@ class Mcplay:
                '--estimator', MCPLAY_ESTIMATOR[strategy], '--spp', str(spp), '--seed', str(seed),
                '--width', str(self.width), '--height', str(self.height), '--threads', str(self.threads),
                '--out', out, '--format', 'json', '--no-cache']
+        if self.pixel_sampler:
+            cmd += ['--pixel-sampler', self.pixel_sampler]
         if strategy == 'path':  # the path scene: the Cornell box's path estimators
             cmd[2] = 'cornell_box_path'
             cmd[6] = 'path_mis'
@@ -257,6 +261,10 @@ def scored(renderer, strategy, spp, ref, images):
     return float(np.mean(rels)), best
 
 
+def ratio_text(r):
+    return f'{r:.2f}' if r is not None else 'n/a'
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split('\n')[0])
     ap.add_argument('--mcplay', default=os.path.join(ROOT, 'build', 'mcplay'))
@@ -267,6 +275,8 @@ def main():
                     help='images per cell whose relative MSE is averaged (heavy-tailed cells need several)')
     ap.add_argument('--quick', action='store_true', help='small images and references: a smoke test')
     ap.add_argument('--scenes', default=','.join(s[0] for s in SCENES))
+    ap.add_argument('--sobol', action='store_true',
+                    help="also mcplay with Sobol' pixels (--pixel-sampler sobol): one more column")
     args = ap.parse_args()
     spps = [int(s) for s in args.spp.split(',')]
     os.environ.setdefault('DRJIT_NUM_THREADS', str(args.threads))
@@ -291,6 +301,7 @@ def main():
                 w, h = w // 4, h // 4
             mit = Mitsuba(mi, os.path.join(ROOT, 'scenes', gltf), w, h, folder)
             mcp = Mcplay(args.mcplay, name, w, h, args.threads, folder)
+            mcp_sobol = Mcplay(args.mcplay, name, w, h, args.threads, folder, 'sobol')
             cache = {}  # the references of this scene, per reference strategy
             for strategy in strategies:
                 ref_strategy = 'path' if strategy == 'path' else 'mis'
@@ -307,27 +318,40 @@ def main():
                 mit.render(strategy, spps[0], 3)  # compiles Mitsuba's kernels for this size
                 for spp in spps:
                     row = {'scene': name, 'strategy': strategy, 'spp': spp, 'refs_rel_mse': between}
-                    for label, r in (('mcplay', mcp), ('mitsuba', mit)):
-                        rel, s = scored(r, strategy, spp, refs[label], args.images)
+                    runs = [('mcplay', mcp, 'mcplay'), ('mitsuba', mit, 'mitsuba')]
+                    if args.sobol:
+                        runs.append(('mcplay_sobol', mcp_sobol, 'mcplay'))
+                    for label, r, ref_label in runs:
+                        rel, s = scored(r, strategy, spp, refs[ref_label], args.images)
                         row[label] = {'seconds': s, 'rel_mse': rel,
                                       'efficiency': 1 / (rel * s) if rel > 0 and s > 0 else None}
                     eff = [row[k]['efficiency'] for k in ('mcplay', 'mitsuba')]
                     row['time_ratio'] = row['mcplay']['seconds'] / row['mitsuba']['seconds']
                     row['efficiency_ratio'] = eff[0] / eff[1] if None not in eff else None
+                    line = (f"{name:16} {strategy:5} {spp:4} spp  mcplay {row['mcplay']['seconds']:7.3f} s "
+                            f"relMSE {row['mcplay']['rel_mse']:.3e}  |  Mitsuba {row['mitsuba']['seconds']:7.3f} s "
+                            f"relMSE {row['mitsuba']['rel_mse']:.3e}  |  time x{row['time_ratio']:.2f}  "
+                            f"efficiency x{ratio_text(row['efficiency_ratio'])}")
+                    if args.sobol:
+                        sob = row['mcplay_sobol']
+                        row['efficiency_ratio_sobol'] = (sob['efficiency'] / eff[1]
+                                                         if sob['efficiency'] and eff[1] else None)
+                        line += (f"  |  sobol {sob['seconds']:7.3f} s relMSE {sob['rel_mse']:.3e} "
+                                 f"efficiency x{ratio_text(row['efficiency_ratio_sobol'])}")
                     rows.append(row)
-                    print(f"{name:16} {strategy:5} {spp:4} spp  mcplay {row['mcplay']['seconds']:7.3f} s "
-                          f"relMSE {row['mcplay']['rel_mse']:.3e}  |  Mitsuba {row['mitsuba']['seconds']:7.3f} s "
-                          f"relMSE {row['mitsuba']['rel_mse']:.3e}  |  time x{row['time_ratio']:.2f}  "
-                          f"efficiency x{row['efficiency_ratio']:.2f}", flush=True)
+                    print(line, flush=True)
     out = os.path.join(ROOT, 'build', 'bench-mitsuba.json')
     with open(out, 'w') as f:
         json.dump(rows, f, indent=1)
-    ratios = sorted(r['efficiency_ratio'] for r in rows if r['efficiency_ratio'])
     times = sorted(r['time_ratio'] for r in rows)
-    if ratios:
-        print(f'efficiency mcplay / Mitsuba over {len(ratios)} cells: median {ratios[len(ratios) // 2]:.2f}, '
-              f'range {ratios[0]:.2f} .. {ratios[-1]:.2f}; mcplay ahead in {sum(r >= 1 for r in ratios)}; '
-              f'time per image mcplay / Mitsuba: median {times[len(times) // 2]:.2f}')
+    for key, label in (('efficiency_ratio', 'mcplay'), ('efficiency_ratio_sobol', 'mcplay sobol')):
+        ratios = sorted(r[key] for r in rows if r.get(key))
+        if ratios:
+            print(f'efficiency {label} / Mitsuba over {len(ratios)} cells: median {ratios[len(ratios) // 2]:.2f}, '
+                  f'range {ratios[0]:.2f} .. {ratios[-1]:.2f}; ahead in {sum(r >= 1 for r in ratios)}')
+    if times:
+        print(f'time per image mcplay / Mitsuba: median {times[len(times) // 2]:.2f}, '
+              f'range {times[0]:.2f} .. {times[-1]:.2f}')
     for name in sorted({r['scene'] for r in rows}):
         print(f'references, mcplay against Mitsuba, {name}: relative MSE '
               + ', '.join(f"{r['strategy']} {r['refs_rel_mse']:.2e}" for r in rows if r['scene'] == name and r['spp'] == spps[0]))
