@@ -280,20 +280,19 @@ class PixelSampler {
     /// sobol_u32(low 32 bits of M' << sample_bits) ^ sobol_u32(s'): the pixel's part is
     /// computed once here.
     struct SobolRequest {
-        uint64_t dim_key = 0; ///< hash of the image's key and d
-        uint64_t high = 0;    ///< M' << sample_bits
-        uint64_t seeds = 0;   ///< two 32-bit scrambling seeds, keyed by dim_key and high >> 32
-        uint32_t high_digits[3] = {0, 0, 0}; ///< sobol_u32(high, c), c = 0, 1, 2
+        uint64_t high = 0;  ///< M' << sample_bits
+        uint64_t seeds = 0; ///< two 32-bit scrambling seeds, keyed by the image, d and high >> 32
+        uint32_t high_digits[3] = {0, 0, 0}; ///< sobol_u32(low 32 bits of high, c), c = 0, 1, 2
         IndexPermutation permutation;        ///< of the sample index, when there is no table
     };
 
     void prepare_sobol(int d, SobolRequest* r, uint16_t* row) const {
         using pixel_sampler_detail::kPerm4;
-        r->dim_key = hash_combine(image_key_, uint64_t(d));
+        const uint64_t dim_key = hash_combine(image_key_, uint64_t(d));
         uint64_t morton = 0;
         for (int shift = morton_bits_ - 2; shift >= 0; shift -= 2) {
             const uint64_t higher = morton_ >> (shift + 2);
-            const uint64_t h = mix64(r->dim_key ^ ((higher << 6) | uint64_t(shift)));
+            const uint64_t h = mix64(dim_key ^ ((higher << 6) | uint64_t(shift)));
             const uint32_t p = uint32_t((uint64_t(uint32_t(h >> 32)) * 24u) >> 32);
             const uint32_t digit = uint32_t(morton_ >> shift) & 3u;
             morton |= uint64_t((kPerm4.p[p] >> (2 * digit)) & 3u) << shift;
@@ -301,9 +300,9 @@ class PixelSampler {
         r->high = morton << sample_bits_;
         // The sample part lies below bit 32 (sample_bits <= 32): the bits of I above 32 are
         // the pixel's, so the seeds are too.
-        r->seeds = hash_combine(r->dim_key ^ 0x6f77656e5365656eULL, r->high >> 32); // "owenSeen"
+        r->seeds = hash_combine(dim_key ^ 0x6f77656e5365656eULL, r->high >> 32); // "owenSeen"
         for (int c = 0; c < 3; ++c) r->high_digits[c] = sobol_u32(uint32_t(r->high), c);
-        const uint64_t key = hash_combine(r->dim_key, morton_);
+        const uint64_t key = hash_combine(dim_key, morton_);
         if (row != nullptr)
             shuffle_row(row, key);
         else
