@@ -32,12 +32,21 @@ struct SphericalTriangle {
     double omega = 0.0;                        ///< solid angle
 };
 
-/// Solid angle of the triangle (a, b, c) seen from the origin, with det = a . (b x c)
-/// computed by the caller: tan(Omega / 2) = |det| / (|a||b||c| + (a.b)|c| + (a.c)|b| +
+/// The vertex vectors' lengths |a|, |b|, |c|.
+struct VertexLengths {
+    double a, b, c;
+};
+VertexLengths vertex_lengths(const Vec3& a, const Vec3& b, const Vec3& c) {
+    return {glm::length(a), glm::length(b), glm::length(c)};
+}
+
+/// Solid angle of the triangle (a, b, c) seen from the origin, with det = a . (b x c) and
+/// the lengths computed by the caller: tan(Omega / 2) = |det| / (|a||b||c| + (a.b)|c| + (a.c)|b| +
 /// (b.c)|a|) [VanOosteromStrackee83]. atan2 keeps the branch right past Omega = pi, where the
 /// denominator turns negative.
-double solid_angle(const Vec3& a, const Vec3& b, const Vec3& c, double det) {
-    double la = glm::length(a), lb = glm::length(b), lc = glm::length(c);
+double solid_angle(const Vec3& a, const Vec3& b, const Vec3& c, double det,
+                   const VertexLengths& len) {
+    const double la = len.a, lb = len.b, lc = len.c;
     double denom = la * lb * lc + glm::dot(a, b) * lc + glm::dot(a, c) * lb + glm::dot(b, c) * la;
     return 2.0 * std::atan2(std::fabs(det), denom);
 }
@@ -78,18 +87,17 @@ void half_angle(double cross_len, double dot_ab, double len_ab, double* sin_half
 /// Fills the map's parameters of the triangle with vertex vectors a, b, c, edges e1 = b - a,
 /// e2 = c - a and triple product det = a . (e1 x e2), det != 0.
 void fill_spherical(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& e1, const Vec3& e2,
-                    double det, SphericalTriangle* st) {
+                    double det, const VertexLengths& len, SphericalTriangle* st) {
     Vec3 n_ab = glm::cross(a, e1); // normal of the great circle through A and B
     Vec3 n_ac = glm::cross(a, e2); // ... through A and C
-    double la = glm::length(a), lb = glm::length(b);
+    const double la = len.a, lb = len.b;
     // The angle at A is the angle between the two arc planes; |n_ab x n_ac| = |a| |det|
     // since (a x e1) x (a x e2) = (a . (e1 x e2)) a. Near pi its supplement is kept instead.
     double cos_term = glm::dot(n_ab, n_ac);
     st->obtuse = cos_term < 0.0;
     unit_pair(la * std::fabs(det), std::fabs(cos_term), &st->sin_alpha, &st->cos_alpha);
     half_angle(glm::length(n_ab), glm::dot(a, b), la * lb, &st->sin_half_c, &st->cos_half_c);
-    half_angle(glm::length(n_ac), glm::dot(a, c), la * glm::length(c), &st->sin_half_b,
-               &st->cos_half_b);
+    half_angle(glm::length(n_ac), glm::dot(a, c), la * len.c, &st->sin_half_b, &st->cos_half_b);
     st->sin_b = 2.0 * st->sin_half_b * st->cos_half_b;
     st->cos_b = (st->cos_half_b - st->sin_half_b) * (st->cos_half_b + st->sin_half_b);
     st->A = a / la;
@@ -102,9 +110,10 @@ void fill_spherical(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& e1,
 bool setup_spherical(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& e1, const Vec3& e2,
                      const Vec3& cross_normal, SphericalTriangle* st) {
     double det = glm::dot(a, cross_normal);
-    st->omega = solid_angle(a, b, c, det);
+    const VertexLengths len = vertex_lengths(a, b, c); // shared by both
+    st->omega = solid_angle(a, b, c, det, len);
     if (!spherical_applies(det, st->omega)) return false;
-    fill_spherical(a, b, c, e1, e2, det, st);
+    fill_spherical(a, b, c, e1, e2, det, len, st);
     return true;
 }
 
@@ -324,7 +333,8 @@ double LightSet::pdf(const Vec3& ref, uint32_t triangle, const Vec3& point,
         // The same rule as sample: the same solid angle and the same regime test.
         Vec3 a = l.p0 - ref;
         double det = glm::dot(a, n);
-        double omega = solid_angle(a, l.p1 - ref, l.p2 - ref, det);
+        const Vec3 b = l.p1 - ref, c = l.p2 - ref;
+        double omega = solid_angle(a, b, c, det, vertex_lengths(a, b, c));
         if (spherical_applies(det, omega)) return pmf / omega;
     }
     return pmf * area_to_solid_angle(ref, point, n);
@@ -338,7 +348,7 @@ Vec3 LightSet::emitted(uint32_t triangle, const Vec3& w) const {
 // --- Spherical triangles and polygons ------------------------------------------------------
 
 double spherical_triangle_area(const Vec3& a, const Vec3& b, const Vec3& c) {
-    return solid_angle(a, b, c, glm::dot(a, glm::cross(b - a, c - a)));
+    return solid_angle(a, b, c, glm::dot(a, glm::cross(b - a, c - a)), vertex_lengths(a, b, c));
 }
 
 Vec3 sample_spherical_triangle(const Vec3& a, const Vec3& b, const Vec3& c, const Vec2& u,
@@ -348,12 +358,13 @@ Vec3 sample_spherical_triangle(const Vec3& a, const Vec3& b, const Vec3& c, cons
     Vec3 e1 = b - a, e2 = c - a;
     double det = glm::dot(a, glm::cross(e1, e2));
     SphericalTriangle st;
-    st.omega = solid_angle(a, b, c, det);
+    const VertexLengths len = vertex_lengths(a, b, c);
+    st.omega = solid_angle(a, b, c, det, len);
     if (det == 0.0 || !(st.omega > 0.0) || !std::isfinite(st.omega)) {
         if (pdf) *pdf = 0.0;
         return Vec3(0.0);
     }
-    fill_spherical(a, b, c, e1, e2, det, &st);
+    fill_spherical(a, b, c, e1, e2, det, len, &st);
     if (pdf) *pdf = 1.0 / st.omega;
     return sample_spherical(st, u);
 }
