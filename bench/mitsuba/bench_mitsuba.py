@@ -27,6 +27,13 @@ also compared with each other (the same relative MSE), which says whether they r
 image. With --sobol, mcplay also renders every cell with its Owen-scrambled Sobol' pixel sampler
 (`--pixel-sampler sobol`; the default is stratified), scored against the same mcplay reference:
 one more column, and its own efficiency ratio against Mitsuba.
+
+A relative MSE marked `!` (with the number) rests on fewer than 10 effective pixel terms, Kish's
+(sum t)^2 / sum t^2 over the pixel terms t of the cell's images: a few rare large pixel errors
+(a camera ray that hits a small bright emitter from a pixel that barely sees it, a heavy-tailed
+BSDF-sampled weight) rule it, so one run of the cell says little and its efficiency ratio is
+noise; rerun with more --images. mcplay's studies flag such levels `rare_large_errors` by the
+same rule. The summary gives the medians with and without the marked cells.
 """
 import argparse
 import base64
@@ -249,20 +256,48 @@ def relative_mse(img, ref, ref_var):
     return float(np.mean(np.where(ok, ((img - ref) ** 2 - ref_var) / (ref ** 2 + eps), 0.0)))
 
 
+def pixel_terms(img, ref):
+    """Each pixel's share of the relative MSE (before the reference's noise is subtracted)."""
+    eps = 1e-2 * np.mean(luminance(ref)) ** 2
+    ok = np.isfinite(img) & np.isfinite(ref)
+    return np.where(ok, (img - ref) ** 2 / (ref ** 2 + eps), 0.0).sum(axis=-1).ravel()
+
+
+# Below this many effective pixel terms a cell's relative MSE is ruled by a few rare large
+# pixel errors (mcplay's studies flag such levels rare_large_errors with the same rule).
+MIN_EFFECTIVE_TERMS = 10
+
+
+def effective_terms(terms):
+    """Kish's effective number of terms, (sum t)^2 / sum t^2 (Kish 1965)."""
+    t = np.concatenate(terms)
+    total, squares = float(t.sum()), float((t ** 2).sum())
+    return total / math.sqrt(squares) * (total / math.sqrt(squares)) if squares > 0 else math.inf
+
+
 def scored(renderer, strategy, spp, ref, images):
     """The mean relative MSE of `images` images of different seeds (one image's is noisy where
-    the weights are heavy-tailed) and the smallest time among them (at least two runs)."""
-    rels, best = [], math.inf
+    the weights are heavy-tailed), the effective number of pixel terms behind it, and the
+    smallest time among them (at least two runs)."""
+    rels, terms, best = [], [], math.inf
     for k in range(max(images, 2)):
         im, s = renderer.render(strategy, spp, 7 + k)
         if k < images:
             rels.append(relative_mse(im, *ref))
+            terms.append(pixel_terms(im, ref[0]))
         best = min(best, s)
-    return float(np.mean(rels)), best
+    return float(np.mean(rels)), effective_terms(terms), best
 
 
 def ratio_text(r):
     return f'{r:.2f}' if r is not None else 'n/a'
+
+
+def rel_text(run):
+    """The relative MSE, marked '!' (with the effective number of pixel terms) where a few
+    rare large pixel errors rule it: such a cell needs more images (--images)."""
+    text = f"{run['rel_mse']:.3e}"
+    return text + (f" !{run['effective_terms']:.1f}" if run['rare_large_errors'] else '')
 
 
 def main():
@@ -322,21 +357,24 @@ def main():
                     if args.sobol:
                         runs.append(('mcplay_sobol', mcp_sobol, 'mcplay'))
                     for label, r, ref_label in runs:
-                        rel, s = scored(r, strategy, spp, refs[ref_label], args.images)
-                        row[label] = {'seconds': s, 'rel_mse': rel,
+                        rel, n_eff, s = scored(r, strategy, spp, refs[ref_label], args.images)
+                        row[label] = {'seconds': s, 'rel_mse': rel, 'effective_terms': n_eff,
+                                      'rare_large_errors': n_eff < MIN_EFFECTIVE_TERMS,
                                       'efficiency': 1 / (rel * s) if rel > 0 and s > 0 else None}
                     eff = [row[k]['efficiency'] for k in ('mcplay', 'mitsuba')]
                     row['time_ratio'] = row['mcplay']['seconds'] / row['mitsuba']['seconds']
                     row['efficiency_ratio'] = eff[0] / eff[1] if None not in eff else None
+                    row['rare_large_errors'] = any(row[k]['rare_large_errors'] for k in ('mcplay', 'mitsuba'))
                     line = (f"{name:16} {strategy:5} {spp:4} spp  mcplay {row['mcplay']['seconds']:7.3f} s "
-                            f"relMSE {row['mcplay']['rel_mse']:.3e}  |  Mitsuba {row['mitsuba']['seconds']:7.3f} s "
-                            f"relMSE {row['mitsuba']['rel_mse']:.3e}  |  time x{row['time_ratio']:.2f}  "
+                            f"relMSE {rel_text(row['mcplay'])}  |  Mitsuba {row['mitsuba']['seconds']:7.3f} s "
+                            f"relMSE {rel_text(row['mitsuba'])}  |  time x{row['time_ratio']:.2f}  "
                             f"efficiency x{ratio_text(row['efficiency_ratio'])}")
                     if args.sobol:
                         sob = row['mcplay_sobol']
                         row['efficiency_ratio_sobol'] = (sob['efficiency'] / eff[1]
                                                          if sob['efficiency'] and eff[1] else None)
-                        line += (f"  |  sobol {sob['seconds']:7.3f} s relMSE {sob['rel_mse']:.3e} "
+                        row['rare_large_errors_sobol'] = sob['rare_large_errors'] or row['mitsuba']['rare_large_errors']
+                        line += (f"  |  sobol {sob['seconds']:7.3f} s relMSE {rel_text(sob)} "
                                  f"efficiency x{ratio_text(row['efficiency_ratio_sobol'])}")
                     rows.append(row)
                     print(line, flush=True)
@@ -344,11 +382,18 @@ def main():
     with open(out, 'w') as f:
         json.dump(rows, f, indent=1)
     times = sorted(r['time_ratio'] for r in rows)
-    for key, label in (('efficiency_ratio', 'mcplay'), ('efficiency_ratio_sobol', 'mcplay sobol')):
+    for key, flag, label in (('efficiency_ratio', 'rare_large_errors', 'mcplay'),
+                             ('efficiency_ratio_sobol', 'rare_large_errors_sobol', 'mcplay sobol')):
         ratios = sorted(r[key] for r in rows if r.get(key))
         if ratios:
             print(f'efficiency {label} / Mitsuba over {len(ratios)} cells: median {ratios[len(ratios) // 2]:.2f}, '
                   f'range {ratios[0]:.2f} .. {ratios[-1]:.2f}; ahead in {sum(r >= 1 for r in ratios)}')
+        steady = sorted(r[key] for r in rows if r.get(key) and not r.get(flag))
+        if ratios and len(steady) < len(ratios):
+            median = f'median {steady[len(steady) // 2]:.2f}, ' if steady else ''
+            print(f'  {len(ratios) - len(steady)} cell(s) marked ! rest on fewer than {MIN_EFFECTIVE_TERMS} '
+                  f'effective pixel terms (rare large errors: more --images); the other {len(steady)}: '
+                  f'{median}ahead in {sum(r >= 1 for r in steady)}')
     if times:
         print(f'time per image mcplay / Mitsuba: median {times[len(times) // 2]:.2f}, '
               f'range {times[0]:.2f} .. {times[-1]:.2f}')
