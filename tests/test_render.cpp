@@ -44,6 +44,26 @@ RenderSettings settings(int w, int h, uint64_t spp, uint64_t stream) {
     return s;
 }
 
+// A stratum's position (k + u) / n and quotient k / n: a power of two n multiplies by its
+// reciprocal and shifts, which must give the division's bits exactly (images do not change
+// with the path taken); other counts divide.
+TEST(PixelSamplerStratified, StrataScaleGivesTheDivisionsBits) {
+    Pcg32 rng(2027u, 3u);
+    std::vector<uint64_t> counts = {1, 3, 12, 100, 4101};
+    for (int b = 1; b <= 40; ++b) counts.push_back(uint64_t(1) << b);
+    for (uint64_t n : counts) {
+        SCOPED_TRACE(n);
+        const pixel_sampler_detail::StrataScale scale(n);
+        for (int i = 0; i < 2000; ++i) {
+            const uint64_t k = (uint64_t(rng.next_u32()) << 32 | rng.next_u32()) % n;
+            const double u = i == 0 ? 0.0 : (i == 1 ? 1.0 - 0x1p-53 : rng.next_double());
+            ASSERT_EQ(scale.position(k, u), (static_cast<double>(k) + u) / static_cast<double>(n));
+            const uint64_t cell = uint64_t(rng.next_u32()) << (i % 32) | rng.next_u32();
+            ASSERT_EQ(scale.quotient(cell), cell / n);
+        }
+    }
+}
+
 // The stratified pixel sampler: in every dimension a pixel's spp samples take each stratum
 // once (1D: [k/spp, (k+1)/spp); 2D: each cell of the grid), and the permutations that pair the
 // strata are uniform and independent between dimensions and pixels. Checked on the shuffled

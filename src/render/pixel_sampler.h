@@ -109,6 +109,28 @@ inline int ceil_log2(uint64_t n) {
     return k;
 }
 
+/// Division by a stratum count n: (k + u) / n and k / n. A power of two takes a
+/// multiplication by its exact reciprocal and a shift, which give the division's bits
+/// (scaling by a power of two is exact) without its latency; other counts divide.
+class StrataScale {
+  public:
+    StrataScale() = default;
+    explicit StrataScale(uint64_t n)
+        : n_(n > 0 ? n : 1), pow2_((n_ & (n_ - 1)) == 0), shift_(ceil_log2(n_)),
+          inverse_(1.0 / double(n_)) {}
+    double position(uint64_t k, double u) const {
+        const double x = static_cast<double>(k) + u;
+        return pow2_ ? x * inverse_ : x / static_cast<double>(n_);
+    }
+    uint64_t quotient(uint64_t k) const { return pow2_ ? k >> shift_ : k / n_; }
+
+  private:
+    uint64_t n_ = 1;
+    bool pow2_ = true;
+    int shift_ = 0;
+    double inverse_ = 1.0;
+};
+
 } // namespace pixel_sampler_detail
 
 struct ChoiceSample {
@@ -144,6 +166,9 @@ class PixelSampler {
         auto grid = stratification_grid(spp, 2);
         grid_x_ = grid[0];
         grid_y_ = grid[1];
+        strata_1d_ = StrataScale(spp);
+        strata_x_ = StrataScale(grid_x_);
+        strata_y_ = StrataScale(grid_y_);
         int side = width > height ? width : height;
         sample_bits_ = ceil_log2(spp);
         if (sample_bits_ > 32) sample_bits_ = 32;
@@ -185,8 +210,7 @@ class PixelSampler {
         if (kind_ == PixelSamplerKind::Independent || d >= kStratifiedDimensions || spp_ <= 1)
             return rng_.next_double();
         uint64_t stratum = stratum_of_sample(d);
-        return clamp_open((static_cast<double>(stratum) + rng_.next_double()) /
-                          static_cast<double>(spp_));
+        return clamp_open(strata_1d_.position(stratum, rng_.next_double()));
     }
 
     // The two draws are separate statements: the order in which function arguments are
@@ -206,9 +230,8 @@ class PixelSampler {
         if (kind_ == PixelSamplerKind::Independent || d >= kStratifiedDimensions || spp_ <= 1)
             return Vec2(u0, u1);
         uint64_t cell = stratum_of_sample(d);
-        uint64_t cx = cell % grid_x_, cy = cell / grid_x_;
-        return Vec2(clamp_open((static_cast<double>(cx) + u0) / static_cast<double>(grid_x_)),
-                    clamp_open((static_cast<double>(cy) + u1) / static_cast<double>(grid_y_)));
+        uint64_t cy = strata_x_.quotient(cell), cx = cell - cy * grid_x_;
+        return Vec2(clamp_open(strata_x_.position(cx, u0)), clamp_open(strata_y_.position(cy, u1)));
     }
 
     /// A discrete choice and the 2D sample it conditions (a light and a point on it, a BSDF
@@ -351,6 +374,7 @@ class PixelSampler {
 
     PixelSamplerKind kind_ = PixelSamplerKind::Independent;
     uint64_t spp_ = 1, grid_x_ = 1, grid_y_ = 1;
+    pixel_sampler_detail::StrataScale strata_1d_, strata_x_, strata_y_; // spp_, grid_x_, grid_y_
     uint64_t width_ = 1, image_key_ = 0;
     uint64_t key_ = 0, index_ = 0, morton_ = 0;
     int sample_bits_ = 0, morton_bits_ = 0;
