@@ -33,7 +33,10 @@ A relative MSE marked `!` (with the number) rests on fewer than 10 effective pix
 (a camera ray that hits a small bright emitter from a pixel that barely sees it, a heavy-tailed
 BSDF-sampled weight) rule it, so one run of the cell says little and its efficiency ratio is
 noise; rerun with more --images. mcplay's studies flag such levels `rare_large_errors` by the
-same rule. The summary gives the medians with and without the marked cells.
+same rule. The summary gives the medians with and without the marked cells. A relative MSE in
+parentheses is below the reference's own noise (the mean of v / (R^2 + eps), what is
+subtracted): it cannot be told from 0 with this reference, and its efficiency ratio says only
+"far ahead".
 """
 import argparse
 import base64
@@ -256,6 +259,14 @@ def relative_mse(img, ref, ref_var):
     return float(np.mean(np.where(ok, ((img - ref) ** 2 - ref_var) / (ref ** 2 + eps), 0.0)))
 
 
+def reference_noise(ref, ref_var):
+    """The reference's own noise in relative MSE (what relative_mse subtracts): a relative MSE
+    below it cannot be told from 0 with this reference."""
+    eps = 1e-2 * np.mean(luminance(ref)) ** 2
+    ok = np.isfinite(ref) & np.isfinite(ref_var)
+    return float(np.mean(np.where(ok, ref_var / (ref ** 2 + eps), 0.0)))
+
+
 def pixel_terms(img, ref):
     """Each pixel's share of the relative MSE (before the reference's noise is subtracted)."""
     eps = 1e-2 * np.mean(luminance(ref)) ** 2
@@ -297,6 +308,8 @@ def rel_text(run):
     """The relative MSE, marked '!' (with the effective number of pixel terms) where a few
     rare large pixel errors rule it: such a cell needs more images (--images)."""
     text = f"{run['rel_mse']:.3e}"
+    if run['below_reference_noise']:
+        text = f'({text})'
     return text + (f" !{run['effective_terms']:.1f}" if run['rare_large_errors'] else '')
 
 
@@ -360,6 +373,7 @@ def main():
                         rel, n_eff, s = scored(r, strategy, spp, refs[ref_label], args.images)
                         row[label] = {'seconds': s, 'rel_mse': rel, 'effective_terms': n_eff,
                                       'rare_large_errors': n_eff < MIN_EFFECTIVE_TERMS,
+                                      'below_reference_noise': rel < reference_noise(*refs[ref_label]),
                                       'efficiency': 1 / (rel * s) if rel > 0 and s > 0 else None}
                     eff = [row[k]['efficiency'] for k in ('mcplay', 'mitsuba')]
                     row['time_ratio'] = row['mcplay']['seconds'] / row['mitsuba']['seconds']
