@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 
+#include "core/points.h"  // u63_to_double
 #include "core/special.h" // kPi
 #include "core/trig.h"
 
@@ -268,7 +269,7 @@ double LightSet::total_power() const {
 
 double LightSet::selection_pmf(int light) const {
     if (light < 0 || size_t(light) >= lights_.size()) return 0.0;
-    if (selection_pmf_.empty()) return 1.0 / double(lights_.size());
+    if (selection_pmf_.empty()) return 1.0 / u63_to_double(lights_.size());
     return selection_pmf_[size_t(light)];
 }
 
@@ -276,8 +277,8 @@ int LightSet::select(double u_select, double* pmf) const {
     size_t n = lights_.size();
     size_t i;
     if (selection_cdf_.empty()) {
-        i = std::min(n - 1, size_t(fmax_inline(0.0, u_select) * double(n)));
-        *pmf = 1.0 / double(n);
+        i = std::min(n - 1, size_t(fmax_inline(0.0, u_select) * u63_to_double(n)));
+        *pmf = 1.0 / u63_to_double(n);
     } else {
         // cdf[i] <= u < cdf[i + 1]: lights of zero weight span an empty interval.
         auto it = std::upper_bound(selection_cdf_.begin(), selection_cdf_.end(), u_select);

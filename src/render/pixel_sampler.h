@@ -52,6 +52,7 @@
 #include <string>
 #include <vector>
 
+#include "core/points.h"
 #include "core/qmc.h"
 #include "core/rng.h"
 #include "core/samplers.h"
@@ -117,10 +118,10 @@ class StrataScale {
     StrataScale() = default;
     explicit StrataScale(uint64_t n)
         : n_(n > 0 ? n : 1), pow2_((n_ & (n_ - 1)) == 0), shift_(ceil_log2(n_)),
-          inverse_(1.0 / double(n_)) {}
+          count_(u63_to_double(n_)), inverse_(1.0 / count_) {}
     double position(uint64_t k, double u) const {
-        const double x = static_cast<double>(k) + u;
-        return pow2_ ? x * inverse_ : x / static_cast<double>(n_);
+        const double x = u63_to_double(k) + u;
+        return pow2_ ? x * inverse_ : x / count_;
     }
     uint64_t quotient(uint64_t k) const { return pow2_ ? k >> shift_ : k / n_; }
 
@@ -128,7 +129,7 @@ class StrataScale {
     uint64_t n_ = 1;
     bool pow2_ = true;
     int shift_ = 0;
-    double inverse_ = 1.0;
+    double count_ = 1.0, inverse_ = 1.0; // n and 1 / n
 };
 
 } // namespace pixel_sampler_detail

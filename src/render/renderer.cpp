@@ -1,6 +1,7 @@
 #include "render/renderer.h"
 
 #include "core/parallel.h"
+#include "core/points.h" // u63_to_double
 
 #include <algorithm>
 #include <chrono>
@@ -72,7 +73,7 @@ void render_rows(const RenderScene& rs, const RenderEstimator& est, const Render
                 }
                 ++kept;
                 Vec3 delta = L - mean;
-                mean += delta / double(kept);
+                mean += delta / u63_to_double(kept);
                 m2 += delta * (L - mean);
                 double lum = std::fabs(luminance(L));
                 lum_sum += lum;
@@ -88,7 +89,8 @@ void render_rows(const RenderScene& rs, const RenderEstimator& est, const Render
                 diag.max_sample_share = std::max(diag.max_sample_share, share);
                 if (share > 0.5) ++diag.dominated_pixels;
             }
-            Vec3 var_mean = kept > 1 ? m2 / (double(kept) * double(kept - 1)) : Vec3(NAN);
+            Vec3 var_mean =
+                kept > 1 ? m2 / (u63_to_double(kept) * u63_to_double(kept - 1)) : Vec3(NAN);
             for (int c = 0; c < 3; ++c) {
                 image.rgb[pixel * 3 + size_t(c)] = kept > 0 ? mean[c] : NAN;
                 image.variance[pixel * 3 + size_t(c)] = var_mean[c];
