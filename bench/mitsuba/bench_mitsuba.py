@@ -253,25 +253,28 @@ def reference(renderer, strategy, spp):
     return (a + b) / 2, (a - b) ** 2 / 4
 
 
-def relative_mse(img, ref, ref_var):
+def relative(x, ref, *others):
+    """x / (R^2 + eps) per pixel and channel, 0 where x, R or any of `others` is not finite."""
     eps = 1e-2 * np.mean(luminance(ref)) ** 2
-    ok = np.isfinite(img) & np.isfinite(ref)
-    return float(np.mean(np.where(ok, ((img - ref) ** 2 - ref_var) / (ref ** 2 + eps), 0.0)))
+    ok = np.isfinite(x) & np.isfinite(ref)
+    for o in others:
+        ok &= np.isfinite(o)
+    return np.where(ok, x / (ref ** 2 + eps), 0.0)
+
+
+def relative_mse(img, ref, ref_var):
+    return float(np.mean(relative((img - ref) ** 2 - ref_var, ref, img)))
 
 
 def reference_noise(ref, ref_var):
     """The reference's own noise in relative MSE (what relative_mse subtracts): a relative MSE
     below it cannot be told from 0 with this reference."""
-    eps = 1e-2 * np.mean(luminance(ref)) ** 2
-    ok = np.isfinite(ref) & np.isfinite(ref_var)
-    return float(np.mean(np.where(ok, ref_var / (ref ** 2 + eps), 0.0)))
+    return float(np.mean(relative(ref_var, ref)))
 
 
 def pixel_terms(img, ref):
     """Each pixel's share of the relative MSE (before the reference's noise is subtracted)."""
-    eps = 1e-2 * np.mean(luminance(ref)) ** 2
-    ok = np.isfinite(img) & np.isfinite(ref)
-    return np.where(ok, (img - ref) ** 2 / (ref ** 2 + eps), 0.0).sum(axis=-1).ravel()
+    return relative((img - ref) ** 2, ref, img).sum(axis=-1).ravel()
 
 
 # Below this many effective pixel terms a cell's relative MSE is ruled by a few rare large
@@ -362,6 +365,7 @@ def main():
                               f'{time.perf_counter() - t0:.1f} s', file=sys.stderr)
                     cache[ref_strategy] = refs
                 refs = cache[ref_strategy]
+                noise = {label: reference_noise(*ref) for label, ref in refs.items()}
                 between = relative_mse(refs['mcplay'][0], refs['mitsuba'][0], refs['mitsuba'][1])
                 mit.render(strategy, spps[0], 3)  # compiles Mitsuba's kernels for this size
                 for spp in spps:
@@ -373,7 +377,7 @@ def main():
                         rel, n_eff, s = scored(r, strategy, spp, refs[ref_label], args.images)
                         row[label] = {'seconds': s, 'rel_mse': rel, 'effective_terms': n_eff,
                                       'rare_large_errors': n_eff < MIN_EFFECTIVE_TERMS,
-                                      'below_reference_noise': rel < reference_noise(*refs[ref_label]),
+                                      'below_reference_noise': rel < noise[ref_label],
                                       'efficiency': 1 / (rel * s) if rel > 0 and s > 0 else None}
                     eff = [row[k]['efficiency'] for k in ('mcplay', 'mitsuba')]
                     row['time_ratio'] = row['mcplay']['seconds'] / row['mitsuba']['seconds']
