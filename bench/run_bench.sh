@@ -8,6 +8,7 @@ tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 echo "mcplay bench: samples per second of the estimator loop (best of 5 runs of 2^22 samples, one thread;"
 echo "  render/*_rays: rays per second per core (camera, shadow and bounce rays), 64x64 at 16 spp, best of 3;"
+echo "  rays/*: the accelerator alone, rays per second: a pixel's camera rays, shadow rays to the lights;"
 echo "  wasm under node --no-liftoff: steady-state optimised code, as a browser reaches after tier-up)"
 echo "machine: $(nproc) cores, $(uname -m), $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //')"
 $native scenes $((1 << 22)) --accumulation >"$tmp/native"
@@ -15,7 +16,7 @@ $wasm scenes $((1 << 22)) --accumulation >"$tmp/wasm"
 # The estimator cases again, native and wasm in turn, case by case (ROUNDS more times): both
 # sides of a ratio then see the same machine load, and each figure is the best of its rounds.
 rounds=${ROUNDS:-2}
-cases=$(grep ^BENCH "$tmp/native" | awk '{print $2}' | grep -v '^render/\|^eval/\|^pcg32\|hand_loop' |
+cases=$(grep ^BENCH "$tmp/native" | awk '{print $2}' | grep -v '^render/\|^rays/\|^eval/\|^pcg32\|hand_loop' |
         cut -d/ -f2 | sort -u)
 for ((r = 0; r < rounds; ++r)); do
     for c in $cases; do

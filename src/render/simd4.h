@@ -9,6 +9,9 @@
 #if defined(__SSE__)
 #include <xmmintrin.h>
 #endif
+#if defined(__EMSCRIPTEN__)
+#include <wasm_simd128.h>
+#endif
 
 namespace mcp {
 
@@ -34,11 +37,22 @@ inline F4 operator*(F4 a, F4 b) {
 }
 /// x > y ? x : y per lane: y when x is NaN.
 inline F4 f4_max_keep(F4 x, F4 y) {
+#if defined(__EMSCRIPTEN__)
+    // Emscripten's _mm_max_ps is a compare and a bitselect; f32x4.pmax(a, b) = a < b ? b : a
+    // is one instruction with maxps's semantics (V8 emits maxps).
+    return {(__m128)wasm_f32x4_pmax((v128_t)y.v, (v128_t)x.v)};
+#else
     return {_mm_max_ps(x.v, y.v)};
+#endif
 }
 /// x < y ? x : y per lane: y when x is NaN.
 inline F4 f4_min_keep(F4 x, F4 y) {
+#if defined(__EMSCRIPTEN__)
+    // f32x4.pmin(a, b) = b < a ? b : a, as for pmax above.
+    return {(__m128)wasm_f32x4_pmin((v128_t)y.v, (v128_t)x.v)};
+#else
     return {_mm_min_ps(x.v, y.v)};
+#endif
 }
 /// Bit i set where lane i of a <= b.
 inline int f4_le_mask(F4 a, F4 b) {
