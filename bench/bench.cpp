@@ -292,7 +292,85 @@ void traversal_rays_per_second(const std::string& dir, const char* scene) {
                 double(occluded) / double(std::max<size_t>(shadow.size(), 1)));
 }
 
+// Where brute force stops paying (Accelerator::kBruteForceMaxTriangles): rays per second of
+// both structures on closed polyhedra around the rays' origins (every ray hits one face, as in
+// a room), from 4 to 80 triangles. Random origins inside, random directions, best of three.
+void brute_force_crossover() {
+    // Unit-sphere polyhedra: tetrahedron, octahedron, icosahedron, and each face of the
+    // octahedron and icosahedron split in four (32 and 80 faces).
+    auto polyhedron = [](int kind) {
+        Mesh m;
+        const double t = (1.0 + std::sqrt(5.0)) / 2.0;
+        if (kind == 0) {
+            m.position = {Vec3(1, 1, 1), Vec3(1, -1, -1), Vec3(-1, 1, -1), Vec3(-1, -1, 1)};
+            m.index = {{0, 1, 2}, {0, 3, 1}, {0, 2, 3}, {1, 3, 2}};
+        } else if (kind == 1 || kind == 3) {
+            m.position = {Vec3(1, 0, 0), Vec3(-1, 0, 0), Vec3(0, 1, 0),
+                          Vec3(0, -1, 0), Vec3(0, 0, 1), Vec3(0, 0, -1)};
+            m.index = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4},
+                       {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
+        } else {
+            m.position = {Vec3(-1, t, 0), Vec3(1, t, 0), Vec3(-1, -t, 0), Vec3(1, -t, 0),
+                          Vec3(0, -1, t), Vec3(0, 1, t), Vec3(0, -1, -t), Vec3(0, 1, -t),
+                          Vec3(t, 0, -1), Vec3(t, 0, 1), Vec3(-t, 0, -1), Vec3(-t, 0, 1)};
+            m.index = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
+                       {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
+                       {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
+                       {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
+        }
+        if (kind >= 3) { // split each face in four at its edge midpoints
+            std::vector<std::array<uint32_t, 3>> split;
+            for (const auto& f : m.index) {
+                uint32_t mid[3];
+                for (int k = 0; k < 3; ++k) {
+                    mid[k] = uint32_t(m.position.size());
+                    m.position.push_back(0.5 * (m.position[f[k]] + m.position[f[(k + 1) % 3]]));
+                }
+                split.push_back({f[0], mid[0], mid[2]});
+                split.push_back({mid[0], f[1], mid[1]});
+                split.push_back({mid[2], mid[1], f[2]});
+                split.push_back({mid[0], mid[1], mid[2]});
+            }
+            m.index = split;
+        }
+        for (Vec3& p : m.position) p = glm::normalize(p);
+        return m;
+    };
+    Pcg32 rng(11u, 5u);
+    std::vector<Ray> rays(1 << 16);
+    for (Ray& r : rays) {
+        r.origin = 0.3 * Vec3(rng.next_double() - 0.5, rng.next_double() - 0.5,
+                              rng.next_double() - 0.5);
+        const double z = 2.0 * rng.next_double() - 1.0, phi = 6.283185307179586 * rng.next_double();
+        const double s = std::sqrt(std::max(0.0, 1.0 - z * z));
+        r.direction = Vec3(s * std::cos(phi), s * std::sin(phi), z);
+    }
+    for (int kind = 0; kind < 5; ++kind) {
+        const Mesh mesh = polyhedron(kind);
+        for (AccelKind k : {AccelKind::BruteForce, AccelKind::Bvh}) {
+            Accelerator a;
+            a.build(mesh, k);
+            double best = 0.0;
+            size_t hits = 0;
+            for (int rep = 0; rep < 4; ++rep) { // the first is a warm-up
+                auto t0 = std::chrono::steady_clock::now();
+                hits = 0;
+                for (const Ray& r : rays) {
+                    Hit h;
+                    hits += a.intersect(r, &h);
+                }
+                const double sec = seconds_since(t0);
+                if (rep > 0) best = std::max(best, double(rays.size()) / sec);
+            }
+            std::printf("BENCH rays/closed_%zu/%s %.6e\n", mesh.triangle_count(),
+                        k == AccelKind::Bvh ? "bvh" : "brute_force",
+                        hits == rays.size() ? best : 0.0);
+        }
+    }
+}
+
 void render_cases(const std::string& dir) {
+    brute_force_crossover();
     traversal_rays_per_second(dir, "cornell_box");
     traversal_rays_per_second(dir, "veach_mis");
     traversal_rays_per_second(dir, "quad_light_floor");

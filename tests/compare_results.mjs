@@ -1,4 +1,6 @@
-// Compares two mcplay result JSON files field by field, ignoring timings and thread counts.
+// Compares two mcplay result JSON files field by field, ignoring timings, thread counts and
+// the ray accelerator (each build picks brute force or the BVH by its own costs; both give the
+// same hits, which test_render_accel checks).
 // Estimates (per-replicate values and their means) must agree to 1e-12 relative; derived
 // spreads (variances, standard errors) amplify last-bit differences of the estimates by
 // mean^2 / variance, so they are held to 1e-6 relative, or to 1e-12 of the problem's scale
@@ -8,7 +10,7 @@ import { readFileSync } from 'node:fs';
 
 const [a, b] = process.argv.slice(2).map((f) => JSON.parse(readFileSync(f, 'utf8')));
 const ignored = new Set(['time_mean_s', 'time_std_s', 'time_median_s', 'time_median_ci95_s', 'time_total_s', 'training_time_mean_s', 'efficiency', 'wall_time_s', 'threads',
-  'rays_per_second', 'seconds', 'file']);
+  'rays_per_second', 'seconds', 'file', 'accel']);
 let worst = 0, worstPath = '', worstDerived = 0, worstDerivedPath = '', mismatches = [];
 const scaleOf = (r) => {
   let m = Math.abs(r.scene?.exact ?? 0);

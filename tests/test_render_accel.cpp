@@ -607,10 +607,41 @@ TEST(Accel, EmptyMeshNeverHits) {
     EXPECT_FALSE(unbuilt.occluded(ray));
 }
 
-TEST(Accel, AutoPicksBruteForceForSmallScenes) {
-    Mesh small = make_soup(int(Accelerator::kBruteForceMaxTriangles), 0.3, 3u);
-    EXPECT_EQ(build(small, AccelKind::Auto).stats().kind, AccelKind::BruteForce);
-    Mesh large = make_soup(int(Accelerator::kBruteForceMaxTriangles) + 1, 0.3, 3u);
+// Auto keeps the BVH of a small scene only when its expected cost per ray (node visits at
+// kNodeCost plus triangle tests, by surface area) is below brute force's triangle count.
+TEST(Accel, AutoPicksTheStructureOfLowerExpectedCost) {
+    // A closed tetrahedron: every box overlaps every other; the BVH saves no test.
+    Mesh tetra;
+    const Vec3 v[4] = {Vec3(1, 1, 1), Vec3(1, -1, -1), Vec3(-1, 1, -1), Vec3(-1, -1, 1)};
+    add_triangle(&tetra, v[0], v[1], v[2]);
+    add_triangle(&tetra, v[0], v[3], v[1]);
+    add_triangle(&tetra, v[0], v[2], v[3]);
+    add_triangle(&tetra, v[1], v[3], v[2]);
+    const Accelerator t = build(tetra, AccelKind::Auto);
+    EXPECT_EQ(t.stats().kind, AccelKind::BruteForce);
+    EXPECT_EQ(t.stats().expected_triangle_tests, 4.0);
+    // 16 small triangles in two clusters 100 apart: a ray meets one cluster's box at most,
+    // and each box is a small part of the scene's.
+    Mesh clusters = make_soup(8, 0.3, 3u);
+    const Mesh far = make_soup(8, 0.3, 5u);
+    for (size_t i = 0; i < far.triangle_count(); ++i) {
+        const Vec3 shift(100.0, 0.0, 0.0);
+        add_triangle(&clusters, far.vertex(i, 0) + shift, far.vertex(i, 1) + shift,
+                     far.vertex(i, 2) + shift);
+    }
+    const Accelerator c = build(clusters, AccelKind::Auto);
+    EXPECT_EQ(c.stats().kind, AccelKind::Bvh);
+    EXPECT_LT(Accelerator::kNodeCost * c.stats().expected_node_visits +
+                  c.stats().expected_triangle_tests,
+              16.0);
+    // The BVH built on request reports the tetrahedron's expected costs, above brute force's.
+    const Accelerator tb = build(tetra, AccelKind::Bvh);
+    EXPECT_EQ(tb.stats().kind, AccelKind::Bvh);
+    EXPECT_GE(Accelerator::kNodeCost * tb.stats().expected_node_visits +
+                  tb.stats().expected_triangle_tests,
+              4.0);
+    // Above kAutoMaxTriangles the BVH is kept without comparing.
+    Mesh large = make_soup(int(Accelerator::kAutoMaxTriangles) + 1, 0.3, 3u);
     EXPECT_EQ(build(large, AccelKind::Auto).stats().kind, AccelKind::Bvh);
 }
 

@@ -351,10 +351,9 @@ void Accelerator::build(const Mesh& mesh, AccelKind kind) {
         prims.push_back(prim);
     }
     const uint32_t n = static_cast<uint32_t>(prims.size());
-    if (kind == AccelKind::Auto) {
-        kind = n <= kBruteForceMaxTriangles ? AccelKind::BruteForce : AccelKind::Bvh;
-    }
-    stats_.kind = kind;
+    // Auto on a small scene builds the BVH and keeps it only if it is expected to pay.
+    const bool choose = kind == AccelKind::Auto && n <= kAutoMaxTriangles;
+    if (kind == AccelKind::Auto) kind = n > 0 ? AccelKind::Bvh : AccelKind::BruteForce;
 
     if (kind == AccelKind::Bvh && n > 0) {
         const std::vector<BuildNode> tree = build_binary(prims, &stats_.build_depth);
@@ -426,6 +425,36 @@ void Accelerator::build(const Mesh& mesh, AccelKind kind) {
         }
         nodes_.shrink_to_fit();
         stats_.nodes = static_cast<uint32_t>(nodes_.size());
+        // Surface area heuristic [MacDonaldBooth90]: the root is always visited; a child box
+        // is entered with the ratio of its area to the root's.
+        const double root_area = tree[0].bounds.half_area();
+        stats_.expected_node_visits = 1.0;
+        for (const Node4& node : nodes_) {
+            for (int l = 0; l < 4; ++l) {
+                const double dx = double(node.bounds[3][l]) - double(node.bounds[0][l]);
+                const double dy = double(node.bounds[4][l]) - double(node.bounds[1][l]);
+                const double dz = double(node.bounds[5][l]) - double(node.bounds[2][l]);
+                if (!(dx >= 0.0)) continue; // an unused lane's empty box
+                const double p = root_area > 0.0 ? (dx * dy + dy * dz + dz * dx) / root_area : 1.0;
+                if (node.count[l] == 0)
+                    stats_.expected_node_visits += std::min(1.0, p);
+                else
+                    stats_.expected_triangle_tests += std::min(1.0, p) * node.count[l];
+            }
+        }
+        const double bvh_cost =
+            kNodeCost * stats_.expected_node_visits + stats_.expected_triangle_tests;
+        if (choose && !(bvh_cost < double(n))) {
+            kind = AccelKind::BruteForce;
+            nodes_.clear();
+            nodes_.shrink_to_fit();
+            stats_ = AccelStats();
+        }
+    }
+    stats_.kind = kind;
+    if (kind == AccelKind::BruteForce) {
+        stats_.expected_node_visits = 0.0;
+        stats_.expected_triangle_tests = double(n);
     }
 
     // Triangles in leaf order (build order for brute force).

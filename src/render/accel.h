@@ -1,7 +1,7 @@
 // Ray-scene intersection: a bounding volume hierarchy built with binned SAH [Wald07] and
 // collapsed to four children per node, whose boxes are tested four at a time [Wald08], or a
-// brute-force loop when the scene is too small for a BVH to pay, both on the watertight
-// ray-triangle test of [Woop13].
+// brute-force loop when the surface area heuristic [MacDonaldBooth90] expects the BVH not to
+// pay, both on the watertight ray-triangle test of [Woop13].
 #pragma once
 
 #include <cstdint>
@@ -26,12 +26,30 @@ struct AccelStats {
     uint32_t max_depth = 0;                 ///< of the 4-wide tree (root at 0)
     uint32_t build_depth = 0; ///< of the binary SAH tree it was collapsed from (<= 64)
     uint64_t bytes = 0;       ///< memory of the structure
+    /// Per ray, by the surface area heuristic [MacDonaldBooth90]: the 4-wide nodes a ray
+    /// visits and the triangles it tests, each weighted by the chance that a ray meeting the
+    /// scene's box meets its box (area ratio). For brute force, 0 and the triangle count.
+    /// Filled for every BVH and for the scenes Auto chose between the two.
+    double expected_node_visits = 0.0;
+    double expected_triangle_tests = 0.0;
 };
 
 class Accelerator {
   public:
-    /// Scenes with at most this many triangles are intersected by brute force under Auto.
-    static constexpr size_t kBruteForceMaxTriangles = 16;
+    /// Under Auto, scenes of up to this many triangles get the structure of lower expected
+    /// cost per ray: brute force's triangle count against the BVH's expected triangle tests
+    /// plus kNodeCost per expected node visit. Larger scenes always get the BVH.
+    static constexpr size_t kAutoMaxTriangles = 64;
+    /// A 4-wide node visit's cost in triangle tests, measured with `make bench`
+    /// (rays/closed_N: both structures on closed meshes of 4 to 80 triangles; figures in
+    /// docs/benchmarks.md). V8 runs the float SIMD box test at about native speed and the
+    /// double-precision triangle test at about 0.65 of it, so a node costs fewer triangle tests
+    /// in wasm.
+#if defined(__EMSCRIPTEN__)
+    static constexpr double kNodeCost = 2.0;
+#else
+    static constexpr double kNodeCost = 4.5;
+#endif
 
     /// Builds over the mesh's triangles (which must outlive nothing: the accelerator keeps
     /// its own copy of the vertices it needs). Triangles with a non-finite vertex coordinate

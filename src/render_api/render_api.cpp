@@ -471,7 +471,9 @@ Json scene_to_json(const Loaded& l) {
                   {"leaves", a.leaves},
                   {"max_depth", a.max_depth},
                   {"build_depth", a.build_depth},
-                  {"bytes", a.bytes}}},
+                  {"bytes", a.bytes},
+                  {"expected_node_visits", a.expected_node_visits},
+                  {"expected_triangle_tests", a.expected_triangle_tests}}},
                 {"warnings", warnings}};
 }
 
