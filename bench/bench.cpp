@@ -305,8 +305,8 @@ void brute_force_crossover() {
             m.position = {Vec3(1, 1, 1), Vec3(1, -1, -1), Vec3(-1, 1, -1), Vec3(-1, -1, 1)};
             m.index = {{0, 1, 2}, {0, 3, 1}, {0, 2, 3}, {1, 3, 2}};
         } else if (kind == 1 || kind == 3) {
-            m.position = {Vec3(1, 0, 0), Vec3(-1, 0, 0), Vec3(0, 1, 0),
-                          Vec3(0, -1, 0), Vec3(0, 0, 1), Vec3(0, 0, -1)};
+            m.position = {Vec3(1, 0, 0),  Vec3(-1, 0, 0), Vec3(0, 1, 0),
+                          Vec3(0, -1, 0), Vec3(0, 0, 1),  Vec3(0, 0, -1)};
             m.index = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4},
                        {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
         } else {
@@ -339,8 +339,8 @@ void brute_force_crossover() {
     Pcg32 rng(11u, 5u);
     std::vector<Ray> rays(1 << 16);
     for (Ray& r : rays) {
-        r.origin = 0.3 * Vec3(rng.next_double() - 0.5, rng.next_double() - 0.5,
-                              rng.next_double() - 0.5);
+        r.origin =
+            0.3 * Vec3(rng.next_double() - 0.5, rng.next_double() - 0.5, rng.next_double() - 0.5);
         const double z = 2.0 * rng.next_double() - 1.0, phi = 6.283185307179586 * rng.next_double();
         const double s = std::sqrt(std::max(0.0, 1.0 - z * z));
         r.direction = Vec3(s * std::cos(phi), s * std::sin(phi), z);

@@ -62,7 +62,9 @@ class Accelerator {
     /// Any hit with 0 < t < ray.t_max (shadow rays).
     bool occluded(const Ray& ray) const;
 
-    const AccelStats& stats() const { return stats_; }
+    const AccelStats& stats() const {
+        return stats_;
+    }
 
   private:
     /// A 4-wide BVH node (128 bytes, two cache lines): its children's boxes as four lanes
