@@ -187,20 +187,26 @@ void accumulation_accuracy() {
 
 // Rays per second of one thread rendering a render scene with an estimator (camera, shadow
 // and bounce rays alike), best of three renders after a warm-up render.
-void render_rays_per_second(const std::string& dir, const char* scene, const char* estimator) {
+std::shared_ptr<RenderRequest> load_render(const std::string& dir, const char* scene) {
     std::ifstream in(dir + "/" + scene + ".json");
     std::stringstream ss;
     ss << in.rdbuf();
     Made<Json> j = parse_json(ss.str().c_str(), scene);
-    if (!j.ok()) return;
+    if (!j.ok()) return nullptr;
     Made<std::shared_ptr<RenderRequest>> r = build_render_request(j.value, Json{{"base_dir", dir}});
     if (!r.ok()) {
         std::fprintf(stderr, "bench: %s: %s\n", scene, r.error.c_str());
-        return;
+        return nullptr;
     }
+    return r.value;
+}
+
+void render_rays_per_second(const std::string& dir, const char* scene, const char* estimator) {
+    const std::shared_ptr<RenderRequest> request = load_render(dir, scene);
+    if (!request) return;
     RenderScene rs;
-    rs.build(*r.value->scene, r.value->accel);
-    for (const RenderEstimator& e : r.value->estimators) {
+    rs.build(*request->scene, request->accel);
+    for (const RenderEstimator& e : request->estimators) {
         if (e.name != estimator) continue;
         RenderSettings st;
         st.width = st.height = 64;
@@ -222,17 +228,12 @@ void render_rays_per_second(const std::string& dir, const char* scene, const cha
 // (any hit), as the direct-lighting integrator traces them. One thread, 64x64 pixels, best of
 // three after a warm-up; the rays are made before the clock starts.
 void traversal_rays_per_second(const std::string& dir, const char* scene) {
-    std::ifstream in(dir + "/" + scene + ".json");
-    std::stringstream ss;
-    ss << in.rdbuf();
-    Made<Json> j = parse_json(ss.str().c_str(), scene);
-    if (!j.ok()) return;
-    Made<std::shared_ptr<RenderRequest>> r = build_render_request(j.value, Json{{"base_dir", dir}});
-    if (!r.ok()) return;
+    const std::shared_ptr<RenderRequest> request = load_render(dir, scene);
+    if (!request) return;
     RenderScene rs;
-    rs.build(*r.value->scene, r.value->accel);
+    rs.build(*request->scene, request->accel);
     const int size = 64, per_pixel = 16;
-    const CameraRays cam = camera_rays(r.value->scene->camera, size, size);
+    const CameraRays cam = camera_rays(request->scene->camera, size, size);
     std::vector<Ray> camera, shadow;
     Pcg32 rng(7u, 3u);
     for (int y = 0; y < size; ++y) {
