@@ -29,7 +29,6 @@ struct AccelStats {
     /// Per ray, by the surface area heuristic [MacDonaldBooth90]: the 4-wide nodes a ray
     /// visits and the triangles it tests, each weighted by the chance that a ray meeting the
     /// scene's box meets its box (area ratio). For brute force, 0 and the triangle count.
-    /// Filled for every BVH and for the scenes Auto chose between the two.
     double expected_node_visits = 0.0;
     double expected_triangle_tests = 0.0;
 };
