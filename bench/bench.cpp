@@ -366,6 +366,11 @@ void brute_force_crossover() {
             std::printf("BENCH rays/closed_%zu/%s %.6e\n", mesh.triangle_count(),
                         k == AccelKind::Bvh ? "bvh" : "brute_force",
                         hits == rays.size() ? best : 0.0);
+            if (k == AccelKind::Bvh)
+                std::printf("INFO rays/closed_%zu: BVH expects %.3f node visits and %.3f "
+                            "triangle tests per ray\n",
+                            mesh.triangle_count(), a.stats().expected_node_visits,
+                            a.stats().expected_triangle_tests);
         }
     }
 }

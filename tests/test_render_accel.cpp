@@ -770,7 +770,7 @@ TEST(Accel, DeepTreesStopAtTheDepthGuard) {
     }
     Accelerator bvh = build(mesh, AccelKind::Bvh), brute = build(mesh, AccelKind::BruteForce);
     EXPECT_EQ(bvh.stats().build_depth, 64u);
-    EXPECT_LE(bvh.stats().max_depth, 64u); // the 4-wide tree is no deeper than the binary one
+    EXPECT_LE(bvh.stats().max_depth, 64u); // the wide tree is no deeper than the binary one
     Pcg32 rng(71u, 13u);
     for (int i = 0; i < 500; ++i) {
         uint32_t target = rng.next_below(uint32_t(mesh.triangle_count()));
@@ -795,15 +795,17 @@ TEST(Bvh, GridTreeIsShallowWithSmallLeaves) {
     Accelerator accel = build(grid, AccelKind::Auto);
     const AccelStats& s = accel.stats();
     EXPECT_EQ(s.kind, AccelKind::Bvh);
-    // Collapsed from a full binary tree: every 4-wide node has 2 to 4 children.
-    EXPECT_GE(3 * s.nodes + 1, s.leaves);
+    // Collapsed from a full binary tree: every node has 2 to kNodeWidth children.
+    const uint32_t width = Accelerator::kNodeWidth;
+    EXPECT_GE((width - 1) * s.nodes + 1, s.leaves);
     EXPECT_LE(s.nodes + 1, s.leaves);
-    EXPECT_LE(s.nodes, (s.leaves + 1) / 2);        // most nodes have 4 children on a grid
-    EXPECT_LE(s.build_depth, 2u * 15u);            // 2 log2(triangles)
-    EXPECT_GE(s.build_depth, 11u);                 // log2(triangles / 16): leaves are not huge
-    EXPECT_LE(s.max_depth, s.build_depth / 2 + 1); // two binary levels per 4-wide level
-    EXPECT_GE(s.max_depth, 6u);                    // log4(triangles / 16)
-    EXPECT_GE(s.leaves, triangles / 8u);           // mean leaf size at most 8
+    EXPECT_LE(s.nodes, (s.leaves + 1) / (width == 8 ? 3 : 2)); // most nodes half full or more
+    EXPECT_LE(s.build_depth, 2u * 15u);                        // 2 log2(triangles)
+    EXPECT_GE(s.build_depth, 11u); // log2(triangles / 16): leaves are not huge
+    // log2(width) binary levels per wide level, but for the last
+    EXPECT_LE(s.max_depth, s.build_depth / (width == 8 ? 3 : 2) + 1);
+    EXPECT_GE(s.max_depth, width == 8 ? 4u : 6u); // log_width(triangles / 16)
+    EXPECT_GE(s.leaves, triangles / 8u);          // mean leaf size at most 8
     EXPECT_LE(s.leaves, triangles);
     EXPECT_GE(s.bytes, uint64_t(triangles) * 3 * sizeof(Vec3));
     // A ray straight down onto the centre of each of a few cells finds exactly that cell.

@@ -1,6 +1,6 @@
 // Ray-scene intersection: the watertight ray-triangle test [Woop13], a binned-SAH BVH
-// [Wald07] collapsed to four children per node and flattened depth first, and its traversal,
-// which tests a node's four boxes at once in float SIMD [Wald08] with a slab test made
+// [Wald07] collapsed to eight children per node and flattened depth first, and its traversal,
+// which tests a node's boxes four at a time in float SIMD [Wald08] with a slab test made
 // conservative as in [Ize13].
 //
 // Robustness, in order of where it matters:
@@ -49,7 +49,8 @@ constexpr double kIntersectCost = 1.0;      // ... relative to one triangle test
 constexpr double kBoxPad = 0x1p-20;         // of the scene's radius ...
 constexpr double kBoxPadAbsolute = 0x1p-40; // ... plus this of its largest coordinate
 constexpr float kFarScale = 1.0f + 0x1p-18f;
-constexpr uint32_t kStackSize = 4 * kMaxDepth; // a node pushes at most 4, pops 1, depth <= 64
+constexpr int kWidth = Accelerator::kNodeWidth;
+constexpr uint32_t kStackSize = kWidth * kMaxDepth; // pushes at most kWidth, pops 1, depth <= 64
 
 /// Everything about a ray that the triangle and box tests reuse [Woop13, sec. 3; Ize13].
 struct RayPrep {
@@ -57,7 +58,7 @@ struct RayPrep {
     int kx, ky, kz;      // axis permutation: kz is the largest |direction| component
     double sx, sy, sz;   // shear that maps the direction to (0, 0, 1)
     double inv[3];       // 1 / direction (+-inf for zero components)
-    int near[3], far[3]; // per axis, the row of Node4::bounds of the entry / exit plane
+    int near[3], far[3]; // per axis, the row of WideNode::bounds of the entry / exit plane
     double zero;         // 0, from memory: a literal 0 turns the first max into a branch
 };
 
@@ -254,7 +255,7 @@ SplitDecision decide(std::vector<Prim>& prims, uint32_t begin, uint32_t end, uin
     return {false, mid};
 }
 
-/// A node of the binary SAH tree, before it is collapsed to four children per node.
+/// A node of the binary SAH tree, before it is collapsed to wide nodes.
 struct BuildNode {
     Box bounds;
     uint32_t left = 0, right = 0;  // interior: children (build indices)
@@ -364,8 +365,8 @@ void Accelerator::build(const Mesh& mesh, AccelKind kind) {
             radius = std::max(radius, std::max(b.hi[k] - center_[k], center_[k] - b.lo[k]));
         }
         const double pad = kBoxPad * radius + kBoxPadAbsolute * scale;
-        // Collapse: each 4-wide node takes a binary node's children and keeps opening the
-        // interior child of largest surface area until it has four [Wald08, sec. 3].
+        // Collapse: each wide node takes a binary node's children and keeps opening the
+        // interior child of largest surface area until it has kWidth [Wald08, sec. 3].
         nodes_.reserve(tree.size() / 2 + 1);
         struct Task {
             uint32_t build, depth; // a binary interior node (or the root leaf) to emit
@@ -380,11 +381,11 @@ void Accelerator::build(const Mesh& mesh, AccelKind kind) {
             nodes_.emplace_back();
             if (task.parent != UINT32_MAX) nodes_[task.parent].child[task.lane] = index;
             stats_.max_depth = std::max(stats_.max_depth, task.depth);
-            uint32_t lanes[4] = {task.build, 0, 0, 0};
+            uint32_t lanes[kWidth] = {task.build};
             int used = 1;
             const BuildNode& top = tree[task.build];
             if (top.count == 0) lanes[0] = top.left, lanes[1] = top.right, used = 2;
-            while (used < 4) {
+            while (used < kWidth) {
                 int open = -1;
                 double area = -1.0;
                 for (int l = 0; l < used; ++l) {
@@ -399,8 +400,8 @@ void Accelerator::build(const Mesh& mesh, AccelKind kind) {
                 lanes[open] = b.left;
                 lanes[used++] = b.right;
             }
-            Node4& node = nodes_[index];
-            for (int l = 0; l < 4; ++l) {
+            WideNode& node = nodes_[index];
+            for (int l = 0; l < kWidth; ++l) {
                 for (int k = 0; k < 3; ++k) {
                     node.bounds[k][l] = std::numeric_limits<float>::infinity();
                     node.bounds[k + 3][l] = -std::numeric_limits<float>::infinity();
@@ -429,8 +430,8 @@ void Accelerator::build(const Mesh& mesh, AccelKind kind) {
         // is entered with the ratio of its area to the root's.
         const double root_area = tree[0].bounds.half_area();
         stats_.expected_node_visits = 1.0;
-        for (const Node4& node : nodes_) {
-            for (int l = 0; l < 4; ++l) {
+        for (const WideNode& node : nodes_) {
+            for (int l = 0; l < kWidth; ++l) {
                 const double dx = double(node.bounds[3][l]) - double(node.bounds[0][l]);
                 const double dy = double(node.bounds[4][l]) - double(node.bounds[1][l]);
                 const double dz = double(node.bounds[5][l]) - double(node.bounds[2][l]);
@@ -465,7 +466,7 @@ void Accelerator::build(const Mesh& mesh, AccelKind kind) {
         triangle_id_[i] = id;
         for (int k = 0; k < 3; ++k) vertices_[3 * size_t(i) + k] = mesh.vertex(id, k);
     }
-    stats_.bytes = nodes_.size() * sizeof(Node4) + vertices_.size() * sizeof(Vec3) +
+    stats_.bytes = nodes_.size() * sizeof(WideNode) + vertices_.size() * sizeof(Vec3) +
                    triangle_id_.size() * sizeof(uint32_t);
 }
 
@@ -519,20 +520,25 @@ template <bool kAnyHit> bool Accelerator::traverse(const Ray& ray, Hit* hit) con
         Pending stack[kStackSize];
         uint32_t top = 0, current = 0;
         for (;;) {
-            const Node4& node = nodes_[current];
+            const WideNode& node = nodes_[current];
             const float t_max = static_cast<float>(best_t);
-            // Slab test of the four boxes [KayKajiya86]; max_keep / min_keep ignore NaN.
-            const F4 tx0 = (f4_load(node.bounds[nx]) - ox) * ix;
-            const F4 tx1 = (f4_load(node.bounds[fx]) - ox) * ix;
-            const F4 ty0 = (f4_load(node.bounds[ny]) - oy) * iy;
-            const F4 ty1 = (f4_load(node.bounds[fy]) - oy) * iy;
-            const F4 tz0 = (f4_load(node.bounds[nz]) - oz) * iz;
-            const F4 tz1 = (f4_load(node.bounds[fz]) - oz) * iz;
-            const F4 t0 = f4_max_keep(tz0, f4_max_keep(ty0, f4_max_keep(tx0, zero)));
-            const F4 t1 = f4_min_keep(tz1, f4_min_keep(ty1, f4_min_keep(tx1, f4_set1(t_max))));
-            int mask = f4_le_mask(t0, t1 * far_scale);
-            alignas(16) float t_enter[4];
-            f4_store(t_enter, t0);
+            // Slab test of the boxes, four at a time [KayKajiya86]; max_keep / min_keep
+            // ignore NaN.
+            const F4 t_far = f4_set1(t_max);
+            int mask = 0;
+            alignas(16) float t_enter[kWidth];
+            for (int g = 0; g < kWidth; g += 4) {
+                const F4 tx0 = (f4_load(node.bounds[nx] + g) - ox) * ix;
+                const F4 tx1 = (f4_load(node.bounds[fx] + g) - ox) * ix;
+                const F4 ty0 = (f4_load(node.bounds[ny] + g) - oy) * iy;
+                const F4 ty1 = (f4_load(node.bounds[fy] + g) - oy) * iy;
+                const F4 tz0 = (f4_load(node.bounds[nz] + g) - oz) * iz;
+                const F4 tz1 = (f4_load(node.bounds[fz] + g) - oz) * iz;
+                const F4 t0 = f4_max_keep(tz0, f4_max_keep(ty0, f4_max_keep(tx0, zero)));
+                const F4 t1 = f4_min_keep(tz1, f4_min_keep(ty1, f4_min_keep(tx1, t_far)));
+                mask |= f4_le_mask(t0, t1 * far_scale) << g;
+                f4_store(t_enter + g, t0);
+            }
             // One interior child met: go straight down.
             if ((mask & (mask - 1)) == 0 && mask != 0) {
                 const int l = __builtin_ctz(static_cast<unsigned>(mask));

@@ -1,5 +1,5 @@
 // Ray-scene intersection: a bounding volume hierarchy built with binned SAH [Wald07] and
-// collapsed to four children per node, whose boxes are tested four at a time [Wald08], or a
+// collapsed to eight children per node, whose boxes are tested in float SIMD [Wald08], or a
 // brute-force loop when the surface area heuristic [MacDonaldBooth90] expects the BVH not to
 // pay, both on the watertight ray-triangle test of [Woop13].
 #pragma once
@@ -21,12 +21,12 @@ enum class AccelKind { Auto, BruteForce, Bvh };
 
 struct AccelStats {
     AccelKind kind = AccelKind::BruteForce; ///< what was built (never Auto)
-    uint32_t nodes = 0;                     ///< 4-wide nodes
+    uint32_t nodes = 0;                     ///< 8-wide nodes
     uint32_t leaves = 0;                    ///< leaves (runs of triangles)
-    uint32_t max_depth = 0;                 ///< of the 4-wide tree (root at 0)
+    uint32_t max_depth = 0;                 ///< of the 8-wide tree (root at 0)
     uint32_t build_depth = 0; ///< of the binary SAH tree it was collapsed from (<= 64)
     uint64_t bytes = 0;       ///< memory of the structure
-    /// Per ray, by the surface area heuristic [MacDonaldBooth90]: the 4-wide nodes a ray
+    /// Per ray, by the surface area heuristic [MacDonaldBooth90]: the 8-wide nodes a ray
     /// visits and the triangles it tests, each weighted by the chance that a ray meeting the
     /// scene's box meets its box (area ratio). For brute force, 0 and the triangle count.
     double expected_node_visits = 0.0;
@@ -39,11 +39,20 @@ class Accelerator {
     /// cost per ray: brute force's triangle count against the BVH's expected triangle tests
     /// plus kNodeCost per expected node visit. Larger scenes always get the BVH.
     static constexpr size_t kAutoMaxTriangles = 64;
-    /// A 4-wide node visit's cost in triangle tests, measured with `make bench`
-    /// (rays/closed_N: both structures on closed meshes of 4 to 80 triangles; figures in
-    /// docs/benchmarks.md). V8 runs the float SIMD box test at about native speed and the
-    /// double-precision triangle test at about 0.65 of it, so a node costs fewer triangle tests
-    /// in wasm.
+    /// Children per BVH node, tested four at a time. Natively, eight visit fewer nodes than
+    /// four for about the same latency per node; in wasm, where V8's SIMD code is slower, the
+    /// second group of four costs what the saved visits do (docs/benchmarks.md, "Eight
+    /// children per node").
+#if defined(__EMSCRIPTEN__)
+    static constexpr int kNodeWidth = 4;
+#else
+    static constexpr int kNodeWidth = 8;
+#endif
+    /// A node visit's cost in triangle tests, measured with `make bench` (rays/closed_N:
+    /// both structures on closed meshes of 4 to 80 triangles; figures in docs/benchmarks.md;
+    /// about 4.5 natively for both widths). V8 runs the float SIMD box test at about native
+    /// speed and the double-precision triangle test at about 0.65 of it, so a node costs fewer
+    /// triangle tests in wasm.
 #if defined(__EMSCRIPTEN__)
     static constexpr double kNodeCost = 2.0;
 #else
@@ -66,19 +75,19 @@ class Accelerator {
     }
 
   private:
-    /// A 4-wide BVH node (128 bytes, two cache lines): its children's boxes as four lanes
-    /// of each bound, in float, rounded and padded outwards (see accel.cpp). Unused lanes
-    /// hold empty boxes (lo = +inf, hi = -inf), which no ray meets.
-    struct alignas(16) Node4 {
-        float bounds[6][4]; ///< lo.x, lo.y, lo.z, hi.x, hi.y, hi.z of each child
-        uint32_t child[4];  ///< interior child: node index; leaf: first triangle (leaf order)
-        uint32_t count[4];  ///< triangles of a leaf child; 0 for an interior child
+    /// A BVH node (256 bytes, four cache lines): its children's boxes as kNodeWidth lanes of
+    /// each bound, in float, rounded and padded outwards (see accel.cpp). Unused lanes hold
+    /// empty boxes (lo = +inf, hi = -inf), which no ray meets.
+    struct alignas(16) WideNode {
+        float bounds[6][kNodeWidth]; ///< lo.x, lo.y, lo.z, hi.x, hi.y, hi.z of each child
+        uint32_t child[kNodeWidth];  ///< interior child: node index; leaf: first triangle
+        uint32_t count[kNodeWidth];  ///< triangles of a leaf child; 0 for an interior child
     };
     template <bool kAnyHit> bool traverse(const Ray& ray, Hit* hit) const;
 
     AccelStats stats_;
     double center_[3] = {0.0, 0.0, 0.0}; // boxes and ray origins are relative to it
-    std::vector<Node4> nodes_;           // empty for brute force
+    std::vector<WideNode> nodes_;        // empty for brute force
     std::vector<Vec3> vertices_;         // p0, p1, p2 of each triangle, in leaf order
     std::vector<uint32_t> triangle_id_;  // leaf order -> mesh triangle id
 };

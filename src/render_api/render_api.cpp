@@ -466,7 +466,7 @@ Json scene_to_json(const Loaded& l) {
                 {"surface_kernel", surface_kernel_name(surface_kernel(sc))},
                 {"accel",
                  {{"kind", a.kind == AccelKind::Bvh ? "bvh" : "brute_force"},
-                  {"width", 4},
+                  {"width", Accelerator::kNodeWidth},
                   {"nodes", a.nodes},
                   {"leaves", a.leaves},
                   {"max_depth", a.max_depth},
