@@ -227,6 +227,19 @@ void render_rays_per_second(const std::string& dir, const char* scene, const cha
 // in pixel order, and shadow rays from their hits to points sampled on the scene's lights
 // (any hit), as the direct-lighting integrator traces them. One thread, 64x64 pixels, best of
 // three after a warm-up; the rays are made before the clock starts.
+// Rays per second of trace() (which traces `rays` rays and returns its hit count, so that the
+// calls are not dropped): best of three after a warm-up.
+template <typename Trace> double best_rays_per_second(Trace&& trace, size_t rays, size_t* hits) {
+    double best = 0.0;
+    for (int rep = 0; rep < 4; ++rep) {
+        auto t0 = std::chrono::steady_clock::now();
+        *hits = trace();
+        const double s = seconds_since(t0);
+        if (rep > 0) best = std::max(best, double(rays) / s);
+    }
+    return best;
+}
+
 void traversal_rays_per_second(const std::string& dir, const char* scene) {
     const std::shared_ptr<RenderRequest> request = load_render(dir, scene);
     if (!request) return;
@@ -256,20 +269,9 @@ void traversal_rays_per_second(const std::string& dir, const char* scene) {
             }
         }
     }
-    // Best of three after a warm-up; the hit counts keep the calls from being dropped.
-    auto best_of_three = [](auto&& trace, size_t rays, size_t* hits) {
-        double best = 0.0;
-        for (int rep = 0; rep < 4; ++rep) {
-            auto t0 = std::chrono::steady_clock::now();
-            *hits = trace();
-            const double s = seconds_since(t0);
-            if (rep > 0) best = std::max(best, double(rays) / s);
-        }
-        return best;
-    };
     const Accelerator& a = rs.accel;
     size_t camera_hits = 0, occluded = 0;
-    const double camera_rate = best_of_three(
+    const double camera_rate = best_rays_per_second(
         [&] {
             size_t hits = 0;
             for (const Ray& ray : camera) {
@@ -279,7 +281,7 @@ void traversal_rays_per_second(const std::string& dir, const char* scene) {
             return hits;
         },
         camera.size(), &camera_hits);
-    const double shadow_rate = best_of_three(
+    const double shadow_rate = best_rays_per_second(
         [&] {
             size_t hits = 0;
             for (const Ray& ray : shadow) hits += a.occluded(ray);
@@ -351,18 +353,17 @@ void brute_force_crossover() {
         for (AccelKind k : {AccelKind::BruteForce, AccelKind::Bvh}) {
             Accelerator a;
             a.build(mesh, k);
-            double best = 0.0;
             size_t hits = 0;
-            for (int rep = 0; rep < 4; ++rep) { // the first is a warm-up
-                auto t0 = std::chrono::steady_clock::now();
-                hits = 0;
-                for (const Ray& r : rays) {
-                    Hit h;
-                    hits += a.intersect(r, &h);
-                }
-                const double sec = seconds_since(t0);
-                if (rep > 0) best = std::max(best, double(rays.size()) / sec);
-            }
+            const double best = best_rays_per_second(
+                [&] {
+                    size_t n = 0;
+                    for (const Ray& r : rays) {
+                        Hit h;
+                        n += a.intersect(r, &h);
+                    }
+                    return n;
+                },
+                rays.size(), &hits);
             std::printf("BENCH rays/closed_%zu/%s %.6e\n", mesh.triangle_count(),
                         k == AccelKind::Bvh ? "bvh" : "brute_force",
                         hits == rays.size() ? best : 0.0);
