@@ -5,9 +5,11 @@
 // quadrature and a closed form, and one-/double-sided emission and degenerate inputs.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <string>
 #include <vector>
 
 #include "core/rng.h"
@@ -118,13 +120,25 @@ struct Config {
 
 const Tri kTri{Vec3(0.0, 0.0, 0.0), Vec3(1.0, 0.0, 0.0), Vec3(0.3, 0.9, 0.0)};
 
+/// LightSet's speed regime for triangle t seen from ref (light_is_small_from), with the
+/// centroid and radius computed here.
+bool small_from(const Tri& t, const Vec3& ref) {
+    const Vec3 c = (t.p0 + t.p1 + t.p2) / 3.0;
+    double r2 = 0.0;
+    for (const Vec3& v : {t.p0, t.p1, t.p2}) r2 = std::max(r2, glm::dot(v - c, v - c));
+    return light_is_small_from(c, r2, ref);
+}
+
 /// Chi-square of n light samples of a one-triangle scene, binned into the sub-triangles,
 /// against the expected probabilities `expected_prob` of the cells. Also checks that every
-/// sample lies on the triangle and carries the density `pdf_expected`.
+/// sample lies on the triangle and carries the density `pdf_expected`. With `map_only`, the
+/// samples come from the spherical map itself (sample_spherical_triangle), whatever regime
+/// the light sampler would choose.
 test::ChiSquareResult sample_chi_square(const Config& cfg, LightSampling mode,
                                         const Subdivision& sub,
                                         const std::vector<double>& expected_prob,
-                                        double pdf_expected, int n, uint64_t seed) {
+                                        double pdf_expected, int n, uint64_t seed,
+                                        bool map_only = false) {
     SceneBuilder sb;
     int m = sb.material(Vec3(1.0));
     sb.triangle(cfg.tri.p0, cfg.tri.p1, cfg.tri.p2, m);
@@ -137,6 +151,13 @@ test::ChiSquareResult sample_chi_square(const Config& cfg, LightSampling mode,
     for (int i = 0; i < n; ++i) {
         double u_select = rng.next_double();
         LightSample s = lights.sample(cfg.ref, u_select, next_u(rng), mode);
+        if (map_only) {
+            const Vec3 a = cfg.tri.p0 - cfg.ref, n_plane = glm::cross(cfg.tri.e1(), cfg.tri.e2());
+            const Vec3 w = sample_spherical_triangle(a, cfg.tri.p1 - cfg.ref, cfg.tri.p2 - cfg.ref,
+                                                     next_u(rng), &s.pdf);
+            s.point = cfg.ref + w * (glm::dot(a, n_plane) / glm::dot(w, n_plane));
+            s.valid = s.pdf > 0.0;
+        }
         if (!s.valid) {
             ++invalid;
             continue;
@@ -270,24 +291,32 @@ TEST(RenderLights, SolidAngleSamplesAreUniformInSolidAngle) {
         ASSERT_GT(omega, kMinSphericalSolidAngle) << cfg.name;
         ASSERT_LT(omega, kMaxSphericalSolidAngle) << cfg.name;
         for (double& p : prob) p /= omega;
-        test::ChiSquareResult r =
-            sample_chi_square(cfg, LightSampling::SolidAngle, sub, prob, 1.0 / omega, n, seed++);
+        // Triangles small from the point are sampled by area (AreaSamplesAreUniformInArea);
+        // the map is tested on them directly.
+        const bool map_only = small_from(cfg.tri, cfg.ref);
+        if (std::string(cfg.name) == "far") {
+            EXPECT_TRUE(map_only);
+        }
+        test::ChiSquareResult r = sample_chi_square(cfg, LightSampling::SolidAngle, sub, prob,
+                                                    1.0 / omega, n, seed++, map_only);
         EXPECT_GT(r.p_value, chi_level())
             << cfg.name << ": chi2 " << r.statistic << " dof " << r.dof;
-        std::printf("  spherical %-18s omega %.4g  chi2 %.1f dof %d p %.3g\n", cfg.name, omega,
-                    r.statistic, r.dof, r.p_value);
+        std::printf("  spherical%s %-18s omega %.4g  chi2 %.1f dof %d p %.3g\n",
+                    map_only ? " (map)" : "", cfg.name, omega, r.statistic, r.dof, r.p_value);
     }
 }
 
 TEST(RenderLights, AreaSamplesAreUniformInArea) {
-    // Area mode, and SolidAngle mode in both of its fallback regimes (solid angle below
-    // kMinSphericalSolidAngle, reference point within ~1e-14 of the triangle's plane).
+    // Area mode, and SolidAngle mode in its three area regimes (a triangle small from the
+    // point, solid angle below kMinSphericalSolidAngle, reference point within ~1e-14 of the
+    // triangle's plane).
     struct Case {
         Config cfg;
         LightSampling mode;
     };
     const Case cases[] = {
         {{"area mode", kTri, Vec3(0.3, 0.2, 0.5)}, LightSampling::Area},
+        {{"small from the point", kTri, Vec3(60.0, -80.0, 150.0)}, LightSampling::SolidAngle},
         {{"tiny (fallback)", kTri, Vec3(1.5e6, -1e6, 1.2e6)}, LightSampling::SolidAngle},
         {{"on the plane (fallback)", kTri, Vec3(0.45, 0.3, 1e-14)}, LightSampling::SolidAngle},
     };
@@ -298,7 +327,8 @@ TEST(RenderLights, AreaSamplesAreUniformInArea) {
         double omega = spherical_triangle_area(c.cfg.tri.p0 - c.cfg.ref, c.cfg.tri.p1 - c.cfg.ref,
                                                c.cfg.tri.p2 - c.cfg.ref);
         if (c.mode == LightSampling::SolidAngle) {
-            EXPECT_TRUE(omega < kMinSphericalSolidAngle || omega > kMaxSphericalSolidAngle)
+            EXPECT_TRUE(small_from(c.cfg.tri, c.cfg.ref) || omega < kMinSphericalSolidAngle ||
+                        omega > kMaxSphericalSolidAngle)
                 << c.cfg.name << ": omega " << omega;
         }
         std::vector<double> prob(sub.cells.size(), 1.0 / double(sub.cells.size()));
@@ -425,7 +455,7 @@ TEST(RenderLights, SampleAgreesWithPdfInEveryRegime) {
     refs.push_back(light0.at(1.2, 0.4));              // in its plane, outside
     Pcg32 rng(77, 1u);
     int checked = 0, mismatched = 0, spherical = 0, off_triangle = 0;
-    int fallback_small = 0, fallback_large = 0;
+    int fallback_small = 0, fallback_large = 0, small_light = 0;
     const LightSelection rules[] = {LightSelection::Uniform, LightSelection::Area,
                                     LightSelection::Power};
     for (LightSelection rule : rules) {
@@ -451,12 +481,17 @@ TEST(RenderLights, SampleAgreesWithPdfInEveryRegime) {
                     if (mode == LightSampling::SolidAngle) {
                         double omega = spherical_triangle_area(t.p0 - ref, t.p1 - ref, t.p2 - ref);
                         double area_pdf = set.pdf(ref, s.triangle, s.point, LightSampling::Area);
-                        if (omega >= kMinSphericalSolidAngle && omega <= kMaxSphericalSolidAngle) {
+                        const bool small = small_from(t, ref);
+                        if (!small && omega >= kMinSphericalSolidAngle &&
+                            omega <= kMaxSphericalSolidAngle) {
                             ++spherical;
                             double expect = set.selection_pmf(set.light_index(s.triangle)) / omega;
                             if (std::fabs(s.pdf - expect) > 1e-9 * expect) ++mismatched;
                         } else {
-                            ++(omega < 1.0 ? fallback_small : fallback_large);
+                            if (small && omega >= kMinSphericalSolidAngle)
+                                ++small_light;
+                            else
+                                ++(omega < 1.0 ? fallback_small : fallback_large);
                             if (s.pdf != area_pdf) ++mismatched; // the same rule, bit for bit
                         }
                     }
@@ -470,11 +505,12 @@ TEST(RenderLights, SampleAgreesWithPdfInEveryRegime) {
     EXPECT_EQ(mismatched, 0);
     EXPECT_EQ(off_triangle, 0);
     EXPECT_GT(spherical, 1000);
-    EXPECT_GT(fallback_small, 100); // both fallback regimes are visited: tiny solid angle,
+    EXPECT_GT(small_light, 100);    // every area regime is visited: a light small from the
+    EXPECT_GT(fallback_small, 100); // point, a tiny solid angle,
     EXPECT_GT(fallback_large, 10);  // and a point within 1e-14 of a light's plane
     EXPECT_GT(checked, 15000);
-    std::printf("  agreement: %d samples, %d spherical, %d + %d fallback\n", checked, spherical,
-                fallback_small, fallback_large);
+    std::printf("  agreement: %d samples, %d spherical, %d small lights, %d + %d fallback\n",
+                checked, spherical, small_light, fallback_small, fallback_large);
 }
 
 // --- Irradiance two ways and Lambert's formula -------------------------------------------

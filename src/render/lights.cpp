@@ -223,6 +223,11 @@ void LightSet::build(const Scene& scene, LightSelection selection) {
         light.cross_normal = glm::cross(light.e1, light.e2);
         light.unit_normal = glm::normalize(light.cross_normal);
         light.emission = le;
+        light.centroid = (light.p0 + light.p1 + light.p2) / 3.0;
+        for (const Vec3* v : {&light.p0, &light.p1, &light.p2}) {
+            const Vec3 r = *v - light.centroid;
+            light.radius2 = std::max(light.radius2, glm::dot(r, r));
+        }
         light.double_sided = mat.double_sided;
         light.triangle = uint32_t(t);
         lights_.push_back(light);
@@ -303,6 +308,7 @@ LightSample LightSet::sample(const Vec3& ref, double u_select, const Vec2& u,
     Vec3 point;
     SphericalTriangle st;
     if (mode == LightSampling::SolidAngle &&
+        !light_is_small_from(light.centroid, light.radius2, ref) &&
         setup_spherical(p0 - ref, p1 - ref, p2 - ref, light.e1, light.e2, n, &st)) {
         Vec3 w = sample_spherical(st, u);
         // Where the direction meets the triangle's plane: (ref + t w - p0) . N = 0.
@@ -332,8 +338,8 @@ double LightSet::pdf(const Vec3& ref, uint32_t triangle, const Vec3& point,
     double pmf = selection_pmf(light);
     const Light& l = lights_[size_t(light)];
     const Vec3& n = l.cross_normal;
-    if (mode == LightSampling::SolidAngle) {
-        // The same rule as sample: the same solid angle and the same regime test.
+    if (mode == LightSampling::SolidAngle && !light_is_small_from(l.centroid, l.radius2, ref)) {
+        // The same rule as sample: the same solid angle and the same regime tests.
         Vec3 a = l.p0 - ref;
         double det = glm::dot(a, n);
         const Vec3 b = l.p1 - ref, c = l.p2 - ref;

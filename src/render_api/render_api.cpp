@@ -23,8 +23,9 @@ namespace {
 
 /// Part of every reference's cache key. Bumped whenever the renderer's image for a given seed
 /// changes, so that no cache (nor a shipped reference) serves a reference the current build
-/// would not render: 4 = stratified strata tables and Sobol' requests prepared per pixel.
-constexpr int kReferenceCacheVersion = 4;
+/// would not render: 4 = stratified strata tables and Sobol' requests prepared per pixel;
+/// 5 = solid-angle light sampling takes area samples of lights small from the point.
+constexpr int kReferenceCacheVersion = 5;
 
 /// Work and memory bounds, checked before anything is rendered: samples of a whole call
 /// (every image of the study and the reference), and bytes of the images held at once
