@@ -21,12 +21,12 @@ enum class AccelKind { Auto, BruteForce, Bvh };
 
 struct AccelStats {
     AccelKind kind = AccelKind::BruteForce; ///< what was built (never Auto)
-    uint32_t nodes = 0;                     ///< 8-wide nodes
+    uint32_t nodes = 0;                     ///< wide nodes (kNodeWidth children)
     uint32_t leaves = 0;                    ///< leaves (runs of triangles)
-    uint32_t max_depth = 0;                 ///< of the 8-wide tree (root at 0)
+    uint32_t max_depth = 0;                 ///< of the wide tree (root at 0)
     uint32_t build_depth = 0; ///< of the binary SAH tree it was collapsed from (<= 64)
     uint64_t bytes = 0;       ///< memory of the structure
-    /// Per ray, by the surface area heuristic [MacDonaldBooth90]: the 8-wide nodes a ray
+    /// Per ray, by the surface area heuristic [MacDonaldBooth90]: the wide nodes a ray
     /// visits and the triangles it tests, each weighted by the chance that a ray meeting the
     /// scene's box meets its box (area ratio). For brute force, 0 and the triangle count.
     double expected_node_visits = 0.0;
@@ -75,9 +75,9 @@ class Accelerator {
     }
 
   private:
-    /// A BVH node (256 bytes, four cache lines): its children's boxes as kNodeWidth lanes of
-    /// each bound, in float, rounded and padded outwards (see accel.cpp). Unused lanes hold
-    /// empty boxes (lo = +inf, hi = -inf), which no ray meets.
+    /// A BVH node (32 bytes per child: 256 natively, 128 in wasm): its children's boxes as
+    /// lanes of each bound, in float, rounded and padded outwards (see accel.cpp). Unused
+    /// lanes hold empty boxes (lo = +inf, hi = -inf), which no ray meets.
     struct alignas(16) WideNode {
         float bounds[6][kNodeWidth]; ///< lo.x, lo.y, lo.z, hi.x, hi.y, hi.z of each child
         uint32_t child[kNodeWidth];  ///< interior child: node index; leaf: first triangle
