@@ -240,6 +240,16 @@ template <typename Trace> double best_rays_per_second(Trace&& trace, size_t rays
     return best;
 }
 
+// How many of the rays hit something (closest-hit queries).
+size_t closest_hits(const Accelerator& accel, const std::vector<Ray>& rays) {
+    size_t hits = 0;
+    for (const Ray& ray : rays) {
+        Hit h;
+        hits += accel.intersect(ray, &h);
+    }
+    return hits;
+}
+
 void traversal_rays_per_second(const std::string& dir, const char* scene) {
     const std::shared_ptr<RenderRequest> request = load_render(dir, scene);
     if (!request) return;
@@ -271,16 +281,8 @@ void traversal_rays_per_second(const std::string& dir, const char* scene) {
     }
     const Accelerator& a = rs.accel;
     size_t camera_hits = 0, occluded = 0;
-    const double camera_rate = best_rays_per_second(
-        [&] {
-            size_t hits = 0;
-            for (const Ray& ray : camera) {
-                Hit h;
-                hits += a.intersect(ray, &h);
-            }
-            return hits;
-        },
-        camera.size(), &camera_hits);
+    const double camera_rate =
+        best_rays_per_second([&] { return closest_hits(a, camera); }, camera.size(), &camera_hits);
     const double shadow_rate = best_rays_per_second(
         [&] {
             size_t hits = 0;
@@ -354,16 +356,8 @@ void brute_force_crossover() {
             Accelerator a;
             a.build(mesh, k);
             size_t hits = 0;
-            const double best = best_rays_per_second(
-                [&] {
-                    size_t n = 0;
-                    for (const Ray& r : rays) {
-                        Hit h;
-                        n += a.intersect(r, &h);
-                    }
-                    return n;
-                },
-                rays.size(), &hits);
+            const double best =
+                best_rays_per_second([&] { return closest_hits(a, rays); }, rays.size(), &hits);
             std::printf("BENCH rays/closed_%zu/%s %.6e\n", mesh.triangle_count(),
                         k == AccelKind::Bvh ? "bvh" : "brute_force",
                         hits == rays.size() ? best : 0.0);
