@@ -44,7 +44,8 @@ DEP_PROBES := /usr/bin/cmake /usr/bin/g++ /usr/src/googletest/CMakeLists.txt \
 	/usr/include/tiny_gltf.h /usr/include/nlohmann/json.hpp /usr/bin/chromium
 
 .PHONY: all deps deps-web build build-wasm site test test-native test-wasm test-compare test-web-core \
-	test-e2e test-sanitize run cli bench bench-mitsuba format clean help fuzz fuzz-build fuzz-smoke deps-fuzz
+	test-e2e test-sanitize run cli bench bench-mitsuba bench-embree format clean help fuzz fuzz-build \
+	fuzz-smoke deps-fuzz
 
 all: build
 
@@ -57,6 +58,7 @@ help:
 	@echo "make bench-flags  the flags judged both ways: false alarms where intervals covered, confident wrong answers"
 	@echo "make bench-qmc  mcplay's randomized QMC beside QMCPy's and scipy's on Genz 1, 4, 5 (pip venv in build/)"
 	@echo "make bench-mitsuba  the renderer beside Mitsuba 3.9.1 on three glTF scenes: time, relMSE, efficiency (ARGS=--quick)"
+	@echo "make bench-embree  the accelerator beside Embree 3 (Debian's libembree-dev) on the same rays, one thread"
 	@echo "make format clang-format every C++ source"
 	@echo "make test-sanitize  the native ctest suite under ASan + UBSan ($(BUILD_ASAN); part of make test)"
 	@echo "make fuzz   libFuzzer targets, $(FUZZ_SECONDS) s each (FUZZ_TARGETS=\"$(FUZZ_TARGETS)\"); docs/fuzzing.md"
@@ -154,6 +156,33 @@ bench: build build-wasm site
 	node web/e2e/first_plot.bench.mjs $(SITE) all 3
 	$(MAKE) --no-print-directory bench-genz
 	$(MAKE) --no-print-directory bench-flags
+
+# ---------------------------------------------------------------------------
+# The accelerator beside Embree 3, the kernels under Mitsuba's llvm variants (docs/benchmarks.md):
+# bench/embree_compare.cpp, built with g++ against the CMake-built static libraries and
+# Debian's libembree-dev; rays per second of one thread on `make bench`'s ray sets.
+.PHONY: bench-embree deps-embree
+EMBREE_ARGS ?= scenes
+
+deps-embree:
+	@if [ ! -e /usr/include/embree3/rtcore.h ]; then \
+	  if [ "$$(id -u)" = 0 ]; then \
+	    apt-get update -q && DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends libembree-dev; \
+	  else \
+	    echo "deps-embree: not root; run: sudo apt-get install -y --no-install-recommends libembree-dev"; exit 1; \
+	  fi; \
+	fi
+
+$(BUILD)/embree_compare: bench/embree_compare.cpp bench/bench_rays.h $(BUILD)/libmcplay_render_api.a \
+		$(BUILD)/libmcplay_render.a $(BUILD)/libmcplay_api.a $(BUILD)/libmcplay_core.a $(wildcard src/*/*.h)
+	g++ -O2 -std=c++17 -ffp-contract=off -Isrc -I$(BUILD)/deps_include bench/embree_compare.cpp \
+	  $(BUILD)/libmcplay_render_api.a $(BUILD)/libmcplay_render.a $(BUILD)/libmcplay_api.a \
+	  $(BUILD)/libmcplay_core.a -lembree3 -pthread -o $@
+
+bench-embree: deps deps-embree $(BUILD)/CMakeCache.txt
+	cmake --build $(BUILD) -j $(JOBS) --target mcplay_render_api
+	$(MAKE) --no-print-directory $(BUILD)/embree_compare
+	$(BUILD)/embree_compare $(EMBREE_ARGS)
 
 # ---------------------------------------------------------------------------
 # GSL's plain, MISER and VEGAS beside mcplay's estimators on Genz's six families

@@ -15,13 +15,12 @@
 #include "core/stats.h"
 #include "render_api/render_request.h"
 
+#include "bench_rays.h"
+
 using namespace mcp;
+using namespace mcp::bench;
 
 namespace {
-
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 
 bool load(const std::string& dir, const std::string& name, SceneRequest* out) {
     std::ifstream in(dir + "/" + name + ".json");
@@ -187,20 +186,6 @@ void accumulation_accuracy() {
 
 // Rays per second of one thread rendering a render scene with an estimator (camera, shadow
 // and bounce rays alike), best of three renders after a warm-up render.
-std::shared_ptr<RenderRequest> load_render(const std::string& dir, const char* scene) {
-    std::ifstream in(dir + "/" + scene + ".json");
-    std::stringstream ss;
-    ss << in.rdbuf();
-    Made<Json> j = parse_json(ss.str().c_str(), scene);
-    if (!j.ok()) return nullptr;
-    Made<std::shared_ptr<RenderRequest>> r = build_render_request(j.value, Json{{"base_dir", dir}});
-    if (!r.ok()) {
-        std::fprintf(stderr, "bench: %s: %s\n", scene, r.error.c_str());
-        return nullptr;
-    }
-    return r.value;
-}
-
 void render_rays_per_second(const std::string& dir, const char* scene, const char* estimator) {
     const std::shared_ptr<RenderRequest> request = load_render(dir, scene);
     if (!request) return;
@@ -223,62 +208,15 @@ void render_rays_per_second(const std::string& dir, const char* scene, const cha
     }
 }
 
-// Rays per second of the accelerator alone: 16 jittered camera rays per pixel (closest hit),
-// in pixel order, and shadow rays from their hits to points sampled on the scene's lights
-// (any hit), as the direct-lighting integrator traces them. One thread, 64x64 pixels, best of
-// three after a warm-up; the rays are made before the clock starts.
-// Rays per second of trace() (which traces `rays` rays and returns its hit count, so that the
-// calls are not dropped): best of three after a warm-up.
-template <typename Trace> double best_rays_per_second(Trace&& trace, size_t rays, size_t* hits) {
-    double best = 0.0;
-    for (int rep = 0; rep < 4; ++rep) {
-        auto t0 = std::chrono::steady_clock::now();
-        *hits = trace();
-        const double s = seconds_since(t0);
-        if (rep > 0) best = std::max(best, double(rays) / s);
-    }
-    return best;
-}
-
-// How many of the rays hit something (closest-hit queries).
-size_t closest_hits(const Accelerator& accel, const std::vector<Ray>& rays) {
-    size_t hits = 0;
-    for (const Ray& ray : rays) {
-        Hit h;
-        hits += accel.intersect(ray, &h);
-    }
-    return hits;
-}
-
+// Rays per second of the accelerator alone on the direct-lighting ray sets of bench_rays.h,
+// one thread, best of three after a warm-up; the rays are made before the clock starts.
 void traversal_rays_per_second(const std::string& dir, const char* scene) {
     const std::shared_ptr<RenderRequest> request = load_render(dir, scene);
     if (!request) return;
     RenderScene rs;
     rs.build(*request->scene, request->accel);
-    const int size = 64, per_pixel = 16;
-    const CameraRays cam = camera_rays(request->scene->camera, size, size);
-    std::vector<Ray> camera, shadow;
-    Pcg32 rng(7u, 3u);
-    for (int y = 0; y < size; ++y) {
-        for (int x = 0; x < size; ++x) {
-            for (int i = 0; i < per_pixel; ++i) {
-                const Ray ray = ray_through(cam, x + rng.next_double(), y + rng.next_double());
-                camera.push_back(ray);
-                Hit hit;
-                if (!rs.accel.intersect(ray, &hit)) continue;
-                const Vec3 p = ray.origin + hit.t * ray.direction;
-                const LightSample ls = rs.lights_power.sample(
-                    p, rng.next_double(), Vec2(rng.next_double(), rng.next_double()),
-                    LightSampling::SolidAngle);
-                if (!ls.valid) continue;
-                Ray s;
-                s.origin = p + 1e-6 * (ls.point - p);
-                s.direction = (ls.point - s.origin) * (1.0 - 1e-6);
-                s.t_max = 1.0;
-                shadow.push_back(s);
-            }
-        }
-    }
+    const DirectRays rays = direct_lighting_rays(rs, request->scene->camera);
+    const std::vector<Ray>&camera = rays.camera, &shadow = rays.shadow;
     const Accelerator& a = rs.accel;
     size_t camera_hits = 0, occluded = 0;
     const double camera_rate =
