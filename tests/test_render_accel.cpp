@@ -426,6 +426,79 @@ TEST(Bvh, MatchesBruteForceOnARandomSoup) {
     EXPECT_GT(limited, 1000); // a third of the rays
 }
 
+// Both structures test a leaf's triangles two at a time (one per SIMD lane); their answers
+// must be the scalar test's, bit for bit: the closest of intersect_triangle over every triangle
+// (lowest id on ties). An odd triangle count leaves a padding lane; rays through vertices and
+// along shared edges of a grid make edge functions exactly 0 (the lanes' scalar fallback), and
+// rays with t_max at the hit distance probe the limit.
+TEST(Accel, PairTestGivesTheScalarTestsAnswers) {
+    Mesh mesh = make_soup(301, 0.3, 37u);
+    const Mesh grid = make_grid(6, 0.25, Vec3(-0.75, -0.75, 0.1));
+    for (size_t t = 0; t < grid.triangle_count(); ++t) {
+        add_triangle(&mesh, grid.vertex(t, 0), grid.vertex(t, 1), grid.vertex(t, 2));
+    }
+    ASSERT_EQ(mesh.triangle_count() % 2, 1u);
+    const Accelerator bvh = build(mesh, AccelKind::Bvh);
+    const Accelerator brute = build(mesh, AccelKind::BruteForce);
+    Pcg32 rng(41u, 6u);
+    int hits = 0, zero_edges = 0;
+    for (int i = 0; i < 3000; ++i) {
+        Ray ray;
+        ray.origin = random_in_box(rng, Vec3(-1.5), Vec3(1.5));
+        ray.direction = random_direction(rng);
+        const uint32_t target = rng.next_below(uint32_t(mesh.triangle_count()));
+        if (i % 3 == 1) ray.direction = mesh.vertex(target, int(rng.next_below(3))) - ray.origin;
+        if (i % 3 == 2) {
+            // Down onto a grid line x = const (an edge shared by two triangles).
+            const double x = -0.75 + 0.25 * double(rng.next_below(7));
+            ray.origin = Vec3(x, -0.6 + 1.2 * rng.next_double(), 1.0);
+            ray.direction = Vec3(0.0, 0.2 * rng.next_double() - 0.1, -1.0);
+            ++zero_edges;
+        }
+        // The reference: the scalar test on every triangle.
+        bool found = false;
+        Hit ref;
+        for (size_t t = 0; t < mesh.triangle_count(); ++t) {
+            double th, b1, b2;
+            if (!intersect_triangle(ray, mesh.vertex(t, 0), mesh.vertex(t, 1), mesh.vertex(t, 2),
+                                    &th, &b1, &b2))
+                continue;
+            if (!found || th < ref.t) {
+                ref.t = th, ref.b1 = b1, ref.b2 = b2, ref.triangle = uint32_t(t);
+                found = true;
+            }
+        }
+        if (i % 4 == 3 && found) ray.t_max = ref.t; // t < t_max is strict: no hit at ref.t
+        for (const Accelerator* a : {&bvh, &brute}) {
+            Hit h;
+            bool want = found && ref.t < ray.t_max;
+            if (found && !want) {
+                // The closest hit below the new t_max, if any, again by the scalar test.
+                for (size_t t = 0; t < mesh.triangle_count(); ++t) {
+                    double th, b1, b2;
+                    if (intersect_triangle(ray, mesh.vertex(t, 0), mesh.vertex(t, 1),
+                                           mesh.vertex(t, 2), &th, &b1, &b2) &&
+                        (!want || th < ref.t)) {
+                        ref.t = th, ref.b1 = b1, ref.b2 = b2, ref.triangle = uint32_t(t);
+                        want = true;
+                    }
+                }
+            }
+            ASSERT_EQ(a->intersect(ray, &h), want) << "ray " << i;
+            ASSERT_EQ(a->occluded(ray), want) << "ray " << i;
+            if (!want) continue;
+            EXPECT_EQ(h.triangle, ref.triangle) << "ray " << i;
+            EXPECT_EQ(h.t, ref.t) << "ray " << i;
+            EXPECT_EQ(h.b1, ref.b1) << "ray " << i;
+            EXPECT_EQ(h.b2, ref.b2) << "ray " << i;
+            hits += a == &bvh;
+        }
+        if (::testing::Test::HasFailure()) return;
+    }
+    EXPECT_GT(hits, 1000);
+    EXPECT_GT(zero_edges, 900);
+}
+
 TEST(Bvh, MatchesBruteForceOnAClosedMeshWithRaysAtVertices) {
     Mesh sphere = make_icosphere(2, Vec3(0.1, 0.2, 0.3), 1.0);
     Accelerator bvh = build(sphere, AccelKind::Bvh), brute = build(sphere, AccelKind::BruteForce);

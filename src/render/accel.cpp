@@ -1,7 +1,7 @@
 // Ray-scene intersection: the watertight ray-triangle test [Woop13], a binned-SAH BVH
 // [Wald07] collapsed to eight children per node and flattened depth first, and its traversal,
 // which tests a node's boxes four at a time in float SIMD [Wald08] with a slab test made
-// conservative as in [Ize13].
+// conservative as in [Ize13], and a leaf's triangles two at a time in double SIMD.
 //
 // Robustness, in order of where it matters:
 // - Triangle test (double precision): every vertex is translated and sheared into the ray's
@@ -22,6 +22,10 @@
 //   carry a relative error of a few 2^-24 besides. The test absorbs both by accepting
 //   t_enter <= t_exit (1 + 2^-18) (the 1 + 2 gamma_3 of [Ize13], with room to spare). NaN
 //   from 0 * inf (origin on a plane, direction parallel to it) counts as inside.
+// - Two triangles at a time: the pair test (watertight2) does the scalar test's operations in
+//   the same order in each lane of a double-precision register, so its numbers are the scalar
+//   test's bit for bit; it has no branch per triangle (a leaf's hit pattern is hard to
+//   predict for rays that scatter, such as shadow rays to light samples).
 // - Ties: the closest hit prefers the lower mesh triangle id among hits at exactly the same
 //   t, so the answer does not depend on traversal order: BVH and brute force return the same
 //   hits, bit for bit.
@@ -34,6 +38,7 @@
 #include <cmath>
 #include <limits>
 
+#include "render/simd2d.h"
 #include "render/simd4.h"
 
 namespace mcp {
@@ -146,6 +151,74 @@ inline bool watertight(const RayPrep& r, const Vec3* p, TriHit* h) {
     h->w = w;
     h->det = det;
     return true;
+}
+
+/// The ray of a RayPrep in both lanes, for watertight2.
+struct RayLanes {
+    int kx, ky, kz;
+    D2 ox, oy, oz; // origin on axes kx, ky, kz
+    D2 sx, sy, sz;
+};
+RayLanes ray_lanes(const RayPrep& r) {
+    return {r.kx,
+            r.ky,
+            r.kz,
+            d2_set1(r.o[r.kx]),
+            d2_set1(r.o[r.ky]),
+            d2_set1(r.o[r.kz]),
+            d2_set1(r.sx),
+            d2_set1(r.sy),
+            d2_set1(r.sz)};
+}
+
+/// watertight() on the two triangles of a pair at once, one per lane, with the same operations
+/// in the same order (so each lane's numbers are the scalar test's, bit for bit) but no branch
+/// per triangle: all of a triangle's arithmetic is done and the outcomes are masks. A lane with
+/// an edge function exactly 0 (rare) goes through the scalar test for its exact sign. Returns
+/// bit l set where triangle l is hit with 0 < t < t_limit (kInclusive: t <= t_limit), with its
+/// edge functions and distance in h[l].
+template <bool kInclusive>
+inline int watertight2(const RayPrep& r, const RayLanes& q, const double (*v)[2], double t_limit,
+                       TriHit* h) {
+    const D2 zero = d2_set1(0.0);
+    const D2 a_z = d2_load(v[q.kz]) - q.oz;
+    const D2 b_z = d2_load(v[3 + q.kz]) - q.oz;
+    const D2 c_z = d2_load(v[6 + q.kz]) - q.oz;
+    const D2 a_x = (d2_load(v[q.kx]) - q.ox) - q.sx * a_z;
+    const D2 a_y = (d2_load(v[q.ky]) - q.oy) - q.sy * a_z;
+    const D2 b_x = (d2_load(v[3 + q.kx]) - q.ox) - q.sx * b_z;
+    const D2 b_y = (d2_load(v[3 + q.ky]) - q.oy) - q.sy * b_z;
+    const D2 c_x = (d2_load(v[6 + q.kx]) - q.ox) - q.sx * c_z;
+    const D2 c_y = (d2_load(v[6 + q.ky]) - q.oy) - q.sy * c_z;
+    const D2 u = c_x * b_y - c_y * b_x;
+    const D2 w_v = a_x * c_y - a_y * c_x;
+    const D2 w_w = b_x * a_y - b_y * a_x;
+    if (d2_mask_bits(d2_eq(u, zero) | d2_eq(w_v, zero) | d2_eq(w_w, zero)) != 0) {
+        int hits = 0;
+        for (int l = 0; l < 2; ++l) {
+            const Vec3 p[3] = {Vec3(v[0][l], v[1][l], v[2][l]), Vec3(v[3][l], v[4][l], v[5][l]),
+                               Vec3(v[6][l], v[7][l], v[8][l])};
+            if (watertight(r, p, &h[l]) && (kInclusive ? h[l].t <= t_limit : h[l].t < t_limit))
+                hits |= 1 << l;
+        }
+        return hits;
+    }
+    const D2 mixed = (d2_lt(u, zero) | d2_lt(w_v, zero) | d2_lt(w_w, zero)) &
+                     (d2_gt(u, zero) | d2_gt(w_v, zero) | d2_gt(w_w, zero));
+    const D2 det = u + w_v + w_w;
+    const D2 tt = (u * (q.sz * a_z) + w_v * (q.sz * b_z) + w_w * (q.sz * c_z)) / det;
+    const D2 limit = d2_set1(t_limit);
+    const D2 in_range = d2_gt(tt, zero) & (kInclusive ? d2_le(tt, limit) : d2_lt(tt, limit));
+    const int hits = d2_mask_bits(d2_andnot(mixed | d2_eq(det, zero), in_range));
+    if (hits != 0) {
+        alignas(16) double t2[2], v2[2], w2[2], det2[2];
+        d2_store(t2, tt);
+        d2_store(v2, w_v);
+        d2_store(w2, w_w);
+        d2_store(det2, det);
+        for (int l = 0; l < 2; ++l) h[l] = TriHit{t2[l], v2[l], w2[l], det2[l]};
+    }
+    return hits;
 }
 
 // --- Build ------------------------------------------------------------------------------
@@ -325,7 +398,7 @@ bool intersect_triangle(const Ray& ray, const Vec3& p0, const Vec3& p1, const Ve
 void Accelerator::build(const Mesh& mesh, AccelKind kind) {
     stats_ = AccelStats();
     nodes_.clear();
-    vertices_.clear();
+    pairs_.clear();
     triangle_id_.clear();
 
     // Usable triangles: finite vertices, nonzero cross product.
@@ -356,8 +429,22 @@ void Accelerator::build(const Mesh& mesh, AccelKind kind) {
     const bool choose = kind == AccelKind::Auto && n <= kAutoMaxTriangles;
     if (kind == AccelKind::Auto) kind = n > 0 ? AccelKind::Bvh : AccelKind::BruteForce;
 
+    // Slot of each prim in leaf order, where every leaf starts a pair (an even slot).
+    std::vector<uint32_t> slot(n);
+    for (uint32_t i = 0; i < n; ++i) slot[i] = i;
+
     if (kind == AccelKind::Bvh && n > 0) {
         const std::vector<BuildNode> tree = build_binary(prims, &stats_.build_depth);
+        std::vector<std::pair<uint32_t, uint32_t>> leaves; // (first, count) in prims order
+        for (const BuildNode& b : tree) {
+            if (b.count > 0) leaves.emplace_back(b.first, b.count);
+        }
+        std::sort(leaves.begin(), leaves.end());
+        uint32_t next = 0;
+        for (const auto& leaf : leaves) {
+            for (uint32_t i = 0; i < leaf.second; ++i) slot[leaf.first + i] = next + i;
+            next += (leaf.second + 1) & ~1u;
+        }
         double radius = 0.0;
         for (int k = 0; k < 3; ++k) {
             const Box& b = tree[0].bounds;
@@ -416,7 +503,7 @@ void Accelerator::build(const Mesh& mesh, AccelKind kind) {
                     node.bounds[k + 3][l] = float_above(b.bounds.hi[k] - center_[k] + pad);
                 }
                 if (b.count > 0) {
-                    node.child[l] = b.first;
+                    node.child[l] = slot[b.first];
                     node.count[l] = b.count;
                     ++stats_.leaves;
                 } else {
@@ -450,6 +537,7 @@ void Accelerator::build(const Mesh& mesh, AccelKind kind) {
             nodes_.clear();
             nodes_.shrink_to_fit();
             stats_ = AccelStats();
+            for (uint32_t i = 0; i < n; ++i) slot[i] = i;
         }
     }
     stats_.kind = kind;
@@ -458,45 +546,65 @@ void Accelerator::build(const Mesh& mesh, AccelKind kind) {
         stats_.expected_triangle_tests = double(n);
     }
 
-    // Triangles in leaf order (build order for brute force).
-    vertices_.resize(3 * size_t(n));
-    triangle_id_.resize(n);
+    // Triangles in leaf order (build order for brute force), two per pair.
+    uint32_t slots = 0;
+    for (uint32_t i = 0; i < n; ++i) slots = std::max(slots, slot[i] + 1);
+    slots = (slots + 1) & ~1u;
+    TrianglePair empty;
+    for (auto& row : empty.v) row[0] = row[1] = std::numeric_limits<double>::quiet_NaN();
+    pairs_.assign(slots / 2, empty);
+    triangle_id_.assign(slots, UINT32_MAX);
+    triangles_ = n;
     for (uint32_t i = 0; i < n; ++i) {
-        const uint32_t id = prims[i].id;
-        triangle_id_[i] = id;
-        for (int k = 0; k < 3; ++k) vertices_[3 * size_t(i) + k] = mesh.vertex(id, k);
+        const uint32_t id = prims[i].id, at = slot[i];
+        triangle_id_[at] = id;
+        for (int j = 0; j < 3; ++j) {
+            for (int k = 0; k < 3; ++k) pairs_[at / 2].v[3 * j + k][at % 2] = mesh.vertex(id, j)[k];
+        }
     }
-    stats_.bytes = nodes_.size() * sizeof(WideNode) + vertices_.size() * sizeof(Vec3) +
+    stats_.bytes = nodes_.size() * sizeof(WideNode) + pairs_.size() * sizeof(TrianglePair) +
                    triangle_id_.size() * sizeof(uint32_t);
 }
 
 template <bool kAnyHit> bool Accelerator::traverse(const Ray& ray, Hit* hit) const {
     RayPrep r;
     if (triangle_id_.empty() || !prepare(ray, !nodes_.empty(), &r)) return false;
-    const Vec3* tri = vertices_.data();
+    const RayLanes lanes = ray_lanes(r);
     double best_t = ray.t_max;
     TriHit best_hit{0.0, 0.0, 0.0, 1.0};
     uint32_t best = 0;
     bool found = false;
-    // Tests triangle i (leaf order); true when an any-hit query can stop.
-    auto test = [&](uint32_t i) {
-        TriHit h;
-        if (!watertight(r, tri + 3 * size_t(i), &h)) return false;
-        if (kAnyHit) return h.t < ray.t_max;
-        if (h.t < best_t || (found && h.t == best_t && triangle_id_[i] < triangle_id_[best])) {
-            best_t = h.t;
-            best_hit = h;
-            best = i;
-            found = true;
+    // Tests the `count` triangles of a leaf from slot `first` (even), two at a time; true when
+    // an any-hit query can stop. Among a pair's hits the closest-hit rule runs in slot order.
+    auto test_leaf = [&](uint32_t first, uint32_t count) {
+        const uint32_t end = first + count;
+        for (uint32_t at = first; at < end; at += 2) {
+            TriHit h[2];
+            int hits =
+                watertight2<!kAnyHit>(r, lanes, pairs_[at / 2].v, kAnyHit ? ray.t_max : best_t, h);
+            if (end - at < 2) hits &= 1;
+            if (kAnyHit) {
+                if (hits != 0) return true;
+                continue;
+            }
+            while (hits != 0) {
+                const int l = __builtin_ctz(static_cast<unsigned>(hits));
+                hits &= hits - 1;
+                const uint32_t i = at + uint32_t(l);
+                if (h[l].t < best_t ||
+                    (found && h[l].t == best_t && triangle_id_[i] < triangle_id_[best])) {
+                    best_t = h[l].t;
+                    best_hit = h[l];
+                    best = i;
+                    found = true;
+                }
+            }
         }
         return false;
     };
 
     if (nodes_.empty()) {
-        const uint32_t n = static_cast<uint32_t>(triangle_id_.size());
-        for (uint32_t i = 0; i < n; ++i) {
-            if (test(i)) return true;
-        }
+        if (test_leaf(0, triangles_)) return true;
     } else {
         // The ray in float, relative to the scene's centre (see the file comment).
         float o_rel[3];
@@ -561,9 +669,7 @@ template <bool kAnyHit> bool Accelerator::traverse(const Ray& ray, Hit* hit) con
                         continue;
                     }
                     --top;
-                    for (uint32_t i = p.child; i < p.child + p.count; ++i) {
-                        if (test(i)) return true;
-                    }
+                    if (test_leaf(p.child, p.count)) return true;
                     continue;
                 }
                 for (; at > base && stack[at - 1].t_enter < p.t_enter; --at)
@@ -579,10 +685,7 @@ template <bool kAnyHit> bool Accelerator::traverse(const Ray& ray, Hit* hit) con
                     descend = true;
                     break;
                 }
-                const uint32_t end = p.child + p.count;
-                for (uint32_t i = p.child; i < end; ++i) {
-                    if (test(i)) return true;
-                }
+                if (test_leaf(p.child, p.count)) return true;
             }
             if (!descend) break;
         }

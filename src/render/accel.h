@@ -1,7 +1,7 @@
 // Ray-scene intersection: a bounding volume hierarchy built with binned SAH [Wald07] and
 // collapsed to eight children per node, whose boxes are tested in float SIMD [Wald08], or a
 // brute-force loop when the surface area heuristic [MacDonaldBooth90] expects the BVH not to
-// pay, both on the watertight ray-triangle test of [Woop13].
+// pay, both on the watertight ray-triangle test of [Woop13], two triangles at a time.
 #pragma once
 
 #include <cstdint>
@@ -80,16 +80,24 @@ class Accelerator {
     /// lanes hold empty boxes (lo = +inf, hi = -inf), which no ray meets.
     struct alignas(16) WideNode {
         float bounds[6][kNodeWidth]; ///< lo.x, lo.y, lo.z, hi.x, hi.y, hi.z of each child
-        uint32_t child[kNodeWidth];  ///< interior child: node index; leaf: first triangle
+        uint32_t child[kNodeWidth];  ///< interior child: node index; leaf: first slot (even)
         uint32_t count[kNodeWidth];  ///< triangles of a leaf child; 0 for an interior child
+    };
+    /// Two triangles' vertices, one per lane (rows p0.x, p0.y, p0.z, p1.x, ..., p2.z), for the
+    /// two-at-a-time watertight test of accel.cpp.
+    struct alignas(16) TrianglePair {
+        double v[9][2];
     };
     template <bool kAnyHit> bool traverse(const Ray& ray, Hit* hit) const;
 
     AccelStats stats_;
     double center_[3] = {0.0, 0.0, 0.0}; // boxes and ray origins are relative to it
     std::vector<WideNode> nodes_;        // empty for brute force
-    std::vector<Vec3> vertices_;         // p0, p1, p2 of each triangle, in leaf order
-    std::vector<uint32_t> triangle_id_;  // leaf order -> mesh triangle id
+    // Leaf order: each leaf's triangles start at an even slot; a slot that pads a leaf to whole
+    // pairs holds NaN vertices and id UINT32_MAX and is never reported.
+    std::vector<TrianglePair> pairs_;   // slots 2k and 2k + 1
+    std::vector<uint32_t> triangle_id_; // slot -> mesh triangle id
+    uint32_t triangles_ = 0;            // usable triangles (brute force: slots 0 .. n - 1)
 };
 
 } // namespace mcp
