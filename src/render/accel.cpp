@@ -178,43 +178,44 @@ RayLanes ray_lanes(const RayPrep& r) {
 /// bit l set where triangle l is hit with 0 < t < t_limit (kInclusive: t <= t_limit), with its
 /// edge functions and distance in h[l].
 template <bool kInclusive>
-inline int watertight2(const RayPrep& r, const RayLanes& q, const double (*v)[2], double t_limit,
+inline int watertight2(const RayPrep& r, const RayLanes& q, const double (*rows)[2], double t_limit,
                        TriHit* h) {
     const D2 zero = d2_set1(0.0);
-    const D2 a_z = d2_load(v[q.kz]) - q.oz;
-    const D2 b_z = d2_load(v[3 + q.kz]) - q.oz;
-    const D2 c_z = d2_load(v[6 + q.kz]) - q.oz;
-    const D2 a_x = (d2_load(v[q.kx]) - q.ox) - q.sx * a_z;
-    const D2 a_y = (d2_load(v[q.ky]) - q.oy) - q.sy * a_z;
-    const D2 b_x = (d2_load(v[3 + q.kx]) - q.ox) - q.sx * b_z;
-    const D2 b_y = (d2_load(v[3 + q.ky]) - q.oy) - q.sy * b_z;
-    const D2 c_x = (d2_load(v[6 + q.kx]) - q.ox) - q.sx * c_z;
-    const D2 c_y = (d2_load(v[6 + q.ky]) - q.oy) - q.sy * c_z;
+    const D2 a_z = d2_load(rows[q.kz]) - q.oz;
+    const D2 b_z = d2_load(rows[3 + q.kz]) - q.oz;
+    const D2 c_z = d2_load(rows[6 + q.kz]) - q.oz;
+    const D2 a_x = (d2_load(rows[q.kx]) - q.ox) - q.sx * a_z;
+    const D2 a_y = (d2_load(rows[q.ky]) - q.oy) - q.sy * a_z;
+    const D2 b_x = (d2_load(rows[3 + q.kx]) - q.ox) - q.sx * b_z;
+    const D2 b_y = (d2_load(rows[3 + q.ky]) - q.oy) - q.sy * b_z;
+    const D2 c_x = (d2_load(rows[6 + q.kx]) - q.ox) - q.sx * c_z;
+    const D2 c_y = (d2_load(rows[6 + q.ky]) - q.oy) - q.sy * c_z;
     const D2 u = c_x * b_y - c_y * b_x;
-    const D2 w_v = a_x * c_y - a_y * c_x;
-    const D2 w_w = b_x * a_y - b_y * a_x;
-    if (d2_mask_bits(d2_eq(u, zero) | d2_eq(w_v, zero) | d2_eq(w_w, zero)) != 0) {
+    const D2 v = a_x * c_y - a_y * c_x;
+    const D2 w = b_x * a_y - b_y * a_x;
+    if (d2_mask_bits(d2_eq(u, zero) | d2_eq(v, zero) | d2_eq(w, zero)) != 0) {
         int hits = 0;
         for (int l = 0; l < 2; ++l) {
-            const Vec3 p[3] = {Vec3(v[0][l], v[1][l], v[2][l]), Vec3(v[3][l], v[4][l], v[5][l]),
-                               Vec3(v[6][l], v[7][l], v[8][l])};
+            const Vec3 p[3] = {Vec3(rows[0][l], rows[1][l], rows[2][l]),
+                               Vec3(rows[3][l], rows[4][l], rows[5][l]),
+                               Vec3(rows[6][l], rows[7][l], rows[8][l])};
             if (watertight(r, p, &h[l]) && (kInclusive ? h[l].t <= t_limit : h[l].t < t_limit))
                 hits |= 1 << l;
         }
         return hits;
     }
-    const D2 mixed = (d2_lt(u, zero) | d2_lt(w_v, zero) | d2_lt(w_w, zero)) &
-                     (d2_gt(u, zero) | d2_gt(w_v, zero) | d2_gt(w_w, zero));
-    const D2 det = u + w_v + w_w;
-    const D2 tt = (u * (q.sz * a_z) + w_v * (q.sz * b_z) + w_w * (q.sz * c_z)) / det;
+    const D2 mixed = (d2_lt(u, zero) | d2_lt(v, zero) | d2_lt(w, zero)) &
+                     (d2_gt(u, zero) | d2_gt(v, zero) | d2_gt(w, zero));
+    const D2 det = u + v + w;
+    const D2 tt = (u * (q.sz * a_z) + v * (q.sz * b_z) + w * (q.sz * c_z)) / det;
     const D2 limit = d2_set1(t_limit);
     const D2 in_range = d2_gt(tt, zero) & (kInclusive ? d2_le(tt, limit) : d2_lt(tt, limit));
     const int hits = d2_mask_bits(d2_andnot(mixed | d2_eq(det, zero), in_range));
     if (hits != 0) {
         alignas(16) double t2[2], v2[2], w2[2], det2[2];
         d2_store(t2, tt);
-        d2_store(v2, w_v);
-        d2_store(w2, w_w);
+        d2_store(v2, v);
+        d2_store(w2, w);
         d2_store(det2, det);
         for (int l = 0; l < 2; ++l) h[l] = TriHit{t2[l], v2[l], w2[l], det2[l]};
     }
