@@ -3,7 +3,7 @@
 and efficiency at 16, 64 and 256 spp, each renderer scored against its own converged reference.
 
   build/mitsuba-venv/bin/python bench/mitsuba/bench_mitsuba.py [--mcplay build/mcplay]
-      [--spp 16,64,256] [--ref-spp 4096] [--threads 2] [--quick] [--sobol]
+      [--spp 16,64,256] [--ref-spp 4096] [--threads 2] [--quick] [--sobol] [--scalar] [--widths]
 
 `make bench-mitsuba` installs what it needs (Debian's libllvm19 for drjit 1.5, Mitsuba 3.9.1 in a
 virtual environment under build/) and runs this. Not part of `make test`.
@@ -26,7 +26,13 @@ size compiled its kernels; mcplay's from its result JSON). The two renderers' re
 also compared with each other (the same relative MSE), which says whether they render the same
 image. With --sobol, mcplay also renders every cell with its Owen-scrambled Sobol' pixel sampler
 (`--pixel-sampler sobol`; the default is stratified), scored against the same mcplay reference:
-one more column, and its own efficiency ratio against Mitsuba.
+one more column, and its own efficiency ratio against Mitsuba. With --scalar, Mitsuba's
+`scalar_rgb` variant renders every cell too: the same integrators one sample at a time per
+thread, as mcplay runs, against `llvm_ad_rgb`'s kernels that run a SIMD register's width of
+samples at once. It is scored against the `llvm_ad_rgb` reference (the same estimator), and
+mcplay's time and efficiency are given over its own. --widths times only, at the largest --spp:
+mcplay, `scalar_rgb`, and `llvm_ad_rgb` with its kernels compiled for 4, 8 and the machine's own
+number of lanes (see width_child).
 
 A relative MSE marked `!` (with the number) rests on fewer than 10 effective pixel terms, Kish's
 (sum t)^2 / sum t^2 over the pixel terms t of the cell's images: a few rare large pixel errors
@@ -40,6 +46,7 @@ subtracted): it cannot be told from 0 with this reference, and its efficiency ra
 """
 import argparse
 import base64
+import ctypes
 import json
 import math
 import os
@@ -187,12 +194,17 @@ MITSUBA_INTEGRATOR = {
 
 
 class Mitsuba:
-    def __init__(self, mi, gltf, width, height, folder):
-        self.mi = mi
+    """One Mitsuba variant's scenes; the variant is made active before each use, so that two
+    variants can be timed in one process."""
+
+    def __init__(self, mi, variant, gltf, width, height, folder):
+        self.mi, self.variant = mi, variant
+        mi.set_variant(variant)
         self.base = mitsuba_scene(mi, gltf, width, height, folder)
         self.scenes = {}
 
     def scene(self, strategy):
+        self.mi.set_variant(self.variant)
         if strategy not in self.scenes:
             self.scenes[strategy] = self.mi.load_dict({**self.base, 'integrator': MITSUBA_INTEGRATOR[strategy]})
         return self.scenes[strategy]
@@ -316,6 +328,91 @@ def rel_text(run):
     return text + (f" !{run['effective_terms']:.1f}" if run['rare_large_errors'] else '')
 
 
+# --------------------------------------------------------------------------------------------
+# What SIMD width buys Mitsuba (--widths): time only
+
+
+# Dr.Jit's LLVM backend compiles its kernels for the machine's widest vectors (16 floats with
+# AVX-512). WebAssembly's SIMD is 128 bits wide, so a renderer that runs the same code in the
+# browser has 4 float lanes at most. --widths times Mitsuba with its kernels compiled for 4 and
+# 8 lanes too, through drjit-core's jit_llvm_set_target(cpu, features, width), a C++ function
+# the Python API does not expose (hence the mangled name). The narrow kernels get Haswell's
+# AVX2 instructions (gathers, FMA): a 4-lane bound more generous than WebAssembly's.
+NARROW_CPU, NARROW_FEATURES = b'haswell', b'+avx,+avx2,+fma,+f16c,+sse4.2,+popcnt,+bmi,+bmi2,+lzcnt,+movbe'
+
+
+def llvm_width(dr, width):
+    """Sets the LLVM kernels' number of lanes (0: the machine's own) and returns it."""
+    core = ctypes.CDLL(os.path.join(os.path.dirname(dr.__file__), 'libdrjit-core.so'))
+    if width:
+        set_target = core._Z19jit_llvm_set_targetPKcS0_j
+        set_target.argtypes = [ctypes.c_char_p, ctypes.c_char_p, ctypes.c_uint]
+        set_target(NARROW_CPU, NARROW_FEATURES, width)
+    vector_width = core._Z21jit_llvm_vector_widthv
+    vector_width.restype = ctypes.c_uint
+    return vector_width()
+
+
+def width_child(args):
+    """Times Mitsuba in one variant (and LLVM vector width) on every scene and strategy at
+    args.spp: the smaller of two runs after a first one, as JSON on standard output."""
+    import mitsuba as mi
+    mi.set_variant(args.child_variant)
+    import drjit as dr
+    dr.set_thread_count(args.threads)
+    width = llvm_width(dr, args.child_width) if args.child_variant.startswith('llvm') else None
+    times = {}
+    with tempfile.TemporaryDirectory() as folder:
+        for name, gltf, w, h, strategies in SCENES:
+            if name not in args.scenes.split(','):
+                continue
+            if args.quick:
+                w, h = w // 4, h // 4
+            mit = Mitsuba(mi, args.child_variant, os.path.join(ROOT, 'scenes', gltf), w, h, folder)
+            for strategy in strategies:
+                mit.render(strategy, 16, 3)
+                times[f'{name} {strategy}'] = min(mit.render(strategy, int(args.spp), 7 + k)[1] for k in range(2))
+    print(json.dumps({'width': width, 'times': times}))
+
+
+def widths(args):
+    """mcplay beside Mitsuba's scalar variant and its LLVM kernels at 4, 8 and the machine's
+    own number of lanes: seconds per image at args.spp, and the ratios."""
+    configs = [('scalar_rgb', 0, 'scalar'), ('llvm_ad_rgb', 4, 'llvm 4 lanes'),
+               ('llvm_ad_rgb', 8, 'llvm 8 lanes'), ('llvm_ad_rgb', 0, 'llvm own width')]
+    columns = {}
+    for variant, width, label in configs:
+        cmd = [sys.executable, os.path.abspath(__file__), '--child-variant', variant, '--child-width', str(width),
+               '--spp', args.spp, '--threads', str(args.threads), '--scenes', args.scenes] + (['--quick'] if args.quick else [])
+        out = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout
+        result = json.loads(out.strip().splitlines()[-1])
+        if variant != 'scalar_rgb' and not width:
+            label = f"llvm {result['width']} lanes (own)"
+        columns[label] = result['times']
+        print(f'  {label}: done', file=sys.stderr, flush=True)
+    mcplay = {}
+    with tempfile.TemporaryDirectory() as folder:
+        for name, gltf, w, h, strategies in SCENES:
+            if name not in args.scenes.split(','):
+                continue
+            if args.quick:
+                w, h = w // 4, h // 4
+            mcp = Mcplay(args.mcplay, name, w, h, args.threads, folder)
+            for strategy in strategies:
+                mcplay[f'{name} {strategy}'] = min(mcp.render(strategy, int(args.spp), 7 + k)[1] for k in range(2))
+    labels = list(columns)
+    own = labels[-1]
+    print(f'seconds per image at {args.spp} spp, {args.threads} threads (smaller of two runs); '
+          f'last columns: mcplay over each, and the 4-lane time over the {own} one')
+    print('| scene | strategy | mcplay | ' + ' | '.join(labels) + ' | '
+          + ' | '.join(f'mcplay / {l}' for l in labels) + ' | 4 lanes / own |')
+    print('|---' * (4 + 2 * len(labels)) + '|')
+    for key, m in mcplay.items():
+        t = [columns[l][key] for l in labels]
+        print(f"| {' | '.join(key.split())} | {m:.3f} | " + ' | '.join(f'{x:.3f}' for x in t) + ' | '
+              + ' | '.join(f'{m / x:.2f}' for x in t) + f' | {t[1] / t[-1]:.2f} |')
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split('\n')[0])
     ap.add_argument('--mcplay', default=os.path.join(ROOT, 'build', 'mcplay'))
@@ -326,11 +423,24 @@ def main():
                     help='images per cell whose relative MSE is averaged (heavy-tailed cells need several)')
     ap.add_argument('--quick', action='store_true', help='small images and references: a smoke test')
     ap.add_argument('--scenes', default=','.join(s[0] for s in SCENES))
+    ap.add_argument('--scalar', action='store_true',
+                    help="also Mitsuba's scalar_rgb variant (one sample at a time per thread, as "
+                         "mcplay runs): one more column, scored against the same Mitsuba reference")
     ap.add_argument('--sobol', action='store_true',
                     help="also mcplay with Sobol' pixels (--pixel-sampler sobol): one more column")
+    ap.add_argument('--widths', action='store_true',
+                    help="time only, at the largest --spp: mcplay beside Mitsuba's scalar variant and "
+                         "its LLVM kernels compiled for 4, 8 and the machine's own number of lanes")
+    ap.add_argument('--child-variant', help=argparse.SUPPRESS)
+    ap.add_argument('--child-width', type=int, default=0, help=argparse.SUPPRESS)
     args = ap.parse_args()
     spps = [int(s) for s in args.spp.split(',')]
     os.environ.setdefault('DRJIT_NUM_THREADS', str(args.threads))
+    if args.child_variant:
+        return width_child(args)
+    if args.widths:
+        args.spp = str(max(spps))
+        return widths(args)
     import mitsuba as mi
     variant = os.environ.get('MI_VARIANT', 'llvm_ad_rgb')
     try:
@@ -350,7 +460,9 @@ def main():
                 continue
             if args.quick:
                 w, h = w // 4, h // 4
-            mit = Mitsuba(mi, os.path.join(ROOT, 'scenes', gltf), w, h, folder)
+            mit = Mitsuba(mi, variant, os.path.join(ROOT, 'scenes', gltf), w, h, folder)
+            mit_scalar = (Mitsuba(mi, 'scalar_rgb', os.path.join(ROOT, 'scenes', gltf), w, h, folder)
+                          if args.scalar else None)
             mcp = Mcplay(args.mcplay, name, w, h, args.threads, folder)
             mcp_sobol = Mcplay(args.mcplay, name, w, h, args.threads, folder, 'sobol')
             cache = {}  # the references of this scene, per reference strategy
@@ -373,6 +485,8 @@ def main():
                     runs = [('mcplay', mcp, 'mcplay'), ('mitsuba', mit, 'mitsuba')]
                     if args.sobol:
                         runs.append(('mcplay_sobol', mcp_sobol, 'mcplay'))
+                    if mit_scalar:
+                        runs.append(('mitsuba_scalar', mit_scalar, 'mitsuba'))
                     for label, r, ref_label in runs:
                         rel, n_eff, s = scored(r, strategy, spp, refs[ref_label], args.images)
                         row[label] = {'seconds': s, 'rel_mse': rel, 'effective_terms': n_eff,
@@ -394,6 +508,14 @@ def main():
                         row['rare_large_errors_sobol'] = sob['rare_large_errors'] or row['mitsuba']['rare_large_errors']
                         line += (f"  |  sobol {sob['seconds']:7.3f} s relMSE {rel_text(sob)} "
                                  f"efficiency x{ratio_text(row['efficiency_ratio_sobol'])}")
+                    if mit_scalar:
+                        sca = row['mitsuba_scalar']
+                        row['time_ratio_scalar'] = row['mcplay']['seconds'] / sca['seconds']
+                        row['efficiency_ratio_scalar'] = (eff[0] / sca['efficiency']
+                                                          if eff[0] and sca['efficiency'] else None)
+                        line += (f"  |  Mitsuba scalar {sca['seconds']:7.3f} s relMSE {rel_text(sca)} "
+                                 f"mcplay time x{row['time_ratio_scalar']:.2f} "
+                                 f"efficiency x{ratio_text(row['efficiency_ratio_scalar'])}")
                     rows.append(row)
                     print(line, flush=True)
     out = os.path.join(ROOT, 'build', 'bench-mitsuba.json')
@@ -415,6 +537,12 @@ def main():
     if times:
         print(f'time per image mcplay / Mitsuba: median {times[len(times) // 2]:.2f}, '
               f'range {times[0]:.2f} .. {times[-1]:.2f}')
+    scalar = sorted(r['time_ratio_scalar'] for r in rows if 'time_ratio_scalar' in r)
+    if scalar:
+        effs = sorted(r['efficiency_ratio_scalar'] for r in rows if r.get('efficiency_ratio_scalar'))
+        print(f'time per image mcplay / Mitsuba scalar_rgb: median {scalar[len(scalar) // 2]:.2f}, '
+              f'range {scalar[0]:.2f} .. {scalar[-1]:.2f}; efficiency median {effs[len(effs) // 2]:.2f}, '
+              f'range {effs[0]:.2f} .. {effs[-1]:.2f}, ahead in {sum(r >= 1 for r in effs)} of {len(effs)}')
     for name in sorted({r['scene'] for r in rows}):
         print(f'references, mcplay against Mitsuba, {name}: relative MSE '
               + ', '.join(f"{r['strategy']} {r['refs_rel_mse']:.2e}" for r in rows if r['scene'] == name and r['spp'] == spps[0]))
