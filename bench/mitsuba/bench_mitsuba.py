@@ -328,6 +328,15 @@ def rel_text(run):
     return text + (f" !{run['effective_terms']:.1f}" if run['rare_large_errors'] else '')
 
 
+def chosen_scenes(args):
+    """The scenes of --scenes as (name, glTF path, width, height, strategies), a quarter of the
+    size with --quick."""
+    for name, gltf, w, h, strategies in SCENES:
+        if name in args.scenes.split(','):
+            scale = 4 if args.quick else 1
+            yield name, os.path.join(ROOT, 'scenes', gltf), w // scale, h // scale, strategies
+
+
 # --------------------------------------------------------------------------------------------
 # What SIMD width buys Mitsuba (--widths): time only
 
@@ -363,12 +372,8 @@ def width_child(args):
     width = llvm_width(dr, args.child_width) if args.child_variant.startswith('llvm') else None
     times = {}
     with tempfile.TemporaryDirectory() as folder:
-        for name, gltf, w, h, strategies in SCENES:
-            if name not in args.scenes.split(','):
-                continue
-            if args.quick:
-                w, h = w // 4, h // 4
-            mit = Mitsuba(mi, args.child_variant, os.path.join(ROOT, 'scenes', gltf), w, h, folder)
+        for name, gltf, w, h, strategies in chosen_scenes(args):
+            mit = Mitsuba(mi, args.child_variant, gltf, w, h, folder)
             for strategy in strategies:
                 mit.render(strategy, 16, 3)
                 times[f'{name} {strategy}'] = min(mit.render(strategy, int(args.spp), 7 + k)[1] for k in range(2))
@@ -392,11 +397,7 @@ def widths(args):
         print(f'  {label}: done', file=sys.stderr, flush=True)
     mcplay = {}
     with tempfile.TemporaryDirectory() as folder:
-        for name, gltf, w, h, strategies in SCENES:
-            if name not in args.scenes.split(','):
-                continue
-            if args.quick:
-                w, h = w // 4, h // 4
+        for name, gltf, w, h, strategies in chosen_scenes(args):
             mcp = Mcplay(args.mcplay, name, w, h, args.threads, folder)
             for strategy in strategies:
                 mcplay[f'{name} {strategy}'] = min(mcp.render(strategy, int(args.spp), 7 + k)[1] for k in range(2))
@@ -455,13 +456,9 @@ def main():
           f'spp {spps}, references {args.ref_spp} spp (two halves), {args.images} image(s) per cell')
     rows = []
     with tempfile.TemporaryDirectory() as folder:
-        for name, gltf, w, h, strategies in SCENES:
-            if name not in args.scenes.split(','):
-                continue
-            if args.quick:
-                w, h = w // 4, h // 4
-            mit = Mitsuba(mi, variant, os.path.join(ROOT, 'scenes', gltf), w, h, folder)
-            mit_scalar = (Mitsuba(mi, 'scalar_rgb', os.path.join(ROOT, 'scenes', gltf), w, h, folder)
+        for name, gltf, w, h, strategies in chosen_scenes(args):
+            mit = Mitsuba(mi, variant, gltf, w, h, folder)
+            mit_scalar = (Mitsuba(mi, 'scalar_rgb', gltf, w, h, folder)
                           if args.scalar else None)
             mcp = Mcplay(args.mcplay, name, w, h, args.threads, folder)
             mcp_sobol = Mcplay(args.mcplay, name, w, h, args.threads, folder, 'sobol')
