@@ -22,8 +22,10 @@ FUZZ_MAX_LEN_hdr := 16384
 fuzz_max_len = $$(case $(1) in scene) echo $(FUZZ_MAX_LEN_scene);; \
 	expression) echo $(FUZZ_MAX_LEN_expression);; gltf) echo $(FUZZ_MAX_LEN_gltf);; \
 	*) echo $(FUZZ_MAX_LEN_hdr);; esac)
-# Seed folders of a target: its own seeds, the scenes (for scene and gltf), tests/corpus/.
-fuzz_seeds = fuzz/seeds/$(1) $$(case $(1) in scene|gltf) echo scenes;; esac) \
+# Seed folders of a target: its own seeds (if it has any: libFuzzer stops at a missing folder),
+# the scenes (for scene and gltf), tests/corpus/.
+fuzz_seeds = $$([ -d fuzz/seeds/$(1) ] && echo fuzz/seeds/$(1)) \
+	$$(case $(1) in scene|gltf) echo scenes;; esac) \
 	$$([ -d tests/corpus ] && echo tests/corpus)
 SCENE ?= scenes/exp_1d.json
 ARGS ?=
