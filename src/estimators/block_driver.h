@@ -1,7 +1,15 @@
-// The one loop every path that samples goes through: generate unit-cube points -> warp them by
-// the proposal (domain points and densities) -> evaluate the integrand, a block of kBlockSize
-// samples at a time (structure of arrays), then hand the block to a consumer (the weight
-// accumulator of a run, a probe counter, a recorder of points). Dispatch happens per block.
+// Block-at-a-time sampling and the estimator interface built on it. Samples are made a block of
+// kBlockSize at a time (structure of arrays): unit-cube points are generated, warped by the
+// proposal into domain points and densities, and the integrand is evaluated on them; dispatch
+// happens per block, never per sample. Declared here:
+// - Workspace and SampleBlock: the reused buffers and one block of samples (u, x, pdf, f);
+//   prepare_workspace, sample_block (generate -> warp -> evaluate for a sampler plan), block_of
+//   (the workspace's buffers as a block, for estimators that fill them their own way: VEGAS
+//   through its map, VEGAS+ and MISER in their hypercubes and regions), and for_each_block
+//   (every block of a plan, handed to a consumer: the support check's probes);
+// - EstimatorAlgorithm, the interface of an estimator's runs (begin, run_block, result), with
+//   the factories of its implementations (make_estimator picks one from a spec), and what the
+//   adaptive ones report: AdaptiveView, TrainingLog, view_of, clock_seconds.
 #pragma once
 
 #include <algorithm>
@@ -59,10 +67,6 @@ void for_each_block(const Problem& problem, const Proposal& proposal, const Samp
     }
 }
 
-/// An estimator as an algorithm: it plans a run, consumes it block by block, and gives the
-/// run's result. Fixed estimators (a sampler and one proposal) are one implementation; adaptive
-/// ones (which change their proposal between blocks or iterations), multi-proposal ones and
-/// sequential ones (stopping at a tolerance) are others. Calls are per block, never per sample.
 /// What an adaptive estimator learnt in its last run, for looking at it (the sample view).
 struct AdaptiveView {
     std::vector<std::vector<double>> edges; ///< VEGAS: per axis, the frozen map's increment edges
@@ -107,6 +111,12 @@ class TrainingLog {
     std::vector<std::vector<std::vector<double>>> history_;
 };
 
+/// An estimator as an algorithm: it plans a run, consumes it block by block, and gives the
+/// run's result. Fixed estimators (a sampler and one proposal; estimators/estimator.cpp) are one
+/// implementation; VEGAS (estimator.cpp), VEGAS+ and MISER (which adapt their sampling between
+/// iterations or regions), MIS (several proposals) and control variates are the others.
+/// Stopping at a tolerance (stopping.h) runs whole estimates of any of them. Calls are per
+/// block, never per sample.
 class EstimatorAlgorithm {
   public:
     virtual ~EstimatorAlgorithm() = default;
@@ -148,7 +158,7 @@ std::unique_ptr<EstimatorAlgorithm> make_control_variate_estimator(const Problem
                                                                    const EstimatorSpec& spec,
                                                                    Accumulator accumulator);
 
-/// The algorithm of an estimator spec: fixed, VEGAS, VEGAS+ or MISER.
+/// The algorithm of an estimator spec: MIS, control variates, MISER, VEGAS+, VEGAS or fixed.
 std::unique_ptr<EstimatorAlgorithm>
 make_estimator(const Problem& problem, const EstimatorSpec& spec, Accumulator accumulator);
 
