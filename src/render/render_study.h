@@ -1,7 +1,13 @@
-// Convergence study of radiance estimators: every estimator renders the image at every spp of
-// a ladder of powers of two, R replicates each, and is measured against a reference image by
-// its relative mean squared error, the same way the integration studies measure estimators
-// by their variance (study.h): relative MSE against spp, and against seconds per image.
+// Convergence studies of radiance estimators (run_render_study): every estimator renders the
+// image at every spp of a ladder of powers of two, R replicates each, and is measured against a
+// reference image by its relative mean squared error, the same way the integration studies
+// measure estimators by their variance (study.h): relative MSE against spp, and against seconds
+// per image. Declared here: the study's settings (RenderStudySettings, with the part of a study
+// split over processes) and result; one image's error against the reference (image_error,
+// mean_luminance, relative_mse_floor) and what a level keeps of it (ImageSummary,
+// ReferenceSummary); a level's statistics, flags and error concentration (render_level_stats,
+// render_level_flags, ErrorConcentration); the fitted order (fit_render_convergence) and the
+// estimator's flags (render_flags).
 //
 // Relative MSE of an image I against the reference R [RousselleKnausZwicker11]:
 //   relMSE = mean over pixels p and channels c of ((I_pc - R_pc)^2 - v_pc) / (R_pc^2 + eps),
@@ -15,10 +21,10 @@
 // The reference's own noise, summed the same way, is the relative-MSE floor
 //   floor = mean over p, c of v_pc / (R_pc^2 + eps):
 // the raw relative MSE of a perfect estimator. v_pc is the reference pixel's sample variance
-// over spp, which for the stratified pixel sampler overestimates the variance of its mean, so
-// the subtraction can overshoot: a level whose corrected relative MSE is below the floor (or
-// negative) measures the reference rather than the estimator. Such levels are flagged
-// (below_reference_noise), have no efficiency, and are left out of the fitted order.
+// over spp, which for the stratified and Sobol' pixel samplers overestimates the variance of
+// its mean, so the subtraction can overshoot: a level whose corrected relative MSE is below the
+// floor (or negative) measures the reference rather than the estimator. Such levels are
+// flagged (below_reference_noise), have no efficiency, and are left out of the fitted order.
 #pragma once
 
 #include <cmath>
@@ -51,7 +57,9 @@ struct RenderStudySettings {
 struct ImageError {
     double rel_mse = 0.0;     ///< reference-noise corrected (see the header comment)
     double rel_mse_raw = 0.0; ///< without the correction
-    double coverage = 0.0;    ///< share of pixels whose 95% interval covers the reference
+    /// Share of pixel channels with |I - R| <= 1.96 sqrt(v_I + v_R): the image's own 95%
+    /// interval, widened by the reference's variance, covers the reference.
+    double coverage = 0.0;
     double mean_luminance = 0.0;
     double mean_luminance_se = 0.0;
     /// The pixel with the largest raw term of the relative MSE (its three channels), and that
@@ -133,19 +141,6 @@ std::vector<Flag> render_flags(const RenderEstimatorStudy& s, double floor);
 std::vector<Flag> render_level_flags(const LevelStats& level, const ErrorConcentration& c,
                                      double floor);
 
-/// Summarises R replicate images of one level in the integration studies' terms:
-///   variance, mse  relative MSE against the reference (mean over replicates), with a 95%
-///                  interval from the replicates' spread in variance_lo / variance_hi
-///   rmse, error    its square root
-///   mean, estimates, ci  the image's mean luminance per replicate and over them, with bias
-///                  against the reference's mean luminance
-///   coverage       share of (pixel, replicate) pairs whose own 95% error bar covers the
-///                  reference pixel: honest per-pixel error bars give 0.95
-///   time_mean      seconds per image; efficiency = 1 / (relMSE * seconds)
-///   diagnostics    discarded samples (nonfinite), largest single-sample share of a pixel
-///   tail_index     Hill's estimate on the luminance of the samples' reflected radiance, pooled
-///                  over the image and the replicates
-
 /// What a level needs of the reference: its mean luminance, that mean's standard error, and
 /// the relative-MSE floor (so that parts of a study can be merged without the image).
 struct ReferenceSummary {
@@ -154,6 +149,21 @@ struct ReferenceSummary {
 ReferenceSummary summarise_reference(const RenderImage& reference);
 ImageSummary summarise_image(const RenderImage& image, const RenderImage& reference);
 
+/// Summarises R replicate images of one level in the integration studies' terms:
+///   variance, mse  relative MSE against the reference (mean over replicates), with a 95%
+///                  t interval from the replicates' spread in variance_lo / variance_hi
+///   rmse, error    its square root (of 0 when it is negative)
+///   mean, estimates, ci  the image's mean luminance per replicate and over them, with bias
+///                  against the reference's mean luminance; std_error also counts the
+///                  reference mean's own standard error, ci does not
+///   coverage       share of (pixel channel, replicate) pairs whose 95% interval covers the
+///                  reference (ImageError::coverage): honest per-pixel error bars give 0.95
+///   time_mean      seconds per image; efficiency = 1 / (relMSE * seconds), none (NaN) below
+///                  the reference's noise
+///   diagnostics    discarded samples (nonfinite), samples (nonzero), largest single-sample
+///                  share of a pixel (max_weight_share)
+///   tail_index     Hill's estimate on the luminance of the samples' reflected radiance, pooled
+///                  over the image and the replicates
 /// With `concentration`, also where the level's relative MSE comes from.
 LevelStats render_level_stats(const std::vector<ImageSummary>& images,
                               const ReferenceSummary& reference,
