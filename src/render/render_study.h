@@ -152,7 +152,7 @@ ImageSummary summarise_image(const RenderImage& image, const RenderImage& refere
 /// Summarises R replicate images of one level in the integration studies' terms:
 ///   variance, mse  relative MSE against the reference (mean over replicates), with a 95%
 ///                  t interval from the replicates' spread in variance_lo / variance_hi
-///   rmse, error    its square root (of 0 when it is negative)
+///   rmse, error    its square root (0 when the relative MSE is negative)
 ///   mean, estimates, ci  the image's mean luminance per replicate and over them, with bias
 ///                  against the reference's mean luminance; std_error also counts the
 ///                  reference mean's own standard error, ci does not
