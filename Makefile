@@ -1,5 +1,6 @@
 # mcplay: the two commands a fresh machine needs are `make run` and `make test`.
-# Both install missing Debian packages first (`make deps`).
+# Both install missing Debian packages first (`make deps`). `make check` is what CI runs:
+# `make test` plus the sanitized suite and the fuzz-corpus replay.
 
 SHELL := /bin/bash
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
@@ -46,15 +47,17 @@ DEP_PROBES := /usr/bin/cmake /usr/bin/g++ /usr/src/googletest/CMakeLists.txt \
 	/usr/include/tiny_gltf.h /usr/include/nlohmann/json.hpp /usr/bin/chromium
 
 .PHONY: all deps deps-web build build-wasm site test test-native test-wasm test-compare test-web-core \
-	test-e2e test-sanitize run cli bench bench-mitsuba bench-embree format clean help fuzz fuzz-build \
-	fuzz-smoke deps-fuzz
+	test-e2e test-sanitize test-suites check run cli bench bench-mitsuba bench-embree format clean help \
+	fuzz fuzz-build fuzz-smoke deps-fuzz
 
 all: build
 
 help:
 	@echo "make run    build everything and serve the playground on http://localhost:$(PORT)/"
 	@echo "make cli    build the native CLI and run it on $(SCENE)"
-	@echo "make test   install what is missing, build native + wasm, run every test suite"
+	@echo "make test   the contributor's loop: install what is missing, build native + wasm, run the"
+	@echo "           native, wasm, Node and Chromium suites (independent ones at the same time)"
+	@echo "make check  everything CI runs: make test, then the ASan/UBSan suite and make fuzz-smoke"
 	@echo "make bench  samples per second natively and in wasm under Node, and their ratio; then bench-genz"
 	@echo "make bench-genz  mcplay beside GSL plain/MISER/VEGAS on Genz's families (GENZ_ARGS=--quick: 15 s)"
 	@echo "make bench-flags  the flags judged both ways: false alarms where intervals covered, confident wrong answers"
@@ -62,7 +65,7 @@ help:
 	@echo "make bench-mitsuba  the renderer beside Mitsuba 3.9.1 on three glTF scenes: time, relMSE, efficiency (ARGS: --quick, --sobol, --scalar, --widths)"
 	@echo "make bench-embree  the accelerator beside Embree 3 (Debian's libembree-dev) on the same rays, one thread"
 	@echo "make format clang-format every C++ source"
-	@echo "make test-sanitize  the native ctest suite under ASan + UBSan ($(BUILD_ASAN); part of make test)"
+	@echo "make test-sanitize  the native ctest suite under ASan + UBSan ($(BUILD_ASAN); part of make check)"
 	@echo "make fuzz   libFuzzer targets, $(FUZZ_SECONDS) s each (FUZZ_TARGETS=\"$(FUZZ_TARGETS)\"); docs/fuzzing.md"
 	@echo "make fuzz-smoke  each fuzz target over its seed corpus only (seconds)"
 
@@ -81,14 +84,15 @@ deps:
 # npm packages of the page (uPlot; playwright-core for the browser tests), from the lock file.
 deps-web: web/node_modules/.package-lock.json
 
-web/node_modules/.package-lock.json: web/package.json web/package-lock.json
+web/node_modules/.package-lock.json: web/package.json web/package-lock.json | deps
 	cd web && npm ci --no-audit --no-fund
 	@touch $@
 
-$(BUILD)/CMakeCache.txt:
+# Order-only on deps: under make -j the configure step must wait for apt-get.
+$(BUILD)/CMakeCache.txt: | deps
 	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release
 
-$(BUILD_WASM)/CMakeCache.txt:
+$(BUILD_WASM)/CMakeCache.txt: | deps
 	emcmake cmake -S . -B $(BUILD_WASM) -DCMAKE_BUILD_TYPE=Release
 
 build: deps $(BUILD)/CMakeCache.txt
@@ -123,7 +127,7 @@ test-e2e: build site
 # The native suite again, built with g++ -fsanitize=address,undefined (CMake option MCPLAY_SANITIZE):
 # a leak, an out-of-bounds access or undefined behaviour fails the test that triggers it.
 # -O1 with assertions on: about 3x slower than Release, and every assert() is checked.
-$(BUILD_ASAN)/CMakeCache.txt:
+$(BUILD_ASAN)/CMakeCache.txt: | deps
 	cmake -S . -B $(BUILD_ASAN) -DMCPLAY_SANITIZE=ON -DCMAKE_BUILD_TYPE=Debug \
 	  -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g"
 
@@ -131,8 +135,24 @@ test-sanitize: deps $(BUILD_ASAN)/CMakeCache.txt
 	cmake --build $(BUILD_ASAN) -j $(JOBS)
 	ctest --test-dir $(BUILD_ASAN) --output-on-failure -j $(JOBS)
 
-test: test-native test-wasm test-compare test-web-core test-e2e test-sanitize
-	@echo "make test: all suites passed"
+# The contributor's loop. The native and the wasm build, and the suites that need only one of
+# them, run at the same time (make -j2: two builds of -j $(JOBS) each); each line of output is
+# prefixed by nothing but kept whole (--output-sync=line).
+TEST_JOBS ?= 2
+test:
+	@start=$$(date +%s); \
+	$(MAKE) --no-print-directory -j $(TEST_JOBS) --output-sync=line test-suites && \
+	echo "make test: all suites passed in $$(( $$(date +%s) - start )) s"
+
+test-suites: test-native test-wasm test-compare test-web-core test-e2e
+
+# Everything: the loop, then the suites too slow for it (sanitizers; the fuzz targets, built with
+# clang, over their seed corpus and past findings). .ci/run runs this.
+check:
+	@start=$$(date +%s); \
+	$(MAKE) --no-print-directory test && \
+	$(MAKE) --no-print-directory -j 2 --output-sync=line test-sanitize fuzz-smoke && \
+	echo "make check: all suites passed in $$(( $$(date +%s) - start )) s"
 
 run: build site
 	PORT=$(PORT) node web/tools/serve.mjs $(SITE)
@@ -154,6 +174,8 @@ bench-mitsuba: build
 	DRJIT_LIBLLVM_PATH=$(LIBLLVM19) $(MITSUBA_VENV)/bin/python bench/mitsuba/bench_mitsuba.py --mcplay $(BUILD)/mcplay $(ARGS)
 
 bench: build build-wasm site
+	cmake --build $(BUILD) -j $(JOBS) --target mcplay_bench
+	cmake --build $(BUILD_WASM) -j $(JOBS) --target mcplay_bench
 	bash bench/run_bench.sh $(BUILD)/mcplay_bench "$(NODE_RUN) --no-liftoff $(BUILD_WASM)/mcplay_bench.js"
 	node web/e2e/first_plot.bench.mjs $(SITE) all 3
 	$(MAKE) --no-print-directory bench-genz

@@ -236,7 +236,7 @@ TEST(Study, DifferentSeedsGiveDifferentNumbers) {
     EXPECT_NE(a.estimators[0].levels.back().estimates, b.estimators[0].levels.back().estimates);
 }
 
-TEST(Diagnostics, NonFiniteSamplesAreCountedAndDropped) {
+TEST(EstimatorDiagnostics, NonFiniteSamplesAreCountedAndDropped) {
     // sqrt(x) on [-1, 1]: NaN for every x < 0 (about half the samples).
     Json scene = {{"domain", {{"type", "interval"}, {"lower", -1}, {"upper", 1}}},
                   {"integrand", {{"type", "monomial"}, {"powers", {0.5}}}},
@@ -438,7 +438,7 @@ TEST(AdaptiveGenz, ConvergeOrFlagAndCoverWhereNotFlagged) {
     }
 }
 
-TEST(Diagnostics, MissedPeakIsFlaggedNotReportedAsExact) {
+TEST(EstimatorDiagnostics, MissedPeakIsFlaggedNotReportedAsExact) {
     SceneRequest req =
         load("stiff_peak_1e-8",
              Json{{"estimators", {"uniform"}}, {"n_min", 1024}, {"n_max", 1024}, {"reps", 8}});
@@ -449,7 +449,7 @@ TEST(Diagnostics, MissedPeakIsFlaggedNotReportedAsExact) {
     EXPECT_TRUE(warning_codes(s.estimators[0], l, s.settings).count("low_ess"));
 }
 
-TEST(Diagnostics, TailIndexSeparatesFiniteFromInfiniteVariance) {
+TEST(EstimatorDiagnostics, TailIndexSeparatesFiniteFromInfiniteVariance) {
     // x^-alpha sampled uniformly: P(w > t) = t^(-1/alpha), tail index 1/alpha.
     for (auto [scene, alpha] : std::vector<std::pair<const char*, double>>{
              {"singular_power_0.3", 1 / 0.3}, {"singular_power_0.9", 1 / 0.9}}) {
@@ -474,7 +474,7 @@ TEST(Diagnostics, TailIndexSeparatesFiniteFromInfiniteVariance) {
     EXPECT_NEAR(s.estimators[0].levels[0].tail_index, 1.5, 0.4);
 }
 
-TEST(Diagnostics, SupportCheckFindsAPdfThatIsZeroWhereFIsNot) {
+TEST(EstimatorDiagnostics, SupportCheckFindsAPdfThatIsZeroWhereFIsNot) {
     SceneRequest req = load("is_zero_pdf", Json{{"n_max", 1024}, {"reps", 4}});
     StudyResult s = run(req);
     const EstimatorStudy& gap = find(s, "importance_gap");
@@ -664,7 +664,7 @@ TEST(ErrorBars, ExactEstimatorsStayQuiet) {
     }
 }
 
-TEST(Diagnostics, AllNonFiniteSamplesGiveNoEstimate) {
+TEST(EstimatorDiagnostics, AllNonFiniteSamplesGiveNoEstimate) {
     SceneRequest req = request({{"f", "log(-1-x)"}, {"estimators", {"uniform", "stratified"}}},
                                Json{{"n_min", 16}, {"n_max", 1024}, {"reps", 4}});
     StudyResult s = run(req);
@@ -691,7 +691,7 @@ TEST(Diagnostics, AllNonFiniteSamplesGiveNoEstimate) {
     EXPECT_NE(table.find("     16                -            -"), std::string::npos) << table;
 }
 
-TEST(Diagnostics, AnOverflowedMeanIsFlaggedNotPrinted) {
+TEST(EstimatorDiagnostics, AnOverflowedMeanIsFlaggedNotPrinted) {
     // 32 weights of 1e307 sum beyond the double range.
     SceneRequest req = request({{"f", "1e307 + 0*x"}, {"estimators", {"uniform"}}},
                                Json{{"n_min", 32}, {"n_max", 32}, {"reps", 2}});
