@@ -136,12 +136,12 @@ test-sanitize: deps $(BUILD_ASAN)/CMakeCache.txt
 	ctest --test-dir $(BUILD_ASAN) --output-on-failure -j $(JOBS)
 
 # The contributor's loop. The native and the wasm build, and the suites that need only one of
-# them, run at the same time (make -j2: two builds of -j $(JOBS) each); each line of output is
-# prefixed by nothing but kept whole (--output-sync=line).
+# them, run at the same time (make -j2: two builds of -j $(JOBS) each), so their lines of output
+# interleave; a failure ends with make naming the target (test-native, test-wasm, ...) that failed.
 TEST_JOBS ?= 2
 test:
 	@start=$$(date +%s); \
-	$(MAKE) --no-print-directory -j $(TEST_JOBS) --output-sync=line test-suites && \
+	$(MAKE) --no-print-directory -j $(TEST_JOBS) test-suites && \
 	echo "make test: all suites passed in $$(( $$(date +%s) - start )) s"
 
 test-suites: test-native test-wasm test-compare test-web-core test-e2e
@@ -151,7 +151,7 @@ test-suites: test-native test-wasm test-compare test-web-core test-e2e
 check:
 	@start=$$(date +%s); \
 	$(MAKE) --no-print-directory test && \
-	$(MAKE) --no-print-directory -j 2 --output-sync=line test-sanitize fuzz-smoke && \
+	$(MAKE) --no-print-directory -j 2 test-sanitize fuzz-smoke && \
 	echo "make check: all suites passed in $$(( $$(date +%s) - start )) s"
 
 run: build site
