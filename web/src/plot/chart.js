@@ -1,0 +1,169 @@
+// uPlot charts by key ('variance', 'time', 'calibration', 'coverage', 'overlay', 'misweights',
+// 'weights'): each built in its element, rebuilt when its set of series changes and otherwise
+// given new data (draw), with a hover readout and the hidden estimators applied; the page's
+// plot elements (dom, filled by plot.js); and the parts the log-scale plots share (scales, N
+// ticks, log-paper grid). The only module that imports uPlot: pixel_ratio.js first, so that it
+// keeps uPlot's pixel-ratio listeners (PNG exports at 2x); the others take uPlot from here.
+import '../pixel_ratio.js';
+import uPlot from '../../vendor/uPlot.esm.js';
+import { fmt } from '../series.js';
+import { el } from '../dom.js';
+import { nTickLabels } from './axes.js';
+import { hidesLabel } from './legend.js';
+
+export { uPlot };
+
+export const charts = {}; // key -> {u, sig, el, xRange, yRange, ...the ranges given to draw}
+
+/** The plot and legend elements by key ('variance', 'legend-variance', 'samples', ...). */
+export const dom = {};
+
+function plotSize(el) {
+  const width = Math.max(280, Math.floor(el.clientWidth || 480));
+  const height = Math.round(Math.min(380, Math.max(240, width * 0.58)));
+  return { width, height };
+}
+
+/** Resizes the charts whose element changed size. */
+export function resizeAll() {
+  for (const c of Object.values(charts)) {
+    if (!c.u) continue;
+    const size = plotSize(c.el);
+    if (size.width !== c.u.width || size.height !== c.u.height) c.u.setSize(size);
+  }
+}
+
+/** Replaces what `el` shows by a line of text (no chart). */
+export function empty(el, text) {
+  el.replaceChildren();
+  const d = document.createElement('div');
+  d.className = 'empty';
+  d.textContent = text;
+  el.append(d);
+}
+
+/** Sets the text of the element `id` (a title or a note), when it differs. */
+export function setText(id, text) {
+  const e = document.getElementById(id);
+  if (e && e.textContent !== text) e.textContent = text;
+}
+
+export function drop(key) {
+  const c = charts[key];
+  if (c) {
+    c.u.destroy();
+    delete charts[key];
+  }
+}
+
+/** Creates or updates chart `key` in `el`: `sig` changes when the series change. */
+export function draw(key, el, sig, makeOpts, data, ranges) {
+  let c = charts[key];
+  if (!c || c.sig !== sig || c.el !== el) {
+    drop(key);
+    el.replaceChildren();
+    c = { sig, el, ...ranges };
+    const opts = makeOpts(c);
+    const hooks = { ...(opts.hooks || {}), setCursor: [...((opts.hooks && opts.hooks.setCursor) || []), readout(key)] };
+    c.u = new uPlot({ ...plotSize(el), legend: { show: false }, padding: [14, 36, 0, 0], ...opts, hooks }, data, el);
+    charts[key] = c;
+  } else {
+    Object.assign(c, ranges);
+    c.u.setData(data);
+  }
+  applyHidden(c);
+  return c;
+}
+
+// Plots whose y values are log10 of what they show (axes.js: lg).
+const LOG10_Y = new Set(['variance', 'time']);
+
+/** The hover readout of a chart: the x under the cursor and each shown estimator's value there
+ *  (bands, references and hidden series left out), in a box in the plot's corner. */
+function readout(key) {
+  return (u) => {
+    let box = u.root.querySelector('.readout');
+    if (!box) {
+      box = el('div', { className: 'readout', role: 'status' });
+      u.root.querySelector('.u-over').after(box);
+    }
+    const i = u.cursor.idx;
+    if (i === null || i === undefined || u.cursor.left < 0) {
+      box.hidden = true;
+      return;
+    }
+    const x = u.data[0][i];
+    const lines = [];
+    u.series.forEach((ser, k) => {
+      if (k === 0 || !ser.show || typeof ser.label !== 'string' || / 95% |^N|^spp|normal|exact/.test(ser.label)) return;
+      const v = u.data[k][i];
+      if (v === null || v === undefined || !Number.isFinite(v)) return;
+      lines.push(`${ser.label}: ${fmt(LOG10_Y.has(key) ? 10 ** v : v, 3)}`);
+    });
+    if (!lines.length) {
+      box.hidden = true;
+      return;
+    }
+    box.hidden = false;
+    box.textContent = `${key === 'time' ? 't' : key === 'calibration' ? 'z' : 'N'} = ${fmt(x, 4)}\n${lines.join('\n')}`;
+  };
+}
+
+/** Shows or hides each series of a chart by the estimator it belongs to (legend.js). */
+function applyHidden(c) {
+  if (!c || !c.u) return;
+  c.u.series.forEach((ser, i) => {
+    if (i === 0 || typeof ser.label !== 'string') return;
+    const hide = hidesLabel(ser.label);
+    if (Boolean(ser.show) === hide) c.u.setSeries(i, { show: !hide });
+  });
+}
+
+/** Applies the hidden estimators to every chart and redraws them (after a legend click). */
+export function applyHiddenAll() {
+  for (const c of Object.values(charts)) {
+    applyHidden(c);
+    if (c && c.u) c.u.redraw(false);
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Log scales
+
+/** A log x scale (base 2 for N, 10 for time) over c.xRange. */
+export function logX(c, base = 2) {
+  return { time: false, distr: 3, log: base, range: () => c.xRange };
+}
+
+/** A y scale holding log10 of the values (axes.js: lg) over c.yRange. */
+export function log10Y(c) {
+  return { range: () => c.yRange };
+}
+
+/** N ticks (powers of two): plain up to 65536, then 2^k; thinned to what fits. */
+export function nTicks(u, splits) {
+  return nTickLabels(u.bbox.width / (uPlot.pxRatio || 1), splits);
+}
+
+/** Minor grid lines at 2..9 x 10^k on a log10 y axis (log paper), under the series. */
+export function minorLogGrid(u) {
+  const { min, max } = u.scales.y;
+  if (!(max - min <= 14)) return;
+  const ctx = u.ctx;
+  const px = uPlot.pxRatio || 1;
+  ctx.save();
+  ctx.strokeStyle = '#eef1f4';
+  ctx.lineWidth = px;
+  ctx.beginPath();
+  for (let k = Math.floor(min); k < Math.ceil(max); k++) {
+    for (let m = 2; m <= 9; m++) {
+      const v = k + Math.log10(m);
+      if (v <= min || v >= max) continue;
+      const y = Math.round(u.valToPos(v, 'y', true)) + 0.5;
+      ctx.moveTo(u.bbox.left, y);
+      ctx.lineTo(u.bbox.left + u.bbox.width, y);
+    }
+  }
+  ctx.stroke();
+  ctx.restore();
+}

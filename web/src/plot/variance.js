@@ -1,0 +1,160 @@
+// The first plot: each estimator's variance (its MSE when the exact value is known; a render
+// study's relative MSE) against N on log-log axes, with its 95% band, the reference slopes
+// N^-1, N^-2, N^-3 (spp^-1 for renders), a run kept for comparison dashed, and the levels that
+// are exact to round-off marked along the bottom; its legend gives each estimator's fitted order.
+import { varianceSeries, anchorOf, referenceLines, fitText } from '../series.js';
+import { withAlpha } from '../palette.js';
+import { keptFor } from '../state.js';
+import { AXIS, LOG10_AXIS, sup, lgAll, log10Range, runLabels, isRender } from './axes.js';
+import { uPlot, dom, draw, setText, logX, log10Y, nTicks, minorLogGrid } from './chart.js';
+import { colorOf, levelFlags, setLegend } from './legend.js';
+
+export const VARIANCE_NOTE = {
+  integral: 'Shaded: 95% interval of the variance (chi-square); dashed grey: reference slopes N⁻¹, N⁻², N⁻³ from the first point. Order = the core\'s least-squares fit of log variance on log N.',
+  render: 'Relative MSE of each estimator\'s images against the reference (mean over the replicates; shaded: its 95% interval from their spread); dashed grey: the reference slope spp⁻¹ of an unbiased estimator, from the first point. Order = the core\'s least-squares fit of log relative MSE on log spp.',
+};
+
+/** Draws labels at the last visible point of the given series (reference lines). */
+function labelHook(items) {
+  return (u) => {
+    const ctx = u.ctx;
+    const px = uPlot.pxRatio || 1;
+    ctx.save();
+    ctx.font = `${11 * px}px "DejaVu Sans", sans-serif`;
+    ctx.fillStyle = '#555';
+    ctx.textBaseline = 'bottom';
+    const { min: ymin, max: ymax } = u.scales.y;
+    for (const { idx, label } of items) {
+      const ys = u.data[idx];
+      if (!ys) continue;
+      let last = -1;
+      for (let i = 0; i < ys.length; i++) if (ys[i] !== null && ys[i] >= ymin && ys[i] <= ymax) last = i;
+      if (last < 0) continue;
+      const w = ctx.measureText(label).width;
+      let x = u.valToPos(u.data[0][last], 'x', true) + 4 * px;
+      x = Math.min(x, u.bbox.left + u.bbox.width - w - 2 * px);
+      const y = Math.max(u.bbox.top + 12 * px, u.valToPos(ys[last], 'y', true) - 2 * px);
+      ctx.fillText(label, x, y);
+    }
+    ctx.restore();
+  };
+}
+
+/** Marks the levels that are exact to round-off (no point on a log axis): a row of squares in
+ *  the series' colour along the bottom of the plot, one row per such estimator (the legend
+ *  says which). */
+function exactHook(rows) {
+  return (u) => {
+    if (!rows.length) return;
+    const ctx = u.ctx;
+    const px = uPlot.pxRatio || 1;
+    ctx.save();
+    rows.forEach(({ color, exactAt }, r) => {
+      const y = u.bbox.top + u.bbox.height - (7 + 11 * r) * px;
+      ctx.fillStyle = color;
+      exactAt.forEach((isExact, i) => {
+        if (!isExact) return;
+        const x = u.valToPos(u.data[0][i], 'x', true);
+        ctx.fillRect(x - 3.5 * px, y - 3.5 * px, 7 * px, 7 * px);
+      });
+    });
+    ctx.restore();
+  };
+}
+
+let exactRows = [];
+
+/** Draws the variance (MSE, relative MSE) plot of a run and its legend; `records` has every
+ *  estimator of run.order (empty until its first level). */
+export function renderVariance(state, run, records) {
+  const render = isRender(run);
+  const names = runLabels(run);
+  // A render level's variance is its relative MSE against the reference (mse is the same number).
+  // With a run kept for comparison (same scene), the x axis spans both ladders.
+  const kept = keptFor(state);
+  const xs = kept ? [...new Set([...run.ladder, ...kept.ladder])].sort((a, b) => a - b) : run.ladder;
+  const vs = varianceSeries(records, run.order, render ? null : run.exact, xs);
+  const anchor = anchorOf(vs.x, vs.series);
+  const orders = render ? [1] : [1, 2, 3];
+  const refs = referenceLines(vs.x, anchor, orders);
+  const data = [vs.x];
+  const series = [{}];
+  const bands = [];
+  vs.series.forEach((s) => {
+    const color = colorOf(run, s.name);
+    const yi = data.length;
+    data.push(lgAll(s.y), lgAll(s.hi), lgAll(s.lo));
+    series.push(
+      { label: s.name, stroke: color, width: 2, points: { show: true, size: 6, fill: color } },
+      { label: `${s.name} 95% high`, stroke: withAlpha(color, 0.35), width: 0.5, points: { show: false } },
+      { label: `${s.name} 95% low`, stroke: withAlpha(color, 0.35), width: 0.5, points: { show: false } },
+    );
+    bands.push({ series: [yi + 1, yi + 2], fill: withAlpha(color, 0.14) });
+  });
+  // The kept run's variance, dashed and lighter.
+  const keptSeries = kept ? varianceSeries(kept.records, kept.order, render ? null : kept.exact, vs.x).series : [];
+  keptSeries.forEach((s) => {
+    const color = colorOf(run, s.name);
+    data.push(lgAll(s.y));
+    series.push({ label: `${s.name} (kept)`, stroke: withAlpha(color, 0.7), width: 1.5, dash: [5, 4],
+      points: { show: true, size: 4, fill: '#fff' } });
+  });
+  // Three reference series always (all null until there is a first point), so the chart keeps
+  // its series while the levels stream in.
+  const refItems = [];
+  orders.map((k) => `${render ? 'spp' : 'N'}${sup(-k)}`).forEach((label, i) => {
+    refItems.push({ idx: data.length, label });
+    data.push(refs[i] ? lgAll(refs[i].y) : vs.x.map(() => null));
+    series.push({ label, stroke: '#8a8f96', width: 1, dash: [6, 5], points: { show: false } });
+  });
+  const values = [...vs.series.flatMap((s) => [...s.y, ...s.lo, ...s.hi]), ...keptSeries.flatMap((s) => s.y)];
+  const yRange = log10Range(values);
+  // Exact levels, drawn as a labelled row along the bottom (the hook reads the latest rows).
+  exactRows = vs.series.filter((s) => s.exactAt.some(Boolean)).map((s) => ({ color: colorOf(run, s.name), exactAt: s.exactAt }));
+  const xRange = vs.x.length > 1 ? [vs.x[0], vs.x[vs.x.length - 1]] : [vs.x[0] / 2, vs.x[0] * 2];
+  const quantity = render ? names.errorAxis || names.error
+    : vs.quantity === 'mse' ? 'MSE of the estimate' : 'variance of the estimate';
+  const title = document.getElementById('variance-title');
+  if (title) {
+    title.textContent = render ? `${names.error[0].toUpperCase()}${names.error.slice(1)} against ${names.n}`
+      : vs.quantity === 'mse' ? 'MSE against N (exact value known)' : 'Variance against N';
+  }
+  setText('variance-note', VARIANCE_NOTE[render ? 'render' : 'integral']);
+  const sig = JSON.stringify([vs.quantity, run.order, run.colors, run.kind, names.nAxis, quantity,
+    keptSeries.map((k) => k.name)]);
+  draw('variance', dom.variance, sig, (c) => ({
+    scales: { x: logX(c, 2), y: log10Y(c) },
+    axes: [
+      { ...AXIS, label: names.nAxis, values: nTicks, space: 30 },
+      { ...AXIS, ...LOG10_AXIS, label: quantity },
+    ],
+    series,
+    bands,
+    cursor: { drag: { x: false, y: false } },
+    hooks: { drawAxes: [minorLogGrid], draw: [(u) => labelHook(refItems)(u), (u) => exactHook(exactRows)(u)] },
+  }), data, { xRange, yRange });
+
+  setLegend('variance', dom['legend-variance'], vs.series.map((s) => {
+    const r = records[s.name];
+    return {
+      name: s.name,
+      color: colorOf(run, s.name),
+      parts: [
+        // The plotted MSE's own order, then the variance's (a flat MSE under a falling
+        // variance is a bias: bias_dominates says from which N).
+        ...(vs.quantity === 'mse' && !render && !s.exact
+          ? ['order of MSE', { text: fitText(r.mse_fit), className: 'fit' }] : []),
+        ...(s.exact ? [{ fit: 'exact: zero variance at every N (■ along the bottom)', name: s.name }] : [
+          render ? `order of ${names.error}` : vs.quantity === 'mse' ? 'of variance' : 'order of variance',
+          { fit: fitText(r.fit), name: s.name }]),
+        ...levelFlags(r).map((w) => ({ warning: w })),
+        ...(r.warnings || []).map((w) => ({ warning: w })),
+      ],
+    };
+  }).concat(keptSeries.map((k) => ({
+    name: `${k.name} (kept)`,
+    color: withAlpha(colorOf(run, k.name), 0.7),
+    dashed: true,
+    parts: [{ text: `${kept.label}: order ${fitText(k.fit)}`, className: 'fit' }],
+  }))));
+}
