@@ -111,8 +111,8 @@ test-wasm: build-wasm
 test-compare: build build-wasm
 	bash tests/compare_native_wasm.sh $(BUILD)/mcplay "$(NODE_RUN) $(BUILD_WASM)/mcplay.js"
 
-# web/core.js (the only caller of the browser wasm module build-wasm/mcplay_web.mjs) under
-# Node's test runner, compared with the native CLI.
+# The page's unit tests (web/test/) under Node's test runner: its pure modules, and web/core.js and
+# web/render_core.js (the only callers of the browser wasm modules) compared with the native CLI.
 test-web-core: build build-wasm deps-web
 	MCPLAY_WASM_DIR=$(BUILD_WASM) MCPLAY_NATIVE=$(BUILD)/mcplay node --test web/test/
 

@@ -1,6 +1,6 @@
 // End-to-end test of the playground in headless Chromium (Debian's chromium, driven by
-// playwright-core). Usage: node web/e2e/playground.e2e.mjs SITE_DIR NATIVE_MCPLAY SHOT_DIR
-// Serves SITE_DIR on a loopback port, runs a study in the page and checks it against the
+// playwright-core). Usage (make test-e2e): MCPLAY_SITE=SITE_DIR MCPLAY_NATIVE=NATIVE_MCPLAY
+// MCPLAY_SHOTS=SHOT_DIR node --test web/e2e/playground.e2e.mjs. Serves SITE_DIR on a loopback port, runs a study in the page and checks it against the
 // native CLI, checks the inline expression error and Cancel, checks that none of that
 // downloads the render module, then runs a small render study (quad_light_floor) and checks its
 // fitted orders against the CLI and its images; saves screenshots.

@@ -72,7 +72,8 @@ const handlers = {
     if (warmup) {
       // A small study of the same scene and estimators first, so that the timed levels do not
       // include V8's lazy compilation of the wasm functions they use (the first call of a
-      // function runs unoptimised code). It shares no random stream with the real study.
+      // function runs unoptimised code). It uses the study's seed, but each study starts its
+      // random streams afresh, so the real study's numbers are those it gives alone.
       try {
         core.runStudy(scene, { estimators: options.estimators, n_min: 16, n_max: 4096, reps: 2, seed: options.seed });
       } catch {

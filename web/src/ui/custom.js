@@ -1,7 +1,8 @@
-// The custom problem: f and p typed as expressions, and its exact value if known. Events only dispatch (edit, apply); the
-// scene is built and validated by the core in a worker (main.js). sync(state) shows the core's
-// parse error inline: the message in #custom-error, the offending field marked invalid, and
-// the expression repeated under it with the reported position highlighted.
+// The custom problem: f and p typed as expressions, and its exact value if known. Events only
+// dispatch (edit, apply); the scene is built and validated by the core in a worker (main.js).
+// sync(state) shows the core's parse error inline: the message in #custom-error, the offending
+// field marked invalid, and the expression repeated under it with the reported position
+// highlighted.
 const $ = (id) => document.getElementById(id);
 
 export function mountCustom(store) {
