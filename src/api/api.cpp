@@ -199,8 +199,13 @@ int mcp_study_samples(const char* scene_json, const char* options_json, char** s
             for (double x : v) out.push_back(std::isfinite(x) ? mcp::Json(x) : mcp::Json(nullptr));
             return out;
         };
+        const mcp::EstimatorKind& kind = mcp::kind_of(spec);
         estimators.push_back(
             {{"name", spec.name},
+             {"kind", kind.name},
+             {"method", mcp::estimator_method(spec)},
+             // whether the mean of the first k points' weights is the estimate at N = k
+             {"replay_is_estimate", kind.replay_is_estimate(spec)},
              {"sampler", mcp::sampler_name(spec.sampler)},
              {"pdf", mcp::describe_sampling(spec)},
              {"strata", d.strata},
@@ -219,11 +224,11 @@ int mcp_study_samples(const char* scene_json, const char* options_json, char** s
         mcp::Json& e = estimators.back();
         if (!d.adaptive.edges.empty()) e["map_edges"] = d.adaptive.edges;
         if (!d.adaptive.history.empty()) e["map_history"] = d.adaptive.history;
-        if (spec.vegas || spec.miser) e["run_n"] = std::max(n, adaptive_n);
+        if (kind.adaptive) e["run_n"] = std::max(n, adaptive_n);
         if (!d.adaptive.box_lo.empty())
             e["boxes"] = {{"lo", d.adaptive.box_lo}, {"hi", d.adaptive.box_hi}};
         // MIS: each technique's density and share, in the order of curve.mis_weights.
-        if (spec.mis) {
+        if (spec.has_techniques()) {
             const mcp::MisOptions& m = spec.mis_options;
             mcp::Json techniques = mcp::Json::array();
             for (size_t k = 0; k < m.proposals.size(); ++k)
@@ -258,7 +263,7 @@ int mcp_study_samples(const char* scene_json, const char* options_json, char** s
         for (const mcp::EstimatorSpec& spec : req.value.estimators) {
             mcp::sampling_density_block(spec, domain, xs, pv.data());
             pdfs[spec.name] = std::vector<double>(pv.begin(), pv.end());
-            if (spec.mis) mis_weights[spec.name] = mis_weight_curves(spec, domain, xs);
+            if (spec.has_techniques()) mis_weights[spec.name] = mis_weight_curves(spec, domain, xs);
         }
         result["curve"] = {{"x", xj}, {"f", fj}, {"pdf", pdfs}};
         if (!mis_weights.empty()) result["curve"]["mis_weights"] = mis_weights;
@@ -323,6 +328,8 @@ int mcp_scene_info(const char* scene_json, char** info_json) {
     mcp::Json names = mcp::Json::array(), more = mcp::Json::array(), details = mcp::Json::array();
     auto detail = [](const mcp::EstimatorSpec& e) {
         return mcp::Json{{"name", e.name},
+                         {"kind", mcp::kind_of(e).name},
+                         {"summary", mcp::kind_of(e).summary},
                          {"method", mcp::estimator_method(e)},
                          {"sampler", mcp::sampler_name(e.sampler)},
                          {"pdf", mcp::describe_sampling(e)}};
@@ -365,18 +372,47 @@ int mcp_catalog(char** catalog_json) {
     mcp::Json presets = mcp::Json::array();
     for (const mcp::EstimatorPreset& p : mcp::estimator_presets())
         presets.push_back({{"name", p.name},
+                           {"kind", p.kind},
                            {"sampler", mcp::sampler_name(p.sampler)},
                            {"needs_pdf", p.needs_pdf},
                            {"summary", p.summary}});
+    mcp::Json kinds = mcp::Json::array();
+    for (const mcp::EstimatorKind* k : mcp::estimator_kinds())
+        kinds.push_back({{"name", k->name}, {"summary", k->summary}});
+    // The samplers parse_sampler knows, and per quasi-Monte Carlo sampler the randomizations
+    // that apply to its points (the randomized ones first, "none" last), from the core's tables.
+    mcp::Json samplers = mcp::Json::array(), randomizations = mcp::Json::object();
+    const std::string names = mcp::sampler_names();
+    for (size_t at = 0; at < names.size();) {
+        const size_t comma = names.find(", ", at);
+        const std::string name =
+            names.substr(at, comma == std::string::npos ? std::string::npos : comma - at);
+        at = comma == std::string::npos ? names.size() : comma + 2;
+        samplers.push_back(name);
+        mcp::SamplerKind sk{};
+        if (!mcp::parse_sampler(name, &sk) || !mcp::is_qmc(sk)) continue;
+        mcp::Json applicable = mcp::Json::array();
+        bool none = false;
+        // QmcRandomization is an int-based enum class; its names end at randomization_name's "?"
+        for (int r = 0;; ++r) {
+            const auto rnd = static_cast<mcp::QmcRandomization>(r);
+            const std::string rname = mcp::randomization_name(rnd);
+            if (rname == "?") break;
+            if (!mcp::check_randomization(mcp::qmc_kind_of(sk), rnd).empty()) continue;
+            if (rnd == mcp::QmcRandomization::None)
+                none = true;
+            else
+                applicable.push_back(rname);
+        }
+        if (none) applicable.push_back("none");
+        randomizations[name] = applicable;
+    }
     mcp::Json catalog{
         {"version", mcp::kResultSchemaVersion},
         {"estimators", presets},
-        {"samplers",
-         {"independent", "stratified", "latin_hypercube", "sobol", "halton", "lattice"}},
-        {"randomizations",
-         {{"sobol", {"owen", "lms_shift", "digital_shift", "none"}},
-          {"halton", {"owen", "permutation", "none"}},
-          {"lattice", {"random_shift", "none"}}}},
+        {"kinds", kinds},
+        {"samplers", samplers},
+        {"randomizations", randomizations},
         {"pdfs",
          {"uniform", "power", "exponential", "gaussian", "cosine", "tabulated", "product",
           "tabulated_2d", "cosine_hemisphere", "expression"}},

@@ -48,11 +48,14 @@ int mcp_study_plan(const char* scene_json, const char* options_json, char** plan
 /* The points behind a small run of each estimator, for plotting them: options_json may give
  * {"estimators": [names], "n": points (1..4096, default 256), "seed", "grid": 1D curve points
  * (default 256), "adaptive_n": calls of the adaptive estimators' run (1..2^20)}. Result:
- * {"version", "n", "estimators": [{"name", "sampler", "pdf", "strata", "samples_per_stratum",
- * "randomization", "randomizations", "u": [per axis], "x": [per axis], "f", "density", "weight"}],
+ * {"version", "n", "estimators": [{"name", "kind", "method", "replay_is_estimate", "sampler",
+ * "pdf", "strata", "samples_per_stratum", "randomization", "randomizations", "u": [per axis],
+ * "x": [per axis], "f", "density", "weight"}],
  * and for 1D box domains "curve": {"x", "f", "pdf": {name: density values}, "mis_weights":
  * {name: [per technique: weights]}}}. The points are those of replicate 0 of a study at N = n,
- * so the mean of "weight" is that replicate's estimate. Adaptive estimators (VEGAS, MISER) run
+ * so the mean of "weight" is that replicate's estimate. "replay_is_estimate" (from the
+ * estimator's kind): whether the mean of the first k weights is its estimate at N = k, with the
+ * independent points' error bar. Adaptive estimators (VEGAS, MISER) run
  * at N = max(n, adaptive_n) ("run_n") and show the first n points of their estimate, with what
  * they learnt: "map_edges" (VEGAS's frozen map, per axis), "map_history" (the map's first two
  * axes before and after each training iteration, at most 65 edges each), "boxes" (MISER's
@@ -65,10 +68,14 @@ int mcp_study_samples(const char* scene_json, const char* options_json, char** s
 int mcp_result_format(const char* result_json, const char* format, char** text);
 
 /* Validates a scene and summarises it: {"name", "description", "domain", "dimension",
- * "exact", "estimators": [names], settings}. */
+ * "exact", "estimators": [names], "more_estimators": [uniform-density presets it does not list],
+ * "estimator_details": [{"name", "kind", "summary" (the kind's), "method", "sampler", "pdf"}],
+ * settings}. */
 int mcp_scene_info(const char* scene_json, char** info_json);
 
-/* What the library offers: estimator presets, samplers, pdfs, integrands, domains. */
+/* What the library offers: "estimators" (the presets: {"name", "kind", "sampler", "needs_pdf",
+ * "summary"}), "kinds" (the estimator kinds: {"name", "summary"}), "samplers", "randomizations"
+ * (per quasi-Monte Carlo sampler), "pdfs", "integrands", "domains". */
 int mcp_catalog(char** catalog_json);
 
 /* Frees a string returned by this API. */

@@ -7,8 +7,9 @@
 #include <map>
 #include <sstream>
 
-#include "api/scene.h"
+#include "api/report.h"
 #include "estimators/diagnostics.h"
+#include "estimators/registry.h"
 #include "estimators/stopping.h"
 
 namespace mcp {
@@ -317,8 +318,6 @@ Json level_to_json(const LevelStats& l) {
            {"run_dof", l.run_dof},
            {"time_mean_s", num(l.time_mean)},
            {"time_std_s", num(l.time_std)}, // over the replicates: the timing's own noise
-           {"time_median_s", num(l.time_median)},
-           {"time_median_ci95_s", {num(l.time_median_lo), num(l.time_median_hi)}},
            {"time_total_s", num(l.time_total)},
            // Adaptive estimators: the share of the calls and the seconds per estimate spent
            // training or probing (in n and time_mean_s too; 0 for fixed estimators).
@@ -354,6 +353,12 @@ Json level_to_json(const LevelStats& l) {
     for (double x : l.estimates) est.push_back(num(x));
     for (double x : l.run_std_errors) se.push_back(num(x));
     j["replicates"] = Json{{"estimate", est}, {"std_error", se}};
+    // The median time per estimate and its interval, where the level measures it (integration
+    // studies): a render level's images are timed by their mean (time_mean_s) alone.
+    if (l.measure != LevelMeasure::RelativeMse) {
+        j["time_median_s"] = num(l.time_median);
+        j["time_median_ci95_s"] = {num(l.time_median_lo), num(l.time_median_hi)};
+    }
     return j;
 }
 
@@ -372,15 +377,18 @@ namespace {
 Json estimator_header(const EstimatorStudy& e, const StudySettings& s) {
     return Json{
         {"name", e.spec.name},
+        {"kind", kind_of(e.spec).name},
         {"method", estimator_method(e.spec)},
         {"sampler", sampler_name(e.spec.sampler)},
         {"samples_per_stratum", e.spec.per_stratum},
         {"pdf", describe_sampling(e.spec)},
-        {"importance", e.spec.proposal.importance || e.spec.mis},
+        {"importance", e.spec.proposal.importance || e.spec.has_techniques()},
         {"randomization",
          is_qmc(e.spec.sampler) ? Json(randomization_name(e.spec.randomization)) : Json(nullptr)},
         {"randomizations", is_qmc(e.spec.sampler) ? Json(e.spec.randomizations) : Json(nullptr)},
         {"error_method", error_method_name(e.error_method)},
+        // Error bars wider than the estimator's spread by design: coverage above 95% is no fault.
+        {"error_bars_conservative", error_method_conservative(e.error_method)},
         {"support_check",
          {{"probes", e.support.probes},
           {"f_nonzero", e.support.f_nonzero},

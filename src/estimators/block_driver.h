@@ -7,9 +7,9 @@
 //   (the workspace's buffers as a block, for estimators that fill them their own way: VEGAS
 //   through its map, VEGAS+ and MISER in their hypercubes and regions), and for_each_block
 //   (every block of a plan, handed to a consumer: the support check's probes);
-// - EstimatorAlgorithm, the interface of an estimator's runs (begin, run_block, result), with
-//   the factories of its implementations (make_estimator picks one from a spec), and what the
-//   adaptive ones report: AdaptiveView, TrainingLog, view_of, clock_seconds.
+// - EstimatorAlgorithm, the interface of an estimator's runs (begin, run_block, result), and what
+//   the adaptive ones report: AdaptiveView, TrainingLog, view_of, clock_seconds. Its
+//   implementations are made through their kinds (estimators/estimator_kind.h, registry.h).
 #pragma once
 
 #include <algorithm>
@@ -112,9 +112,9 @@ class TrainingLog {
 };
 
 /// An estimator as an algorithm: it plans a run, consumes it block by block, and gives the
-/// run's result. Fixed estimators (a sampler and one proposal; estimators/estimator.cpp) are one
-/// implementation; VEGAS (estimator.cpp), VEGAS+ and MISER (which adapt their sampling between
-/// iterations or regions), MIS (several proposals) and control variates are the others.
+/// run's result. Fixed estimators (a sampler and one proposal; estimators/fixed.cpp) are one
+/// implementation; VEGAS (vegas_estimator.cpp), VEGAS+ and MISER (which adapt their sampling
+/// between iterations or regions), MIS (several proposals) and control variates are the others.
 /// Stopping at a tolerance (stopping.h) runs whole estimates of any of them. Calls are per
 /// block, never per sample.
 class EstimatorAlgorithm {
@@ -139,27 +139,5 @@ class EstimatorAlgorithm {
     }
     BlockObserver observer_;
 };
-
-/// VEGAS+ (estimators/vegas_plus.cpp): the VEGAS map and adaptive stratification.
-std::unique_ptr<EstimatorAlgorithm> make_vegas_plus_estimator(const Problem& problem,
-                                                              const EstimatorSpec& spec,
-                                                              Accumulator accumulator);
-
-/// MISER (estimators/miser.cpp): recursive stratified sampling.
-std::unique_ptr<EstimatorAlgorithm>
-make_miser_estimator(const Problem& problem, const EstimatorSpec& spec, Accumulator accumulator);
-
-/// Multiple importance sampling (estimators/mis.cpp): heuristics, one-sample, optimal.
-std::unique_ptr<EstimatorAlgorithm>
-make_mis_estimator(const Problem& problem, const EstimatorSpec& spec, Accumulator accumulator);
-
-/// Control variates with fitted or given coefficients (estimators/control_variates.cpp).
-std::unique_ptr<EstimatorAlgorithm> make_control_variate_estimator(const Problem& problem,
-                                                                   const EstimatorSpec& spec,
-                                                                   Accumulator accumulator);
-
-/// The algorithm of an estimator spec: MIS, control variates, MISER, VEGAS+, VEGAS or fixed.
-std::unique_ptr<EstimatorAlgorithm>
-make_estimator(const Problem& problem, const EstimatorSpec& spec, Accumulator accumulator);
 
 } // namespace mcp

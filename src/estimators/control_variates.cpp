@@ -17,7 +17,7 @@
 
 #include "core/regression.h"
 #include "core/stats.h"
-#include "estimators/block_driver.h"
+#include "estimators/estimator_kind.h"
 
 namespace mcp {
 namespace {
@@ -210,10 +210,22 @@ class ControlVariateEstimator final : public EstimatorAlgorithm {
 
 } // namespace
 
-std::unique_ptr<EstimatorAlgorithm> make_control_variate_estimator(const Problem& problem,
-                                                                   const EstimatorSpec& spec,
-                                                                   Accumulator accumulator) {
-    return std::make_unique<ControlVariateEstimator>(problem, spec, accumulator);
+const EstimatorKind& control_variate_estimator_kind() {
+    static const EstimatorKind kind{
+        "control_variates",
+        "f - c . (g - G) with functions g of known integrals G, c fitted by cross-fitting",
+        [](const EstimatorSpec&) { return "control_variates"; },
+        // the sum of independent parts: the folds
+        [](const EstimatorSpec&) { return ErrorMethod::PartsSum; },
+        [](const Problem& problem, const EstimatorSpec& spec,
+           Accumulator accumulator) -> std::unique_ptr<EstimatorAlgorithm> {
+            return std::make_unique<ControlVariateEstimator>(problem, spec, accumulator);
+        },
+        // independent points: the running mean of f/p (not the fitted estimate) is replayed
+        [](const EstimatorSpec&) { return true; },
+        false,
+    };
+    return kind;
 }
 
 } // namespace mcp

@@ -46,7 +46,12 @@ enum class ErrorMethod {
     Regression,
 };
 const char* error_method_name(ErrorMethod m);
-ErrorMethod error_method_for(const EstimatorSpec& spec);
+/// Whether the method's error bars are wider than the estimator's spread by design (collapsed
+/// strata, the iid formula for Latin hypercubes): their coverage stays above 95%.
+bool error_method_conservative(ErrorMethod m);
+/// The error method of the spec's sampler and its options: the fixed estimators' and the frozen
+/// VEGAS map's (the spec's own, whatever its kind, is error_method_for in estimators/registry.h).
+ErrorMethod sampler_error_method(const EstimatorSpec& spec);
 
 /// How the weights are summed. Float32 is a teaching mode: a naive single-precision running
 /// sum, to show where naive accumulation stalls (the error bar stays in double).
@@ -93,7 +98,8 @@ double hill_tail_index(const std::vector<double>& top_descending, int k);
 /// Buffers reused across runs (estimators/block_driver.h).
 struct Workspace;
 
-/// Runs one estimate of the problem with n samples, all randomness drawn from rng.
+/// Runs one estimate of the problem with n samples, all randomness drawn from rng: the spec's
+/// kind's algorithm (estimators/registry.cpp), run to completion.
 RunResult run_estimate(const Problem& problem, const EstimatorSpec& spec, uint64_t n, Pcg32& rng,
                        Workspace& ws, Accumulator accumulator = Accumulator::Compensated);
 

@@ -20,7 +20,7 @@
 
 #include "core/regression.h"
 #include "core/stats.h"
-#include "estimators/block_driver.h"
+#include "estimators/estimator_kind.h"
 
 namespace mcp {
 namespace {
@@ -260,9 +260,25 @@ class MisEstimator final : public EstimatorAlgorithm {
 
 } // namespace
 
-std::unique_ptr<EstimatorAlgorithm>
-make_mis_estimator(const Problem& problem, const EstimatorSpec& spec, Accumulator accumulator) {
-    return std::make_unique<MisEstimator>(problem, spec, accumulator);
+const EstimatorKind& mis_estimator_kind() {
+    static const EstimatorKind kind{
+        "mis",
+        "multiple importance sampling: techniques combined by a heuristic's or optimal weights",
+        [](const EstimatorSpec&) { return "mis"; },
+        [](const EstimatorSpec& spec) {
+            // Multi-sample: the techniques are independent strata; one-sample: independent
+            // points, or the residuals of their regression for optimal weights.
+            if (!spec.mis_options.one_sample) return ErrorMethod::PartsSum;
+            return spec.mis_options.optimal ? ErrorMethod::Regression : ErrorMethod::Iid;
+        },
+        [](const Problem& problem, const EstimatorSpec& spec,
+           Accumulator accumulator) -> std::unique_ptr<EstimatorAlgorithm> {
+            return std::make_unique<MisEstimator>(problem, spec, accumulator);
+        },
+        [](const EstimatorSpec&) { return true; }, // independent points
+        false,
+    };
+    return kind;
 }
 
 } // namespace mcp

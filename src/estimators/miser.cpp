@@ -12,7 +12,7 @@
 #include <limits>
 
 #include "core/stats.h"
-#include "estimators/block_driver.h"
+#include "estimators/estimator_kind.h"
 #include "estimators/miser.h"
 
 namespace mcp {
@@ -233,9 +233,21 @@ std::vector<MiserBox> miser_leaves(const Problem& problem, const EstimatorSpec& 
     return leaves;
 }
 
-std::unique_ptr<EstimatorAlgorithm>
-make_miser_estimator(const Problem& problem, const EstimatorSpec& spec, Accumulator accumulator) {
-    return std::make_unique<MiserEstimator>(problem, spec, accumulator);
+const EstimatorKind& miser_estimator_kind() {
+    static const EstimatorKind kind{
+        "miser",
+        "MISER: recursive bisection of the unit cube, calls to the halves by their spread",
+        [](const EstimatorSpec&) { return "miser"; },
+        // the sum of independent parts: the leaves
+        [](const EstimatorSpec&) { return ErrorMethod::PartsSum; },
+        [](const Problem& problem, const EstimatorSpec& spec,
+           Accumulator accumulator) -> std::unique_ptr<EstimatorAlgorithm> {
+            return std::make_unique<MiserEstimator>(problem, spec, accumulator);
+        },
+        [](const EstimatorSpec&) { return false; }, // points in regions cut by the run itself
+        true,
+    };
+    return kind;
 }
 
 } // namespace mcp

@@ -346,7 +346,8 @@ bool density_bounded_below(const Proposal& p) {
 } // namespace
 
 bool weights_bounded(const Problem& problem, const EstimatorSpec& spec) {
-    if (!integrand_bounded(problem.integrand) || spec.control_variates) return false;
+    if (!integrand_bounded(problem.integrand) || !spec.control_variate_options.variates.empty())
+        return false;
     for (const Proposal* p : proposals_of(spec))
         if (density_bounded_below(*p)) return true; // MIS: the mixture is at least c_k p_k
     return false;
@@ -354,7 +355,7 @@ bool weights_bounded(const Problem& problem, const EstimatorSpec& spec) {
 
 std::vector<const Proposal*> proposals_of(const EstimatorSpec& spec) {
     std::vector<const Proposal*> out;
-    if (!spec.mis) {
+    if (!spec.has_techniques()) {
         out.push_back(&spec.proposal);
         return out;
     }
@@ -364,7 +365,7 @@ std::vector<const Proposal*> proposals_of(const EstimatorSpec& spec) {
 
 void sampling_density_block(const EstimatorSpec& spec, const Domain& domain, const PointBlock& x,
                             double* pdf) {
-    if (!spec.mis) {
+    if (!spec.has_techniques()) {
         proposal_pdf_block(spec.proposal, domain, x, pdf);
         return;
     }
@@ -378,7 +379,7 @@ void sampling_density_block(const EstimatorSpec& spec, const Domain& domain, con
 }
 
 std::string describe_sampling(const EstimatorSpec& spec) {
-    if (!spec.mis) return spec.proposal.describe();
+    if (!spec.has_techniques()) return spec.proposal.describe();
     const MisOptions& m = spec.mis_options;
     std::string s = std::string("mis(") +
                     (m.optimal ? "optimal" : mis_heuristic_name(m.weighting.heuristic)) +
@@ -389,20 +390,6 @@ std::string describe_sampling(const EstimatorSpec& spec) {
         s += (k ? ", " : "") + m.proposals[k].describe() + share;
     }
     return s + ")";
-}
-
-const char* estimator_method(const EstimatorSpec& spec) {
-    if (spec.control_variates) return "control_variates";
-    if (spec.mis) return "mis";
-    if (spec.miser) return "miser";
-    if (spec.vegas) return spec.vegas_options.stratify ? "vegas_plus" : "vegas";
-    if (is_qmc(spec.sampler)) return spec.randomization == QmcRandomization::None ? "qmc" : "rqmc";
-    const bool importance = spec.proposal.importance;
-    switch (spec.sampler) {
-    case SamplerKind::Stratified: return importance ? "stratified_importance" : "stratified";
-    case SamplerKind::LatinHypercube: return "latin_hypercube";
-    default: return importance ? "importance" : "uniform";
-    }
 }
 
 } // namespace mcp

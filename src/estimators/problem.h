@@ -17,6 +17,8 @@
 
 namespace mcp {
 
+struct EstimatorKind; // estimators/estimator_kind.h
+
 enum class DomainKind { Box, Disk, Triangle, Sphere, Hemisphere };
 
 const char* domain_kind_name(DomainKind kind);
@@ -142,28 +144,27 @@ struct ControlVariateOptions {
 
 struct EstimatorSpec {
     std::string name;
+    /// What the estimator is (its algorithm, method and error method; estimators/registry.h):
+    /// set by the scene parser; null is the fixed kind (a sampler and one proposal).
+    const EstimatorKind* kind = nullptr;
     SamplerKind sampler = SamplerKind::Independent;
     uint64_t per_stratum = 1; ///< stratified: points per cell; 2 gives an unbiased error bar
     QmcRandomization randomization = QmcRandomization::Owen; ///< quasi-Monte Carlo samplers
     int randomizations = kDefaultRandomizations; ///< quasi-Monte Carlo: K batches per run
     Proposal proposal;
-    /// VEGAS: train a map of the unit cube on a share of the N evaluations, then estimate with
-    /// the frozen map composed before the proposal's warp (estimators/vegas.h).
-    bool vegas = false;
+    /// The options of the kinds that have them (each read by its kind only). VEGAS and VEGAS+:
+    /// the map of the unit cube composed before the proposal's warp (estimators/vegas.h).
     VegasOptions vegas_options;
-    /// MISER: recursive stratified sampling of the unit cube before the warp
-    /// (estimators/miser.cpp).
-    bool miser = false;
-    MiserOptions miser_options;
-
-    /// Multiple importance sampling (estimators/mis.cpp); `proposal` is then the first technique's.
-    bool mis = false;
+    MiserOptions miser_options; ///< MISER (estimators/miser.cpp)
+    /// Multiple importance sampling (estimators/mis.cpp): its techniques; `proposal` is then the
+    /// first technique's. Empty for every other kind.
     MisOptions mis_options;
-    /// Control variates (estimators/control_variates.cpp).
-    bool control_variates = false;
+    /// Control variates (estimators/control_variates.cpp); empty for every other kind.
     ControlVariateOptions control_variate_options;
 
     SamplerOptions sampler_options() const { return {per_stratum, randomization, randomizations}; }
+    /// Whether it samples a mixture of techniques (MIS) rather than one proposal.
+    bool has_techniques() const { return !mis_options.proposals.empty(); }
 };
 
 /// Whether the weights f/p of an estimator are bounded by what the problem and the estimator
@@ -185,11 +186,5 @@ void sampling_density_block(const EstimatorSpec& spec, const Domain& domain, con
 
 /// The density as a report names it: the proposal's, or "mis(balance: a 0.5, b 0.5)".
 std::string describe_sampling(const EstimatorSpec& spec);
-
-/// The method an estimator is an instance of, for explaining it: "uniform", "importance",
-/// "stratified", "stratified_importance", "latin_hypercube", "rqmc" (randomized quasi-Monte
-/// Carlo), "qmc" (no randomization), "vegas", "vegas_plus", "miser", "mis" or
-/// "control_variates" (the outermost idea when several combine).
-const char* estimator_method(const EstimatorSpec& spec);
 
 } // namespace mcp

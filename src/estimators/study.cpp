@@ -12,6 +12,7 @@
 #include "core/special.h"
 
 #include "core/parallel.h"
+#include "estimators/registry.h"
 
 namespace mcp {
 
@@ -302,7 +303,7 @@ SupportCheck check_support(const Problem& problem, const EstimatorSpec& spec, ui
     std::vector<Rect> rects;
     std::string why_not;
     double share = 0.0;
-    if (spec.mis)
+    if (spec.has_techniques())
         why_not = "the zero set of a mixture of pdfs is not computed";
     else if (zero_set(spec.proposal, d, &rects, &share, &why_not)) {
         Budget budget;
@@ -767,7 +768,8 @@ SampleDump dump_samples(const Problem& problem, const EstimatorSpec& spec, uint6
                         uint64_t seed, uint64_t adaptive_n) {
     SampleDump dump;
     const uint64_t shown = n;
-    if (spec.vegas || spec.miser) n = std::max(n, adaptive_n);
+    const bool adaptive = kind_of(spec).adaptive;
+    if (adaptive) n = std::max(n, adaptive_n);
     const Domain& d = problem.domain;
     dump.sample_dim = d.sample_dim();
     dump.point_dim = d.point_dim();
@@ -777,7 +779,7 @@ SampleDump dump_samples(const Problem& problem, const EstimatorSpec& spec, uint6
     Pcg32 plan_rng = rng;
     const SamplerPlan plan =
         make_sampler_plan(spec.sampler, dump.sample_dim, n, plan_rng, spec.sampler_options());
-    if (!spec.vegas && !spec.miser) {
+    if (!adaptive) {
         dump.strata = plan.strata;
         dump.per_stratum = plan.per_stratum;
         dump.randomizations = plan.batches();

@@ -9,7 +9,7 @@
 #include <limits>
 
 #include "core/stats.h"
-#include "estimators/block_driver.h"
+#include "estimators/estimator_kind.h"
 
 namespace mcp {
 namespace {
@@ -238,10 +238,21 @@ class VegasPlusEstimator final : public EstimatorAlgorithm {
 
 } // namespace
 
-std::unique_ptr<EstimatorAlgorithm> make_vegas_plus_estimator(const Problem& problem,
-                                                              const EstimatorSpec& spec,
-                                                              Accumulator accumulator) {
-    return std::make_unique<VegasPlusEstimator>(problem, spec, accumulator);
+const EstimatorKind& vegas_plus_estimator_kind() {
+    static const EstimatorKind kind{
+        "vegas_plus",
+        "VEGAS+: the VEGAS map and adaptively allocated hypercubes, trained then frozen",
+        [](const EstimatorSpec&) { return "vegas_plus"; },
+        // the sum of independent parts: the hypercubes
+        [](const EstimatorSpec&) { return ErrorMethod::PartsSum; },
+        [](const Problem& problem, const EstimatorSpec& spec,
+           Accumulator accumulator) -> std::unique_ptr<EstimatorAlgorithm> {
+            return std::make_unique<VegasPlusEstimator>(problem, spec, accumulator);
+        },
+        [](const EstimatorSpec&) { return false; }, // a learnt map and allocation
+        true,
+    };
+    return kind;
 }
 
 } // namespace mcp

@@ -1,7 +1,9 @@
 // What each estimator is, for the page's estimator panels: its formula, the order its variance
 // should reach (the exponent of N) and what to look for. Keyed by the method the core names
-// (sceneInfo.estimator_details[].method, src/estimators/problem.h estimator_method). Pure data
-// and functions, no DOM: web/test/explain.test.mjs.
+// (sceneInfo.estimator_details[].method: the method of the estimator's kind, src/estimators/
+// registry.h). A method without a text here (a new estimator) gets a generic one with the
+// kind's own summary (estimator_details[].summary): no code change is needed for it to show.
+// Pure data and functions, no DOM: web/test/explain.test.mjs.
 //
 // Orders of the variance of the estimate for square-integrable f/p [Owen13, chapters 2, 8-10,
 // 15, 17]; where they depend on the integrand, the smooth case and the discontinuous one.
@@ -96,9 +98,9 @@ const METHODS = {
 export const EXPLAINED = Object.freeze(Object.keys(METHODS));
 
 /**
- * The explanation of an estimator from its details ({name, method, sampler, pdf}) and the
- * problem's dimension: {title, formula, order, look, density}, or a generic text for a method
- * this module does not know.
+ * The explanation of an estimator from its details ({name, method, summary, sampler, pdf}) and
+ * the problem's dimension: {title, formula, order, look, density}, or for a method this module
+ * does not know a generic text with the core's summary of its kind.
  */
 export function explainEstimator(detail, dimension = null) {
   const m = detail && METHODS[detail.method];
@@ -107,7 +109,7 @@ export function explainEstimator(detail, dimension = null) {
       title: detail && detail.method ? detail.method : 'Estimator',
       formula: 'I_N = (1/N) Σ f(xᵢ)/p(xᵢ)',
       order: ORDER_UNKNOWN,
-      look: '',
+      look: detail && typeof detail.summary === 'string' ? detail.summary : '',
       density: detail && detail.pdf ? detail.pdf : '',
     };
   }

@@ -957,17 +957,21 @@ export function runningEstimate(weights) {
  * narrower than N(0, 1) and their coverage above 95%: that is what conservative means.
  */
 export function conservativeErrorBars(record) {
-  const m = record && record.error_method;
-  if (m === 'collapsed_strata') return 'conservative error bars (collapsed strata: neighbouring cells paired)';
-  if (m === 'iid_conservative') return 'conservative error bars (the iid formula, wider than this design\'s spread)';
-  return null;
+  // The core says which error bars are conservative (error_bars_conservative, from the error
+  // method); the words say why, for the methods that have words.
+  if (!record || record.error_bars_conservative !== true) return null;
+  const why = {
+    collapsed_strata: 'collapsed strata: neighbouring cells paired',
+    iid_conservative: 'the iid formula, wider than this design\'s spread',
+  }[record.error_method];
+  return `conservative error bars (${why || 'wider than the estimator\'s spread by design'})`;
 }
 
 /** Is the mean of the first k of an estimator's points its estimate at N = k (independent points)? */
 export function replayIsEstimator(e) {
-  const strata = Array.isArray(e.strata) ? e.strata : [];
-  return !(e.randomizations > 0) && !strata.some((c) => c > 1) && e.sampler !== 'latin_hypercube'
-    && !e.map_edges && !e.boxes;
+  // The core says so per estimator (samples output replay_is_estimate, from its kind); without
+  // it, no band is drawn.
+  return Boolean(e && e.replay_is_estimate === true);
 }
 
 export function domainView(samples, domain = null, pair = [0, 1]) {

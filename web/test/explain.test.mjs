@@ -4,7 +4,7 @@ import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { explainEstimator, EXPLAINED } from '../src/explain.js';
 
-// The methods of src/estimators/problem.cpp estimator_method.
+// The methods the core's estimator kinds name (src/estimators/registry.h estimator_method).
 const CORE_METHODS = ['uniform', 'importance', 'stratified', 'stratified_importance', 'latin_hypercube', 'rqmc',
   'qmc', 'vegas', 'vegas_plus', 'miser', 'mis', 'control_variates'];
 
@@ -29,4 +29,11 @@ test('an unknown method gets a generic text, not an exception', () => {
   assert.equal(x.title, 'teleport');
   assert.equal(x.density, 'p');
   assert.equal(explainEstimator(null).title, 'Estimator');
+});
+
+test('a method without a text here shows the summary the core gives its kind', () => {
+  const x = explainEstimator({ name: 'a', method: 'antithetic', summary: 'pairs x and 1 - x', pdf: 'uniform' }, 1);
+  assert.equal(x.title, 'antithetic');
+  assert.equal(x.look, 'pairs x and 1 - x');
+  assert.equal(x.order, 'depends on the integrand');
 });

@@ -630,13 +630,13 @@ test('the running estimate is the mean of the first k weights, with a t-free 95%
   assert.ok(Math.abs(covered / sets - 0.95) < 4 * Math.sqrt(0.95 * 0.05 / sets), `${covered} of ${sets}`);
 });
 
-test('replaying the first k points is the estimator only for independent points', () => {
-  assert.equal(replayIsEstimator({ sampler: 'uniform', strata: [1] }), true);
-  assert.equal(replayIsEstimator({ sampler: 'uniform', strata: [] }), true);
-  assert.equal(replayIsEstimator({ sampler: 'stratified', strata: [16, 16] }), false);
-  assert.equal(replayIsEstimator({ sampler: 'latin_hypercube', strata: [] }), false);
-  assert.equal(replayIsEstimator({ sampler: 'sobol', strata: [], randomizations: 16 }), false);
-  assert.equal(replayIsEstimator({ sampler: 'vegas', strata: [], map_edges: [[0, 1]] }), false);
+test('replaying the first k points is the estimator when the core says so', () => {
+  assert.equal(replayIsEstimator({ sampler: 'independent', replay_is_estimate: true }), true);
+  assert.equal(replayIsEstimator({ sampler: 'stratified', strata: [16, 16], replay_is_estimate: false }), false);
+  // no knowledge of samplers or maps here: without the core's word, no band
+  assert.equal(replayIsEstimator({ sampler: 'independent', strata: [] }), false);
+  assert.equal(replayIsEstimator({ sampler: 'vegas', map_edges: [[0, 1]] }), false);
+  assert.equal(replayIsEstimator(undefined), false);
 });
 
 test('a box of d > 2 axes is shown on the chosen pair of axes', () => {
@@ -649,9 +649,12 @@ test('a box of d > 2 axes is shown on the chosen pair of axes', () => {
   assert.deepEqual(domainView(samples, null, [0, 9]).axes, [0, 1]);
 });
 
-test('conservative error bars are named for the methods that make them so', () => {
-  assert.match(conservativeErrorBars({ error_method: 'collapsed_strata' }), /conservative error bars \(collapsed strata/);
-  assert.match(conservativeErrorBars({ error_method: 'iid_conservative' }), /conservative/);
-  for (const m of ['iid', 'paired_strata', 'randomizations', 'none', undefined]) assert.equal(conservativeErrorBars({ error_method: m }), null, m);
+test('conservative error bars are the ones the core calls so, named for their method', () => {
+  assert.match(conservativeErrorBars({ error_method: 'collapsed_strata', error_bars_conservative: true }), /conservative error bars \(collapsed strata/);
+  assert.match(conservativeErrorBars({ error_method: 'iid_conservative', error_bars_conservative: true }), /conservative/);
+  // a method these words do not know still says so
+  assert.match(conservativeErrorBars({ error_method: 'pairs_collapsed', error_bars_conservative: true }), /conservative error bars \(wider than the estimator's spread by design\)/);
+  for (const m of ['iid', 'paired_strata', 'randomizations', 'none', undefined]) assert.equal(conservativeErrorBars({ error_method: m, error_bars_conservative: false }), null, m);
+  assert.equal(conservativeErrorBars({ error_method: 'collapsed_strata' }), null, 'without the core\'s word');
   assert.equal(conservativeErrorBars(undefined), null);
 });

@@ -1,0 +1,40 @@
+// An estimator kind: the one place that says what an estimator is, as pbrt-v4 creates its
+// integrators by name from one table [PBR4, sec. 1.3]. A kind owns its method name (what the
+// page explains), its error method, its factory, and the facts the page and the reports read
+// instead of knowing estimators (whether the running mean of its first points is its estimate,
+// whether it adapts). Each kind defines its entry in its own file (estimators/fixed.cpp,
+// vegas_estimator.cpp, vegas_plus.cpp, miser.cpp, mis.cpp, control_variates.cpp,
+// antithetic.cpp); estimators/registry.cpp lists them with the presets
+// (docs/adding-an-estimator.md).
+#pragma once
+
+#include <memory>
+
+#include "estimators/block_driver.h"
+#include "estimators/estimator.h"
+#include "estimators/problem.h"
+
+namespace mcp {
+
+struct EstimatorKind {
+    const char* name;    ///< "fixed", "vegas", "vegas_plus", "miser", "mis", ... (spec.kind)
+    const char* summary; ///< one line: what an estimator of this kind does
+    /// The method an estimator of this kind is an instance of, for explaining it (the page's
+    /// panels are keyed by it): "uniform", "stratified", "rqmc", "vegas", "miser", ...
+    const char* (*method)(const EstimatorSpec& spec);
+    /// How its per-run standard error is estimated.
+    ErrorMethod (*error_method)(const EstimatorSpec& spec);
+    /// Its algorithm, for one problem; called once per run, never per sample.
+    std::unique_ptr<EstimatorAlgorithm> (*make)(const Problem& problem, const EstimatorSpec& spec,
+                                                Accumulator accumulator);
+    /// Whether the mean of the first k of its points' weights f/p (in the order the sample view
+    /// shows them) is its estimate at N = k, with the independent points' error bar: its points
+    /// are independent and not a design of the whole N (strata, nets, pairs, a learnt map).
+    bool (*replay_is_estimate)(const EstimatorSpec& spec);
+    /// Whether it learns from its own run (VEGAS's map, MISER's cuts): the sample view runs it
+    /// at a larger N (options.adaptive_n) and shows its first points; its points follow no
+    /// sampler plan of their own.
+    bool adaptive;
+};
+
+} // namespace mcp

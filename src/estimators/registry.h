@@ -1,0 +1,51 @@
+// The registry of estimators: every estimator kind (estimators/estimator_kind.h) and the named
+// presets built on them, in one list (estimators/registry.cpp), and what is looked up through
+// it: a spec's kind, method, error method and algorithm, and one whole estimate (run_estimate,
+// declared in estimators/estimator.h). Dependencies point one way: the kinds' files know the
+// block driver, this registry knows the kinds, and the studies and the C API know the registry.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/samplers.h"
+#include "estimators/estimator_kind.h"
+
+namespace mcp {
+
+/// Every estimator kind, in the order the catalog lists them.
+const std::vector<const EstimatorKind*>& estimator_kinds();
+/// The kind of that name, or null.
+const EstimatorKind* find_estimator_kind(const std::string& name);
+/// The kind of a spec: spec.kind, or the fixed kind when it has none.
+const EstimatorKind& kind_of(const EstimatorSpec& spec);
+
+/// A named estimator with its defaults: scene and options "estimators": ["vegas", ...]
+/// (docs/scene-format.md).
+struct EstimatorPreset {
+    const char* name;
+    const char* kind; ///< the name of its EstimatorKind
+    SamplerKind sampler;
+    bool needs_pdf; ///< samples the scene's pdf (an estimator object must give one)
+    const char* summary;
+};
+/// Every preset, in the order messages and the catalog list them.
+const std::vector<EstimatorPreset>& estimator_presets();
+/// The preset of that name, or null.
+const EstimatorPreset* find_preset(const std::string& name);
+
+/// The method a spec is an instance of, for explaining it (its kind's method): "uniform",
+/// "importance", "stratified", "stratified_importance", "latin_hypercube", "rqmc" (randomized
+/// quasi-Monte Carlo), "qmc" (no randomization), "vegas", "vegas_plus", "miser", "mis",
+/// "control_variates", "antithetic".
+const char* estimator_method(const EstimatorSpec& spec);
+
+/// How a spec's per-run standard error is estimated (its kind's error method).
+ErrorMethod error_method_for(const EstimatorSpec& spec);
+
+/// The algorithm of a spec (its kind's factory).
+std::unique_ptr<EstimatorAlgorithm>
+make_estimator(const Problem& problem, const EstimatorSpec& spec, Accumulator accumulator);
+
+} // namespace mcp

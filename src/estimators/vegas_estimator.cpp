@@ -1,0 +1,222 @@
+// VEGAS [Lepage78, Lepage21] as an estimator: training iterations adapt a map of the unit cube
+// (estimators/vegas.h), then the frozen map warps the spec's sampler's points before the
+// proposal's warp, for an ordinary estimate with the sampler's error bar; or, with "report":
+// "iterations", the map keeps adapting and the iterations' weighted average is reported.
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <limits>
+
+#include "estimators/estimator_kind.h"
+
+namespace mcp {
+namespace {
+
+
+// VEGAS [Lepage21]: training iterations of independent points through the current map adapt
+// it; then the map is frozen and N_final points of the spec's sampler, mapped, warped and
+// weighted, make an ordinary estimate with an ordinary error bar (iid, strata or
+// randomizations): the training points are not in it, so they cannot bias it. The result
+// counts all N evaluations.
+class VegasEstimator final : public EstimatorAlgorithm {
+  public:
+    VegasEstimator(const Problem& problem, const EstimatorSpec& spec, Accumulator accumulator)
+        : problem_(problem), spec_(spec), float32_(accumulator == Accumulator::Float32) {}
+
+    void begin(uint64_t n, Pcg32& /*rng*/) override {
+        const VegasOptions& o = spec_.vegas_options;
+        const int dim = problem_.domain.sample_dim();
+        total_ = n;
+        uint64_t train = static_cast<uint64_t>(o.train_fraction * static_cast<double>(n));
+        iterations_ = vegas_training_iterations(o, train);
+        if (train < 2) train = 0;
+        final_ = n - train;
+        // A net's randomizations are full nets when each holds a power of two points: the
+        // estimation share is rounded down to K 2^m, and training takes the rest.
+        const uint64_t k = static_cast<uint64_t>(std::max(spec_.randomizations, 1));
+        if (spec_.sampler == SamplerKind::Sobol && train > 0 && final_ >= k) {
+            uint64_t per = 1; // per k <= final_ throughout
+            while (2 * per * k <= final_) per *= 2;
+            final_ = per * k;
+        }
+        train_ = n - final_;
+        if (train_ == 0) iterations_ = 0;
+        // Iteration average: the estimation share in `iterations` parts (each at least 2 points).
+        rounds_ = 1;
+        if (o.report == VegasReport::Iterations)
+            rounds_ = static_cast<int>(std::max<uint64_t>(
+                1,
+                std::min<uint64_t>(static_cast<uint64_t>(std::max(o.iterations, 1)), final_ / 2)));
+        round_ = 0;
+        rounds_done_.clear();
+        const uint64_t per_iteration = iterations_ > 0 ? train_ / iterations_ : 0;
+        map_ = VegasMap(dim, spec_.vegas_options.increments > 0
+                                 ? spec_.vegas_options.increments
+                                 : vegas_increments(dim, per_iteration));
+        iteration_ = 0;
+        next_ = 0;
+        plan_ready_ = false;
+        prepared_ = false;
+        log_.begin(map_, iterations_, static_cast<bool>(observer_));
+        jacobian_.assign(kBlockSize, 1.0);
+        bins_.assign(static_cast<size_t>(dim) * kBlockSize, 0);
+    }
+
+    bool run_block(Pcg32& rng, Workspace& ws) override {
+        if (!prepared_) {
+            prepare_workspace(problem_.domain, ws);
+            prepared_ = true;
+        }
+        const bool training = iteration_ < iterations_;
+        if (!plan_ready_) {
+            const int dim = problem_.domain.sample_dim();
+            if (training) {
+                const uint64_t size = part_of(train_, iterations_, iteration_);
+                plan_ = make_sampler_plan(SamplerKind::Independent, dim, size, rng, {});
+            } else {
+                if (final_ == 0 || round_ >= rounds_) return false;
+                log_.end_training();
+                const uint64_t size = part_of(final_, rounds_, round_);
+                plan_ = make_sampler_plan(spec_.sampler, dim, size, rng, spec_.sampler_options());
+                accumulator_.reset(sampler_error_method(spec_), plan_, float32_);
+            }
+            plan_ready_ = true;
+            next_ = 0;
+        }
+        const bool averaging = rounds_ > 1; // iteration average: the map keeps learning
+        const size_t count =
+            static_cast<size_t>(std::min<uint64_t>(kBlockSize, plan_.total - next_));
+        generate_block(plan_, next_, count, ws.u);
+        map_.apply_block(ws.u, jacobian_.data(), training || averaging ? bins_.data() : nullptr);
+        warp_block(spec_.proposal, problem_.domain, ws.u, ws.x, ws.pdf.data());
+        for (size_t i = 0; i < count; ++i) ws.pdf[i] /= jacobian_[i]; // p(x) / J(y)
+        evaluate_block(problem_.integrand, ws.x, ws.f.data());
+        if (training) {
+            for (size_t i = 0; i < count; ++i) jacobian_[i] = ws.f[i] / ws.pdf[i]; // weights
+            map_.add_training(bins_.data(), jacobian_.data(), count);
+            next_ += count;
+            log_.trained(count);
+            if (next_ == plan_.total) {
+                map_.adapt(spec_.vegas_options.alpha, spec_.vegas_options.uniform_share);
+                ++iteration_;
+                log_.adapted(map_, iteration_);
+                plan_ready_ = false;
+            }
+            return true;
+        }
+        if (observer_) notify(block_of(ws, next_, count));
+        accumulator_.add_block(next_, ws.f.data(), ws.pdf.data(), ws.pdf.data(), count);
+        if (averaging) map_.add_training(bins_.data(), ws.pdf.data(), count); // the weights
+        next_ += count;
+        if (next_ == plan_.total) {
+            // One estimation iteration done: keep its result, adapt for the next.
+            rounds_done_.push_back(finish_round());
+            if (averaging) map_.adapt(spec_.vegas_options.alpha, spec_.vegas_options.uniform_share);
+            ++round_;
+            plan_ready_ = false;
+        }
+        return true;
+    }
+
+    RunResult result() const override {
+        RunResult r = rounds_done_.size() == 1 ? rounds_done_[0] : average(rounds_done_);
+        r.n = total_;
+        log_.report(&r);
+        return r;
+    }
+
+    AdaptiveView adaptive_view() const override {
+        AdaptiveView v = view_of(map_);
+        log_.add_history(&v);
+        return v;
+    }
+
+  private:
+    RunResult finish_round() const {
+        const double scale = quantity_scale(problem_);
+        return accumulator_.finish(scale);
+    }
+
+    /// The weighted average of the iterations, weights 1 / se_i^2, its standard error
+    /// (sum 1 / se_i^2)^-1/2, and chi^2 = sum (I_i - I)^2 / se_i^2 on (iterations - 1) degrees
+    /// of freedom [Lepage78]. An iteration without a positive finite error bar (an exact or
+    /// empty one) makes the weights meaningless: then the plain mean, and no chi^2.
+    static RunResult average(const std::vector<RunResult>& rounds) {
+        RunResult r;
+        if (rounds.empty()) {
+            r.estimate = r.std_error = std::numeric_limits<double>::quiet_NaN();
+            return r;
+        }
+        bool weighted = true;
+        for (const RunResult& x : rounds)
+            weighted = weighted && std::isfinite(x.estimate) && std::isfinite(x.std_error) &&
+                       x.std_error > 0.0;
+        NeumaierSum sum_w, sum_wi, sum_se2;
+        long dof = 0;
+        for (const RunResult& x : rounds) {
+            const double w = weighted ? 1.0 / (x.std_error * x.std_error) : 1.0;
+            sum_w.add(w);
+            sum_wi.add(w * x.estimate);
+            sum_se2.add(x.std_error * x.std_error);
+            dof += x.dof;
+            const double ess = r.diagnostics.ess + x.diagnostics.ess;
+            r.diagnostics.merge(x.diagnostics);
+            r.diagnostics.ess = ess;
+            r.top.insert(r.top.end(), x.top.begin(), x.top.end());
+        }
+        const double m = static_cast<double>(rounds.size());
+        r.estimate = sum_wi.value() / sum_w.value();
+        r.std_error = weighted ? 1.0 / std::sqrt(sum_w.value()) : std::sqrt(sum_se2.value()) / m;
+        r.dof = static_cast<int>(std::min<long>(dof, 1000000));
+        std::sort(r.top.begin(), r.top.end(), std::greater<double>());
+        if (r.top.size() > kTopWeights) r.top.resize(kTopWeights);
+        if (weighted && rounds.size() > 1) {
+            NeumaierSum chi2;
+            for (const RunResult& x : rounds) {
+                const double z = (x.estimate - r.estimate) / x.std_error;
+                chi2.add(z * z);
+            }
+            r.iteration_chi2 = chi2.value();
+            r.iteration_dof = static_cast<int>(rounds.size()) - 1;
+        }
+        return r;
+    }
+
+  public:
+  private:
+    const Problem& problem_;
+    const EstimatorSpec& spec_;
+    bool float32_;
+    uint64_t total_ = 0, train_ = 0, final_ = 0, next_ = 0;
+    TrainingLog log_;
+    int iterations_ = 0, iteration_ = 0; // training iterations
+    int rounds_ = 1, round_ = 0;         // estimation iterations (1 unless averaging)
+    std::vector<RunResult> rounds_done_;
+    bool plan_ready_ = false, prepared_ = false;
+    VegasMap map_;
+    SamplerPlan plan_;
+    WeightAccumulator accumulator_;
+    std::vector<double> jacobian_;
+    std::vector<uint32_t> bins_;
+};
+
+
+} // namespace
+
+const EstimatorKind& vegas_estimator_kind() {
+    static const EstimatorKind kind{
+        "vegas",
+        "a VEGAS map trained on a share of N, then frozen for the sampler's points",
+        [](const EstimatorSpec&) { return "vegas"; },
+        sampler_error_method, // the frozen map's points are the sampler's, mapped
+        [](const Problem& problem, const EstimatorSpec& spec,
+           Accumulator accumulator) -> std::unique_ptr<EstimatorAlgorithm> {
+            return std::make_unique<VegasEstimator>(problem, spec, accumulator);
+        },
+        [](const EstimatorSpec&) { return false; }, // a learnt map: the first points are training
+        true,
+    };
+    return kind;
+}
+
+} // namespace mcp
