@@ -1,5 +1,5 @@
 // A renderable scene: one world-space triangle mesh, its materials, the camera, and the
-// textures its materials use. The glTF loader (src/render_api/gltf_scene.*) fills it; the
+// textures its materials use. The glTF loader (src/render_api/gltf_scene.h) fills it; the
 // renderer only reads it. Everything is world space and double precision.
 #pragma once
 
