@@ -14,7 +14,8 @@ namespace mcp {
 /// Why not static_cast: V8 compiles wasm's float-to-int truncation to roundsd + cvttsd2si, and
 /// roundsd writes only the low lane of a register it also reads. That false dependency can chain
 /// the iterations of a loop: a tabulated-density loop ran 2.5x slower under V8 with the cast than
-/// with this form (docs/benchmarks.md); natively the two cost the same.
+/// with this form (docs/performance-notes.md#the-estimator-loop-in-wasm); natively the two cost
+/// the same.
 inline uint32_t floor_to_index(double x) {
     const double shifted = x + 0x1p52;
     uint64_t bits;

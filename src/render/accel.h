@@ -1,7 +1,8 @@
 // Ray-scene intersection: a bounding volume hierarchy built with binned SAH [Wald07] and
-// collapsed to eight children per node, whose boxes are tested in float SIMD [Wald08], or a
-// brute-force loop when the surface area heuristic [MacDonaldBooth90] expects the BVH not to
-// pay, both on the watertight ray-triangle test of [Woop13], two triangles at a time.
+// collapsed to eight children per node (four in wasm: kNodeWidth), whose boxes are tested in
+// float SIMD [Wald08], or a brute-force loop when the surface area heuristic [MacDonaldBooth90]
+// expects the BVH not to pay, both on the watertight ray-triangle test of [Woop13], two
+// triangles at a time.
 #pragma once
 
 #include <cstdint>
@@ -41,18 +42,19 @@ class Accelerator {
     static constexpr size_t kAutoMaxTriangles = 64;
     /// Children per BVH node, tested four at a time. Natively, eight visit fewer nodes than
     /// four for about the same latency per node; in wasm, where V8's SIMD code is slower, the
-    /// second group of four costs what the saved visits do (docs/benchmarks.md, "Eight
-    /// children per node").
+    /// second group of four costs what the saved visits do
+    /// (docs/performance-notes.md#traversal-and-the-bvh).
 #if defined(__EMSCRIPTEN__)
     static constexpr int kNodeWidth = 4;
 #else
     static constexpr int kNodeWidth = 8;
 #endif
     /// A node visit's cost in triangle tests, measured with `make bench` (rays/closed_N:
-    /// both structures on closed meshes of 4 to 80 triangles; figures in docs/benchmarks.md;
-    /// about 4.5 natively for both widths). V8 runs the float SIMD box test at about native
-    /// speed and the double-precision triangle test at about 0.65 of it, so a node costs fewer
-    /// triangle tests in wasm.
+    /// both structures on closed meshes of 4 to 80 triangles; figures in
+    /// docs/benchmarks.md#brute-force-against-the-bvh-on-closed-meshes; about 4.5 natively for
+    /// both widths). V8 runs the float SIMD box test at about native speed and the
+    /// double-precision triangle test at about 0.65 of it, so a node costs fewer triangle tests
+    /// in wasm.
 #if defined(__EMSCRIPTEN__)
     static constexpr double kNodeCost = 2.0;
 #else
