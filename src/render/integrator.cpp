@@ -171,13 +171,14 @@ Vec3 light_sample_term(const RenderScene& rs, const LightSet& lights, LightSampl
     return f * ls.radiance * (wi_local.z * w / ls.pdf);
 }
 
-/// Emitted radiance found along a sampled direction with density `pdf` (in solid angle):
-/// traces the ray and returns Le at the hit, or 0. `hit_out` receives the hit for paths.
+/// What a direction sampled at a shading point reaches: whether the ray hits, the hit, and the
+/// radiance emitted there towards the point (0 when the hit does not emit).
 struct DirectionResult {
     bool hit = false;
     Hit h;
     Vec3 emitted{0.0};
 };
+/// Traces the ray from the shading point along the world-space direction wi.
 DirectionResult trace_direction(const RenderScene& rs, const ShadingPoint& sp, const Vec3& wi,
                                 SampleCounters& c) {
     DirectionResult r;

@@ -67,7 +67,7 @@ struct SampleCounters {
 };
 
 /// What the integrator needs of a scene: the scene, its accelerator, and its lights built
-/// for one light-selection rule.
+/// for each light-selection rule.
 struct RenderScene {
     const Scene* scene = nullptr;
     Accelerator accel;

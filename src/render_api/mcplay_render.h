@@ -3,13 +3,13 @@
  * JSON in and out, results released with mcp_free). Built as a separate library (and a
  * separate WebAssembly module) so that the integration playground does not carry it.
  *
- * Scene JSON: a render scene (docs/scene-format.md, "Render scenes"). Options JSON (may be
- * NULL): base_dir (folder that a relative glTF path is resolved against), cache_dir (where
- * high-spp references are cached; none when absent), and overrides of the scene's render
- * settings: width, height, spp_min, spp_max, reps, seed, threads, estimators, reference,
- * jitter_pixels, exposure, accel, and reference_data (a reference made earlier: the
- * reference_data of mcp_render_reference, used when it was made from the same glTF, scene name,
- * image size and reference settings, else rendered again and said so). */
+ * Scene JSON: a render scene (docs/render-scenes.md). Options JSON (may be NULL): base_dir
+ * (folder that a relative glTF path is resolved against), cache_dir (where high-spp references
+ * are cached; none when absent), overrides of the scene's render settings: width, height,
+ * spp_min, spp_max, reps, seed, threads, estimators, reference, jitter_pixels, exposure, accel;
+ * pixel_sampler (every estimator's, not the reference's); and reference_data (a reference made
+ * earlier: the reference_data of mcp_render_reference, used when it was made from the same
+ * glTF, scene name, image size and reference settings, else rendered again and said so). */
 #ifndef MCPLAY_RENDER_H
 #define MCPLAY_RENDER_H
 
@@ -56,10 +56,10 @@ int mcp_render_study_plan(const char* scene_json, const char* options_json, char
 
 /* One image: options.estimator (a name from the scene or an estimator object; default the
  * scene's best, the reference's), options.spp (default spp_max), options.outputs (any of "png",
- * "hdr", "error_png"; default ["png"]; "error_png" renders or reads the reference). The result
- * carries the images base64-encoded, the diagnostics and the rays per second. With the outputs
- * "reference_png" and/or "reference_hdr" alone, the result is the study's reference image
- * (options.reference_data, the cache, its file, or rendered) and its "reference" block. */
+ * "hdr", "pfm", "error_png"; default ["png"]; "error_png" renders or reads the reference). The
+ * result carries the images base64-encoded, the diagnostics and the rays per second. With the
+ * outputs "reference_png" and/or "reference_hdr" alone, the result is the study's reference
+ * image (options.reference_data, the cache, its file, or rendered) and its "reference" block. */
 int mcp_render_image(const char* scene_json, const char* options_json, char** result_json);
 
 /* What a render scene holds: triangles, lights, materials, camera, accelerator, loader

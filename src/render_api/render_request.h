@@ -1,5 +1,5 @@
-// Render scene JSON (docs/scene-format.md, "Render scenes") -> the loaded glTF scene, the
-// estimators, the study settings and the reference. Internal to the render C API.
+// Render scene JSON (docs/render-scenes.md) -> the loaded glTF scene, the estimators, the
+// study settings and the reference. Internal to the render C API.
 #pragma once
 
 #include <memory>
@@ -43,8 +43,8 @@ bool is_render_scene(const Json& scene);
 /// resolves a relative glTF path (the CLI passes the scene file's folder).
 Made<std::shared_ptr<RenderRequest>> build_render_request(const Json& scene, const Json& options);
 
-/// The option keys that select one estimator for mcp_render_image: "estimator" (a name or
-/// an estimator object) and "spp".
+/// One estimator, a strategy name or an estimator object, as mcp_render_image's
+/// options.estimator names one that is not in the scene's list; errors start with `path`.
 Made<RenderEstimator> parse_render_estimator(const Json& j, const std::string& path);
 
 } // namespace mcp
