@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "estimators/estimator_kind.h"
+#include "estimators/vegas_train.h"
 
 namespace mcp {
 namespace {
@@ -18,7 +19,7 @@ namespace {
 // weighted, make an ordinary estimate with an ordinary error bar (iid, strata or
 // randomizations): the training points are not in it, so they cannot bias it. The result
 // counts all N evaluations.
-class VegasEstimator final : public EstimatorAlgorithm {
+class VegasEstimator final : public EstimatorAlgorithm, private TrainingPoints {
   public:
     VegasEstimator(const Problem& problem, const EstimatorSpec& spec, Accumulator accumulator)
         : problem_(problem), spec_(spec), float32_(accumulator == Accumulator::Float32) {}
@@ -50,16 +51,13 @@ class VegasEstimator final : public EstimatorAlgorithm {
         round_ = 0;
         rounds_done_.clear();
         const uint64_t per_iteration = iterations_ > 0 ? train_ / iterations_ : 0;
-        map_ = VegasMap(dim, spec_.vegas_options.increments > 0
-                                 ? spec_.vegas_options.increments
-                                 : vegas_increments(dim, per_iteration));
-        iteration_ = 0;
+        const int increments = spec_.vegas_options.increments;
+        stage_.reset(dim, increments > 0 ? increments : vegas_increments(dim, per_iteration));
+        trained_ = false;
         next_ = 0;
         plan_ready_ = false;
         prepared_ = false;
-        log_.begin(map_, iterations_, static_cast<bool>(observer_));
-        jacobian_.assign(kBlockSize, 1.0);
-        bins_.assign(static_cast<size_t>(dim) * kBlockSize, 0);
+        log_.begin(stage_.map(), iterations_, static_cast<bool>(observer_));
     }
 
     bool run_block(Pcg32& rng, Workspace& ws) override {
@@ -67,19 +65,18 @@ class VegasEstimator final : public EstimatorAlgorithm {
             prepare_workspace(problem_.domain, ws);
             prepared_ = true;
         }
-        const bool training = iteration_ < iterations_;
+        if (!trained_) {
+            train_map(stage_, spec_.vegas_options, problem_, spec_.proposal, iterations_, train_,
+                      *this, rng, ws, log_);
+            trained_ = true;
+        }
         if (!plan_ready_) {
-            const int dim = problem_.domain.sample_dim();
-            if (training) {
-                const uint64_t size = part_of(train_, iterations_, iteration_);
-                plan_ = make_sampler_plan(SamplerKind::Independent, dim, size, rng, {});
-            } else {
-                if (final_ == 0 || round_ >= rounds_) return false;
-                log_.end_training();
-                const uint64_t size = part_of(final_, rounds_, round_);
-                plan_ = make_sampler_plan(spec_.sampler, dim, size, rng, spec_.sampler_options());
-                accumulator_.reset(sampler_error_method(spec_), plan_, float32_);
-            }
+            if (final_ == 0 || round_ >= rounds_) return false;
+            log_.end_training();
+            const uint64_t size = part_of(final_, rounds_, round_);
+            plan_ = make_sampler_plan(spec_.sampler, problem_.domain.sample_dim(), size, rng,
+                                      spec_.sampler_options());
+            accumulator_.reset(sampler_error_method(spec_), plan_, float32_);
             plan_ready_ = true;
             next_ = 0;
         }
@@ -87,35 +84,27 @@ class VegasEstimator final : public EstimatorAlgorithm {
         const size_t count =
             static_cast<size_t>(std::min<uint64_t>(kBlockSize, plan_.total - next_));
         generate_block(plan_, next_, count, ws.u);
-        map_.apply_block(ws.u, jacobian_.data(), training || averaging ? bins_.data() : nullptr);
-        warp_block(spec_.proposal, problem_.domain, ws.u, ws.x, ws.pdf.data());
-        for (size_t i = 0; i < count; ++i) ws.pdf[i] /= jacobian_[i]; // p(x) / J(y)
+        stage_.warp(problem_, spec_.proposal, ws, averaging);
         evaluate_block(problem_.integrand, ws.x, ws.f.data());
-        if (training) {
-            for (size_t i = 0; i < count; ++i) jacobian_[i] = ws.f[i] / ws.pdf[i]; // weights
-            map_.add_training(bins_.data(), jacobian_.data(), count);
-            next_ += count;
-            log_.trained(count);
-            if (next_ == plan_.total) {
-                map_.adapt(spec_.vegas_options.alpha, spec_.vegas_options.uniform_share);
-                ++iteration_;
-                log_.adapted(map_, iteration_);
-                plan_ready_ = false;
-            }
-            return true;
-        }
         if (observer_) notify(block_of(ws, next_, count));
         accumulator_.add_block(next_, ws.f.data(), ws.pdf.data(), ws.pdf.data(), count);
-        if (averaging) map_.add_training(bins_.data(), ws.pdf.data(), count); // the weights
+        if (averaging) stage_.map().add_training(stage_.bins(), ws.pdf.data(), count); // weights
         next_ += count;
         if (next_ == plan_.total) {
             // One estimation iteration done: keep its result, adapt for the next.
             rounds_done_.push_back(finish_round());
-            if (averaging) map_.adapt(spec_.vegas_options.alpha, spec_.vegas_options.uniform_share);
+            if (averaging)
+                stage_.map().adapt(spec_.vegas_options.alpha, spec_.vegas_options.uniform_share);
             ++round_;
             plan_ready_ = false;
         }
         return true;
+    }
+
+    AdaptiveView adaptive_view() const override {
+        AdaptiveView v = view_of(stage_.map());
+        log_.add_history(&v);
+        return v;
     }
 
     RunResult result() const override {
@@ -125,13 +114,27 @@ class VegasEstimator final : public EstimatorAlgorithm {
         return r;
     }
 
-    AdaptiveView adaptive_view() const override {
-        AdaptiveView v = view_of(map_);
-        log_.add_history(&v);
-        return v;
+  private:
+    // The training points (TrainingPoints, for train_map): independent points of the unit
+    // cube, a fresh plan per iteration; their weights f / p as they are.
+    void start(uint64_t calls, Pcg32& rng) override {
+        plan_ = make_sampler_plan(SamplerKind::Independent, problem_.domain.sample_dim(), calls,
+                                  rng, {});
+        next_ = 0;
+    }
+    size_t next(PointBlock& u) override {
+        const size_t count =
+            static_cast<size_t>(std::min<uint64_t>(kBlockSize, plan_.total - next_));
+        if (count == 0) return 0;
+        generate_block(plan_, next_, count, u);
+        next_ += count;
+        return count;
+    }
+    const double* weigh(const Workspace& ws, size_t count, double* weights) override {
+        for (size_t i = 0; i < count; ++i) weights[i] = ws.f[i] / ws.pdf[i];
+        return nullptr; // uniform y
     }
 
-  private:
     RunResult finish_round() const {
         const double scale = quantity_scale(problem_);
         return accumulator_.finish(scale);
@@ -182,22 +185,19 @@ class VegasEstimator final : public EstimatorAlgorithm {
         return r;
     }
 
-  public:
-  private:
     const Problem& problem_;
     const EstimatorSpec& spec_;
     bool float32_;
     uint64_t total_ = 0, train_ = 0, final_ = 0, next_ = 0;
     TrainingLog log_;
-    int iterations_ = 0, iteration_ = 0; // training iterations
+    int iterations_ = 0;                 // training iterations
+    bool trained_ = false;
     int rounds_ = 1, round_ = 0;         // estimation iterations (1 unless averaging)
     std::vector<RunResult> rounds_done_;
     bool plan_ready_ = false, prepared_ = false;
-    VegasMap map_;
-    SamplerPlan plan_;
+    MapStage stage_;   // the map and its buffers
+    SamplerPlan plan_; // the training iteration's, then the estimation round's
     WeightAccumulator accumulator_;
-    std::vector<double> jacobian_;
-    std::vector<uint32_t> bins_;
 };
 
 

@@ -3,20 +3,22 @@
 // n_h >= 2 points in h, n_h proportional to sigma_h^beta (sigma_h the standard deviation of the
 // weights w = f J / p in h at the previous iteration), and estimates
 //   I = sum_h V mean_h(w),   var(I) = sum_h V^2 s_h^2 / n_h.
-// Training iterations adapt the map and the allocation; the final iteration freezes both.
+// Training iterations (train_map, estimators/vegas_train.h, fed by the hypercubes' points) adapt
+// the map and the allocation; the final iteration freezes both.
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
 #include "core/stats.h"
 #include "estimators/estimator_kind.h"
+#include "estimators/vegas_train.h"
 
 namespace mcp {
 namespace {
 
 constexpr uint64_t kMaxHypercubes = uint64_t(1) << 20;
 
-class VegasPlusEstimator final : public EstimatorAlgorithm {
+class VegasPlusEstimator final : public EstimatorAlgorithm, private TrainingPoints {
   public:
     VegasPlusEstimator(const Problem& problem, const EstimatorSpec& spec, Accumulator accumulator)
         : problem_(problem), spec_(spec), float32_(accumulator == Accumulator::Float32) {}
@@ -48,21 +50,19 @@ class VegasPlusEstimator final : public EstimatorAlgorithm {
         if (train == 0) iterations_ = 0;
         final_ = n - train;
         train_ = train;
-        map_ = VegasMap(
-            dim_, o.increments > 0
-                      ? o.increments
-                      : vegas_increments(dim_, iterations_ > 0 ? train_ / iterations_ : final_));
+        stage_.reset(dim_, o.increments > 0 ? o.increments
+                                            : vegas_increments(dim_, iterations_ > 0
+                                                                         ? train_ / iterations_
+                                                                         : final_));
         sigma_.assign(cubes_, 1.0); // uniform allocation first
-        iteration_ = 0;
+        trained_ = false;
         planned_ = false;
         prepared_ = false;
         finished_final_ = false;
-        log_.begin(map_, iterations_, static_cast<bool>(observer_));
-        jacobian_.assign(kBlockSize, 1.0);
+        log_.begin(stage_.map(), iterations_, static_cast<bool>(observer_));
         importance_.assign(kBlockSize, 1.0);
         weight_.assign(kBlockSize, 0.0);
         cube_of_.assign(kBlockSize, 0);
-        bins_.assign(static_cast<size_t>(dim_) * kBlockSize, 0);
     }
 
     bool run_block(Pcg32& rng, Workspace& ws) override {
@@ -70,65 +70,36 @@ class VegasPlusEstimator final : public EstimatorAlgorithm {
             prepare_workspace(problem_.domain, ws);
             prepared_ = true;
         }
-        const bool training = iteration_ < iterations_;
+        if (!trained_) {
+            train_map(stage_, spec_.vegas_options, problem_, spec_.proposal, iterations_, train_,
+                      *this, rng, ws, log_);
+            trained_ = true;
+        }
         if (!planned_) {
-            if (!training && finished_final_) return false;
-            if (!training) log_.end_training();
-            start_iteration(training ? part_of(train_, iterations_, iteration_) : final_, rng,
-                            training);
+            if (finished_final_) return false;
+            log_.end_training();
+            start_iteration(final_, rng, false);
         }
-        // The next block: points of the current hypercube, then the next ones.
-        size_t count = 0;
-        while (count < kBlockSize && cube_ < cubes_) {
-            if (left_in_cube_ == 0) {
-                if (++cube_ == cubes_) break;
-                advance_digits();
-                left_in_cube_ = allocation_[cube_];
-                continue;
-            }
-            for (int j = 0; j < dim_; ++j)
-                ws.u.coord(j)[count] = below_one(
-                    (static_cast<double>(digits_[j]) + jitter_.next_double()) / per_axis_);
-            cube_of_[count] = static_cast<uint32_t>(cube_);
-            --left_in_cube_;
-            ++count;
-        }
+        const size_t count = next(ws.u);
         if (count == 0) {
-            finish_iteration(training);
+            finish_iteration(false);
             return true;
         }
-        ws.u.n = count;
-        map_.apply_block(ws.u, jacobian_.data(), training ? bins_.data() : nullptr);
-        warp_block(spec_.proposal, problem_.domain, ws.u, ws.x, ws.pdf.data());
+        stage_.warp(problem_, spec_.proposal, ws, false);
         evaluate_block(problem_.integrand, ws.x, ws.f.data());
-        const double n_iteration = static_cast<double>(points_);
-        for (size_t i = 0; i < count; ++i) {
-            ws.pdf[i] /= jacobian_[i]; // p(x) / J(y)
-            const double w = ws.f[i] / ws.pdf[i];
-            // Dropped as 0, as the weight accumulator drops (and counts) them.
-            weight_[i] = std::isfinite(w) && !(ws.pdf[i] == 0.0 && ws.f[i] != 0.0) ? w : 0.0;
-            cube_moments_[cube_of_[i]].add(weight_[i]);
-            // 1 / q(y) relative to uniform: V N / n_h.
-            importance_[i] = n_iteration / (static_cast<double>(cubes_) *
-                                            static_cast<double>(allocation_[cube_of_[i]]));
-        }
-        if (training) {
-            map_.add_training(bins_.data(), weight_.data(), importance_.data(), count);
-            log_.trained(count);
-        } else {
-            // The accumulator sees the weights scaled by V N / n_h (its plain mean is then the
-            // stratified estimate), for its diagnostics: non-finite and zero-pdf counts, the
-            // largest weights, the effective sample size.
-            if (observer_) notify(block_of(ws, accumulated_, count));
-            for (size_t i = 0; i < count; ++i) ws.pdf[i] /= importance_[i];
-            accumulator_.add_block(accumulated_, ws.f.data(), ws.pdf.data(), ws.pdf.data(), count);
-            accumulated_ += count;
-        }
+        weigh(ws, count, weight_.data());
+        // The accumulator sees the weights scaled by V N / n_h (its plain mean is then the
+        // stratified estimate), for its diagnostics: non-finite and zero-pdf counts, the
+        // largest weights, the effective sample size.
+        if (observer_) notify(block_of(ws, accumulated_, count));
+        for (size_t i = 0; i < count; ++i) ws.pdf[i] /= importance_[i];
+        accumulator_.add_block(accumulated_, ws.f.data(), ws.pdf.data(), ws.pdf.data(), count);
+        accumulated_ += count;
         return true;
     }
 
     AdaptiveView adaptive_view() const override {
-        AdaptiveView v = view_of(map_);
+        AdaptiveView v = view_of(stage_.map());
         log_.add_history(&v);
         return v;
     }
@@ -141,6 +112,46 @@ class VegasPlusEstimator final : public EstimatorAlgorithm {
     }
 
   private:
+    // The training points (TrainingPoints, for train_map): an iteration in the hypercubes.
+    void start(uint64_t calls, Pcg32& rng) override { start_iteration(calls, rng, true); }
+    void finish() override { finish_iteration(true); }
+
+    // The iteration's next block: points of the current hypercube, then the next ones.
+    size_t next(PointBlock& u) override {
+        size_t count = 0;
+        while (count < kBlockSize && cube_ < cubes_) {
+            if (left_in_cube_ == 0) {
+                if (++cube_ == cubes_) break;
+                advance_digits();
+                left_in_cube_ = allocation_[cube_];
+                continue;
+            }
+            for (int j = 0; j < dim_; ++j)
+                u.coord(j)[count] = below_one(
+                    (static_cast<double>(digits_[j]) + jitter_.next_double()) / per_axis_);
+            cube_of_[count] = static_cast<uint32_t>(cube_);
+            --left_in_cube_;
+            ++count;
+        }
+        if (count > 0) u.n = count;
+        return count;
+    }
+
+    // The block's weights w = f J / p into `weights` (dropped ones as 0, as the weight
+    // accumulator drops and counts them) and into their hypercubes' moments; the points'
+    // importance 1 / q(y) relative to uniform, V N / n_h, into importance_.
+    const double* weigh(const Workspace& ws, size_t count, double* weights) override {
+        const double n_iteration = static_cast<double>(points_);
+        for (size_t i = 0; i < count; ++i) {
+            const double w = ws.f[i] / ws.pdf[i];
+            weights[i] = std::isfinite(w) && !(ws.pdf[i] == 0.0 && ws.f[i] != 0.0) ? w : 0.0;
+            cube_moments_[cube_of_[i]].add(weights[i]);
+            importance_[i] = n_iteration / (static_cast<double>(cubes_) *
+                                            static_cast<double>(allocation_[cube_of_[i]]));
+        }
+        return importance_.data();
+    }
+
     // Allocation n_h = 2 + the rest of the iteration's points in proportion to sigma_h^beta
     // (largest remainders), so that they sum to the iteration's size exactly.
     void start_iteration(uint64_t points, Pcg32& rng, bool training) {
@@ -201,12 +212,7 @@ class VegasPlusEstimator final : public EstimatorAlgorithm {
             strata.add(volume, m);
         }
         planned_ = false;
-        if (training) {
-            map_.adapt(spec_.vegas_options.alpha, spec_.vegas_options.uniform_share);
-            ++iteration_;
-            log_.adapted(map_, iteration_);
-            return;
-        }
+        if (training) return; // train_map adapts the map
         const double scale = quantity_scale(problem_);
         final_result_ = accumulator_.finish(scale);
         final_result_.estimate = scale * strata.estimate();
@@ -222,14 +228,14 @@ class VegasPlusEstimator final : public EstimatorAlgorithm {
     int dim_ = 1;
     uint64_t total_ = 0, train_ = 0, final_ = 0, points_ = 0, accumulated_ = 0;
     uint64_t per_axis_ = 1, cubes_ = 1, cube_ = 0, left_in_cube_ = 0;
-    int iterations_ = 0, iteration_ = 0;
-    bool planned_ = false, prepared_ = false, finished_final_ = false;
+    int iterations_ = 0;
+    bool trained_ = false, planned_ = false, prepared_ = false, finished_final_ = false;
     TrainingLog log_;
-    VegasMap map_;
+    MapStage stage_; // the map and its buffers
     Pcg32 jitter_;
     std::vector<uint64_t> digits_, allocation_;
-    std::vector<double> sigma_, jacobian_, importance_, weight_;
-    std::vector<uint32_t> cube_of_, bins_;
+    std::vector<double> sigma_, importance_, weight_;
+    std::vector<uint32_t> cube_of_;
     std::vector<RunningMoments> cube_moments_;
     SamplerPlan plan_; // outlives the accumulator's use of it
     WeightAccumulator accumulator_;
