@@ -31,8 +31,8 @@ bool decode_hdr(const std::string& bytes, RenderImage* out, std::string* error);
 
 /// A reference image as bytes (the cache file, and what options.reference_data carries): the
 /// magic "MCREF02\n", `key` (the hash of everything the reference was rendered from, see
-/// reference_key in render_api.cpp), width, height and spp as int64, then the means and their
-/// variances as doubles, native (little-endian) byte order.
+/// reference_key in render_reference.h), width, height and spp as int64, then the means and
+/// their variances as doubles, native (little-endian) byte order.
 std::string encode_reference(const RenderImage& image, uint64_t key);
 /// Reads what encode_reference wrote: the magic, the same `key`, sizes within the limits above,
 /// spp >= 1, exactly the bytes those sizes need, and no infinite mean or negative variance.
