@@ -196,7 +196,7 @@ template <class S>
 Vec3 direction_sample_term(const RenderScene& rs, const RenderEstimator& est,
                            const LightSet& lights, const ShadingPoint& sp, PixelSampler& sampler,
                            SampleCounters& c, bool mis, bool power) {
-    Vec3 wi_local, f;
+    Vec3 wi_local(0.0), f(0.0); // f stays black for a strategy out of range: no term
     double pdf = 0.0;
     bool delta = false;
     switch (est.strategy) {
@@ -215,7 +215,9 @@ Vec3 direction_sample_term(const RenderScene& rs, const RenderEstimator& est,
         f = S::eval_pdf(sp.bsdf, sp.wo_local, wi_local, &unused_pdf);
         break;
     }
-    default: {
+    case RadianceStrategy::Bsdf:
+    case RadianceStrategy::MisBalance:
+    case RadianceStrategy::MisPower: {
         ChoiceSample cs = sampler.get_choice_2d();
         BsdfSample bs = S::sample(sp.bsdf, sp.wo_local, cs.choice, cs.u);
         if (!bs.valid || !(bs.pdf > 0.0)) return Vec3(0.0);
@@ -225,6 +227,10 @@ Vec3 direction_sample_term(const RenderScene& rs, const RenderEstimator& est,
         delta = bs.delta;
         break;
     }
+    case RadianceStrategy::LightArea:
+    case RadianceStrategy::LightSolidAngle:
+    case RadianceStrategy::Path:
+        return Vec3(0.0); // never called with these (direct_radiance, path_radiance)
     }
     if (is_black(f)) return Vec3(0.0);
     Vec3 wi = sp.frame.to_world(wi_local);
@@ -257,6 +263,11 @@ RadianceSample direct_radiance(const RenderScene& rs, const RenderEstimator& est
     const LightSet& lights = rs.lights(est.light_selection);
     if (lights.empty()) return out;
     switch (est.strategy) {
+    case RadianceStrategy::UniformHemisphere:
+    case RadianceStrategy::CosineHemisphere:
+    case RadianceStrategy::Bsdf:
+        out.reflected = direction_sample_term<S>(rs, est, lights, sp, sampler, c, false, false);
+        break;
     case RadianceStrategy::LightArea:
         out.reflected =
             light_sample_term<S>(rs, lights, LightSampling::Area, sp, sampler, c, false, false);
@@ -276,9 +287,7 @@ RadianceSample direct_radiance(const RenderScene& rs, const RenderEstimator& est
         out.reflected = from_light + from_bsdf;
         break;
     }
-    default:
-        out.reflected = direction_sample_term<S>(rs, est, lights, sp, sampler, c, false, false);
-        break;
+    case RadianceStrategy::Path: break; // path_radiance's (sample_radiance_with)
     }
     return out;
 }
@@ -360,9 +369,17 @@ bool parse_strategy(const std::string& name, RadianceStrategy* s) {
 }
 
 bool strategy_samples_lights(RadianceStrategy s) {
-    return s == RadianceStrategy::LightArea || s == RadianceStrategy::LightSolidAngle ||
-           s == RadianceStrategy::MisBalance || s == RadianceStrategy::MisPower ||
-           s == RadianceStrategy::Path;
+    switch (s) {
+    case RadianceStrategy::UniformHemisphere:
+    case RadianceStrategy::CosineHemisphere:
+    case RadianceStrategy::Bsdf: return false;
+    case RadianceStrategy::LightArea:
+    case RadianceStrategy::LightSolidAngle:
+    case RadianceStrategy::MisBalance:
+    case RadianceStrategy::MisPower:
+    case RadianceStrategy::Path: return true;
+    }
+    return false; // not reached: every strategy is a case
 }
 
 void RenderScene::build(const Scene& s, AccelKind accel_kind) {
@@ -375,10 +392,11 @@ void RenderScene::build(const Scene& s, AccelKind accel_kind) {
 
 const LightSet& RenderScene::lights(LightSelection selection) const {
     switch (selection) {
+    case LightSelection::Uniform: return lights_uniform;
     case LightSelection::Area: return lights_area;
     case LightSelection::Power: return lights_power;
-    default: return lights_uniform;
     }
+    return lights_uniform; // not reached: every selection is a case
 }
 
 BsdfParams material_at(const Scene& scene, const Hit& hit) {
@@ -434,11 +452,12 @@ SurfaceKernel surface_kernel(const Scene& scene) {
 
 const char* surface_kernel_name(SurfaceKernel k) {
     switch (k) {
-    case SurfaceKernel::Lambertian: return "lambertian";
-    case SurfaceKernel::LambertianTextured: return "lambertian_textured";
+    case SurfaceKernel::GeneralTextured: return "gltf_textured";
     case SurfaceKernel::General: return "gltf";
-    default: return "gltf_textured";
+    case SurfaceKernel::LambertianTextured: return "lambertian_textured";
+    case SurfaceKernel::Lambertian: return "lambertian";
     }
+    return "?"; // not reached: every kernel is a case
 }
 
 } // namespace mcp

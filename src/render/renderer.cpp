@@ -156,14 +156,14 @@ RenderImage render_image(const RenderScene& rs, const RenderEstimator& est,
     // The integrator version for the scene's surfaces, chosen once for the whole image.
     const SurfaceKernel kernel =
         settings.specialize ? surface_kernel(*rs.scene) : SurfaceKernel::GeneralTextured;
-    auto rows = &render_rows<SurfaceKernel::GeneralTextured>;
+    auto rows = &render_rows<SurfaceKernel::GeneralTextured>; // serves every scene
     switch (kernel) {
+    case SurfaceKernel::GeneralTextured: break;
     case SurfaceKernel::General: rows = &render_rows<SurfaceKernel::General>; break;
     case SurfaceKernel::LambertianTextured:
         rows = &render_rows<SurfaceKernel::LambertianTextured>;
         break;
     case SurfaceKernel::Lambertian: rows = &render_rows<SurfaceKernel::Lambertian>; break;
-    default: break;
     }
     run_workers(threads, [&](int t) {
         rows(rs, est, settings, t, threads, image, diags[size_t(t)], progress);

@@ -14,10 +14,11 @@ namespace {
 
 const char* selection_name(LightSelection s) {
     switch (s) {
+    case LightSelection::Uniform: return "uniform";
     case LightSelection::Area: return "area";
     case LightSelection::Power: return "power";
-    default: return "uniform";
     }
+    return "?"; // not reached: every selection is a case
 }
 
 /// The error concentration of level i (a default, flagless one if the study has none).
@@ -126,7 +127,27 @@ Json render_warnings(const RenderEstimatorStudy& s, double floor) {
                                     std::to_string(f.n) +
                                     ": per-pixel error bars are too small (heavy tails or bias)"));
             break;
-        default: break;
+        // A level's flags (render_level_to_json words them), and the integration studies' flags,
+        // which render_flags never raises.
+        case FlagCode::BelowReferenceNoise:
+        case FlagCode::FewPixelErrors:
+        case FlagCode::NoEstimate:
+        case FlagCode::NonfiniteEstimate:
+        case FlagCode::NonfiniteVariance:
+        case FlagCode::ZeroErrorBar:
+        case FlagCode::NonfiniteSamples:
+        case FlagCode::ZeroPdfSamples:
+        case FlagCode::SkewedWeights:
+        case FlagCode::LowEss:
+        case FlagCode::ExactOutsideCi:
+        case FlagCode::PdfSupport:
+        case FlagCode::LevelDrift:
+        case FlagCode::Float32Accumulator:
+        case FlagCode::IterationsDisagree:
+        case FlagCode::ErrorBarsUnderstate:
+        case FlagCode::ErrorBarsUnstable:
+        case FlagCode::BiasDominates:
+        case FlagCode::ConservativeErrorBars: break;
         }
     }
     sort_by_severity(w);
