@@ -5,6 +5,7 @@
 #include <cmath>
 #include <fstream>
 #include <map>
+#include <set>
 #include <sstream>
 #include <string>
 
@@ -358,10 +359,56 @@ TEST(Api, SceneInfoAndCatalog) {
     mcp_free(out);
     EXPECT_EQ(info["estimator_details"][0]["method"], "importance");
     EXPECT_EQ(info["estimator_details"][1]["method"], "mis");
+    EXPECT_EQ(info["estimator_details"][1]["kind"], "mis");
+    EXPECT_FALSE(info["estimator_details"][1]["summary"].get<std::string>().empty());
     ASSERT_EQ(mcp_catalog(&out), MCP_OK);
     json cat = json::parse(out);
     mcp_free(out);
     EXPECT_GE(cat["estimators"].size(), 5u);
+    // The kinds, the presets' kinds and the samplers come from the core's tables.
+    std::set<std::string> kinds;
+    for (const json& k : cat["kinds"]) kinds.insert(k["name"].get<std::string>());
+    for (const char* k :
+         {"fixed", "vegas", "vegas_plus", "miser", "mis", "control_variates", "antithetic"})
+        EXPECT_TRUE(kinds.count(k)) << k;
+    for (const json& p : cat["estimators"]) EXPECT_TRUE(kinds.count(p["kind"].get<std::string>()));
+    EXPECT_EQ(cat["samplers"], json({"independent", "stratified", "latin_hypercube", "sobol",
+                                     "halton", "lattice"}));
+    EXPECT_EQ(cat["randomizations"],
+              json({{"sobol", {"owen", "lms_shift", "digital_shift", "none"}},
+                    {"halton", {"owen", "permutation", "none"}},
+                    {"lattice", {"random_shift", "none"}}}));
+}
+
+TEST(Api, TheKindsFactsReachTheJson) {
+    // Study records: the kind and whether its error bars are conservative by design.
+    Outcome o = run(R"({"f": "x*x", "estimators": ["uniform", "latin_hypercube", "vegas"],
+                        "n_min": 64, "n_max": 128, "reps": 2})");
+    ASSERT_EQ(o.status, MCP_OK) << o.error;
+    std::map<std::string, json> by_name;
+    for (const json& e : o.result["estimators"]) by_name[e["name"]] = e;
+    EXPECT_EQ(by_name["uniform"]["kind"], "fixed");
+    EXPECT_EQ(by_name["uniform"]["error_bars_conservative"], false);
+    EXPECT_EQ(by_name["latin_hypercube"]["error_bars_conservative"], true);
+    EXPECT_EQ(by_name["vegas"]["kind"], "vegas");
+    // Integration levels time their median; render levels do not (test_render_scenes).
+    EXPECT_TRUE(by_name["uniform"]["levels"][0].contains("time_median_s"));
+    // Samples: whether the running mean of the first k points is the estimate at N = k.
+    char* out = nullptr;
+    ASSERT_EQ(mcp_study_samples(R"({"f": "x*x", "estimators": ["uniform", "stratified",
+                                    "vegas", "antithetic"]})",
+                                R"({"n": 64})", &out),
+              MCP_OK)
+        << mcp_last_error();
+    const json dump = json::parse(out);
+    mcp_free(out);
+    std::map<std::string, bool> replay;
+    for (const json& e : dump["estimators"]) replay[e["name"]] = e["replay_is_estimate"];
+    EXPECT_TRUE(replay["uniform"]);
+    EXPECT_FALSE(replay["stratified"]);
+    EXPECT_FALSE(replay["vegas"]);
+    EXPECT_FALSE(replay["antithetic"]);
+    EXPECT_EQ(dump["estimators"][3]["method"], "antithetic");
 }
 
 // --- Hardening (issue 10) ----------------------------------------------------------------

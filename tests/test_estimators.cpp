@@ -732,3 +732,38 @@ TEST(Study, PlanPredictsFromAShortPilot) {
     EXPECT_GT(plan.predicted_seconds, 0.0);
     EXPECT_LT(plan.pilot_seconds, 0.05);
 }
+
+// --- the registry of estimator kinds ----------------------------------------------------
+
+TEST(Registry, EveryKindIsFoundByItsNameAndEveryPresetMakesItsKind) {
+    std::set<std::string> names;
+    for (const EstimatorKind* k : estimator_kinds()) {
+        ASSERT_NE(k, nullptr);
+        EXPECT_TRUE(names.insert(k->name).second) << "two kinds named " << k->name;
+        EXPECT_EQ(find_estimator_kind(k->name), k);
+        EXPECT_TRUE(k->summary && *k->summary) << k->name;
+    }
+    EXPECT_EQ(find_estimator_kind("teleport"), nullptr);
+    // A spec without a kind is a fixed estimator.
+    EXPECT_STREQ(kind_of(EstimatorSpec()).name, "fixed");
+    // Each uniform-density preset, built on a 2-D box, is of its preset's kind, and its method,
+    // error method and algorithm come from that kind.
+    Made<Json> scene = parse_json(R"({"f": "x*y", "domain": {"type": "box", "dim": 2}})", "s");
+    ASSERT_TRUE(scene.ok());
+    Made<SceneRequest> req = build_request(scene.value, Json());
+    ASSERT_TRUE(req.ok()) << req.error;
+    for (const EstimatorPreset& p : estimator_presets()) {
+        ASSERT_NE(find_estimator_kind(p.kind), nullptr) << p.name;
+        if (p.needs_pdf) continue;
+        const Made<EstimatorSpec> spec = preset_estimator(req.value.problem, p.name);
+        ASSERT_TRUE(spec.ok()) << p.name << ": " << spec.error;
+        const EstimatorKind& kind = kind_of(spec.value);
+        EXPECT_STREQ(kind.name, p.kind) << p.name;
+        EXPECT_STREQ(estimator_method(spec.value), kind.method(spec.value));
+        EXPECT_EQ(error_method_for(spec.value), kind.error_method(spec.value));
+        Workspace ws;
+        Pcg32 rng(1, 2);
+        const RunResult r = run_estimate(req.value.problem, spec.value, 4096, rng, ws);
+        EXPECT_NEAR(r.estimate, 0.25, 6.0 * r.std_error + 1e-12) << p.name;
+    }
+}

@@ -40,7 +40,7 @@ constexpr const char* kNewName = "; a new name needs \"sampler\", \"pdf\", \"veg
 
 constexpr const char* kPresets =
     "presets: uniform, stratified, latin_hypercube, importance, stratified_importance, sobol, "
-    "halton, lattice, vegas, vegas_sobol, miser, vegas_plus";
+    "halton, lattice, vegas, vegas_sobol, miser, vegas_plus, antithetic";
 
 // --- 1. estimator names -----------------------------------------------------------------
 

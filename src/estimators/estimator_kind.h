@@ -1,10 +1,10 @@
-// An estimator kind: the one place that says what an estimator is, as pbrt-v4 creates its
-// integrators by name from one table [PBR4, sec. 1.3]. A kind owns its method name (what the
-// page explains), its error method, its factory, and the facts the page and the reports read
-// instead of knowing estimators (whether the running mean of its first points is its estimate,
-// whether it adapts). Each kind defines its entry in its own file (estimators/fixed.cpp,
-// vegas_estimator.cpp, vegas_plus.cpp, miser.cpp, mis.cpp, control_variates.cpp,
-// antithetic.cpp); estimators/registry.cpp lists them with the presets
+// An estimator kind: the one place that says what an estimator is, as pbrt-v4 makes its
+// integrators by name in one place (Integrator::Create, src/pbrt/cpu/integrators.cpp). A kind
+// owns its method name (what the page explains), its error method, its factory, and the facts
+// the page and the reports read instead of knowing estimators (whether the running mean of its
+// first points is its estimate, whether it adapts). Each kind defines its entry in its own file
+// (estimators/fixed.cpp, vegas_estimator.cpp, vegas_plus.cpp, miser.cpp, mis.cpp,
+// control_variates.cpp, antithetic.cpp); estimators/registry.cpp lists them with the presets
 // (docs/adding-an-estimator.md).
 #pragma once
 

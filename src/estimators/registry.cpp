@@ -13,11 +13,14 @@ const EstimatorKind& vegas_plus_estimator_kind();       // estimators/vegas_plus
 const EstimatorKind& miser_estimator_kind();            // estimators/miser.cpp
 const EstimatorKind& mis_estimator_kind();              // estimators/mis.cpp
 const EstimatorKind& control_variate_estimator_kind();  // estimators/control_variates.cpp
+const EstimatorKind& antithetic_estimator_kind();       // estimators/antithetic.cpp
 
 const std::vector<const EstimatorKind*>& estimator_kinds() {
     static const std::vector<const EstimatorKind*> kinds = {
-        &fixed_estimator_kind(), &vegas_estimator_kind(), &vegas_plus_estimator_kind(),
-        &miser_estimator_kind(), &mis_estimator_kind(),   &control_variate_estimator_kind(),
+        &fixed_estimator_kind(),      &vegas_estimator_kind(),
+        &vegas_plus_estimator_kind(), &miser_estimator_kind(),
+        &mis_estimator_kind(),        &control_variate_estimator_kind(),
+        &antithetic_estimator_kind(),
     };
     return kinds;
 }
@@ -49,6 +52,8 @@ const std::vector<EstimatorPreset>& estimator_presets() {
         {"vegas_plus", "vegas_plus", SamplerKind::Independent, false,
          "VEGAS+: the map and hypercubes with points allocated by sigma^0.75, trained then "
          "frozen"},
+        {"antithetic", "antithetic", SamplerKind::Independent, false,
+         "antithetic pairs u and 1 - u: N/2 independent pairs, the error bar from their means"},
     };
     return presets;
 }
