@@ -21,6 +21,23 @@ const char* selection_name(LightSelection s) {
     return "?"; // not reached: every selection is a case
 }
 
+const char* sampling_name(LightSampling s) {
+    switch (s) {
+    case LightSampling::Area: return "area";
+    case LightSampling::SolidAngle: return "solid_angle";
+    }
+    return "?"; // not reached: every sampling is a case
+}
+
+const char* accel_kind_name(AccelKind k) {
+    switch (k) {
+    case AccelKind::Auto: return "auto"; // not in AccelStats: it names what was built
+    case AccelKind::BruteForce: return "brute_force";
+    case AccelKind::Bvh: return "bvh";
+    }
+    return "?"; // not reached: every kind is a case
+}
+
 /// The error concentration of level i (a default, flagless one if the study has none).
 const ErrorConcentration& concentration_of(const RenderEstimatorStudy& s, size_t i) {
     static const ErrorConcentration none;
@@ -71,7 +88,7 @@ Json estimator_to_json(const RenderEstimator& e) {
     Json j{{"name", e.name},
            {"strategy", strategy_name(e.strategy)},
            {"light_selection", selection_name(e.light_selection)},
-           {"light_sampling", e.light_sampling == LightSampling::Area ? "area" : "solid_angle"},
+           {"light_sampling", sampling_name(e.light_sampling)},
            {"pixel_sampler", pixel_sampler_name(e.pixel_sampler)}};
     if (e.strategy == RadianceStrategy::Path) {
         j["max_depth"] = e.max_depth;
@@ -227,7 +244,7 @@ Json render_scene_to_json(const LoadedRender& l) {
                 {"textures", sc.textures.size()},
                 {"surface_kernel", surface_kernel_name(surface_kernel(sc))},
                 {"accel",
-                 {{"kind", a.kind == AccelKind::Bvh ? "bvh" : "brute_force"},
+                 {{"kind", accel_kind_name(a.kind)},
                   {"width", Accelerator::kNodeWidth},
                   {"nodes", a.nodes},
                   {"leaves", a.leaves},
