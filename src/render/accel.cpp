@@ -1,7 +1,8 @@
 // Ray-scene intersection: the watertight ray-triangle test [Woop13], a binned-SAH BVH
-// [Wald07] collapsed to eight children per node and flattened depth first, and its traversal,
-// which tests a node's boxes four at a time in float SIMD [Wald08] with a slab test made
-// conservative as in [Ize13], and a leaf's triangles two at a time in double SIMD.
+// [Wald07] collapsed to eight children per node (four in wasm: kNodeWidth) and flattened depth
+// first, and its traversal, which tests a node's boxes four at a time in float SIMD [Wald08]
+// with a slab test made conservative as in [Ize13], and a leaf's triangles two at a time in
+// double SIMD.
 //
 // Robustness, in order of where it matters:
 // - Triangle test (double precision): every vertex is translated and sheared into the ray's

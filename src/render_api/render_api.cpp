@@ -263,7 +263,8 @@ int mcp_render_study_plan(const char* scene_json, const char* options_json, char
         samples += per_estimator;
         predicted += per_estimator * cost / threads;
     }
-    // The reference: read from a file or the cache, or rendered first.
+    // The reference: read from its file, taken from options.reference_data or the cache, or
+    // rendered first.
     const std::string cache_file = reference_cache_file(r);
     std::string source = "rendered";
     if (!r.reference.file.empty())
