@@ -1,3 +1,6 @@
+// The radiance estimators of integrator.h: direct lighting by sampling directions or lights
+// (and both, weighted by MIS), and path tracing with next-event estimation, each compiled for
+// the four SurfaceKernels.
 #include "render/integrator.h"
 
 #include <algorithm>

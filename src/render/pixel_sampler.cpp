@@ -1,3 +1,5 @@
+// Pixel sampler names and the spp check; the samplers themselves are inline in
+// pixel_sampler.h.
 #include "render/pixel_sampler.h"
 
 namespace mcp {

@@ -1,3 +1,6 @@
+// Render convergence studies (render_study.h): an image's error against the reference, a
+// level's statistics, flags and error concentration, the fitted order, and the study's loop
+// over the spp ladder and the replicates.
 #include "render/render_study.h"
 
 #include <algorithm>

@@ -1,3 +1,5 @@
+// One image (renderer.h): its rows shared among worker threads, each pixel's Welford moments
+// and the sample diagnostics, with the integrator compiled for the scene's surfaces.
 #include "render/renderer.h"
 
 #include "core/parallel.h"

@@ -1,3 +1,5 @@
+// Image files (image_io.h): the PNG, Radiance HDR, PFM and error-PNG encoders, the checked
+// HDR reader, the reference format and its cache file, and base64.
 #include "render_api/image_io.h"
 
 #include <algorithm>

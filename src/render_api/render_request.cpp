@@ -1,3 +1,6 @@
+// Render scene JSON -> RenderRequest (render_request.h): every field checked with a message
+// naming its path, the glTF loaded from inside the scene's folder, and the settings taken from
+// the glTF's extras.mcplay, the scene and the options, each over the one before.
 #include "render_api/render_request.h"
 
 #include <cmath>
