@@ -1,9 +1,10 @@
+// What every estimator's runs share (estimators/estimator.h): merging run diagnostics, the error
+// methods (names, which are conservative, the sampler's), the interval quantile and Hill's tail
+// index. The estimators themselves are kinds (estimators/estimator_kind.h, registry.h).
 #include "estimators/estimator.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
-#include <functional>
 #include <limits>
 
 #include "core/special.h"

@@ -26,7 +26,8 @@ struct VegasOptions {
     VegasReport report = VegasReport::Frozen;
     int iterations = 5; ///< Iterations: the estimation share is split into this many
     /// VEGAS+ [Lepage21, sec. 3]: hypercubes of the y space, each sampled with n_h >= 2 points,
-    /// n_h proportional to sigma_h^beta from the previous iteration.
+    /// n_h proportional to sigma_h^beta from the previous iteration. Read by the scene parser
+    /// only: it makes the estimator of kind vegas_plus (estimators/vegas_plus.cpp).
     bool stratify = false;
     double beta = 0.75;
 };
