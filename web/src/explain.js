@@ -92,6 +92,12 @@ const METHODS = {
     order: () => 'N⁻¹, the variance times 1 − ρ² (ρ the correlation of f and g)',
     look: 'The same slope, a lower line: how much lower depends on how well g follows f. A fitted c costs a little bias at small N.',
   },
+  antithetic: {
+    title: 'Antithetic variates',
+    formula: 'I_N = (2/N) Σ_{i ≤ N/2} [f(uᵢ)/p(uᵢ) + f(1 − uᵢ)/p(1 − uᵢ)] / 2, uᵢ independent and uniform (warped by p)',
+    order: () => 'N⁻¹, the variance times 1 + ρ (ρ the correlation of f at u and at 1 − u)',
+    look: 'The same slope as uniform sampling, a lower line when f is monotone in each coordinate (then ρ < 0); a higher one when f is symmetric about the centre (ρ > 0). The error bar comes from the N/2 pair means.',
+  },
 };
 
 /** The methods this module explains. */
