@@ -396,6 +396,21 @@ TEST(SceneParsing, MisAndControlVariateFieldsAreChecked) {
               "scene.estimators[0].coefficients: applies with \"control_variates\" only");
     EXPECT_EQ(est(R"({"name": "c", "control_variates": [{"g": "x", "integral": 0.5, "G": 1}]})"),
               "scene.estimators[0].control_variates[0]: unknown field 'G' (known: g, integral)");
+    // An estimator is of one kind: the fields of two kinds, or a preset of another kind, are
+    // refused by name.
+    EXPECT_EQ(est(R"({"name": "vm", "vegas": {}, "miser": {}})"),
+              "scene.estimators[0]: an estimator is of one kind: the fields of vegas (\"vegas\") "
+              "and of miser (\"miser\") do not combine");
+    EXPECT_EQ(est(R"({"name": "mc", "proposals": ["uniform"],
+                      "control_variates": [{"g": "x", "integral": 0.5}]})"),
+              "scene.estimators[0]: an estimator is of one kind: the fields of mis "
+              "(\"proposals\") and of control_variates (\"control_variates\") do not combine");
+    EXPECT_EQ(est(R"({"name": "uniform", "vegas": {}})"),
+              "scene.estimators[0]: 'uniform' is a preset of kind fixed; give the estimator "
+              "another name to use \"vegas\"");
+    EXPECT_EQ(est(R"({"name": "m", "sampler": "stratified", "miser": {}})"),
+              "scene.estimators[0].sampler: MISER draws its own points in its regions: the "
+              "sampler must be independent");
     // A built-in g brings its own integral; a defensive pdf is MIS with the uniform density.
     Made<SceneRequest> ok = build(
         R"({"f": "x*x", "estimators": [{"name": "c", "control_variates": [{"g": {"type":
