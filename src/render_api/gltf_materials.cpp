@@ -70,19 +70,17 @@ bool Converter::convert_materials() {
         def.name = "default";
         r_.scene.materials.push_back(def);
         uv_set_.push_back(-1);
-        log_.warn(
-            first_default +
-            (defaults > 1 ? " and " + num(defaults - 1) + " more primitives have" : " has") +
-            " no material; the glTF default material (base colour 1, metallic 1, "
-            "roughness 1) is used");
+        log_.warn(first_default +
+                  (defaults > 1 ? " and " + num(defaults - 1) + " more primitives have" : " has") +
+                  " no material; the glTF default material (base colour 1, metallic 1, "
+                  "roughness 1) is used");
     }
     return true;
 }
 
 bool Converter::factor(double value, const std::string& what, double* out) {
     if (!std::isfinite(value)) return log_.fail(what + " is not finite");
-    if (value < 0.0 || value > 1.0)
-        log_.warn(what + " = " + num(value) + " is clamped to [0, 1]");
+    if (value < 0.0 || value > 1.0) log_.warn(what + " = " + num(value) + " is clamped to [0, 1]");
     *out = std::fmin(std::fmax(value, 0.0), 1.0);
     return true;
 }
@@ -102,8 +100,7 @@ bool Converter::convert_material(int index, Material* out, int* uv_set) {
     if (!std::isfinite(alpha)) return log_.fail(where + ": baseColorFactor[3] is not finite");
     if (alpha < 1.0 || mat.alphaMode != "OPAQUE")
         log_.warn(where + ": alpha (alphaMode " + quoted(mat.alphaMode) +
-                  ", baseColorFactor alpha " + num(alpha) +
-                  ") is ignored; the material is opaque");
+                  ", baseColorFactor alpha " + num(alpha) + ") is ignored; the material is opaque");
     if (!factor(pbr.metallicFactor, where + ": metallicFactor", &out->metallic) ||
         !factor(pbr.roughnessFactor, where + ": roughnessFactor", &out->roughness))
         return false;
@@ -127,8 +124,7 @@ bool Converter::convert_material(int index, Material* out, int* uv_set) {
         } else if (ext.first == "KHR_materials_specular") {
             if (!convert_specular(ext.second, where, out)) return false;
         } else {
-            log_.warn(where + ": " + quoted(ext.first, 80) +
-                      " is not supported and is ignored");
+            log_.warn(where + ": " + quoted(ext.first, 80) + " is not supported and is ignored");
         }
     }
     for (int k = 0; k < 3; ++k) {
@@ -177,8 +173,7 @@ bool Converter::convert_specular(const tinygltf::Value& ext, const std::string& 
     if (ext.Has("specularFactor")) {
         const tinygltf::Value& f = ext.Get("specularFactor");
         if (!f.IsNumber()) return log_.fail(name + ".specularFactor is not a number");
-        if (!factor(f.GetNumberAsDouble(), name + ".specularFactor", &out->specular))
-            return false;
+        if (!factor(f.GetNumberAsDouble(), name + ".specularFactor", &out->specular)) return false;
     }
     if (ext.Has("specularColorFactor")) {
         const tinygltf::Value& c = ext.Get("specularColorFactor");
@@ -188,8 +183,7 @@ bool Converter::convert_specular(const tinygltf::Value& ext, const std::string& 
         if (!white) log_.warn(name + ".specularColorFactor is not supported and is ignored");
     }
     for (const char* texture : {"specularTexture", "specularColorTexture"})
-        if (ext.Has(texture))
-            log_.warn(name + "." + texture + " is not supported and is ignored");
+        if (ext.Has(texture)) log_.warn(name + "." + texture + " is not supported and is ignored");
     return true;
 }
 
@@ -252,8 +246,7 @@ bool Converter::convert_texture(int index, const std::string& material, int* out
             stbi_image_free(px);
             return log_.fail(image_ref + ": cannot decode (" + stbi_failure_reason() + ")");
         }
-        for (size_t k = 0; k < t.rgb.size(); ++k)
-            t.rgb[k] = float(srgb_to_linear(px[k] / 65535.0));
+        for (size_t k = 0; k < t.rgb.size(); ++k) t.rgb[k] = float(srgb_to_linear(px[k] / 65535.0));
         stbi_image_free(px);
     } else {
         stbi_uc* px = stbi_load_from_memory(bytes, size, &w, &h, &channels, 3);

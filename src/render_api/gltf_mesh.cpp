@@ -60,13 +60,12 @@ bool Converter::build_mesh() {
                 return log_.fail(ref + ": mode " + num(mode) + " is not a glTF mode");
             if (!p.targets.empty()) log_.warn(ref + ": morph targets are ignored");
             for (const auto& ext : p.extensions)
-                log_.warn(ref + ": " + quoted(ext.first, 80) +
-                          " is not supported and is ignored");
+                log_.warn(ref + ": " + quoted(ext.first, 80) + " is not supported and is ignored");
             auto pos = p.attributes.find("POSITION");
             if (pos == p.attributes.end()) return log_.fail(ref + ": no POSITION attribute");
             AccessorView pv;
-            if (!view_accessor(m_, pos->second, "POSITION of " + ref, TINYGLTF_TYPE_VEC3,
-                               {kFloat}, &pv, log_) ||
+            if (!view_accessor(m_, pos->second, "POSITION of " + ref, TINYGLTF_TYPE_VEC3, {kFloat},
+                               &pv, log_) ||
                 !read_doubles(pv, &values, log_))
                 return false;
             const uint64_t n = pv.count;
@@ -83,8 +82,7 @@ bool Converter::build_mesh() {
                 mesh.position.push_back(w);
             }
             if (use_normals_ && !append_normals(p, ref, n, normal_matrix)) return false;
-            uint32_t material =
-                p.material == -1 ? default_material_ : material_map_[p.material];
+            uint32_t material = p.material == -1 ? default_material_ : material_map_[p.material];
             if (use_uv_ && !append_uvs(p, ref, n, uv_set_[material])) return false;
 
             if (p.indices != -1) {
@@ -144,8 +142,7 @@ bool Converter::append_normals(const tinygltf::Primitive& p, const std::string& 
         !read_doubles(v, &values, log_))
         return false;
     if (v.count != n)
-        return log_.fail(v.name + ": count " + num(v.count) + " differs from POSITION's " +
-                         num(n));
+        return log_.fail(v.name + ": count " + num(v.count) + " differs from POSITION's " + num(n));
     for (uint64_t i = 0; i < n; ++i) {
         Vec3 w = normal_matrix * Vec3(values[3 * i], values[3 * i + 1], values[3 * i + 2]);
         double len = glm::length(w);
@@ -179,8 +176,7 @@ bool Converter::append_uvs(const tinygltf::Primitive& p, const std::string& ref,
         return log_.fail(v.name + ": integer texture coordinates must be normalized");
     if (!read_doubles(v, &values, log_)) return false;
     if (v.count != n)
-        return log_.fail(v.name + ": count " + num(v.count) + " differs from POSITION's " +
-                         num(n));
+        return log_.fail(v.name + ": count " + num(v.count) + " differs from POSITION's " + num(n));
     for (uint64_t i = 0; i < n; ++i) uv.push_back(Vec2(values[2 * i], values[2 * i + 1]));
     return true;
 }

@@ -87,8 +87,7 @@ bool Converter::collect_instances() {
                 int c = nodes[i].children[k];
                 if (c < 0 || size_t(c) >= nodes.size())
                     return log_.fail("nodes[" + num(uint64_t(i)) + "].children[" +
-                                     num(uint64_t(k)) + "]: node " + num(c) +
-                                     " does not exist");
+                                     num(uint64_t(k)) + "]: node " + num(c) + " does not exist");
                 is_child[size_t(c)] = 1;
             }
         for (size_t i = 0; i < nodes.size(); ++i)

@@ -130,12 +130,11 @@ bool Converter::check_buffers() {
 
 bool Converter::finish() {
     if (r_.scene.mesh.index.empty()) {
-        std::string scene = scene_index_ >= 0 ? "scenes[" + num(scene_index_) + "]"
-                                              : std::string("the root nodes");
-        return log_.fail(instances_.empty()
-                             ? "no triangles: " + scene + " has no node with a mesh"
-                             : "no triangles: the meshes of " + scene +
-                                   " have no non-degenerate triangle");
+        std::string scene =
+            scene_index_ >= 0 ? "scenes[" + num(scene_index_) + "]" : std::string("the root nodes");
+        return log_.fail(instances_.empty() ? "no triangles: " + scene + " has no node with a mesh"
+                                            : "no triangles: the meshes of " + scene +
+                                                  " have no non-degenerate triangle");
     }
     if (scene_index_ >= 0 && m_.scenes[size_t(scene_index_)].extras.IsObject())
         r_.extras_json = m_.scenes[size_t(scene_index_)].extras_json_string;

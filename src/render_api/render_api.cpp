@@ -43,8 +43,8 @@ int mcp_render_scene_info(const char* scene_json, const char* options_json, char
     using namespace mcp;
     LoadedRender l;
     Json options;
-    if (int st = begin_render_call("mcp_render_scene_info", info_json, scene_json, options_json,
-                                   &l, &options))
+    if (int st = begin_render_call("mcp_render_scene_info", info_json, scene_json, options_json, &l,
+                                   &options))
         return st;
     Json j = render_scene_to_json(l);
     Json ests = Json::array();
@@ -64,8 +64,8 @@ int mcp_render_image(const char* scene_json, const char* options_json, char** re
     using namespace mcp;
     LoadedRender l;
     Json options;
-    if (int st = begin_render_call("mcp_render_image", result_json, scene_json, options_json,
-                                   &l, &options))
+    if (int st = begin_render_call("mcp_render_image", result_json, scene_json, options_json, &l,
+                                   &options))
         return st;
     const RenderRequest& r = *l.request;
     // Without options.estimator, the scene's best estimator: the reference's (MIS with the power
@@ -147,12 +147,9 @@ int mcp_render_image(const char* scene_json, const char* options_json, char** re
         Json images = Json::object();
         if (reference_png) images["reference_png"] = base64_encode(encode_png(ref, r.exposure));
         if (reference_hdr) images["reference_hdr"] = base64_encode(encode_hdr(ref));
-        Json j{{"version", kResultSchemaVersion},
-               {"kind", "render_image"},
-               {"mcplay", mcp_version()},
-               {"scene", render_scene_to_json(l)},
-               {"reference", info},
-               {"images", images}};
+        Json j{
+            {"version", kResultSchemaVersion},  {"kind", "render_image"}, {"mcplay", mcp_version()},
+            {"scene", render_scene_to_json(l)}, {"reference", info},      {"images", images}};
         *result_json = copy_out(dump(j));
         if (!*result_json) return fail(MCP_ERROR_INTERNAL, "out of memory writing the result");
         return boundary::succeed();
@@ -229,8 +226,8 @@ int mcp_render_study_plan(const char* scene_json, const char* options_json, char
     using namespace mcp;
     LoadedRender l;
     Json options;
-    if (int st = begin_render_call("mcp_render_study_plan", plan_json, scene_json, options_json,
-                                   &l, &options))
+    if (int st = begin_render_call("mcp_render_study_plan", plan_json, scene_json, options_json, &l,
+                                   &options))
         return st;
     const RenderRequest& r = *l.request;
     const RenderStudySettings& s = r.settings;
