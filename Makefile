@@ -128,7 +128,7 @@ test-e2e: build site
 # a leak, an out-of-bounds access or undefined behaviour fails the test that triggers it.
 # -O1 with assertions on: about 3x slower than Release, and every assert() is checked.
 $(BUILD_ASAN)/CMakeCache.txt: | deps
-	cmake -S . -B $(BUILD_ASAN) -DMCPLAY_SANITIZE=ON -DCMAKE_BUILD_TYPE=Debug \
+	cmake -S . -B $(BUILD_ASAN) -DMCPLAY_SANITIZE=ON -DMCPLAY_UNITY=OFF -DCMAKE_BUILD_TYPE=Debug \
 	  -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g"
 
 test-sanitize: deps $(BUILD_ASAN)/CMakeCache.txt
@@ -313,7 +313,7 @@ deps-fuzz: deps
 	fi
 
 $(BUILD_FUZZ)/CMakeCache.txt: | deps-fuzz
-	CC=clang CXX=clang++ cmake -S . -B $(BUILD_FUZZ) -DMCPLAY_FUZZ=ON -DCMAKE_BUILD_TYPE=Debug \
+	CC=clang CXX=clang++ cmake -S . -B $(BUILD_FUZZ) -DMCPLAY_FUZZ=ON -DMCPLAY_UNITY=OFF -DCMAKE_BUILD_TYPE=Debug \
 	  -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g"
 
 fuzz-build: deps-fuzz $(BUILD_FUZZ)/CMakeCache.txt
