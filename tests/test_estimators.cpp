@@ -8,6 +8,7 @@
 #include <set>
 #include <sstream>
 
+#include "api/report.h"
 #include "api/scene.h"
 #include "integrands/genz.h"
 

@@ -7,6 +7,7 @@
 
 #include "api/boundary.h"
 #include "api/mcplay.h"
+#include "api/report.h"
 #include "api/scene.h"
 #include "estimators/stopping.h"
 

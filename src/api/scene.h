@@ -1,7 +1,6 @@
 // Scene JSON -> problem, estimators and study settings (docs/scene-format.md): the scene-file
 // reader (api/scene.cpp) and the presets on a problem. Internal to the C API. The report API
-// (results -> JSON, table, CSV) is api/report.h, included here for the files that still reach
-// it through this header (src/render_api).
+// (results -> JSON, table, CSV) is api/report.h.
 #pragma once
 
 #include <string>
@@ -10,7 +9,6 @@
 #include <nlohmann/json.hpp>
 
 #include "api/json_read.h"
-#include "api/report.h"
 #include "core/made.h"
 #include "estimators/diagnostics.h"
 #include "estimators/registry.h"

@@ -9,6 +9,7 @@
 
 #include "api/boundary.h"
 #include "api/files.h"
+#include "api/report.h"
 #include "api/scene.h"
 #include "estimators/study.h"
 #include "render_api/image_io.h"

@@ -4,6 +4,7 @@
 
 #include "api/boundary.h"
 #include "api/mcplay.h"
+#include "api/report.h"
 #include "api/scene.h"
 #include "estimators/study.h"
 

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <string>
 
+#include "api/report.h"
 #include "api/scene.h"
 #include "render_api/image_io.h"
 

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "api/report.h"
 #include "api/scene.h"
 #include "render/render_study.h"
 #include "render_api/render_json.h"

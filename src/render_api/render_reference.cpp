@@ -7,6 +7,7 @@
 
 #include "api/boundary.h"
 #include "api/files.h"
+#include "api/report.h"
 #include "api/scene.h"
 #include "core/rng.h"
 #include "estimators/study.h"
