@@ -371,20 +371,6 @@ bool parse_strategy(const std::string& name, RadianceStrategy* s) {
     return false;
 }
 
-bool strategy_samples_lights(RadianceStrategy s) {
-    switch (s) {
-    case RadianceStrategy::UniformHemisphere:
-    case RadianceStrategy::CosineHemisphere:
-    case RadianceStrategy::Bsdf: return false;
-    case RadianceStrategy::LightArea:
-    case RadianceStrategy::LightSolidAngle:
-    case RadianceStrategy::MisBalance:
-    case RadianceStrategy::MisPower:
-    case RadianceStrategy::Path: return true;
-    }
-    return false; // not reached: every strategy is a case
-}
-
 void RenderScene::build(const Scene& s, AccelKind accel_kind) {
     scene = &s;
     accel.build(s.mesh, accel_kind);

@@ -44,8 +44,6 @@ enum class RadianceStrategy {
 };
 const char* strategy_name(RadianceStrategy s);
 bool parse_strategy(const std::string& name, RadianceStrategy* s);
-/// Does the strategy sample the lights (and so need a light-selection distribution)?
-bool strategy_samples_lights(RadianceStrategy s);
 
 struct RenderEstimator {
     std::string name; ///< unique within a study: keys its random streams
