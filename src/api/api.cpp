@@ -383,29 +383,14 @@ int mcp_catalog(char** catalog_json) {
     // The samplers parse_sampler knows, and per quasi-Monte Carlo sampler the randomizations
     // that apply to its points (the randomized ones first, "none" last), from the core's tables.
     mcp::Json samplers = mcp::Json::array(), randomizations = mcp::Json::object();
-    const std::string names = mcp::sampler_names();
-    for (size_t at = 0; at < names.size();) {
-        const size_t comma = names.find(", ", at);
-        const std::string name =
-            names.substr(at, comma == std::string::npos ? std::string::npos : comma - at);
-        at = comma == std::string::npos ? names.size() : comma + 2;
+    for (const mcp::SamplerKind sk : mcp::kSamplerKinds) {
+        const char* name = mcp::sampler_name(sk);
         samplers.push_back(name);
-        mcp::SamplerKind sk{};
-        if (!mcp::parse_sampler(name, &sk) || !mcp::is_qmc(sk)) continue;
+        if (!mcp::is_qmc(sk)) continue;
         mcp::Json applicable = mcp::Json::array();
-        bool none = false;
-        // QmcRandomization is an int-based enum class; its names end at randomization_name's "?"
-        for (int r = 0;; ++r) {
-            const auto rnd = static_cast<mcp::QmcRandomization>(r);
-            const std::string rname = mcp::randomization_name(rnd);
-            if (rname == "?") break;
-            if (!mcp::check_randomization(mcp::qmc_kind_of(sk), rnd).empty()) continue;
-            if (rnd == mcp::QmcRandomization::None)
-                none = true;
-            else
-                applicable.push_back(rname);
-        }
-        if (none) applicable.push_back("none");
+        for (const mcp::QmcRandomization rnd : mcp::kQmcRandomizations)
+            if (mcp::check_randomization(mcp::qmc_kind_of(sk), rnd).empty())
+                applicable.push_back(mcp::randomization_name(rnd));
         randomizations[name] = applicable;
     }
     mcp::Json catalog{

@@ -54,6 +54,11 @@ enum class QmcRandomization {
     Permutation,  ///< random digit permutations per digit position (Halton)
     RandomShift,  ///< Cranley-Patterson shift modulo 1 (lattice)
 };
+/// Every randomization, the randomized ones first and the deterministic points last (the order
+/// the C API's catalog lists those that apply to a point set).
+inline constexpr QmcRandomization kQmcRandomizations[] = {
+    QmcRandomization::Owen,        QmcRandomization::LmsShift,    QmcRandomization::DigitalShift,
+    QmcRandomization::Permutation, QmcRandomization::RandomShift, QmcRandomization::None};
 
 const char* qmc_kind_name(QmcKind kind);
 const char* randomization_name(QmcRandomization r);

@@ -24,6 +24,10 @@
 namespace mcp {
 
 enum class SamplerKind { Independent, Stratified, LatinHypercube, Sobol, Halton, Lattice };
+/// Every sampler, in the order messages and the C API's catalog list them.
+inline constexpr SamplerKind kSamplerKinds[] = {
+    SamplerKind::Independent, SamplerKind::Stratified, SamplerKind::LatinHypercube,
+    SamplerKind::Sobol,       SamplerKind::Halton,     SamplerKind::Lattice};
 
 const char* sampler_name(SamplerKind kind);
 /// Parses "independent", "stratified", "latin_hypercube", "sobol", "halton", "lattice".
