@@ -38,9 +38,14 @@ std::string repeated(size_t n, const std::string& item) {
 constexpr const char* kNewName = "; a new name needs \"sampler\", \"pdf\", \"vegas\", "
                                  "\"miser\", \"proposals\" or \"control_variates\")";
 
-constexpr const char* kPresets =
-    "presets: uniform, stratified, latin_hypercube, importance, stratified_importance, sobol, "
-    "halton, lattice, vegas, vegas_sobol, miser, vegas_plus, antithetic";
+// The unknown-name message lists every preset of the registry, in its order (a new preset joins
+// the message without a change here).
+std::string presets_text() {
+    std::string names;
+    for (const EstimatorPreset& p : estimator_presets())
+        names += (names.empty() ? "" : ", ") + std::string(p.name);
+    return "presets: " + names;
+}
 
 // --- 1. estimator names -----------------------------------------------------------------
 
@@ -48,15 +53,15 @@ TEST(SceneParsing, UnknownEstimatorNamesAreRefused) {
     EXPECT_EQ(error_of(R"({"f": "x*x", "estimators": ["stratifed"]})"),
               std::string("scene.estimators[0]: unknown estimator 'stratifed' (did you mean "
                           "'stratified'? ") +
-                  kPresets + kNewName);
+                  presets_text() + kNewName);
     EXPECT_EQ(error_of(R"({"f": "x*x", "estimators": ["uniform", "faure"]})"),
-              std::string("scene.estimators[1]: unknown estimator 'faure' (") + kPresets +
+              std::string("scene.estimators[1]: unknown estimator 'faure' (") + presets_text() +
                   kNewName);
     // An object with only a name is a bare name too.
     EXPECT_EQ(error_of(R"({"f": "x*x", "estimators": [{"name": "latin_hypercub"}]})"),
               std::string("scene.estimators[0]: unknown estimator 'latin_hypercub' (did you "
                           "mean 'latin_hypercube'? ") +
-                  kPresets + kNewName);
+                  presets_text() + kNewName);
     // A new name with its sampler or pdf spelled out is fine, and runs what it says.
     Made<SceneRequest> r = build(
         R"({"f": "x*x", "estimators": [{"name": "jitter", "sampler": "stratified"},
@@ -68,7 +73,7 @@ TEST(SceneParsing, UnknownEstimatorNamesAreRefused) {
     EXPECT_EQ(error_of(R"({"f": "x*x"})", R"({"estimators": ["uniform", "stratifed"]})"),
               std::string("options.estimators[1]: unknown estimator 'stratifed' (did you mean "
                           "'stratified'? this scene has: uniform, stratified, latin_hypercube; ") +
-                  kPresets + ")");
+                  presets_text() + ")");
 }
 
 // A typed density that goes negative is an error at its field, not silently |p| (what the page's
