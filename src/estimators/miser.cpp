@@ -101,14 +101,8 @@ class MiserEstimator final : public EstimatorAlgorithm {
                 const double wi = ws.f[i] / ws.pdf[i];
                 w[i] = std::isfinite(wi) && !(ws.pdf[i] == 0.0 && ws.f[i] != 0.0) ? wi : 0.0;
             }
-            SampleBlock b;
-            b.first = done;
-            b.count = count;
-            b.u = &ws.u;
-            b.x = &ws.x;
-            b.pdf = ws.pdf.data();
-            b.f = ws.f.data();
-            consume(static_cast<const SampleBlock&>(b), static_cast<const double*>(w));
+            const SampleBlock b = block_of(ws, done, count);
+            consume(b, static_cast<const double*>(w));
         }
     }
 
