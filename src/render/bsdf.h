@@ -11,6 +11,7 @@
 // for any unit directions (grazing ones included), never NaN or Inf.
 #pragma once
 
+#include "core/microfacet.h" // the GGX pieces: ggx_d, ggx_g1, visible normals [Heitz18]
 #include "render/geometry.h"
 
 namespace mcp {
@@ -72,13 +73,7 @@ bool bsdf_is_lambertian(const BsdfParams& m);
 Vec3 lambert_eval_pdf(const BsdfParams& m, const Vec3& wo, const Vec3& wi, double* pdf);
 BsdfSample lambert_sample(const BsdfParams& m, const Vec3& wo, const Vec2& u);
 
-// The pieces, exposed for tests: GGX normal distribution D(h) [Walter07] (local h), Smith's
-// G1, the visible-normal density D_v(h) = G1(wo) max(0, wo.h) D(h) / wo.z [Heitz18], and
-// visible-normal sampling. wo must lie above the surface (wo.z > 0; otherwise the density is
-// 0 and the sampler returns n); alpha below 1e-12 is raised to 1e-12.
-double ggx_d(double alpha, const Vec3& h);
-double ggx_g1(double alpha, const Vec3& w);
-double ggx_visible_normal_pdf(double alpha, const Vec3& wo, const Vec3& h);
-Vec3 ggx_sample_visible_normal(double alpha, const Vec3& wo, const Vec2& u);
+// The GGX pieces the BRDF is built of (ggx_d, ggx_g1, ggx_visible_normal_pdf,
+// ggx_sample_visible_normal) are declared in core/microfacet.h.
 
 } // namespace mcp

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/spherical_triangle.h"
 #include "render/scene.h"
 
 namespace mcp {
@@ -116,11 +117,9 @@ inline bool light_is_small_from(const Vec3& centroid, double radius2, const Vec3
     return radius2 * (kSmallLightInverseRatio * kSmallLightInverseRatio) <= glm::dot(d, d);
 }
 
-// Spherical triangles, exposed for tests: the solid angle of triangle (a, b, c) seen from
-// the origin [VanOosteromStrackee83], and Arvo's area-preserving map from the unit square.
-double spherical_triangle_area(const Vec3& a, const Vec3& b, const Vec3& c);
-Vec3 sample_spherical_triangle(const Vec3& a, const Vec3& b, const Vec3& c, const Vec2& u,
-                               double* pdf);
+// Spherical triangles (the solid angle of triangle (a, b, c) seen from the origin
+// [VanOosteromStrackee83], and Arvo's area-preserving map from the unit square) are declared in
+// core/spherical_triangle.h: spherical_triangle_area, sample_spherical_triangle.
 
 /// Most vertices lambert_polygon_form_factor accepts.
 constexpr int kMaxFormFactorVertices = 32;
