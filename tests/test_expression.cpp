@@ -301,6 +301,34 @@ TEST(Expression, VariablesByNameAndIndex) {
                                 "(variables: x, x1 for a 1-dimensional domain)");
 }
 
+// Warps read the unit cube's coordinates as u, u1 .. u<dim> (ExprVariables::Unit); there x, y,
+// z are unknown, and in a domain's expressions u is.
+TEST(Expression, UnitCubeVariables) {
+    auto unit = [](const std::string& text, int dim) {
+        return compile_expression(text, dim, ExprVariables::Unit);
+    };
+    auto p = unit("u1 + 10*u2 + 100*u3 - u", 3);
+    ASSERT_TRUE(p.ok()) << p.error;
+    const double u[3] = {0.25, 2.0, 3.0};
+    EXPECT_EQ(p.value->evaluate_point(u), 320.0);
+    auto one = unit("sqrt(u)", 1);
+    ASSERT_TRUE(one.ok()) << one.error;
+    const double quarter = 0.25;
+    EXPECT_EQ(one.value->evaluate_point(&quarter), 0.5);
+
+    EXPECT_EQ(unit("u3", 2).error, "at position 1: variable 'u3' is beyond the unit cube's "
+                                   "dimension (variables: u, u1, u2 for a 2-dimensional unit "
+                                   "cube)");
+    EXPECT_EQ(unit("u1 + x", 2).error, "at position 6: unknown variable 'x' (variables: u, u1, "
+                                       "u2 for a 2-dimensional unit cube)");
+    EXPECT_EQ(unit("u0", 4).error, "at position 1: unknown variable 'u0' (variables: u, "
+                                   "u1..u4 for a 4-dimensional unit cube)");
+    EXPECT_EQ(unit("u(2)", 1).error,
+              "at position 1: 'u' is a variable, not a function (write u*(...) to multiply)");
+    EXPECT_EQ(error_of("u", 1), "at position 1: unknown variable 'u' "
+                                "(variables: x, x1 for a 1-dimensional domain)");
+}
+
 TEST(Expression, DimensionAndSource) {
     auto p = compile_ok("x3 * 2", 4);
     ASSERT_TRUE(p);

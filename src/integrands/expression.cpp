@@ -338,8 +338,18 @@ bool is_space(char c) {
     return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\f' || c == '\v';
 }
 
-/// "x, y, z, x1..x5" for the variables of a dim-dimensional domain.
-std::string variables_text(int dim) {
+/// "x, y, z, x1..x5" for the variables of a dim-dimensional domain, or "u, u1, u2" for those
+/// of a unit cube.
+std::string variables_text(int dim, ExprVariables kind) {
+    if (kind == ExprVariables::Unit) {
+        std::string s = "u";
+        if (dim <= 3) {
+            for (int j = 1; j <= dim; ++j) s += ", u" + std::to_string(j);
+        } else {
+            s += ", u1..u" + std::to_string(dim);
+        }
+        return s + " for a " + std::to_string(dim) + "-dimensional unit cube";
+    }
     std::string s = "x";
     if (dim >= 2) s += ", y";
     if (dim >= 3) s += ", z";
@@ -351,13 +361,16 @@ std::string variables_text(int dim) {
     return s + " for a " + std::to_string(dim) + "-dimensional domain";
 }
 
-/// 0-based index of the variable x, y, z or x<k> (k >= 1, no leading zero), -1 for other
-/// names; the index may be beyond the domain.
-long variable_index(const std::string& name) {
-    if (name == "x") return 0;
-    if (name == "y") return 1;
-    if (name == "z") return 2;
-    if (name.size() < 2 || name[0] != 'x' || name[1] == '0') return -1;
+/// 0-based index of the variable x, y, z or x<k> (k >= 1, no leading zero), or of u, u<k> for
+/// a unit cube; -1 for other names. The index may be beyond the domain.
+long variable_index(const std::string& name, ExprVariables kind) {
+    const char letter = kind == ExprVariables::Unit ? 'u' : 'x';
+    if (name.size() == 1 && name[0] == letter) return 0;
+    if (kind == ExprVariables::Point) {
+        if (name == "y") return 1;
+        if (name == "z") return 2;
+    }
+    if (name.size() < 2 || name[0] != letter || name[1] == '0') return -1;
     for (size_t i = 1; i < name.size(); ++i)
         if (!is_digit(name[i])) return -1;
     if (name.size() > 7) return 1000000; // beyond any domain
@@ -386,7 +399,8 @@ class ExprCompiler {
     using Operand = ExprProgram::Operand;
     using Instr = ExprProgram::Instr;
 
-    ExprCompiler(const std::string& text, int dim) : text_(text), dim_(dim) {}
+    ExprCompiler(const std::string& text, int dim, ExprVariables variables)
+        : text_(text), dim_(dim), variables_(variables) {}
 
     bool compile(ExprProgram& program);
     const std::string& error() const { return error_; }
@@ -473,6 +487,7 @@ class ExprCompiler {
 
     const std::string& text_;
     int dim_;
+    ExprVariables variables_;
     size_t pos_ = 0;
     Token tok_;
     TokKind prev_kind_ = TEnd;
@@ -701,13 +716,14 @@ bool ExprCompiler::parse_name(const std::string& name, size_t pos, Operand& v) {
     if (find_function(name))
         return fail(pos, "function '" + name + "' needs its arguments in parentheses, as in " +
                              name + (find_function(name)->arity == 2 ? "(a, b)" : "(x)"));
-    const long index = variable_index(name);
+    const long index = variable_index(name, variables_);
     if (index < 0)
-        return fail(pos,
-                    "unknown variable '" + name + "' (variables: " + variables_text(dim_) + ")");
+        return fail(pos, "unknown variable '" + name +
+                             "' (variables: " + variables_text(dim_, variables_) + ")");
     if (index >= dim_)
-        return fail(pos, "variable '" + name + "' is beyond the domain's dimension (variables: " +
-                             variables_text(dim_) + ")");
+        return fail(pos, "variable '" + name + "' is beyond the " +
+                             (variables_ == ExprVariables::Unit ? "unit cube's" : "domain's") +
+                             " dimension (variables: " + variables_text(dim_, variables_) + ")");
     v = Operand{};
     v.kind = Operand::Var;
     v.index = static_cast<int>(index);
@@ -720,7 +736,7 @@ bool ExprCompiler::parse_call(const std::string& name, size_t name_pos, Operand&
         if (name == "pi" || name == "e")
             return fail(name_pos, "'" + name + "' is a constant, not a function (write " + name +
                                       "*(...) to multiply)");
-        if (variable_index(name) >= 0)
+        if (variable_index(name, variables_) >= 0)
             return fail(name_pos, "'" + name + "' is a variable, not a function (write " + name +
                                       "*(...) to multiply)");
         const FunctionInfo* similar = find_function(to_lower(name));
@@ -995,12 +1011,13 @@ double ExprProgram::evaluate_point(const double* x) const {
     return out;
 }
 
-Made<std::shared_ptr<const ExprProgram>> compile_expression(const std::string& text, int dim) {
+Made<std::shared_ptr<const ExprProgram>> compile_expression(const std::string& text, int dim,
+                                                            ExprVariables variables) {
     using Result = std::shared_ptr<const ExprProgram>;
     if (dim < 1 || dim > kMaxDim)
         return made_error<Result>("expression: dimension must be in 1.." + std::to_string(kMaxDim) +
                                   ", got " + std::to_string(dim));
-    ExprCompiler compiler(text, dim);
+    ExprCompiler compiler(text, dim, variables);
     auto program = std::make_shared<ExprProgram>();
     if (!compiler.compile(*program)) return made_error<Result>(compiler.error());
     return Made<Result>{std::move(program), std::string()};

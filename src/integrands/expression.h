@@ -6,7 +6,9 @@
 // Language (see compile_expression):
 //   numbers     12  0.5  .5  1.  1e-3  2.5E+8   (finite; "1e999" is an error)
 //   constants   pi  e
-//   variables   x y z (= x1 x2 x3), x1 .. x<dim>
+//   variables   x y z (= x1 x2 x3), x1 .. x<dim>; or, compiled with ExprVariables::Unit (the
+//               coordinates of a point of the unit cube, as warps read them), u (= u1), u1 ..
+//               u<dim>
 //   operators   precedence from loosest to tightest:
 //                 + -  binary, left-associative
 //                 * /  binary, left-associative
@@ -94,9 +96,18 @@ class ExprProgram {
     std::vector<double> splats_; ///< kBlockSize copies of each constant of a fused operation
 };
 
-/// Parses and compiles `text` for points of `dim` dimensions (1..64). Variables:
-/// x, y, z name x1, x2, x3 (x alone is x1); x1..x<dim> by index. Using a variable beyond dim is an
-/// error. On error, Made::error is "at position P: MESSAGE" (P = 1-based character column).
-Made<std::shared_ptr<const ExprProgram>> compile_expression(const std::string& text, int dim);
+/// Which names the variables of an expression have.
+enum class ExprVariables {
+    Point, ///< a domain point: x, y, z (= x1, x2, x3) and x1 .. x<dim>
+    Unit,  ///< a point of the unit cube (a warp's input): u (= u1) and u1 .. u<dim>
+};
+
+/// Parses and compiles `text` for points of `dim` dimensions (1..64). Variables (Point):
+/// x, y, z name x1, x2, x3 (x alone is x1); x1..x<dim> by index; (Unit): u names u1, u1..u<dim>
+/// by index, and x, y, z are unknown. Using a variable beyond dim is an error. On error,
+/// Made::error is "at position P: MESSAGE" (P = 1-based character column).
+Made<std::shared_ptr<const ExprProgram>>
+compile_expression(const std::string& text, int dim,
+                   ExprVariables variables = ExprVariables::Point);
 
 } // namespace mcp
