@@ -31,7 +31,9 @@ export class McplayError extends Error {
 export const WASM_FUNCTIONS = Object.freeze([
   '_malloc', '_free',
   '_mcp_version', '_mcp_last_error', '_mcp_study_run', '_mcp_study_plan', '_mcp_result_format',
-  '_mcp_scene_info', '_mcp_catalog', '_mcp_study_samples', '_mcp_free',
+  '_mcp_scene_info', '_mcp_catalog', '_mcp_study_samples',
+  '_mcp_points', '_mcp_points_analyze', '_mcp_discrepancy_curve', '_mcp_points_integrate', '_mcp_warp_test',
+  '_mcp_free',
   '_mallinfo',
 ]);
 
@@ -331,6 +333,64 @@ function makeCore(M) {
       [b.jsonText(scene, 'scene'), b.optionalJson(options, 'options')]);
   }
 
+  // The sampler lab (src/api/mcplay.h, "The sampler lab"): JSON in, JSON out.
+
+  /**
+   * The points of one sampler: `request` {sampler ("uniform", "stratified", "latin_hypercube",
+   * "sobol", "halton", "lattice"), n, dim, seed, randomization?} (mcp_points); returns
+   * {sampler, randomization, n, dim, seed, points: [[x_1..x_dim] per point]}.
+   */
+  function points(request) {
+    b.usable('points');
+    return b.callJson('points', M._mcp_points, 'mcp_points', [b.jsonText(request, 'request')]);
+  }
+
+  /**
+   * The analysis of point sets in [0,1)^d (mcp_points_analyze): `request` is one of
+   * {points: rows or K sets of rows}, {csv: text} or {sampler: {..., sets}}, with spectrum
+   * (false or {axes, size}) and pairwise (false skips the O(N^2 d) measures). Returns the
+   * discrepancies, minimum distances, their independent-points expectation, the power spectrum
+   * and its radial average, and `skipped` {measure: why}.
+   */
+  function analyzePoints(request) {
+    b.usable('analyzePoints');
+    return b.callJson('analyzePoints', M._mcp_points_analyze, 'mcp_points_analyze', [b.jsonText(request, 'request')]);
+  }
+
+  /**
+   * Discrepancy against N for several samplers (mcp_discrepancy_curve): `request` {samplers,
+   * dim, n_min, n_max (<= 65536), seed, reps, scene? (a problem with an exact value: its RMS
+   * integration error with the same points)}. Returns {curves: [{sampler, n, l2_star_discrepancy,
+   * wraparound_l2_discrepancy, rms_error?}], problem?, exact?, ...}.
+   */
+  function discrepancyCurve(request) {
+    b.usable('discrepancyCurve');
+    return b.callJson('discrepancyCurve', M._mcp_discrepancy_curve, 'mcp_discrepancy_curve',
+      [b.jsonText(request, 'request')]);
+  }
+
+  /**
+   * A scene's problem integrated with point sets given whole (mcp_points_integrate): `request`
+   * as analyzePoints' points / csv / sampler. Returns {estimate, per_set, exact, error,
+   * error_bar (null for one set: a deterministic rule, `note` says so), ...}.
+   */
+  function integratePoints(scene, request) {
+    b.usable('integratePoints');
+    return b.callJson('integratePoints', M._mcp_points_integrate, 'mcp_points_integrate',
+      [b.jsonText(scene, 'scene'), b.jsonText(request, 'request')]);
+  }
+
+  /**
+   * The chi-square test of a scene's warp (mcp_warp_test): `options` null or {samples, seed,
+   * significance, tests, bins}. A failed test is a result ("passed": false); a warp that cannot
+   * be tested (g leaves the domain, p negative or NaN) throws McplayError SCENE.
+   */
+  function warpTest(scene, options = null) {
+    b.usable('warpTest');
+    return b.callJson('warpTest', M._mcp_warp_test, 'mcp_warp_test',
+      [b.jsonText(scene, 'scene'), b.optionalJson(options, 'options')]);
+  }
+
   /**
    * Runs a convergence study. `scene`: object or JSON text; `options`: object, JSON text or
    * null ({estimators, n_min, n_max, reps, seed, threads}); `onLevel(level)` (optional) is
@@ -371,7 +431,8 @@ function makeCore(M) {
   }
 
   return Object.freeze({
-    version: b.version, catalog, sceneInfo, samples, plan, runStudy, format, heapStats: b.heapStats,
-    dispose: b.dispose,
+    version: b.version, catalog, sceneInfo, samples, plan, runStudy, format,
+    points, analyzePoints, discrepancyCurve, integratePoints, warpTest,
+    heapStats: b.heapStats, dispose: b.dispose,
   });
 }

@@ -17,6 +17,11 @@
 //   format   {result, format}               formatted {text}          (core.format)
 //   samples  {scene, options, fields?}      sampled   {samples}       (core.samples; `fields`
 //                                                     keeps only those per-estimator arrays)
+//   points   {request}                      pointsDrawn {points}      (core.points)
+//   analyze  {request}                      analyzed  {analysis}      (core.analyzePoints)
+//   curve    {request}                      curved    {curve}         (core.discrepancyCurve)
+//   integratePoints {scene, request}        integrated {result}       (core.integratePoints)
+//   warpTest {scene, options}               warpTested {result}       (core.warpTest)
 //   any request                             error     {status, statusName, message, field?, position?}
 //
 // A render scene (one with a "render" object: isRenderScene) goes to the render core
@@ -42,6 +47,16 @@ export const MSG = Object.freeze({
   IMAGED: 'imaged',
   MERGE: 'merge',
   MERGED: 'merged',
+  POINTS: 'points',
+  POINTS_DRAWN: 'pointsDrawn',
+  ANALYZE: 'analyze',
+  ANALYZED: 'analyzed',
+  CURVE: 'curve',
+  CURVED: 'curved',
+  INTEGRATE_POINTS: 'integratePoints',
+  INTEGRATED: 'integrated',
+  WARP_TEST: 'warpTest',
+  WARP_TESTED: 'warpTested',
   ERROR: 'error',
 });
 
@@ -54,6 +69,11 @@ export const FINAL_REPLY = Object.freeze({
   [MSG.SAMPLES]: MSG.SAMPLED,
   [MSG.IMAGE]: MSG.IMAGED,
   [MSG.MERGE]: MSG.MERGED,
+  [MSG.POINTS]: MSG.POINTS_DRAWN,
+  [MSG.ANALYZE]: MSG.ANALYZED,
+  [MSG.CURVE]: MSG.CURVED,
+  [MSG.INTEGRATE_POINTS]: MSG.INTEGRATED,
+  [MSG.WARP_TEST]: MSG.WARP_TESTED,
 });
 
 /** True for a render scene (an object, or JSON text of one, with a "render" key), the test

@@ -109,6 +109,22 @@ const handlers = {
     }
     reply(id, MSG.SAMPLED, { samples });
   },
+  // The sampler lab: one call of the core each, answered whole.
+  [MSG.POINTS](core, id, { request }) {
+    reply(id, MSG.POINTS_DRAWN, { points: core.points(request) });
+  },
+  [MSG.ANALYZE](core, id, { request }) {
+    reply(id, MSG.ANALYZED, { analysis: core.analyzePoints(request) });
+  },
+  [MSG.CURVE](core, id, { request }) {
+    reply(id, MSG.CURVED, { curve: core.discrepancyCurve(request) });
+  },
+  [MSG.INTEGRATE_POINTS](core, id, { scene, request }) {
+    reply(id, MSG.INTEGRATED, { result: core.integratePoints(scene, request) });
+  },
+  [MSG.WARP_TEST](core, id, { scene, options = null }) {
+    reply(id, MSG.WARP_TESTED, { result: core.warpTest(scene, options) });
+  },
 };
 
 self.onmessage = async (e) => {
