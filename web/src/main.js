@@ -33,6 +33,8 @@ import { mountCustom, syncCustom } from './ui/custom.js';
 import { mountExports, syncExports } from './ui/exports.js';
 import { mountRace, syncRace } from './ui/race.js';
 import { raceOptions, withoutStopping } from './race.js';
+import { startLab } from './lab/wiring.js';
+import { labSnapshot } from './lab/model.js';
 
 const WORKER_URL = new URL('./worker.js', import.meta.url);
 const MAX_WORKERS = 16;
@@ -68,6 +70,15 @@ mountControls(store);
 mountCustom(store);
 mountExports(store);
 mountRace(store);
+// The sampler lab (src/lab/): its own store and view, the same service worker; its inputs go
+// in the URL instead of the study's while it is shown.
+const lab = startLab({
+  service: () => service,
+  scenes: () => store.getState().scenes,
+  fetchScene: (entry) => fetchScene(entry),
+  onChange: () => writeUrl(store.getState()),
+  openStudy: (name) => dispatch({ type: 'scene/request', payload: { sceneId: name } }),
+}, window.location.search);
 
 // Plots and tables are drawn in an animation frame, and at most every RUNNING_RENDER_MS while
 // a study runs: on a machine whose cores all run workers, the page's drawing takes time from
@@ -98,8 +109,10 @@ function scheduleHeavy() {
 
 /** The comparison into the address bar (replaceState: no history entry per keystroke). */
 function writeUrl(state) {
-  if (!urlReady || !state.sceneId) return;
-  const q = stateToQuery(state);
+  if (!urlReady) return;
+  const labQuery = lab.query();
+  if (!labQuery && !state.sceneId) return;
+  const q = labQuery || stateToQuery(state);
   if (q !== window.location.search) window.history.replaceState(null, '', `${window.location.pathname}${q}`);
 }
 
@@ -684,6 +697,7 @@ async function start() {
     return;
   }
   dispatch({ type: 'scenes/loaded', payload: { scenes } });
+  lab.scenesLoaded(scenes);
 
   const search = window.location.search;
   const q = queryToState(search, { scene: scenes.length ? scenes[0].name : null });
@@ -732,5 +746,6 @@ ready.catch(() => {});
 window.mcplayDebug = Object.freeze({
   state: () => structuredClone(debugSnapshot(store.getState())),
   hidden: () => hiddenEstimators(),
+  lab: () => structuredClone(labSnapshot(lab.store.getState())),
   ready,
 });

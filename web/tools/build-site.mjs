@@ -5,7 +5,8 @@
 // vendor/uPlot.esm.js + uPlot.min.css (+ its LICENSE) from web/node_modules/uplot/dist,
 // mcplay_web.mjs + .wasm and mcplay_render_web.mjs + .wasm from WASM_DIR, scenes/*.json and
 // scenes/manifest.json ([{file, name, description, kind, dimension, estimators, n_min, n_max,
-// group, look}], render scenes also {reps, width, height, reference}; read from the scene files themselves;
+// group, look}], warp scenes also {warp: true} (kind 'warp' without an integrand; they need no
+// stop of the tour and come last unless it names them), render scenes also {reps, width, height, reference}; read from the scene files themselves;
 // the page asks the core, sceneInfo, for the rest), in the order of the teaching path
 // web/tour.json, which gives each scene its group and what to look for. Its first scene is an
 // integral (the page opens it, and only render scenes load the render module).
@@ -88,6 +89,11 @@ export function isRenderScene(scene) {
   return Boolean(scene) && typeof scene === 'object' && !Array.isArray(scene) && 'render' in scene;
 }
 
+/** Does a scene carry a warp to test (a top-level "warp": a name or an object)? */
+export function isWarpScene(scene) {
+  return Boolean(scene) && typeof scene === 'object' && !Array.isArray(scene) && 'warp' in scene;
+}
+
 // An estimator of a scene's list: a preset name, or an object with a name (render estimators
 // default their name to their strategy).
 function estimatorName(e) {
@@ -102,6 +108,11 @@ function estimatorName(e) {
  * must agree.
  */
 export function orderByTour(manifest, tour) {
+  // Warp scenes (a top-level "warp": the sampler lab's examples) need no stop of the tour:
+  // those it does not name come last, in file order.
+  const inTour = new Set(((tour && tour.groups) || []).flatMap((g) => (g.scenes || []).map((s) => s.name)));
+  const labOnly = manifest.filter((m) => m.warp && !inTour.has(m.name));
+  manifest = manifest.filter((m) => !labOnly.includes(m));
   const byName = new Map(manifest.map((m) => [m.name, m]));
   const seen = new Set();
   const out = [];
@@ -120,7 +131,7 @@ export function orderByTour(manifest, tour) {
   const missing = manifest.filter((m) => !seen.has(m.name)).map((m) => m.name);
   if (missing.length) problems.push(`scenes in no group of the tour: ${missing.join(', ')}`);
   if (problems.length) throw new Error(problems.join('; '));
-  return out;
+  return [...out, ...labOnly];
 }
 
 export function manifestEntry(file, scene) {
@@ -136,6 +147,17 @@ export function manifestEntry(file, scene) {
     };
   }
   const estimators = Array.isArray(scene.estimators) ? scene.estimators.map(estimatorName) : DEFAULT_ESTIMATORS;
+  if (isWarpScene(scene)) {
+    // A warp for the sampler lab; with an integrand also a study (the warp as the estimator "warp").
+    const integral = scene.f !== undefined || scene.integrand !== undefined;
+    return {
+      file, name, description, kind: integral ? 'integral' : 'warp', warp: true,
+      dimension: integral ? sceneDimension(scene) : null,
+      estimators: integral ? estimators : [],
+      n_min: scene.n_min ?? 16,
+      n_max: scene.n_max ?? 65536,
+    };
+  }
   return {
     file,
     name,

@@ -114,8 +114,9 @@ function sceneOptions(scenes, userGltf) {
   };
   const label = (s) => (kindOf(s) === KIND.RENDER ? `${s.name}  (render)` : `${s.name}  (${s.dimension ?? '?'}D)`);
   const groups = new Map();
-  for (const s of scenes) {
-    const title = s.group || (kindOf(s) === KIND.RENDER ? 'Render scenes (glTF)' : 'Integrals');
+  // A warp without an integrand (kind 'warp') has no study: the sampler lab tests it.
+  for (const s of scenes.filter((e) => e.kind !== 'warp')) {
+    const title = s.group || (kindOf(s) === KIND.RENDER ? 'Render scenes (glTF)' : s.warp ? 'Warps (importance sampling)' : 'Integrals');
     if (!groups.has(title)) groups.set(title, []);
     groups.get(title).push(option(s.name, label(s)));
   }
