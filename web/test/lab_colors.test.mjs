@@ -82,3 +82,11 @@ test('radialSeries and the 1-D densities', () => {
   assert.deepEqual(binCentres({ bins: [2], edges: [[0, 1, 3]] }), [0.5, 2]);
   assert.deepEqual(density1d({ bins: [2], observed: [3, 5], expected: [4, 4] }), { x: [0.25, 0.75], observed: [3, 5], expected: [4, 4] });
 });
+
+test('mapCounts: 2-D results as they are, 3-D ones summed over the third coordinate', async () => {
+  const { mapCounts } = await import('../src/lab/colors.js');
+  const two = { bins: [2, 1], observed: [1, 2], expected: [1.5, 1.5] };
+  assert.deepEqual(mapCounts(two), { bins: [2, 1], observed: [1, 2], expected: [1.5, 1.5], summed: false });
+  const three = { bins: [2, 1, 2], observed: [1, 2, 3, 4], expected: [1, 1, 2, 2] };
+  assert.deepEqual(mapCounts(three), { bins: [2, 1], observed: [4, 6], expected: [3, 3], summed: true });
+});

@@ -145,7 +145,7 @@ test('the words: verdict, facts, measures with the independent-points expectatio
   assert.equal(verdictText(null), '');
   const facts = Object.fromEntries(warpFacts({ pdf_integral: 1.0000001, pdf_integral_error: 2e-4, statistic: 1234.5, dof: 99, pooled_bins: 100, p_value: 1e-30, significance: 0.01 }));
   assert.equal(facts['degrees of freedom'], '99');
-  assert.equal(facts['bins after pooling'], '100');
+  assert.equal(facts['bins pooled (expected < 5)'], '100');
   assert.equal(facts['p-value'], '1.000e-30');
   assert.equal(facts['∫ p over the domain (should be 1)'], '1.0000001 ± 2.0e-4');
   const a = { l2_star_discrepancy: 0.001, centered_l2_discrepancy: null, wraparound_l2_discrepancy: 0.002, min_distance: null,

@@ -56,6 +56,26 @@ export function heatGrid(values, bins) {
   return { nx, ny, at: (i, j) => values[i + nx * j] };
 }
 
+/**
+ * The maps of a warp test over its first two natural coordinates: {bins: [nx, ny], observed,
+ * expected}. A 1-D or 2-D result as it is; a 3-D one summed over its third coordinate (the
+ * marginal counts, which the page says it shows). Flat indices i0 + n0 (i1 + n1 i2).
+ */
+export function mapCounts(result) {
+  const b = result.bins;
+  if (b.length < 3) return { bins: b.slice(), observed: result.observed, expected: result.expected, summed: false };
+  const [n0, n1, n2] = b;
+  const observed = new Array(n0 * n1).fill(0);
+  const expected = new Array(n0 * n1).fill(0);
+  for (let k = 0; k < n2; ++k) {
+    for (let i = 0; i < n0 * n1; ++i) {
+      observed[i] += result.observed[i + n0 * n1 * k];
+      expected[i] += result.expected[i + n0 * n1 * k];
+    }
+  }
+  return { bins: [n0, n1], observed, expected, summed: true };
+}
+
 /** The largest finite value of several arrays (the shared scale of observed and expected). */
 export function sharedMax(...arrays) {
   let m = 0;
@@ -66,7 +86,7 @@ export function sharedMax(...arrays) {
 /** The standardised residuals (o - e) / sqrt(e) of each bin, null where e = 0: the display of
  *  the core's counts (a result that carries "residuals" is shown as it is). */
 export function residuals(result) {
-  if (Array.isArray(result.residuals)) return result.residuals;
+  if (Array.isArray(result.residuals) && result.residuals.length === result.observed.length) return result.residuals;
   return result.observed.map((o, k) => {
     const e = result.expected[k];
     return e > 0 ? (o - e) / Math.sqrt(e) : null;

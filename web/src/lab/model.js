@@ -465,18 +465,22 @@ export function warpFacts(r) {
   if (!r) return [];
   const rows = [];
   const add = (label, v) => { if (v !== undefined) rows.push([label, v]); };
+  if (r.warp !== undefined) add('warp', `${r.warp}${r.domain ? ` on the ${r.domain}` : ''}`);
   if (r.pdf_integral !== undefined) {
-    add('∫ p over the domain (should be 1)', `${num(r.pdf_integral, 8)}${r.pdf_integral_error !== undefined ? ` ± ${num(r.pdf_integral_error, 2)}` : ''}`);
+    add('∫ p over the domain (should be 1)', `${num(r.pdf_integral, 8)}${r.pdf_integral_error !== undefined ? ` ± ${num(r.pdf_integral_error, 2)}` : ''}` +
+      (r.pdf_integral_ok === false ? ' (not 1: p is not a density)' : ''));
   }
   if (r.statistic !== undefined) add('chi-square statistic', num(r.statistic, 6));
   if (r.dof !== undefined) add('degrees of freedom', String(r.dof));
-  if (r.pooled_bins !== undefined) add('bins after pooling', String(r.pooled_bins));
+  if (r.cells !== undefined) add('cells in the statistic', String(r.cells));
+  if (r.pooled_bins !== undefined) add('bins pooled (expected < 5)', String(r.pooled_bins));
+  if (r.zero_bins_hit) add('samples where p = 0', String(r.zero_bins_hit));
   if (r.p_value !== undefined) add('p-value', num(r.p_value, 4));
   if (r.significance !== undefined) add('significance', num(r.significance, 4));
   if (r.tests !== undefined) add('tests (Šidák)', String(r.tests));
   const level = r.sidak_level ?? r.level ?? r.threshold;
   if (level !== undefined) add('Šidák level (reject below)', num(level, 4));
-  if (r.samples !== undefined) add('samples', String(r.samples));
+  if (r.samples !== undefined) add('samples', `${r.samples}${r.seed !== undefined ? `, seed ${r.seed}` : ''}`);
   return rows;
 }
 

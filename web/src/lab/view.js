@@ -6,7 +6,7 @@ import {
   SAMPLERS, QMC_SAMPLERS, RANDOMIZATIONS, DOMAIN_TYPES, NAMED_WARPS, TYPED, measureRows, skippedLines,
   verdictText, warpFacts, integrateText, num, displayRows, problemChoices,
 } from './model.js';
-import { heatGrid, sequentialColor, residualColor, residualLimit, residuals, sharedMax } from './colors.js';
+import { heatGrid, sequentialColor, residualColor, residualLimit, residuals, sharedMax, mapCounts } from './colors.js';
 import { drawHeat, drawColorBar, drawSpectrum, drawScatter } from './draw.js';
 import { renderCurve, renderRadial, renderDensity1d } from './charts.js';
 import { colorAt } from '../palette.js';
@@ -268,22 +268,25 @@ function renderWarp(r) {
       el('th', { scope: 'col' }, 'observed'), el('th', { scope: 'col' }, 'expected'), el('th', { scope: 'col' }, '(o − e)/√e')));
     worst.tBodies[0].replaceChildren(...r.worst_bins.map((b) => el('tr', {},
       ...coords.map((_, k) => el('td', {}, b.range && b.range[k] ? `[${num(b.range[k][0])}, ${num(b.range[k][1])})` : '–')),
-      el('td', {}, num(b.observed, 6)), el('td', {}, num(b.expected, 6)), el('td', {}, num(b.residual, 3)))));
+      el('td', {}, num(b.observed, 6)), el('td', {}, num(b.expected, 6)),
+      el('td', {}, b.residual === null && b.expected === 0 ? '∞ (p = 0 there)' : num(b.residual, 3)))));
   }
   if (oneD || !Array.isArray(r.bins) || !Array.isArray(r.observed)) return;
-  const top = sharedMax(r.observed, r.expected) || 1;
+  const m = mapCounts(r);
+  const top = sharedMax(m.observed, m.expected) || 1;
   const countColor = (v) => sequentialColor(v / top);
-  const res = residuals(r);
+  const res = residuals(m);
   const limit = residualLimit(res);
-  drawHeat($('warp-observed'), heatGrid(r.observed, r.bins), countColor);
-  drawHeat($('warp-expected'), heatGrid(r.expected, r.bins), countColor);
-  drawHeat($('warp-residual'), heatGrid(res, r.bins), (v) => residualColor(v, limit));
+  drawHeat($('warp-observed'), heatGrid(m.observed, m.bins), countColor);
+  drawHeat($('warp-expected'), heatGrid(m.expected, m.bins), countColor);
+  drawHeat($('warp-residual'), heatGrid(res, m.bins), (v) => residualColor(v, limit));
   drawColorBar($('warp-count-bar'), (v) => sequentialColor(v / top), 0, top, 160);
   drawColorBar($('warp-residual-bar'), (v) => residualColor(v, limit), -limit, limit, 160);
   $('warp-count-text').textContent = `samples per bin: 0 (left) to ${num(top, 4)} (right), the same scale for observed and expected`;
   $('warp-residual-text').textContent = `residual: −${limit} and below (blue) · 0 (white) · +${limit} and above (red); grey: no expected samples`;
   const [cx, cy] = coords;
-  $('warp-axes').textContent = `Horizontal: ${cx ?? 'first coordinate'} (${r.bins[0]} bins), vertical: ${cy ?? 'second coordinate'} (${r.bins[1]} bins), growing up.`;
+  $('warp-axes').textContent = `Horizontal: ${cx ?? 'first coordinate'} (${r.bins[0]} bins), vertical: ${cy ?? 'second coordinate'} (${r.bins[1]} bins), growing up.` +
+    (m.summed ? ` Summed over ${coords[2] ?? 'the third coordinate'} (${r.bins[2]} bins): the maps show the marginal counts.` : '');
   for (const id of ['warp-observed', 'warp-expected', 'warp-residual']) {
     $(id).setAttribute('aria-description', `${r.bins[0]} by ${r.bins[1]} bins over ${coords.join(' and ')}`);
   }
