@@ -1,0 +1,208 @@
+// End-to-end test of the sampler lab in headless Chromium (Debian's chromium, driven by
+// playwright-core). Usage: MCPLAY_SITE=SITE_DIR MCPLAY_SHOTS=SHOT_DIR node --test web/e2e/lab.e2e.mjs
+// Serves SITE_DIR on a loopback port, opens the lab from the page's tabs, tests the wrong polar
+// disk warp (fails) and the right one (passes), analyses Sobol' points (spectrum and measures),
+// uploads a CSV with a value outside [0, 1) (the core's error line shown), draws discrepancy
+// curves, checks the URL round trip and runs axe-core on the lab; saves screenshots.
+import { spawn } from 'node:child_process';
+import { mkdtempSync, mkdirSync, rmSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join, resolve, dirname } from 'node:path';
+import { fileURLToPath } from 'node:url';
+import { test, after, before } from 'node:test';
+import assert from 'node:assert/strict';
+import { chromium } from 'playwright-core';
+
+const here = dirname(fileURLToPath(import.meta.url));
+const site = resolve(process.env.MCPLAY_SITE ?? 'build/site');
+const shots = resolve(process.env.MCPLAY_SHOTS ?? 'build/e2e');
+const chromiumPath = process.env.CHROMIUM ?? '/usr/bin/chromium';
+const port = 20000 + Math.floor(Math.random() * 20000);
+const url = `http://127.0.0.1:${port}/`;
+
+let server, context, page, profile;
+const pageErrors = [];
+
+async function waitForServer() {
+  for (let i = 0; i < 100; ++i) {
+    try {
+      const r = await fetch(url);
+      if (r.ok) return;
+    } catch { /* not up yet */ }
+    await new Promise((r) => setTimeout(r, 100));
+  }
+  throw new Error(`the playground server did not answer at ${url}`);
+}
+
+before(async () => {
+  mkdirSync(shots, { recursive: true });
+  server = spawn(process.execPath, [join(here, '..', 'tools', 'serve.mjs'), site], {
+    env: { ...process.env, PORT: String(port), HOST: '127.0.0.1' },
+    stdio: ['ignore', 'pipe', 'inherit'],
+  });
+  await waitForServer();
+  profile = mkdtempSync(join(tmpdir(), 'mcplay-lab-chromium-'));
+  context = await chromium.launchPersistentContext(profile, {
+    executablePath: chromiumPath,
+    headless: true,
+    args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
+      '--disable-background-networking', '--disable-component-update', '--disable-sync'],
+    viewport: { width: 1300, height: 1000 },
+  });
+  page = context.pages()[0] ?? (await context.newPage());
+  page.on('pageerror', (e) => {
+    pageErrors.push(e.message);
+    console.error('page error:', e.message);
+  });
+  await page.goto(url);
+  await page.waitForFunction(() => window.mcplayDebug !== undefined, null, { timeout: 20000 });
+  await page.evaluate(() => window.mcplayDebug.ready);
+});
+
+after(async () => {
+  await context?.close();
+  server?.kill();
+  if (profile) rmSync(profile, { recursive: true, force: true });
+});
+
+const lab = () => page.evaluate(() => window.mcplayDebug.lab());
+
+async function warpTest(g) {
+  await page.selectOption('#warp-example', 'typed');
+  await page.evaluate(() => { document.getElementById('warp-typed').open = true; });
+  await page.selectOption('#warp-named', '');
+  await page.selectOption('#warp-domain', 'disk');
+  await page.fill('#warp-params', '"radius": 1');
+  await page.fill('#warp-g1', g[0]);
+  await page.fill('#warp-g2', g[1]);
+  await page.fill('#warp-g3', '');
+  await page.fill('#warp-p', '1/pi');
+  await page.selectOption('#warp-samples', '100000');
+  const before = (await lab()).warp;
+  await page.click('#warp-run');
+  await page.waitForFunction((was) => {
+    const w = window.mcplayDebug.lab().warp;
+    return (w.status === 'done' || w.status === 'error') && w.result !== was;
+  }, before.result, { timeout: 60000 });
+  return (await lab()).warp;
+}
+
+test('the lab opens from the page\'s tabs, by keyboard too, and puts itself in the URL', async () => {
+  assert.equal(await page.isVisible('#lab-view'), false);
+  await page.focus('#tab-study');
+  await page.keyboard.press('ArrowRight');
+  await page.waitForSelector('#lab-view', { state: 'visible' });
+  assert.equal(await page.getAttribute('#tab-lab', 'aria-selected'), 'true');
+  assert.equal(await page.isVisible('#study-view'), false);
+  await page.waitForFunction(() => window.location.search.startsWith('?view=lab&lab=warp'));
+  // the site's warp scenes are the examples
+  const examples = (await lab()).examples;
+  assert.ok(examples.includes('warp_disk_polar_wrong'), examples.join(', '));
+  await page.click('#tab-study');
+  await page.waitForSelector('#study-view', { state: 'visible' });
+  assert.doesNotMatch(new URL(page.url()).search, /view=lab/);
+  await page.click('#tab-lab');
+  await page.waitForSelector('#lab-view', { state: 'visible' });
+});
+
+test('warp test: the wrong polar disk (r = u1) fails, the right one (r = sqrt(u1)) passes', async () => {
+  const wrong = await warpTest(['u1*cos(2*pi*u2)', 'u1*sin(2*pi*u2)']);
+  assert.equal(wrong.status, 'done', wrong.message);
+  assert.equal(wrong.result.passed, false);
+  assert.match(await page.textContent('#warp-verdict'), /^Failed/);
+  assert.equal(await page.isVisible('#warp-maps'), true);
+  assert.ok(await page.$$eval('#warp-worst tbody tr', (rows) => rows.length) > 0);
+  const facts = await page.textContent('#warp-facts');
+  for (const word of ['chi-square statistic', 'degrees of freedom', 'p-value', 'Šidák level']) assert.ok(facts.includes(word), word);
+  await page.screenshot({ path: join(shots, 'lab-warp-wrong.png'), fullPage: true });
+  const right = await warpTest(['sqrt(u1)*cos(2*pi*u2)', 'sqrt(u1)*sin(2*pi*u2)']);
+  assert.equal(right.status, 'done', right.message);
+  assert.equal(right.result.passed, true, right.result.verdict);
+  assert.match(await page.textContent('#warp-verdict'), /^Passed/);
+  // the typed warp is in the link
+  const q = new URLSearchParams(new URL(page.url()).search);
+  assert.equal(q.get('warp'), 'typed');
+  assert.equal(q.get('g1'), 'sqrt(u1)*cos(2*pi*u2)');
+});
+
+test('a warp scene with an integrand opens its study', async () => {
+  await page.selectOption('#warp-example', 'warp_disk_polar');
+  await page.waitForSelector('#warp-study', { state: 'visible' });
+  await page.click('#warp-study');
+  await page.waitForSelector('#study-view', { state: 'visible' });
+  await page.waitForFunction(() => window.mcplayDebug.state().sceneInfo?.name === 'warp_disk_polar', null, { timeout: 20000 });
+  await page.click('#tab-lab');
+  await page.waitForSelector('#lab-view', { state: 'visible' });
+});
+
+test('point sets: Sobol\' points analysed (spectrum drawn, discrepancies shown), and a link restores the inputs', async () => {
+  await page.click('#lab-tab-points');
+  await page.waitForSelector('#lab-points', { state: 'visible' });
+  await page.check('input[name=points-source][value=sampler]');
+  await page.selectOption('#points-sampler', 'sobol');
+  await page.fill('#points-n', '1024');
+  await page.fill('#points-dim', '2');
+  await page.click('#points-run');
+  await page.waitForFunction(() => ['done', 'error'].includes(window.mcplayDebug.lab().points.status), null, { timeout: 60000 });
+  const p = (await lab()).points;
+  assert.equal(p.status, 'done', p.message);
+  assert.equal(p.analysis.n, 1024);
+  assert.ok(p.analysis.l2_star_discrepancy < p.analysis.expected_iid.l2_star_discrepancy);
+  assert.equal(p.rows, 1024);
+  assert.equal(await page.getAttribute('#points-spectrum', 'data-drawn'), 'true');
+  // the spectrum canvas holds an image (not blank)
+  const lit = await page.$eval('#points-spectrum', (c) => {
+    const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
+    let n = 0;
+    for (let i = 0; i < d.length; i += 4) if (d[i] > 0) n++;
+    return n;
+  });
+  assert.ok(lit > 1000, `${lit} lit pixels`);
+  const measures = await page.textContent('#points-measures');
+  assert.match(measures, /L2-star discrepancy/);
+  assert.match(measures, /wrap-around L2 discrepancy/);
+  assert.match(await page.$eval('#points-measures tr[data-measure="l2_star_discrepancy"] td', (td) => td.textContent), /\d/);
+  // discrepancy curves of several samplers
+  await page.click('#curve-run');
+  await page.waitForFunction(() => ['done', 'error'].includes(window.mcplayDebug.lab().curve.status), null, { timeout: 60000 });
+  const c = (await lab()).curve;
+  assert.equal(c.status, 'done', c.message);
+  assert.ok(c.result.curves.length >= 2);
+  assert.match(await page.textContent('#lab-points'), /up to log factors/);
+  await page.screenshot({ path: join(shots, 'lab-points.png'), fullPage: true });
+  // the link brings the same inputs back
+  const link = page.url();
+  await page.goto(link);
+  await page.evaluate(() => window.mcplayDebug.ready);
+  const back = await lab();
+  assert.equal(back.view, 'lab');
+  assert.equal(back.tab, 'points');
+  assert.equal(await page.inputValue('#points-n'), '1024');
+  assert.equal(await page.inputValue('#points-sampler'), 'sobol');
+});
+
+test('a CSV with a value outside [0, 1) shows the core\'s error line as it is', async () => {
+  const csv = ['x,y', ...Array.from({ length: 10 }, (_, i) => `${(i + 0.5) / 10},0.5`), '0.3,1.2', '0.1,0.1'].join('\n');
+  await page.setInputFiles('#points-file', { name: 'bad.csv', mimeType: 'text/csv', buffer: Buffer.from(csv) });
+  await page.waitForFunction(() => window.mcplayDebug.lab().points.status === 'error', null, { timeout: 30000 });
+  const text = await page.textContent('#points-error');
+  assert.equal(text, 'request.csv: row 12, column 2: \'1.2\' is outside [0, 1)');
+  assert.equal(await page.isVisible('#points-error'), true);
+  // a good file is analysed
+  await page.setInputFiles('#points-file', { name: 'good.json', mimeType: 'application/json', buffer: Buffer.from('[[0.1,0.2],[0.6,0.7],[0.35,0.9]]') });
+  await page.waitForFunction(() => window.mcplayDebug.lab().points.status === 'done', null, { timeout: 30000 });
+  assert.equal((await lab()).points.analysis.n, 3);
+  assert.equal(await page.textContent('#points-error'), '');
+});
+
+test('accessibility: axe-core finds no serious or critical WCAG 2 A/AA violation in the lab', async () => {
+  await page.addScriptTag({ path: join(here, '..', 'node_modules', 'axe-core', 'axe.min.js') });
+  for (const tab of ['#lab-tab-points', '#lab-tab-warp']) {
+    await page.click(tab);
+    const result = await page.evaluate(() => window.axe.run(document, { runOnly: { type: 'tag', values: ['wcag2a', 'wcag2aa'] } }));
+    const serious = result.violations.filter((v) => v.impact === 'serious' || v.impact === 'critical');
+    assert.deepEqual(serious.map((v) => `${v.id}: ${v.help} (${v.nodes.map((n) => n.target.join(' ')).slice(0, 3).join('; ')})`), [], tab);
+    console.log(`# axe (${tab}): ${result.passes.length} rules passed, ${result.violations.length} minor or moderate violations`);
+  }
+  assert.deepEqual(pageErrors, []);
+});
