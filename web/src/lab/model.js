@@ -443,7 +443,8 @@ export function problemChoices(scenes) {
 /** The verdict of a warp test in plain words: the core's own verdict, led by passed / failed. */
 export function verdictText(result) {
   if (!result) return '';
-  const v = typeof result.verdict === 'string' ? result.verdict : '';
+  // the core's verdict starts with its own word for the outcome: said once, ours
+  const v = typeof result.verdict === 'string' ? result.verdict.replace(/^(passed|rejected|failed|accepted)\s*:\s*/i, '') : '';
   if (result.passed === true) return v ? `Passed: ${v}` : 'Passed: the samples agree with the density.';
   if (result.passed === false) return v ? `Failed: ${v}` : 'Failed: the samples do not follow the density.';
   return v;

@@ -259,7 +259,7 @@ function renderWarp(r) {
   const worst = $('warp-worst');
   facts.hidden = !r;
   worst.hidden = !r || !Array.isArray(r.worst_bins) || !r.worst_bins.length;
-  $('warp-axes').textContent = '';
+  $('warp-axes').textContent = oneD ? `Samples per bin over ${r.coordinates ? r.coordinates[0] : 'the coordinate'} (${r.bins[0]} bins of equal measure): orange, observed; dashed black, expected from p.` : '';
   if (!r) return;
   facts.tBodies[0].replaceChildren(...warpFacts(r).map(([k, v]) => el('tr', {}, el('th', { scope: 'row' }, k), el('td', {}, v))));
   const coords = Array.isArray(r.coordinates) ? r.coordinates : [];
