@@ -1,18 +1,18 @@
 // Discrepancies, minimum distances and periodograms of point sets (see point_analysis.h).
 //
 // The O(N^2 d) double sums run over the pairs i < j (plus the diagonal) in chunks of
-// kChunkRows rows; a chunk walks the columns j > i in tiles of kTile points, and for each row
-// of the chunk builds the tile's kernel products one coordinate at a time into a small array
-// (structure of arrays: every inner loop is elementwise over the tile, so GCC and clang
-// vectorise it, natively and with wasm SIMD128). Each column position of the tile keeps its
-// own accumulator; a chunk's accumulators are summed with a compensated sum, and the chunks'
-// sums likewise in chunk order [Neumaier74]. Threads take whole chunks, so the numbers do not
-// depend on how many there are.
+// kChunkRows rows. A chunk takes its rows four at a time against four columns at a time, the
+// sixteen kernel products kept in vector registers while the coordinates go by (structure of
+// arrays: each step loads one coordinate of four columns for four rows), the columns in tiles
+// that stay in L1. The products go into a compensated sum per chunk, and the chunks' sums are
+// added in chunk order [Neumaier74]: threads take whole chunks, so the numbers do not depend on
+// how many there are. The three terms of each closed form are then added in double-double.
 #include "core/point_analysis.h"
 
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstring>
 #include <limits>
 
 #include "core/parallel.h"
@@ -25,7 +25,7 @@ namespace mcp {
 namespace {
 
 constexpr int kTile = 256;          ///< columns per tile (d * 2 KB of coordinates)
-constexpr uint64_t kChunkRows = 64; ///< rows per chunk (<= kTile)
+constexpr uint64_t kChunkRows = 64; ///< rows per chunk (a multiple of 4)
 constexpr double kThreadWork = 3e7; ///< pair-coordinates below which one thread does it all
 
 int hardware_threads() {
@@ -124,104 +124,162 @@ class CompensatedSum {
 };
 
 // ---------------------------------------------------------------------------------------
+// The pair loops, written with the vector extension of GCC and clang: four lanes of doubles,
+// which the AVX2 clone keeps in one register, the SSE2 build and wasm SIMD128 in two. Every
+// operation is the IEEE operation of the scalar code lane by lane (min and abs as selects), so
+// a lane computes what pair_value computes, bit for bit.
+
+#if defined(__GNUC__) && !defined(__clang__)
+// Vec4 values never cross a call that is not inlined: the ABI note is moot.
+#pragma GCC diagnostic ignored "-Wpsabi"
+#endif
+typedef double Vec4 __attribute__((vector_size(32)));
+// The pair loops must be compiled inside each MCP_VECTOR_CLONES entry (for its instruction set),
+// not called as one shared baseline copy.
+#define MCP_ANALYSIS_INLINE inline __attribute__((always_inline))
+
+inline Vec4 load4(const double* p) {
+    Vec4 v;
+    std::memcpy(&v, p, sizeof v);
+    return v;
+}
+inline Vec4 splat4(double x) {
+    return Vec4{x, x, x, x};
+}
+inline double vmin(double a, double b) {
+    return a < b ? a : b;
+}
+inline Vec4 vmin(Vec4 a, Vec4 b) {
+    return a < b ? a : b;
+}
+typedef int64_t Int4 __attribute__((vector_size(32)));
+/// |a| by clearing the sign bit, as fabs does (one AND in each build, v128.and in wasm).
+inline double vabs(double a) {
+    return std::fabs(a);
+}
+inline Vec4 vabs(Vec4 a) {
+    return reinterpret_cast<Vec4>(reinterpret_cast<Int4>(a) & INT64_MAX);
+}
+
 // Kernel factors: K(x_i, x_j) = prod_k f(a_ik, a_jk) over transformed coordinates a.
 
 /// L2-star: 1 - max(x, y) = min(1 - x, 1 - y) (exactly so in floating point: x -> 1 - x
 /// rounds monotonically); the arrays hold 1 - x.
 struct StarFactor {
-    static double f(double a, double b) { return a < b ? a : b; }
+    template <class T> static T f(T a, T b) { return vmin(a, b); }
 };
 /// Centred: 1 + |x-1/2|/2 + |y-1/2|/2 - |x-y|/2; the arrays hold s = x - 1/2.
 struct CenteredFactor {
-    static double f(double a, double b) {
-        return 1.0 + 0.5 * ((std::fabs(a) + std::fabs(b)) - std::fabs(a - b));
+    template <class T> static T f(T a, T b) {
+        return 1.0 + 0.5 * ((vabs(a) + vabs(b)) - vabs(a - b));
     }
 };
 /// Wrap-around: 3/2 - t (1 - t) with t = |x - y|; the arrays hold x.
 struct WrapFactor {
-    static double f(double a, double b) {
-        const double t = std::fabs(a - b);
+    template <class T> static T f(T a, T b) {
+        const T t = vabs(a - b);
         return 1.5 - t * (1.0 - t);
     }
 };
 /// Squared coordinate differences, plain and on the torus.
 struct PlainSquare {
-    static double f(double a, double b) {
-        const double t = a - b;
+    template <class T> static T f(T a, T b) {
+        const T t = a - b;
         return t * t;
     }
 };
 struct TorusSquare {
-    static double f(double a, double b) {
-        const double t0 = std::fabs(a - b), t1 = 1.0 - t0;
-        const double t = t0 < t1 ? t0 : t1;
+    template <class T> static T f(T a, T b) {
+        const T t0 = vabs(a - b);
+        const T t = vmin(t0, 1.0 - t0);
         return t * t;
     }
 };
 
-/// sum_{i in [i0, i1), j > i} prod_k F(t_ik, t_jk): one chunk of the off-diagonal sum, returned
-/// as hi (the return value) + *lo_part.
-template <class F>
-inline double product_chunk(const double* t, uint64_t n, int d, uint64_t i0, uint64_t i1,
-                            double* lo_part) {
-    alignas(64) double acc[kTile];
-    alignas(64) double p[kTile];
-    for (int l = 0; l < kTile; ++l) acc[l] = 0.0;
-    for (uint64_t j0 = i0 + 1; j0 < n; j0 += kTile) {
-        const int len = static_cast<int>(std::min<uint64_t>(kTile, n - j0));
-        for (uint64_t i = i0; i < i1; ++i) {
-            // Row i starts at column i + 1: inside the first tile only (kChunkRows <= kTile).
-            const int lo = i + 1 > j0 ? static_cast<int>(i + 1 - j0) : 0;
-            if (lo >= len) break;
-            const double* c = t + j0;
-            double a = t[i];
-            if (d == 1) {
-                for (int l = lo; l < len; ++l) acc[l] += F::f(a, c[l]);
-                continue;
-            }
-            for (int l = lo; l < len; ++l) p[l] = F::f(a, c[l]);
-            for (int k = 1; k < d - 1; ++k) {
-                a = t[uint64_t(k) * n + i];
-                c = t + uint64_t(k) * n + j0;
-                for (int l = lo; l < len; ++l) p[l] *= F::f(a, c[l]);
-            }
-            a = t[uint64_t(d - 1) * n + i];
-            c = t + uint64_t(d - 1) * n + j0;
-            for (int l = lo; l < len; ++l) acc[l] += p[l] * F::f(a, c[l]);
-        }
+/// The pair term of points i and j: prod_k F (kMin false) or sum_k F (kMin true), k in order.
+template <class F, bool kMin>
+MCP_ANALYSIS_INLINE double pair_value(const double* t, uint64_t n, int d, uint64_t i, uint64_t j) {
+    double p = F::f(t[i], t[j]);
+    for (int k = 1; k < d; ++k) {
+        const double v = F::f(t[uint64_t(k) * n + i], t[uint64_t(k) * n + j]);
+        if constexpr (kMin)
+            p += v;
+        else
+            p *= v;
     }
-    CompensatedSum s;
-    for (int l = 0; l < kTile; ++l) s.add(acc[l]);
-    const DoubleDouble v = s.value();
-    *lo_part = v.lo;
-    return v.hi;
+    return p;
 }
 
-/// min_{i in [i0, i1), j > i} sum_k F(x_ik, x_jk): one chunk of the smallest squared distance.
-template <class F>
-inline double min_chunk(const double* x, uint64_t n, int d, uint64_t i0, uint64_t i1) {
-    alignas(64) double best[kTile];
-    alignas(64) double p[kTile];
-    for (int l = 0; l < kTile; ++l) best[l] = std::numeric_limits<double>::infinity();
-    for (uint64_t j0 = i0 + 1; j0 < n; j0 += kTile) {
-        const int len = static_cast<int>(std::min<uint64_t>(kTile, n - j0));
-        for (uint64_t i = i0; i < i1; ++i) {
-            const int lo = i + 1 > j0 ? static_cast<int>(i + 1 - j0) : 0;
-            if (lo >= len) break;
-            const double* c = x + j0;
-            double a = x[i];
-            for (int l = lo; l < len; ++l) p[l] = F::f(a, c[l]);
-            for (int k = 1; k < d; ++k) {
-                a = x[uint64_t(k) * n + i];
-                c = x + uint64_t(k) * n + j0;
-                for (int l = lo; l < len; ++l) p[l] += F::f(a, c[l]);
+/// One chunk of rows [i0, i1) against every column j > i: the sum of the pair terms (returned
+/// as hi, the return value, + *lo_part) or, kMin, their minimum. Rows go in blocks of four
+/// against four columns at a time, the products of all sixteen pairs kept in registers across
+/// the coordinates (a column's coordinates are loaded once for four rows); columns in tiles of
+/// kTile, which stay in L1 while the chunk's row blocks pass over them. The pairs inside a row
+/// block, a last partial block and the columns past the last multiple of four: scalar.
+template <class F, bool kMin>
+MCP_ANALYSIS_INLINE double pair_chunk(const double* t, uint64_t n, int d, uint64_t i0, uint64_t i1,
+                                      double* lo_part) {
+    constexpr int kRows = 4;
+    CompensatedSum total;
+    double best = std::numeric_limits<double>::infinity();
+    auto take = [&](double v) {
+        if constexpr (kMin)
+            best = vmin(v, best);
+        else
+            total.add(v);
+    };
+    const uint64_t blocks_end = i0 + (i1 - i0) / kRows * kRows;
+    for (uint64_t i = blocks_end; i < i1; ++i)
+        for (uint64_t j = i + 1; j < n; ++j) take(pair_value<F, kMin>(t, n, d, i, j));
+    for (uint64_t r0 = i0; r0 < blocks_end; r0 += kRows)
+        for (int a = 0; a < kRows; ++a)
+            for (int b = a + 1; b < kRows; ++b)
+                take(pair_value<F, kMin>(t, n, d, r0 + uint64_t(a), r0 + uint64_t(b)));
+    // Tiles start at i0 + 4 and every block's first column r0 + 4 is i0 + 4 modulo 4 too: the
+    // vector loop ends short of a multiple of four only at n.
+    for (uint64_t j0 = i0 + kRows; j0 < n; j0 += kTile) {
+        const uint64_t j1 = std::min<uint64_t>(j0 + kTile, n);
+        for (uint64_t r0 = i0; r0 < blocks_end; r0 += kRows) {
+            uint64_t j = std::max<uint64_t>(j0, r0 + kRows);
+            if (j >= j1) break; // the later blocks start later still
+            Vec4 acc = kMin ? splat4(best) : Vec4{};
+            for (; j + 4 <= j1; j += 4) {
+                Vec4 c = load4(t + j);
+                Vec4 p0 = F::f(splat4(t[r0]), c), p1 = F::f(splat4(t[r0 + 1]), c);
+                Vec4 p2 = F::f(splat4(t[r0 + 2]), c), p3 = F::f(splat4(t[r0 + 3]), c);
+                for (int k = 1; k < d; ++k) {
+                    const double* tk = t + uint64_t(k) * n;
+                    c = load4(tk + j);
+                    if constexpr (kMin) {
+                        p0 += F::f(splat4(tk[r0]), c);
+                        p1 += F::f(splat4(tk[r0 + 1]), c);
+                        p2 += F::f(splat4(tk[r0 + 2]), c);
+                        p3 += F::f(splat4(tk[r0 + 3]), c);
+                    } else {
+                        p0 *= F::f(splat4(tk[r0]), c);
+                        p1 *= F::f(splat4(tk[r0 + 1]), c);
+                        p2 *= F::f(splat4(tk[r0 + 2]), c);
+                        p3 *= F::f(splat4(tk[r0 + 3]), c);
+                    }
+                }
+                if constexpr (kMin)
+                    acc = vmin(acc, vmin(vmin(p0, p1), vmin(p2, p3)));
+                else
+                    acc += (p0 + p1) + (p2 + p3);
             }
-            for (int l = lo; l < len; ++l) best[l] = p[l] < best[l] ? p[l] : best[l];
+            for (int l = 0; l < 4; ++l) take(acc[l]);
+            for (; j < j1; ++j)
+                for (int a = 0; a < kRows; ++a)
+                    take(pair_value<F, kMin>(t, n, d, r0 + uint64_t(a), j));
         }
     }
-    double m = best[0];
-    for (int l = 1; l < kTile; ++l) m = std::min(m, best[l]);
-    return m;
+    if constexpr (kMin) {
+        *lo_part = 0.0;
+        return best;
+    }
+    const DoubleDouble v = total.value();
+    *lo_part = v.lo;
+    return v.hi;
 }
 
 // One non-template entry per kernel, so that on x86-64 GCC compiles the inlined loops for AVX2
@@ -230,23 +288,23 @@ inline double min_chunk(const double* x, uint64_t n, int d, uint64_t i0, uint64_
 using ChunkFunction = double (*)(const double*, uint64_t, int, uint64_t, uint64_t, double*);
 MCP_VECTOR_CLONES double star_chunk(const double* t, uint64_t n, int d, uint64_t i0, uint64_t i1,
                                     double* lo) {
-    return product_chunk<StarFactor>(t, n, d, i0, i1, lo);
+    return pair_chunk<StarFactor, false>(t, n, d, i0, i1, lo);
 }
 MCP_VECTOR_CLONES double centered_chunk(const double* t, uint64_t n, int d, uint64_t i0,
                                         uint64_t i1, double* lo) {
-    return product_chunk<CenteredFactor>(t, n, d, i0, i1, lo);
+    return pair_chunk<CenteredFactor, false>(t, n, d, i0, i1, lo);
 }
 MCP_VECTOR_CLONES double wrap_chunk(const double* t, uint64_t n, int d, uint64_t i0, uint64_t i1,
                                     double* lo) {
-    return product_chunk<WrapFactor>(t, n, d, i0, i1, lo);
+    return pair_chunk<WrapFactor, false>(t, n, d, i0, i1, lo);
 }
 MCP_VECTOR_CLONES double plain_min_chunk(const double* t, uint64_t n, int d, uint64_t i0,
-                                         uint64_t i1, double*) {
-    return min_chunk<PlainSquare>(t, n, d, i0, i1);
+                                         uint64_t i1, double* lo) {
+    return pair_chunk<PlainSquare, true>(t, n, d, i0, i1, lo);
 }
 MCP_VECTOR_CLONES double torus_min_chunk(const double* t, uint64_t n, int d, uint64_t i0,
-                                         uint64_t i1, double*) {
-    return min_chunk<TorusSquare>(t, n, d, i0, i1);
+                                         uint64_t i1, double* lo) {
+    return pair_chunk<TorusSquare, true>(t, n, d, i0, i1, lo);
 }
 
 /// The chunk function over all chunks of rows, in parallel; the chunks' results in order.
@@ -436,9 +494,9 @@ void phases(double x, int k0, int count, double* re, double* im) {
 
 /// F row += sum over points of B_j A_j (four points a step: A rows a0..a3 re/im, 16-bit
 /// aligned stride), over the columns [0, columns).
-MCP_VECTOR_CLONES void accumulate_row(double* fr, double* fi, const double* are, const double* aim,
-                                      size_t stride, const double* br, const double* bi, int points,
-                                      int columns) {
+MCP_VECTOR_CLONES void accumulate_row(double* __restrict fr, double* __restrict fi,
+                                      const double* are, const double* aim, size_t stride,
+                                      const double* br, const double* bi, int points, int columns) {
     for (int j = 0; j < points; j += 4) {
         const double r0 = br[j], r1 = br[j + 1], r2 = br[j + 2], r3 = br[j + 3];
         const double i0 = bi[j], i1 = bi[j + 1], i2 = bi[j + 2], i3 = bi[j + 3];
