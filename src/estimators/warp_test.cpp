@@ -1,0 +1,753 @@
+// The chi-square test of a warp: see warp_test.h. Three passes: the samples are drawn,
+// warped and binned block by block; the pdf is integrated over every bin by a pair of tensor
+// rules of degree 5 (Gauss-Legendre of 3 nodes per axis and an inset Gauss-Lobatto of 4),
+// cells where the two disagree being split in 2^k halves, level by level, so that steps and
+// peaks inside a bin are resolved (every level's nodes run through the pdf in blocks); then
+// the counts are pooled and the statistic, its p-value and the verdict computed.
+#include "estimators/warp_test.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numeric>
+
+#include "core/points.h"
+#include "core/rng.h"
+#include "core/special.h"
+#include "core/stats.h" // NeumaierSum
+#include "core/trig.h"  // sincos_turns
+
+namespace mcp {
+namespace {
+
+/// A cell's quadrature is refined when its two rules differ by more than this share of the
+/// Poisson standard deviation sqrt(expected) of its bin's count...
+constexpr double kCountAccuracy = 0.02;
+/// ... and by more than a threshold in probability scaled by this share of pdf_tolerance (see
+/// integrate_bins), so that the summed error estimate stays under the tolerance.
+constexpr double kIntegralAccuracy = 0.01;
+/// Most cells in one level of the refinement (bounds its memory).
+constexpr size_t kMaxCellsPerLevel = size_t(1) << 18;
+/// Pooling threshold on the expected count of a cell [Mitsuba3].
+constexpr double kMinExpected = 5.0;
+
+std::string fmt(double v, int digits = 4) {
+    if (std::isnan(v)) return "nan"; // printf may write "-nan"
+    char buf[40];
+    std::snprintf(buf, sizeof buf, "%.*g", digits, v);
+    return buf;
+}
+
+std::string tuple(const double* v, int n) {
+    std::string s = "(";
+    for (int j = 0; j < n; ++j) s += (j ? ", " : "") + fmt(v[j], 10);
+    return s + ")";
+}
+
+/// atan(a) for a in [0, 1] to 1.4e-8 [AS64, 4.4.49]: a first guess of the azimuth's bin, which
+/// Natural::azimuth_bin then corrects exactly.
+double atan_unit(double a) {
+    static const double c[9] = {0.0028662257,  -0.0161657367, 0.0429096138,
+                                -0.0752896400, 0.1065626393,  -0.1420889944,
+                                0.1999355085,  -0.3333314528, 1.0};
+    const double s = a * a;
+    double p = c[0];
+    for (int i = 1; i < 9; ++i) p = p * s + c[i];
+    return a * p;
+}
+
+/// phi / 2 pi in [0, 1] of the direction (x, y), to ~2e-9; y < 0 gives phi in [pi, 2 pi].
+double approx_turns(double x, double y) {
+    const double ax = std::fabs(x), ay = std::fabs(y);
+    const double big = ax > ay ? ax : ay, small = ax > ay ? ay : ax;
+    double r = big > 0.0 ? atan_unit(small / big) : 0.0;
+    r = ay > ax ? 0.5 * kPi - r : r;
+    r = x < 0.0 ? kPi - r : r;
+    const double t = r * (0.5 / kPi);
+    return y < 0.0 ? 1.0 - t : t;
+}
+
+/// The domain's natural coordinates (warp_test.h): forward (t -> x) for the quadrature's
+/// nodes, backward (x -> t, with the membership test) for the samples.
+class Natural {
+  public:
+    /// bins: per axis, for bin_block (may be null for forward alone).
+    explicit Natural(const Domain& d, const int* bins = nullptr) : d_(d) {
+        axes_ = d.kind == DomainKind::Box ? static_cast<int>(d.lo.size()) : 2;
+        if (bins && d.kind != DomainKind::Box && d.kind != DomainKind::Triangle) {
+            // The azimuth's bin edges as unit vectors, e_j at phi = 2 pi j / bins.
+            const int nb = bins[1];
+            edges_.resize(size_t(nb) + 1);
+            for (int j = 0; j <= nb; ++j) {
+                const SinCos e = sincos_turns(static_cast<double>(j) / nb);
+                edges_[size_t(j)] = Vec2{e.cos, e.sin};
+            }
+        }
+        if (d.kind == DomainKind::Triangle) {
+            e0_ = d.v0 - d.v2;
+            e1_ = d.v1 - d.v2;
+            inv_det_ = 1.0 / (e0_.x * e1_.y - e1_.x * e0_.y);
+        }
+    }
+    int axes() const { return axes_; }
+
+    std::vector<std::string> names() const {
+        switch (d_.kind) {
+        case DomainKind::Box: {
+            static const char* const kNames[3] = {"(x - lo) / (hi - lo)", "(y - lo) / (hi - lo)",
+                                                  "(z - lo) / (hi - lo)"};
+            return std::vector<std::string>(kNames, kNames + axes_);
+        }
+        case DomainKind::Disk: return {"|x - c|^2 / R^2", "phi / 2 pi"};
+        case DomainKind::Triangle: return {"(1 - b0)^2", "b1 / (1 - b0)"};
+        case DomainKind::Sphere: return {"(1 - z) / 2", "phi / 2 pi"};
+        case DomainKind::Hemisphere: return {"1 - z", "phi / 2 pi"};
+        }
+        return {};
+    }
+
+    /// x (point_dim coordinates) of t.
+    void forward(const double* t, double* x) const {
+        switch (d_.kind) {
+        case DomainKind::Box:
+            for (int j = 0; j < axes_; ++j)
+                x[j] = d_.lo[size_t(j)] + (d_.hi[size_t(j)] - d_.lo[size_t(j)]) * t[j];
+            return;
+        case DomainKind::Disk: {
+            const double r = d_.radius * std::sqrt(t[0]), phi = 2.0 * kPi * t[1];
+            x[0] = d_.center.x + r * std::cos(phi);
+            x[1] = d_.center.y + r * std::sin(phi);
+            return;
+        }
+        case DomainKind::Triangle: {
+            const double s = std::sqrt(t[0]);
+            const double b0 = 1.0 - s, b1 = t[1] * s;
+            const Vec2 q = b0 * d_.v0 + b1 * d_.v1 + (1.0 - b0 - b1) * d_.v2;
+            x[0] = q.x;
+            x[1] = q.y;
+            return;
+        }
+        case DomainKind::Sphere:
+        case DomainKind::Hemisphere: {
+            const bool sphere = d_.kind == DomainKind::Sphere;
+            const double z = sphere ? 1.0 - 2.0 * t[0] : 1.0 - t[0];
+            const double r =
+                sphere ? 2.0 * std::sqrt(t[0] * (1.0 - t[0])) : std::sqrt(t[0] * (2.0 - t[0]));
+            const double phi = 2.0 * kPi * t[1];
+            x[0] = r * std::cos(phi);
+            x[1] = r * std::sin(phi);
+            x[2] = z;
+            return;
+        }
+        }
+    }
+
+    /// Writes the flat bin of each of the n points of x; returns the index of the first point
+    /// outside the domain (beyond kWarpDomainTolerance), or n.
+    size_t bin_block(const PointBlock& x, size_t n, const int* bins, uint32_t* out) const {
+        constexpr double tol = kWarpDomainTolerance;
+        auto flat = [&](double t0, double t1, double t2) {
+            const double t[3] = {t0, t1, t2};
+            uint32_t index = 0, stride = 1;
+            for (int j = 0; j < axes_; ++j) {
+                int k = static_cast<int>(t[j] * bins[j]);
+                k = k < 0 ? 0 : (k >= bins[j] ? bins[j] - 1 : k);
+                index += stride * static_cast<uint32_t>(k);
+                stride *= static_cast<uint32_t>(bins[j]);
+            }
+            return index;
+        };
+        // A radial coordinate t0 and the azimuth's bin.
+        auto flat_azimuth = [&](double t0, double px, double py) {
+            int k = static_cast<int>(t0 * bins[0]);
+            k = k < 0 ? 0 : (k >= bins[0] ? bins[0] - 1 : k);
+            return static_cast<uint32_t>(k) +
+                   static_cast<uint32_t>(bins[0]) *
+                       static_cast<uint32_t>(azimuth_bin(px, py, bins[1]));
+        };
+        switch (d_.kind) {
+        case DomainKind::Box: {
+            double lo[3] = {0, 0, 0}, w[3] = {1, 1, 1};
+            for (int j = 0; j < axes_; ++j) {
+                lo[j] = d_.lo[size_t(j)];
+                w[j] = d_.hi[size_t(j)] - d_.lo[size_t(j)];
+            }
+            for (size_t i = 0; i < n; ++i) {
+                double t[3] = {0, 0, 0};
+                for (int j = 0; j < axes_; ++j) {
+                    t[j] = (x.coord(j)[i] - lo[j]) / w[j];
+                    if (!(t[j] >= -tol && t[j] <= 1.0 + tol)) return i;
+                }
+                out[i] = flat(t[0], t[1], t[2]);
+            }
+            return n;
+        }
+        case DomainKind::Disk: {
+            const double inv_r2 = 1.0 / (d_.radius * d_.radius), limit = (1 + tol) * (1 + tol);
+            for (size_t i = 0; i < n; ++i) {
+                const double dx = x.coord(0)[i] - d_.center.x, dy = x.coord(1)[i] - d_.center.y;
+                const double r2 = (dx * dx + dy * dy) * inv_r2;
+                if (!(r2 <= limit)) return i;
+                out[i] = flat_azimuth(r2, dx, dy);
+            }
+            return n;
+        }
+        case DomainKind::Triangle:
+            for (size_t i = 0; i < n; ++i) {
+                const double px = x.coord(0)[i] - d_.v2.x, py = x.coord(1)[i] - d_.v2.y;
+                const double b0 = (px * e1_.y - e1_.x * py) * inv_det_;
+                const double b1 = (e0_.x * py - px * e0_.y) * inv_det_;
+                if (!(b0 >= -tol && b1 >= -tol && 1.0 - b0 - b1 >= -tol)) return i;
+                const double s = 1.0 - b0;
+                out[i] = flat(s * s, s > 0.0 ? b1 / s : 0.0, 0.0);
+            }
+            return n;
+        case DomainKind::Sphere:
+        case DomainKind::Hemisphere: {
+            const bool sphere = d_.kind == DomainKind::Sphere;
+            for (size_t i = 0; i < n; ++i) {
+                const double a = x.coord(0)[i], b = x.coord(1)[i], z = x.coord(2)[i];
+                const double r2 = a * a + b * b + z * z;
+                if (!(std::fabs(r2 - 1.0) <= 2.0 * tol) || !(sphere || z >= -tol)) return i;
+                out[i] = flat_azimuth(sphere ? 0.5 * (1.0 - z) : 1.0 - z, a, b);
+            }
+            return n;
+        }
+        }
+        return 0;
+    }
+
+  private:
+    /// The bin of phi / 2 pi of (x, y) among nb: approx_turns' guess, moved to the bin whose
+    /// edges e_k, e_k+1 have v at or past e_k (e_k x v >= 0) and before e_k+1, the cross
+    /// products' signs being exact up to rounding and valid within half a turn of the edge.
+    int azimuth_bin(double x, double y, int nb) const {
+        int k = static_cast<int>(approx_turns(x, y) * nb);
+        k = k < 0 ? 0 : (k >= nb ? nb - 1 : k);
+        auto past = [&](int j) {
+            const Vec2& e = edges_[size_t(j)];
+            return e.x * y - e.y * x >= 0.0;
+        };
+        while (k > 0 && !past(k)) --k;
+        while (k + 1 < nb && past(k + 1)) ++k;
+        return k;
+    }
+
+    const Domain& d_;
+    std::vector<Vec2> edges_;
+    int axes_ = 1;
+    Vec2 e0_{0.0}, e1_{0.0};
+    double inv_det_ = 0.0;
+};
+
+/// One node of the pair of rules on [0, 1]^k: its position and its weight in each rule.
+struct Node {
+    double at[3];
+    double w3, w4; ///< in the Gauss-Legendre rule (3 nodes per axis), in the Lobatto one (4)
+};
+
+/// How far the end nodes of the second rule sit inside the cell (a share of its width): off
+/// the domain's boundary, where a pdf may be singular or a direction ambiguous.
+constexpr double kEndInset = 1e-3;
+
+/// Tensor rules of 3 and 4 points per axis on [0, 1]^k, one after the other: Gauss-Legendre
+/// (the value), and Gauss-Lobatto with its end nodes moved in by kEndInset and its interior
+/// nodes and weights solved again for degree 5 (the check). A step inside a cell changes the
+/// two rules' sums by different amounts wherever it lies (their cumulative weights, 0.28,
+/// 0.72 at 0.11, 0.5, 0.89 and 0.084, 0.5, 0.92 at 0.001, 0.28, 0.72, 0.999, never coincide
+/// between the inset end nodes), so it is always detected; two Gauss rules would both miss a
+/// step near an edge of the cell, and two symmetric rules of even order one in its middle.
+std::vector<Node> rule_pair(int k) {
+    const double g3x[3] = {0.5 - 0.5 * std::sqrt(0.6), 0.5, 0.5 + 0.5 * std::sqrt(0.6)};
+    const double g3w[3] = {5.0 / 18.0, 8.0 / 18.0, 5.0 / 18.0};
+    // Symmetric nodes 1/2 -+ sqrt(e), 1/2 -+ sqrt(m) with weights we, wm: exact for 1, t^2
+    // and t^4 about 1/2 (the odd powers by symmetry) when we + wm = 1/2, we e + wm m = 1/24,
+    // we e^2 + wm m^2 = 1/160; e is fixed by the inset, which gives m and the weights
+    // (kEndInset = 0: Gauss-Lobatto, m = 1/20, we = 1/12).
+    const double e = (0.5 - kEndInset) * (0.5 - kEndInset);
+    const double m = (1.0 / 160.0 - e / 24.0) / (1.0 / 24.0 - e / 2.0);
+    const double we = (1.0 / 24.0 - m / 2.0) / (e - m), wm = 0.5 - we;
+    const double l4x[4] = {kEndInset, 0.5 - std::sqrt(m), 0.5 + std::sqrt(m), 1.0 - kEndInset};
+    const double l4w[4] = {we, wm, wm, we};
+    std::vector<Node> nodes;
+    for (int rule = 0; rule < 2; ++rule) {
+        const int count_1d = rule == 0 ? 3 : 4;
+        const double* xs = rule == 0 ? g3x : l4x;
+        const double* ws = rule == 0 ? g3w : l4w;
+        int count = 1;
+        for (int j = 0; j < k; ++j) count *= count_1d;
+        for (int c = 0; c < count; ++c) {
+            Node nd{{0.5, 0.5, 0.5}, 0.0, 0.0};
+            double w = 1.0;
+            for (int j = 0, r = c; j < k; ++j, r /= count_1d) {
+                nd.at[j] = xs[r % count_1d];
+                w *= ws[r % count_1d];
+            }
+            (rule == 0 ? nd.w3 : nd.w4) = w;
+            nodes.push_back(nd);
+        }
+    }
+    return nodes;
+}
+
+/// A cell of the quadrature: a box of [0, 1)^k inside one bin, of width 2^-level of the bin's.
+struct Cell {
+    double lo[3];
+    uint32_t bin;
+    uint16_t level;
+    bool force; ///< samples fell in its bin: refined while the pdf reads 0 at all its nodes
+};
+
+struct Quadrature {
+    std::vector<double> expected; ///< per bin, N times the integral
+    double integral = 0.0, error = 0.0;
+    uint64_t evaluations = 0;
+    std::string error_message;
+};
+
+/// The expected counts of the bins `which` (flat indices), by the adaptive rule pair (see the
+/// top of the file); `force`: their cells are split while the pdf reads 0 at all their nodes
+/// (for bins where samples fell).
+Quadrature integrate_bins(const Domain& domain, const Warp& warp, const Natural& natural,
+                          const int* bins, size_t nbins, const std::vector<uint32_t>& which,
+                          bool force, double n_samples, double tolerance) {
+    const int k = natural.axes();
+    const int point_dim = domain.point_dim();
+    const std::vector<Node> nodes = rule_pair(k);
+    const size_t per_cell = nodes.size();
+    const int max_level = k == 1 ? 30 : (k == 2 ? 10 : 6);
+    const int max_forced_level = k == 1 ? 12 : (k == 2 ? 6 : 4);
+    const double measure = domain.measure();
+    double bin_width[3] = {1.0, 1.0, 1.0};
+    for (int j = 0; j < k; ++j) bin_width[j] = 1.0 / bins[j];
+    // The threshold in probability of a cell that is a share f of the domain: tol' f^((k-1)/k)
+    // with tol' = kIntegralAccuracy tol. A step across a square or cube crosses about
+    // f^((1-k)/k) cells of share f, so the cells along it accept errors that sum to about tol'
+    // per unit of its length or area, at every level; in 1D the few cells of a step cost
+    // little, and theirs is tol' / 1e6.
+    auto mass_threshold = [&](int level) {
+        const double share = std::ldexp(1.0 / static_cast<double>(nbins), -k * level);
+        const double t = kIntegralAccuracy * tolerance;
+        return k == 1 ? t * 1e-6 : t * std::pow(share, (k - 1.0) / k);
+    };
+
+    Quadrature q;
+    q.expected.assign(nbins, 0.0);
+    std::vector<double> bin_estimate(nbins, 0.0);
+    std::vector<Cell> cells(which.size());
+    for (size_t c = 0; c < which.size(); ++c) {
+        Cell& cell = cells[c];
+        size_t r = which[c];
+        for (int j = 0; j < 3; ++j) {
+            cell.lo[j] = 0.0;
+            if (j < k) {
+                cell.lo[j] = static_cast<double>(r % size_t(bins[j])) * bin_width[j];
+                r /= size_t(bins[j]);
+            }
+        }
+        cell.bin = which[c];
+        cell.level = 0;
+        cell.force = force;
+    }
+
+    PointBlock x;
+    x.reset(point_dim, kBlockSize);
+    double pdf[kBlockSize], w3[kBlockSize], w4[kBlockSize];
+    uint32_t owner[kBlockSize];
+    std::vector<double> q3, q4;
+    NeumaierSum integral, error;
+    while (!cells.empty()) {
+        // The cells' two rules, their nodes through the pdf a block at a time.
+        q3.assign(cells.size(), 0.0);
+        q4.assign(cells.size(), 0.0);
+        size_t fill = 0;
+        auto flush = [&]() -> bool {
+            x.n = fill;
+            warp.pdf(x, pdf);
+            q.evaluations += fill;
+            for (size_t i = 0; i < fill; ++i) {
+                if (!(pdf[i] >= 0.0) || !std::isfinite(pdf[i])) {
+                    double at[3];
+                    for (int j = 0; j < point_dim; ++j) at[j] = x.coord(j)[i];
+                    q.error_message = "the pdf is " + fmt(pdf[i], 10) +
+                                      " at x = " + tuple(at, point_dim) + " (in " +
+                                      domain.describe() + "): a density must be finite and >= 0";
+                    return false;
+                }
+                q3[owner[i]] += w3[i] * pdf[i];
+                q4[owner[i]] += w4[i] * pdf[i];
+            }
+            fill = 0;
+            return true;
+        };
+        for (size_t c = 0; c < cells.size(); ++c) {
+            const Cell& cell = cells[c];
+            double width[3] = {1.0, 1.0, 1.0};
+            for (int j = 0; j < k; ++j) width[j] = std::ldexp(bin_width[j], -cell.level);
+            for (const Node& nd : nodes) {
+                double t[3] = {0.5, 0.5, 0.5}, at[3];
+                for (int j = 0; j < k; ++j) t[j] = cell.lo[j] + width[j] * nd.at[j];
+                natural.forward(t, at);
+                for (int j = 0; j < point_dim; ++j) x.coord(j)[fill] = at[j];
+                w3[fill] = nd.w3;
+                w4[fill] = nd.w4;
+                owner[fill] = static_cast<uint32_t>(c);
+                if (++fill == kBlockSize && !flush()) return q;
+            }
+        }
+        if (fill > 0 && !flush()) return q;
+
+        // Accept the cells whose rules agree, or that may not be split further.
+        struct Candidate {
+            size_t cell;
+            double err;
+        };
+        std::vector<Candidate> split;
+        auto accept = [&](const Cell& cell, double mass, double err) {
+            q.expected[cell.bin] += n_samples * mass;
+            integral.add(mass);
+            error.add(err);
+        };
+        for (size_t c = 0; c < cells.size(); ++c) {
+            const Cell& cell = cells[c];
+            double volume = measure;
+            for (int j = 0; j < k; ++j) volume *= std::ldexp(bin_width[j], -cell.level);
+            const double m3 = volume * q3[c], m4 = volume * q4[c];
+            const double err = std::fabs(m4 - m3);
+            if (cell.level == 0) bin_estimate[cell.bin] = n_samples * m3;
+            const double count_threshold =
+                kCountAccuracy * std::sqrt(std::max(bin_estimate[cell.bin], 1.0)) / n_samples;
+            const bool zero = cell.force && m3 == 0.0 && m4 == 0.0;
+            const bool refine = (err > std::min(count_threshold, mass_threshold(cell.level)) &&
+                                 cell.level < max_level) ||
+                                (zero && cell.level < max_forced_level);
+            if (refine)
+                split.push_back({c, err});
+            else
+                accept(cell, m3, err);
+        }
+        // Within the budget (pdf evaluations and cells per level), the largest errors first;
+        // the rest are accepted as they are.
+        const size_t children = size_t(1) << k;
+        const uint64_t left = kMaxWarpTestPdfEvaluations > q.evaluations
+                                  ? kMaxWarpTestPdfEvaluations - q.evaluations
+                                  : 0;
+        const size_t affordable = std::min(static_cast<size_t>(left / (children * per_cell)),
+                                           kMaxCellsPerLevel / children);
+        if (split.size() > affordable) {
+            std::stable_sort(split.begin(), split.end(),
+                             [](const Candidate& a, const Candidate& b) { return a.err > b.err; });
+            for (size_t s = affordable; s < split.size(); ++s) {
+                const size_t c = split[s].cell;
+                double volume = measure;
+                for (int j = 0; j < k; ++j) volume *= std::ldexp(bin_width[j], -cells[c].level);
+                accept(cells[c], volume * q3[c], split[s].err);
+            }
+            split.resize(affordable);
+        }
+        std::vector<Cell> next;
+        next.reserve(split.size() * children);
+        for (const Candidate& s : split) {
+            const Cell& parent = cells[s.cell];
+            for (size_t child = 0; child < children; ++child) {
+                Cell c = parent;
+                c.level = static_cast<uint16_t>(parent.level + 1);
+                for (int j = 0; j < k; ++j)
+                    if (child >> j & 1u) c.lo[j] += std::ldexp(bin_width[j], -c.level);
+                next.push_back(c);
+            }
+        }
+        cells.swap(next);
+    }
+    q.integral = integral.value();
+    q.error = error.value();
+    return q;
+}
+
+std::string bin_text(const WarpTestResult& r, const WarpTestBin& b) {
+    std::string s = "bin (";
+    for (int j = 0; j < r.axes; ++j) s += (j ? ", " : "") + std::to_string(b.index[j]);
+    s += "):";
+    for (int j = 0; j < r.axes; ++j)
+        s += (j ? "," : "") + std::string(" ") + r.axis_names[size_t(j)] + " in [" + fmt(b.lo[j]) +
+             ", " + fmt(b.hi[j]) + ")";
+    return s;
+}
+
+WarpTestBin describe_bin(const WarpTestResult& r, size_t flat) {
+    WarpTestBin b;
+    size_t rest = flat;
+    for (int j = 0; j < r.axes; ++j) {
+        b.index[j] = static_cast<int>(rest % size_t(r.bins[j]));
+        rest /= size_t(r.bins[j]);
+        b.lo[j] = static_cast<double>(b.index[j]) / r.bins[j];
+        b.hi[j] = static_cast<double>(b.index[j] + 1) / r.bins[j];
+    }
+    b.observed = r.observed[flat];
+    b.expected = r.expected[flat];
+    const double diff = static_cast<double>(b.observed) - b.expected;
+    b.residual =
+        b.expected > 0.0 ? diff / std::sqrt(b.expected) : (b.observed > 0 ? HUGE_VAL : 0.0);
+    return b;
+}
+
+std::string check_options(const WarpTestOptions& o, int axes) {
+    if (o.samples < 1 || o.samples > kMaxWarpTestSamples)
+        return "warp test: samples must be in 1.." + std::to_string(kMaxWarpTestSamples) +
+               ", got " + std::to_string(o.samples);
+    uint64_t total = 1;
+    for (int j = 0; j < axes; ++j) {
+        if (o.bins[j] < 0 || o.bins[j] > kMaxWarpTestBinsPerAxis)
+            return "warp test: bins[" + std::to_string(j) + "] must be in 0.." +
+                   std::to_string(kMaxWarpTestBinsPerAxis) + " (0: the default), got " +
+                   std::to_string(o.bins[j]);
+        total *= static_cast<uint64_t>(std::max(o.bins[j], 1));
+    }
+    if (total > static_cast<uint64_t>(kMaxWarpTestBins))
+        return "warp test: at most " + std::to_string(kMaxWarpTestBins) + " bins in all, got " +
+               std::to_string(total);
+    if (!(o.significance > 0.0 && o.significance < 1.0))
+        return "warp test: significance must be in (0, 1), got " + fmt(o.significance, 10);
+    if (o.tests < 1 || o.tests > 1000000)
+        return "warp test: tests must be in 1..1000000, got " + std::to_string(o.tests);
+    if (o.worst < 0 || o.worst > 1000)
+        return "warp test: worst must be in 0..1000, got " + std::to_string(o.worst);
+    if (!(o.pdf_tolerance > 0.0 && o.pdf_tolerance < 1.0))
+        return "warp test: pdf_tolerance must be in (0, 1), got " + fmt(o.pdf_tolerance, 10);
+    return "";
+}
+
+} // namespace
+
+double sidak_level(double alpha, int tests) {
+    return -std::expm1(std::log1p(-alpha) / static_cast<double>(tests));
+}
+
+void pooled_chi_square(const std::vector<uint64_t>& observed, const std::vector<double>& expected,
+                       double* chi_square, int* cells, int* pooled_bins) {
+    std::vector<size_t> order(expected.size());
+    std::iota(order.begin(), order.end(), size_t(0));
+    std::stable_sort(order.begin(), order.end(),
+                     [&](size_t a, size_t b) { return expected[a] < expected[b]; });
+    double chi = 0.0, pool_e = 0.0, pool_o = 0.0;
+    double last_e = 0.0, last_o = 0.0; // the last cell emitted, for a leftover pool
+    int count = 0, pooled = 0;
+    bool pool_open = false;
+    auto term = [](double o, double e) { return (o - e) * (o - e) / e; };
+    for (size_t i : order) {
+        const double e = expected[i], o = static_cast<double>(observed[i]);
+        if (!(e > 0.0)) continue;
+        if (e < kMinExpected || pool_open) {
+            pool_e += e;
+            pool_o += o;
+            ++pooled;
+            pool_open = true;
+            if (pool_e >= kMinExpected) {
+                chi += term(pool_o, pool_e);
+                last_e = pool_e;
+                last_o = pool_o;
+                ++count;
+                pool_e = pool_o = 0.0;
+                pool_open = false;
+            }
+            continue;
+        }
+        chi += term(o, e);
+        last_e = e;
+        last_o = o;
+        ++count;
+    }
+    if (pool_open) {
+        if (count > 0) { // the leftover joins the last cell: replace its term
+            chi -= term(last_o, last_e);
+            chi += term(last_o + pool_o, last_e + pool_e);
+        } else {
+            chi += term(pool_o, pool_e);
+            ++count;
+        }
+    }
+    *chi_square = chi;
+    *cells = count;
+    *pooled_bins = pooled;
+}
+
+namespace {
+
+/// Checks the domain, the warp and the options, and resolves the bins per axis (1 for unused
+/// axes). Returns an error or "".
+std::string set_up(const Domain& domain, const Warp& warp, const WarpTestOptions& options,
+                   int* bins) {
+    const int point_dim = domain.point_dim();
+    if (point_dim < 1 || point_dim > kMaxWarpDim)
+        return "warp test: the domain has " + std::to_string(point_dim) + " coordinates; at most " +
+               std::to_string(kMaxWarpDim);
+    if (!warp.map || !warp.pdf) return "warp test: warp '" + warp.name + "' has no map or no pdf";
+    if (warp.sample_dim != domain.sample_dim())
+        return "warp test: warp '" + warp.name + "' reads " + std::to_string(warp.sample_dim) +
+               " unit-cube coordinates, the domain " + domain.describe() + " is sampled from " +
+               std::to_string(domain.sample_dim());
+    const int axes = Natural(domain).axes();
+    if (std::string e = check_options(options, axes); !e.empty()) return e;
+    const int cap = axes == 1 ? 1024 : (axes == 2 ? 64 : 16);
+    const int by_samples = static_cast<int>(
+        std::floor(std::pow(static_cast<double>(options.samples) / 256.0, 1.0 / axes) + 1e-9));
+    for (int j = 0; j < 3; ++j)
+        bins[j] = j >= axes ? 1
+                            : (options.bins[j] > 0 ? options.bins[j]
+                                                   : std::min(std::max(by_samples, 2), cap));
+    return "";
+}
+
+} // namespace
+
+Made<WarpTestExpectation> expect_warp_counts(const Domain& domain, const Warp& warp,
+                                             const WarpTestOptions& options) {
+    WarpTestExpectation e;
+    if (std::string error = set_up(domain, warp, options, e.bins); !error.empty())
+        return made_error<WarpTestExpectation>(error);
+    e.samples = options.samples;
+    const size_t nbins = static_cast<size_t>(e.bins[0]) * e.bins[1] * e.bins[2];
+    std::vector<uint32_t> all(nbins);
+    std::iota(all.begin(), all.end(), uint32_t(0));
+    Quadrature q = integrate_bins(domain, warp, Natural(domain), e.bins, nbins, all, false,
+                                  static_cast<double>(options.samples), options.pdf_tolerance);
+    if (!q.error_message.empty()) return made_error<WarpTestExpectation>(q.error_message);
+    e.expected = std::move(q.expected);
+    e.pdf_integral = q.integral;
+    e.pdf_integral_error = q.error;
+    e.pdf_evaluations = q.evaluations;
+    return {std::move(e), {}};
+}
+
+Made<WarpTestResult> run_warp_test(const Domain& domain, const Warp& warp,
+                                   const WarpTestOptions& options) {
+    Made<WarpTestExpectation> e = expect_warp_counts(domain, warp, options);
+    if (!e.ok()) return made_error<WarpTestResult>(e.error);
+    return run_warp_test(domain, warp, options, e.value);
+}
+
+Made<WarpTestResult> run_warp_test(const Domain& domain, const Warp& warp,
+                                   const WarpTestOptions& options,
+                                   const WarpTestExpectation& expectation) {
+    WarpTestResult r;
+    if (std::string e = set_up(domain, warp, options, r.bins); !e.empty())
+        return made_error<WarpTestResult>(e);
+    if (expectation.samples != options.samples || !std::equal(r.bins, r.bins + 3, expectation.bins))
+        return made_error<WarpTestResult>(
+            "warp test: the expected counts were computed for other samples or bins");
+    const Natural natural(domain, r.bins);
+    const int point_dim = domain.point_dim();
+    r.axes = natural.axes();
+    r.axis_names = natural.names();
+    r.samples = options.samples;
+    const double n_samples = static_cast<double>(options.samples);
+    const size_t nbins = static_cast<size_t>(r.bins[0]) * r.bins[1] * r.bins[2];
+
+    // Samples: PCG32 in the order sample by sample, coordinate by coordinate.
+    r.observed.assign(nbins, 0);
+    {
+        Pcg32 rng(options.seed, kWarpTestStream);
+        const int sd = warp.sample_dim;
+        PointBlock u, x;
+        u.reset(sd, kBlockSize);
+        x.reset(point_dim, kBlockSize);
+        uint32_t bin[kBlockSize];
+        for (uint64_t start = 0; start < options.samples; start += kBlockSize) {
+            const size_t n =
+                static_cast<size_t>(std::min<uint64_t>(kBlockSize, options.samples - start));
+            for (size_t i = 0; i < n; ++i)
+                for (int j = 0; j < sd; ++j) u.coord(j)[i] = rng.next_double();
+            u.n = n;
+            x.n = n;
+            warp.map(u, x);
+            x.n = n;
+            const size_t bad = natural.bin_block(x, n, r.bins, bin);
+            if (bad < n) {
+                double uu[kMaxWarpDim], xx[kMaxWarpDim];
+                for (int j = 0; j < sd; ++j) uu[j] = u.coord(j)[bad];
+                for (int j = 0; j < point_dim; ++j) xx[j] = x.coord(j)[bad];
+                return made_error<WarpTestResult>("sample " + std::to_string(start + bad) +
+                                                  " (u = " + tuple(uu, sd) +
+                                                  ") maps to x = " + tuple(xx, point_dim) +
+                                                  ", outside the domain " + domain.describe());
+            }
+            for (size_t i = 0; i < n; ++i) ++r.observed[bin[i]];
+        }
+    }
+
+    // Expected counts; bins with samples where the pdf read 0 at every node are searched
+    // again, finer, for a part of the pdf's support the nodes missed.
+    r.expected = expectation.expected;
+    r.pdf_integral = expectation.pdf_integral;
+    r.pdf_integral_error = expectation.pdf_integral_error;
+    r.pdf_evaluations = expectation.pdf_evaluations;
+    std::vector<uint32_t> hit_zero;
+    for (size_t b = 0; b < nbins; ++b)
+        if (r.expected[b] == 0.0 && r.observed[b] > 0) hit_zero.push_back(uint32_t(b));
+    if (!hit_zero.empty()) {
+        Quadrature q = integrate_bins(domain, warp, natural, r.bins, nbins, hit_zero, true,
+                                      n_samples, options.pdf_tolerance);
+        if (!q.error_message.empty()) return made_error<WarpTestResult>(q.error_message);
+        for (uint32_t b : hit_zero) r.expected[b] = q.expected[b];
+        r.pdf_integral += q.integral;
+        r.pdf_integral_error += q.error;
+        r.pdf_evaluations += q.evaluations;
+    }
+    r.pdf_integral_ok = std::fabs(r.pdf_integral - 1.0) <= options.pdf_tolerance;
+
+    // The statistic and the verdict.
+    pooled_chi_square(r.observed, r.expected, &r.chi_square, &r.cells, &r.pooled_bins);
+    r.dof = r.cells - 1;
+    r.p_value = r.dof >= 1 ? chi_square_sf(r.chi_square, r.dof) : 1.0;
+    r.level = sidak_level(options.significance, options.tests);
+    size_t first_zero = nbins;
+    uint64_t zero_samples = 0;
+    for (size_t b = 0; b < nbins; ++b)
+        if (r.expected[b] == 0.0 && r.observed[b] > 0) {
+            ++r.zero_bins_hit;
+            zero_samples += r.observed[b];
+            if (first_zero == nbins) first_zero = b;
+        }
+
+    std::vector<size_t> order(nbins);
+    std::iota(order.begin(), order.end(), size_t(0));
+    std::vector<double> key(nbins);
+    for (size_t b = 0; b < nbins; ++b) key[b] = std::fabs(describe_bin(r, b).residual);
+    const size_t shown = std::min(nbins, static_cast<size_t>(options.worst));
+    std::partial_sort(
+        order.begin(), order.begin() + static_cast<std::ptrdiff_t>(shown), order.end(),
+        [&](size_t a, size_t b) { return key[a] > key[b] || (key[a] == key[b] && a < b); });
+    for (size_t s = 0; s < shown; ++s) r.worst.push_back(describe_bin(r, order[s]));
+
+    const std::string stat = "chi-square " + fmt(r.chi_square, 6) + " on " + std::to_string(r.dof) +
+                             " degrees of freedom, p-value " + fmt(r.p_value, 3);
+    const std::string integral = "the pdf integrates to " + fmt(r.pdf_integral, 7) + " (+- " +
+                                 fmt(r.pdf_integral_error, 2) + ")";
+    if (r.zero_bins_hit > 0) {
+        const WarpTestBin b = describe_bin(r, first_zero);
+        r.reason = "rejected: " + std::to_string(zero_samples) + " samples fell in " +
+                   std::to_string(r.zero_bins_hit) +
+                   " bins where the pdf is 0 (its integral is exactly 0), the first " +
+                   bin_text(r, b) + ": the warp lands where its pdf says it cannot";
+    } else if (!r.pdf_integral_ok) {
+        r.reason = "rejected: " + integral + " over the domain, not 1 (tolerance " +
+                   fmt(options.pdf_tolerance, 3) + "); " + stat;
+    } else if (r.dof < 1) {
+        r.reason = "not tested: " + std::to_string(r.cells) +
+                   " cell(s) after pooling bins of expected count under 5; take more samples "
+                   "or fewer bins";
+    } else if (!(r.p_value >= r.level)) {
+        r.reason =
+            "rejected: the samples do not follow the pdf: " + stat + " < level " + fmt(r.level, 3);
+        if (!r.worst.empty())
+            r.reason += "; the most deviant " + bin_text(r, r.worst[0]) + " has " +
+                        std::to_string(r.worst[0].observed) + " samples where " +
+                        fmt(r.worst[0].expected, 6) + " are expected";
+    } else {
+        r.passed = true;
+        r.reason = "passed: " + stat + " >= level " + fmt(r.level, 3) + "; " + integral;
+    }
+    return {std::move(r), {}};
+}
+
+} // namespace mcp
