@@ -1,7 +1,7 @@
 // The chi-square warp test (estimators/warp_test.h) and the named and expression warps
 // (estimators/named_warps.h): every named warp passes on many seeds as often as its level
 // says; wrong warps and wrong pdfs are rejected, with the reason; the errors name the sample
-// or the point; pooling and Sidak's level on hand cases.
+// or the point; pooling and Sidak's level on hand cases; a warp as an importance proposal.
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -12,9 +12,12 @@
 
 #include "core/rng.h"
 #include "core/special.h"
+#include "estimators/block_driver.h" // Workspace
+#include "estimators/estimator.h"
 #include "estimators/named_warps.h"
 #include "estimators/problem.h"
 #include "estimators/warp_test.h"
+#include "integrands/integrand.h"
 
 using namespace mcp;
 
@@ -503,4 +506,82 @@ TEST(WarpTest, MillionSamplesTiming) {
                     name, r.bins[0], r.bins[1], static_cast<unsigned long long>(r.pdf_evaluations),
                     s);
     }
+}
+
+// ---------------------------------------------------------------------------
+// A warp as an importance proposal.
+
+TEST(WarpProposal, SamplesAndDensitiesAreTheWarps) {
+    const NamedWarp w = named("ggx_visible_normals");
+    auto shared = std::make_shared<const Warp>(w.warp);
+    const Proposal p = warp_proposal(shared, w.domain);
+    EXPECT_EQ(p.kind, ProposalKind::Warp);
+    EXPECT_TRUE(p.importance);
+    EXPECT_EQ(check_proposal(p, w.domain), "");
+    EXPECT_EQ(p.describe(), "warp 'ggx_visible_normals'");
+    EXPECT_STREQ(proposal_kind_name(p.kind), "warp");
+    EXPECT_EQ(check_proposal(p, make_sphere()),
+              "warp 'ggx_visible_normals' maps onto hemisphere of directions z >= 0, the "
+              "domain is unit sphere of directions");
+
+    PointBlock u, x, x2;
+    u.reset(2, kBlockSize);
+    x.reset(3, kBlockSize);
+    x2.reset(3, kBlockSize);
+    Pcg32 rng(3, 4);
+    for (size_t i = 0; i < kBlockSize; ++i) {
+        u.coord(0)[i] = rng.next_double();
+        u.coord(1)[i] = rng.next_double();
+    }
+    u.n = kBlockSize;
+    double pdf[kBlockSize], pdf2[kBlockSize], pdf3[kBlockSize];
+    warp_block(p, w.domain, u, x, pdf);
+    ASSERT_EQ(x.n, kBlockSize);
+    x2.n = kBlockSize;
+    w.warp.map(u, x2);
+    w.warp.pdf(x2, pdf2);
+    proposal_pdf_block(p, w.domain, x, pdf3);
+    for (size_t i = 0; i < kBlockSize; ++i) {
+        EXPECT_EQ(x.coord(2)[i], x2.coord(2)[i]);
+        EXPECT_EQ(pdf[i], pdf2[i]);
+        EXPECT_EQ(pdf[i], pdf3[i]);
+    }
+
+    // A box warp on another box, and a warp of another sample dimension, are refused.
+    const NamedWarp line = named("tabulated_1d");
+    const Proposal q = warp_proposal(std::make_shared<const Warp>(line.warp), line.domain);
+    EXPECT_EQ(check_proposal(q, line.domain), "");
+    EXPECT_TRUE(contains(check_proposal(q, make_box({0.0}, {2.0}).value), "maps onto [0, 1]"));
+    Warp odd = line.warp;
+    odd.sample_dim = 2;
+    EXPECT_TRUE(contains(
+        check_proposal(warp_proposal(std::make_shared<const Warp>(odd), line.domain), line.domain),
+        "reads 2 unit-cube coordinates"));
+    EXPECT_EQ(check_proposal(warp_proposal(nullptr, line.domain), line.domain),
+              "pdf 'warp' has no map or density");
+}
+
+// A tested warp as an estimator's importance proposal: the cosine-weighted hemisphere samples
+// f = cos(theta) with the weight f / p = pi exactly (zero variance), and f = cos^2 unbiasedly.
+TEST(WarpProposal, EstimatesThroughTheFixedEstimator) {
+    const NamedWarp w = named("cosine_hemisphere");
+    Problem problem;
+    problem.name = "cosines";
+    problem.domain = w.domain;
+    EstimatorSpec spec;
+    spec.name = "warp";
+    spec.proposal = warp_proposal(std::make_shared<const Warp>(w.warp), w.domain);
+    ASSERT_EQ(check_proposal(spec.proposal, problem.domain), "");
+    Workspace ws;
+
+    problem.integrand = make_expression_integrand("z", 3).value;
+    Pcg32 rng(11, 12);
+    const RunResult flat = run_estimate(problem, spec, 4096, rng, ws);
+    EXPECT_NEAR(flat.estimate, kPi, 1e-12);
+    EXPECT_LT(flat.std_error, 1e-12);
+
+    problem.integrand = make_expression_integrand("z^2", 3).value; // integral 2 pi / 3
+    const RunResult r = run_estimate(problem, spec, 100000, rng, ws);
+    EXPECT_GT(r.std_error, 0.0);
+    EXPECT_LT(std::fabs(r.estimate - 2.0 * kPi / 3.0), 5.0 * r.std_error);
 }

@@ -415,4 +415,13 @@ Made<Warp> make_expression_warp(const Domain& domain, const std::vector<std::str
     return {w, {}};
 }
 
+Proposal warp_proposal(std::shared_ptr<const Warp> warp, const Domain& domain) {
+    Proposal p;
+    p.kind = ProposalKind::Warp;
+    p.warp = std::move(warp);
+    p.warp_domain = domain;
+    p.importance = true;
+    return p;
+}
+
 } // namespace mcp

@@ -2,7 +2,8 @@
 // run on whole blocks of points. The named warps wrap the core's sampling routines (one
 // implementation each: core/warps.h, core/distributions.h, core/microfacet.h,
 // core/spherical_triangle.h); expression warps are typed by a user. Either can be put to a
-// chi-square test (estimators/warp_test.h).
+// chi-square test (estimators/warp_test.h) or serve as an importance proposal
+// (ProposalKind::Warp, estimators/problem.h).
 #pragma once
 
 #include <functional>
@@ -89,5 +90,8 @@ Made<NamedWarp> make_named_warp(const std::string& name, const NamedWarpParams& 
 /// has at most 3 coordinates. Errors name the expression: "g2: at position 5: ...", "p: ...".
 Made<Warp> make_expression_warp(const Domain& domain, const std::vector<std::string>& g,
                                 const std::string& p);
+
+/// A checked warp and its domain as an importance proposal (ProposalKind::Warp).
+Proposal warp_proposal(std::shared_ptr<const Warp> warp, const Domain& domain);
 
 } // namespace mcp

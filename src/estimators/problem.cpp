@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "core/special.h"
+#include "estimators/named_warps.h"
 
 namespace mcp {
 
@@ -140,6 +141,7 @@ const char* proposal_kind_name(ProposalKind kind) {
     case ProposalKind::CosineHemisphere: return "cosine_hemisphere";
     case ProposalKind::Product1D: return "product";
     case ProposalKind::Tabulated2D: return "tabulated_2d";
+    case ProposalKind::Warp: return "warp";
     }
     return "?";
 }
@@ -162,6 +164,7 @@ std::string Proposal::describe() const {
     case ProposalKind::Tabulated2D:
         return "tabulated_2d(" + std::to_string(table.nx()) + " x " + std::to_string(table.ny()) +
                ")";
+    case ProposalKind::Warp: return "warp '" + (warp ? warp->name : std::string("?")) + "'";
     }
     return "?";
 }
@@ -179,6 +182,21 @@ Proposal uniform_proposal(const Domain& domain, bool disk_polar) {
     }
     return p;
 }
+
+namespace {
+// The same domain: kind and parameters equal.
+bool same_domain(const Domain& a, const Domain& b) {
+    if (a.kind != b.kind) return false;
+    switch (a.kind) {
+    case DomainKind::Box: return a.lo == b.lo && a.hi == b.hi;
+    case DomainKind::Disk: return a.center == b.center && a.radius == b.radius;
+    case DomainKind::Triangle: return a.v0 == b.v0 && a.v1 == b.v1 && a.v2 == b.v2;
+    case DomainKind::Sphere:
+    case DomainKind::Hemisphere: return true;
+    }
+    return false;
+}
+} // namespace
 
 std::string check_proposal(const Proposal& p, const Domain& d) {
     auto need = [&](DomainKind k) -> std::string {
@@ -210,6 +228,17 @@ std::string check_proposal(const Proposal& p, const Domain& d) {
         if (p.table.x0() != d.lo[0] || p.table.x1() != d.hi[0] || p.table.y0() != d.lo[1] ||
             p.table.y1() != d.hi[1])
             return "tabulated_2d table does not span the box";
+        return "";
+    }
+    case ProposalKind::Warp: {
+        if (!p.warp || !p.warp->map || !p.warp->pdf) return "pdf 'warp' has no map or density";
+        if (!same_domain(p.warp_domain, d))
+            return "warp '" + p.warp->name + "' maps onto " + p.warp_domain.describe() +
+                   ", the domain is " + d.describe();
+        if (p.warp->sample_dim != d.sample_dim())
+            return "warp '" + p.warp->name + "' reads " + std::to_string(p.warp->sample_dim) +
+                   " unit-cube coordinates, the domain's samplers give " +
+                   std::to_string(d.sample_dim());
         return "";
     }
     }
@@ -305,6 +334,11 @@ void warp_block(const Proposal& p, const Domain& d, const PointBlock& u, PointBl
     case ProposalKind::Tabulated2D:
         p.table.sample_block(u.coord(0), u.coord(1), x.coord(0), x.coord(1), pdf, n);
         break;
+    case ProposalKind::Warp:
+        p.warp->map(u, x);
+        x.n = n;
+        p.warp->pdf(x, pdf);
+        break;
     }
 }
 
@@ -333,15 +367,17 @@ void proposal_pdf_block(const Proposal& p, const Domain& d, const PointBlock& x,
     case ProposalKind::Tabulated2D:
         for (size_t i = 0; i < n; ++i) pdf[i] = p.table.pdf(x.coord(0)[i], x.coord(1)[i]);
         break;
+    case ProposalKind::Warp: p.warp->pdf(x, pdf); break;
     }
 }
 
 namespace {
 // A density bounded below on its domain: the uniform ones (the cosine-weighted hemisphere
-// vanishes at the horizon; importance densities may vanish anywhere).
+// vanishes at the horizon; importance densities, warps' included, may vanish anywhere).
 bool density_bounded_below(const Proposal& p) {
     return !p.importance && p.kind != ProposalKind::CosineHemisphere &&
-           p.kind != ProposalKind::Product1D && p.kind != ProposalKind::Tabulated2D;
+           p.kind != ProposalKind::Product1D && p.kind != ProposalKind::Tabulated2D &&
+           p.kind != ProposalKind::Warp;
 }
 } // namespace
 

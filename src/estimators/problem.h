@@ -2,6 +2,7 @@
 // domain: uniform warps of the unit square/cube, or importance distributions.
 #pragma once
 
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -18,6 +19,7 @@
 namespace mcp {
 
 struct EstimatorKind; // estimators/estimator_kind.h
+struct Warp;          // estimators/named_warps.h
 
 enum class DomainKind { Box, Disk, Triangle, Sphere, Hemisphere };
 
@@ -75,6 +77,7 @@ enum class ProposalKind {
     CosineHemisphere, ///< cos(theta)/pi on the hemisphere
     Product1D,        ///< independent 1D distributions per box axis
     Tabulated2D,      ///< piecewise-constant table over a 2D box
+    Warp,             ///< a warp object (named or typed; estimators/named_warps.h)
 };
 
 const char* proposal_kind_name(ProposalKind kind);
@@ -84,6 +87,8 @@ struct Proposal {
     ProposalKind kind = ProposalKind::UniformBox;
     std::vector<Distribution1D> marginals; ///< Product1D: one per axis
     TabulatedDistribution2D table;         ///< Tabulated2D
+    std::shared_ptr<const Warp> warp;      ///< Warp: its map and density
+    Domain warp_domain;                    ///< Warp: the domain it maps onto
     bool importance = false;               ///< true for a non-uniform density
     std::string describe() const;
 };
@@ -92,7 +97,8 @@ struct Proposal {
 Proposal uniform_proposal(const Domain& domain, bool disk_polar = false);
 
 /// Checks that a proposal can sample a domain (kinds and dimensions match, the 1D
-/// distributions cover exactly the box axes). Returns an error message or "".
+/// distributions cover exactly the box axes, a warp maps onto this very domain from its
+/// unit cube). Returns an error message or "".
 std::string check_proposal(const Proposal& proposal, const Domain& domain);
 
 /// Warps a block of unit-cube points u (domain.sample_dim() coordinates) to domain points x
