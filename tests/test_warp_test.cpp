@@ -370,7 +370,7 @@ TEST(WarpTest, MapLeavingTheDomainIsAnError) {
 
     // NaN is outside every domain; round-off just outside is not.
     EXPECT_TRUE(
-        contains(error_of(sq, expression(sq, {"log(u1-0.5)", "u2"}, "1")), "maps to x = (nan, "));
+        contains(error_of(sq, expression(sq, {"log(u1-0.5)", "u2"}, "1")), "maps to x = (NaN, "));
     const Warp rounded = expression(sq, {"u1*(1+1e-12)", "u2"}, "1");
     EXPECT_EQ(error_of(sq, rounded), "(no error)");
     const Domain h = make_hemisphere();
@@ -384,7 +384,7 @@ TEST(WarpTest, NegativeOrNanPdfIsAnError) {
     EXPECT_TRUE(contains(neg, "the pdf is -")) << neg;
     EXPECT_TRUE(contains(neg, ": a density must be finite and >= 0")) << neg;
     const std::string nan = error_of(sq, expression(sq, {"u1", "u2"}, "sqrt(x - 0.5) + 1"));
-    EXPECT_TRUE(contains(nan, "the pdf is nan at x = (")) << nan;
+    EXPECT_TRUE(contains(nan, "the pdf is NaN at x = (")) << nan;
 }
 
 TEST(WarpTest, OptionsAreChecked) {

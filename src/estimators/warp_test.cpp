@@ -32,7 +32,7 @@ constexpr size_t kMaxCellsPerLevel = size_t(1) << 18;
 constexpr double kMinExpected = 5.0;
 
 std::string fmt(double v, int digits = 4) {
-    if (std::isnan(v)) return "nan"; // printf may write "-nan"
+    if (std::isnan(v)) return "NaN"; // printf writes "nan" or "-nan"
     char buf[40];
     std::snprintf(buf, sizeof buf, "%.*g", digits, v);
     return buf;
