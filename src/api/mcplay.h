@@ -78,6 +78,48 @@ int mcp_scene_info(const char* scene_json, char** info_json);
  * (per quasi-Monte Carlo sampler), "pdfs", "integrands", "domains". */
 int mcp_catalog(char** catalog_json);
 
+/* --- The sampler lab (docs/sampler-lab.md) --------------------------------------------- */
+
+/* The points one sampler draws: request {"sampler" ("uniform" = "independent", "stratified",
+ * "latin_hypercube", "sobol", "halton", "lattice"), "n" (1..2^20), "dim" (1..64), "seed",
+ * "randomization" (quasi-Monte Carlo samplers; "none" for the deterministic points)}, at most
+ * 2^22 numbers. Result: {"version", "sampler", "randomization", "n", "dim", "seed",
+ * "points": [[x_1, ..., x_dim] per point]}. */
+int mcp_points(const char* request_json, char** points_json);
+
+/* Analyses point sets in [0,1)^d: request {"points": rows, or an array of K sets of rows} or
+ * {"csv": text (a column "set" splits the rows into K sets)} or {"sampler": {as mcp_points, and
+ * "sets": K}}, with "spectrum": false or {"axes": [a, b], "size": even S <= 1024 (default 256)}
+ * and "pairwise": false to skip the O(N^2 d) measures. Result: {"version", "source", "n", "dim",
+ * "sets", "set_names", "l2_star_discrepancy", "centered_l2_discrepancy",
+ * "wraparound_l2_discrepancy", "min_distance", "min_distance_toroidal" (means over the sets;
+ * null when skipped), "per_set": {measure: [per set]} (K > 1), "expected_iid": {the root mean
+ * square discrepancies of N independent uniform points}, "spectrum": {"size", "axes", "power"
+ * (S x S, row ky + S/2, column kx + S/2, averaged over the sets), "radial": {"frequency",
+ * "power", "count"}}, "skipped": {measure: why}}. */
+int mcp_points_analyze(const char* request_json, char** analysis_json);
+
+/* Discrepancy against N for several samplers (the Koksma-Hlawka picture): request {"samplers":
+ * [names], "dim", "n_min", "n_max" (<= 65536; powers of two between), "seed", "reps" (<= 64),
+ * "scene" (optional: a problem with an exact value whose integration error is measured with the
+ * same points)}. Result: {"version", "dim", "reps", "seed", "statistic", "curves": [{"sampler",
+ * "n", "l2_star_discrepancy", "wraparound_l2_discrepancy", "rms_error"?}], "problem"?, "exact"?}:
+ * root mean squares over reps independent sets. */
+int mcp_discrepancy_curve(const char* request_json, char** curve_json);
+
+/* A scene's problem integrated with point sets given whole (request as mcp_points_analyze's
+ * "points" / "csv" / "sampler"): {"version", "problem", "source", "n", "sets", "estimate",
+ * "per_set", "evaluations", "exact", "error", "error_bar": null for one set (a deterministic rule,
+ * "note" says so), else {"standard_error", "half_width_95", "degrees_of_freedom", "method"}}. */
+int mcp_points_integrate(const char* scene_json, const char* request_json, char** result_json);
+
+/* Tests a warp (docs/scene-format.md, "warp"): its density integrates to 1, and a chi-square
+ * test of its samples against that density in equal-measure bins. options_json may be NULL or
+ * {"samples", "seed", "significance", "tests" (Sidak), "bins": [per natural coordinate]}.
+ * A failed test is a result (MCP_OK, "passed": false); a warp that cannot be tested (g leaves
+ * the domain, p negative or NaN) is MCP_ERROR_SCENE naming the sample or the point. */
+int mcp_warp_test(const char* scene_json, const char* options_json, char** result_json);
+
 /* Frees a string returned by this API. */
 void mcp_free(char* p);
 

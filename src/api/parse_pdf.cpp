@@ -229,6 +229,14 @@ bool parse_pdf(Ctx& c, const Json& j, const std::string& path, const Problem& pr
     if (type == "cosine_hemisphere") {
         if (!check_keys(c, j, path, {"type"})) return false;
         out->kind = ProposalKind::CosineHemisphere;
+    } else if (type == "warp") {
+        // A warp as the importance density: its map draws the points, its p weighs them.
+        if (!check_keys(c, j, path, {"type", "warp"})) return false;
+        const Json* w = find(j, "warp");
+        if (!w) return c.fail(path, "a warp pdf needs \"warp\": a warp name or object");
+        NamedWarp warp;
+        if (!parse_warp(c, *w, sub(path, "warp"), &warp)) return false;
+        *out = warp_proposal(std::make_shared<const Warp>(std::move(warp.warp)), warp.domain);
     } else if (type == "tabulated_2d") {
         if (!check_keys(c, j, path, {"type", "bins", "values", "shape"})) return false;
         if (dom.kind != DomainKind::Box || dom.lo.size() != 2)

@@ -14,6 +14,15 @@
 
 namespace mcp {
 
+namespace {
+
+/// The estimator "warp" of a scene with a warp: importance sampling with the warp's density.
+Json warp_estimator(const Json& warp) {
+    return Json{{"name", "warp"}, {"pdf", {{"type", "warp"}, {"warp", warp}}}};
+}
+
+} // namespace
+
 Made<SceneRequest> build_request(const Json& scene, const Json& options) {
     Ctx c;
     SceneRequest req;
@@ -21,7 +30,7 @@ Made<SceneRequest> build_request(const Json& scene, const Json& options) {
     if (!check_keys(c, scene, path,
                     {"name", "description", "domain", "integrand", "f", "quantity", "exact",
                      "estimators", "n_min", "n_max", "reps", "seed", "threads", "accumulator",
-                     "rel_tol", "abs_tol", "max_seconds", "notes"}))
+                     "rel_tol", "abs_tol", "max_seconds", "notes", "warp"}))
         return made_error<SceneRequest>(c.error);
     Problem& pr = req.problem;
     pr.name = "scene";
@@ -38,6 +47,16 @@ Made<SceneRequest> build_request(const Json& scene, const Json& options) {
         integrand = f;
         integrand_path = "scene.f";
     }
+    // A scene's warp (the sampler lab) is tested by mcp_warp_test; in a study it is the
+    // importance density of the estimator "warp", on the warp's domain unless one is given.
+    const Json* warp = find(scene, "warp");
+    NamedWarp named_warp;
+    if (warp && !parse_warp(c, *warp, "scene.warp", &named_warp))
+        return made_error<SceneRequest>(c.error);
+    if (!integrand && warp)
+        return made_error<SceneRequest>(
+            "scene: a warp and no integrand: test the warp with mcplay warp-test (or the page's "
+            "sampler lab), or add \"f\" to integrate with it as an importance sampler");
     if (!integrand)
         return made_error<SceneRequest>("scene: missing \"integrand\" (or \"f\": an expression)");
     int default_dim = 1;
@@ -46,6 +65,8 @@ Made<SceneRequest> build_request(const Json& scene, const Json& options) {
     if (const Json* d = find(scene, "domain")) {
         if (!parse_domain(c, *d, "scene.domain", default_dim, &pr.domain))
             return made_error<SceneRequest>(c.error);
+    } else if (warp) {
+        pr.domain = named_warp.domain;
     } else {
         Made<Domain> unit = make_box(std::vector<double>(static_cast<size_t>(default_dim), 0.0),
                                      std::vector<double>(static_cast<size_t>(default_dim), 1.0));
@@ -93,7 +114,9 @@ Made<SceneRequest> build_request(const Json& scene, const Json& options) {
             return made_error<SceneRequest>("scene.estimators: expected a non-empty array");
         for (size_t i = 0; i < list->size(); ++i) {
             EstimatorSpec spec;
-            if (!parse_estimator(c, (*list)[i], "scene.estimators[" + std::to_string(i) + "]", pr,
+            // "warp" names the importance sampler of the scene's warp.
+            const Json entry = warp && (*list)[i] == "warp" ? warp_estimator(*warp) : (*list)[i];
+            if (!parse_estimator(c, entry, "scene.estimators[" + std::to_string(i) + "]", pr,
                                  &spec))
                 return made_error<SceneRequest>(c.error);
             if (!names.insert(spec.name).second)
@@ -105,6 +128,12 @@ Made<SceneRequest> build_request(const Json& scene, const Json& options) {
         for (const char* n : {"uniform", "stratified", "latin_hypercube"}) {
             EstimatorSpec spec;
             parse_estimator(c, Json(n), "scene.estimators", pr, &spec);
+            all.push_back(spec);
+        }
+        if (warp) {
+            EstimatorSpec spec;
+            if (!parse_estimator(c, warp_estimator(*warp), "scene.warp", pr, &spec))
+                return made_error<SceneRequest>(c.error);
             all.push_back(spec);
         }
     }

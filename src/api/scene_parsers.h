@@ -10,6 +10,7 @@
 
 #include "api/json_read.h"
 #include "estimators/estimator.h"
+#include "estimators/named_warps.h"
 #include "estimators/problem.h"
 
 namespace mcp {
@@ -28,6 +29,10 @@ bool integrand_dimension(Ctx& c, const Json& j, const std::string& path, int* ou
 /// A "pdf" object: a proposal density over the problem's domain.
 bool parse_pdf(Ctx& c, const Json& j, const std::string& path, const Problem& problem,
                Proposal* out);
+
+/// A scene's "warp": a named warp's name, {"name", its parameters}, or {"domain", "g", "p"}
+/// (api/parse_warp.cpp); the warp and the domain it maps onto.
+bool parse_warp(Ctx& c, const Json& j, const std::string& path, NamedWarp* out);
 
 /// One entry of "estimators": a preset name, or an object naming its sampler, pdf and its
 /// kind's fields.

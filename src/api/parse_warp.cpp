@@ -1,0 +1,133 @@
+// A scene's "warp" (docs/scene-format.md, "Warps"): a named warp ("concentric_disk", or
+// {"name": ..., its parameters}) or one typed as expressions ({"domain", "g", "p"}).
+#include <cmath>
+
+#include "api/scene_parsers.h"
+#include "estimators/named_warps.h"
+
+namespace mcp {
+namespace {
+
+bool get_vec3(Ctx& c, const Json& j, const char* key, const std::string& path, Vec3* out) {
+    const Json* v = find(j, key);
+    if (!v) return true;
+    std::vector<double> xs;
+    if (!to_numbers(c, *v, sub(path, key), &xs)) return false;
+    if (xs.size() != 3) return c.fail(sub(path, key), "expected [x, y, z]");
+    *out = Vec3(xs[0], xs[1], xs[2]);
+    return true;
+}
+
+bool get_point2(Ctx& c, const Json& v, const std::string& path, Vec2* out) {
+    std::vector<double> xs;
+    if (!to_numbers(c, v, path, &xs)) return false;
+    if (xs.size() != 2) return c.fail(path, "expected [x, y]");
+    *out = Vec2(xs[0], xs[1]);
+    return true;
+}
+
+/// The parameters of a named warp from its object (each warp reads its own).
+bool parse_named_params(Ctx& c, const Json& j, const std::string& path, NamedWarpParams* p) {
+    if (!check_keys(c, j, path,
+                    {"name", "lower", "upper", "center", "radius", "vertices", "values", "f",
+                     "bins", "nx", "ny", "alpha", "wo", "a", "b", "c", "viewpoint"}))
+        return false;
+    if (!get_numbers(c, j, "lower", path, &p->lo) || !get_numbers(c, j, "upper", path, &p->hi) ||
+        !get_number(c, j, "radius", path, &p->radius) ||
+        !get_number(c, j, "alpha", path, &p->alpha) || !get_vec3(c, j, "wo", path, &p->wo) ||
+        !get_vec3(c, j, "a", path, &p->a) || !get_vec3(c, j, "b", path, &p->b) ||
+        !get_vec3(c, j, "c", path, &p->c) || !get_vec3(c, j, "viewpoint", path, &p->viewpoint) ||
+        !get_string(c, j, "f", path, &p->expression))
+        return false;
+    if (const Json* center = find(j, "center"))
+        if (!get_point2(c, *center, sub(path, "center"), &p->center)) return false;
+    if (const Json* v = find(j, "vertices")) {
+        if (!v->is_array() || v->size() != 3)
+            return c.fail(sub(path, "vertices"), "expected three [x, y] points");
+        Vec2* corners[] = {&p->v0, &p->v1, &p->v2};
+        for (size_t i = 0; i < 3; ++i)
+            if (!get_point2(c, (*v)[i], sub(path, "vertices") + "[" + std::to_string(i) + "]",
+                            corners[i]))
+                return false;
+    }
+    if (const Json* v = find(j, "values"); v && v->is_array() && v->size() > (size_t(1) << 20))
+        return c.fail(sub(path, "values"), "at most 2^20 values");
+    if (!get_numbers(c, j, "values", path, &p->values)) return false;
+    uint64_t bins = 0, nx = 0, ny = 0;
+    if (!get_count(c, j, "bins", path, &bins) || !get_count(c, j, "nx", path, &nx) ||
+        !get_count(c, j, "ny", path, &ny))
+        return false;
+    for (uint64_t v : {bins, nx, ny})
+        if (v > 4096) return c.fail(path, "bins, nx and ny must be at most 4096");
+    p->nx = static_cast<int>(bins ? bins : nx);
+    p->ny = static_cast<int>(ny);
+    return true;
+}
+
+} // namespace
+
+bool parse_warp(Ctx& c, const Json& j, const std::string& path, NamedWarp* out) {
+    if (j.is_string()) {
+        Made<NamedWarp> w = make_named_warp(j.get<std::string>());
+        if (!w.ok()) return c.fail(path, w.error);
+        *out = std::move(w.value);
+        return true;
+    }
+    if (!j.is_object()) return c.fail(path, "expected a warp name or object, got " + type_of(j));
+    if (find(j, "name")) {
+        std::string name;
+        if (!get_string(c, j, "name", path, &name)) return false;
+        NamedWarpParams params;
+        if (!parse_named_params(c, j, path, &params)) return false;
+        Made<NamedWarp> w = make_named_warp(name, params);
+        if (!w.ok()) return c.fail(path, w.error);
+        *out = std::move(w.value);
+        return true;
+    }
+    // Typed: {"domain", "g": [one expression per coordinate of x] (a string in 1-D), "p"}.
+    if (!check_keys(c, j, path, {"domain", "g", "p"})) return false;
+    const Json* g = find(j, "g");
+    const Json* p = find(j, "p");
+    if (!g || !p)
+        return c.fail(path, "a typed warp needs \"g\" (x as expressions in u1, u2, ...) and \"p\" "
+                            "(its density in x, y, z), or \"name\": one of " +
+                                named_warp_names());
+    std::vector<std::string> g_texts;
+    if (g->is_string()) {
+        g_texts.push_back(g->get<std::string>());
+    } else if (g->is_array() && !g->empty() && g->size() <= size_t(kMaxWarpDim)) {
+        for (size_t i = 0; i < g->size(); ++i) {
+            if (!(*g)[i].is_string())
+                return c.fail(sub(path, "g") + "[" + std::to_string(i) + "]",
+                              "expected an expression string, got " + type_of((*g)[i]));
+            g_texts.push_back((*g)[i].get<std::string>());
+        }
+    } else {
+        return c.fail(sub(path, "g"), "expected 1 to " + std::to_string(kMaxWarpDim) +
+                                          " expressions, one per coordinate of x");
+    }
+    if (!p->is_string())
+        return c.fail(sub(path, "p"), "expected an expression string, got " + type_of(*p));
+    Domain domain;
+    if (const Json* d = find(j, "domain")) {
+        if (!parse_domain(c, *d, sub(path, "domain"), static_cast<int>(g_texts.size()), &domain))
+            return false;
+    } else {
+        Made<Domain> unit = make_box(std::vector<double>(g_texts.size(), 0.0),
+                                     std::vector<double>(g_texts.size(), 1.0));
+        if (!unit.ok()) return c.fail(path, unit.error);
+        domain = unit.value;
+    }
+    if (static_cast<int>(g_texts.size()) != domain.point_dim())
+        return c.fail(sub(path, "g"), "has " + std::to_string(g_texts.size()) +
+                                          " expressions, but points of the " + domain.describe() +
+                                          " have " + std::to_string(domain.point_dim()) +
+                                          " coordinates");
+    Made<Warp> w = make_expression_warp(domain, g_texts, p->get<std::string>());
+    if (!w.ok()) return c.fail(path, w.error);
+    out->warp = std::move(w.value);
+    out->domain = domain;
+    return true;
+}
+
+} // namespace mcp
