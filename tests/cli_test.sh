@@ -191,5 +191,34 @@ check part-table 2 '--part is for render scenes, with --format json' -- run quad
 check part-integral 2 '--part is for render scenes' -- run exp_1d --part 0/2 --format json
 check part-too-many 2 'options.parts: must be in 1..reps = 3' -- run "${split[@]}" --part 0/4 --format json
 
+# The sampler lab: points, analyze, warp-test (docs/sampler-lab.md).
+check points-csv 0 '^x1,x2,x3$' -- points sobol --n 16 --dim 3 --seed 2
+check points-out 0 '' -- points halton --n 256 --dim 2 --out "$tmp/h.csv"
+if [ "$(wc -l <"$tmp/h.csv")" != 257 ]; then
+    echo "FAIL points-out: $tmp/h.csv has $(wc -l <"$tmp/h.csv") lines, expected 257"; failed=$((failed + 1))
+fi
+check points-unknown 2 "unknown sampler 'faure'" -- points faure --n 16
+check points-no-n 2 'points needs --n N' -- points sobol
+check points-too-many 2 'n: expected 1 to 1048576 points' -- points sobol --n 2000000
+check analyze-table 0 'L2-star discrepancy \(Warnock\) +[0-9.e-]+ +\(independent points' -- analyze "$tmp/h.csv"
+check analyze-json 0 '"l2_star_discrepancy": [0-9.e-]+' -- analyze "$tmp/h.csv" --format json --spectrum-out "$tmp/h.png"
+if [ "$(head -c 4 "$tmp/h.png" | tail -c 3)" != "PNG" ]; then
+    echo "FAIL analyze-png: $tmp/h.png is not a PNG"; failed=$((failed + 1))
+fi
+printf '0.1,0.2\n0.3\n' >"$tmp/short.csv"
+check analyze-columns 2 'row 2: expected 2 columns, got 1' -- analyze "$tmp/short.csv"
+printf 'x,y\n0.1,0.2\n0.3,1.5\n' >"$tmp/outside.csv"
+check analyze-range 2 "row 3, column 2: '1.5' is outside \[0, 1\)" -- analyze "$tmp/outside.csv"
+printf '0.1,0.2\n0.3,abc\n' >"$tmp/text.csv"
+check analyze-text 2 "row 2, column 2: 'abc' is not a number" -- analyze "$tmp/text.csv"
+check analyze-missing 2 "cannot open '$tmp/none.csv'" -- analyze "$tmp/none.csv"
+check warp-pass 0 'verdict: passed' -- warp-test warp_disk_polar --samples 100000
+check warp-fail 0 'verdict: rejected' -- warp-test warp_disk_polar_wrong --samples 100000
+check warp-json 0 '"passed": false' -- warp-test warp_disk_polar_wrong --samples 100000 --format json
+check warp-no-warp 3 'no "warp" to test' -- warp-test exp_1d
+printf '{"warp": {"domain": {"type": "disk"}, "g": ["2*sqrt(u1)*cos(2*pi*u2)", "2*sqrt(u1)*sin(2*pi*u2)"], "p": "1/pi"}}' >"$tmp/outside_warp.json"
+check warp-outside 3 'sample [0-9]+ \(u = .*outside' -- warp-test "$tmp/outside_warp.json" --samples 1000
+check warp-bad-samples 2 'options.samples: expected 1 to' -- warp-test warp_disk_polar --samples 0
+
 echo "$passed passed, $failed failed"
 [ "$failed" = 0 ]

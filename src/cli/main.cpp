@@ -20,6 +20,7 @@
 #include "api/files.h"
 #include "api/json_read.h"
 #include "api/mcplay.h"
+#include "cli/lab.h"
 #include "render_api/mcplay_render.h"
 
 namespace {
@@ -39,6 +40,11 @@ const char* kUsage =
     "  mcplay render SCENE [--estimator NAME] [--spp N] --out FILE [render options]\n"
     "  mcplay reference SCENE --out FILE.mcref [--width W] [--height H] [--threads T]\n"
     "  mcplay merge PART.json... [--format F] [--out FILE]\n"
+    "  mcplay points SAMPLER --n N [--dim D] [--seed S] [--randomization R] [--out FILE.csv]\n"
+    "  mcplay analyze FILE.csv|FILE.json [--format table|json] [--spectrum-out FILE.png]\n"
+    "                [--spectrum-size S] [--axes A,B]\n"
+    "  mcplay warp-test SCENE [--samples N] [--seed S] [--significance A] [--tests T]\n"
+    "                [--format table|json]\n"
     "  mcplay --help | --version\n"
     "\n"
     "SCENE is a scene JSON file, or the name of one in the scenes directory\n"
@@ -82,6 +88,18 @@ const char* kUsage =
     "  writes it to --out: a study given it (options.reference_data) renders none, if it was\n"
     "  made from the same glTF, name, image size and reference settings (the site ships\n"
     "  its scenes' references this way)\n"
+    "\n"
+    "sampler lab (docs/sampler-lab.md):\n"
+    "  points writes the points a sampler draws as CSV (x1,...,xD header, one point per row):\n"
+    "  SAMPLER uniform, stratified, latin_hypercube, sobol, halton or lattice; --dim default 2,\n"
+    "  --randomization none gives the deterministic quasi-Monte Carlo points\n"
+    "  analyze reads points in [0,1)^d (CSV with an optional header, a column named set\n"
+    "  splitting the rows into randomizations; or a JSON array of rows) and prints their\n"
+    "  L2-star, centred and wrap-around L2 discrepancies, minimum distances and the radial\n"
+    "  power spectrum; --spectrum-out writes the spectrum of axes --axes (default 1,2) as a PNG\n"
+    "  warp-test tests a scene's \"warp\" (g and p, or a named warp): the density's integral\n"
+    "  and a chi-square test of --samples (default 10^6) samples in equal-measure bins; exits 0\n"
+    "  whether the warp passes or fails (a failed test is a result)\n"
     "\n"
     "exit codes: 0 ok, 1 runtime error, 2 bad arguments, 3 bad scene\n";
 
@@ -873,5 +891,8 @@ int main(int argc, char** argv) {
     if (cmd == "render") return cmd_render(rest);
     if (cmd == "reference") return cmd_reference(rest);
     if (cmd == "merge") return cmd_merge(rest);
+    if (cmd == "points") return mcp::cli::cmd_points(rest);
+    if (cmd == "analyze") return mcp::cli::cmd_analyze(rest);
+    if (cmd == "warp-test") return mcp::cli::cmd_warp_test(rest, load_scene);
     return usage_error("unknown command '" + cmd + "'");
 }
