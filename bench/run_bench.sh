@@ -9,6 +9,8 @@ trap 'rm -rf "$tmp"' EXIT
 echo "mcplay bench: samples per second of the estimator loop (best of 5 runs of 2^22 samples, one thread;"
 echo "  render/*_rays: rays per second per core (camera, shadow and bounce rays), 64x64 at 16 spp, best of 3;"
 echo "  rays/*: the accelerator alone, rays per second: a pixel's camera rays, shadow rays to the lights;"
+echo "  analysis/*, warp/*: the sampler lab, runs per second (L2-star of 16,384 points in d = 8, the"
+echo "  spectrum of 4,096 points on 256 x 256 frequencies, a warp test of 10^6 samples);"
 echo "  wasm under node --no-liftoff: steady-state optimised code, as a browser reaches after tier-up)"
 echo "machine: $(nproc) cores, $(uname -m), $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //')"
 $native scenes $((1 << 22)) --accumulation >"$tmp/native"
@@ -16,7 +18,7 @@ $wasm scenes $((1 << 22)) --accumulation >"$tmp/wasm"
 # The estimator cases again, native and wasm in turn, case by case (ROUNDS more times): both
 # sides of a ratio then see the same machine load, and each figure is the best of its rounds.
 rounds=${ROUNDS:-2}
-cases=$(grep ^BENCH "$tmp/native" | awk '{print $2}' | grep -v '^render/\|^rays/\|^eval/\|^pcg32\|hand_loop' |
+cases=$(grep ^BENCH "$tmp/native" | awk '{print $2}' | grep -v '^render/\|^rays/\|^eval/\|^pcg32\|hand_loop\|^analysis/\|^warp/' |
         cut -d/ -f2 | sort -u)
 for ((r = 0; r < rounds; ++r)); do
     for c in $cases; do
