@@ -197,6 +197,8 @@ check points-out 0 '' -- points halton --n 256 --dim 2 --out "$tmp/h.csv"
 if [ "$(wc -l <"$tmp/h.csv")" != 257 ]; then
     echo "FAIL points-out: $tmp/h.csv has $(wc -l <"$tmp/h.csv") lines, expected 257"; failed=$((failed + 1))
 fi
+check points-pixel 0 '^x1,x2$' -- points pixel_sobol --n 64
+check points-pixel-spp 2 "needs a power-of-two spp" -- points pixel_sobol --n 48
 check points-unknown 2 "unknown sampler 'faure'" -- points faure --n 16
 check points-no-n 2 'points needs --n N' -- points sobol
 check points-too-many 2 'n: expected 1 to 1048576 points' -- points sobol --n 2000000

@@ -10,6 +10,7 @@
 
 #include "api/mcplay.h"
 #include "core/special.h"
+#include "render_api/mcplay_render.h"
 
 using nlohmann::json;
 
@@ -413,4 +414,61 @@ TEST(SamplerLabWarpTest, ATestedWarpBecomesTheImportanceSamplerOfAStudy) {
         call([&](char** out) { return mcp_study_run(t2.c_str(), nullptr, nullptr, nullptr, out); });
     EXPECT_EQ(e.status, MCP_ERROR_SCENE);
     EXPECT_NE(e.error.find("warp-test"), std::string::npos) << e.error;
+}
+
+namespace {
+
+Call pixel_points(const json& request) {
+    const std::string text = request.dump();
+    return call([&](char** out) { return mcp_render_pixel_points(text.c_str(), out); });
+}
+
+/// Whether every cell of a kx x ky grid over the unit square holds exactly one of the points.
+bool one_per_cell(const json& rows, int kx, int ky) {
+    std::vector<int> cells(size_t(kx * ky), 0);
+    for (const json& r : rows)
+        ++cells[size_t(int(r[0].get<double>() * kx) + kx * int(r[1].get<double>() * ky))];
+    for (int c : cells)
+        if (c != 1) return false;
+    return true;
+}
+
+} // namespace
+
+TEST(SamplerLabPixelPoints, SobolPixelsAreNetsAndStratifiedPixelsFillTheirStrata) {
+    // A pixel's 64 Sobol' samples are a (0, 6, 2)-net: one point in every elementary interval
+    // of area 1/64, whatever the pixel and image.
+    for (const json& pixel : {json{0, 0}, json{5, 3}}) {
+        Call c = pixel_points({{"pixel_sampler", "sobol"},
+                               {"spp", 64},
+                               {"width", 8},
+                               {"height", 6},
+                               {"pixel", pixel},
+                               {"seed", 9}});
+        ASSERT_EQ(c.status, MCP_OK) << c.error;
+        ASSERT_EQ(c.result["points"].size(), 64u);
+        for (int k = 0; k <= 6; ++k)
+            EXPECT_TRUE(one_per_cell(c.result["points"], 1 << k, 1 << (6 - k))) << k;
+    }
+    Call st = pixel_points({{"pixel_sampler", "stratified"}, {"spp", 64}});
+    ASSERT_EQ(st.status, MCP_OK) << st.error;
+    EXPECT_TRUE(one_per_cell(st.result["points"], 8, 8));
+    Call four = pixel_points({{"pixel_sampler", "independent"}, {"spp", 16}, {"dim", 4}});
+    ASSERT_EQ(four.status, MCP_OK) << four.error;
+    EXPECT_EQ(four.result["points"][0].size(), 4u);
+    // The rows go straight into the analysis.
+    Call a = analyze({{"points", four.result["points"]}, {"spectrum", false}});
+    EXPECT_EQ(a.status, MCP_OK) << a.error;
+}
+
+TEST(SamplerLabPixelPoints, BadRequestsNameTheField) {
+    EXPECT_NE(pixel_points({{"pixel_sampler", "halton"}}).error.find("unknown pixel sampler"),
+              std::string::npos);
+    EXPECT_NE(pixel_points({{"pixel_sampler", "sobol"}, {"spp", 48}}).error.find("power-of-two"),
+              std::string::npos);
+    EXPECT_NE(pixel_points({{"spp", 0}}).error.find("request.spp"), std::string::npos);
+    EXPECT_NE(pixel_points({{"dim", 3}}).error.find("request.dim"), std::string::npos);
+    EXPECT_NE(pixel_points({{"pixel", {4, 0}}, {"width", 4}}).error.find("request.pixel"),
+              std::string::npos);
+    EXPECT_EQ(pixel_points({{"spp", 4}, {"sampler", "sobol"}}).status, MCP_ERROR_ARGUMENT);
 }

@@ -20,7 +20,7 @@ export { McplayError, Status };
 export const RENDER_WASM_FUNCTIONS = Object.freeze([
   '_malloc', '_free',
   '_mcp_version', '_mcp_last_error', '_mcp_render_study_run', '_mcp_render_study_plan', '_mcp_render_image',
-  '_mcp_render_scene_info', '_mcp_render_study_merge', '_mcp_free',
+  '_mcp_render_scene_info', '_mcp_render_study_merge', '_mcp_render_pixel_points', '_mcp_free',
   '_mallinfo',
 ]);
 
@@ -112,7 +112,18 @@ function makeRenderCore(M) {
       [b.jsonText({ parts }, 'parts')]);
   }
 
+  /**
+   * The points one pixel's samples take from a render pixel sampler (mcp_render_pixel_points):
+   * {pixel_sampler, spp, dim, seed, width, height, pixel} to {n, dim, points: rows, ...}, rows as
+   * the integration core's analyzePoints takes them. Failures throw McplayError.
+   */
+  function pixelPoints(request) {
+    b.usable('pixelPoints');
+    return b.callJson('pixelPoints', M._mcp_render_pixel_points, 'mcp_render_pixel_points',
+      [b.jsonText(request, 'request')]);
+  }
+
   return Object.freeze({
-    version: b.version, sceneInfo, plan, runStudy, renderImage, mergeParts, heapStats: b.heapStats, dispose: b.dispose,
+    version: b.version, sceneInfo, plan, runStudy, renderImage, mergeParts, pixelPoints, heapStats: b.heapStats, dispose: b.dispose,
   });
 }

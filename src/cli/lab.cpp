@@ -18,6 +18,7 @@
 #include "api/boundary.h"
 #include "api/files.h"
 #include "api/mcplay.h"
+#include "render_api/mcplay_render.h"
 
 namespace mcp::cli {
 namespace {
@@ -225,16 +226,25 @@ int cmd_points(const std::vector<std::string>& args) {
         return usage_error(error);
     if (o.positional.size() != 1)
         return usage_error("points needs one SAMPLER (uniform, stratified, latin_hypercube, sobol, "
-                           "halton, lattice)");
-    nlohmann::json request{{"sampler", o.positional[0]}};
+                           "halton, lattice, pixel_independent, pixel_stratified, pixel_sobol)");
+    // pixel_independent, pixel_stratified, pixel_sobol: one pixel's samples from the
+    // renderer's pixel samplers (--n is its spp).
+    const std::string& sampler = o.positional[0];
+    const bool pixel = sampler.rfind("pixel_", 0) == 0;
+    nlohmann::json request = pixel ? nlohmann::json{{"pixel_sampler", sampler.substr(6)}}
+                                   : nlohmann::json{{"sampler", sampler}};
     if (!o.get("--n")) return usage_error("points needs --n N");
-    if (!count_option(o, "--n", "n", &request, &error) ||
+    if (!count_option(o, "--n", pixel ? "spp" : "n", &request, &error) ||
         !count_option(o, "--dim", "dim", &request, &error) ||
         !count_option(o, "--seed", "seed", &request, &error))
         return usage_error(error);
-    if (const std::string* r = o.get("--randomization")) request["randomization"] = *r;
+    if (const std::string* r = o.get("--randomization")) {
+        if (pixel) return usage_error("--randomization: the pixel samplers have their own");
+        request["randomization"] = *r;
+    }
     char* text = nullptr;
-    const int status = mcp_points(request.dump().c_str(), &text);
+    const int status = pixel ? mcp_render_pixel_points(request.dump().c_str(), &text)
+                             : mcp_points(request.dump().c_str(), &text);
     if (status != MCP_OK) return api_error("points", status);
     const nlohmann::json result = nlohmann::json::parse(text);
     mcp_free(text);

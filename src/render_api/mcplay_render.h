@@ -62,6 +62,15 @@ int mcp_render_study_plan(const char* scene_json, const char* options_json, char
  * image (options.reference_data, the cache, its file, or rendered) and its "reference" block. */
 int mcp_render_image(const char* scene_json, const char* options_json, char** result_json);
 
+/* The points one pixel's samples take from a render pixel sampler, for the sampler lab:
+ * request {"pixel_sampler": "independent" | "stratified" | "sobol" (default), "spp" (1..65536; a
+ * power of two for sobol; default 64), "dim" (2, 4, 6 or 8: the sample's first dim / 2 2D requests,
+ * default 2), "seed" (the image's key, default 1), "width", "height" (the image, default 1 x 1),
+ * "pixel": [x, y] (default [0, 0])}. Result: {"pixel_sampler", "n", "dim", "seed", "width",
+ * "height", "pixel", "points": [[u_1, ..., u_dim] per sample]}, rows as mcp_points_analyze
+ * takes them. */
+int mcp_render_pixel_points(const char* request_json, char** points_json);
+
 /* What a render scene holds: triangles, lights, materials, camera, accelerator, loader
  * warnings, estimators and settings. */
 int mcp_render_scene_info(const char* scene_json, const char* options_json, char** info_json);
