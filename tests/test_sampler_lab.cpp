@@ -472,3 +472,17 @@ TEST(SamplerLabPixelPoints, BadRequestsNameTheField) {
               std::string::npos);
     EXPECT_EQ(pixel_points({{"spp", 4}, {"sampler", "sobol"}}).status, MCP_ERROR_ARGUMENT);
 }
+
+TEST(SamplerLabWarpTest, EveryNamedWarpOfTheCatalogIsTestableByName) {
+    char* out = nullptr;
+    ASSERT_EQ(mcp_catalog(&out), MCP_OK);
+    const json catalog = json::parse(out);
+    mcp_free(out);
+    ASSERT_GE(catalog["warps"].size(), 11u);
+    for (const json& w : catalog["warps"]) {
+        EXPECT_FALSE(w["summary"].get<std::string>().empty());
+        Call c = warp_test({{"warp", w["name"]}}, {{"samples", 20000}, {"seed", 4}});
+        EXPECT_EQ(c.status, MCP_OK) << w["name"] << ": " << c.error;
+        EXPECT_EQ(c.result["warp"], w["name"]);
+    }
+}

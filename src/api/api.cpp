@@ -9,6 +9,7 @@
 #include "api/mcplay.h"
 #include "api/report.h"
 #include "api/scene.h"
+#include "estimators/named_warps.h"
 #include "estimators/stopping.h"
 
 using mcp::boundary::copy_out;
@@ -393,20 +394,24 @@ int mcp_catalog(char** catalog_json) {
                 applicable.push_back(mcp::randomization_name(rnd));
         randomizations[name] = applicable;
     }
-    mcp::Json catalog{
-        {"version", mcp::kResultSchemaVersion},
-        {"estimators", presets},
-        {"kinds", kinds},
-        {"samplers", samplers},
-        {"randomizations", randomizations},
-        {"pdfs",
-         {"uniform", "power", "exponential", "gaussian", "cosine", "tabulated", "product",
-          "tabulated_2d", "cosine_hemisphere", "expression"}},
-        {"integrands",
-         {"constant", "monomial", "exponential", "gaussian", "indicator_ball", "expression",
-          "genz_oscillatory", "genz_product_peak", "genz_corner_peak", "genz_gaussian",
-          "genz_continuous", "genz_discontinuous"}},
-        {"domains", {"box", "interval", "disk", "triangle", "sphere", "hemisphere"}}};
+    // The named warps a scene's "warp" may name (estimators/named_warps.h).
+    mcp::Json warps = mcp::Json::array();
+    for (const mcp::NamedWarpInfo& w : mcp::named_warp_infos())
+        warps.push_back({{"name", w.name}, {"summary", w.summary}});
+    mcp::Json catalog{{"version", mcp::kResultSchemaVersion},
+                      {"estimators", presets},
+                      {"kinds", kinds},
+                      {"samplers", samplers},
+                      {"randomizations", randomizations},
+                      {"pdfs",
+                       {"uniform", "power", "exponential", "gaussian", "cosine", "tabulated",
+                        "product", "tabulated_2d", "cosine_hemisphere", "expression", "warp"}},
+                      {"integrands",
+                       {"constant", "monomial", "exponential", "gaussian", "indicator_ball",
+                        "expression", "genz_oscillatory", "genz_product_peak", "genz_corner_peak",
+                        "genz_gaussian", "genz_continuous", "genz_discontinuous"}},
+                      {"domains", {"box", "interval", "disk", "triangle", "sphere", "hemisphere"}},
+                      {"warps", warps}};
     *catalog_json = copy_out(dump(catalog));
     g_last_error.clear();
     return MCP_OK;

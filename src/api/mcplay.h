@@ -75,7 +75,8 @@ int mcp_scene_info(const char* scene_json, char** info_json);
 
 /* What the library offers: "estimators" (the presets: {"name", "kind", "sampler", "needs_pdf",
  * "summary"}), "kinds" (the estimator kinds: {"name", "summary"}), "samplers", "randomizations"
- * (per quasi-Monte Carlo sampler), "pdfs", "integrands", "domains". */
+ * (per quasi-Monte Carlo sampler), "pdfs", "integrands", "domains", "warps" (the named warps:
+ * {"name", "summary"}). */
 int mcp_catalog(char** catalog_json);
 
 /* --- The sampler lab (docs/sampler-lab.md) --------------------------------------------- */
