@@ -8,7 +8,7 @@ BUILD ?= build
 BUILD_WASM ?= build-wasm
 BUILD_ASAN ?= build-asan
 BUILD_FUZZ ?= build-fuzz
-FUZZ_TARGETS ?= scene expression gltf hdr
+FUZZ_TARGETS ?= scene expression gltf hdr points
 FUZZ_SECONDS ?= 600
 # -fork=1 runs the fuzzing in one child process at a time and goes on after a crash, a timeout
 # or an OOM (each saved in findings/), so one known bug does not end the run.
@@ -20,6 +20,7 @@ FUZZ_MAX_LEN_scene := 16384
 FUZZ_MAX_LEN_expression := 12000
 FUZZ_MAX_LEN_gltf := 65536
 FUZZ_MAX_LEN_hdr := 16384
+FUZZ_MAX_LEN_points := 16384
 fuzz_max_len = $$(case $(1) in scene) echo $(FUZZ_MAX_LEN_scene);; \
 	expression) echo $(FUZZ_MAX_LEN_expression);; gltf) echo $(FUZZ_MAX_LEN_gltf);; \
 	*) echo $(FUZZ_MAX_LEN_hdr);; esac)
