@@ -23,6 +23,20 @@ test('web/tour.json lists every scene of scenes/ once, an integral first, with w
   }
 });
 
+test('the warp scenes that are studies have a stop of the tour, each pointing to the lab\'s warp test', () => {
+  const files = fs.readdirSync(path.join(ROOT, 'scenes')).filter((f) => f.startsWith('warp_') && f.endsWith('.json'));
+  const tour = JSON.parse(fs.readFileSync(path.join(ROOT, 'web', 'tour.json'), 'utf8'));
+  const stops = new Map(tour.groups.flatMap((g) => g.scenes.map((s) => [s.name, { ...s, group: g.title }])));
+  const studies = files.map((f) => JSON.parse(fs.readFileSync(path.join(ROOT, 'scenes', f), 'utf8'))).filter((s) => s.f !== undefined);
+  assert.ok(studies.length >= 7, `${studies.length} warp studies`);
+  for (const s of studies) {
+    const stop = stops.get(s.name);
+    assert.ok(stop, `${s.name}: not in the tour`);
+    assert.match(stop.group, /Warps/, s.name);
+    assert.ok(stop.look.includes(`warp test (example ${s.name})`), `${s.name}: the look does not point to the lab's warp test`);
+  }
+});
+
 test('orderByTour: the tour order, and every disagreement with the folder named', () => {
   const m = (name) => ({ name, kind: 'integral' });
   const tour = { groups: [{ title: 'B', scenes: [{ name: 'b', look: 'x' }] }, { title: 'A', scenes: [{ name: 'a' }] }] };
