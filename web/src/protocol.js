@@ -18,6 +18,8 @@
 //   samples  {scene, options, fields?}      sampled   {samples}       (core.samples; `fields`
 //                                                     keeps only those per-estimator arrays)
 //   points   {request}                      pointsDrawn {points}      (core.points)
+//   pixelPoints {request}                   pixelPointsDrawn {points} (render core: pixelPoints,
+//                                                     one pixel's samples of a renderer's sampler)
 //   analyze  {request}                      analyzed  {analysis}      (core.analyzePoints)
 //   curve    {request}                      curved    {curve}         (core.discrepancyCurve)
 //   integratePoints {scene, request}        integrated {result}       (core.integratePoints)
@@ -49,6 +51,8 @@ export const MSG = Object.freeze({
   MERGED: 'merged',
   POINTS: 'points',
   POINTS_DRAWN: 'pointsDrawn',
+  PIXEL_POINTS: 'pixelPoints',
+  PIXEL_POINTS_DRAWN: 'pixelPointsDrawn',
   ANALYZE: 'analyze',
   ANALYZED: 'analyzed',
   CURVE: 'curve',
@@ -70,6 +74,7 @@ export const FINAL_REPLY = Object.freeze({
   [MSG.IMAGE]: MSG.IMAGED,
   [MSG.MERGE]: MSG.MERGED,
   [MSG.POINTS]: MSG.POINTS_DRAWN,
+  [MSG.PIXEL_POINTS]: MSG.PIXEL_POINTS_DRAWN,
   [MSG.ANALYZE]: MSG.ANALYZED,
   [MSG.CURVE]: MSG.CURVED,
   [MSG.INTEGRATE_POINTS]: MSG.INTEGRATED,

@@ -113,6 +113,11 @@ const handlers = {
   [MSG.POINTS](core, id, { request }) {
     reply(id, MSG.POINTS_DRAWN, { points: core.points(request) });
   },
+  // The renderer's per-pixel samplers: the render core, loaded on first use as for render scenes.
+  async [MSG.PIXEL_POINTS](core, id, { request }) {
+    const render = await renderCore();
+    reply(id, MSG.PIXEL_POINTS_DRAWN, { points: render.pixelPoints(request) });
+  },
   [MSG.ANALYZE](core, id, { request }) {
     reply(id, MSG.ANALYZED, { analysis: core.analyzePoints(request) });
   },

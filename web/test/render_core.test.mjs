@@ -447,3 +447,34 @@ test('plan predicts a study from a pilot and validates like runStudy', async () 
   assert.equal(p.reference.source, 'rendered');
   assertMcplayError(() => core.plan(SCENE, { ...SMALL, reference: { spp: 8 } }), Status.SCENE, /reference\.spp: expected at least 4 x spp_max = 16/);
 });
+
+test('pixelPoints: one pixel\'s samples (a Sobol\' pixel stratified as a (0, 6, 2)-net), the CLI\'s points, the core\'s errors', async () => {
+  const core = await getCore();
+  const p = core.pixelPoints({ pixel_sampler: 'sobol', spp: 64, dim: 2, seed: 1 });
+  assert.equal(p.pixel_sampler, 'sobol');
+  assert.equal(p.n, 64);
+  assert.equal(p.dim, 2);
+  assert.equal(p.points.length, 64);
+  // every elementary box of area 1/64 holds one point, e.g. the 8 x 8 grid and the 64 x 1 strips
+  for (const [bx, by] of [[8, 8], [64, 1], [1, 64], [2, 32]]) {
+    const cells = new Set(p.points.map(([x, y]) => `${Math.floor(x * bx)},${Math.floor(y * by)}`));
+    assert.equal(cells.size, 64, `${bx} x ${by} boxes`);
+  }
+  assert.deepEqual(core.pixelPoints({ pixel_sampler: 'sobol', spp: 64, dim: 2, seed: 1 }).points, p.points, 'same request, same points');
+  // the native CLI's points, bit for bit (its CSV prints 17 significant digits)
+  if (fs.existsSync(NATIVE)) {
+    const csv = execFileSync(NATIVE, ['points', 'pixel_sobol', '--n', '64', '--dim', '2', '--seed', '1'], { encoding: 'utf8' });
+    const rows = csv.trim().split('\n').slice(1).map((l) => l.split(',').map(Number));
+    assert.deepEqual(rows, p.points);
+  }
+  const s = core.pixelPoints({ pixel_sampler: 'stratified', spp: 48, dim: 4, seed: 2 });
+  assert.equal(s.points.length, 48);
+  for (const row of s.points) {
+    assert.equal(row.length, 4);
+    for (const v of row) assert.ok(v >= 0 && v < 1, String(v));
+  }
+  assertMcplayError(() => core.pixelPoints({ pixel_sampler: 'sobol', spp: 48 }), Status.ARGUMENT,
+    /^request\.spp: the 'sobol' pixel sampler needs a power-of-two spp, got 48 \(the nearest are 32 and 64\)$/);
+  assertMcplayError(() => core.pixelPoints({ pixel_sampler: 'independent', spp: 4, dim: 3 }), Status.ARGUMENT, /^request\.dim: expected 2, 4, 6 or 8/);
+  assertMcplayError(() => core.pixelPoints({ pixel_sampler: 'blue' }), Status.ARGUMENT, /^request\.pixel_sampler: unknown pixel sampler 'blue'/);
+});
