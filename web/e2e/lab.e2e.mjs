@@ -1,7 +1,8 @@
 // End-to-end test of the sampler lab in headless Chromium (Debian's chromium, driven by
 // playwright-core). Usage: MCPLAY_SITE=SITE_DIR MCPLAY_SHOTS=SHOT_DIR node --test web/e2e/lab.e2e.mjs
 // Serves SITE_DIR on a loopback port, opens the lab from the page's tabs, tests the wrong polar
-// disk warp (fails) and the right one (passes), analyses Sobol' points (spectrum and measures),
+// disk warp (fails) and the right one (passes), a named warp with a parameter (GGX, alpha 0.3),
+// analyses Sobol' points (spectrum and measures) and a renderer's Sobol' pixel (64 spp),
 // uploads a CSV with a value outside [0, 1) (the core's error line shown), draws discrepancy
 // curves, checks the URL round trip and runs axe-core on the lab; saves screenshots.
 import { spawn } from 'node:child_process';
@@ -125,6 +126,47 @@ test('warp test: the wrong polar disk (r = u1) fails, the right one (r = sqrt(u1
   assert.equal(q.get('g1'), 'sqrt(u1)*cos(2*pi*u2)');
 });
 
+test('a named warp with parameters: GGX visible normals with alpha 0.3 passes; an alpha out of range gets the core\'s line', async () => {
+  await page.selectOption('#warp-example', 'typed');
+  await page.evaluate(() => { document.getElementById('warp-typed').open = true; });
+  await page.selectOption('#warp-named', 'ggx_visible_normals');
+  // the chosen name's fields, labelled, the docs' defaults as placeholders
+  await page.waitForSelector('#warp-np-alpha', { state: 'visible' });
+  assert.equal(await page.getAttribute('#warp-np-wo', 'placeholder'), '[0.6, 0, 0.8]');
+  assert.match(await page.textContent('label[for=warp-np-alpha]'), /alpha/);
+  assert.equal(await page.isDisabled('#warp-g1'), true);
+  await page.selectOption('#warp-samples', '100000');
+  const run = async () => {
+    const before = (await lab()).warp;
+    // Enter in a field of the typed warp tests it
+    await page.focus('#warp-np-alpha');
+    await page.keyboard.press('Enter');
+    await page.waitForFunction((was) => {
+      const w = window.mcplayDebug.lab().warp;
+      return (w.status === 'done' || w.status === 'error') && (w.result !== was.result || w.message !== was.message);
+    }, before, { timeout: 60000 });
+    return (await lab()).warp;
+  };
+  await page.fill('#warp-np-alpha', '30');
+  const bad = await run();
+  assert.equal(bad.status, 'error');
+  const line = 'scene.warp: ggx_visible_normals: alpha must be in [0.001, 10], got 30';
+  assert.equal(bad.message, line);
+  await page.waitForFunction(() => document.getElementById('warp-error').textContent !== '');
+  assert.equal(await page.textContent('#warp-error'), line);
+  await page.fill('#warp-np-alpha', '0.3');
+  const ggx = await run();
+  assert.equal(ggx.status, 'done', ggx.message);
+  assert.equal(ggx.example, 'typed');
+  assert.equal(ggx.result.passed, true, ggx.result.verdict);
+  await page.waitForFunction(() => document.getElementById('warp-error').textContent === '');
+  assert.match(await page.textContent('#warp-verdict'), /^Passed/);
+  const q = new URLSearchParams(new URL(page.url()).search);
+  assert.equal(q.get('named'), 'ggx_visible_normals');
+  assert.equal(q.get('wp.alpha'), '0.3');
+  await page.screenshot({ path: join(shots, 'lab-warp-ggx.png'), fullPage: true });
+});
+
 test('a warp scene with an integrand opens its study', async () => {
   await page.selectOption('#warp-example', 'warp_disk_polar');
   await page.waitForSelector('#warp-study', { state: 'visible' });
@@ -179,6 +221,44 @@ test('point sets: Sobol\' points analysed (spectrum drawn, discrepancies shown),
   assert.equal(back.tab, 'points');
   assert.equal(await page.inputValue('#points-n'), '1024');
   assert.equal(await page.inputValue('#points-sampler'), 'sobol');
+});
+
+test('the renderer\'s pixel samplers: a Sobol\' pixel of 64 spp analysed (measures shown); 48 spp gets the core\'s line', async () => {
+  await page.click('#lab-tab-points');
+  await page.check('input[name=points-source][value=sampler]');
+  await page.selectOption('#points-sampler', 'pixel_sobol');
+  assert.equal(await page.isVisible('#points-pixel-note'), true);
+  assert.equal(await page.isDisabled('#points-sets'), true);
+  await page.fill('#points-dim', '2');
+  const analyse = async (n) => {
+    await page.fill('#points-n', n);
+    const was = (await lab()).points;
+    await page.click('#points-run');
+    await page.waitForFunction((w) => {
+      const p = window.mcplayDebug.lab().points;
+      return (p.status === 'done' || p.status === 'error') && (p.analysis !== w.analysis || p.message !== w.message);
+    }, was, { timeout: 60000 });
+    return (await lab()).points;
+  };
+  const bad = await analyse('48');
+  assert.equal(bad.status, 'error');
+  const line = 'request.spp: the \'sobol\' pixel sampler needs a power-of-two spp, got 48 (the nearest are 32 and 64)';
+  assert.equal(bad.message, line);
+  await page.waitForFunction(() => document.getElementById('points-error').textContent !== '');
+  assert.equal(await page.textContent('#points-error'), line);
+  const p = await analyse('64');
+  assert.equal(p.status, 'done', p.message);
+  assert.equal(p.analysis.n, 64);
+  assert.equal(p.analysis.dim, 2);
+  assert.equal(p.rows, 64);
+  assert.ok(p.analysis.l2_star_discrepancy > 0 && p.analysis.l2_star_discrepancy < p.analysis.expected_iid.l2_star_discrepancy,
+    `a Sobol' pixel ${p.analysis.l2_star_discrepancy} against independent points ${p.analysis.expected_iid.l2_star_discrepancy}`);
+  assert.match(await page.$eval('#points-measures tr[data-measure="l2_star_discrepancy"] td', (td) => td.textContent), /\d/);
+  assert.match(await page.$eval('#points-measures tr[data-measure="min_distance"] td', (td) => td.textContent), /\d/);
+  assert.equal(await page.isVisible('#points-measures'), true);
+  await page.waitForFunction(() => document.getElementById('points-error').textContent === '');
+  assert.match(new URL(page.url()).search, /sampler=pixel_sobol&n=64/);
+  await page.screenshot({ path: join(shots, 'lab-points-pixel-sobol.png'), fullPage: true });
 });
 
 test('a CSV with a value outside [0, 1) shows the core\'s error line as it is', async () => {

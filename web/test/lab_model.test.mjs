@@ -182,3 +182,71 @@ test('labSnapshot is structured-cloneable and leaves out the spectrum grid', () 
   assert.equal(snap.points.analysis.spectrum.power, undefined);
   assert.equal(snap.points.rows, 1);
 });
+
+test('the renderer\'s pixel samplers: a pixelPoints request (n = spp), analysed as the rows it gives; in the URL, not in the curve', async () => {
+  const { pixelRequest, isPixelSampler, PIXEL_SAMPLERS, SAMPLERS } = await import('../src/lab/model.js');
+  let s = act(act(initialLab(), 'lab/view', { view: 'lab' }), 'lab/tab', { tab: 'points' });
+  for (const [field, value] of [['sampler', 'pixel_sobol'], ['n', '64'], ['dim', '4'], ['seed', '3'], ['sets', '5']]) {
+    s = act(s, 'lab/points/edit', { field, value });
+  }
+  assert.ok(isPixelSampler('pixel_sobol') && !isPixelSampler('sobol'));
+  assert.deepEqual(pixelRequest(s.points), { pixel: { pixel_sampler: 'sobol', spp: 64, dim: 4, seed: 3 } });
+  // the source is the pixel's request; the analysis needs its rows first, then sends them as points
+  assert.deepEqual(pointSource(s.points), { pixel: { pixel_sampler: 'sobol', spp: 64, dim: 4, seed: 3 } });
+  assert.match(analyzeRequest(s.points).error, /pixel's points are needed first/);
+  const rows = [[0.1, 0.2, 0.3, 0.4], [0.6, 0.7, 0.8, 0.9]];
+  assert.deepEqual(analyzeRequest(s.points, rows).request, { points: rows, spectrum: { axes: [0, 1], size: 256 } });
+  // a spp that is not a power of two is the core's to refuse (its error names the nearest)
+  assert.equal(pixelRequest({ ...s.points, n: '48' }).pixel.spp, 48);
+  assert.match(pixelRequest({ ...s.points, n: 'x' }).error, /spp/);
+  assert.match(pixelRequest({ ...s.points, sampler: 'sobol' }).error, /not one of the renderer's pixel samplers/);
+  for (const name of PIXEL_SAMPLERS) assert.equal(pixelRequest({ ...s.points, sampler: name }).pixel.pixel_sampler, name.replace('pixel_', ''));
+  // the URL keeps the sampler (sets have no meaning for one pixel: left out)
+  const q = labToQuery(s);
+  assert.match(q, /sampler=pixel_sobol/);
+  assert.doesNotMatch(q, /sets=/);
+  assert.equal(queryToLab(q).points.sampler, 'pixel_sobol');
+  // the discrepancy curve keeps the integration samplers only
+  assert.equal(act(s, 'lab/curve/edit', { field: 'sampler', value: 'pixel_sobol', checked: true }).curve.samplers.includes('pixel_sobol'), false);
+  assert.ok(!SAMPLERS.some(isPixelSampler));
+  // an unknown sampler is not taken
+  assert.equal(act(s, 'lab/points/edit', { field: 'sampler', value: 'magic' }).points.sampler, 'pixel_sobol');
+});
+
+test('named warps with parameters: only the chosen name\'s fields that are filled in are sent, parsed as the docs give them', async () => {
+  const { namedWarp, warpParam, NAMED_WARP_PARAMS, NAMED_WARPS } = await import('../src/lab/model.js');
+  // every named warp has its parameter list (docs/scene-format.md, "Warps")
+  assert.deepEqual(Object.keys(NAMED_WARP_PARAMS).sort(), [...NAMED_WARPS].sort());
+  assert.deepEqual(NAMED_WARP_PARAMS.ggx_visible_normals.map(([k]) => k), ['alpha', 'wo']);
+  assert.deepEqual(NAMED_WARP_PARAMS.spherical_triangle.map(([k]) => k), ['a', 'b', 'c', 'viewpoint']);
+  // none filled in: the bare name
+  assert.deepEqual(namedWarp('ggx_visible_normals', {}), { warp: 'ggx_visible_normals' });
+  assert.deepEqual(namedWarp('ggx_visible_normals', { alpha: ' 0.3 ' }), { warp: { name: 'ggx_visible_normals', alpha: 0.3 } });
+  // brackets optional for a vector; a matrix as JSON; an expression as text; other names' fields left out
+  assert.deepEqual(namedWarp('ggx_visible_normals', { alpha: '0.3', wo: '0, 0.6, 0.8', radius: '2' }),
+    { warp: { name: 'ggx_visible_normals', alpha: 0.3, wo: [0, 0.6, 0.8] } });
+  assert.deepEqual(namedWarp('triangle', { vertices: '[[0,0],[2,0],[0,1]]' }), { warp: { name: 'triangle', vertices: [[0, 0], [2, 0], [0, 1]] } });
+  assert.deepEqual(namedWarp('tabulated_1d', { f: 'exp(-x)', bins: '32', values: '' }), { warp: { name: 'tabulated_1d', f: 'exp(-x)', bins: 32 } });
+  assert.deepEqual(namedWarp('cosine_hemisphere', { alpha: '0.3' }), { warp: 'cosine_hemisphere' });
+  // what does not parse is said, naming the field; ranges are the core's to check
+  assert.match(namedWarp('ggx_visible_normals', { alpha: 'rough' }).error, /^alpha: 'rough' is not a number/);
+  assert.match(namedWarp('polar_disk', { center: '[0, ' }).error, /^center: '\[0,' is not a list of numbers such as \[0, 0\]$/);
+  assert.deepEqual(warpParam('alpha', 'number', '30'), { value: 30 });
+
+  // the reducer keeps one text per key; the typed warp's scene; the URL keeps the chosen name's
+  let s = act(initialLab(), 'lab/view', { view: 'lab' });
+  s = act(s, 'lab/warp/edit', { field: 'example', value: TYPED });
+  s = act(s, 'lab/warp/edit', { field: 'named', value: 'ggx_visible_normals' });
+  s = act(s, 'lab/warp/edit', { field: 'wp', key: 'alpha', value: '0.3' });
+  s = act(s, 'lab/warp/edit', { field: 'wp', key: 'wo', value: '[0, 0, 1]' });
+  assert.equal(act(s, 'lab/warp/edit', { field: 'wp', key: 'nope', value: '1' }), s);
+  assert.deepEqual(s.warp.typed.wp, { alpha: '0.3', wo: '[0, 0, 1]' });
+  assert.deepEqual(typedWarpScene(s.warp.typed).scene, { name: 'ggx_visible_normals', warp: { name: 'ggx_visible_normals', alpha: 0.3, wo: [0, 0, 1] } });
+  const q = labToQuery(s);
+  assert.match(q, /named=ggx_visible_normals&wp\.alpha=0\.3&wp\.wo=/);
+  assert.deepEqual(queryToLab(q).warp.typed, s.warp.typed);
+  // emptied: no longer sent
+  s = act(s, 'lab/warp/edit', { field: 'wp', key: 'wo', value: '' });
+  assert.deepEqual(s.warp.typed.wp, { alpha: '0.3' });
+  assert.match(typedWarpScene({ ...s.warp.typed, wp: { alpha: 'x' } }).error, /^alpha:/);
+});

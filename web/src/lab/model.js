@@ -7,11 +7,38 @@
  *  (the core's default: Owen for Sobol' and Halton, a random shift for lattices). */
 export const SAMPLERS = Object.freeze(['uniform', 'stratified', 'latin_hypercube', 'sobol', 'halton', 'lattice']);
 export const QMC_SAMPLERS = Object.freeze(['sobol', 'halton', 'lattice']);
+/** The renderer's per-pixel samplers (mcp_render_pixel_points, the render core): one pixel's
+ *  samples, n = spp, dim 2, 4, 6 or 8; sampler names as the CLI's (mcplay points pixel_sobol). */
+export const PIXEL_SAMPLERS = Object.freeze(['pixel_independent', 'pixel_stratified', 'pixel_sobol']);
+/** Every sampler of the point-set view (the discrepancy curve takes SAMPLERS only). */
+export const POINT_SAMPLERS = Object.freeze([...SAMPLERS, ...PIXEL_SAMPLERS]);
+export const isPixelSampler = (name) => PIXEL_SAMPLERS.includes(name);
 export const RANDOMIZATIONS = Object.freeze(['default', 'none', 'owen', 'lms_shift', 'digital_shift', 'permutation', 'random_shift']);
 export const DOMAIN_TYPES = Object.freeze(['disk', 'interval', 'box', 'triangle', 'sphere', 'hemisphere']);
 export const NAMED_WARPS = Object.freeze(['uniform', 'polar_disk', 'concentric_disk', 'uniform_sphere',
   'uniform_hemisphere', 'cosine_hemisphere', 'triangle', 'tabulated_1d', 'tabulated_2d', 'ggx_visible_normals',
   'spherical_triangle']);
+/**
+ * The parameters of each named warp (docs/scene-format.md, "Warps"), in the order the form
+ * shows them: [key, kind, default as the docs give it]. Kinds: 'number', 'whole', 'vector' (a
+ * JSON array of numbers), 'matrix' (a JSON array of arrays), 'expr' (an expression text).
+ */
+export const NAMED_WARP_PARAMS = Object.freeze({
+  uniform: [['lower', 'vector', '[0, 0]'], ['upper', 'vector', '[1, 1]']],
+  polar_disk: [['center', 'vector', '[0, 0]'], ['radius', 'number', '1']],
+  concentric_disk: [['center', 'vector', '[0, 0]'], ['radius', 'number', '1']],
+  uniform_sphere: [],
+  uniform_hemisphere: [],
+  cosine_hemisphere: [],
+  triangle: [['vertices', 'matrix', '[[0, 0], [1, 0], [0, 1]]']],
+  tabulated_1d: [['lower', 'vector', '[0]'], ['upper', 'vector', '[1]'], ['values', 'vector', 'or f below'], ['f', 'expr', 'in x'], ['bins', 'whole', '64']],
+  tabulated_2d: [['lower', 'vector', '[0, 0]'], ['upper', 'vector', '[1, 1]'], ['values', 'matrix', 'ny rows of nx, or f below'], ['nx', 'whole', '16'], ['ny', 'whole', '16'], ['f', 'expr', 'in x, y']],
+  ggx_visible_normals: [['alpha', 'number', '0.5, in [0.001, 10]'], ['wo', 'vector', '[0.6, 0, 0.8]']],
+  spherical_triangle: [['a', 'vector', 'corner [x, y, z]'], ['b', 'vector', 'corner [x, y, z]'], ['c', 'vector', 'corner [x, y, z]'], ['viewpoint', 'vector', '[0, 0, 0]']],
+});
+/** Every parameter key of any named warp (the state keeps one text per key). */
+export const WARP_PARAM_KEYS = Object.freeze([...new Set(Object.values(NAMED_WARP_PARAMS).flat().map(([k]) => k))]);
+
 /** Samples of a warp test offered by the page (the core's default is 10^6; 10^5 is quicker). */
 export const WARP_SAMPLES = Object.freeze([10000, 100000, 1000000]);
 export const LAB_LIMITS = Object.freeze({ nMax: 2 ** 20, dimMax: 64, curveNMax: 65536, repsMax: 64, fileBytes: 64 * 1024 * 1024 });
@@ -43,7 +70,7 @@ export function initialLab() {
     examples: BUILTIN_WARPS.map((w) => ({ name: w.name, label: w.label, builtin: true, hasIntegrand: false })),
     warp: {
       example: BUILTIN_WARPS[0].name,
-      typed: { domain: 'disk', params: '"radius": 1', g1: 'sqrt(u1)*cos(2*pi*u2)', g2: 'sqrt(u1)*sin(2*pi*u2)', g3: '', p: '1/pi', named: '' },
+      typed: { domain: 'disk', params: '"radius": 1', g1: 'sqrt(u1)*cos(2*pi*u2)', g2: 'sqrt(u1)*sin(2*pi*u2)', g3: '', p: '1/pi', named: '', wp: {} },
       samples: 100000,
       seed: '1',
       status: 'idle', // idle | running | done | error
@@ -118,7 +145,13 @@ export function labReducer(state, action) {
         if (p.field === 'samples' && !WARP_SAMPLES.includes(value)) return state;
         return { ...state, warp: { ...state.warp, [p.field]: value } };
       }
-      if (Object.prototype.hasOwnProperty.call(state.warp.typed, p.field)) {
+      if (p.field === 'wp' && WARP_PARAM_KEYS.includes(p.key)) {
+        const wp = { ...state.warp.typed.wp };
+        if (String(p.value ?? '') === '') delete wp[p.key];
+        else wp[p.key] = String(p.value);
+        return { ...state, warp: { ...state.warp, typed: { ...state.warp.typed, wp } } };
+      }
+      if (p.field !== 'wp' && Object.prototype.hasOwnProperty.call(state.warp.typed, p.field)) {
         return { ...state, warp: { ...state.warp, typed: { ...state.warp.typed, [p.field]: String(p.value) } } };
       }
       return state;
@@ -136,6 +169,7 @@ export function labReducer(state, action) {
         const axes = Array.isArray(p.value) ? p.value.map(Number) : pts.axes;
         return { ...state, points: { ...pts, axes } };
       }
+      if (p.field === 'sampler' && !POINT_SAMPLERS.includes(String(p.value))) return state;
       if (['source', 'sampler', 'randomization', 'n', 'dim', 'seed', 'sets', 'problem'].includes(p.field)) {
         return { ...state, points: { ...pts, [p.field]: String(p.value) } };
       }
@@ -208,8 +242,10 @@ export function labToQuery(lab) {
     add('warp', w.example);
     if (w.example === TYPED) {
       const t = w.typed;
-      if (t.named) add('named', t.named);
-      else {
+      if (t.named) {
+        add('named', t.named);
+        for (const [k] of NAMED_WARP_PARAMS[t.named] || []) add(`wp.${k}`, t.wp[k]);
+      } else {
         add('domain', t.domain);
         add('params', t.params);
         add('g1', t.g1);
@@ -227,7 +263,7 @@ export function labToQuery(lab) {
     add('n', pt.n);
     add('dim', pt.dim);
     add('seed', pt.seed);
-    if (pt.sets !== '1') add('sets', pt.sets);
+    if (pt.sets !== '1' && !isPixelSampler(pt.sampler)) add('sets', pt.sets);
     if (pt.axes[0] !== 0 || pt.axes[1] !== 1) add('axes', pt.axes.join(','));
     add('problem', pt.problem);
     const c = lab.curve;
@@ -264,6 +300,12 @@ export function queryToLab(search, base = initialLab()) {
   if (ex !== null && (ex === TYPED || NAME_RE.test(ex))) out.warp.example = ex;
   const named = text('named', 100);
   if (named !== null && NAME_RE.test(named)) out.warp.typed.named = named;
+  const wp = {};
+  for (const k of WARP_PARAM_KEYS) {
+    const v = text(`wp.${k}`, 20000);
+    if (v !== null && v !== '') wp[k] = v;
+  }
+  out.warp.typed.wp = wp;
   const dom = text('domain', 20);
   if (dom !== null && DOMAIN_TYPES.includes(dom)) out.warp.typed.domain = dom;
   for (const [k, field] of [['params', 'params'], ['g1', 'g1'], ['g2', 'g2'], ['g3', 'g3'], ['pdf', 'p']]) {
@@ -277,7 +319,7 @@ export function queryToLab(search, base = initialLab()) {
   if (seed !== null) out.warp.seed = seed;
   // points
   const sampler = q.get('sampler');
-  if (SAMPLERS.includes(sampler)) out.points.sampler = sampler;
+  if (POINT_SAMPLERS.includes(sampler)) out.points.sampler = sampler;
   const rand = q.get('rand');
   if (RANDOMIZATIONS.includes(rand)) out.points.randomization = rand;
   const n = num('n', 1, LAB_LIMITS.nMax);
@@ -331,12 +373,48 @@ export function typedDomain(type, params) {
   return { domain: { type, ...extra } };
 }
 
+/**
+ * One parameter of a named warp from its text: a number ('number', 'whole'), a JSON array
+ * ('vector', 'matrix'; the outer brackets may be left out: "0.6, 0, 0.8") or the text itself
+ * ('expr'). Returns {value} or {error}; what the value must be (range, length) is the core's to say.
+ */
+export function warpParam(key, kind, text, example = kind === 'matrix' ? '[[0, 0], [1, 0], [0, 1]]' : '[0.6, 0, 0.8]') {
+  const t = String(text ?? '').trim();
+  if (kind === 'expr') return { value: t };
+  if (kind === 'number' || kind === 'whole') {
+    const v = Number(t);
+    if (!t || !Number.isFinite(v)) return { error: `${key}: '${t}' is not a number` };
+    return { value: v };
+  }
+  try {
+    const v = JSON.parse(t.startsWith('[') ? t : `[${t}]`);
+    if (Array.isArray(v)) return { value: v };
+  } catch {
+    // said below
+  }
+  return { error: `${key}: '${t}' is not a list of numbers such as ${example}` };
+}
+
+/** A named warp with the parameters typed for it (only those of its name that are filled in):
+ *  {warp: name} when none is, {warp: {name, ...params}} otherwise; or {error}. */
+export function namedWarp(name, wp = {}) {
+  const warp = { name };
+  for (const [key, kind, dflt] of NAMED_WARP_PARAMS[name] || []) {
+    if (wp[key] === undefined || String(wp[key]).trim() === '') continue;
+    const p = warpParam(key, kind, wp[key], dflt.startsWith('[') ? dflt : undefined);
+    if (p.error) return p;
+    warp[key] = p.value;
+  }
+  return { warp: Object.keys(warp).length > 1 ? warp : name };
+}
+
 /** The scene of the typed warp: a named warp, or the domain, g (1 to 3 expressions) and p.
  *  Returns {scene} or {error}. */
 export function typedWarpScene(typed) {
   if (typed.named) {
     if (!NAME_RE.test(typed.named)) return { error: `'${typed.named}' is not a warp name` };
-    return { scene: { name: typed.named, warp: typed.named } };
+    const made = namedWarp(typed.named, typed.wp);
+    return made.error ? made : { scene: { name: typed.named, warp: made.warp } };
   }
   const d = typedDomain(typed.domain, typed.params);
   if (d.error) return d;
@@ -395,22 +473,41 @@ export function fileRequest(name, text, bytes = text.length) {
   return { request: { csv: text } };
 }
 
-/** The point source of an analysis or an integration: the file's, or the sampler's. */
+/** The request of a renderer's pixel sampler (mcp_render_pixel_points): {pixel_sampler, spp =
+ *  n, dim, seed}, one pixel of a 1 x 1 image; or {error}. The core checks spp (a power of two for
+ *  sobol) and dim (2, 4, 6 or 8) and says what is wrong. */
+export function pixelRequest(pts) {
+  if (!isPixelSampler(pts.sampler)) return { error: `'${pts.sampler}' is not one of the renderer's pixel samplers` };
+  const spp = whole(pts.n, 1, LAB_LIMITS.nMax);
+  if (spp === null) return { error: `n (the pixel's spp) must be a whole number in 1..${LAB_LIMITS.nMax}` };
+  const dim = whole(pts.dim, 1, LAB_LIMITS.dimMax);
+  if (dim === null) return { error: `dim must be a whole number in 1..${LAB_LIMITS.dimMax}` };
+  const seed = whole(pts.seed, 0, Number.MAX_SAFE_INTEGER);
+  if (seed === null) return { error: 'seed must be a whole number' };
+  return { pixel: { pixel_sampler: pts.sampler.slice('pixel_'.length), spp, dim, seed } };
+}
+
+/** The point source of an analysis or an integration: the file's, or the sampler's; for a
+ *  renderer's pixel sampler {pixel: request}, whose rows the caller fetches first (pixelPoints)
+ *  and sends as {points: rows}. */
 export function pointSource(pts) {
   if (pts.source === 'file') {
     if (!pts.file) return { error: pts.fileError || 'choose a file of points (CSV or JSON)' };
     return { source: pts.file.request };
   }
+  if (isPixelSampler(pts.sampler)) return pixelRequest(pts);
   const s = samplerRequest(pts);
   return s.error ? s : { source: { sampler: s.sampler } };
 }
 
 /** The analysis request: the source, the spectrum of the chosen axes (when the points have two
  *  coordinates or more; the core checks them against the points). */
-export function analyzeRequest(pts) {
+export function analyzeRequest(pts, rows = null) {
   const s = pointSource(pts);
   if (s.error) return s;
-  return { request: { ...s.source, spectrum: { axes: pts.axes.slice(), size: 256 } } };
+  if (s.pixel && !rows) return { error: 'the pixel\'s points are needed first (pixelPoints)' };
+  const source = s.pixel ? { points: rows } : s.source;
+  return { request: { ...source, spectrum: { axes: pts.axes.slice(), size: 256 } } };
 }
 
 /** The discrepancy curve's request ({samplers, dim, n_min, n_max, reps, seed, scene?}) or {error}. */

@@ -3,7 +3,8 @@
 // Also the page's two tabs (the study and the lab), keyboard-operable as WAI-ARIA tabs.
 import { el } from '../dom.js';
 import {
-  SAMPLERS, QMC_SAMPLERS, RANDOMIZATIONS, DOMAIN_TYPES, NAMED_WARPS, TYPED, measureRows, skippedLines,
+  SAMPLERS, QMC_SAMPLERS, PIXEL_SAMPLERS, RANDOMIZATIONS, DOMAIN_TYPES, NAMED_WARPS, NAMED_WARP_PARAMS, TYPED, isPixelSampler,
+  measureRows, skippedLines,
   verdictText, warpFacts, integrateText, num, displayRows, problemChoices,
 } from './model.js';
 import { heatGrid, sequentialColor, residualColor, residualLimit, residuals, sharedMax, mapCounts } from './colors.js';
@@ -19,6 +20,19 @@ function option(value, text) {
   o.textContent = text;
   return o;
 }
+
+function optgroup(label, options) {
+  const g = document.createElement('optgroup');
+  g.label = label;
+  g.append(...options);
+  return g;
+}
+
+/** What some named warps' parameters are, beside their names (docs/scene-format.md, "Warps"). */
+const PARAM_HINTS = Object.freeze({
+  lower: 'corner', upper: 'corner', values: 'the table', f: 'to tabulate', nx: 'columns', ny: 'rows',
+  alpha: 'roughness', wo: 'view direction', a: 'corner', b: 'corner', c: 'corner',
+});
 
 /** Tabs: click or arrow keys / Home / End select; `onSelect(id)` is told the tab chosen. */
 function tablist(list, onSelect) {
@@ -70,6 +84,12 @@ export function mountLab(store, hooks = {}) {
     ['warp-g2', 'g2'], ['warp-g3', 'g3'], ['warp-p', 'p']]) {
     $(id).addEventListener(id === 'warp-named' || id === 'warp-domain' ? 'change' : 'input', warpEdit(field));
   }
+  // Enter in a field of the typed warp tests that warp (not the example chosen above)
+  $('warp-typed').addEventListener('keydown', (e) => {
+    if (e.key !== 'Enter' || e.target.tagName !== 'INPUT') return;
+    e.preventDefault();
+    $('warp-use-typed').click();
+  });
   $('warp-use-typed').addEventListener('click', () => {
     dispatch({ type: 'lab/warp/edit', payload: { field: 'example', value: TYPED } });
     dispatch({ type: 'lab/warp/request' });
@@ -83,7 +103,10 @@ export function mountLab(store, hooks = {}) {
   });
 
   // Point sets
-  $('points-sampler').replaceChildren(...SAMPLERS.map((s) => option(s, s)));
+  $('points-sampler').replaceChildren(
+    optgroup('the integration samplers', SAMPLERS.map((s) => option(s, s))),
+    optgroup('the renderer\'s per-pixel samplers (n = spp)', PIXEL_SAMPLERS.map((s) => option(s, `${s.replace('pixel_', '')} (renderer, one pixel)`))),
+  );
   $('points-randomization').replaceChildren(...RANDOMIZATIONS.map((r) => option(r, r === 'default' ? 'the sampler\'s default' : r)));
   const pointsEdit = (field) => (e) => dispatch({ type: 'lab/points/edit', payload: { field, value: e.target.value } });
   for (const [id, field] of [['points-sampler', 'sampler'], ['points-randomization', 'randomization']]) $(id).addEventListener('change', pointsEdit(field));
@@ -135,11 +158,26 @@ function setValue(id, value) {
 }
 
 let examplesSig = null;
+let namedSig = null;
+
+/** The fields of the chosen named warp's parameters (rebuilt when the name changes). */
+function namedParamFields(name, dispatch) {
+  const params = NAMED_WARP_PARAMS[name] || [];
+  if (!name) return [];
+  if (!params.length) return [el('p', { className: 'small muted wide' }, `${name} takes no parameters.`)];
+  return params.flatMap(([key, kind, dflt]) => {
+    const input = el('input', { id: `warp-np-${key}`, type: 'text', spellcheck: false, autocomplete: 'off',
+      className: kind === 'number' || kind === 'whole' ? '' : 'mono', placeholder: dflt });
+    input.dataset.param = key;
+    input.addEventListener('input', () => dispatch({ type: 'lab/warp/edit', payload: { field: 'wp', key, value: input.value } }));
+    return [el('label', { htmlFor: input.id }, key, PARAM_HINTS[key] ? el('span', { className: 'muted' }, ` (${PARAM_HINTS[key]})`) : null), input];
+  });
+}
 let problemsSig = null;
 let axesSig = null;
 
 /** Writes the lab's state into its controls; `scenes` is the manifest (the problems offered). */
-export function syncLab(lab, scenes) {
+export function syncLab(lab, scenes, dispatch = null) {
   const inLab = lab.view === 'lab';
   selectTab(['tab-study', 'tab-lab'], inLab ? 'tab-lab' : 'tab-study');
   $('intro').hidden = inLab;
@@ -159,6 +197,13 @@ export function syncLab(lab, scenes) {
   for (const [id, field] of [['warp-named', 'named'], ['warp-domain', 'domain'], ['warp-params', 'params'], ['warp-g1', 'g1'],
     ['warp-g2', 'g2'], ['warp-g3', 'g3'], ['warp-p', 'p']]) setValue(id, w.typed[field]);
   for (const id of ['warp-domain', 'warp-params', 'warp-g1', 'warp-g2', 'warp-g3', 'warp-p']) $(id).disabled = Boolean(w.typed.named);
+  if (dispatch && namedSig !== w.typed.named) {
+    namedSig = w.typed.named;
+    $('warp-named-params').replaceChildren(...namedParamFields(w.typed.named, dispatch));
+  }
+  $('warp-named-params').hidden = !w.typed.named;
+  $('warp-expr-fields').hidden = Boolean(w.typed.named);
+  for (const input of $('warp-named-params').querySelectorAll('input')) setValue(input.id, w.typed.wp[input.dataset.param] ?? '');
   $('warp-run').disabled = w.status === 'running';
   $('warp-status').textContent = w.status === 'running' ? 'testing…' : w.status === 'done' ? 'done' : '';
   const ex = lab.examples.find((e) => e.name === w.example);
@@ -169,6 +214,10 @@ export function syncLab(lab, scenes) {
   setValue('points-sampler', pt.sampler);
   setValue('points-randomization', pt.randomization);
   $('points-randomization').disabled = !QMC_SAMPLERS.includes(pt.sampler);
+  const pixel = isPixelSampler(pt.sampler);
+  $('points-sets').disabled = pixel;
+  $('points-pixel-note').hidden = !pixel;
+  $('points-n').previousElementSibling.textContent = pixel ? 'points n (spp)' : 'points n';
   setValue('points-n', pt.n);
   setValue('points-dim', pt.dim);
   setValue('points-seed', pt.seed);

@@ -1,12 +1,12 @@
 // The sampler lab's wiring: its store, its view, and the effects that send its requests to the
-// service worker (protocol.js: warpTest, analyze, points, integratePoints, curve) and put the
+// service worker (protocol.js: warpTest, analyze, points, pixelPoints, integratePoints, curve) and put the
 // answers in the store. main.js starts it with the page's service worker, the manifest and the
 // hooks it shares with the study (the URL, opening a warp scene's study).
 import { createStore } from '../state.js';
 import { MSG } from '../protocol.js';
 import {
   labReducer, queryToLab, labToQuery, TYPED, BUILTIN_WARPS, typedWarpScene, warpOptions, analyzeRequest,
-  samplerRequest, fileRequest, pointSource, curveRequest, displayRows,
+  samplerRequest, fileRequest, pointSource, curveRequest, displayRows, isPixelSampler,
 } from './model.js';
 import { mountLab, syncLab, renderLab } from './view.js';
 
@@ -38,7 +38,7 @@ export function startLab(page, search) {
     }
   };
   store.subscribe((state) => {
-    syncLab(state, page.scenes());
+    syncLab(state, page.scenes(), dispatch);
     if (!framed) {
       framed = true;
       requestAnimationFrame(frame);
@@ -81,20 +81,34 @@ export function startLab(page, search) {
     }
   }
 
+  /** The rows of a renderer's pixel sampler (the render core, through the service worker). */
+  async function pixelRows(request) {
+    return (await need().request(MSG.PIXEL_POINTS, { request })).points.points;
+  }
+
   async function runAnalysis() {
     const id = ++serial;
     const pt = store.getState().points;
     dispatch({ type: 'lab/points/start', payload: { id } });
     try {
+      // a renderer's pixel sampler: its rows first, analysed as given points
+      const pixel = pt.source !== 'file' && isPixelSampler(pt.sampler);
+      let rows = null;
+      if (pixel) {
+        const s = pointSource(pt);
+        if (s.error) throw new Error(s.error);
+        rows = await pixelRows(s.pixel);
+      }
       // one coordinate: no spectrum axes to ask for
-      const made = analyzeRequest(pt);
+      const made = analyzeRequest(pt, rows);
       if (made.error) throw new Error(made.error);
       const request = made.request;
       const dim = pt.source === 'file' ? null : Number(pt.dim);
       if (dim === 1) request.spectrum = { size: 256 };
       const { analysis } = await need().request(MSG.ANALYZE, { request });
-      let rows;
-      if (pt.source === 'file') {
+      if (pixel) {
+        // rows already drawn
+      } else if (pt.source === 'file') {
         rows = displayRows(pt.file.request);
       } else {
         const s = samplerRequest(pt).sampler;
@@ -121,7 +135,8 @@ export function startLab(page, search) {
       const s = pointSource(pt);
       if (s.error) throw new Error(s.error);
       const scene = await problemScene(pt.problem);
-      const { result } = await need().request(MSG.INTEGRATE_POINTS, { scene, request: s.source });
+      const request = s.pixel ? { points: await pixelRows(s.pixel) } : s.source;
+      const { result } = await need().request(MSG.INTEGRATE_POINTS, { scene, request });
       dispatch({ type: 'lab/integrate/done', payload: { id, result } });
     } catch (e) {
       dispatch({ type: 'lab/integrate/error', payload: { id, message: message(e) } });
@@ -172,6 +187,6 @@ export function startLab(page, search) {
     dispatch({ type: 'lab/examples', payload: { entries } });
   }
 
-  syncLab(store.getState(), []);
+  syncLab(store.getState(), [], dispatch);
   return { store, query: () => labToQuery(store.getState()), scenesLoaded };
 }
