@@ -12,6 +12,8 @@
 
 #include "api/scene.h"
 #include "core/point_analysis.h"
+#include "estimators/named_warps.h"
+#include "estimators/warp_test.h"
 #include "core/rng.h"
 #include "core/stats.h"
 #include "render_api/render_request.h"
@@ -345,6 +347,21 @@ void point_analysis_cases() {
     std::printf("INFO analysis/spectrum_4096_256: %.3f s a run, %.3e complex multiply-adds per "
                 "second\n",
                 1.0 / spectrum, spectrum_operations(b.n, 256) * spectrum);
+    // A warp test of 10^6 samples (the lab's default): the concentric disk (named) and the polar
+    // disk typed as expressions, each a whole run_warp_test (quadrature, sampling, binning).
+    const Made<NamedWarp> concentric = make_named_warp("concentric_disk");
+    const double named = runs_per_second([&] {
+        return run_warp_test(concentric.value.domain, concentric.value.warp).value.p_value;
+    });
+    std::printf("BENCH warp/concentric_disk_1e6 %.6e\n", named);
+    std::printf("INFO warp/concentric_disk_1e6: %.3f s a test of 10^6 samples\n", 1.0 / named);
+    const Made<Domain> disk = make_disk({0.0, 0.0}, 1.0);
+    const Made<Warp> typed = make_expression_warp(
+        disk.value, {"sqrt(u1)*cos(2*pi*u2)", "sqrt(u1)*sin(2*pi*u2)"}, "1/pi");
+    const double expression = runs_per_second(
+        [&] { return run_warp_test(disk.value, typed.value).value.p_value; });
+    std::printf("BENCH warp/expression_disk_1e6 %.6e\n", expression);
+    std::printf("INFO warp/expression_disk_1e6: %.3f s a test of 10^6 samples\n", 1.0 / expression);
 }
 
 void render_cases(const std::string& dir) {
@@ -380,7 +397,7 @@ int main(int argc, char** argv) {
         {"hemisphere_cos2", "cosine"},
     };
     // --only NAME: one estimator case, "render" for the render cases alone, or "analysis" for
-    // the point-set analysis cases alone.
+    // the sampler lab's cases alone (point-set analysis, warp tests).
     const char* only = argc > 4 && std::string(argv[3]) == "--only" ? argv[4] : nullptr;
     const bool render_only = only && std::string(only) == "render";
     if (only && std::string(only) == "analysis") {

@@ -40,15 +40,10 @@ int hardware_threads() {
 /// Workers for `tasks` tasks of `work` operations in all: `threads` if given, else the
 /// hardware's count for large jobs and one for small ones.
 int choose_workers(int threads, double work, uint64_t tasks) {
-#if MCPLAY_HAS_THREADS
-    const int w = threads > 0 ? threads : (work < kThreadWork ? 1 : hardware_threads());
-#else
-    // run_workers runs worker 0 alone here: the power spectrum hands out fixed ranges of rows
-    // by worker count, so it must be told one worker.
-    (void)threads;
-    (void)work;
-    const int w = 1;
-#endif
+    // Without threads run_workers runs worker 0 alone, and the power spectrum hands out fixed
+    // ranges of rows by worker count: it must be told one worker (hardware_threads() is 1).
+    const int asked = threads > 0 && MCPLAY_HAS_THREADS ? threads : hardware_threads();
+    const int w = threads <= 0 && work < kThreadWork ? 1 : asked;
     return static_cast<int>(std::max<uint64_t>(1, std::min<uint64_t>(uint64_t(w), tasks)));
 }
 
