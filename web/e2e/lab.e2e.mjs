@@ -66,7 +66,11 @@ after(async () => {
   if (profile) rmSync(profile, { recursive: true, force: true });
 });
 
-const lab = () => page.evaluate(() => window.mcplayDebug.lab());
+// The lab's state, read after two animation frames: the view draws a state on the next frame,
+// so the page's text then shows (at least) the state read.
+const lab = () => page.evaluate(() => new Promise((resolve) => {
+  requestAnimationFrame(() => requestAnimationFrame(() => resolve(window.mcplayDebug.lab())));
+}));
 
 async function warpTest(g) {
   await page.selectOption('#warp-example', 'typed');
@@ -265,6 +269,8 @@ test('a CSV with a value outside [0, 1) shows the core\'s error line as it is', 
   const csv = ['x,y', ...Array.from({ length: 10 }, (_, i) => `${(i + 0.5) / 10},0.5`), '0.3,1.2', '0.1,0.1'].join('\n');
   await page.setInputFiles('#points-file', { name: 'bad.csv', mimeType: 'text/csv', buffer: Buffer.from(csv) });
   await page.waitForFunction(() => window.mcplayDebug.lab().points.status === 'error', null, { timeout: 30000 });
+  // The state changes at once, the view on the next frame: wait for the line to be drawn.
+  await page.waitForFunction(() => document.getElementById('points-error').textContent !== '');
   const text = await page.textContent('#points-error');
   assert.equal(text, 'request.csv: row 12, column 2: \'1.2\' is outside [0, 1)');
   assert.equal(await page.isVisible('#points-error'), true);
