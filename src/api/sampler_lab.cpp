@@ -65,8 +65,10 @@ bool read_point_set_request(Ctx& c, const Json& j, const std::string& path,
     if (!parse_point_sampler(sampler, &out->kind))
         return c.fail(sub(path, "sampler"), "unknown sampler '" + sampler +
                                                 "' (expected uniform, " + sampler_names() + ")");
-    out->dim =
-        dim > static_cast<uint64_t>(kMaxAnalysisDim) ? kMaxAnalysisDim + 1 : static_cast<int>(dim);
+    if (dim < 1 || dim > static_cast<uint64_t>(kMaxAnalysisDim))
+        return c.fail(sub(path, "dim"), "expected 1 to " + std::to_string(kMaxAnalysisDim) +
+                                            ", got " + std::to_string(dim));
+    out->dim = static_cast<int>(dim);
     if (is_qmc(out->kind)) {
         out->randomization = default_randomization(qmc_kind_of(out->kind));
         if (!randomization.empty() && !parse_randomization(randomization, &out->randomization))
