@@ -110,21 +110,10 @@ DoubleDouble ratio_power(double p, double q, int d) {
     return a / b;
 }
 
-/// A compensated sum [Neumaier74] that hands out its value as a double-double.
-class CompensatedSum {
-  public:
-    void add(double x) {
-        const double t = sum_ + x;
-        const bool sum_larger = std::fabs(sum_) >= std::fabs(x);
-        const double big = sum_larger ? sum_ : x, small = sum_larger ? x : sum_;
-        comp_ += (big - t) + small;
-        sum_ = t;
-    }
-    DoubleDouble value() const { return two_sum(sum_, comp_); }
-
-  private:
-    double sum_ = 0.0, comp_ = 0.0;
-};
+/// A compensated sum [Neumaier74] (core/stats.h) with its value as a double-double.
+DoubleDouble value_of(const NeumaierSum& s) {
+    return two_sum(s.running_sum(), s.compensation());
+}
 
 // ---------------------------------------------------------------------------------------
 // The pair loops, written with the vector extension of GCC and clang: four lanes of doubles,
@@ -223,7 +212,7 @@ template <class F, bool kMin>
 MCP_ANALYSIS_INLINE double pair_chunk(const double* t, uint64_t n, int d, uint64_t i0, uint64_t i1,
                                       double* lo_part) {
     constexpr int kRows = 4;
-    CompensatedSum total;
+    NeumaierSum total;
     double best = std::numeric_limits<double>::infinity();
     auto take = [&](double v) {
         if constexpr (kMin)
@@ -280,7 +269,7 @@ MCP_ANALYSIS_INLINE double pair_chunk(const double* t, uint64_t n, int d, uint64
         *lo_part = 0.0;
         return best;
     }
-    const DoubleDouble v = total.value();
+    const DoubleDouble v = value_of(total);
     *lo_part = v.lo;
     return v.hi;
 }
@@ -362,7 +351,7 @@ double l2_star_discrepancy(const PointSet& set, int threads) {
     // prod_k (1 - x_ik^2) = prod_k y_ik (1 + x_ik) (no cancellation near x = 1).
     std::vector<double> y(set.coords.size());
     for (size_t m = 0; m < y.size(); ++m) y[m] = 1.0 - set.coords[m];
-    CompensatedSum diag, middle;
+    NeumaierSum diag, middle;
     for (uint64_t i = 0; i < n; ++i) {
         double k = 1.0, h = 1.0;
         for (int a = 0; a < d; ++a) {
@@ -375,11 +364,11 @@ double l2_star_discrepancy(const PointSet& set, int threads) {
     }
     const double nn = static_cast<double>(n);
     // [Warnock72]: 3^-d - (2^(1-d) / N) sum_i prod_k (1 - x_ik^2) + (1/N^2) sum_ij K.
-    const DoubleDouble m = middle.value();
+    const DoubleDouble m = value_of(middle);
     return discrepancy_from_terms(
         ratio_power(1.0, 3.0, d),
         -(DoubleDouble{std::ldexp(m.hi, 1 - d), std::ldexp(m.lo, 1 - d)} / DoubleDouble{nn, 0.0}),
-        kernel_mean(star_chunk, y, n, d, diag.value(), threads));
+        kernel_mean(star_chunk, y, n, d, value_of(diag), threads));
 }
 
 double centered_l2_discrepancy(const PointSet& set, int threads) {
@@ -388,7 +377,7 @@ double centered_l2_discrepancy(const PointSet& set, int threads) {
     if (n == 0 || d < 1) return std::numeric_limits<double>::quiet_NaN();
     std::vector<double> s(set.coords.size());
     for (size_t m = 0; m < s.size(); ++m) s[m] = set.coords[m] - 0.5;
-    CompensatedSum diag, middle;
+    NeumaierSum diag, middle;
     for (uint64_t i = 0; i < n; ++i) {
         double k = 1.0, h = 1.0;
         for (int a = 0; a < d; ++a) {
@@ -402,8 +391,8 @@ double centered_l2_discrepancy(const PointSet& set, int threads) {
     const double nn = static_cast<double>(n);
     // [Hickernell98]: (13/12)^d - (2/N) sum_i prod_k (...) + (1/N^2) sum_ij K.
     return discrepancy_from_terms(ratio_power(13.0, 12.0, d),
-                                  -(middle.value() * 2.0 / DoubleDouble{nn, 0.0}),
-                                  kernel_mean(centered_chunk, s, n, d, diag.value(), threads));
+                                  -(value_of(middle) * 2.0 / DoubleDouble{nn, 0.0}),
+                                  kernel_mean(centered_chunk, s, n, d, value_of(diag), threads));
 }
 
 double wraparound_l2_discrepancy(const PointSet& set, int threads) {

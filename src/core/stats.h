@@ -22,6 +22,9 @@ class NeumaierSum {
         sum_ = t;
     }
     double value() const { return sum_ + comp_; }
+    /// The running sum and its compensation, unrounded: value() is their rounded sum.
+    double running_sum() const { return sum_; }
+    double compensation() const { return comp_; }
 
   private:
     double sum_ = 0.0;
