@@ -3,12 +3,10 @@
 #include "cli/lab.h"
 
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <fstream>
 #include <string>
 #include <vector>
 
@@ -18,53 +16,18 @@
 #include "api/boundary.h"
 #include "api/files.h"
 #include "api/mcplay.h"
+#include "cli/cli_support.h"
 #include "render_api/mcplay_render.h"
 
 namespace mcp::cli {
 namespace {
 
-constexpr int kExitOk = 0, kExitRuntime = 1, kExitUsage = 2, kExitScene = 3;
 /// A point file is at most this many bytes (2^20 points of 64 coordinates in 25 characters).
 constexpr uint64_t kMaxPointFileBytes = uint64_t(1) << 31;
 
-int usage_error(const std::string& msg) {
-    std::fprintf(stderr, "mcplay: %s (see mcplay --help)\n", boundary::one_line(msg).c_str());
-    return kExitUsage;
-}
-
 int api_error(const char* command, int status) {
     std::fprintf(stderr, "mcplay: %s: %s\n", command, mcp_last_error());
-    return status == MCP_ERROR_SCENE      ? kExitScene
-           : status == MCP_ERROR_ARGUMENT ? kExitUsage
-                                          : kExitRuntime;
-}
-
-bool parse_whole(const std::string& text, unsigned long long* out) {
-    if (text.empty() || text.size() > 20) return false;
-    for (char c : text)
-        if (c < '0' || c > '9') return false;
-    errno = 0;
-    char* end = nullptr;
-    const unsigned long long v = std::strtoull(text.c_str(), &end, 10);
-    if (errno == ERANGE || *end != '\0') return false;
-    *out = v;
-    return true;
-}
-
-bool write_bytes(const std::string& path, const std::string& bytes) {
-    std::ofstream out(path, std::ios::binary);
-    out << bytes;
-    return bool(out);
-}
-
-int write_text(const std::string& path, const std::string& text) {
-    if (path.empty()) {
-        std::fputs(text.c_str(), stdout);
-        return kExitOk;
-    }
-    if (write_bytes(path, text)) return kExitOk;
-    std::fprintf(stderr, "mcplay: cannot write '%s'\n", boundary::one_line(path).c_str());
-    return kExitRuntime;
+    return exit_code(status);
 }
 
 std::string num(double v, const char* format = "%.6g") {
@@ -119,7 +82,7 @@ bool count_option(const Options& o, const char* name, const char* key, nlohmann:
     const std::string* v = o.get(name);
     if (!v) return true;
     unsigned long long n = 0;
-    if (!parse_whole(*v, &n)) {
+    if (!parse_count(*v, &n)) {
         *error = std::string(name) + ": expected a whole number, got '" + *v + "'";
         return false;
     }
@@ -259,7 +222,7 @@ int cmd_points(const std::vector<std::string>& args) {
         csv += "\n";
     }
     const std::string* out = o.get("--out");
-    return write_text(out ? *out : "", csv);
+    return write_output(out ? *out : "", csv);
 }
 
 int cmd_analyze(const std::vector<std::string>& args) {
@@ -295,8 +258,8 @@ int cmd_analyze(const std::vector<std::string>& args) {
     if (const std::string* axes = o.get("--axes")) {
         unsigned long long a = 0, b = 0;
         const size_t comma = axes->find(',');
-        if (comma == std::string::npos || !parse_whole(axes->substr(0, comma), &a) ||
-            !parse_whole(axes->substr(comma + 1), &b) || a < 1 || b < 1)
+        if (comma == std::string::npos || !parse_count(axes->substr(0, comma), &a) ||
+            !parse_count(axes->substr(comma + 1), &b) || a < 1 || b < 1)
             return usage_error("--axes: expected two 1-based axes such as 1,2, got '" + *axes +
                                "'");
         spectrum["axes"] = {a - 1, b - 1};
@@ -307,7 +270,7 @@ int cmd_analyze(const std::vector<std::string>& args) {
     if (status != MCP_OK) {
         std::fprintf(stderr, "mcplay: analyze: %s: %s\n", boundary::one_line(path).c_str(),
                      mcp_last_error());
-        return status == MCP_ERROR_ARGUMENT ? kExitUsage : kExitRuntime;
+        return exit_code(status);
     }
     const nlohmann::json result = nlohmann::json::parse(text);
     mcp_free(text);
@@ -316,7 +279,7 @@ int cmd_analyze(const std::vector<std::string>& args) {
             std::fprintf(stderr, "mcplay: analyze: no spectrum to write\n");
             return kExitRuntime;
         }
-        if (!write_bytes(*png, spectrum_png(result["spectrum"]))) {
+        if (!write_file(*png, spectrum_png(result["spectrum"]))) {
             std::fprintf(stderr, "mcplay: cannot write '%s'\n", boundary::one_line(*png).c_str());
             return kExitRuntime;
         }
@@ -325,9 +288,9 @@ int cmd_analyze(const std::vector<std::string>& args) {
         // The spectrum's grid goes to the image; the JSON keeps the radial average only.
         nlohmann::json shown = result;
         if (shown.contains("spectrum")) shown["spectrum"].erase("power");
-        return write_text("", shown.dump(2) + "\n");
+        return write_output("", shown.dump(2) + "\n");
     }
-    return write_text("", analysis_table(result));
+    return write_output("", analysis_table(result));
 }
 
 int cmd_warp_test(const std::vector<std::string>& args, LoadScene load_scene) {
@@ -361,14 +324,12 @@ int cmd_warp_test(const std::vector<std::string>& args, LoadScene load_scene) {
     if (status != MCP_OK) {
         std::fprintf(stderr, "mcplay: warp-test: %s: %s\n", boundary::one_line(path).c_str(),
                      mcp_last_error());
-        return status == MCP_ERROR_SCENE      ? kExitScene
-               : status == MCP_ERROR_ARGUMENT ? kExitUsage
-                                              : kExitRuntime;
+        return exit_code(status);
     }
     const nlohmann::json result = nlohmann::json::parse(text);
     mcp_free(text);
-    if (format == "json") return write_text("", result.dump(2) + "\n");
-    return write_text("", warp_table(result));
+    if (format == "json") return write_output("", result.dump(2) + "\n");
+    return write_output("", warp_table(result));
 }
 
 } // namespace mcp::cli

@@ -20,16 +20,13 @@
 #include "api/files.h"
 #include "api/json_read.h"
 #include "api/mcplay.h"
+#include "cli/cli_support.h"
 #include "cli/lab.h"
 #include "render_api/mcplay_render.h"
 
 namespace {
 
-// Exit codes.
-constexpr int kExitOk = 0;
-constexpr int kExitRuntime = 1; // I/O failure, cancelled study, internal error
-constexpr int kExitUsage = 2;   // bad command line
-constexpr int kExitScene = 3;   // bad scene file
+using namespace mcp::cli;
 
 const char* kUsage =
     "mcplay - Monte Carlo estimator playground\n"
@@ -109,18 +106,6 @@ std::string fmt_number(const char* format, double x) {
     char buf[64];
     std::snprintf(buf, sizeof buf, format, x);
     return buf;
-}
-
-/// The exit code for a failed C API call.
-int exit_code(int status) {
-    if (status == MCP_ERROR_SCENE) return kExitScene;
-    if (status == MCP_ERROR_ARGUMENT) return kExitUsage;
-    return kExitRuntime;
-}
-
-int usage_error(const std::string& msg) {
-    std::fprintf(stderr, "mcplay: %s (see mcplay --help)\n", mcp::boundary::one_line(msg).c_str());
-    return kExitUsage;
 }
 
 /// A scene file: a regular file of at most mcp::kMaxSceneFileBytes (never a device or FIFO).
@@ -212,12 +197,6 @@ std::string base64_decode(const std::string& in) {
     return out;
 }
 
-bool write_file(const std::string& path, const std::string& bytes) {
-    std::ofstream out(path, std::ios::binary);
-    out << bytes;
-    return bool(out);
-}
-
 // Finds a scene (a path, or a name in the scenes directory) and reads it; a .gltf/.glb file
 // becomes a render scene of its own. On failure prints why and returns false.
 bool load_scene(const std::string& arg, const std::string& dir_arg, std::string* path,
@@ -275,19 +254,6 @@ struct OutputFile {
         if (created) std::remove(path.c_str());
     }
 };
-
-// Strict whole-number parsing: digits only, no sign, no trailing text, no overflow.
-bool parse_count(const std::string& text, unsigned long long* out) {
-    if (text.empty() || text.size() > 20) return false;
-    for (char c : text)
-        if (c < '0' || c > '9') return false;
-    errno = 0;
-    char* end = nullptr;
-    unsigned long long v = std::strtoull(text.c_str(), &end, 10);
-    if (errno == ERANGE || *end != '\0') return false;
-    *out = v;
-    return true;
-}
 
 /// --pixel-sampler's value: one of the render API's pixel samplers (the API checks it again).
 bool pixel_sampler_option(const std::string& v, nlohmann::json* options, std::string* error) {
@@ -425,19 +391,6 @@ void announce_long_study(const std::string& scene, const std::string& options, b
                  "Ctrl-C stops it\n",
                  when.c_str(), fmt_number("%.4g", count.get<double>()).c_str(), unit,
                  p["threads"].dump().c_str());
-}
-
-/// Writes a formatted result to `out_path`, or to standard output when it is empty.
-int write_output(const std::string& out_path, const char* formatted) {
-    if (out_path.empty()) {
-        std::fputs(formatted, stdout);
-        return kExitOk;
-    }
-    std::ofstream out(out_path, std::ios::binary);
-    out << formatted;
-    if (out) return kExitOk;
-    std::fprintf(stderr, "mcplay: cannot write '%s'\n", out_path.c_str());
-    return kExitRuntime;
 }
 
 int cmd_run(const std::vector<std::string>& args) {

@@ -1,0 +1,64 @@
+// What every mcplay command shares: exit codes, the one-line usage error, strict whole numbers,
+// and writing a result to a file or to standard output.
+#pragma once
+
+#include <cerrno>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <string>
+
+#include "api/boundary.h"
+#include "api/mcplay.h"
+
+namespace mcp::cli {
+
+// Exit codes.
+constexpr int kExitOk = 0;
+constexpr int kExitRuntime = 1; // I/O failure, cancelled study, internal error
+constexpr int kExitUsage = 2;   // bad command line
+constexpr int kExitScene = 3;   // bad scene file
+
+/// The exit code for a failed C API call.
+inline int exit_code(int status) {
+    if (status == MCP_ERROR_SCENE) return kExitScene;
+    if (status == MCP_ERROR_ARGUMENT) return kExitUsage;
+    return kExitRuntime;
+}
+
+inline int usage_error(const std::string& msg) {
+    std::fprintf(stderr, "mcplay: %s (see mcplay --help)\n", boundary::one_line(msg).c_str());
+    return kExitUsage;
+}
+
+/// Strict whole-number parsing: digits only, no sign, no trailing text, no overflow.
+inline bool parse_count(const std::string& text, unsigned long long* out) {
+    if (text.empty() || text.size() > 20) return false;
+    for (char c : text)
+        if (c < '0' || c > '9') return false;
+    errno = 0;
+    char* end = nullptr;
+    unsigned long long v = std::strtoull(text.c_str(), &end, 10);
+    if (errno == ERANGE || *end != '\0') return false;
+    *out = v;
+    return true;
+}
+
+inline bool write_file(const std::string& path, const std::string& bytes) {
+    std::ofstream out(path, std::ios::binary);
+    out << bytes;
+    return bool(out);
+}
+
+/// Writes a formatted result to `out_path`, or to standard output when it is empty.
+inline int write_output(const std::string& out_path, const std::string& formatted) {
+    if (out_path.empty()) {
+        std::fputs(formatted.c_str(), stdout);
+        return kExitOk;
+    }
+    if (write_file(out_path, formatted)) return kExitOk;
+    std::fprintf(stderr, "mcplay: cannot write '%s'\n", boundary::one_line(out_path).c_str());
+    return kExitRuntime;
+}
+
+} // namespace mcp::cli
