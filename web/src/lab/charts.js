@@ -1,35 +1,13 @@
 // The sampler lab's uPlot charts (through plot/chart.js): the discrepancy (and integration
 // error) against N, the spectrum's radial average against the line P = 1, and a 1-D warp's
 // observed and expected counts. Data from series.js.
-import { uPlot, draw, drop, empty, logX, minorLogGrid } from '../plot/chart.js';
+import { draw, drop, empty, logX, minorLogGrid, labelHook } from '../plot/chart.js';
 import { AXIS, LOG10_AXIS, lgAll, log10Range } from '../plot/axes.js';
 import { colorAt } from '../palette.js';
 import { SAMPLERS } from './model.js';
 import { curveSeries, radialSeries, density1d } from './series.js';
 
 const colorOfSampler = (name) => colorAt(Math.max(0, SAMPLERS.indexOf(name === 'independent' ? 'uniform' : name)));
-
-/** Labels at the right end of the given series (the reference slopes). */
-function endLabels(items) {
-  return (u) => {
-    const ctx = u.ctx;
-    const px = uPlot.pxRatio || 1;
-    ctx.save();
-    ctx.font = `${11 * px}px "DejaVu Sans", sans-serif`;
-    ctx.fillStyle = '#555';
-    ctx.textBaseline = 'bottom';
-    for (const { idx, label } of items) {
-      const ys = u.data[idx];
-      const last = ys.length - 1;
-      if (last < 0 || ys[last] === null) continue;
-      const w = ctx.measureText(label).width;
-      const x = Math.min(u.valToPos(u.data[0][last], 'x', true) - w - 4 * px, u.bbox.left + u.bbox.width - w - 2 * px);
-      const y = Math.max(u.bbox.top + 12 * px, u.valToPos(ys[last], 'y', true) - 3 * px);
-      ctx.fillText(label, x, y);
-    }
-    ctx.restore();
-  };
-}
 
 /** Discrepancy (and RMS error) against N, log-log, reference slopes labelled "up to log factors". */
 export function renderCurve(el, result) {
@@ -66,7 +44,7 @@ export function renderCurve(el, result) {
       { ...AXIS, ...LOG10_AXIS, label: s.errors.length ? 'discrepancy (solid), RMS error (dashed)' : 'L2-star discrepancy (RMS over sets)' },
     ],
     series,
-    hooks: { drawClear: [minorLogGrid], draw: [endLabels(labels)] },
+    hooks: { drawClear: [minorLogGrid], draw: [labelHook(labels)] },
   }), data, { xRange, yRange });
 }
 
@@ -86,7 +64,7 @@ export function renderRadial(el, spectrum) {
     axes: [{ ...AXIS, label: 'frequency |k|' }, { ...AXIS, ...LOG10_AXIS, label: 'radially averaged power' }],
     series: [{}, { label: 'power', stroke: '#0072B2', width: 2, points: { show: false } },
       { label: 'P = 1 (independent points)', stroke: '#888', width: 1, dash: [4, 4], points: { show: false } }],
-    hooks: { draw: [endLabels([{ idx: 2, label: 'P = 1: independent points' }])] },
+    hooks: { draw: [labelHook([{ idx: 2, label: 'P = 1: independent points' }])] },
   }), data, { xRange: [r.x[0] ?? 0, r.x[r.x.length - 1] ?? 1], yRange });
 }
 

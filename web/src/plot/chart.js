@@ -167,3 +167,29 @@ export function minorLogGrid(u) {
   ctx.stroke();
   ctx.restore();
 }
+
+/** Draws labels at the last visible point of the given series (reference lines). */
+export function labelHook(items) {
+  return (u) => {
+    const ctx = u.ctx;
+    const px = uPlot.pxRatio || 1;
+    ctx.save();
+    ctx.font = `${11 * px}px "DejaVu Sans", sans-serif`;
+    ctx.fillStyle = '#555';
+    ctx.textBaseline = 'bottom';
+    const { min: ymin, max: ymax } = u.scales.y;
+    for (const { idx, label } of items) {
+      const ys = u.data[idx];
+      if (!ys) continue;
+      let last = -1;
+      for (let i = 0; i < ys.length; i++) if (ys[i] !== null && ys[i] >= ymin && ys[i] <= ymax) last = i;
+      if (last < 0) continue;
+      const w = ctx.measureText(label).width;
+      let x = u.valToPos(u.data[0][last], 'x', true) + 4 * px;
+      x = Math.min(x, u.bbox.left + u.bbox.width - w - 2 * px);
+      const y = Math.max(u.bbox.top + 12 * px, u.valToPos(ys[last], 'y', true) - 2 * px);
+      ctx.fillText(label, x, y);
+    }
+    ctx.restore();
+  };
+}

@@ -6,39 +6,13 @@ import { varianceSeries, anchorOf, referenceLines, fitText } from '../series.js'
 import { withAlpha } from '../palette.js';
 import { keptFor } from '../state.js';
 import { AXIS, LOG10_AXIS, sup, lgAll, log10Range, runLabels, isRender } from './axes.js';
-import { uPlot, dom, draw, setText, logX, log10Y, nTicks, minorLogGrid } from './chart.js';
+import { uPlot, dom, draw, setText, logX, log10Y, nTicks, minorLogGrid, labelHook } from './chart.js';
 import { colorOf, levelFlags, setLegend } from './legend.js';
 
 export const VARIANCE_NOTE = {
   integral: 'Shaded: 95% interval of the variance (chi-square); dashed grey: reference slopes N⁻¹, N⁻², N⁻³ from the first point. Order = the core\'s least-squares fit of log variance on log N.',
   render: 'Relative MSE of each estimator\'s images against the reference (mean over the replicates; shaded: its 95% interval from their spread); dashed grey: the reference slope spp⁻¹ of an unbiased estimator, from the first point. Order = the core\'s least-squares fit of log relative MSE on log spp.',
 };
-
-/** Draws labels at the last visible point of the given series (reference lines). */
-function labelHook(items) {
-  return (u) => {
-    const ctx = u.ctx;
-    const px = uPlot.pxRatio || 1;
-    ctx.save();
-    ctx.font = `${11 * px}px "DejaVu Sans", sans-serif`;
-    ctx.fillStyle = '#555';
-    ctx.textBaseline = 'bottom';
-    const { min: ymin, max: ymax } = u.scales.y;
-    for (const { idx, label } of items) {
-      const ys = u.data[idx];
-      if (!ys) continue;
-      let last = -1;
-      for (let i = 0; i < ys.length; i++) if (ys[i] !== null && ys[i] >= ymin && ys[i] <= ymax) last = i;
-      if (last < 0) continue;
-      const w = ctx.measureText(label).width;
-      let x = u.valToPos(u.data[0][last], 'x', true) + 4 * px;
-      x = Math.min(x, u.bbox.left + u.bbox.width - w - 2 * px);
-      const y = Math.max(u.bbox.top + 12 * px, u.valToPos(ys[last], 'y', true) - 2 * px);
-      ctx.fillText(label, x, y);
-    }
-    ctx.restore();
-  };
-}
 
 /** Marks the levels that are exact to round-off (no point on a log axis): a row of squares in
  *  the series' colour along the bottom of the plot, one row per such estimator (the legend
