@@ -5,65 +5,29 @@
 // analyses Sobol' points (spectrum and measures) and a renderer's Sobol' pixel (64 spp),
 // uploads a CSV with a value outside [0, 1) (the core's error line shown), draws discrepancy
 // curves, checks the URL round trip and runs axe-core on the lab; saves screenshots.
-import { spawn } from 'node:child_process';
-import { mkdtempSync, mkdirSync, rmSync } from 'node:fs';
-import { tmpdir } from 'node:os';
+import { mkdirSync } from 'node:fs';
 import { join, resolve, dirname } from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { test, after, before } from 'node:test';
 import assert from 'node:assert/strict';
-import { chromium } from 'playwright-core';
+import { openPlayground } from './harness.mjs';
 
 const here = dirname(fileURLToPath(import.meta.url));
 const site = resolve(process.env.MCPLAY_SITE ?? 'build/site');
 const shots = resolve(process.env.MCPLAY_SHOTS ?? 'build/e2e');
-const chromiumPath = process.env.CHROMIUM ?? '/usr/bin/chromium';
-const port = 20000 + Math.floor(Math.random() * 20000);
-const url = `http://127.0.0.1:${port}/`;
 
-let server, context, page, profile;
+let browser, page;
 const pageErrors = [];
-
-async function waitForServer() {
-  for (let i = 0; i < 100; ++i) {
-    try {
-      const r = await fetch(url);
-      if (r.ok) return;
-    } catch { /* not up yet */ }
-    await new Promise((r) => setTimeout(r, 100));
-  }
-  throw new Error(`the playground server did not answer at ${url}`);
-}
 
 before(async () => {
   mkdirSync(shots, { recursive: true });
-  server = spawn(process.execPath, [join(here, '..', 'tools', 'serve.mjs'), site], {
-    env: { ...process.env, PORT: String(port), HOST: '127.0.0.1' },
-    stdio: ['ignore', 'pipe', 'inherit'],
-  });
-  await waitForServer();
-  profile = mkdtempSync(join(tmpdir(), 'mcplay-lab-chromium-'));
-  context = await chromium.launchPersistentContext(profile, {
-    executablePath: chromiumPath,
-    headless: true,
-    args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
-      '--disable-background-networking', '--disable-component-update', '--disable-sync'],
-    viewport: { width: 1300, height: 1000 },
-  });
-  page = context.pages()[0] ?? (await context.newPage());
-  page.on('pageerror', (e) => {
-    pageErrors.push(e.message);
-    console.error('page error:', e.message);
-  });
-  await page.goto(url);
-  await page.waitForFunction(() => window.mcplayDebug !== undefined, null, { timeout: 20000 });
-  await page.evaluate(() => window.mcplayDebug.ready);
+  browser = await openPlayground({ site, viewport: { width: 1300, height: 1000 },
+    profilePrefix: 'mcplay-lab-chromium-', onPageError: (message) => pageErrors.push(message) });
+  ({ page } = browser);
 });
 
 after(async () => {
-  await context?.close();
-  server?.kill();
-  if (profile) rmSync(profile, { recursive: true, force: true });
+  await browser?.close();
 });
 
 // The lab's state, read after two animation frames: the view draws a state on the next frame,

@@ -4,65 +4,32 @@
 // native CLI, checks the inline expression error and Cancel, checks that none of that
 // downloads the render module, then runs a small render study (quad_light_floor) and checks its
 // fitted orders against the CLI and its images; saves screenshots.
-import { spawn, execFileSync } from 'node:child_process';
-import { mkdtempSync, mkdirSync, rmSync, readFileSync } from 'node:fs';
-import { tmpdir } from 'node:os';
+import { execFileSync } from 'node:child_process';
+import { mkdirSync, readFileSync } from 'node:fs';
 import { join, resolve, dirname } from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { test, after, before } from 'node:test';
 import assert from 'node:assert/strict';
-import { chromium } from 'playwright-core';
+import { openPlayground } from './harness.mjs';
 
 const here = dirname(fileURLToPath(import.meta.url));
 const site = resolve(process.env.MCPLAY_SITE ?? 'build/site');
 const native = resolve(process.env.MCPLAY_NATIVE ?? 'build/mcplay');
 const shots = resolve(process.env.MCPLAY_SHOTS ?? 'build/e2e');
-const chromiumPath = process.env.CHROMIUM ?? '/usr/bin/chromium';
-const port = 20000 + Math.floor(Math.random() * 20000);
-const url = `http://127.0.0.1:${port}/`;
 
-let server, context, page, profile;
+let browser, url, context, page;
 const requested = []; // every URL the page and its workers asked for
-
-async function waitForServer() {
-  for (let i = 0; i < 100; ++i) {
-    try {
-      const r = await fetch(url);
-      if (r.ok) return;
-    } catch { /* not up yet */ }
-    await new Promise((r) => setTimeout(r, 100));
-  }
-  throw new Error(`the playground server did not answer at ${url}`);
-}
 
 before(async () => {
   mkdirSync(shots, { recursive: true });
-  server = spawn(process.execPath, [join(here, '..', 'tools', 'serve.mjs'), site], {
-    env: { ...process.env, PORT: String(port), HOST: '127.0.0.1' },
-    stdio: ['ignore', 'pipe', 'inherit'],
-  });
-  await waitForServer();
-  profile = mkdtempSync(join(tmpdir(), 'mcplay-chromium-'));
-  context = await chromium.launchPersistentContext(profile, {
-    executablePath: chromiumPath,
-    headless: true,
-    args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
-      '--disable-background-networking', '--disable-component-update', '--disable-sync'],
-    viewport: { width: 1400, height: 1000 },
-  });
   // The context sees the requests of the page and of its workers (the wasm glue runs there).
-  context.on('request', (r) => requested.push(r.url()));
-  page = context.pages()[0] ?? (await context.newPage());
-  page.on('pageerror', (e) => console.error('page error:', e.message));
-  await page.goto(url);
-  await page.waitForFunction(() => window.mcplayDebug !== undefined, null, { timeout: 20000 });
-  await page.evaluate(() => window.mcplayDebug.ready);
+  browser = await openPlayground({ site, viewport: { width: 1400, height: 1000 },
+    onContext: (c) => c.on('request', (r) => requested.push(r.url())) });
+  ({ url, context, page } = browser);
 });
 
 after(async () => {
-  await context?.close();
-  server?.kill();
-  if (profile) rmSync(profile, { recursive: true, force: true });
+  await browser?.close();
 });
 
 // The native CLI's fitted orders for the same scene and settings.
