@@ -121,8 +121,10 @@ DoubleDouble value_of(const NeumaierSum& s) {
 // operation is the IEEE operation of the scalar code lane by lane (min and abs as selects), so
 // a lane computes what pair_value computes, bit for bit.
 
-#if defined(__GNUC__) && !defined(__clang__)
 // Vec4 values never cross a call that is not inlined: the ABI note is moot.
+#if defined(__clang__)
+#pragma clang diagnostic ignored "-Wpsabi"
+#elif defined(__GNUC__)
 #pragma GCC diagnostic ignored "-Wpsabi"
 #endif
 typedef double Vec4 __attribute__((vector_size(32)));
