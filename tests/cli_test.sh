@@ -140,7 +140,7 @@ check render-bad-gltf 3 'scene.render.gltf: ' -- run "$tmp/lines.json"
 check render-sobol-study 0 'sobol pixels' -- run quad_light_floor --n-min 1 --n-max 4 --reps 2 --estimators light_solid_angle --pixel-sampler sobol "${tiny[@]}"
 check render-sobol-image 0 'quad_light_floor: mis_power at 4 spp, 8x6' -- render quad_light_floor --estimator mis_power --spp 4 --pixel-sampler sobol --out "$tmp/sobol.png" "${tiny[@]}"
 check render-sobol-spp 2 "options.spp: the 'sobol' pixel sampler needs a power-of-two spp, got 3 \(the nearest are 2 and 4\)" -- render quad_light_floor --spp 3 --pixel-sampler sobol --out "$tmp/x.png" "${tiny[@]}"
-check render-bad-pixel-sampler 2 "--pixel-sampler: unknown pixel sampler 'halton' \(known: independent, stratified, sobol\)" -- render quad_light_floor --pixel-sampler halton --out "$tmp/x.png"
+check render-bad-pixel-sampler 2 "--pixel-sampler: unknown pixel sampler 'halton' \(known: independent, stratified, sobol, padded_sobol\)" -- render quad_light_floor --pixel-sampler halton --out "$tmp/x.png"
 check run-bad-pixel-sampler 2 "--pixel-sampler: unknown pixel sampler 'zsobol'" -- run quad_light_floor --pixel-sampler zsobol
 check pixel-sampler-on-integral 2 'for render scenes' -- run exp_1d --pixel-sampler sobol
 printf '{"render": {"gltf": "quad_light_floor.gltf", "spp_max": 4, "estimators": [{"strategy": "mis_power", "pixel_sampler": "sobol"}], "reference": {"estimator": {"strategy": "mis_power", "pixel_sampler": "sobol"}, "spp": 100}}}' >"$tmp/own/sobol_ref.json"

@@ -496,12 +496,12 @@ TEST(RenderSobol, ApiReadsAndChecksThePixelSampler) {
     // Unknown names, with the known ones.
     call_info(scene, json{{"pixel_sampler", "halton"}}, &error);
     EXPECT_EQ(error, "options.pixel_sampler: unknown value 'halton' (known: independent, "
-                     "stratified, sobol)");
+                     "stratified, sobol, padded_sobol)");
     json bad = scene;
     bad["render"]["estimators"][1]["pixel_sampler"] = "zsobol";
     call_info(bad, json::object(), &error);
     EXPECT_EQ(error, "scene.render.estimators[1].pixel_sampler: unknown value 'zsobol' (known: "
-                     "independent, stratified, sobol)");
+                     "independent, stratified, sobol, padded_sobol)");
     // A Sobol' reference needs a power-of-two spp: named, never silently changed.
     bad = scene;
     bad["render"]["reference"] = {

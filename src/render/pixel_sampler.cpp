@@ -14,6 +14,7 @@ constexpr PixelSamplerName kPixelSamplerNames[] = {
     {PixelSamplerKind::Independent, "independent"},
     {PixelSamplerKind::Stratified, "stratified"},
     {PixelSamplerKind::Sobol, "sobol"},
+    {PixelSamplerKind::PaddedSobol, "padded_sobol"},
 };
 
 } // namespace
@@ -22,6 +23,10 @@ const char* pixel_sampler_name(PixelSamplerKind kind) {
     for (const auto& n : kPixelSamplerNames)
         if (n.kind == kind) return n.name;
     return "?";
+}
+
+bool sampler_extends(PixelSamplerKind kind) {
+    return kind == PixelSamplerKind::Independent || kind == PixelSamplerKind::PaddedSobol;
 }
 
 std::vector<std::string> pixel_sampler_names() {

@@ -42,6 +42,27 @@
 //   Indices beyond 32 bits (images and spp so large that 2 log2(side) + log2(spp) > 32) keep
 //   their low 32 bits for the Sobol' point and fold the rest into the scrambling seed: each
 //   block of 2^32 indices is an independently scrambled copy of the sequence.
+// - padded_sobol: every pixel and every request d has its own Owen-scrambled Sobol' sequence
+//   (pbrt-v4's PaddedSobolSampler [PBR4, 8.7]), so that a pixel's samples do not depend on its
+//   spp and a render can go on from where it stopped (the progressive live view):
+//     * the request's key is a hash of the pixel's key (the image's key and the pixel) and d;
+//     * sample index i is shuffled by Owen scrambling its 32 binary digits as a number, most
+//       significant first, with a seed from the key [Burley20]: the flip of a digit depends on
+//       the digits above it only, so the first 2^k indices map onto one aligned block of 2^k
+//       indices, and every power-of-two prefix of the pixel's samples is the point set of an
+//       aligned block: a (0, k, 2)-net in each 2D request [Sobol67];
+//     * that index's Sobol' point (dimensions 0, 1 and 2 for get_choice_2d, as above),
+//       Owen-scrambled per request with 53 random bits per value (sobol_value).
+//   Independent shuffles per request pair the requests of a sample at random ("padding").
+//   Pixels are independent of each other (white noise between pixels, where the sobol sampler
+//   spreads the error as blue noise). spp need not be a power of two (the first spp samples
+//   of the sequence), but only powers of two are whole nets.
+//
+// Which samplers extend (sampler_extends): the first n samples of a pixel are the same for every
+// spp >= n for independent and padded_sobol, so n more samples continue a pixel's image. The
+// stratified sampler cuts each dimension into spp strata and the sobol sampler gives a pixel a
+// block of spp indices of the image's sequence: both depend on the final spp from the first
+// sample, and a pixel of 2n samples does not begin with the pixel of n.
 //
 // Everything here is integer hashing (the independent and stratified kinds add IEEE
 // arithmetic on exact values): the same numbers natively and in wasm, for any thread count.
@@ -60,10 +81,13 @@
 
 namespace mcp {
 
-enum class PixelSamplerKind { Independent, Stratified, Sobol };
+enum class PixelSamplerKind { Independent, Stratified, Sobol, PaddedSobol };
 
-/// "independent", "stratified", "sobol".
+/// "independent", "stratified", "sobol", "padded_sobol".
 const char* pixel_sampler_name(PixelSamplerKind kind);
+/// Are a pixel's first n samples the same whatever its spp (>= n), so that a render can add
+/// samples to an image (independent, padded_sobol; see the header comment)?
+bool sampler_extends(PixelSamplerKind kind);
 /// Every kind's name, in the enum's order.
 std::vector<std::string> pixel_sampler_names();
 bool parse_pixel_sampler(const std::string& name, PixelSamplerKind* kind);
@@ -192,9 +216,18 @@ class PixelSampler {
         prepared_ = 0; // the pixel's permutations are prepared on first use
         if (kind_ == PixelSamplerKind::Sobol)
             morton_ = pixel_sampler_detail::morton2(uint32_t(x), uint32_t(y));
-        else
+        else if (kind_ != PixelSamplerKind::PaddedSobol)
             rng_.set_seed(mix64(key_), key_);
     }
+
+    /// Starts pixel (x, y) where an earlier pass left it: as start_pixel, with the pixel's
+    /// generator (independent and stratified samplers) as pixel_rng() returned it then.
+    void resume_pixel(int x, int y, const Pcg32& rng) {
+        start_pixel(x, y);
+        rng_ = rng;
+    }
+    /// The pixel's generator after the samples drawn so far (independent, stratified).
+    const Pcg32& pixel_rng() const { return rng_; }
 
     void start_sample(uint64_t index) {
         index_ = index;
@@ -203,6 +236,10 @@ class PixelSampler {
 
     double get_1d() {
         int d = dimension_++;
+        if (kind_ == PixelSamplerKind::PaddedSobol) {
+            const PaddedRequest r = padded_request(d);
+            return sobol_value(sobol_u32(r.index, 0), 0, r.seeds);
+        }
         if (kind_ == PixelSamplerKind::Sobol) {
             uint32_t v[1];
             const uint64_t seeds = sobol_point(d, 1, v);
@@ -219,6 +256,12 @@ class PixelSampler {
     Vec2 get_2d() {
         int d = dimension_;
         dimension_ += 2;
+        if (kind_ == PixelSamplerKind::PaddedSobol) {
+            const PaddedRequest r = padded_request(d);
+            double u0 = sobol_value(sobol_u32(r.index, 0), 0, r.seeds);
+            double u1 = sobol_value(sobol_u32(r.index, 1), 1, r.seeds);
+            return Vec2(u0, u1);
+        }
         if (kind_ == PixelSamplerKind::Sobol) {
             uint32_t v[2];
             const uint64_t seeds = sobol_point(d, 2, v);
@@ -243,7 +286,7 @@ class PixelSampler {
     /// (1, 3)-sequence: the half of a pixel's 2^m points with the choice below 1/2 is a
     /// (1, m - 1, 2)-net in the other two) instead of a random subset of them.
     ChoiceSample get_choice_2d() {
-        if (kind_ != PixelSamplerKind::Sobol) {
+        if (kind_ != PixelSamplerKind::Sobol && kind_ != PixelSamplerKind::PaddedSobol) {
             ChoiceSample c;
             c.choice = get_1d();
             c.u = get_2d();
@@ -252,7 +295,14 @@ class PixelSampler {
         int d = dimension_;
         dimension_ += 3;
         uint32_t v[3];
-        const uint64_t seeds = sobol_point(d, 3, v);
+        uint64_t seeds;
+        if (kind_ == PixelSamplerKind::PaddedSobol) {
+            const PaddedRequest r = padded_request(d);
+            for (int k = 0; k < 3; ++k) v[k] = sobol_u32(r.index, k);
+            seeds = r.seeds;
+        } else {
+            seeds = sobol_point(d, 3, v);
+        }
         ChoiceSample c;
         double u0 = sobol_value(v[0], 0, seeds);
         double u1 = sobol_value(v[1], 1, seeds);
@@ -263,6 +313,33 @@ class PixelSampler {
 
   private:
     static double clamp_open(double u) { return below_one(u); }
+
+    /// The padded Sobol' sampler's request d for the current sample: the shuffled index of
+    /// the sample in the request's own sequence, and the request's scrambling seeds (keyed by
+    /// the pixel, d, and the index's bits above 32: each block of 2^32 samples is another
+    /// scrambled copy). The first kSobolPreparedRequests requests keep their keys per pixel.
+    struct PaddedRequest {
+        uint32_t index = 0;
+        uint64_t seeds = 0;
+    };
+    PaddedRequest padded_request(int d) {
+        uint64_t key;
+        if (d < kSobolPreparedRequests) {
+            if (!((prepared_ >> d) & 1u)) {
+                padded_keys_[d] = hash_combine(key_, uint64_t(d));
+                prepared_ |= uint64_t(1) << d;
+            }
+            key = padded_keys_[d];
+        } else {
+            key = hash_combine(key_, uint64_t(d));
+        }
+        const uint64_t block = index_ >> 32;
+        if (block != 0) key = hash_combine(key, block);
+        PaddedRequest r;
+        r.index = owen_scramble_u32(uint32_t(index_), uint32_t(mix64(key ^ 0x73687566666c65ULL)));
+        r.seeds = hash_combine(key ^ 0x6f77656e5365656eULL, 0); // "owenSeen"
+        return r;
+    }
 
     /// The stratum of the current sample in dimension d (d < kStratifiedDimensions) of the
     /// stratified sampler: its index through the pixel's permutation of [0, spp) for d, keyed
@@ -386,6 +463,7 @@ class PixelSampler {
                   "one bit of prepared_ per dimension");
     IndexPermutation permutations_[kStratifiedDimensions]; ///< spp > kTableMaxSpp
     SobolRequest sobol_requests_[kSobolPreparedRequests];
+    uint64_t padded_keys_[kSobolPreparedRequests] = {};
     std::vector<uint16_t> strata_; ///< row d: the pixel's shuffled strata of dimension d
 };
 

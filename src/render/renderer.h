@@ -40,8 +40,13 @@ struct RenderDiagnostics {
     /// directly is not random given the camera ray), decreasing: for Hill's tail index.
     std::vector<double> top;
 
+    /// Adds o's counts; top must be a min-heap (as push_top_weight keeps it) and o.top any
+    /// order.
     void merge(const RenderDiagnostics& o);
 };
+
+/// Keeps the kTopWeights largest values pushed in `heap`, a min-heap.
+void push_top_weight(std::vector<double>& heap, double x);
 
 struct RenderImage {
     int width = 0, height = 0;
@@ -67,6 +72,7 @@ struct CameraRays {
 CameraRays camera_rays(const Camera& camera, int width, int height);
 Ray ray_through(const CameraRays& c, double x, double y);
 
+/// The image in one pass (progressive.h) from 0 to settings.spp samples per pixel.
 RenderImage render_image(const RenderScene& rs, const RenderEstimator& est,
                          const RenderSettings& settings);
 
