@@ -22,6 +22,7 @@
 #include "api/mcplay.h"
 #include "cli/cli_support.h"
 #include "cli/lab.h"
+#include "render/pixel_sampler.h"
 #include "render_api/mcplay_render.h"
 
 namespace {
@@ -70,8 +71,9 @@ const char* kUsage =
     "  image, cached in --cache DIR (default $MCPLAY_CACHE, else ~/.cache/mcplay).\n"
     "  --width W, --height H  image size (default from the scene)\n"
     "  --cache DIR | --no-cache  where high-spp references are kept\n"
-    "  --pixel-sampler P    independent, stratified or sobol: every estimator's pixel\n"
-    "                       sampler (run and render; sobol needs a power-of-two spp)\n"
+    "  --pixel-sampler P    independent, stratified, sobol or padded_sobol: every\n"
+    "                       estimator's pixel sampler (run and render; sobol needs a\n"
+    "                       power-of-two spp)\n"
     "  --part I/K           render only replicates r with r % K == I (K <= reps), as JSON\n"
     "                       for merge: K such runs (on K machines) merged give the whole\n"
     "                       study's numbers; merge prints them like run\n"
@@ -257,14 +259,14 @@ struct OutputFile {
 
 /// --pixel-sampler's value: one of the render API's pixel samplers (the API checks it again).
 bool pixel_sampler_option(const std::string& v, nlohmann::json* options, std::string* error) {
-    static const char* const kKnown[] = {"independent", "stratified", "sobol"};
-    for (const char* k : kKnown)
-        if (v == k) {
-            (*options)["pixel_sampler"] = v;
-            return true;
-        }
-    *error = "--pixel-sampler: unknown pixel sampler '" + v +
-             "' (known: independent, stratified, sobol)";
+    mcp::PixelSamplerKind kind;
+    if (mcp::parse_pixel_sampler(v, &kind)) {
+        (*options)["pixel_sampler"] = v;
+        return true;
+    }
+    std::string known;
+    for (const std::string& k : mcp::pixel_sampler_names()) known += (known.empty() ? "" : ", ") + k;
+    *error = "--pixel-sampler: unknown pixel sampler '" + v + "' (known: " + known + ")";
     return false;
 }
 
@@ -447,7 +449,7 @@ int cmd_run(const std::vector<std::string>& args) {
             no_cache = true;
         } else if (a == "--pixel-sampler") {
             if (!value(&v))
-                return usage_error("--pixel-sampler needs independent, stratified or sobol");
+                return usage_error("--pixel-sampler needs independent, stratified, sobol or padded_sobol");
             std::string why;
             if (!pixel_sampler_option(v, &options, &why)) return usage_error(why);
         } else if (a == "--part") {
@@ -567,7 +569,7 @@ int parse_image_command(const char* command, const std::vector<std::string>& arg
             c->options["estimator"] = v;
         } else if (render_only && a == "--pixel-sampler") {
             if (!value(&v))
-                return usage_error("--pixel-sampler needs independent, stratified or sobol");
+                return usage_error("--pixel-sampler needs independent, stratified, sobol or padded_sobol");
             std::string why;
             if (!pixel_sampler_option(v, &c->options, &why)) return usage_error(why);
         } else if (render_only && a == "--error-out") {
