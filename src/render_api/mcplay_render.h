@@ -71,6 +71,55 @@ int mcp_render_image(const char* scene_json, const char* options_json, char** re
  * takes them. */
 int mcp_render_pixel_points(const char* request_json, char** points_json);
 
+/* The live view: images that converge pass by pass (render/progressive.h). A session holds one
+ * scene, 1 to 4 estimators and, for the rows [row_begin, row_end) of an image of width x height
+ * pixels, each estimator's running pixel moments; a pass adds samples to one estimator's band.
+ * Bands of one image rendered in several sessions (the page's workers) merge into the image one
+ * session rendering every row gives, bit for bit, and passes to 1, 2, 4, ... spp leave the image
+ * a one-shot render of that spp gives (same seed, estimator and pixel sampler).
+ *
+ * mcp_render_live_open: the scene JSON and options as mcp_render_image's (width, height, seed,
+ * threads, exposure, reference_data, base_dir, cache_dir, pixel_sampler), and
+ *   estimators: names from the scene or estimator objects, 1 to 4 (default the scene's first
+ *     four);
+ *   pixel_sampler: "padded_sobol" (default) or "independent": the samplers whose samples do not
+ *     depend on the final spp ("stratified" and "sobol" are refused, saying why);
+ *   long_side: without width and height, the image's longer side (16..4096, default 256), the
+ *     other from the camera's aspect ratio (the glTF's aspectRatio, else the scene's width /
+ *     height; refused beyond 8:1);
+ *   rows: [row_begin, row_end] (default every row);
+ *   live_reference: "obtain" (default: the reference as a study obtains it, rendered and cached
+ *     when there is no other; progress lines {"kind": "render_reference", "rows_done", "rows"},
+ *     non-zero return cancels) or "available" (only a file, options.reference_data or the cache:
+ *     never rendered; the session then has none until mcp_render_live_reference gives one);
+ *   pixels: true to return float32 pixels (below).
+ * Result: {"version", "kind": "render_live", "session" (an integer > 0), "scene", "width",
+ * "height", "rows": [begin, end], "pixel_sampler", "stream_seed", "estimators": [objects], "reference":
+ * null or {"source", "spp", "mean_luminance", "relative_mse_floor", "rgb_f32" (with pixels: the
+ * band's reference, base64 little-endian float32 RGB, rows from row_begin)}, "warnings"}.
+ *
+ * mcp_render_live_pass: pass_json {"estimator": index (0-based, in the session's list), "spp":
+ * the samples per pixel the band is taken to (more than it has; at most 2^20), "pixels": bool,
+ * "outputs": any of "png", "hdr" (the band as image files, base64, for the CLI)}. Result:
+ * {"estimator", "spp", "seconds" (the band's rendering time over all its passes), "pass_seconds",
+ * "samples", "rays", "discarded_nonfinite", "dominated_pixels", "rows", "error": null (no
+ * reference) or {"sum", "sum_raw", "terms"} (the band's sums of the relative MSE's terms against
+ * the reference, docs/result-schema.md: the image's relative MSE is the sum over bands of "sum"
+ * divided by the sum of "terms"), "rgb_f32" (with pixels), "images" (with outputs)}. A cancelled
+ * pass (progress returns non-zero: one line {"kind": "render_live_pass", "rows_done", "rows"}
+ * per row) fails with MCP_ERROR_CANCELLED and the estimator's band takes no more passes.
+ *
+ * mcp_render_live_reference: gives a session its reference: reference_json {"reference_data":
+ * mcp_render_reference's, made at the session's image size}; result as the open's "reference".
+ * mcp_render_live_close: frees a session (unknown ids are an error). At most 16 sessions are
+ * open at once. */
+int mcp_render_live_open(const char* scene_json, const char* options_json, mcp_progress_fn progress,
+                         void* user, char** result_json);
+int mcp_render_live_pass(int session, const char* pass_json, mcp_progress_fn progress, void* user,
+                         char** result_json);
+int mcp_render_live_reference(int session, const char* reference_json, char** result_json);
+int mcp_render_live_close(int session);
+
 /* What a render scene holds: triangles, lights, materials, camera, accelerator, loader
  * warnings, estimators and settings. */
 int mcp_render_scene_info(const char* scene_json, const char* options_json, char** info_json);
