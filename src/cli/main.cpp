@@ -36,7 +36,7 @@ const char* kUsage =
     "  mcplay list [--scenes DIR]\n"
     "  mcplay run SCENE [options]\n"
     "  mcplay render SCENE [--estimator NAME] [--spp N] --out FILE [render options]\n"
-    "  mcplay reference SCENE --out FILE.mcref [--width W] [--height H] [--threads T]\n"
+    "  mcplay reference SCENE --out FILE.mcref [--live] [--width W] [--height H] [--threads T]\n"
     "  mcplay merge PART.json... [--format F] [--out FILE]\n"
     "  mcplay points SAMPLER --n N [--dim D] [--seed S] [--randomization R] [--out FILE.csv]\n"
     "  mcplay analyze FILE.csv|FILE.json [--format table|json] [--spectrum-out FILE.png]\n"
@@ -86,7 +86,8 @@ const char* kUsage =
     "  reference renders (or takes from the cache) the scene's reference image alone and\n"
     "  writes it to --out: a study given it (options.reference_data) renders none, if it was\n"
     "  made from the same glTF, name, image size and reference settings (the site ships\n"
-    "  its scenes' references this way)\n"
+    "  its scenes' references this way); --live: the reference of the live view (render\n"
+    "  --progressive) at its default size and reference spp\n"
     "\n"
     "sampler lab (docs/sampler-lab.md):\n"
     "  points writes the points a sampler draws as CSV (x1,...,xD header, one point per row):\n"
@@ -265,7 +266,8 @@ bool pixel_sampler_option(const std::string& v, nlohmann::json* options, std::st
         return true;
     }
     std::string known;
-    for (const std::string& k : mcp::pixel_sampler_names()) known += (known.empty() ? "" : ", ") + k;
+    for (const std::string& k : mcp::pixel_sampler_names())
+        known += (known.empty() ? "" : ", ") + k;
     *error = "--pixel-sampler: unknown pixel sampler '" + v + "' (known: " + known + ")";
     return false;
 }
@@ -449,7 +451,8 @@ int cmd_run(const std::vector<std::string>& args) {
             no_cache = true;
         } else if (a == "--pixel-sampler") {
             if (!value(&v))
-                return usage_error("--pixel-sampler needs independent, stratified, sobol or padded_sobol");
+                return usage_error(
+                    "--pixel-sampler needs independent, stratified, sobol or padded_sobol");
             std::string why;
             if (!pixel_sampler_option(v, &options, &why)) return usage_error(why);
         } else if (a == "--part") {
@@ -541,13 +544,14 @@ int cmd_run(const std::vector<std::string>& args) {
 /// What `render` and `reference` are told: the scene, the files and the options the C API gets.
 struct ImageCommand {
     std::string scene_arg, out_path, error_path, dir_arg, cache_arg, format = "summary";
-    bool no_cache = false, quiet = false;
+    bool no_cache = false, quiet = false, live = false;
     nlohmann::json options = nlohmann::json::object();
 };
 
 /// Parses the arguments of `command` (render or reference): `counts` are its whole-number
 /// options (--spp, --width, ...), `render_only` adds --estimator, --pixel-sampler and
-/// --error-out. Returns -1 when the arguments are good, else the exit code of the usage error.
+/// --error-out; `reference` takes --live. Returns -1 when the arguments are good, else the exit
+/// code of the usage error.
 int parse_image_command(const char* command, const std::vector<std::string>& args,
                         const std::vector<std::string>& counts, bool render_only, ImageCommand* c) {
     for (size_t i = 0; i < args.size(); ++i) {
@@ -567,9 +571,12 @@ int parse_image_command(const char* command, const std::vector<std::string>& arg
         } else if (render_only && a == "--estimator") {
             if (!value(&v)) return usage_error("--estimator needs a name");
             c->options["estimator"] = v;
+        } else if (!render_only && a == "--live") {
+            c->live = true;
         } else if (render_only && a == "--pixel-sampler") {
             if (!value(&v))
-                return usage_error("--pixel-sampler needs independent, stratified, sobol or padded_sobol");
+                return usage_error(
+                    "--pixel-sampler needs independent, stratified, sobol or padded_sobol");
             std::string why;
             if (!pixel_sampler_option(v, &c->options, &why)) return usage_error(why);
         } else if (render_only && a == "--error-out") {
@@ -709,6 +716,8 @@ int cmd_reference(const std::vector<std::string>& args) {
     const bool no_cache = c.no_cache, quiet = c.quiet;
     nlohmann::json& options = c.options;
     if (out_path.empty()) return usage_error("reference needs --out FILE.mcref");
+    // --live: the live view's reference (its default size and reference spp)
+    if (c.live) options["live"] = true;
     std::string path, text, error;
     if (!load_scene(scene_arg, dir_arg, &path, &text)) return kExitScene;
     if (!is_render_scene_text(text))
