@@ -24,6 +24,18 @@
 //   curve    {request}                      curved    {curve}         (core.discrepancyCurve)
 //   integratePoints {scene, request}        integrated {result}       (core.integratePoints)
 //   warpTest {scene, options}               warpTested {result}       (core.warpTest)
+//   reference {scene, options}              referenceRows {progress} x N, then
+//                                           referenced {reference} (render core: reference,
+//                                                     mcp_render_reference; the live view's
+//                                                     reference at its size, in the background)
+//   liveOpen {scene, options}               liveOpened {session}      (render core: liveOpen; the
+//                                                     band's reference pixels as
+//                                                     session.reference.rgb, a Float32Array)
+//   livePass {session, pass}                livePassed {pass}         (render core: livePass; the
+//                                                     band's pixels as pass.rgb, a Float32Array,
+//                                                     transferred, not base64)
+//   liveReference {session, reference}      liveReferenced {reference} (render core: liveReference)
+//   liveClose {session}                     liveClosed {}             (render core: liveClose)
 //   any request                             error     {status, statusName, message, field?, position?}
 //
 // A render scene (one with a "render" object: isRenderScene) goes to the render core
@@ -61,6 +73,17 @@ export const MSG = Object.freeze({
   INTEGRATED: 'integrated',
   WARP_TEST: 'warpTest',
   WARP_TESTED: 'warpTested',
+  REFERENCE: 'reference',
+  REFERENCE_ROWS: 'referenceRows',
+  REFERENCED: 'referenced',
+  LIVE_OPEN: 'liveOpen',
+  LIVE_OPENED: 'liveOpened',
+  LIVE_PASS: 'livePass',
+  LIVE_PASSED: 'livePassed',
+  LIVE_REFERENCE: 'liveReference',
+  LIVE_REFERENCED: 'liveReferenced',
+  LIVE_CLOSE: 'liveClose',
+  LIVE_CLOSED: 'liveClosed',
   ERROR: 'error',
 });
 
@@ -79,7 +102,24 @@ export const FINAL_REPLY = Object.freeze({
   [MSG.CURVE]: MSG.CURVED,
   [MSG.INTEGRATE_POINTS]: MSG.INTEGRATED,
   [MSG.WARP_TEST]: MSG.WARP_TESTED,
+  [MSG.REFERENCE]: MSG.REFERENCED,
+  [MSG.LIVE_OPEN]: MSG.LIVE_OPENED,
+  [MSG.LIVE_PASS]: MSG.LIVE_PASSED,
+  [MSG.LIVE_REFERENCE]: MSG.LIVE_REFERENCED,
+  [MSG.LIVE_CLOSE]: MSG.LIVE_CLOSED,
 });
+
+/** Little-endian float32 values from base64 (the render core's rgb_f32); an empty array for
+ *  none. Runs in the worker, so the page gets a Float32Array it can take over (transfer). */
+export function float32OfBase64(text) {
+  if (typeof text !== 'string' || !text.length) return new Float32Array(0);
+  const bin = atob(text);
+  if (bin.length % 4) throw new Error(`rgb_f32: ${bin.length} bytes is not a whole number of float32 values`);
+  const bytes = new Uint8Array(bin.length);
+  for (let i = 0; i < bin.length; ++i) bytes[i] = bin.charCodeAt(i);
+  // wasm and every browser are little-endian: the bytes are the Float32Array's own
+  return new Float32Array(bytes.buffer);
+}
 
 /** True for a render scene (an object, or JSON text of one, with a "render" key), the test
  *  the C API applies (is_render_scene); anything else goes to the integration core. */

@@ -11,7 +11,7 @@
 // message; nothing is thrown out of a handler.
 import createMcplay from '../mcplay_web.mjs';
 import { loadCore } from '../core.js';
-import { MSG, message, errorPayload, isRenderScene } from './protocol.js';
+import { MSG, message, errorPayload, isRenderScene, float32OfBase64 } from './protocol.js';
 
 const ready = loadCore(createMcplay);
 ready.catch(() => {}); // reported to each request below, not as an unhandled rejection
@@ -28,8 +28,19 @@ function renderCore() {
   return renderReady;
 }
 
-function reply(id, type, payload) {
-  self.postMessage(message(id, type, payload));
+function reply(id, type, payload, transfer = []) {
+  self.postMessage(message(id, type, payload), transfer);
+}
+
+// The live view's pixels: the core's base64 rgb_f32 becomes `rgb`, a Float32Array whose buffer
+// is transferred to the page (no copy, no base64 on the page's thread).
+function withPixels(block, transfer) {
+  if (!block || typeof block !== 'object') return block;
+  const { rgb_f32: b64, ...rest } = block;
+  if (typeof b64 !== 'string') return rest;
+  const rgb = float32OfBase64(b64);
+  transfer.push(rgb.buffer);
+  return { ...rest, rgb };
 }
 
 // A small image of each estimator before a render study, for the same reason as the
@@ -129,6 +140,42 @@ const handlers = {
   },
   [MSG.WARP_TEST](core, id, { scene, options = null }) {
     reply(id, MSG.WARP_TESTED, { result: core.warpTest(scene, options) });
+  },
+  // The live view (render scenes): a reference rendered in the background (its rows as they
+  // finish, at most one line per percent), and the sessions of one band each, pass by pass.
+  async [MSG.REFERENCE](core, id, { scene, options = null }) {
+    const render = await renderCore();
+    let last = -1;
+    const reference = render.reference(scene, options, (p) => {
+      const pct = p && p.rows ? Math.floor((100 * p.rows_done) / p.rows) : 0;
+      if (pct !== last) {
+        last = pct;
+        reply(id, MSG.REFERENCE_ROWS, { progress: p });
+      }
+    });
+    reply(id, MSG.REFERENCED, { reference });
+  },
+  async [MSG.LIVE_OPEN](core, id, { scene, options = null }) {
+    const render = await renderCore();
+    const session = render.liveOpen(scene, options);
+    const transfer = [];
+    session.reference = withPixels(session.reference, transfer);
+    reply(id, MSG.LIVE_OPENED, { session }, transfer);
+  },
+  async [MSG.LIVE_PASS](core, id, { session, pass }) {
+    const render = await renderCore();
+    const transfer = [];
+    reply(id, MSG.LIVE_PASSED, { pass: withPixels(render.livePass(session, pass), transfer) }, transfer);
+  },
+  async [MSG.LIVE_REFERENCE](core, id, { session, reference }) {
+    const render = await renderCore();
+    const transfer = [];
+    reply(id, MSG.LIVE_REFERENCED, { reference: withPixels(render.liveReference(session, reference), transfer) }, transfer);
+  },
+  async [MSG.LIVE_CLOSE](core, id, { session }) {
+    const render = await renderCore();
+    render.liveClose(session);
+    reply(id, MSG.LIVE_CLOSED, {});
   },
 };
 

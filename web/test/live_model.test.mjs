@@ -1,0 +1,189 @@
+// The live view's pure parts (web/src/live/model.js): bands, the pass schedule, merging bands
+// into levels (pixels, relative MSE, seconds), tone mapping, the error colours, the wipe, zoom
+// and the prediction, and the reducer.
+import { test } from 'node:test';
+import assert from 'node:assert/strict';
+import {
+  splitRows, workerOfBand, nextSpp, sppSchedule, createCollector, relativeMse, estimatorSeconds, toneMap, srgbEncode,
+  errorColor, errorMap, wipeFromPointer, wipeClip, commonSpp, zoomStep, fitZoom, predictionText, predictSeconds,
+  duration, oneLine, liveWorkers, defaultEstimators, sessionOptions, initialLive, liveReducer, liveActive, LONG_SECONDS,
+} from '../src/live/model.js';
+
+test('row bands cover every row exactly once, in order, sizes within one row', () => {
+  for (const h of [1, 2, 3, 7, 16, 144, 180, 576, 1024]) {
+    for (const k of [1, 2, 3, 4, 8, 16]) {
+      const bands = splitRows(h, k);
+      assert.equal(bands.length, Math.min(h, k), `h ${h} k ${k}`);
+      const seen = new Uint8Array(h);
+      let row = 0;
+      for (const [b, e] of bands) {
+        assert.equal(b, row, 'bands follow each other');
+        assert.ok(e > b, 'no empty band');
+        for (let r = b; r < e; ++r) seen[r] += 1;
+        row = e;
+      }
+      assert.equal(row, h);
+      assert.ok(seen.every((v) => v === 1), `h ${h} k ${k}: every row once`);
+      const sizes = bands.map(([b, e]) => e - b);
+      assert.ok(Math.max(...sizes) - Math.min(...sizes) <= 1);
+    }
+  }
+  assert.deepEqual(splitRows(0, 4), []);
+  assert.deepEqual(splitRows(10, 3), [[0, 4], [4, 7], [7, 10]]);
+  assert.deepEqual([0, 1, 2, 3, 4].map((i) => workerOfBand(i, 2)), [0, 1, 0, 1, 0]);
+});
+
+test('the pass schedule doubles from 1 spp', () => {
+  assert.equal(nextSpp(0), 1);
+  assert.equal(nextSpp(1), 2);
+  assert.equal(nextSpp(64), 128);
+  assert.deepEqual(sppSchedule(64), [1, 2, 4, 8, 16, 32, 64]);
+  assert.deepEqual(sppSchedule(100), [1, 2, 4, 8, 16, 32, 64]);
+  assert.deepEqual(sppSchedule(0), []);
+});
+
+test('workers: hardwareConcurrency, at most 4, an override wins', () => {
+  assert.equal(liveWorkers(2), 2);
+  assert.equal(liveWorkers(16), 4);
+  assert.equal(liveWorkers(undefined), 1);
+  assert.equal(liveWorkers(16, 2), 2);
+  assert.equal(liveWorkers(2, 9), 4);
+  assert.deepEqual(defaultEstimators(['a', 'b', 'c', 'd', 'e']), ['a', 'b', 'c', 'd']);
+  const o = sessionOptions({ estimators: ['bsdf'], sampler: 'padded_sobol', longSide: 256, rows: [0, 10], referenceData: 'QQ==', seed: 3 });
+  assert.deepEqual(o, { estimators: ['bsdf'], pixel_sampler: 'padded_sobol', long_side: 256, rows: [0, 10],
+    live_reference: 'available', pixels: true, threads: 1, reference_data: 'QQ==', seed: 3 });
+  assert.equal('reference_data' in sessionOptions({ estimators: [], sampler: 'independent', longSide: 128, rows: [0, 1] }), false);
+});
+
+test('the collector places bands by rows and merges relative MSE from the band sums', () => {
+  const width = 3;
+  const height = 5;
+  const bands = splitRows(height, 3); // [0,2) [2,4) [4,5)
+  const c = createCollector({ width, height, bands, workers: 2 });
+  const band = (i, v, error, seconds) => {
+    const [b, e] = bands[i];
+    return { spp: 4, rgb: new Float32Array((e - b) * width * 3).fill(v), error, seconds };
+  };
+  assert.equal(c.add(0, 2, band(2, 3, { sum: 1, terms: 3 }, 0.5)), null);
+  assert.equal(c.add(0, 0, band(0, 1, { sum: 2, terms: 6 }, 1.0)), null);
+  assert.equal(c.pendingLevels(), 1);
+  const level = c.add(0, 1, band(1, 2, { sum: 3, terms: 6 }, 1.5));
+  assert.equal(c.pendingLevels(), 0);
+  assert.equal(level.spp, 4);
+  // (1 + 2 + 3) / (3 + 6 + 6), not the mean of the bands' ratios
+  assert.equal(level.relmse, 6 / 15);
+  assert.notEqual(level.relmse, (1 / 3 + 2 / 6 + 3 / 6) / 3);
+  assert.equal(level.seconds, 3 / 2);
+  for (let row = 0; row < height; ++row) {
+    const want = row < 2 ? 1 : row < 4 ? 2 : 3;
+    for (let k = 0; k < width * 3; ++k) assert.equal(level.rgb[row * width * 3 + k], want, `row ${row}`);
+  }
+  // a band without a reference: the level has no relative MSE (but its image)
+  c.add(1, 0, band(0, 1, null, 1));
+  c.add(1, 1, band(1, 1, { sum: 1, terms: 1 }, 1));
+  assert.equal(c.add(1, 2, band(2, 1, { sum: 1, terms: 1 }, 1)).relmse, null);
+  // a band twice, or of the wrong size, is refused
+  c.add(0, 0, { spp: 8, rgb: new Float32Array(2 * width * 3), error: null, seconds: 0 });
+  assert.throws(() => c.add(0, 0, { spp: 8, rgb: new Float32Array(2 * width * 3), error: null, seconds: 0 }), /twice/);
+  assert.throws(() => c.add(0, 1, { spp: 8, rgb: new Float32Array(5), error: null, seconds: 0 }), /expected 18/);
+  assert.equal(relativeMse([{ sum: 1, terms: 2 }, { sum: 3, terms: 2 }]), 1);
+  assert.equal(relativeMse([{ sum: 1, terms: 2 }, null]), null);
+  assert.equal(relativeMse([{ sum: 0, terms: 0 }]), null);
+  assert.equal(estimatorSeconds([1, 2, 3, 4], 2), 5);
+});
+
+test('tone mapping: exposure, clamping, sRGB like the core, not a number black', () => {
+  const out = new Uint8ClampedArray(4 * 4);
+  toneMap(new Float32Array([0, 0.5, 1, 2, -1, NaN, 0.0031308, 0.25, 0.18, 0.5, 0.5, 0.5]), out, 0);
+  assert.deepEqual([...out.slice(0, 4)], [0, Math.round(srgbEncode(0.5) * 255), 255, 255]);
+  assert.deepEqual([...out.slice(4, 8)], [255, 0, 0, 255]);
+  assert.equal(out[8], Math.round(12.92 * 0.0031308 * 255));
+  assert.equal(out[9], 137); // sRGB of 0.25
+  // exposure +1 doubles: 0.25 shows as 0.5
+  const two = new Uint8ClampedArray(4);
+  toneMap(new Float32Array([0.25, 0.25, 0.25]), two, 1);
+  assert.equal(two[0], Math.round(srgbEncode(0.5) * 255));
+  assert.equal(out[12], Math.round(srgbEncode(0.5) * 255));
+});
+
+test('error colours: log scale 1e-3 dark blue to 1 yellow, magenta for not a number', () => {
+  assert.deepEqual(errorColor(1e-5), errorColor(1e-3));
+  assert.deepEqual(errorColor(1e-3), [18, 5, 77]);
+  assert.deepEqual(errorColor(1), [252, 232, 38]);
+  assert.deepEqual(errorColor(100), [252, 232, 38]);
+  assert.deepEqual(errorColor(NaN), [255, 0, 255]);
+  // monotone in green along the ramp's first half
+  assert.ok(errorColor(0.01)[1] > errorColor(0.002)[1]);
+  const ref = new Float32Array([1, 1, 1, 1, 1, 1]);
+  const img = new Float32Array([1, 1, 1, 2, 2, 2]);
+  const out = errorMap(img, ref, new Uint8ClampedArray(8));
+  assert.deepEqual([...out.slice(0, 4)], [...errorColor(0), 255]);
+  // |2 - 1| / (1 + 0.01): about 1, yellow
+  assert.deepEqual([...out.slice(4, 8)], [...errorColor(1 / 1.01), 255]);
+});
+
+test('the wipe: pointer to percent, clip-path, the spp both images have', () => {
+  assert.equal(wipeFromPointer(150, 100, 200), 25);
+  assert.equal(wipeFromPointer(50, 100, 200), 0);
+  assert.equal(wipeFromPointer(400, 100, 200), 100);
+  assert.equal(wipeFromPointer(150, 100, 0), 50);
+  assert.equal(wipeClip(25), 'inset(0 0 0 25%)');
+  assert.equal(wipeClip(-3), 'inset(0 0 0 0%)');
+  assert.equal(wipeClip(33.333), 'inset(0 0 0 33.33%)');
+  assert.equal(commonSpp([1, 2, 4, 8], [1, 2, 4]), 4);
+  assert.equal(commonSpp([1, 2], [1, 2, 4, 8]), 2);
+  assert.equal(commonSpp([], [1]), null);
+  assert.equal(commonSpp(null, [1, 2]), 2);
+  assert.equal(commonSpp([4, 8], null), 8);
+});
+
+test('zoom steps and the default zoom', () => {
+  assert.equal(zoomStep(1, 1), 2);
+  assert.equal(zoomStep(1, -1), 1);
+  assert.equal(zoomStep(16, 1), 16);
+  assert.equal(zoomStep(5, 1), 8);
+  assert.equal(fitZoom(128, 2, 1200), 4);
+  assert.equal(fitZoom(1024, 4, 1200), 1);
+});
+
+test('the prediction to 64 spp from the first pass, and its words', () => {
+  assert.equal(predictSeconds(0.05), 3.2);
+  const short = predictionText(0.05, 256, 144);
+  assert.equal(short.long, false);
+  assert.match(short.text, /256 × 144 pixels: the first pass took 50 ms, so 64 spp will take about 3\.2 s\.$/);
+  const long = predictionText(1, 1024, 576);
+  assert.equal(long.long, 64 > LONG_SECONDS);
+  assert.match(long.text, /about 1 min 4 s\. Paused/);
+  assert.equal(duration(0.0004), '1 ms');
+  assert.equal(duration(42), '42 s');
+  assert.equal(duration(7200), '2.0 h');
+  assert.equal(oneLine('options.long_side: 5000 is beyond 4096\n  detail'), 'options.long_side: 5000 is beyond 4096');
+});
+
+test('the reducer: a view starts, takes levels (curves only with a relative MSE), pauses, ends; old views are ignored', () => {
+  let s = initialLive();
+  s = liveReducer(s, { type: 'live/start', payload: { id: 1, order: ['bsdf', 'mis_power'], colors: { bsdf: 2, mis_power: 6 }, workers: 2, startedAt: 100 } });
+  assert.equal(s.status, 'starting');
+  assert.equal(liveActive(s), true);
+  assert.deepEqual([s.view.wipeA, s.view.wipeB], ['bsdf', 'mis_power']);
+  s = liveReducer(s, { type: 'live/opened', payload: { id: 1, size: { width: 256, height: 144 } } });
+  assert.equal(s.status, 'running');
+  s = liveReducer(s, { type: 'live/level', payload: { id: 1, estimator: 'bsdf', spp: 1, seconds: 0.1, relmse: null, now: 350 } });
+  assert.equal(s.firstImageMs, 250);
+  assert.deepEqual(s.estimators.bsdf.points, []);
+  s = liveReducer(s, { type: 'live/level', payload: { id: 1, estimator: 'bsdf', spp: 2, seconds: 0.2, relmse: 0.5, now: 400 } });
+  assert.deepEqual(s.estimators.bsdf.points, [{ spp: 2, seconds: 0.2, relmse: 0.5 }]);
+  assert.deepEqual(s.estimators.bsdf.levels, [1, 2]);
+  assert.equal(s.firstImageMs, 250);
+  const stale = liveReducer(s, { type: 'live/level', payload: { id: 0, estimator: 'bsdf', spp: 4, seconds: 1, relmse: 0.1, now: 1 } });
+  assert.equal(stale, s);
+  s = liveReducer(s, { type: 'live/prediction', payload: { id: 1, prediction: { long: true, text: 'long' } } });
+  assert.equal(s.status, 'paused');
+  s = liveReducer(s, { type: 'live/resume', payload: { id: 1 } });
+  assert.equal(s.status, 'running');
+  s = liveReducer(s, { type: 'live/cancel', payload: { id: 1 } });
+  assert.equal(s.status, 'cancelled');
+  assert.equal(liveActive(s), false);
+  s = liveReducer(s, { type: 'live/error', payload: { id: 1, message: 'options.long_side: 9999 beyond 4096\nmore' } });
+  assert.equal(s.message, 'options.long_side: 9999 beyond 4096');
+});
