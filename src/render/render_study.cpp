@@ -80,6 +80,36 @@ ImageError image_error(const RenderImage& image, const RenderImage& reference) {
     return e;
 }
 
+ErrorSums band_error_sums(const RenderImage& band, const RenderImage& reference, int row_begin) {
+    ErrorSums s;
+    const double scale = reference_scale(reference);
+    const size_t first = size_t(std::max(row_begin, 0)) * size_t(reference.width);
+    const size_t available = reference.pixel_count() > first ? reference.pixel_count() - first : 0;
+    const size_t n = std::min(band.pixel_count(), available);
+    s.terms = 3 * uint64_t(n);
+    if (!(scale > 0.0)) {
+        s.sum = s.sum_raw = NAN;
+        return s;
+    }
+    // The terms of image_error, in the same order.
+    for (size_t p = 0; p < n; ++p) {
+        double pixel_raw = 0.0;
+        for (size_t c = 0; c < 3; ++c) {
+            const size_t k = 3 * p + c, kr = 3 * (first + p) + c;
+            const double d = band.rgb[k] - reference.rgb[kr];
+            const double v_ref =
+                std::isfinite(reference.variance[kr]) ? reference.variance[kr] : 0.0;
+            const double ds = d / scale, r = reference.rgb[kr] / scale;
+            const double vs = v_ref / scale / scale;
+            const double denom = r * r + kRelEps;
+            pixel_raw += ds * ds / denom;
+            s.sum += (ds * ds - vs) / denom;
+        }
+        s.sum_raw += pixel_raw;
+    }
+    return s;
+}
+
 double mean_luminance(const RenderImage& image, double* se) {
     size_t n = image.pixel_count();
     double dn = n ? double(n) : 1.0;

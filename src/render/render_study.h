@@ -71,6 +71,17 @@ struct ImageError {
 };
 ImageError image_error(const RenderImage& image, const RenderImage& reference);
 
+/// The relative MSE's sums over the rows of one band of an image (band: width x rows pixels,
+/// its row 0 the reference's row `row_begin`), with the whole reference's mean luminance as the
+/// scale: bands' sums add up, and the image's relMSE is (sum of sum) / (sum of terms), its raw
+/// one (sum of sum_raw) / (sum of terms); a black reference gives NaN sums. For the whole image
+/// (row_begin 0) sum / terms is image_error's rel_mse.
+struct ErrorSums {
+    double sum = 0.0, sum_raw = 0.0;
+    uint64_t terms = 0; ///< pixel channels: 3 per pixel
+};
+ErrorSums band_error_sums(const RenderImage& band, const RenderImage& reference, int row_begin);
+
 /// What a level keeps of one image.
 struct ImageSummary {
     ImageError error;

@@ -60,6 +60,9 @@ struct Camera {
     Vec3 position{0.0};
     Vec3 right{1.0, 0.0, 0.0}, up{0.0, 1.0, 0.0}, forward{0.0, 0.0, -1.0}; ///< orthonormal
     double yfov = 0.8; ///< vertical field of view, radians
+    /// The glTF's aspectRatio (width / height) when it gives one, else 0: the live view's
+    /// image shape (a render's own width and height decide its rays).
+    double aspect_ratio = 0.0;
 };
 
 struct Scene {

@@ -174,6 +174,10 @@ bool Converter::set_camera(int index, int node, const Mat4& world) {
     cam.right = right;
     cam.up = glm::cross(right, forward);
     cam.yfov = yfov;
+    const double aspect = c.perspective.aspectRatio;
+    if (aspect != 0.0 && !(aspect > 0.0 && std::isfinite(aspect)))
+        return log_.fail(where + ": aspectRatio " + num(aspect) + " is not positive");
+    cam.aspect_ratio = aspect;
     r_.has_camera = true;
     return true;
 }

@@ -56,6 +56,18 @@ int mcp_render_scene_info(const char* scene_json, const char* options_json, char
     j["reference"] = Json{{"estimator", estimator_to_json(l.request->reference.estimator)},
                           {"spp", l.request->reference.spp},
                           {"file", l.request->reference.file}};
+    // The live view's default image (mcp_render_live_open), or why the scene has none.
+    const Camera& camera = l.request->scene->camera;
+    j["camera"] = Json{
+        {"aspect_ratio", camera.aspect_ratio > 0.0 ? Json(camera.aspect_ratio) : Json(nullptr)},
+        {"yfov", camera.yfov}};
+    int live_width = 0, live_height = 0;
+    std::string why;
+    if (live_image_size(camera, l.request->settings.width, l.request->settings.height,
+                        kLiveDefaultLongSide, &live_width, &live_height, &why))
+        j["live_size"] = Json{{"width", live_width}, {"height", live_height}};
+    else
+        j["live_size"] = Json{{"error", why}};
     *info_json = copy_out(dump(j));
     if (!*info_json) return fail(MCP_ERROR_INTERNAL, "out of memory");
     return boundary::succeed();
@@ -165,7 +177,10 @@ int mcp_render_image(const char* scene_json, const char* options_json, char** re
     rs.width = r.settings.width;
     rs.height = r.settings.height;
     rs.spp = spp;
-    rs.stream = replicate_stream(r.settings.seed, est.name, spp, 0);
+    // A sampler that extends keys the image by the seed and estimator alone (spp 0), as the
+    // live view's passes do: its image at N spp is the live view's at N spp, bit for bit.
+    rs.stream = replicate_stream(r.settings.seed, est.name,
+                                 sampler_extends(est.pixel_sampler) ? 0 : spp, 0);
     rs.threads = resolve_threads(r.settings.threads);
     rs.jitter_pixels = r.settings.jitter_pixels;
     RenderImage image = render_image(l.scene, est, rs);

@@ -71,7 +71,7 @@ std::string reference_cache_file(const RenderRequest& r) {
 }
 
 bool obtain_reference(const LoadedRender& l, RenderImage* ref, Json* info, std::string* error,
-                      const ReferenceProgress& progress) {
+                      const ReferenceProgress& progress, bool may_render) {
     const RenderRequest& r = *l.request;
     const RenderStudySettings& s = r.settings;
     if (!r.reference.file.empty()) {
@@ -120,6 +120,11 @@ bool obtain_reference(const LoadedRender& l, RenderImage* ref, Json* info, std::
         (*info)["file"] = cache_file;
         return true;
     }
+    if (!may_render) {
+        *ref = RenderImage();
+        (*info)["source"] = "none";
+        return true;
+    }
     RenderSettings rs;
     rs.width = s.width;
     rs.height = s.height;
@@ -143,9 +148,10 @@ bool obtain_reference(const LoadedRender& l, RenderImage* ref, Json* info, std::
 }
 
 int obtain_reference_reporting(const LoadedRender& l, mcp_progress_fn progress, void* user,
-                               RenderImage* ref, Json* info, std::string* error) {
+                               RenderImage* ref, Json* info, std::string* error, bool may_render) {
     bool cancelled = false;
-    if (obtain_reference(l, ref, info, error, reference_progress(progress, user, &cancelled)))
+    if (obtain_reference(l, ref, info, error, reference_progress(progress, user, &cancelled),
+                         may_render))
         return MCP_OK;
     return cancelled ? MCP_ERROR_CANCELLED : MCP_ERROR_SCENE;
 }

@@ -28,13 +28,16 @@ using ReferenceProgress = std::function<bool(int rows_done, int rows)>;
 
 /// The reference image: read from the scene's HDR file, taken from options.reference_data
 /// when it was made from the same scene and settings, read from the cache, or rendered (and
-/// then cached). `source` says which; a supplied reference that is not used says why.
+/// then cached). `source` says which; a supplied reference that is not used says why. With
+/// may_render false, a reference that would have to be rendered is not: true with `source`
+/// "none" and an empty image (width 0).
 bool obtain_reference(const LoadedRender& l, RenderImage* ref, Json* info, std::string* error,
-                      const ReferenceProgress& progress = nullptr);
+                      const ReferenceProgress& progress = nullptr, bool may_render = true);
 
 /// obtain_reference for a C API call with a progress callback: MCP_OK, or the status to fail
 /// with (MCP_ERROR_CANCELLED when the callback stopped it, else MCP_ERROR_SCENE; `error` says).
 int obtain_reference_reporting(const LoadedRender& l, mcp_progress_fn progress, void* user,
-                               RenderImage* ref, Json* info, std::string* error);
+                               RenderImage* ref, Json* info, std::string* error,
+                               bool may_render = true);
 
 } // namespace mcp

@@ -6,7 +6,8 @@
 #include <cmath>
 
 #include "api/files.h"
-#include "api/scene.h" // parse_json
+#include "api/report.h" // fmt
+#include "api/scene.h"  // parse_json
 #include "core/rng.h"
 #include "render_api/gltf_scene.h"
 #include "render_api/image_io.h"
@@ -190,6 +191,28 @@ bool parse_estimator_list(Ctx& c, const Json& list, const std::string& path,
 
 } // namespace
 
+bool live_image_size(const Camera& camera, int scene_width, int scene_height, int long_side,
+                     int* width, int* height, std::string* error) {
+    const bool from_camera = camera.aspect_ratio > 0.0;
+    const double aspect =
+        from_camera ? camera.aspect_ratio
+                    : double(std::max(scene_width, 1)) / double(std::max(scene_height, 1));
+    if (!(aspect <= kLiveMaxAspect && aspect >= 1.0 / kLiveMaxAspect)) {
+        *error = std::string(from_camera ? "the glTF camera's aspectRatio"
+                                         : "the scene's width / height") +
+                 " is " + fmt("%.4g", aspect) +
+                 ", beyond the live view's 8:1 either way: give "
+                 "options.width and options.height";
+        return false;
+    }
+    const auto shorter = [&](double ratio) {
+        return std::max(1, int(std::lround(double(long_side) * ratio)));
+    };
+    *width = aspect >= 1.0 ? long_side : shorter(aspect);
+    *height = aspect >= 1.0 ? shorter(1.0 / aspect) : long_side;
+    return true;
+}
+
 bool is_render_scene(const Json& scene) {
     return scene.is_object() && scene.contains("render");
 }
@@ -222,8 +245,20 @@ Made<std::shared_ptr<RenderRequest>> build_render_request(const Json& scene, con
                      "spp_max",   "reps",          "seed",     "threads",       "estimators",
                      "reference", "jitter_pixels", "exposure", "accel",         "estimator",
                      "spp",       "outputs",       "previews", "pixel_sampler", "reference_data",
-                     "part",      "parts"}))
+                     "part",      "parts",         "live",     "long_side"}))
         return error();
+    bool live = false;
+    if (const Json* v = find(opts, "live")) {
+        if (!v->is_boolean()) {
+            c.fail("options.live", "expected true or false");
+            return error();
+        }
+        live = v->get<bool>();
+    }
+    if (find(opts, "long_side") && (!live || find(opts, "width") || find(opts, "height")))
+        return made_error<std::shared_ptr<RenderRequest>>(
+            "options.long_side: sizes the live view's image (with live: true), without width "
+            "and height");
     std::string base_dir = ".", reference_data;
     if (!get_string(c, opts, "base_dir", "options", &base_dir) ||
         !get_string(c, opts, "cache_dir", "options", &r->cache_dir) ||
@@ -293,7 +328,22 @@ Made<std::shared_ptr<RenderRequest>> build_render_request(const Json& scene, con
     }
     if (!parse_settings(c, render, rp, r.get())) return error();
     const uint64_t scene_spp_max = r->settings.spp_max;
+    const int scene_width = r->settings.width, scene_height = r->settings.height;
     if (!parse_settings(c, opts, "options", r.get())) return error();
+    // The live view's size: the longer side given (or the default), the other from the
+    // camera's aspect, unless width and height are given.
+    if (live && !find(opts, "width") && !find(opts, "height")) {
+        uint64_t long_side = kLiveDefaultLongSide;
+        if (!get_count(c, opts, "long_side", "options", &long_side)) return error();
+        if (long_side < uint64_t(kLiveMinLongSide) || long_side > uint64_t(kLiveMaxLongSide))
+            return made_error<std::shared_ptr<RenderRequest>>(
+                "options.long_side: " + std::to_string(long_side) + " is not in " +
+                std::to_string(kLiveMinLongSide) + ".." + std::to_string(kLiveMaxLongSide));
+        std::string why;
+        if (!live_image_size(r->scene->camera, scene_width, scene_height, int(long_side),
+                             &r->settings.width, &r->settings.height, &why))
+            return made_error<std::shared_ptr<RenderRequest>>(why);
+    }
     // A part of a study split over processes (mcp_render_study_merge).
     uint64_t part = 0, parts = 1;
     if (!get_count(c, opts, "part", "options", &part) ||
@@ -392,6 +442,9 @@ Made<std::shared_ptr<RenderRequest>> build_render_request(const Json& scene, con
         if (!parse_reference(c, *ref, "options.reference", "", root, &r->reference)) return error();
         if (find(*ref, "spp")) ref_spp_field = "options.reference.spp";
     }
+    // The live view's reference: at most kLiveReferenceSpp, unless the options give its spp.
+    if (live && ref_spp_field != "options.reference.spp")
+        r->reference.spp = std::min(r->reference.spp, kLiveReferenceSpp);
     if (r->reference.file.empty()) {
         std::string why =
             check_pixel_sampler_spp(r->reference.estimator.pixel_sampler, r->reference.spp);

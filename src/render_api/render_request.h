@@ -36,6 +36,21 @@ struct RenderRequest {
     std::string supplied_reference;
 };
 
+/// The live view (mcp_render_live_open, options.live): its image's longer side by default and
+/// its bounds, the largest camera aspect ratio it takes (either way), and its reference's spp
+/// at most (the scene's reference spp when lower): 256 spp at the live size keep a site's
+/// shipped references to about a minute of rendering for all bundled scenes.
+constexpr int kLiveDefaultLongSide = 256;
+constexpr int kLiveMinLongSide = 16, kLiveMaxLongSide = 4096;
+constexpr double kLiveMaxAspect = 8.0;
+constexpr uint64_t kLiveReferenceSpp = 256;
+
+/// The live view's image size for a longer side of `long_side` pixels: the camera's aspect
+/// ratio (the glTF's aspectRatio, else the scene's width / height), the shorter side rounded
+/// and at least 1. False (and why) for an aspect beyond kLiveMaxAspect either way.
+bool live_image_size(const Camera& camera, int scene_width, int scene_height, int long_side,
+                     int* width, int* height, std::string* error);
+
 /// Does this scene JSON describe a render scene (it has a "render" object)?
 bool is_render_scene(const Json& scene);
 
