@@ -20,7 +20,8 @@ export { McplayError, Status };
 export const RENDER_WASM_FUNCTIONS = Object.freeze([
   '_malloc', '_free',
   '_mcp_version', '_mcp_last_error', '_mcp_render_study_run', '_mcp_render_study_plan', '_mcp_render_image',
-  '_mcp_render_scene_info', '_mcp_render_study_merge', '_mcp_render_pixel_points', '_mcp_free',
+  '_mcp_render_scene_info', '_mcp_render_study_merge', '_mcp_render_pixel_points', '_mcp_render_reference',
+  '_mcp_render_live_open', '_mcp_render_live_pass', '_mcp_render_live_reference', '_mcp_render_live_close', '_mcp_free',
   '_mallinfo',
 ]);
 
@@ -123,7 +124,68 @@ function makeRenderCore(M) {
       [b.jsonText(request, 'request')]);
   }
 
+  /**
+   * The study's reference image alone (mcp_render_reference): options as runStudy's (width,
+   * height, reference_data, ...). onProgress({kind: "render_reference", rows_done, rows}), when
+   * given, hears the rows while it renders; returning exactly `true` cancels (McplayError
+   * CANCELLED). Returns {kind: "render_reference", spp, width, height, reference_data, ...}.
+   */
+  function reference(scene, options = null, onProgress = null) {
+    const r = b.study('reference', M._mcp_render_reference, 'mcp_render_reference', scene, options, onProgress);
+    if (!r || r.kind !== 'render_reference') throw new McplayError(Status.CANCELLED, 'reference: cancelled');
+    return r;
+  }
+
+  // A call whose first argument is a session id: (session, inputs..., extra..., out).
+  function sessionCall(what, fn, fnName, session, inputs, extra = []) {
+    b.usable(what);
+    if (!Number.isInteger(session) || session <= 0) {
+      throw new McplayError(Status.ARGUMENT, `${what}: session must be an integer > 0, got ${session}`);
+    }
+    const r = b.callOut((...args) => fn(session, ...args), inputs, extra);
+    return JSON.parse(b.textOf(r, fnName));
+  }
+
+  /**
+   * Opens a live session (mcp_render_live_open): one scene, 1 to 4 estimators, the rows
+   * options.rows = [begin, end] of an image of options.long_side (or width x height) pixels;
+   * options {estimators, pixel_sampler: "padded_sobol" | "independent", long_side, rows,
+   * live_reference: "available" | "obtain", reference_data, pixels, seed, threads}. Returns
+   * {kind: "render_live", session, width, height, rows, estimators, reference: null or
+   * {source, spp, mean_luminance, relative_mse_floor, rgb_f32?}, warnings}. Throws McplayError.
+   */
+  function liveOpen(scene, options = null) {
+    b.usable('liveOpen');
+    return b.callJson('liveOpen', (...a) => M._mcp_render_live_open(a[0], a[1], 0, 0, a[2]), 'mcp_render_live_open',
+      [b.jsonText(scene, 'scene'), b.optionalJson(options, 'options')]);
+  }
+
+  /**
+   * One pass of a session (mcp_render_live_pass): pass {estimator: index, spp: the band's new
+   * total, pixels: bool}. Returns {estimator, spp, seconds (the band's, all its passes),
+   * pass_seconds, samples, error: null | {sum, sum_raw, terms}, rgb_f32?, ...}.
+   */
+  function livePass(session, pass) {
+    return sessionCall('livePass', M._mcp_render_live_pass, 'mcp_render_live_pass', session,
+      [b.jsonText(pass, 'pass')], [0, 0]);
+  }
+
+  /** Gives a session its reference (mcp_render_live_reference): {reference_data} made at the
+   *  session's image size. Returns the session's reference block (as liveOpen's "reference"). */
+  function liveReference(session, reference) {
+    return sessionCall('liveReference', M._mcp_render_live_reference, 'mcp_render_live_reference', session,
+      [b.jsonText(reference, 'reference')]);
+  }
+
+  /** Frees a session (mcp_render_live_close); unknown ids throw. */
+  function liveClose(session) {
+    b.usable('liveClose');
+    const status = M._mcp_render_live_close(session);
+    if (status !== Status.OK) throw new McplayError(status, M.UTF8ToString(M._mcp_last_error()) || `liveClose: status ${status}`);
+  }
+
   return Object.freeze({
-    version: b.version, sceneInfo, plan, runStudy, renderImage, mergeParts, pixelPoints, heapStats: b.heapStats, dispose: b.dispose,
+    version: b.version, sceneInfo, plan, runStudy, renderImage, mergeParts, pixelPoints,
+    reference, liveOpen, livePass, liveReference, liveClose, heapStats: b.heapStats, dispose: b.dispose,
   });
 }

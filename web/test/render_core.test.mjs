@@ -478,3 +478,62 @@ test('pixelPoints: one pixel\'s samples (a Sobol\' pixel stratified as a (0, 6, 
   assertMcplayError(() => core.pixelPoints({ pixel_sampler: 'independent', spp: 4, dim: 3 }), Status.ARGUMENT, /^request\.dim: expected 2, 4, 6 or 8/);
   assertMcplayError(() => core.pixelPoints({ pixel_sampler: 'blue' }), Status.ARGUMENT, /^request\.pixel_sampler: unknown pixel sampler 'blue'/);
 });
+
+// The live view (web/src/live/): an image split in row bands over sessions (the page's workers)
+// merges into the image one session gives, float for float; the relative MSE of the merged bands
+// (sum of their sums over the sum of their terms) is the one session's; a reference rendered by
+// reference() with options.live and given to sessions (liveReference) is the one they measure with.
+const { float32OfBase64 } = await import('../src/protocol.js');
+const { splitRows, createCollector, relativeMse } = await import('../src/live/model.js');
+
+test('live sessions: two bands merge into the one-session image exactly, pass after pass', async () => {
+  const core = await getCore();
+  const scene = siteScene(JSON.parse(fs.readFileSync(path.join(ROOT, 'scenes', 'quad_light_floor.json'), 'utf8')),
+    path.join(ROOT, 'scenes')).scene;
+  const info = core.sceneInfo(scene);
+  const base = { estimators: ['bsdf', 'mis_power'], pixel_sampler: 'padded_sobol', long_side: 16, pixels: true, threads: 1,
+    live_reference: 'available', seed: 7 };
+  const whole = core.liveOpen(scene, base);
+  assert.equal(whole.kind, 'render_live');
+  assert.equal(Math.max(whole.width, whole.height), 16);
+  assert.ok(info.live_size && info.live_size.width > 0, 'scene info gives the live size');
+  const { width, height } = whole;
+  const bands = splitRows(height, 2);
+  assert.deepEqual(bands, [[0, height / 2], [height / 2, height]]);
+  const parts = bands.map((rows) => core.liveOpen(scene, { ...base, rows }));
+  parts.forEach((p, i) => assert.deepEqual(p.rows, bands[i]));
+  // a reference at the live size, given to every session
+  const ref = core.reference(scene, { live: true, long_side: 16 });
+  assert.equal(ref.width, width);
+  assert.equal(ref.height, height);
+  const given = [whole, ...parts].map((s) => core.liveReference(s.session, { reference_data: ref.reference_data }));
+  const refWhole = float32OfBase64(given[0].rgb_f32);
+  assert.equal(refWhole.length, width * height * 3);
+  const refMerged = new Float32Array(width * height * 3);
+  given.slice(1).forEach((g, i) => refMerged.set(float32OfBase64(g.rgb_f32), bands[i][0] * width * 3));
+  assert.deepEqual(refMerged, refWhole, 'the bands\' reference pixels are the whole reference\'s');
+  const collector = createCollector({ width, height, bands, workers: 2 });
+  for (const spp of [1, 2, 4, 8]) {
+    for (let e = 0; e < 2; ++e) {
+      const one = core.livePass(whole.session, { estimator: e, spp, pixels: true });
+      assert.equal(one.spp, spp);
+      const rgb = float32OfBase64(one.rgb_f32);
+      assert.equal(rgb.length, width * height * 3);
+      let level = null;
+      parts.forEach((p, b) => {
+        const pass = core.livePass(p.session, { estimator: e, spp, pixels: true });
+        assert.ok(pass.error && pass.error.terms > 0, 'a band with a reference has error sums');
+        level = collector.add(e, b, { ...pass, rgb: float32OfBase64(pass.rgb_f32) }) || level;
+      });
+      assert.ok(level, `estimator ${e} at ${spp} spp: every band in`);
+      assert.deepEqual(level.rgb, rgb, `estimator ${e} at ${spp} spp: merged bands = one session, float for float`);
+      const whole1 = relativeMse([one.error]);
+      assert.ok(Math.abs(level.relmse - whole1) <= 1e-12 * whole1, `relMSE ${level.relmse} vs ${whole1}`);
+    }
+  }
+  // the sampler that cannot extend is refused, saying why; an extreme size is one clear error
+  assertMcplayError(() => core.liveOpen(scene, { ...base, pixel_sampler: 'stratified' }), Status.ARGUMENT, /stratified/);
+  assertMcplayError(() => core.liveOpen(scene, { ...base, long_side: 100000 }), Status.ARGUMENT, /long_side/);
+  for (const s of [whole, ...parts]) core.liveClose(s.session);
+  assert.throws(() => core.liveClose(whole.session), McplayError);
+});
