@@ -158,6 +158,62 @@ if ! cmp -s "$tmp/q.mcref" "$tmp/q2.mcref"; then
 fi
 check reference-no-out 2 'reference needs --out' -- reference quad_light_floor
 check reference-integral 2 'reference is for render scenes' -- reference exp_1d --out "$tmp/x.mcref"
+check reference-live 0 'quad_light_floor: reference 16x16 at [0-9]+ spp' -- reference quad_light_floor --live --long-side 16 --out "$tmp/live.mcref" --cache "$tmp/livecache"
+if [ "$(head -c 8 "$tmp/live.mcref")" != "MCREF02" ]; then
+    echo "FAIL reference-live: $tmp/live.mcref does not start with the magic"; failed=$((failed + 1))
+fi
+check reference-long-side-not-live 2 '--long-side sizes the live view.s reference: it needs --live' -- reference quad_light_floor --long-side 16 --out "$tmp/x.mcref"
+
+# Progressive renders (the live view's progression): each estimator in passes to 1, 2, 4 spp,
+# a PNG and an HDR and one JSON line at each; the reference from the cache reference-live filled.
+check progressive 0 '"spp":4' -- render quad_light_floor --progressive --spp 4 --long-side 16 --out-dir "$tmp/prog" --cache "$tmp/livecache" --quiet
+if node -e '
+const fs = require("fs"), [out, dir] = process.argv.slice(1);
+const lines = fs.readFileSync(out, "utf8").trim().split("\n").map((l) => JSON.parse(l));
+const names = ["uniform_hemisphere", "cosine_hemisphere", "bsdf", "light_area"]; // the first four
+const bad = (why) => { console.error(why); process.exit(1); };
+if (lines.length !== 12) bad(`${lines.length} lines, expected 12`);
+for (const name of names) {
+  const mine = lines.filter((l) => l.estimator === name);
+  if (mine.map((l) => l.spp).join() !== "1,2,4") bad(`${name}: spp ${mine.map((l) => l.spp)}`);
+  for (const l of mine) {
+    if (!(Number.isFinite(l.relative_mse) && l.relative_mse >= 0)) bad(`${name}: relative_mse ${l.relative_mse}`);
+    if (!Number.isFinite(l.relative_mse_raw) || !Number.isFinite(l.seconds)) bad(`${name}: ${JSON.stringify(l)}`);
+    if (l.width !== 16 || l.height !== 16) bad(`${name}: ${l.width}x${l.height}, expected 16x16`);
+    const png = `${dir}/${name}_${l.spp}spp.png`, hdr = `${dir}/${name}_${l.spp}spp.hdr`;
+    if (l.png !== png || l.hdr !== hdr) bad(`${name}: files ${l.png} ${l.hdr}`);
+    if (fs.readFileSync(png).subarray(1, 4).toString() !== "PNG") bad(`${png} is not a PNG`);
+    if (fs.readFileSync(hdr).subarray(0, 10).toString() !== "#?RADIANCE") bad(`${hdr} is not an HDR`);
+  }
+  if (!(mine[2].seconds >= mine[0].seconds)) bad(`${name}: seconds fall`);
+}
+' "$tmp/out" "$tmp/prog"; then
+    passed=$((passed + 1))
+else
+    echo "FAIL progressive-output: not 1, 2, 4 spp images and JSON lines for each estimator"; failed=$((failed + 1))
+fi
+# The 4 spp image of the passes is the one-shot 4 spp image (same seed, size and pixel sampler).
+check progressive-one-estimator 0 '"estimator":"mis_power","spp":4' -- render quad_light_floor --progressive --spp 4 --estimator mis_power --width 12 --height 8 --out-dir "$tmp/prog1" --no-cache --quiet
+check progressive-one-shot 0 '' -- render quad_light_floor --estimator mis_power --spp 4 --pixel-sampler padded_sobol --width 12 --height 8 --out "$tmp/oneshot.hdr" --no-cache
+if ! cmp -s "$tmp/prog1/mis_power_4spp.hdr" "$tmp/oneshot.hdr"; then
+    echo "FAIL progressive-equals-one-shot: the 4 spp pass image differs from a 4 spp render"; failed=$((failed + 1))
+fi
+touch "$tmp/afile"
+prog=(quad_light_floor --progressive --spp 4 --no-cache)
+check progressive-no-out-dir 2 '--progressive needs --out-dir DIR' -- render "${prog[@]}"
+check progressive-with-out 2 '--progressive writes its images to --out-dir' -- render "${prog[@]}" --out-dir "$tmp/p" --out "$tmp/x.png"
+check progressive-spp 2 '--spp: --progressive needs a power of two, got 100 \(the nearest are 64 and 128\)' -- render quad_light_floor --progressive --spp 100 --out-dir "$tmp/p"
+check progressive-no-spp 2 '--progressive needs --spp N' -- render quad_light_floor --progressive --out-dir "$tmp/p"
+check progressive-integral 2 "--progressive is for render scenes; 'exp_1d' is an integral" -- render exp_1d --progressive --spp 4 --out-dir "$tmp/p"
+check progressive-five 2 '--estimators: at most 4 side by side, got 5' -- render "${prog[@]}" --out-dir "$tmp/p" --estimators bsdf,light_area,mis_power,mis_balance,cosine_hemisphere
+check progressive-long-side-small 2 '--long-side: expected 16 to 4096 pixels, got 8' -- render "${prog[@]}" --out-dir "$tmp/p" --long-side 8
+check progressive-long-side-large 2 '--long-side: expected 16 to 4096 pixels, got 5000' -- render "${prog[@]}" --out-dir "$tmp/p" --long-side 5000
+check progressive-long-side-and-width 2 '--long-side or --width and --height' -- render "${prog[@]}" --out-dir "$tmp/p" --long-side 16 --width 8 --height 8
+check progressive-out-dir-file 2 "--out-dir: '$tmp/afile' exists and is not a directory" -- render "${prog[@]}" --out-dir "$tmp/afile"
+check progressive-out-dir-deep 2 "--out-dir: cannot create '$tmp/no/such'" -- render "${prog[@]}" --out-dir "$tmp/no/such"
+check progressive-stratified 2 "the 'stratified' sampler cannot .*use 'padded_sobol' or 'independent'" -- render "${prog[@]}" --out-dir "$tmp/p" --long-side 16 --pixel-sampler stratified
+if [ -e "$tmp/p" ]; then echo "FAIL progressive-out-dir-removed: $tmp/p left behind by a failed run"; failed=$((failed + 1)); else passed=$((passed + 1)); fi
+check progressive-options-alone 2 '--out-dir, --estimators and --long-side are for --progressive' -- render quad_light_floor --long-side 16 --out "$tmp/x.png"
 
 # A study split over runs (machines) by replicate: `run --part I/K --format json` writes the
 # parts, `merge` gives the whole study's numbers (seconds aside), as the table run prints.

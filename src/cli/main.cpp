@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -12,6 +13,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -36,7 +38,10 @@ const char* kUsage =
     "  mcplay list [--scenes DIR]\n"
     "  mcplay run SCENE [options]\n"
     "  mcplay render SCENE [--estimator NAME] [--spp N] --out FILE [render options]\n"
-    "  mcplay reference SCENE --out FILE.mcref [--live] [--width W] [--height H] [--threads T]\n"
+    "  mcplay render SCENE --progressive --spp N --out-dir DIR [--estimators A,B,..]\n"
+    "                [--long-side L | --width W --height H] [render options]\n"
+    "  mcplay reference SCENE --out FILE.mcref [--live [--long-side L]] [--width W] [--height H]\n"
+    "                [--threads T]\n"
     "  mcplay merge PART.json... [--format F] [--out FILE]\n"
     "  mcplay points SAMPLER --n N [--dim D] [--seed S] [--randomization R] [--out FILE.csv]\n"
     "  mcplay analyze FILE.csv|FILE.json [--format table|json] [--spectrum-out FILE.png]\n"
@@ -83,11 +88,21 @@ const char* kUsage =
     "  --estimator NAME (default the scene's best: MIS with the power heuristic, or path\n"
     "  tracing with MIS for a path scene), --spp N (default the scene's spp_max),\n"
     "  --seed S, --threads T, --format json (print the result JSON instead of a summary)\n"
+    "  render --progressive writes the live view's progression: each estimator (--estimators,\n"
+    "  at most 4, or --estimator; default the scene's first four) is rendered in passes to 1,\n"
+    "  2, 4, ... N spp (--spp, a power of two), never restarting; at each power of two its\n"
+    "  image goes to DIR/<estimator>_<spp>spp.png and .hdr (--out-dir DIR, created if missing)\n"
+    "  and one JSON line to standard output: estimator, spp, seconds, relative_mse,\n"
+    "  relative_mse_raw (null without a reference), width, height, png, hdr. The size:\n"
+    "  --long-side L (16..4096, default 256; the other side from the camera's aspect) or\n"
+    "  --width and --height; --pixel-sampler padded_sobol (default) or independent (the\n"
+    "  samplers that extend; stratified and sobol depend on the final spp). The reference is\n"
+    "  obtained as run obtains it (cache, else rendered, with progress on standard error)\n"
     "  reference renders (or takes from the cache) the scene's reference image alone and\n"
     "  writes it to --out: a study given it (options.reference_data) renders none, if it was\n"
     "  made from the same glTF, name, image size and reference settings (the site ships\n"
     "  its scenes' references this way); --live: the reference of the live view (render\n"
-    "  --progressive) at its default size and reference spp\n"
+    "  --progressive) at its default size (or --long-side L) and its reference spp\n"
     "\n"
     "sampler lab (docs/sampler-lab.md):\n"
     "  points writes the points a sampler draws as CSV (x1,...,xD header, one point per row):\n"
@@ -362,10 +377,16 @@ int progress_line(const char* level_json, void*) {
     nlohmann::json j = nlohmann::json::parse(level_json, nullptr, false);
     if (j.is_discarded()) return 0;
     if (j["kind"] == "render_reference") {
-        // A reference being rendered: one line per tenth of its rows.
+        // A reference being rendered: one line per tenth of its rows (rows finish out of order
+        // on several threads, so rows_done may step over a tenth).
+        static int last_tenth = 0;
         const int done = j["rows_done"].get<int>(), rows = std::max(1, j["rows"].get<int>());
-        if ((10 * done) / rows != (10 * (done - 1)) / rows)
-            std::fprintf(stderr, "mcplay: reference %d%% rendered\n", 100 * done / rows);
+        const int tenth = (10 * done) / rows;
+        if (done <= 1) last_tenth = 0;
+        if (tenth > last_tenth) {
+            last_tenth = tenth;
+            std::fprintf(stderr, "mcplay: reference %d%% rendered\n", 10 * tenth);
+        }
         return 0;
     }
     std::fprintf(stderr, "mcplay: N = %s done\n", j["n"].dump().c_str());
@@ -543,15 +564,15 @@ int cmd_run(const std::vector<std::string>& args) {
 
 /// What `render` and `reference` are told: the scene, the files and the options the C API gets.
 struct ImageCommand {
-    std::string scene_arg, out_path, error_path, dir_arg, cache_arg, format = "summary";
-    bool no_cache = false, quiet = false, live = false;
+    std::string scene_arg, out_path, error_path, out_dir, dir_arg, cache_arg, format;
+    bool no_cache = false, quiet = false, progressive = false, live = false;
     nlohmann::json options = nlohmann::json::object();
 };
 
 /// Parses the arguments of `command` (render or reference): `counts` are its whole-number
-/// options (--spp, --width, ...), `render_only` adds --estimator, --pixel-sampler and
-/// --error-out; `reference` takes --live. Returns -1 when the arguments are good, else the exit
-/// code of the usage error.
+/// options (--spp, --width, ...), `render_only` adds --estimator, --estimators,
+/// --pixel-sampler, --error-out, --progressive and --out-dir; `reference` takes --live.
+/// Returns -1 when the arguments are good, else the exit code of the usage error.
 int parse_image_command(const char* command, const std::vector<std::string>& args,
                         const std::vector<std::string>& counts, bool render_only, ImageCommand* c) {
     for (size_t i = 0; i < args.size(); ++i) {
@@ -567,10 +588,31 @@ int parse_image_command(const char* command, const std::vector<std::string>& arg
             unsigned long long x = 0;
             if (!parse_count(v, &x))
                 return usage_error(a + ": expected a whole number, got '" + v + "'");
-            c->options[a.substr(2)] = x;
+            std::string key = a.substr(2);
+            std::replace(key.begin(), key.end(), '-', '_');
+            c->options[key] = x;
         } else if (render_only && a == "--estimator") {
             if (!value(&v)) return usage_error("--estimator needs a name");
             c->options["estimator"] = v;
+        } else if (render_only && a == "--estimators") {
+            if (!value(&v))
+                return usage_error("--estimators needs a comma-separated list of names");
+            nlohmann::json list = nlohmann::json::array();
+            std::stringstream ss(v);
+            std::string item;
+            while (std::getline(ss, item, ',')) {
+                if (item.empty()) return usage_error("--estimators: empty name in '" + v + "'");
+                for (const auto& seen : list)
+                    if (seen == item)
+                        return usage_error("--estimators: '" + item + "' is named twice");
+                list.push_back(item);
+            }
+            if (list.empty()) return usage_error("--estimators needs at least one name");
+            c->options["estimators"] = list;
+        } else if (render_only && a == "--progressive") {
+            c->progressive = true;
+        } else if (render_only && a == "--out-dir") {
+            if (!value(&c->out_dir)) return usage_error("--out-dir needs a directory");
         } else if (!render_only && a == "--live") {
             c->live = true;
         } else if (render_only && a == "--pixel-sampler") {
@@ -608,12 +650,203 @@ int parse_image_command(const char* command, const std::vector<std::string>& arg
     return -1;
 }
 
+/// A live session of the render C API, closed when it goes out of scope.
+struct LiveSession {
+    int id = 0;
+    ~LiveSession() {
+        if (id > 0) mcp_render_live_close(id);
+    }
+};
+
+/// A file name's part for an estimator name: letters, digits, '-', '_' and '.' kept, the rest '_'.
+std::string file_stem(const std::string& name) {
+    std::string out;
+    for (char ch : name)
+        out += std::isalnum(static_cast<unsigned char>(ch)) || ch == '-' || ch == '_' || ch == '.'
+                   ? ch
+                   : '_';
+    return out.empty() || out[0] == '.' ? "estimator" + out : out;
+}
+
+/// --long-side (the live view's image size): 16..4096, not with --width or --height. Returns -1
+/// when it is good or absent, else the exit code of the usage error.
+int check_long_side(const nlohmann::json& options) {
+    if (!options.contains("long_side")) return -1;
+    const unsigned long long side = options["long_side"].get<unsigned long long>();
+    if (side < 16 || side > 4096)
+        return usage_error("--long-side: expected 16 to 4096 pixels, got " + std::to_string(side));
+    if (options.contains("width") || options.contains("height"))
+        return usage_error("--long-side or --width and --height: give one of them");
+    return -1;
+}
+
+/// The largest spp a progressive pass takes (mcp_render_live_pass's limit).
+constexpr unsigned long long kMaxLiveSpp = 1ull << 20;
+
+/// `mcplay render SCENE --progressive --spp N --out-dir DIR`: the live view's progression.
+/// Each estimator's image is taken pass by pass to 1, 2, 4, ..., N spp (the estimators in turn,
+/// so that a run stopped early leaves them all at one spp); at each power of two its PNG and HDR
+/// go to DIR/<estimator>_<spp>spp.png|.hdr and one JSON line to standard output.
+int cmd_render_progressive(ImageCommand& c) {
+    nlohmann::json& options = c.options;
+    if (c.out_dir.empty()) return usage_error("--progressive needs --out-dir DIR");
+    if (!c.out_path.empty() || !c.error_path.empty())
+        return usage_error(
+            "--out and --error-out write one image; --progressive writes its images to --out-dir");
+    if (!c.format.empty())
+        return usage_error("--format: --progressive prints one JSON line per image");
+    if (!options.contains("spp"))
+        return usage_error("--progressive needs --spp N, a power of two (the last pass)");
+    const unsigned long long spp = options["spp"].get<unsigned long long>();
+    if (spp == 0 || (spp & (spp - 1)) != 0) {
+        unsigned long long below = 1;
+        while (below * 2 <= spp) below *= 2;
+        return usage_error("--spp: --progressive needs a power of two, got " + std::to_string(spp) +
+                           (spp == 0 ? std::string(" (the nearest is 1)")
+                                     : " (the nearest are " + std::to_string(below) + " and " +
+                                           std::to_string(below * 2) + ")"));
+    }
+    if (spp > kMaxLiveSpp)
+        return usage_error("--spp: --progressive takes at most " + std::to_string(kMaxLiveSpp) +
+                           ", got " + std::to_string(spp));
+    options.erase("spp");
+    if (options.contains("estimator") && options.contains("estimators"))
+        return usage_error("--estimator and --estimators: give one of them");
+    if (options.contains("estimator")) {
+        options["estimators"] = nlohmann::json::array({options["estimator"]});
+        options.erase("estimator");
+    }
+    if (options.contains("estimators") && options["estimators"].size() > 4)
+        return usage_error("--estimators: at most 4 side by side, got " +
+                           std::to_string(options["estimators"].size()));
+    if (int rc = check_long_side(options); rc >= 0) return rc;
+    if (options.contains("width") != options.contains("height"))
+        return usage_error(
+            "--progressive takes --width and --height together (or --long-side alone)");
+
+    std::string path, text;
+    if (!load_scene(c.scene_arg, c.dir_arg, &path, &text)) return kExitScene;
+    if (!is_render_scene_text(text))
+        return usage_error("--progressive is for render scenes; '" + c.scene_arg +
+                           "' is an integral");
+    std::string dir = c.out_dir;
+    while (dir.size() > 1 && dir.back() == '/') dir.pop_back();
+    // Created up front (a long reference render must not end in "cannot create"), and removed
+    // again when the session cannot be opened.
+    struct CreatedDir {
+        std::string path;
+        ~CreatedDir() {
+            if (!path.empty()) ::rmdir(path.c_str()); // only when still empty
+        }
+    } created;
+    if (path_exists(dir)) {
+        if (!mcp::is_directory(dir))
+            return usage_error("--out-dir: '" + dir + "' exists and is not a directory");
+    } else if (::mkdir(dir.c_str(), 0755) != 0) {
+        return usage_error("--out-dir: cannot create '" + dir + "': " + std::strerror(errno));
+    } else {
+        created.path = dir;
+    }
+
+    options["base_dir"] = dirname_of(path);
+    if (!c.no_cache) {
+        std::string cache = cache_dir(c.cache_arg);
+        if (!cache.empty()) options["cache_dir"] = cache;
+    }
+    options["live_reference"] = "obtain";
+    char* result = nullptr;
+    int status = mcp_render_live_open(text.c_str(), options.dump().c_str(),
+                                      c.quiet ? nullptr : progress_line, nullptr, &result);
+    if (status != MCP_OK) {
+        std::fprintf(stderr, "mcplay: %s: %s\n", mcp::boundary::one_line(path).c_str(),
+                     mcp_last_error());
+        return exit_code(status);
+    }
+    nlohmann::json open = nlohmann::json::parse(result, nullptr, false);
+    mcp_free(result);
+    if (open.is_discarded() || !open["session"].is_number_integer()) return kExitRuntime;
+    LiveSession session{open["session"].get<int>()};
+    created.path.clear();
+    const int width = open["width"].get<int>(), height = open["height"].get<int>();
+    if (!c.quiet)
+        for (const auto& w : open["warnings"])
+            if (w.is_object() && w["message"].is_string())
+                std::fprintf(stderr, "mcplay: WARNING: %s\n",
+                             mcp::boundary::one_line(w["message"].get<std::string>()).c_str());
+
+    // Each estimator's name, and the stem of its files (made unique).
+    std::vector<std::string> names, stems;
+    for (const auto& e : open["estimators"]) {
+        const std::string name = e.is_object() && e["name"].is_string()
+                                     ? e["name"].get<std::string>()
+                                     : "estimator" + std::to_string(names.size());
+        std::string stem = file_stem(name);
+        if (std::find(stems.begin(), stems.end(), stem) != stems.end())
+            stem += "_" + std::to_string(names.size());
+        names.push_back(name);
+        stems.push_back(stem);
+    }
+    for (unsigned long long s = 1; s <= spp; s *= 2) {
+        for (size_t i = 0; i < names.size(); ++i) {
+            const nlohmann::json pass = {
+                {"estimator", i}, {"spp", s}, {"outputs", nlohmann::json::array({"png", "hdr"})}};
+            status =
+                mcp_render_live_pass(session.id, pass.dump().c_str(), nullptr, nullptr, &result);
+            if (status != MCP_OK) {
+                std::fprintf(stderr, "mcplay: %s: %s at %llu spp: %s\n",
+                             mcp::boundary::one_line(path).c_str(),
+                             mcp::boundary::one_line(names[i]).c_str(), s, mcp_last_error());
+                return exit_code(status);
+            }
+            nlohmann::json r = nlohmann::json::parse(result, nullptr, false);
+            mcp_free(result);
+            if (r.is_discarded() || !r["images"].is_object()) return kExitRuntime;
+            const std::string base = dir + "/" + stems[i] + "_" + std::to_string(s) + "spp";
+            for (const char* kind : {"png", "hdr"}) {
+                const std::string file = base + "." + kind;
+                if (!r["images"][kind].is_string() ||
+                    !write_file(file, base64_decode(r["images"][kind].get<std::string>()))) {
+                    std::fprintf(stderr, "mcplay: cannot write '%s'\n",
+                                 mcp::boundary::one_line(file).c_str());
+                    return kExitRuntime;
+                }
+            }
+            nlohmann::ordered_json line = {{"estimator", names[i]},
+                                           {"spp", s},
+                                           {"seconds", r["seconds"]},
+                                           {"relative_mse", nullptr},
+                                           {"relative_mse_raw", nullptr},
+                                           {"width", width},
+                                           {"height", height},
+                                           {"png", base + ".png"},
+                                           {"hdr", base + ".hdr"}};
+            const nlohmann::json& error = r["error"];
+            if (error.is_object() && error["terms"].is_number() &&
+                error["terms"].get<double>() > 0) {
+                const double terms = error["terms"].get<double>();
+                for (const auto& [key, field] :
+                     {std::pair<const char*, const char*>{"sum", "relative_mse"},
+                      {"sum_raw", "relative_mse_raw"}})
+                    if (error[key].is_number() && std::isfinite(error[key].get<double>()))
+                        line[field] = error[key].get<double>() / terms;
+            }
+            std::printf("%s\n", line.dump().c_str());
+            std::fflush(stdout);
+        }
+    }
+    return kExitOk;
+}
+
 int cmd_render(const std::vector<std::string>& args) {
     ImageCommand c;
     if (int rc = parse_image_command(
-            "render", args, {"--spp", "--width", "--height", "--seed", "--threads"}, true, &c);
+            "render", args, {"--spp", "--width", "--height", "--seed", "--threads", "--long-side"},
+            true, &c);
         rc >= 0)
         return rc;
+    if (c.progressive) return cmd_render_progressive(c);
+    if (!c.out_dir.empty() || c.options.contains("estimators") || c.options.contains("long_side"))
+        return usage_error("--out-dir, --estimators and --long-side are for --progressive");
     // --quiet is accepted as for run: a single render prints no progress lines anyway
     const std::string &scene_arg = c.scene_arg, &out_path = c.out_path, &error_path = c.error_path,
                       &dir_arg = c.dir_arg, &cache_arg = c.cache_arg, &format = c.format;
@@ -707,8 +940,8 @@ int cmd_render(const std::vector<std::string>& args) {
 
 int cmd_reference(const std::vector<std::string>& args) {
     ImageCommand c;
-    if (int rc =
-            parse_image_command("reference", args, {"--width", "--height", "--threads"}, false, &c);
+    if (int rc = parse_image_command(
+            "reference", args, {"--width", "--height", "--threads", "--long-side"}, false, &c);
         rc >= 0)
         return rc;
     const std::string &scene_arg = c.scene_arg, &out_path = c.out_path, &dir_arg = c.dir_arg,
@@ -718,6 +951,9 @@ int cmd_reference(const std::vector<std::string>& args) {
     if (out_path.empty()) return usage_error("reference needs --out FILE.mcref");
     // --live: the live view's reference (its default size and reference spp)
     if (c.live) options["live"] = true;
+    if (options.contains("long_side") && !c.live)
+        return usage_error("--long-side sizes the live view's reference: it needs --live");
+    if (int rc = check_long_side(options); rc >= 0) return rc;
     std::string path, text, error;
     if (!load_scene(scene_arg, dir_arg, &path, &text)) return kExitScene;
     if (!is_render_scene_text(text))
