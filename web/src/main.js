@@ -35,6 +35,7 @@ import { mountRace, syncRace } from './ui/race.js';
 import { raceOptions, withoutStopping } from './race.js';
 import { startLab } from './lab/wiring.js';
 import { labSnapshot } from './lab/model.js';
+import { startLive } from './live/wiring.js';
 
 const WORKER_URL = new URL('./worker.js', import.meta.url);
 const MAX_WORKERS = 16;
@@ -79,6 +80,33 @@ const lab = startLab({
   onChange: () => writeUrl(store.getState()),
   openStudy: (name) => dispatch({ type: 'scene/request', payload: { sceneId: name } }),
 }, window.location.search);
+
+// The live view of render scenes (src/live/): the study's scene, its own pool of workers, the
+// site's reference at the default live size (manifest entry.live_reference).
+const liveReferences = new Map();
+const live = startLive({
+  study: () => {
+    const s = store.getState();
+    return { scene: s.scene, info: s.sceneInfo, sceneId: s.sceneId, entry: s.scenes.find((e) => e.name === s.sceneId) || null };
+  },
+  liveReference: (entry) => {
+    if (!entry || typeof entry.live_reference !== 'string') return Promise.resolve(null);
+    if (!liveReferences.has(entry.name)) {
+      liveReferences.set(entry.name, fetch(entry.live_reference)
+        .then((r) => (r.ok ? r.arrayBuffer() : null))
+        .then((buf) => (buf ? base64Of(new Uint8Array(buf)) : null))
+        .catch(() => null));
+    }
+    return liveReferences.get(entry.name);
+  },
+  runStudy: () => {
+    dispatch({ type: 'run/request' });
+    document.getElementById('plot-variance').closest('figure').scrollIntoView({ block: 'start' });
+  },
+  workerUrl: WORKER_URL,
+  cores: navigator.hardwareConcurrency || 2,
+  workers: Number(new URLSearchParams(window.location.search).get('live_workers')) || null,
+});
 
 // Plots and tables are drawn in an animation frame, and at most every RUNNING_RENDER_MS while
 // a study runs: on a machine whose cores all run workers, the page's drawing takes time from
@@ -154,8 +182,11 @@ store.subscribe((state, action) => {
       break;
     case 'scene/loaded':
       if (state.run.status !== 'running') stopRunners(); // a run of the previous problem, if any
+      live.sceneChanged();
       break;
     case 'run/request':
+      // the study measures time: a live view running beside it would take its cores
+      if (live.store.getState().status === 'running') live.store.dispatch({ type: 'live/pause', payload: {} });
       startRun();
       break;
     case 'run/cancel':
@@ -747,5 +778,6 @@ window.mcplayDebug = Object.freeze({
   state: () => structuredClone(debugSnapshot(store.getState())),
   hidden: () => hiddenEstimators(),
   lab: () => structuredClone(labSnapshot(lab.store.getState())),
+  live: () => structuredClone(live.snapshot()),
   ready,
 });

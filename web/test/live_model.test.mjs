@@ -62,7 +62,7 @@ test('the collector places bands by rows and merges relative MSE from the band s
   const c = createCollector({ width, height, bands, workers: 2 });
   const band = (i, v, error, seconds) => {
     const [b, e] = bands[i];
-    return { spp: 4, rgb: new Float32Array((e - b) * width * 3).fill(v), error, seconds };
+    return { spp: 4, rgb: new Float32Array((e - b) * width * 3).fill(v), error, seconds, pass_seconds: seconds / 2 };
   };
   assert.equal(c.add(0, 2, band(2, 3, { sum: 1, terms: 3 }, 0.5)), null);
   assert.equal(c.add(0, 0, band(0, 1, { sum: 2, terms: 6 }, 1.0)), null);
@@ -74,6 +74,7 @@ test('the collector places bands by rows and merges relative MSE from the band s
   assert.equal(level.relmse, 6 / 15);
   assert.notEqual(level.relmse, (1 / 3 + 2 / 6 + 3 / 6) / 3);
   assert.equal(level.seconds, 3 / 2);
+  assert.equal(level.passSeconds, 3 / 4);
   for (let row = 0; row < height; ++row) {
     const want = row < 2 ? 1 : row < 4 ? 2 : 3;
     for (let k = 0; k < width * 3; ++k) assert.equal(level.rgb[row * width * 3 + k], want, `row ${row}`);
@@ -146,12 +147,12 @@ test('zoom steps and the default zoom', () => {
   assert.equal(fitZoom(1024, 4, 1200), 1);
 });
 
-test('the prediction to 64 spp from the first pass, and its words', () => {
-  assert.equal(predictSeconds(0.05), 3.2);
-  const short = predictionText(0.05, 256, 144);
+test('the prediction to 64 spp from the first passes, and its words', () => {
+  assert.equal(predictSeconds(0.2, 0.05), 0.2 + 62 * 0.05);
+  const short = predictionText(0.2, 0.05, 256, 144);
   assert.equal(short.long, false);
-  assert.match(short.text, /256 × 144 pixels: the first pass took 50 ms, so 64 spp will take about 3\.2 s\.$/);
-  const long = predictionText(1, 1024, 576);
+  assert.match(short.text, /^256 × 144 pixels: 2 spp took 200 ms and each further spp takes about 50 ms, so 64 spp will take about 3\.3 s\.$/);
+  const long = predictionText(2, 1, 1024, 576);
   assert.equal(long.long, 64 > LONG_SECONDS);
   assert.match(long.text, /about 1 min 4 s\. Paused/);
   assert.equal(duration(0.0004), '1 ms');

@@ -6,7 +6,7 @@
 // mcplay_web.mjs + .wasm and mcplay_render_web.mjs + .wasm from WASM_DIR, scenes/*.json and
 // scenes/manifest.json ([{file, name, description, kind, dimension, estimators, n_min, n_max,
 // group, look}], warp scenes also {warp: true} (kind 'warp' without an integrand; they need no
-// stop of the tour and come last unless it names them), render scenes also {reps, width, height, reference}; read from the scene files themselves;
+// stop of the tour and come last unless it names them), render scenes also {reps, width, height, reference, live_reference}; read from the scene files themselves;
 // the page asks the core, sceneInfo, for the rest), in the order of the teaching path
 // web/tour.json, which gives each scene its group and what to look for. Its first scene is an
 // integral (the page opens it, and only render scenes load the render module).
@@ -14,7 +14,8 @@
 // inline, its external buffers and images turned into data: URIs (a .glb becomes the same
 // JSON with its binary chunk as buffer 0), since the wasm module cannot read the site's files,
 // and their reference images are rendered here by the native CLI into refs/<name>.mcref (the
-// page never renders a bundled scene's reference; see shipReference).
+// page never renders a bundled scene's reference; see shipReference), and the live view's at its
+// default size into refs/<name>.live.mcref (manifest live_reference; shipLiveReference).
 // OUT and WASM_DIR default to build/site and build-wasm in the repository. Fails with a message
 // naming what is missing.
 import fs from 'node:fs';
@@ -275,6 +276,23 @@ function shipReference(sceneFile, name) {
   return rel;
 }
 
+/**
+ * The reference of the live view at its default size (`mcplay reference --live`: the long side
+ * and spp the live view uses), written to OUT/refs/<name>.live.mcref; the page gives it to every
+ * session of a bundled scene at the default size (options.reference_data), so that its curves
+ * start with the first pass. Returns the path the manifest gives the page (entry.live_reference).
+ */
+function shipLiveReference(sceneFile, name) {
+  const rel = `refs/${name.replace(/[^A-Za-z0-9_.-]/g, '_')}.live.mcref`;
+  const out = path.join(OUT, rel);
+  fs.mkdirSync(path.dirname(out), { recursive: true });
+  const run = spawnSync(NATIVE, ['reference', sceneFile, '--live', '--out', out, '--cache', REF_CACHE, '--quiet'],
+    { encoding: 'utf8' });
+  if (run.status !== 0) fail(`${shown(sceneFile)}: the live view's reference could not be rendered: ${(run.stderr || run.error || '').toString().trim()}`);
+  console.log(`build-site: ${run.stdout.trim()} (live view)`);
+  return rel;
+}
+
 function main() {
   need(NATIVE, 'build the native CLI with `make build` (or pass its path as the third argument): it renders the render scenes\' references');
   fs.mkdirSync(REF_CACHE, { recursive: true });
@@ -324,7 +342,9 @@ function main() {
       for (const note of site.notes) console.log(`build-site: scenes/${file}: ${note}`);
       fs.mkdirSync(path.join(OUT, 'scenes'), { recursive: true });
       fs.writeFileSync(path.join(OUT, 'scenes', file), `${JSON.stringify(site.scene)}\n`);
-      manifest[manifest.length - 1].reference = shipReference(path.join(OUT, 'scenes', file), manifest[manifest.length - 1].name);
+      const entry = manifest[manifest.length - 1];
+      entry.reference = shipReference(path.join(OUT, 'scenes', file), entry.name);
+      entry.live_reference = shipLiveReference(path.join(OUT, 'scenes', file), entry.name);
     } else {
       copy(path.join(scenesDir, file), path.join(OUT, 'scenes', file));
     }

@@ -99,7 +99,7 @@ export function createCollector({ width, height, bands, workers }) {
     let level = pending.get(key);
     if (!level) {
       level = { estimator, spp: pass.spp, rgb: new Float32Array(width * height * 3), seen: new Set(), sum: 0, terms: 0,
-        errors: 0, seconds: 0 };
+        errors: 0, seconds: 0, passSeconds: 0 };
       pending.set(key, level);
     }
     if (level.seen.has(band)) throw new Error(`band ${band} sent ${pass.spp} spp of estimator ${estimator} twice`);
@@ -116,12 +116,14 @@ export function createCollector({ width, height, bands, workers }) {
       level.errors += 1;
     }
     level.seconds += pass.seconds || 0;
+    level.passSeconds += pass.pass_seconds || 0;
     if (level.seen.size < bands.length) return null;
     pending.delete(key);
     return {
       estimator, spp: level.spp, rgb: level.rgb, complete: true,
       relmse: level.errors === bands.length ? relativeMse([{ sum: level.sum, terms: level.terms }]) : null,
       seconds: level.seconds / Math.max(1, workers),
+      passSeconds: level.passSeconds / Math.max(1, workers),
     };
   }
   return { add, pendingLevels: () => pending.size };
@@ -266,20 +268,26 @@ export function duration(seconds) {
   return m >= 60 ? `${(seconds / 3600).toFixed(1)} h` : `${m} min${s ? ` ${s} s` : ''}`;
 }
 
-/** The wall time to reach `spp` predicted from the first pass (1 spp of every estimator took
- *  `firstSeconds` of wall time): passes double, so spp samples per pixel cost spp first passes. */
-export function predictSeconds(firstSeconds, spp = 64) {
-  return firstSeconds * spp;
+/**
+ * The wall time to reach `spp` predicted after the first two passes: `elapsed` seconds brought
+ * every estimator to 2 spp, and the second pass (1 spp of every estimator and band) cost
+ * `perSpp` seconds of the workers' time (its bands' pass seconds over the workers; the first
+ * pass also paid for compiling the wasm, so it is not the measure); each further spp costs as
+ * much: spp - 2 more of them.
+ */
+export function predictSeconds(elapsed, perSpp, spp = 64) {
+  return elapsed + Math.max(0, spp - 2) * perSpp;
 }
 
-/** The line said after the first pass: how long 64 spp will take; long = pause and ask. */
-export function predictionText(firstSeconds, width, height) {
-  const t = predictSeconds(firstSeconds, 64);
+/** The line said after the first passes: how long 64 spp will take; long = pause and ask. */
+export function predictionText(elapsed, perSpp, width, height) {
+  const t = predictSeconds(elapsed, perSpp, 64);
   const long = t > LONG_SECONDS;
   return {
     long,
-    text: `${width} × ${height} pixels: the first pass took ${duration(firstSeconds)}, so 64 spp will take about ` +
-      `${duration(t)}${long ? '. Paused: press Resume to go on, or choose a smaller size.' : '.'}`,
+    seconds: t,
+    text: `${width} × ${height} pixels: 2 spp took ${duration(elapsed)} and each further spp takes about ${duration(perSpp)}, ` +
+      `so 64 spp will take about ${duration(t)}${long ? '. Paused: press Resume to go on, or choose a smaller size.' : '.'}`,
   };
 }
 

@@ -76,7 +76,7 @@ export function draw(key, el, sig, makeOpts, data, ranges) {
 }
 
 // Plots whose y values are log10 of what they show (axes.js: lg).
-const LOG10_Y = new Set(['variance', 'time']);
+const LOG10_Y = new Set(['variance', 'time', 'live-spp', 'live-seconds']);
 
 /** The hover readout of a chart: the x under the cursor and each shown estimator's value there
  *  (bands, references and hidden series left out), in a box in the plot's corner. */
@@ -105,7 +105,7 @@ function readout(key) {
       return;
     }
     box.hidden = false;
-    box.textContent = `${key === 'time' ? 't' : key === 'calibration' ? 'z' : 'N'} = ${fmt(x, 4)}\n${lines.join('\n')}`;
+    box.textContent = `${key === 'time' || key === 'live-seconds' ? 't' : key === 'calibration' ? 'z' : key === 'live-spp' ? 'spp' : 'N'} = ${fmt(x, 4)}\n${lines.join('\n')}`;
   };
 }
 

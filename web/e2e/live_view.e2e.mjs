@@ -1,0 +1,174 @@
+// End-to-end test of the live view in headless Chromium (Debian's chromium, driven by
+// playwright-core). Usage: MCPLAY_SITE=SITE_DIR MCPLAY_SHOTS=SHOT_DIR node --test web/e2e/live_view.e2e.mjs
+// Opens Veach's MIS scene, chooses MIS (mis_power), light sampling and BSDF sampling, starts the
+// live view and waits for 16 spp; checks the canvases' sizes are the core's live size, that the
+// reference shipped with the site is used and the relative-MSE curves have points, that zoom
+// and the error maps redraw, moves the wipe (its clip follows), cancels (no pass arrives after),
+// shows one clear line for a size the core refuses, and runs axe-core on the view.
+import { mkdirSync, readFileSync } from 'node:fs';
+import { join, resolve, dirname } from 'node:path';
+import { fileURLToPath } from 'node:url';
+import { test, after, before } from 'node:test';
+import assert from 'node:assert/strict';
+import { openPlayground } from './harness.mjs';
+
+const here = dirname(fileURLToPath(import.meta.url));
+const site = resolve(process.env.MCPLAY_SITE ?? 'build/site');
+const shots = resolve(process.env.MCPLAY_SHOTS ?? 'build/e2e');
+
+let browser, page;
+const pageErrors = [];
+
+before(async () => {
+  mkdirSync(shots, { recursive: true });
+  browser = await openPlayground({ site, viewport: { width: 1300, height: 1000 },
+    profilePrefix: 'mcplay-live-chromium-', onPageError: (message) => pageErrors.push(message) });
+  ({ page } = browser);
+});
+
+after(async () => {
+  await browser?.close();
+});
+
+// The view's state after two animation frames (the view draws a state on the next frame).
+const live = () => page.evaluate(() => new Promise((resolve) => {
+  requestAnimationFrame(() => requestAnimationFrame(() => resolve(window.mcplayDebug.live())));
+}));
+
+const CHOSEN = ['mis_power', 'light_area', 'bsdf'];
+
+test('Veach\'s scene: three estimators converge to 16 spp at the core\'s live size, with curves', async () => {
+  await page.selectOption('#scene', 'veach_mis');
+  await page.waitForSelector('#live-section', { state: 'visible' });
+  // the scene's first four are chosen; choose MIS, light sampling and BSDF sampling instead
+  // (four are chosen: the others are disabled until one is unchosen)
+  for (const wantOn of [false, true]) {
+    for (const box of await page.$$('#live-estimators input')) {
+      const want = CHOSEN.includes(await box.getAttribute('value'));
+      if (want === wantOn && (await box.isChecked()) !== want) await box.click();
+    }
+  }
+  let s = await live();
+  assert.deepEqual([...s.choice.estimators].sort(), [...CHOSEN].sort());
+  assert.equal(s.choice.sampler, 'padded_sobol');
+  assert.match(await page.textContent('#live-sampler-why'), /cannot extend/);
+  await page.click('#live-start');
+  await page.waitForFunction(() => {
+    const v = window.mcplayDebug.live();
+    return v.status === 'error' || (v.order.length && v.order.every((n) => v.estimators[n].spp >= 16));
+  }, null, { timeout: 120000 });
+  s = await live();
+  assert.equal(s.message, '', s.message);
+  // the size the core gives (scene info's live_size at the default long side)
+  const info = await page.evaluate(() => window.mcplayDebug.state().sceneInfo.live_size);
+  assert.ok(info && info.width > 0, JSON.stringify(info));
+  assert.deepEqual(s.size, { width: info.width, height: info.height });
+  assert.equal(Math.max(info.width, info.height), 256);
+  const cards = s.canvases.filter((c) => ['reference', ...CHOSEN].includes(c.key));
+  assert.equal(cards.length, 4);
+  for (const c of s.canvases) assert.deepEqual([c.width, c.height], [info.width, info.height], c.key);
+  // every band of every estimator merged: the cards say their spp
+  for (const n of CHOSEN) assert.ok(Number(s.canvases.find((c) => c.key === n).spp) >= 16, n);
+  // the reference shipped with the site: the curves have a point per level from 1 spp on
+  assert.equal(s.reference.status, 'ready');
+  assert.equal(s.reference.source, 'shipped');
+  for (const n of CHOSEN) {
+    const pts = s.estimators[n].points;
+    assert.ok(pts.length >= 5, `${n}: ${pts.length} points`);
+    assert.deepEqual(pts.slice(0, 5).map((p) => p.spp), [1, 2, 4, 8, 16]);
+    assert.ok(pts.every((p) => p.relmse > 0 && p.seconds > 0), n);
+    assert.ok(pts[4].relmse < pts[0].relmse, `${n}: relMSE falls from 1 to 16 spp`);
+  }
+  assert.ok(Number(await page.getAttribute('#live-plot-spp', 'data-points')) >= 15);
+  assert.ok(Number(await page.getAttribute('#live-plot-seconds', 'data-points')) >= 15);
+  assert.equal(await page.locator('#live-plot-spp canvas').count() > 0, true);
+  // the first image appeared, and the prediction to 64 spp was said
+  assert.ok(s.firstImageMs > 0);
+  assert.match(s.notice, /64 spp will take about/);
+  // MIS beats BSDF sampling on Veach's plates at equal spp
+  const at = (n) => s.estimators[n].points.find((p) => p.spp === 16).relmse;
+  assert.ok(at('mis_power') < at('bsdf'), `mis_power ${at('mis_power')} vs bsdf ${at('bsdf')}`);
+  // the caption says a single image's relative MSE has no error bar and points to the study
+  assert.match(await page.textContent('.live-caption'), /no replicate error bar/);
+  await page.screenshot({ path: join(shots, 'live-view.png'), fullPage: true });
+});
+
+test('zoom keeps pixels unsmoothed; the error maps redraw the cards; the wipe\'s clip follows the slider', async () => {
+  assert.equal(await page.$eval('#live-section canvas.live-canvas', (c) => getComputedStyle(c).imageRendering), 'pixelated');
+  const w0 = await page.$eval('canvas[data-live="bsdf"]', (c) => c.getBoundingClientRect().width);
+  await page.click('#live-zoom-in');
+  await page.waitForFunction((w) => document.querySelector('canvas[data-live="bsdf"]').getBoundingClientRect().width > w * 1.5, w0);
+  await page.click('#live-zoom-out');
+  await page.check('#live-errors');
+  await page.waitForFunction(() => /relative error map/.test(document.querySelector('canvas[data-live="bsdf"]').getAttribute('aria-label')));
+  await page.uncheck('#live-errors');
+  await page.selectOption('#live-wipe-a', 'bsdf');
+  await page.selectOption('#live-wipe-b', 'mis_power');
+  const clip0 = await page.$eval('#live-wipe-right', (c) => c.style.clipPath);
+  await page.fill('#live-wipe', '20');
+  await page.waitForFunction((c) => document.querySelector('#live-wipe-right').style.clipPath !== c, clip0);
+  const clip = await page.$eval('#live-wipe-right', (c) => c.style.clipPath);
+  assert.match(clip, /inset\(0(px)? 0(px)? 0(px)? 20%\)/);
+  // the keyboard moves it too
+  await page.focus('#live-wipe');
+  await page.keyboard.press('ArrowRight');
+  await page.waitForFunction(() => /21%/.test(document.querySelector('#live-wipe-right').style.clipPath));
+  // both sides at the same spp
+  const [l, r] = await page.$$eval('#live-wipe-left, #live-wipe-right', (cs) => cs.map((c) => c.dataset.spp));
+  assert.equal(l, r);
+  assert.match(await page.textContent('#live-wipe-spp'), /both at \d+ spp/);
+});
+
+test('Cancel stops at once: no pass arrives after it', async () => {
+  const s0 = await live();
+  if (!['running', 'paused'].includes(s0.status)) {
+    // it may have been paused by a long prediction; start again
+    await page.click('#live-start');
+    await page.waitForFunction(() => window.mcplayDebug.live().status === 'running');
+  }
+  await page.click('#live-cancel');
+  const s1 = await live();
+  assert.equal(s1.status, 'cancelled');
+  const spp = Object.fromEntries(s1.order.map((n) => [n, s1.estimators[n].levels.length]));
+  await page.waitForTimeout(1500);
+  const s2 = await live();
+  assert.deepEqual(Object.fromEntries(s2.order.map((n) => [n, s2.estimators[n].levels.length])), spp);
+  assert.equal(await page.isDisabled('#live-cancel'), true);
+  assert.equal(await page.isDisabled('#live-start'), false);
+});
+
+test('a size the core refuses: one clear line, and the view stays usable', async () => {
+  // a size beyond the limits, as a reader could ask through the page's own control
+  await page.evaluate(() => {
+    const sel = document.getElementById('live-size');
+    const o = document.createElement('option');
+    o.value = '100000';
+    o.textContent = '100000';
+    sel.append(o);
+  });
+  await page.selectOption('#live-size', '100000');
+  await page.click('#live-start');
+  await page.waitForFunction(() => document.getElementById('live-error').textContent !== '', null, { timeout: 30000 });
+  assert.equal((await live()).status, 'error');
+  const text = (await page.textContent('#live-error')).trim();
+  assert.match(text, /long_side/);
+  assert.equal(text.includes('\n'), false);
+  await page.selectOption('#live-size', '128');
+  await page.click('#live-start');
+  await page.waitForFunction(() => {
+    const v = window.mcplayDebug.live();
+    return v.status !== 'error' && v.order.every((n) => v.estimators[n].spp >= 2);
+  }, null, { timeout: 60000 });
+  const s = await live();
+  assert.equal(Math.max(s.size.width, s.size.height), 128);
+  await page.waitForFunction(() => document.getElementById('live-error').textContent === '');
+  await page.click('#live-cancel');
+});
+
+test('axe-core finds no violations in the live view, and the page threw nothing', async () => {
+  const axe = readFileSync(join(here, '..', 'node_modules', 'axe-core', 'axe.min.js'), 'utf8');
+  await page.addScriptTag({ content: axe });
+  const result = await page.evaluate(() => window.axe.run('#live-section', { resultTypes: ['violations'] }));
+  assert.deepEqual(result.violations.map((v) => `${v.id}: ${v.nodes.map((n) => n.target.join(' ')).join(', ')}`), []);
+  assert.deepEqual(pageErrors, []);
+});

@@ -1,0 +1,62 @@
+// The live view's two charts (through plot/chart.js, so their axes are the study's: log-log,
+// powers of two for spp, decades for the relative MSE): each estimator's relative MSE against
+// spp and against its seconds, one curve per estimator, a point per level as the passes arrive.
+import { draw, drop, empty, logX, nTicks, minorLogGrid } from '../plot/chart.js';
+import { AXIS, LOG10_AXIS, lg, log10Range, decadeLabel } from '../plot/axes.js';
+import { colorAt } from '../palette.js';
+
+/** The x values of every estimator's points (sorted, once each) and each estimator's y at
+ *  them (null where it has no point): the shape uPlot wants. Pure (web/test). */
+export function alignPoints(order, estimators, key) {
+  const xs = [...new Set(order.flatMap((n) => (estimators[n] ? estimators[n].points : []).map((p) => p[key])))]
+    .filter((x) => x > 0).sort((a, b) => a - b);
+  const at = new Map(xs.map((x, i) => [x, i]));
+  const ys = order.map((n) => {
+    const y = new Array(xs.length).fill(null);
+    for (const p of (estimators[n] ? estimators[n].points : [])) if (at.has(p[key]) && p.relmse > 0) y[at.get(p[key])] = p.relmse;
+    return y;
+  });
+  return { xs, ys };
+}
+
+function chart(key, el, live, xKey, emptyText) {
+  const { order } = live;
+  const { xs, ys } = alignPoints(order, live.estimators, xKey);
+  if (!xs.length) {
+    drop(key);
+    empty(el, emptyText);
+    return 0;
+  }
+  const all = ys.flat().filter((v) => v !== null);
+  const yRange = log10Range(all);
+  const xRange = xKey === 'spp'
+    ? [xs[0], Math.max(xs[xs.length - 1], xs[0] * 2)]
+    : [10 ** Math.floor(Math.log10(xs[0])), 10 ** Math.ceil(Math.log10(xs[xs.length - 1]) + 1e-9)];
+  const series = [{}, ...order.map((n) => {
+    const color = colorAt(live.colors[n] ?? order.indexOf(n));
+    return { label: n, stroke: color, width: 2, spanGaps: true, points: { show: true, size: 6, fill: color } };
+  })];
+  draw(key, el, JSON.stringify([order, xKey]), (c) => ({
+    scales: { x: logX(c, xKey === 'spp' ? 2 : 10), y: { range: () => c.yRange } },
+    axes: [
+      xKey === 'spp'
+        ? { ...AXIS, label: 'spp [samples per pixel]', values: nTicks }
+        : { ...AXIS, label: 'seconds per image (its bands\' seconds / workers)', values: (u, splits) => splits.map(decadeLabel) },
+      { ...AXIS, ...LOG10_AXIS, label: 'relative MSE against the reference' },
+    ],
+    series,
+    hooks: { drawClear: [minorLogGrid] },
+  }), [xs, ...ys.map((y) => y.map(lg))], { xRange, yRange });
+  return all.length;
+}
+
+/** Draws both charts from the view's state; returns the number of points drawn in each. */
+export function renderLiveCharts(dom, live) {
+  const wait = live.reference.status === 'ready' || live.reference.status === 'none'
+    ? 'The curves start with the first pass measured against the reference.'
+    : 'The curves wait for the reference (its progress is shown above); the images converge meanwhile.';
+  return {
+    spp: chart('live-spp', dom.spp, live, 'spp', wait),
+    seconds: chart('live-seconds', dom.seconds, live, 'seconds', wait),
+  };
+}
