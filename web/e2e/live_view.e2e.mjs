@@ -69,18 +69,20 @@ test('Veach\'s scene: three estimators converge to 16 spp at the core\'s live si
   for (const c of s.canvases) assert.deepEqual([c.width, c.height], [info.width, info.height], c.key);
   // every band of every estimator merged: the cards say their spp
   for (const n of CHOSEN) assert.ok(Number(s.canvases.find((c) => c.key === n).spp) >= 16, n);
-  // the reference shipped with the site: the curves have a point per level from 1 spp on
+  // the reference shipped with the site, given to the sessions after their first pass: the
+  // curves have a point per level from (at the latest) 4 spp on
   assert.equal(s.reference.status, 'ready');
   assert.equal(s.reference.source, 'shipped');
   for (const n of CHOSEN) {
     const pts = s.estimators[n].points;
-    assert.ok(pts.length >= 5, `${n}: ${pts.length} points`);
-    assert.deepEqual(pts.slice(0, 5).map((p) => p.spp), [1, 2, 4, 8, 16]);
+    const spp = pts.map((p) => p.spp);
+    assert.ok(spp.includes(4) && spp.includes(8) && spp.includes(16), `${n}: points at ${spp}`);
     assert.ok(pts.every((p) => p.relmse > 0 && p.seconds > 0), n);
-    assert.ok(pts[4].relmse < pts[0].relmse, `${n}: relMSE falls from 1 to 16 spp`);
+    const at = (k) => pts.find((p) => p.spp === k).relmse;
+    assert.ok(at(16) < at(4), `${n}: relMSE falls from 4 to 16 spp`);
   }
-  assert.ok(Number(await page.getAttribute('#live-plot-spp', 'data-points')) >= 15);
-  assert.ok(Number(await page.getAttribute('#live-plot-seconds', 'data-points')) >= 15);
+  assert.ok(Number(await page.getAttribute('#live-plot-spp', 'data-points')) >= 9);
+  assert.ok(Number(await page.getAttribute('#live-plot-seconds', 'data-points')) >= 9);
   assert.equal(await page.locator('#live-plot-spp canvas').count() > 0, true);
   // the first image appeared, and the prediction to 64 spp was said
   assert.ok(s.firstImageMs > 0);

@@ -142,40 +142,40 @@ export function startLive(page) {
     px.exposure = Number(scene.render && scene.render.exposure) || 0;
     dispatch({ type: 'live/start', payload: { id, order, colors, workers: k, startedAt: performance.now() } });
     try {
-      const shipped = longSide === DEFAULT_LONG_SIDE && entry ? await page.liveReference(entry) : null;
-      if (!live()) return;
+      performance.mark('live:start');
+      // the shipped reference (fetched when the scene was shown) is given to the sessions after
+      // their first pass is sent: reading it costs each session a few hundred ms, which the first
+      // image should not wait for (its curves start at the next pass)
+      const shipped = longSide === DEFAULT_LONG_SIDE && entry ? page.liveReference(entry) : Promise.resolve(null);
       const base = { estimators: order, sampler, longSide, rows: [0, 1] };
       const size = await imageSize(scene, info, longSide, sessionOptions(base));
       if (!live()) return;
       const key = `${sceneKey}:${size.width}x${size.height}`;
-      const referenceData = shipped || references.get(key) || null;
       const bands = splitRows(size.height, k * BANDS_PER_WORKER);
       px.width = size.width;
       px.height = size.height;
+      px.bands = bands.length;
       // the images side by side at the largest whole zoom that fits the page (the reader may change it)
       const box = document.getElementById('live-images').clientWidth || 1200;
       dispatch({ type: 'live/view', payload: { zoom: Math.min(8, fitZoom(size.width + 20, order.length + 1, box)) } });
-      px.bands = bands.length;
       me.bands = bands;
       me.collector = createCollector({ width: size.width, height: size.height, bands, workers: k });
       me.workerState = ws.map((w, i) => ({ w, bands: bands.map((_, b) => b).filter((b) => workerOfBand(b, k) === i), spp: 0, outstanding: 0 }))
         .filter((x) => x.bands.length);
       // every band's session, in its worker
       const opened = await Promise.all(bands.map((rows, b) => ws[workerOfBand(b, k)].request(MSG.LIVE_OPEN, {
-        scene, options: sessionOptions({ ...base, rows, referenceData }),
+        scene, options: sessionOptions({ ...base, rows }),
       })));
       if (!live()) return;
       me.sessions = opened.map((o) => o.session.session);
+      performance.mark('live:opened');
       dispatch({ type: 'live/opened', payload: { id, size } });
-      const refs = opened.map((o) => o.session.reference);
-      if (refs.every((r) => r && r.rgb)) {
-        placeReference(me, refs);
-        dispatch({ type: 'live/reference', payload: { id, reference: { status: 'ready', source: shipped ? 'shipped' : refs[0].source, spp: refs[0].spp } } });
-      } else {
-        renderReference(me, scene, size, key);
-      }
       me.passesFrom = performance.now();
       pump(me);
+      const shippedData = await shipped;
+      if (!live()) return;
+      const data = shippedData || references.get(key) || null;
+      if (!data || !(await giveReference(me, data, shippedData ? 'shipped' : 'rendered'))) renderReference(me, scene, size, key);
     } catch (e) {
       if (e && e.cancelled) return;
       fail(id, e);
@@ -188,6 +188,24 @@ export function startLive(page) {
     const img = new Float32Array(w * px.height * 3);
     refs.forEach((r, b) => img.set(r.rgb, me.bands[b][0] * w * 3));
     px.reference = img;
+  }
+
+  /** Gives every session the reference (mcp_render_live_reference); false when the core does
+   *  not take it (made from another scene or size: then one is rendered). */
+  async function giveReference(me, data, source) {
+    try {
+      const given = await Promise.all(me.sessions.map((session, b) => me.ws[workerOfBand(b, me.ws.length)]
+        .request(MSG.LIVE_REFERENCE, { session, reference: { reference_data: data } })));
+      if (run !== me) return true;
+      placeReference(me, given.map((g) => g.reference));
+      performance.mark('live:reference');
+      dispatch({ type: 'live/reference', payload: { id: me.id, reference: { status: 'ready', source, spp: given[0].reference.spp,
+        floor: given[0].reference.relative_mse_floor ?? null, progress: 1 } } });
+      return true;
+    } catch (e) {
+      if (e && e.cancelled) return true;
+      return false;
+    }
   }
 
   /** The reference at the view's size, rendered by one more worker, then given to every session. */
@@ -205,11 +223,9 @@ export function startLive(page) {
       });
       references.set(key, reference.reference_data);
       if (run !== me) return;
-      const given = await Promise.all(me.sessions.map((session, b) => me.ws[workerOfBand(b, me.ws.length)]
-        .request(MSG.LIVE_REFERENCE, { session, reference: { reference_data: reference.reference_data } })));
-      if (run !== me) return;
-      placeReference(me, given.map((g) => g.reference));
-      dispatch({ type: 'live/reference', payload: { id, reference: { status: 'ready', source: 'rendered', spp: reference.spp, progress: 1 } } });
+      if (!(await giveReference(me, reference.reference_data, 'rendered')) && run === me) {
+        dispatch({ type: 'live/reference', payload: { id, reference: { status: 'error', message: 'the sessions did not take the reference rendered for them' } } });
+      }
     } catch (e) {
       if (e && e.cancelled) return;
       if (run === me) dispatch({ type: 'live/reference', payload: { id, reference: { status: 'error', message: oneLine(e.message) } } });
@@ -256,6 +272,10 @@ export function startLive(page) {
     im.history.set(level.spp, level.rgb);
     while (im.history.size > HISTORY) im.history.delete(im.history.keys().next().value);
     px.images.set(name, im);
+    if (!me.firstLevel) {
+      me.firstLevel = true;
+      performance.mark('live:first-level');
+    }
     dispatch({ type: 'live/level', payload: { id: me.id, estimator: name, spp: level.spp, seconds: level.seconds, relmse: level.relmse, now: performance.now() } });
     const st = store.getState();
     const reached = me.order.map((n) => st.estimators[n].spp);
@@ -298,6 +318,7 @@ export function startLive(page) {
     const chosen = render ? defaultEstimators(info.estimators) : null;
     dispatch({ type: 'live/choose', payload: { estimators: chosen } });
     if (render) {
+      page.liveReference(page.study().entry); // fetched while the reader looks
       // the render module compiles in every worker of the pool while the reader looks
       for (const w of workers(poolSize())) w.request(MSG.VALIDATE, { scene }).catch(() => {});
     }
