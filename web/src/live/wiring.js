@@ -4,8 +4,10 @@
 //
 // A view: the image size comes from the core (the scene info's live_size at the default long
 // side, else a probe session of one row); the rows are cut into BANDS_PER_WORKER bands per
-// worker, and every band opens a session (mcp_render_live_open, options.rows) in its worker, with
-// the shipped reference (reference_data) when the site has one at this size. Each worker then
+// worker, and every band opens a session (mcp_render_live_open, options.rows) in its worker. The
+// reference the site ships at the default size (or one rendered here earlier) is given to the
+// sessions (mcp_render_live_reference) right after their first pass is sent, so that the first
+// image does not wait for it to be read (a few hundred ms a session). Each worker then
 // takes its bands level by level (1, 2, 4, ... spp: every estimator's pass of every band it
 // holds), at most one level ahead of the slowest worker, so the page holds few pending levels.
 // The passes' pixels (Float32Array, transferred) and error sums are merged by model.js's
