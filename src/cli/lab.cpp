@@ -189,9 +189,10 @@ int cmd_points(const std::vector<std::string>& args) {
         return usage_error(error);
     if (o.positional.size() != 1)
         return usage_error("points needs one SAMPLER (uniform, stratified, latin_hypercube, sobol, "
-                           "halton, lattice, pixel_independent, pixel_stratified, pixel_sobol)");
-    // pixel_independent, pixel_stratified, pixel_sobol: one pixel's samples from the
-    // renderer's pixel samplers (--n is its spp).
+                           "halton, lattice, pixel_independent, pixel_stratified, pixel_sobol, "
+                           "pixel_padded_sobol)");
+    // pixel_independent, pixel_stratified, pixel_sobol, pixel_padded_sobol: one pixel's samples
+    // from the renderer's pixel samplers (--n is its spp).
     const std::string& sampler = o.positional[0];
     const bool pixel = sampler.rfind("pixel_", 0) == 0;
     nlohmann::json request = pixel ? nlohmann::json{{"pixel_sampler", sampler.substr(6)}}

@@ -63,8 +63,8 @@ int mcp_render_study_plan(const char* scene_json, const char* options_json, char
 int mcp_render_image(const char* scene_json, const char* options_json, char** result_json);
 
 /* The points one pixel's samples take from a render pixel sampler, for the sampler lab:
- * request {"pixel_sampler": "independent" | "stratified" | "sobol" (default), "spp" (1..65536; a
- * power of two for sobol; default 64), "dim" (2, 4, 6 or 8: the sample's first dim / 2 2D requests,
+ * request {"pixel_sampler": "independent" | "stratified" | "sobol" (default) | "padded_sobol",
+ * "spp" (1..65536; a power of two for sobol; default 64), "dim" (2, 4, 6 or 8: the sample's first dim / 2 2D requests,
  * default 2), "seed" (the image's key, default 1), "width", "height" (the image, default 1 x 1),
  * "pixel": [x, y] (default [0, 0])}. Result: {"pixel_sampler", "n", "dim", "seed", "width",
  * "height", "pixel", "points": [[u_1, ..., u_dim] per sample]}, rows as mcp_points_analyze

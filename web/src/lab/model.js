@@ -9,7 +9,7 @@ export const SAMPLERS = Object.freeze(['uniform', 'stratified', 'latin_hypercube
 export const QMC_SAMPLERS = Object.freeze(['sobol', 'halton', 'lattice']);
 /** The renderer's per-pixel samplers (mcp_render_pixel_points, the render core): one pixel's
  *  samples, n = spp, dim 2, 4, 6 or 8; sampler names as the CLI's (mcplay points pixel_sobol). */
-export const PIXEL_SAMPLERS = Object.freeze(['pixel_independent', 'pixel_stratified', 'pixel_sobol']);
+export const PIXEL_SAMPLERS = Object.freeze(['pixel_independent', 'pixel_stratified', 'pixel_sobol', 'pixel_padded_sobol']);
 /** Every sampler of the point-set view (the discrepancy curve takes SAMPLERS only). */
 export const POINT_SAMPLERS = Object.freeze([...SAMPLERS, ...PIXEL_SAMPLERS]);
 export const isPixelSampler = (name) => PIXEL_SAMPLERS.includes(name);
