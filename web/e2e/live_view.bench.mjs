@@ -71,7 +71,7 @@ try {
       paused = paused || t.paused;
       await page.click('#live-cancel').catch(() => {});
     }
-    const predicted = paused ? / about ([^.]+?)\./.exec(paused) : null;
+    const predicted = paused ? /64 spp will take about (.+?)\. /.exec(paused) : null;
     console.log(`${scene}: first image ${size.width}x${size.height} at ${median(first).toFixed(0)} ms; 64 spp at ${median(full).toFixed(0)} ms` +
       (paused ? ` (paused: predicted ${predicted ? predicted[1] : 'long'})` : ''));
   }

@@ -6,7 +6,7 @@ import assert from 'node:assert/strict';
 import {
   splitRows, workerOfBand, nextSpp, sppSchedule, createCollector, relativeMse, estimatorSeconds, toneMap, srgbEncode,
   errorColor, errorMap, wipeFromPointer, wipeClip, commonSpp, zoomStep, fitZoom, predictionText, predictSeconds,
-  duration, oneLine, liveWorkers, defaultEstimators, sessionOptions, initialLive, liveReducer, liveActive, LONG_SECONDS,
+  duration, oneLine, liveWorkers, alignPoints, PREDICT_AT, defaultEstimators, sessionOptions, initialLive, liveReducer, liveActive, LONG_SECONDS,
 } from '../src/live/model.js';
 
 test('row bands cover every row exactly once, in order, sizes within one row', () => {
@@ -148,13 +148,16 @@ test('zoom steps and the default zoom', () => {
 });
 
 test('the prediction to 64 spp from the first passes, and its words', () => {
-  assert.equal(predictSeconds(0.2, 0.05), 0.2 + 62 * 0.05);
+  assert.equal(PREDICT_AT, 4);
+  assert.equal(predictSeconds(0.2, 0.05), 0.2 + 60 * 0.05);
   const short = predictionText(0.2, 0.05, 256, 144);
   assert.equal(short.long, false);
-  assert.match(short.text, /^256 × 144 pixels: 2 spp took 200 ms and each further spp takes about 50 ms, so 64 spp will take about 3\.3 s\.$/);
-  const long = predictionText(2, 1, 1024, 576);
-  assert.equal(long.long, 64 > LONG_SECONDS);
-  assert.match(long.text, /about 1 min 4 s\. Paused/);
+  assert.match(short.text, /^256 × 144 pixels: 4 spp took 200 ms and each further spp takes about 50 ms, so 64 spp will take about 3\.2 s\.$/);
+  const long = predictionText(4, 2, 1024, 576);
+  assert.equal(long.seconds, 124);
+  assert.equal(long.long, 124 > LONG_SECONDS);
+  assert.match(long.text, /about 2 min 4 s\. Paused/);
+  assert.equal(predictionText(4, 0.1, 1, 1).long, false);
   assert.equal(duration(0.0004), '1 ms');
   assert.equal(duration(42), '42 s');
   assert.equal(duration(7200), '2.0 h');
@@ -187,4 +190,15 @@ test('the reducer: a view starts, takes levels (curves only with a relative MSE)
   assert.equal(liveActive(s), false);
   s = liveReducer(s, { type: 'live/error', payload: { id: 1, message: 'options.long_side: 9999 beyond 4096\nmore' } });
   assert.equal(s.message, 'options.long_side: 9999 beyond 4096');
+});
+
+test('the curves: every estimator\'s points on the x values of all, null where it has none', () => {
+  const estimators = {
+    a: { points: [{ spp: 2, seconds: 0.1, relmse: 1 }, { spp: 4, seconds: 0.3, relmse: 0.5 }] },
+    b: { points: [{ spp: 4, seconds: 0.2, relmse: 0.25 }, { spp: 8, seconds: 0.4, relmse: 0 }] },
+  };
+  assert.deepEqual(alignPoints(['a', 'b'], estimators, 'spp'), { xs: [2, 4, 8], ys: [[1, 0.5, null], [null, 0.25, null]] });
+  assert.deepEqual(alignPoints(['a', 'b'], estimators, 'seconds'),
+    { xs: [0.1, 0.2, 0.3, 0.4], ys: [[1, null, 0.5, null], [null, 0.25, null, null]] });
+  assert.deepEqual(alignPoints(['c'], estimators, 'spp'), { xs: [], ys: [[]] });
 });

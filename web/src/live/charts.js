@@ -4,20 +4,7 @@
 import { draw, drop, empty, logX, nTicks, minorLogGrid, labelHook } from '../plot/chart.js';
 import { AXIS, LOG10_AXIS, lg, log10Range, decadeLabel } from '../plot/axes.js';
 import { colorAt } from '../palette.js';
-
-/** The x values of every estimator's points (sorted, once each) and each estimator's y at
- *  them (null where it has no point): the shape uPlot wants. Pure (web/test). */
-export function alignPoints(order, estimators, key) {
-  const xs = [...new Set(order.flatMap((n) => (estimators[n] ? estimators[n].points : []).map((p) => p[key])))]
-    .filter((x) => x > 0).sort((a, b) => a - b);
-  const at = new Map(xs.map((x, i) => [x, i]));
-  const ys = order.map((n) => {
-    const y = new Array(xs.length).fill(null);
-    for (const p of (estimators[n] ? estimators[n].points : [])) if (at.has(p[key]) && p.relmse > 0) y[at.get(p[key])] = p.relmse;
-    return y;
-  });
-  return { xs, ys };
-}
+import { alignPoints } from './model.js';
 
 function chart(key, el, live, xKey, emptyText) {
   const { order } = live;

@@ -25,8 +25,9 @@ export const MAX_LIVE_WORKERS = 4;
 /** Bands per worker, interleaved (band i to worker i mod K), so that an expensive part of the
  *  image (a bright light, glossy plates) is shared out rather than given to one worker. */
 export const BANDS_PER_WORKER = 2;
-/** Predicted times to 64 spp above this (seconds) pause the view after the first pass and say so. */
-export const LONG_SECONDS = 20;
+/** Predicted times to 64 spp above this (seconds) pause the view after the first passes (every
+ *  prediction is said; a lecture can wait 20 s, not several minutes unannounced). */
+export const LONG_SECONDS = 60;
 
 /** The workers of the pool: hardwareConcurrency, at most MAX_LIVE_WORKERS, at least 1. */
 export function liveWorkers(cores, override = null) {
@@ -256,6 +257,23 @@ export function fitZoom(w, count, box) {
 }
 
 // ---------------------------------------------------------------------------------------------
+// Curves
+
+/** The x values of every estimator's points (sorted, once each) and each estimator's y at
+ *  them (null where it has no point): the shape uPlot wants. Pure (web/test). */
+export function alignPoints(order, estimators, key) {
+  const xs = [...new Set(order.flatMap((n) => (estimators[n] ? estimators[n].points : []).map((p) => p[key])))]
+    .filter((x) => x > 0).sort((a, b) => a - b);
+  const at = new Map(xs.map((x, i) => [x, i]));
+  const ys = order.map((n) => {
+    const y = new Array(xs.length).fill(null);
+    for (const p of (estimators[n] ? estimators[n].points : [])) if (at.has(p[key]) && p.relmse > 0) y[at.get(p[key])] = p.relmse;
+    return y;
+  });
+  return { xs, ys };
+}
+
+// ---------------------------------------------------------------------------------------------
 // Words
 
 /** A duration for people: 850 ms, 12 s, 3 min 20 s. */
@@ -268,15 +286,17 @@ export function duration(seconds) {
   return m >= 60 ? `${(seconds / 3600).toFixed(1)} h` : `${m} min${s ? ` ${s} s` : ''}`;
 }
 
+/** The spp after which the time to 64 spp is predicted: the passes to 1 and 2 spp also pay for
+ *  compiling the wasm (V8 optimises a function after its first calls), so they overstate it. */
+export const PREDICT_AT = 4;
+
 /**
- * The wall time to reach `spp` predicted after the first two passes: `elapsed` seconds brought
- * every estimator to 2 spp, and the second pass (1 spp of every estimator and band) cost
- * `perSpp` seconds of the workers' time (its bands' pass seconds over the workers; the first
- * pass also paid for compiling the wasm, so it is not the measure); each further spp costs as
- * much: spp - 2 more of them.
+ * The wall time to reach `spp` predicted after the first passes: `elapsed` seconds brought every
+ * estimator to PREDICT_AT spp, and each further spp costs `perSpp` seconds of the workers' time
+ * (the last pass's bands' pass seconds over the workers, per spp it added).
  */
 export function predictSeconds(elapsed, perSpp, spp = 64) {
-  return elapsed + Math.max(0, spp - 2) * perSpp;
+  return elapsed + Math.max(0, spp - PREDICT_AT) * perSpp;
 }
 
 /** The line said after the first passes: how long 64 spp will take; long = pause and ask. */
@@ -286,7 +306,7 @@ export function predictionText(elapsed, perSpp, width, height) {
   return {
     long,
     seconds: t,
-    text: `${width} × ${height} pixels: 2 spp took ${duration(elapsed)} and each further spp takes about ${duration(perSpp)}, ` +
+    text: `${width} × ${height} pixels: ${PREDICT_AT} spp took ${duration(elapsed)} and each further spp takes about ${duration(perSpp)}, ` +
       `so 64 spp will take about ${duration(t)}${long ? '. Paused: press Resume to go on, or choose a smaller size.' : '.'}`,
   };
 }

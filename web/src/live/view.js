@@ -229,6 +229,9 @@ export function renderLive(live, px, dom) {
       text = e && e.spp ? `${e.spp} spp · ${duration(e.seconds)}${last && last.spp === e.spp ? ` · relMSE ${last.relmse.toPrecision(3)}` : ''}` : 'waiting…';
     }
     if (facts.textContent !== text) facts.textContent = text;
+    const tip = key === 'reference' ? 'the reference the relative MSE is measured against'
+      : `seconds: the sum of this image's bands' own rendering seconds (one thread each) divided by the ${live.workers} workers`;
+    if (facts.title !== tip) facts.title = tip;
   }
   // the wipe: both sides at the largest spp they share
   const a = live.view.wipeA;

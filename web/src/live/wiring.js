@@ -22,7 +22,7 @@ import { CoreWorker } from '../client.js';
 import { MSG } from '../protocol.js';
 import {
   initialLive, liveReducer, liveActive, liveSnapshot, splitRows, workerOfBand, nextSpp, sessionOptions, createCollector,
-  defaultEstimators, predictionText, liveWorkers, fitZoom, BANDS_PER_WORKER, DEFAULT_LONG_SIDE, oneLine,
+  defaultEstimators, predictionText, liveWorkers, fitZoom, PREDICT_AT, BANDS_PER_WORKER, DEFAULT_LONG_SIDE, oneLine,
 } from './model.js';
 import { mountLive, syncLive, renderLive } from './view.js';
 
@@ -281,8 +281,9 @@ export function startLive(page) {
     dispatch({ type: 'live/level', payload: { id: me.id, estimator: name, spp: level.spp, seconds: level.seconds, relmse: level.relmse, now: performance.now() } });
     const st = store.getState();
     const reached = me.order.map((n) => st.estimators[n].spp);
-    me.perSpp = (me.perSpp || 0) + (level.spp === 2 ? level.passSeconds : 0);
-    if (reached.every((v) => v >= 2) && !me.predicted) {
+    // the pass to PREDICT_AT spp added PREDICT_AT / 2 spp to every pixel
+    if (level.spp === PREDICT_AT) me.perSpp = (me.perSpp || 0) + level.passSeconds / (PREDICT_AT / 2);
+    if (reached.every((v) => v >= PREDICT_AT) && !me.predicted) {
       me.predicted = true;
       const elapsed = (performance.now() - me.passesFrom) / 1000;
       dispatch({ type: 'live/prediction', payload: { id: me.id, prediction: predictionText(elapsed, me.perSpp, px.width, px.height) } });
