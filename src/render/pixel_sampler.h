@@ -317,27 +317,33 @@ class PixelSampler {
     /// The padded Sobol' sampler's request d for the current sample: the shuffled index of
     /// the sample in the request's own sequence, and the request's scrambling seeds (keyed by
     /// the pixel, d, and the index's bits above 32: each block of 2^32 samples is another
-    /// scrambled copy). The first kSobolPreparedRequests requests keep their keys per pixel.
+    /// scrambled copy). The first kSobolPreparedRequests requests keep their seeds per pixel.
     struct PaddedRequest {
         uint32_t index = 0;
-        uint64_t seeds = 0;
+        uint32_t shuffle = 0; ///< the index's scrambling seed
+        uint64_t seeds = 0;   ///< the value's scrambling seeds (sobol_value)
     };
+    static PaddedRequest padded_seeds(uint64_t key) {
+        PaddedRequest r;
+        r.shuffle = uint32_t(mix64(key ^ 0x73687566666c65ULL)); // "shuffle"
+        r.seeds = hash_combine(key ^ 0x6f77656e5365656eULL, 0); // "owenSeen"
+        return r;
+    }
     PaddedRequest padded_request(int d) {
-        uint64_t key;
-        if (d < kSobolPreparedRequests) {
+        const uint64_t block = index_ >> 32;
+        PaddedRequest r;
+        if (d < kSobolPreparedRequests && block == 0) {
             if (!((prepared_ >> d) & 1u)) {
-                padded_keys_[d] = hash_combine(key_, uint64_t(d));
+                padded_requests_[d] = padded_seeds(hash_combine(key_, uint64_t(d)));
                 prepared_ |= uint64_t(1) << d;
             }
-            key = padded_keys_[d];
+            r = padded_requests_[d];
         } else {
-            key = hash_combine(key_, uint64_t(d));
+            uint64_t key = hash_combine(key_, uint64_t(d));
+            if (block != 0) key = hash_combine(key, block);
+            r = padded_seeds(key);
         }
-        const uint64_t block = index_ >> 32;
-        if (block != 0) key = hash_combine(key, block);
-        PaddedRequest r;
-        r.index = owen_scramble_u32(uint32_t(index_), uint32_t(mix64(key ^ 0x73687566666c65ULL)));
-        r.seeds = hash_combine(key ^ 0x6f77656e5365656eULL, 0); // "owenSeen"
+        r.index = owen_scramble_u32(uint32_t(index_), r.shuffle);
         return r;
     }
 
@@ -463,7 +469,7 @@ class PixelSampler {
                   "one bit of prepared_ per dimension");
     IndexPermutation permutations_[kStratifiedDimensions]; ///< spp > kTableMaxSpp
     SobolRequest sobol_requests_[kSobolPreparedRequests];
-    uint64_t padded_keys_[kSobolPreparedRequests] = {};
+    PaddedRequest padded_requests_[kSobolPreparedRequests];
     std::vector<uint16_t> strata_; ///< row d: the pixel's shuffled strata of dimension d
 };
 
