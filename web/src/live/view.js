@@ -226,7 +226,11 @@ export function renderLive(live, px, dom) {
     else {
       const e = live.estimators[key];
       const last = e && e.points.length ? e.points[e.points.length - 1] : null;
-      text = e && e.spp ? `${e.spp} spp · ${duration(e.seconds)}${last && last.spp === e.spp ? ` · relMSE ${last.relmse.toPrecision(3)}` : ''}` : 'waiting…';
+      const rel = last && last.spp === e.spp ? last.relmse : null;
+      // the relative MSE less the reference's own variance: at or below 0 the image is as close
+      // to the truth as the reference can tell
+      const relText = rel === null ? '' : rel > 0 ? ` · relMSE ${rel.toPrecision(3)}` : ' · relMSE below the reference\'s noise';
+      text = e && e.spp ? `${e.spp} spp · ${duration(e.seconds)}${relText}` : 'waiting…';
     }
     if (facts.textContent !== text) facts.textContent = text;
     const tip = key === 'reference' ? 'the reference the relative MSE is measured against'
