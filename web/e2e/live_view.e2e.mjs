@@ -1,9 +1,9 @@
 // End-to-end test of the live view in headless Chromium (Debian's chromium, driven by
 // playwright-core). Usage: MCPLAY_SITE=SITE_DIR MCPLAY_SHOTS=SHOT_DIR node --test web/e2e/live_view.e2e.mjs
 // Opens Veach's MIS scene, chooses MIS (mis_power), light sampling and BSDF sampling, starts the
-// live view and waits for 16 spp; checks the canvases' sizes are the core's live size, that the
-// reference shipped with the site is used and the relative-MSE curves have points, that zoom
-// and the error maps redraw, moves the wipe (its clip follows), cancels (no pass arrives after),
+// live view and waits for 16 spp (the animation frames keep coming meanwhile); checks the
+// canvases' sizes are the core's live size, that the reference shipped with the site is used
+// and the relative-MSE curves have points, that zoom and the error maps redraw, moves the wipe (its clip follows), cancels (no pass arrives after),
 // shows one clear line for a size the core refuses, and runs axe-core on the view.
 import { mkdirSync, readFileSync } from 'node:fs';
 import { join, resolve, dirname } from 'node:path';
@@ -52,11 +52,33 @@ test('Veach\'s scene: three estimators converge to 16 spp at the core\'s live si
   assert.deepEqual([...s.choice.estimators].sort(), [...CHOSEN].sort());
   assert.equal(s.choice.sampler, 'padded_sobol');
   assert.match(await page.textContent('#live-sampler-why'), /cannot extend/);
+  // the page stays responsive while the passes arrive: the gaps between animation frames
+  await page.evaluate(() => {
+    window.liveFrameGaps = [];
+    let last = performance.now();
+    const tick = (t) => {
+      if (!window.liveFrameGaps) return;
+      window.liveFrameGaps.push(t - last);
+      last = t;
+      requestAnimationFrame(tick);
+    };
+    requestAnimationFrame(tick);
+  });
   await page.click('#live-start');
   await page.waitForFunction(() => {
     const v = window.mcplayDebug.live();
     return v.status === 'error' || (v.order.length && v.order.every((n) => v.estimators[n].spp >= 16));
   }, null, { timeout: 120000 });
+  const gaps = await page.evaluate(() => {
+    const g = window.liveFrameGaps.slice(1).sort((a, b) => a - b);
+    window.liveFrameGaps = null;
+    return g;
+  });
+  assert.ok(gaps.length > 10, `${gaps.length} frames`);
+  const medianGap = gaps[Math.floor(gaps.length / 2)];
+  console.log(`live view: ${gaps.length} frames, median gap ${medianGap.toFixed(1)} ms, longest ${gaps.at(-1).toFixed(0)} ms`);
+  assert.ok(medianGap < 40, `median frame gap ${medianGap} ms`);
+  assert.ok(gaps.at(-1) < 1000, `longest frame gap ${gaps.at(-1)} ms`);
   s = await live();
   assert.equal(s.message, '', s.message);
   // the size the core gives (scene info's live_size at the default long side)

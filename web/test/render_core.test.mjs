@@ -534,6 +534,12 @@ test('live sessions: two bands merge into the one-session image exactly, pass af
   // the sampler that cannot extend is refused, saying why; an extreme size is one clear error
   assertMcplayError(() => core.liveOpen(scene, { ...base, pixel_sampler: 'stratified' }), Status.ARGUMENT, /stratified/);
   assertMcplayError(() => core.liveOpen(scene, { ...base, long_side: 100000 }), Status.ARGUMENT, /long_side/);
+  // a camera 10:1 wide: beyond the live view's 8:1, said in one line (the scene info says why too)
+  const wide = quadLightGltf();
+  wide.cameras[0].perspective.aspectRatio = 10;
+  const wideScene = { ...SCENE, render: { ...SCENE.render, gltf: wide } };
+  assert.ok(core.sceneInfo(wideScene).live_size.error, 'the scene info says why there is no live size');
+  assertMcplayError(() => core.liveOpen(wideScene, { ...base, long_side: 256 }), Status.SCENE, /^[^\n]*aspectRatio is 10, beyond the live view's 8:1[^\n]*$/);
   for (const s of [whole, ...parts]) core.liveClose(s.session);
   assert.throws(() => core.liveClose(whole.session), McplayError);
 });
