@@ -68,13 +68,6 @@ export function nextSpp(spp) {
   return spp >= 1 ? spp * 2 : 1;
 }
 
-/** The schedule up to maxSpp: [1, 2, 4, ..., the largest power of two <= maxSpp]. */
-export function sppSchedule(maxSpp) {
-  const out = [];
-  for (let s = 1; s <= maxSpp; s *= 2) out.push(s);
-  return out;
-}
-
 /** The options of one band's session (mcp_render_live_open). */
 export function sessionOptions({ estimators, sampler, longSide, rows, referenceData = null, seed = null }) {
   const o = {
@@ -100,7 +93,7 @@ export function createCollector({ width, height, bands, workers }) {
     let level = pending.get(key);
     if (!level) {
       level = { estimator, spp: pass.spp, rgb: new Float32Array(width * height * 3), seen: new Set(), sum: 0, terms: 0,
-        errors: 0, seconds: 0, passSeconds: 0 };
+        errors: 0, seconds: [], passSeconds: 0 };
       pending.set(key, level);
     }
     if (level.seen.has(band)) throw new Error(`band ${band} sent ${pass.spp} spp of estimator ${estimator} twice`);
@@ -116,14 +109,14 @@ export function createCollector({ width, height, bands, workers }) {
       level.terms += pass.error.terms;
       level.errors += 1;
     }
-    level.seconds += pass.seconds || 0;
+    level.seconds.push(pass.seconds || 0);
     level.passSeconds += pass.pass_seconds || 0;
     if (level.seen.size < bands.length) return null;
     pending.delete(key);
     return {
       estimator, spp: level.spp, rgb: level.rgb, complete: true,
       relmse: level.errors === bands.length ? relativeMse([{ sum: level.sum, terms: level.terms }]) : null,
-      seconds: level.seconds / Math.max(1, workers),
+      seconds: estimatorSeconds(level.seconds, workers),
       passSeconds: level.passSeconds / Math.max(1, workers),
     };
   }
