@@ -3,8 +3,9 @@
 // Opens Veach's MIS scene, chooses MIS (mis_power), light sampling and BSDF sampling, starts the
 // live view and waits for 16 spp (the animation frames keep coming meanwhile); checks the
 // canvases' sizes are the core's live size, that the reference shipped with the site is used
-// and the relative-MSE curves have points, that zoom and the error maps redraw, moves the wipe (its clip follows), cancels (no pass arrives after),
-// shows one clear line for a size the core refuses, and runs axe-core on the view.
+// and the relative-MSE curves have points, that zoom and the error maps redraw, moves the wipe
+// (its clip follows), pauses and resumes, cancels (no pass arrives after), shows one clear line
+// for a size the core refuses, and runs axe-core on the view.
 import { mkdirSync, readFileSync } from 'node:fs';
 import { join, resolve, dirname } from 'node:path';
 import { fileURLToPath } from 'node:url';
@@ -143,10 +144,36 @@ test('zoom keeps pixels unsmoothed; the error maps redraw the cards; the wipe\'s
   assert.match(await page.textContent('#live-wipe-spp'), /both at \d+ spp/);
 });
 
+const levelsOf = (v) => v.order.map((n) => v.estimators[n].levels.length).join(',');
+
+test('Pause sends no more passes (those sent finish), Resume goes on from there', async () => {
+  const s0 = await live();
+  if (s0.status === 'paused') await page.click('#live-pause'); // paused by a long prediction
+  await page.waitForFunction(() => window.mcplayDebug.live().status === 'running');
+  await page.click('#live-pause');
+  assert.equal((await live()).status, 'paused');
+  assert.equal(await page.textContent('#live-pause'), 'Resume');
+  // the levels stop growing once the passes already sent are in
+  let before = levelsOf(await live());
+  for (let i = 0; i < 60; ++i) {
+    await page.waitForTimeout(1500);
+    const now = levelsOf(await live());
+    if (now === before) break;
+    before = now;
+  }
+  await page.waitForTimeout(1500);
+  assert.equal(levelsOf(await live()), before, 'no level while paused');
+  await page.click('#live-pause');
+  await page.waitForFunction((was) => {
+    const v = window.mcplayDebug.live();
+    return v.order.map((n) => v.estimators[n].levels.length).join(',') !== was;
+  }, before, { timeout: 120000 });
+  assert.equal((await live()).status, 'running');
+});
+
 test('Cancel stops at once: no pass arrives after it', async () => {
   const s0 = await live();
   if (!['running', 'paused'].includes(s0.status)) {
-    // it may have been paused by a long prediction; start again
     await page.click('#live-start');
     await page.waitForFunction(() => window.mcplayDebug.live().status === 'running');
   }
