@@ -22,9 +22,11 @@ export const MAX_SPP_CHOICES = Object.freeze([64, 256, 1024, 4096, 16384]);
 export const DEFAULT_MAX_SPP = 4096;
 /** Workers of the view's own pool: at most this many (the core renders one thread per worker). */
 export const MAX_LIVE_WORKERS = 4;
-/** Bands per worker, interleaved (band i to worker i mod K), so that an expensive part of the
- *  image (a bright light, glossy plates) is shared out rather than given to one worker. */
-export const BANDS_PER_WORKER = 2;
+/** Bands per worker (band i goes to worker i mod K, so several a worker interleave). One: two
+ *  interleaved bands a worker (to share out an expensive region of the image) made 64 spp 7-9%
+ *  slower on veach_mis, near_mirror and cornell_box (2 workers, 2026-12-04): each session reads
+ *  the shipped reference again, and each pass is one more call. */
+export const BANDS_PER_WORKER = 1;
 /** Predicted times to 64 spp above this (seconds) pause the view after the first passes (every
  *  prediction is said; a lecture can wait 20 s, not several minutes unannounced). */
 export const LONG_SECONDS = 60;

@@ -1,6 +1,6 @@
 // The live view's wiring: its store, its own pool of workers (up to 4, one thread each), the
-// sessions (one per row band, bands interleaved over the workers), the passes, the reference and
-// the drawing (once per animation frame).
+// sessions (one per row band, band i in worker i mod K), the passes, the reference and the
+// drawing (once per animation frame).
 //
 // A view: the image size comes from the core (the scene info's live_size at the default long
 // side, else a probe session of one row); the rows are cut into BANDS_PER_WORKER bands per
