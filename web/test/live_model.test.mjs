@@ -158,6 +158,16 @@ test('the prediction to 64 spp from the first passes, and its words', () => {
   assert.equal(long.long, 124 > LONG_SECONDS);
   assert.match(long.text, /about 2 min 4 s\. Paused/);
   assert.equal(predictionText(4, 0.1, 1, 1).long, false);
+  // after the first pass (1 spp took 2 s): 64 of them; said, and paused, at once
+  const early = predictionText(2, 2, 1024, 1024, 1);
+  assert.equal(early.seconds, 128);
+  assert.equal(early.pause, true);
+  assert.match(early.text, /^1024 × 1024 pixels: 1 spp took 2\.0 s, so 64 spp will take about 2 min 8 s\. Paused/);
+  // the closer figure later does not pause a view the reader resumed
+  const later = predictionText(8, 1.5, 1024, 1024, 4, false);
+  assert.equal(later.long, true);
+  assert.equal(later.pause, false);
+  assert.doesNotMatch(later.text, /Paused/);
   assert.equal(duration(0.0004), '1 ms');
   assert.equal(duration(42), '42 s');
   assert.equal(duration(7200), '2.0 h');
@@ -181,7 +191,9 @@ test('the reducer: a view starts, takes levels (curves only with a relative MSE)
   assert.equal(s.firstImageMs, 250);
   const stale = liveReducer(s, { type: 'live/level', payload: { id: 0, estimator: 'bsdf', spp: 4, seconds: 1, relmse: 0.1, now: 1 } });
   assert.equal(stale, s);
-  s = liveReducer(s, { type: 'live/prediction', payload: { id: 1, prediction: { long: true, text: 'long' } } });
+  s = liveReducer(s, { type: 'live/prediction', payload: { id: 1, prediction: { long: true, pause: false, text: 'long' } } });
+  assert.equal(s.status, 'running');
+  s = liveReducer(s, { type: 'live/prediction', payload: { id: 1, prediction: { long: true, pause: true, text: 'long' } } });
   assert.equal(s.status, 'paused');
   s = liveReducer(s, { type: 'live/resume', payload: { id: 1 } });
   assert.equal(s.status, 'running');

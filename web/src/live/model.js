@@ -287,22 +287,28 @@ export const PREDICT_AT = 4;
 
 /**
  * The wall time to reach `spp` predicted after the first passes: `elapsed` seconds brought every
- * estimator to PREDICT_AT spp, and each further spp costs `perSpp` seconds of the workers' time
- * (the last pass's bands' pass seconds over the workers, per spp it added).
+ * estimator to `at` spp, and each further spp costs `perSpp` seconds of the workers' time (the
+ * last pass's bands' pass seconds over the workers, per spp it added).
  */
-export function predictSeconds(elapsed, perSpp, spp = 64) {
-  return elapsed + Math.max(0, spp - PREDICT_AT) * perSpp;
+export function predictSeconds(elapsed, perSpp, spp = 64, at = PREDICT_AT) {
+  return elapsed + Math.max(0, spp - at) * perSpp;
 }
 
-/** The line said after the first passes: how long 64 spp will take; long = pause and ask. */
-export function predictionText(elapsed, perSpp, width, height) {
-  const t = predictSeconds(elapsed, perSpp, 64);
+/**
+ * The line said after the first passes: how long 64 spp will take, from `at` spp (PREDICT_AT;
+ * or 1, after the first pass, when that pass alone says the wait is long: a large image should
+ * not wait for 4 spp to be told, and its first pass is mostly rendering, not compiling). `long`
+ * (over LONG_SECONDS) pauses the view, unless `pause` is false (the view was paused once).
+ */
+export function predictionText(elapsed, perSpp, width, height, at = PREDICT_AT, pause = true) {
+  const t = predictSeconds(elapsed, perSpp, 64, at);
   const long = t > LONG_SECONDS;
   return {
     long,
+    pause: long && pause,
     seconds: t,
-    text: `${width} × ${height} pixels: ${PREDICT_AT} spp took ${duration(elapsed)} and each further spp takes about ${duration(perSpp)}, ` +
-      `so 64 spp will take about ${duration(t)}${long ? '. Paused: press Resume to go on, or choose a smaller size.' : '.'}`,
+    text: `${width} × ${height} pixels: ${at} spp took ${duration(elapsed)}${at > 1 ? ` and each further spp takes about ${duration(perSpp)}` : ''}, ` +
+      `so 64 spp will take about ${duration(t)}${long && pause ? '. Paused: press Resume to go on, or choose a smaller size.' : '.'}`,
   };
 }
 
@@ -371,7 +377,7 @@ export function liveReducer(state, action) {
     case 'live/reference':
       return { ...state, reference: { ...state.reference, ...p.reference } };
     case 'live/prediction':
-      return { ...state, prediction: p.prediction, status: p.prediction.long && state.status === 'running' ? 'paused' : state.status,
+      return { ...state, prediction: p.prediction, status: p.prediction.pause && state.status === 'running' ? 'paused' : state.status,
         notice: p.prediction.text };
     case 'live/pause':
       return state.status === 'running' ? { ...state, status: 'paused' } : state;

@@ -281,12 +281,22 @@ export function startLive(page) {
     dispatch({ type: 'live/level', payload: { id: me.id, estimator: name, spp: level.spp, seconds: level.seconds, relmse: level.relmse, now: performance.now() } });
     const st = store.getState();
     const reached = me.order.map((n) => st.estimators[n].spp);
-    // the pass to PREDICT_AT spp added PREDICT_AT / 2 spp to every pixel
+    // how long 64 spp will take: after the first pass when that pass alone says it is long, else
+    // (and more closely) after PREDICT_AT spp; the pass to PREDICT_AT spp added PREDICT_AT / 2 spp
     if (level.spp === PREDICT_AT) me.perSpp = (me.perSpp || 0) + level.passSeconds / (PREDICT_AT / 2);
+    const elapsed = (performance.now() - me.passesFrom) / 1000;
+    if (reached.every((v) => v >= 1) && !me.early && level.spp === 1) {
+      me.early = true;
+      const early = predictionText(elapsed, elapsed, px.width, px.height, 1);
+      if (early.long) {
+        me.pausedOnce = true;
+        dispatch({ type: 'live/prediction', payload: { id: me.id, prediction: early } });
+      }
+    }
     if (reached.every((v) => v >= PREDICT_AT) && !me.predicted) {
       me.predicted = true;
-      const elapsed = (performance.now() - me.passesFrom) / 1000;
-      dispatch({ type: 'live/prediction', payload: { id: me.id, prediction: predictionText(elapsed, me.perSpp, px.width, px.height) } });
+      const prediction = predictionText(elapsed, me.perSpp, px.width, px.height, PREDICT_AT, !me.pausedOnce);
+      dispatch({ type: 'live/prediction', payload: { id: me.id, prediction } });
     }
     if (reached.every((v) => v >= me.maxSpp)) {
       dispatch({ type: 'live/done', payload: { id: me.id } });
