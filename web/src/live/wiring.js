@@ -44,7 +44,8 @@ export function startLive(page) {
   const references = new Map(); // `${scene key}:${w}x${h}` -> reference_data rendered here
   const px = { width: 0, height: 0, bands: 0, exposure: 0, images: new Map(), reference: null };
   const dom = { spp: document.getElementById('live-plot-spp'), seconds: document.getElementById('live-plot-seconds') };
-  let sceneKey = null;
+  let sceneKey = null;   // the scene's name (references rendered here are kept by it and the size;
+  let sceneShown = null; // the core refuses one made from another glTF, and one is rendered again)
 
   const poolSize = () => liveWorkers(page.cores, page.workers);
   function workers(k) {
@@ -325,8 +326,9 @@ export function startLive(page) {
     const { scene, info, sceneId } = page.study();
     const render = Boolean(info && info.kind === 'render');
     const next = render ? `${sceneId}:${info.name}` : null;
-    if (next === sceneKey) return;
+    if (next === sceneKey && scene === sceneShown) return;
     sceneKey = next;
+    sceneShown = scene;
     if (run) cancel();
     const chosen = render ? defaultEstimators(info.estimators) : null;
     dispatch({ type: 'live/choose', payload: { estimators: chosen } });
