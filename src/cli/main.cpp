@@ -287,6 +287,24 @@ bool pixel_sampler_option(const std::string& v, nlohmann::json* options, std::st
     return false;
 }
 
+/// --estimators A,B,..: options.estimators, the names in order (`refuse_repeats`: a name given
+/// twice is an error). Returns -1 when the list is good, else the exit code of the usage error.
+int estimator_list(const std::string& v, bool refuse_repeats, nlohmann::json* options) {
+    nlohmann::json list = nlohmann::json::array();
+    std::stringstream ss(v);
+    std::string item;
+    while (std::getline(ss, item, ',')) {
+        if (item.empty()) return usage_error("--estimators: empty name in '" + v + "'");
+        if (refuse_repeats)
+            for (const auto& seen : list)
+                if (seen == item) return usage_error("--estimators: '" + item + "' is named twice");
+        list.push_back(item);
+    }
+    if (list.empty()) return usage_error("--estimators needs at least one name");
+    (*options)["estimators"] = list;
+    return -1;
+}
+
 int cmd_list(const std::vector<std::string>& args) {
     std::string dir_arg;
     for (size_t i = 0; i < args.size(); ++i) {
@@ -433,15 +451,7 @@ int cmd_run(const std::vector<std::string>& args) {
         if (a == "--estimators") {
             if (!value(&v))
                 return usage_error("--estimators needs a comma-separated list of names");
-            nlohmann::json list = nlohmann::json::array();
-            std::stringstream ss(v);
-            std::string item;
-            while (std::getline(ss, item, ',')) {
-                if (item.empty()) return usage_error("--estimators: empty name in '" + v + "'");
-                list.push_back(item);
-            }
-            if (list.empty()) return usage_error("--estimators needs at least one name");
-            options["estimators"] = list;
+            if (int rc = estimator_list(v, false, &options); rc >= 0) return rc;
         } else if (a == "--n-min" || a == "--n-max" || a == "--reps" || a == "--seed" ||
                    a == "--threads") {
             if (!value(&v)) return usage_error(a + " needs a value");
@@ -597,18 +607,7 @@ int parse_image_command(const char* command, const std::vector<std::string>& arg
         } else if (render_only && a == "--estimators") {
             if (!value(&v))
                 return usage_error("--estimators needs a comma-separated list of names");
-            nlohmann::json list = nlohmann::json::array();
-            std::stringstream ss(v);
-            std::string item;
-            while (std::getline(ss, item, ',')) {
-                if (item.empty()) return usage_error("--estimators: empty name in '" + v + "'");
-                for (const auto& seen : list)
-                    if (seen == item)
-                        return usage_error("--estimators: '" + item + "' is named twice");
-                list.push_back(item);
-            }
-            if (list.empty()) return usage_error("--estimators needs at least one name");
-            c->options["estimators"] = list;
+            if (int rc = estimator_list(v, true, &c->options); rc >= 0) return rc;
         } else if (render_only && a == "--progressive") {
             c->progressive = true;
         } else if (render_only && a == "--out-dir") {
