@@ -25,6 +25,8 @@ namespace mcp {
 
 namespace {
 
+using boundary::copy_out;
+using boundary::dump;
 using boundary::fail;
 
 constexpr size_t kMaxLiveEstimators = 4;
