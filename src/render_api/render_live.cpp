@@ -296,19 +296,7 @@ int pass_session(int id, const char* pass_json, mcp_progress_fn progress, void* 
     rs.threads = s->threads;
     rs.jitter_pixels = r.settings.jitter_pixels;
     bool cancelled = false;
-    if (progress)
-        rs.progress = [progress, user, &cancelled, last = -1](int done, int rows) mutable {
-            const int percent = int(100.0 * done / std::max(1, rows));
-            if (percent == last) return true;
-            last = percent;
-            const std::string line = dump(Json{{"version", kResultSchemaVersion},
-                                               {"kind", "render_live_pass"},
-                                               {"rows_done", done},
-                                               {"rows", rows}});
-            if (progress(line.c_str(), user) == 0) return true;
-            cancelled = true;
-            return false;
-        };
+    rs.progress = rows_progress(progress, user, "render_live_pass", &cancelled);
     const double before = band.seconds;
     const uint64_t samples_before = band.diagnostics.samples;
     if (!render_pass(s->loaded.scene, est, rs, band))

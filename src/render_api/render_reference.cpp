@@ -32,16 +32,17 @@ std::string hex(uint64_t x) {
     return buf;
 }
 
-/// The progress lines of a reference being rendered, {"kind": "render_reference", "rows_done",
-/// "rows"}, at most one per percent; sets *cancelled when the callback asks to stop.
-ReferenceProgress reference_progress(mcp_progress_fn progress, void* user, bool* cancelled) {
+} // namespace
+
+ReferenceProgress rows_progress(mcp_progress_fn progress, void* user, const char* kind,
+                                bool* cancelled) {
     if (!progress) return nullptr;
-    return [progress, user, cancelled, last = -1](int rows_done, int rows) mutable {
+    return [progress, user, kind, cancelled, last = -1](int rows_done, int rows) mutable {
         const int percent = int(100.0 * rows_done / std::max(1, rows));
         if (percent == last) return true;
         last = percent;
         const std::string text = dump(Json{{"version", kResultSchemaVersion},
-                                           {"kind", "render_reference"},
+                                           {"kind", kind},
                                            {"rows_done", rows_done},
                                            {"rows", rows}});
         if (progress(text.c_str(), user) == 0) return true;
@@ -49,8 +50,6 @@ ReferenceProgress reference_progress(mcp_progress_fn progress, void* user, bool*
         return false;
     };
 }
-
-} // namespace
 
 uint64_t reference_key(const RenderRequest& r) {
     const RenderStudySettings& s = r.settings;
@@ -150,8 +149,8 @@ bool obtain_reference(const LoadedRender& l, RenderImage* ref, Json* info, std::
 int obtain_reference_reporting(const LoadedRender& l, mcp_progress_fn progress, void* user,
                                RenderImage* ref, Json* info, std::string* error, bool may_render) {
     bool cancelled = false;
-    if (obtain_reference(l, ref, info, error, reference_progress(progress, user, &cancelled),
-                         may_render))
+    if (obtain_reference(l, ref, info, error,
+                         rows_progress(progress, user, "render_reference", &cancelled), may_render))
         return MCP_OK;
     return cancelled ? MCP_ERROR_CANCELLED : MCP_ERROR_SCENE;
 }

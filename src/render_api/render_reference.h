@@ -26,6 +26,12 @@ std::string reference_cache_file(const RenderRequest& r);
 /// Called with the rows of the reference rendered so far and the image's rows; false cancels.
 using ReferenceProgress = std::function<bool(int rows_done, int rows)>;
 
+/// Progress lines {"kind": kind, "rows_done", "rows"} of an image being rendered, at most one
+/// per percent, for a C API callback; sets *cancelled when the callback asks to stop. nullptr
+/// without a callback.
+ReferenceProgress rows_progress(mcp_progress_fn progress, void* user, const char* kind,
+                                bool* cancelled);
+
 /// The reference image: read from the scene's HDR file, taken from options.reference_data
 /// when it was made from the same scene and settings, read from the cache, or rendered (and
 /// then cached). `source` says which; a supplied reference that is not used says why. With
