@@ -61,14 +61,12 @@ std::shared_ptr<LiveSession> find_session(int id) {
 std::string float_pixels(const std::vector<double>& rgb, size_t first, size_t count) {
     std::string bytes(count * sizeof(float), '\0');
     for (size_t k = 0; k < count; ++k) {
-        const float v = float(rgb[first + k]);
-        unsigned char b[sizeof(float)];
-        std::memcpy(b, &v, sizeof(float));
         // Little-endian whatever the host (wasm and x86 are; this keeps the format defined).
+        const float v = float(rgb[first + k]);
         uint32_t u = 0;
         std::memcpy(&u, &v, sizeof(u));
-        for (size_t i = 0; i < sizeof(float); ++i) b[i] = static_cast<unsigned char>(u >> (8 * i));
-        std::memcpy(&bytes[k * sizeof(float)], b, sizeof(float));
+        for (size_t i = 0; i < sizeof(u); ++i)
+            bytes[k * sizeof(u) + i] = static_cast<char>((u >> (8 * i)) & 0xffu);
     }
     return base64_encode(bytes);
 }
