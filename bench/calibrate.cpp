@@ -2,9 +2,19 @@
 // (docs/benchmarks.md). A flag that fires where every interval covered teaches users to
 // ignore flags; an estimate far off with no flag is a confident wrong answer.
 //
-//   calibrate [--quick] [--reps R] [--n-min N] [--n-max N] [--param-seeds 1,2,3]
-//             [--dims 2,4,8] [--scenes DIR] [--json FILE] [--cells FILE] [--list N]
+//   calibrate [--quick] [--reps R] [--n-min N] [--n-max N] [--ns N1,N2] [--param-seeds 1,2,3]
+//             [--dims 2,4,8] [--families 1,..,6] [--singular] [--fine 3t|coverage]
+//             [--scenes DIR] [--json FILE] [--cells FILE] [--list N]
 //             [--stopping REL [--stop-n-max N] [--max-seconds S]]
+//
+// --ns runs each listed N as a study of its own (instead of the ladder n_min..n_max).
+// --singular adds, per dimension and parameter seed, two products prod x_i^-a_i (monomial
+// integrands, exact prod 1 / (1 - a_i)): one of finite variance whose weights have an infinite
+// fourth moment (every a_i in (0.25, 0.35), tail index 1 / a_i near 3: the sample skewness is erratic), and one of
+// infinite variance (one a_i in (0.55, 0.85)); every cell of the latter must carry an alarm.
+// --fine coverage judges a cell by its coverage instead of its worst replicate (use R = 32):
+// fine when at least R - floor(3 R / 32) replicates lie within 1.96 t of their own standard
+// error of the exact value (29 of 32) and none beyond 3.5 t.
 //
 // The battery: Genz's six families [Genz84] at d = 2, 4, 8 with the project's own random
 // parameters (genz_random, seeds 1..3), each run with every uniform-density preset, and every
@@ -44,6 +54,7 @@
 
 #include "api/json_read.h"
 #include "api/mcplay.h"
+#include "core/rng.h"
 #include "core/special.h"
 #include "integrands/genz.h"
 
@@ -59,6 +70,10 @@ struct Options {
     uint64_t n_min = 1024, n_max = 65536, seed = 2026;
     std::vector<int> dims{2, 4, 8};
     std::vector<uint64_t> param_seeds{1, 2, 3};
+    std::vector<uint64_t> ns; // --ns: these N, each a study of its own
+    std::vector<int> families{1, 2, 3, 4, 5, 6};
+    bool singular = false;         // --singular: singular products too
+    bool fine_by_coverage = false; // --fine coverage
     std::string scenes_dir = "scenes", json_path, cells_path;
     int recheck = 0, recheck_reps = 100; // --recheck K: fine cells run again, per kind
     int list = 20;                       // confident wrong answers and flag codes listed
@@ -70,7 +85,9 @@ struct Options {
 [[noreturn]] void usage(const std::string& msg) {
     if (!msg.empty()) std::fprintf(stderr, "calibrate: %s\n", msg.c_str());
     std::fprintf(stderr, "usage: calibrate [--quick] [--reps R] [--n-min N] [--n-max N]\n"
-                         "         [--param-seeds 1,2,3] [--dims 2,4,8] [--scenes DIR]\n"
+                         "         [--ns N1,N2] [--param-seeds 1,2,3] [--dims 2,4,8]\n"
+                         "         [--families 1,..,6] [--singular] [--fine 3t|coverage]\n"
+                         "         [--scenes DIR]\n"
                          "         [--json FILE] [--cells FILE] [--list N]\n"
                          "         [--stopping REL [--stop-n-max N] [--max-seconds S]]\n"
                          "         [--recheck K [--recheck-reps R]]\n");
@@ -116,7 +133,18 @@ Options parse_options(int argc, char** argv) {
             o.n_max = one("--n-max", 16, uint64_t(1) << 24);
         else if (a == "--param-seeds")
             o.param_seeds = parse_list(value(), "--param-seeds", 1, 1000000);
-        else if (a == "--dims") {
+        else if (a == "--ns")
+            o.ns = parse_list(value(), "--ns", 16, uint64_t(1) << 24);
+        else if (a == "--families") {
+            o.families.clear();
+            for (uint64_t f : parse_list(value(), "--families", 1, 6)) o.families.push_back(int(f));
+        } else if (a == "--singular")
+            o.singular = true;
+        else if (a == "--fine") {
+            const std::string v = value();
+            if (v != "3t" && v != "coverage") usage("--fine: expected 3t or coverage");
+            o.fine_by_coverage = v == "coverage";
+        } else if (a == "--dims") {
             o.dims.clear();
             for (uint64_t d : parse_list(value(), "--dims", 1, 64)) o.dims.push_back(int(d));
         } else if (a == "--scenes")
@@ -157,16 +185,18 @@ Options parse_options(int argc, char** argv) {
 struct Case {
     std::string name;
     Json scene;
-    Json options; // mcp_study_run options (estimators for the Genz cases)
+    Json options;                   // mcp_study_run options (estimators for the Genz cases)
+    bool infinite_variance = false; // every cell must carry an alarm
 };
 
 std::vector<Case> genz_cases(const Options& o) {
     std::vector<Case> cases;
     Json presets = Json::array();
     for (const char* p : kPresets) presets.push_back(p);
-    for (int fam = 0; fam < 6; ++fam)
+    for (int fam1 : o.families)
         for (int d : o.dims)
             for (uint64_t seed : o.param_seeds) {
+                const int fam = fam1 - 1;
                 const GenzParams g = genz_random(GenzFamily(fam), d, seed);
                 Case c;
                 c.name = std::string(genz_family_name(GenzFamily(fam))) + "_d" + std::to_string(d) +
@@ -175,6 +205,32 @@ std::vector<Case> genz_cases(const Options& o) {
                            {"integrand",
                             {{"type", genz_family_name(GenzFamily(fam))}, {"a", g.a}, {"u", g.u}}},
                            {"exact", genz_exact(g)},
+                           {"estimators", presets}};
+                cases.push_back(c);
+            }
+    if (!o.singular) return cases;
+    // Singular products prod x_i^-a_i: E f^k is finite iff every k a_i < 1.
+    for (int d : o.dims)
+        for (uint64_t seed : o.param_seeds)
+            for (const bool infinite_variance : {false, true}) {
+                Pcg32 rng(seed, hash_string(infinite_variance ? "singular_iv" : "singular_fv"));
+                std::vector<double> powers(static_cast<size_t>(d));
+                double exact = 1.0;
+                for (size_t i = 0; i < powers.size(); ++i) {
+                    const bool heavy = infinite_variance && i == 0;
+                    const double a =
+                        heavy ? 0.55 + 0.3 * rng.next_double() : 0.25 + 0.1 * rng.next_double();
+                    powers[i] = -a;
+                    exact /= 1.0 - a;
+                }
+                Case c;
+                c.name = std::string(infinite_variance ? "singular_infvar" : "singular_finvar") +
+                         "_d" + std::to_string(d) + "_s" + std::to_string(seed);
+                c.infinite_variance = infinite_variance;
+                c.scene = {{"name", c.name},
+                           {"domain", {{"type", "box"}, {"dim", d}}},
+                           {"integrand", {{"type", "monomial"}, {"powers", powers}}},
+                           {"exact", exact},
                            {"estimators", presets}};
                 cases.push_back(c);
             }
@@ -213,6 +269,7 @@ double number_or_nan(const Json& v) {
 
 struct Tally {
     long fine = 0, fine_flagged = 0, cells = 0, runs = 0, confident_wrong = 0;
+    long infvar_cells = 0, infvar_unflagged = 0;  // cells of infinite-variance cases
     std::map<std::string, long> false_flag_codes; // codes on fine cells
     // Codes that are a cell's only alarm where a replicate missed by more than 5 t standard
     // errors: without them those misses would be confident wrong answers.
@@ -235,9 +292,10 @@ struct FineCell {
 // Judges every level of every estimator of one study result.
 // cells (if not null) gets one JSON line per cell: the verdict, the alarms and the level's
 // statistics, for studying what separates the misses from the fine cells.
-void judge(const std::string& case_name, size_t case_index, const Json& result, double exact,
+void judge(const Options& o, const Case& c, size_t case_index, const Json& result, double exact,
            Tally* t, std::vector<Wrong>* wrong, std::vector<FineCell>* fine_cells,
            std::FILE* cells) {
+    const std::string& case_name = c.name;
     for (const Json& e : result["estimators"]) {
         // Alarms only: a flag of severity info says nothing is wrong.
         auto alarms = [](const Json& warnings, std::vector<std::string>* codes) {
@@ -256,17 +314,28 @@ void judge(const std::string& case_name, size_t case_index, const Json& result, 
             const Json& est = l["replicates"]["estimate"];
             const Json& se = l["replicates"]["std_error"];
             bool fine = true;
+            long covered = 0, judged = 0, beyond35 = 0;
             std::vector<double> misses;
             for (size_t i = 0; i < est.size() && i < se.size(); ++i) {
                 const double x = number_or_nan(est[i]), s = number_or_nan(se[i]);
                 const double err = std::fabs(x - exact);
                 const double roundoff = 1e-12 * std::max(std::fabs(exact), std::fabs(x));
                 ++t->runs;
+                ++judged;
                 if (!(err <= 3.0 * widen * s + roundoff)) fine = false;
+                if (err <= 1.959963985 * widen * s + roundoff) ++covered;
+                if (!(err <= 3.5 * widen * s + roundoff)) ++beyond35;
                 if (!(err <= 5.0 * widen * s + roundoff))
                     misses.push_back(s > 0.0 ? err / s : INFINITY);
             }
+            if (o.fine_by_coverage) fine = covered >= judged - (3 * judged) / 32 && beyond35 == 0;
             ++t->cells;
+            // Infinite variance: an alarm is right on every cell, fine or not (judged apart).
+            if (c.infinite_variance) {
+                ++t->infvar_cells;
+                if (codes.empty()) ++t->infvar_unflagged;
+                fine = false;
+            }
             if (cells) {
                 Json line = {{"case", case_name},
                              {"estimator", e.value("name", "?")},
@@ -473,10 +542,14 @@ int main(int argc, char** argv) {
     std::vector<Case> cases = genz_cases(o);
     const size_t genz_count = cases.size();
     for (Case& c : scene_cases(o)) cases.push_back(std::move(c));
-    std::printf("calibrate: %zu studies (%zu Genz cases; %zu on the scenes of %s, with their own "
-                "estimators and each preset), N = %llu..%llu, R = %d\n",
+    std::printf("calibrate: %zu studies (%zu Genz and singular cases; %zu on the scenes of %s, "
+                "with their own estimators and each preset), N = %llu..%llu%s, R = %d, fine by "
+                "%s\n",
                 cases.size(), genz_count, cases.size() - genz_count, o.scenes_dir.c_str(),
-                (unsigned long long)o.n_min, (unsigned long long)o.n_max, o.reps);
+                (unsigned long long)o.n_min, (unsigned long long)o.n_max,
+                o.ns.empty() ? "" : " (--ns: each N alone)", o.reps,
+                o.fine_by_coverage ? "coverage (29 of 32 within 1.96 t se, none beyond 3.5)"
+                                   : "every replicate within 3 t se");
     std::FILE* json = o.json_path.empty() ? nullptr : std::fopen(o.json_path.c_str(), "w");
     if (!o.json_path.empty() && !json) usage("--json: cannot write " + o.json_path);
     std::FILE* cells = o.cells_path.empty() ? nullptr : std::fopen(o.cells_path.c_str(), "w");
@@ -488,53 +561,62 @@ int main(int argc, char** argv) {
     // Presets a scene does not take (a domain MISER cannot split, ...): count, first reason.
     std::map<std::string, std::pair<int, std::string>> not_applicable;
     std::set<std::string> no_exact; // scenes dropped, by the name before "+preset"
-    for (size_t ci = 0; ci < cases.size(); ++ci) {
-        const Case& c = cases[ci];
-        const std::string base = c.name.substr(0, c.name.find('+'));
-        if (no_exact.count(base)) continue;
-        Json options = c.options;
-        options["n_min"] = o.n_min;
-        options["n_max"] = o.n_max;
-        options["reps"] = o.reps;
-        options["seed"] = o.seed + ci;
-        options["threads"] = 0;
-        char* out = nullptr;
-        const int status =
-            mcp_study_run(c.scene.dump().c_str(), options.dump().c_str(), nullptr, nullptr, &out);
-        if (status == MCP_ERROR_SCENE && c.options.contains("estimators")) {
-            auto& [count, reason] = not_applicable[c.options["estimators"][0].get<std::string>()];
-            if (count++ == 0) reason = c.name + ": " + mcp_last_error();
+    // The N ranges each case is run over: the ladder, or each --ns value on its own.
+    std::vector<std::pair<uint64_t, uint64_t>> ranges;
+    if (o.ns.empty())
+        ranges.push_back({o.n_min, o.n_max});
+    else
+        for (uint64_t n : o.ns) ranges.push_back({n, n});
+    for (size_t ci = 0; ci < cases.size(); ++ci)
+        for (size_t ri = 0; ri < ranges.size(); ++ri) {
+            const Case& c = cases[ci];
+            const std::string base = c.name.substr(0, c.name.find('+'));
+            if (no_exact.count(base)) continue;
+            Json options = c.options;
+            options["n_min"] = ranges[ri].first;
+            options["n_max"] = ranges[ri].second;
+            options["reps"] = o.reps;
+            options["seed"] = o.seed + ci + 7919 * ri;
+            options["threads"] = 0;
+            char* out = nullptr;
+            const int status = mcp_study_run(c.scene.dump().c_str(), options.dump().c_str(),
+                                             nullptr, nullptr, &out);
+            if (status == MCP_ERROR_SCENE && c.options.contains("estimators")) {
+                auto& [count, reason] =
+                    not_applicable[c.options["estimators"][0].get<std::string>()];
+                if (ri == 0 && count++ == 0) reason = c.name + ": " + mcp_last_error();
+                mcp_free(out);
+                continue;
+            }
+            if (status != MCP_OK) {
+                std::printf("  %s: error %d: %s\n", c.name.c_str(), status, mcp_last_error());
+                mcp_free(out);
+                continue;
+            }
+            Made<Json> r = parse_json(out, c.name.c_str());
             mcp_free(out);
-            continue;
+            if (!r.ok()) {
+                std::printf("  %s: result is not JSON: %s\n", c.name.c_str(), r.error.c_str());
+                continue;
+            }
+            const Json& scene = r.value["scene"];
+            if (!scene.contains("exact") || !scene["exact"].is_number()) {
+                std::printf("  %s: no exact value, skipped\n", c.name.c_str());
+                no_exact.insert(base);
+                continue;
+            }
+            const double exact = scene["exact"].get<double>();
+            Tally& t = ci < genz_count ? genz : scenes;
+            const size_t before = wrong.size();
+            judge(o, c, ci, r.value, exact, &t, &wrong, &fine_cells, cells);
+            if (json)
+                std::fprintf(json, "%s\n",
+                             Json({{"case", c.name}, {"confident_wrong", wrong.size() - before}})
+                                 .dump()
+                                 .c_str());
+            std::fprintf(stderr, "[%zu/%zu] %s N=%llu\n", ci + 1, cases.size(), c.name.c_str(),
+                         (unsigned long long)ranges[ri].first);
         }
-        if (status != MCP_OK) {
-            std::printf("  %s: error %d: %s\n", c.name.c_str(), status, mcp_last_error());
-            mcp_free(out);
-            continue;
-        }
-        Made<Json> r = parse_json(out, c.name.c_str());
-        mcp_free(out);
-        if (!r.ok()) {
-            std::printf("  %s: result is not JSON: %s\n", c.name.c_str(), r.error.c_str());
-            continue;
-        }
-        const Json& scene = r.value["scene"];
-        if (!scene.contains("exact") || !scene["exact"].is_number()) {
-            std::printf("  %s: no exact value, skipped\n", c.name.c_str());
-            no_exact.insert(base);
-            continue;
-        }
-        const double exact = scene["exact"].get<double>();
-        Tally& t = ci < genz_count ? genz : scenes;
-        const size_t before = wrong.size();
-        judge(c.name, ci, r.value, exact, &t, &wrong, &fine_cells, cells);
-        if (json)
-            std::fprintf(json, "%s\n",
-                         Json({{"case", c.name}, {"confident_wrong", wrong.size() - before}})
-                             .dump()
-                             .c_str());
-        std::fprintf(stderr, "[%zu/%zu] %s\n", ci + 1, cases.size(), c.name.c_str());
-    }
 
     if (!not_applicable.empty()) {
         std::printf("presets skipped on scenes that do not take them:\n");
@@ -559,7 +641,12 @@ int main(int argc, char** argv) {
     all.runs += scenes.runs;
     for (const auto& [k, v] : scenes.false_flag_codes) all.false_flag_codes[k] += v;
     for (const auto& [k, v] : scenes.sole_alarm_on_miss) all.sole_alarm_on_miss[k] += v;
+    all.infvar_cells += scenes.infvar_cells;
+    all.infvar_unflagged += scenes.infvar_unflagged;
     report("all", all);
+    if (all.infvar_cells)
+        std::printf("infinite-variance cases: %ld cells, %ld of them without an alarm (target 0)\n",
+                    all.infvar_cells, all.infvar_unflagged);
     std::printf("\nalarms on fine cells (cells carrying each), and cells with a miss beyond 5 t "
                 "standard errors\nwhere it is the only alarm (without it they would be "
                 "confident wrong answers):\n");

@@ -126,10 +126,10 @@ TEST(Diagnostics, EveryFlagHasTheSeverityOfWhatItSays) {
          {FlagCode::NoEstimate, FlagCode::NonfiniteEstimate, FlagCode::NonfiniteVariance,
           FlagCode::ZeroErrorBar, FlagCode::NonfiniteSamples, FlagCode::ZeroPdfSamples,
           FlagCode::ExactOutsideCi, FlagCode::PdfSupport, FlagCode::IterationsDisagree,
-          FlagCode::ErrorBarsUnderstate, FlagCode::PixelErrorBars})
+          FlagCode::ErrorBarsUnderstate, FlagCode::PixelErrorBars, FlagCode::ValuesUnderflow})
         EXPECT_EQ(default_severity(c), Severity::Error) << flag_code_name(c);
     for (FlagCode c : {FlagCode::SkewedWeights, FlagCode::LowEss, FlagCode::HeavyTail,
-                       FlagCode::LevelDrift, FlagCode::SlowConvergence,
+                       FlagCode::LevelDrift, FlagCode::SlowConvergence, FlagCode::ReplicateFarOff,
                        FlagCode::FewPixelErrors, FlagCode::RareLargeErrors})
         EXPECT_EQ(default_severity(c), Severity::Warning) << flag_code_name(c);
     for (FlagCode c : {FlagCode::HeavyTail4, FlagCode::Float32Accumulator,
@@ -385,4 +385,181 @@ TEST(Diagnostics, LevelDriftIsRareOnConsistentLaddersAndCatchesAShift) {
     for (int i = 0; i < 200; ++i)
         caught += level_consistency(normal_ladder(rng, 10, 10.0)).p_value < kLevelDriftP;
     EXPECT_GE(caught, 150) << "of 200";
+}
+
+namespace {
+
+// A level of R replicates with error bars 1 (dof 1000) about the exact value 0: replicate i's
+// estimate is z[i]. Its weights are skewed (one in 1024 non-zero: Cochran's rule needs
+// N > 25570) so that skewed_weights fires on the weights alone at N = 4096.
+LevelStats replicates_level(const std::vector<double>& z, bool with_exact) {
+    const int r = static_cast<int>(z.size());
+    LevelStats l;
+    l.n = 4096;
+    l.reps = r;
+    l.estimates_spread = true;
+    l.has_exact = with_exact;
+    l.exact = with_exact ? 0.0 : std::numeric_limits<double>::quiet_NaN();
+    for (uint64_t i = 0; i < uint64_t(r) * l.n; ++i)
+        l.diagnostics.weights.add(i % 1024 == 0 ? 1.0 : 0.0);
+    l.diagnostics.error_units = l.diagnostics.weights;
+    l.estimates = z;
+    l.run_std_errors.assign(z.size(), 1.0);
+    l.run_dofs.assign(z.size(), 1000);
+    l.ess_mean = 4096.0;
+    RunningMoments m;
+    for (double x : z) m.add(x);
+    l.mean = m.mean();
+    l.variance = m.variance();
+    l.mean_run_variance = 1.0;
+    l.run_dof_total = 1000.0 * r;
+    return l;
+}
+
+// n replicates spread like honest N(0, 1) errors (normal quantiles at (i + 1/2) / n, shuffled
+// by a fixed stride): their misses beyond 1.96 are the 5% that honest intervals give.
+std::vector<double> honest_errors(int n) {
+    std::vector<double> z(static_cast<size_t>(n));
+    for (int i = 0; i < n; ++i) z[size_t((i * 7) % n)] = normal_quantile((i + 0.5) / n);
+    return z;
+}
+
+} // namespace
+
+// The replicates' own evidence overrules a warning that rests on the weights alone, once there
+// are enough of them (20): with 32 replicates whose intervals miss as honest ones do (2 of 32;
+// up to 3 allowed, P(Bin(32, 0.05) >= 4) = 0.077 < 0.1), skewed_weights is info and carries the
+// counts; with 5 misses or more (P(Bin(32, 0.05) >= 5) = 0.026) it stays a warning; with 10 replicates (too few to tell 80%
+// coverage from 95%) the weights' rule stands alone. error_bars_unstable follows the same rule.
+TEST(Diagnostics, ReplicatesThatCoverOverruleWarningsFromTheWeights) {
+    LevelStats covered = replicates_level(honest_errors(32), true);
+    std::optional<Flag> f = find(level_flags(covered), FlagCode::SkewedWeights);
+    ASSERT_TRUE(f.has_value());
+    EXPECT_EQ(f->severity, Severity::Info);
+    EXPECT_EQ(f->replicates_judged, 32);
+    EXPECT_EQ(f->replicate_misses, 2);
+    EXPECT_EQ(f->miss_allowance, 3);
+    EXPECT_FALSE(find(level_flags(covered), FlagCode::ReplicateFarOff));
+
+    std::vector<double> missing = honest_errors(32);
+    for (int i = 0; i < 4; ++i) missing[size_t(i)] = 2.5 + 0.1 * i; // 5 or 6 misses in all
+    f = find(level_flags(replicates_level(missing, true)), FlagCode::SkewedWeights);
+    ASSERT_TRUE(f.has_value());
+    EXPECT_EQ(f->severity, Severity::Warning);
+    EXPECT_GE(f->replicate_misses, 5);
+
+    f = find(level_flags(replicates_level(honest_errors(10), true)), FlagCode::SkewedWeights);
+    ASSERT_TRUE(f.has_value());
+    EXPECT_EQ(f->severity, Severity::Warning);
+
+    // Unstable error bars (one run's se 5 times the others', Bartlett p < 1e-3): info when the
+    // replicates cover, a warning when they do not.
+    LevelStats unstable = replicates_level(honest_errors(32), true);
+    unstable.diagnostics.weights = RunningMoments();
+    for (int i = 0; i < 1000; ++i) unstable.diagnostics.weights.add(i % 2 ? 1.0 : -1.0);
+    unstable.diagnostics.error_units = unstable.diagnostics.weights;
+    unstable.run_std_errors[5] = 5.0;
+    f = find(level_flags(unstable), FlagCode::ErrorBarsUnstable);
+    ASSERT_TRUE(f.has_value());
+    EXPECT_EQ(f->severity, Severity::Info);
+    for (int i = 0; i < 5; ++i) unstable.estimates[size_t(10 + i)] = 3.0;
+    f = find(level_flags(unstable), FlagCode::ErrorBarsUnstable);
+    ASSERT_TRUE(f.has_value());
+    EXPECT_EQ(f->severity, Severity::Warning);
+}
+
+// A replicate beyond 5 of its own standard errors (widened by t_0.975(dof) / 1.96 for few
+// degrees of freedom) is an alarm by itself, against the exact value or, without one, against
+// the other replicates' mean: 5.6 with 1000 dof is raised, 4.5 is not; with 3 dof (4
+// randomizations) the limit is 5 x 3.18 / 1.96 = 8.1, so 7 is not raised and 16.5 is.
+TEST(Diagnostics, AReplicateFarOutsideItsIntervalIsAnAlarm) {
+    std::vector<double> z = honest_errors(32);
+    z[7] = 5.6;
+    std::optional<Flag> f = find(level_flags(replicates_level(z, true)), FlagCode::ReplicateFarOff);
+    ASSERT_TRUE(f.has_value());
+    EXPECT_EQ(f->severity, Severity::Warning);
+    EXPECT_EQ(f->dof, 7); // which replicate
+    EXPECT_NEAR(f->value, 5.6, 1e-12);
+    EXPECT_NEAR(f->threshold, 5.0 * student_t_quantile(0.975, 1000.0) / 1.959963984540054, 1e-9);
+    z[7] = 4.5;
+    EXPECT_FALSE(find(level_flags(replicates_level(z, true)), FlagCode::ReplicateFarOff));
+
+    // Without the exact value: the other 31 replicates' mean (about 0) and their spread.
+    z[7] = 6.5;
+    f = find(level_flags(replicates_level(z, false)), FlagCode::ReplicateFarOff);
+    ASSERT_TRUE(f.has_value());
+    EXPECT_GT(f->value, 5.5);
+    EXPECT_LT(f->value, 6.5);
+
+    LevelStats few_dof = replicates_level(honest_errors(32), true);
+    few_dof.run_dofs.assign(32, 3);
+    few_dof.estimates[7] = 7.0;
+    EXPECT_FALSE(find(level_flags(few_dof), FlagCode::ReplicateFarOff));
+    few_dof.estimates[7] = 16.5;
+    f = find(level_flags(few_dof), FlagCode::ReplicateFarOff);
+    ASSERT_TRUE(f.has_value());
+    EXPECT_NEAR(f->threshold, 5.0 * student_t_quantile(0.975, 3.0) / 1.959963984540054, 1e-9);
+}
+
+// Agreement is not exactness. A deterministic point set (Sobol' without randomization) gives
+// the same wrong answer in every replicate: not exact, and with the exact value known an error.
+// Values whose squares underflow (1e-170 x) agree in their variances (0) while the estimates
+// differ: not exact, and flagged values_underflow (an error). A stated exact value that the
+// replicates agree on to round-off (the matched density of a narrow peak) stays exact; the same
+// estimator with a wrong stated value is not, and misses it.
+TEST(Diagnostics, AgreementIsNotExactness) {
+    auto run = [](const Json& scene) {
+        Made<SceneRequest> r =
+            build_request(scene, Json{{"n_min", 64}, {"n_max", 128}, {"reps", 8}, {"seed", 2}});
+        EXPECT_TRUE(r.ok()) << r.error;
+        return run_study(r.value.problem, r.value.estimators, r.value.settings);
+    };
+    const Json box = {{"type", "box"}, {"dim", 1}};
+    StudyResult det = run(Json{
+        {"name", "det"},
+        {"domain", box},
+        {"integrand", {{"type", "expression"}, {"f", "x^2"}}},
+        {"exact", 1.0 / 3.0},
+        {"estimators", {{{"name", "fixed"}, {"sampler", "sobol"}, {"randomization", "none"}}}}});
+    for (const LevelStats& l : det.estimators[0].levels) {
+        EXPECT_TRUE(l.deterministic) << l.n;
+        EXPECT_FALSE(l.exact_to_roundoff) << l.n;
+        EXPECT_TRUE(has(level_flags(l), FlagCode::ExactOutsideCi)) << l.n;
+    }
+    StudyResult tiny = run(Json{{"name", "tiny"},
+                                {"domain", box},
+                                {"integrand", {{"type", "expression"}, {"f", "1e-170*x"}}},
+                                {"estimators", {"uniform"}}});
+    for (const LevelStats& l : tiny.estimators[0].levels) {
+        EXPECT_TRUE(l.values_underflow) << l.n;
+        EXPECT_FALSE(l.exact_to_roundoff) << l.n;
+        const std::optional<Flag> f = find(level_flags(l), FlagCode::ValuesUnderflow);
+        ASSERT_TRUE(f.has_value());
+        EXPECT_EQ(f->severity, Severity::Error);
+    }
+    StudyResult scaled = run(Json{{"name", "scaled"},
+                                  {"domain", box},
+                                  {"integrand", {{"type", "expression"}, {"f", "1e-100*x"}}},
+                                  {"estimators", {"uniform"}}});
+    for (const LevelStats& l : scaled.estimators[0].levels) {
+        EXPECT_FALSE(l.values_underflow) << l.n;
+        EXPECT_TRUE(l.estimates_spread) << l.n;
+        EXPECT_FALSE(has(level_flags(l), FlagCode::ValuesUnderflow)) << l.n;
+    }
+    // The matched density of x^2 on [0, 1] is 3 x^2: f/p = 1/3 at every point.
+    const Json matched = {
+        {"name", "m"},
+        {"domain", box},
+        {"integrand", {{"type", "monomial"}, {"powers", {2.0}}}},
+        {"exact", 1.0 / 3.0},
+        {"estimators", {{{"name", "matched"}, {"pdf", {{"type", "power"}, {"k", 2.0}}}}}}};
+    StudyResult right = run(matched);
+    Json wrong_exact = matched;
+    wrong_exact["exact"] = 0.34;
+    StudyResult wrong = run(wrong_exact);
+    for (size_t i = 0; i < right.estimators[0].levels.size(); ++i) {
+        EXPECT_TRUE(right.estimators[0].levels[i].exact_to_roundoff);
+        EXPECT_FALSE(wrong.estimators[0].levels[i].exact_to_roundoff);
+        EXPECT_TRUE(has(level_flags(wrong.estimators[0].levels[i]), FlagCode::ExactOutsideCi));
+    }
 }

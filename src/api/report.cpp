@@ -61,6 +61,13 @@ Json diagnostics_to_json(const RunDiagnostics& d) {
 
 // Plain-language sentences for the flags the core raises (estimators/diagnostics.h).
 
+// "2 of 32 (up to 3 is what honest 95% intervals give)".
+std::string replicate_evidence(const Flag& f) {
+    return std::to_string(f.replicate_misses) + " of " + std::to_string(f.replicates_judged) +
+           " (up to " + std::to_string(f.miss_allowance) +
+           " is what honest 95% intervals give), none far off";
+}
+
 Json level_warning(const Flag& f, const LevelStats& l) {
     const std::string at_n = " at N = " + std::to_string(l.n);
     switch (f.code) {
@@ -108,6 +115,12 @@ Json level_warning(const Flag& f, const LevelStats& l) {
                 : "the weights are skewed " + skew +
                       ", and a normal error bar needs N above 25 x skewness^2 = " +
                       fmt("%.3g", f.threshold) + " (Cochran's rule)";
+        if (f.severity == Severity::Info && f.replicates_judged > 0 &&
+            f.replicate_misses <= f.miss_allowance)
+            return flag_warning(f, rule + "; but the replicates' own intervals missed " +
+                                       replicate_evidence(f) +
+                                       ": the error bars hold here, though the skew may show "
+                                       "in some runs");
         if (f.severity == Severity::Info)
             return flag_warning(f, rule + ": the intervals may cover a few percent less than "
                                           "95% until then");
@@ -130,6 +143,14 @@ Json level_warning(const Flag& f, const LevelStats& l) {
                                    fmt("%.2g", f.p_value) +
                                    "): the intervals cover, and are wider than they need be");
     case FlagCode::ErrorBarsUnstable:
+        if (f.severity == Severity::Info)
+            return flag_warning(f, "the replicates' own error bars differ by a factor " +
+                                       fmt("%.3g", f.value) + at_n +
+                                       " (Bartlett's test, p = " + fmt("%.2g", f.p_value) +
+                                       ", which assumes normal data), but their intervals "
+                                       "missed " +
+                                       replicate_evidence(f) +
+                                       ": the error bars vary from run to run and still hold");
         return flag_warning(f, "the replicates' own error bars differ by a factor " +
                                    fmt("%.3g", f.value) + at_n +
                                    " (Bartlett's test, p = " + fmt("%.2g", f.p_value) +
@@ -141,6 +162,21 @@ Json level_warning(const Flag& f, const LevelStats& l) {
                                    std::to_string(l.n) + at_n +
                                    ": the estimate rests on a few samples (narrow peak, small "
                                    "support or huge weights), its error bar is unreliable");
+    case FlagCode::ValuesUnderflow:
+        return flag_warning(f, "the estimates are about " + fmt("%.3g", f.value) + at_n +
+                                   ", below " + fmt("%.0e", f.threshold) +
+                                   ": their squares underflow double precision, so variances "
+                                   "and error bars computed from them are 0 or wrong (scale the "
+                                   "integrand up)");
+    case FlagCode::ReplicateFarOff:
+        return flag_warning(f, "replicate " + std::to_string(f.dof + 1) + " of " +
+                                   std::to_string(f.of) + " lies " + fmt("%.1f", f.value) +
+                                   " of its own standard errors from " +
+                                   (f.se > 0.0 ? "the exact value" : "the other replicates' mean") +
+                                   at_n + " (beyond " + fmt("%.1f", f.threshold) +
+                                   ", 5 standard errors widened for its degrees of freedom" +
+                                   (f.count > 1 ? "; " + std::to_string(f.count) + " such" : "") +
+                                   "): its error bar is far too small, and any one run's may be");
     case FlagCode::ExactOutsideCi:
         return flag_warning(
             f, "the mean of " + std::to_string(f.of) + " replicates misses the exact value by " +
@@ -291,6 +327,8 @@ Json level_to_json(const LevelStats& l) {
            {"ess", num(l.ess_mean)},
            {"no_estimate_runs", l.no_estimate_runs},
            {"zero_error_runs", l.zero_error_runs},
+           {"deterministic", l.deterministic},
+           {"values_underflow", l.values_underflow},
            {"exact_to_roundoff", l.exact_to_roundoff},
            {"warnings", warnings_for(l)}};
     // A variance below 0 is not a variance: null, like NaN (warnings_for flags both).

@@ -34,6 +34,8 @@ const char* flag_code_name(FlagCode code) {
     case FlagCode::PixelErrorBars: return "pixel_error_bars";
     case FlagCode::FewPixelErrors: return "few_pixel_errors";
     case FlagCode::RareLargeErrors: return "rare_large_errors";
+    case FlagCode::ValuesUnderflow: return "values_underflow";
+    case FlagCode::ReplicateFarOff: return "replicate_far_off";
     }
     return "?";
 }
@@ -56,6 +58,7 @@ Severity default_severity(FlagCode code) {
     case FlagCode::NonfiniteSamples:
     case FlagCode::ZeroPdfSamples:
     case FlagCode::ExactOutsideCi:
+    case FlagCode::ValuesUnderflow:
     case FlagCode::PdfSupport:
     case FlagCode::IterationsDisagree:
     case FlagCode::ErrorBarsUnderstate:
@@ -67,6 +70,7 @@ Severity default_severity(FlagCode code) {
     case FlagCode::LevelDrift:
     case FlagCode::FewPixelErrors:
     case FlagCode::RareLargeErrors:
+    case FlagCode::ReplicateFarOff:
     case FlagCode::SlowConvergence: return Severity::Warning;
     case FlagCode::HeavyTail4:
     case FlagCode::BiasDominates:
@@ -112,7 +116,57 @@ double bartlett_p(const std::vector<double>& se, const std::vector<int>& dofs) {
     const double t = (nu_sum * std::log(pooled / nu_sum) - log_sum) / c;
     return chi_square_sf(std::max(t, 0.0), static_cast<double>(k - 1));
 }
+// The most misses of their 95% interval that n honest replicates exceed with probability below
+// kMissAllowanceP: the largest k with P(Bin(n, 0.05) >= k) >= that, where
+// P(Bin(n, p) >= k) = I_p(k, n - k + 1) [AbramowitzStegun, 26.5.24].
+int miss_allowance(int n) {
+    int k = 0;
+    while (k < n && beta_regularized(k + 1.0, n - k, 0.05) >= kMissAllowanceP) ++k;
+    return k;
+}
 } // namespace
+
+ReplicateCheck check_replicates(const LevelStats& l) {
+    ReplicateCheck c;
+    const size_t reps = std::min({l.estimates.size(), l.run_std_errors.size(), l.run_dofs.size()});
+    // Leave-one-out needs the others' mean and spread: their squared deviations about the
+    // whole mean, less replicate i's share, S_-i = S - (x_i - m)^2 R / (R - 1).
+    double mean = 0.0, squares = 0.0;
+    size_t finite = 0;
+    for (size_t i = 0; i < reps; ++i)
+        if (std::isfinite(l.estimates[i])) {
+            ++finite;
+            const double delta = l.estimates[i] - mean;
+            mean += delta / static_cast<double>(finite);
+            squares += delta * (l.estimates[i] - mean);
+        }
+    const bool against_exact = l.has_exact && std::isfinite(l.exact);
+    if (!against_exact && finite < 3) return c;
+    const double r = static_cast<double>(finite);
+    for (size_t i = 0; i < reps; ++i) {
+        const double x = l.estimates[i], se = l.run_std_errors[i];
+        if (!std::isfinite(x) || !(std::isfinite(se) && se > 0.0) || l.run_dofs[i] < 1) continue;
+        double centre = l.exact, spread = se;
+        if (!against_exact) {
+            centre = (r * mean - x) / (r - 1.0);
+            const double others = std::max(0.0, squares - (x - mean) * (x - mean) * r / (r - 1.0));
+            spread = std::sqrt(se * se + others / ((r - 2.0) * (r - 1.0)));
+        }
+        const double t = student_t_quantile(0.975, static_cast<double>(l.run_dofs[i]));
+        const double z = std::fabs(x - centre) / spread;
+        const double far_limit = kFarOffZ * t / 1.959963984540054;
+        ++c.judged;
+        if (z > t) ++c.misses;
+        if (z > far_limit) ++c.far;
+        if (c.worst_index < 0 || z / far_limit > c.worst_z / c.worst_limit) {
+            c.worst_index = static_cast<int>(i);
+            c.worst_z = z;
+            c.worst_limit = far_limit;
+        }
+    }
+    c.allowance = miss_allowance(c.judged);
+    return c;
+}
 
 std::vector<Flag> level_flags(const LevelStats& l) {
     std::vector<Flag> flags;
@@ -133,6 +187,37 @@ std::vector<Flag> level_flags(const LevelStats& l) {
         raise(FlagCode::NonfiniteEstimate);
     else if (!std::isfinite(l.variance) || l.variance < 0.0)
         raise(FlagCode::NonfiniteVariance).value = l.variance;
+    // Values whose squares underflow: every variance, error bar and test below is 0 or wrong.
+    if (l.values_underflow) {
+        Flag& f = raise(FlagCode::ValuesUnderflow);
+        f.value = std::fabs(l.mean);
+        f.threshold = kUnderflowScale;
+    }
+    // The replicates against their own intervals: the evidence that warnings resting on the
+    // weights alone (skewed_weights, error_bars_unstable) must agree with once there is enough
+    // of it, and a replicate far outside its interval is itself an alarm.
+    const ReplicateCheck replicates =
+        l.exact_to_roundoff || l.values_underflow ? ReplicateCheck() : check_replicates(l);
+    const bool replicates_cover = replicates.judged >= kEvidenceReplicates &&
+                                  replicates.misses <= replicates.allowance && replicates.far == 0;
+    auto record_evidence = [&](Flag& f) {
+        f.replicates_judged = replicates.judged;
+        f.replicate_misses = replicates.misses;
+        f.miss_allowance = replicates.allowance;
+        if (replicates_cover && f.severity == Severity::Warning) f.severity = Severity::Info;
+    };
+    if (replicates.far > 0) {
+        Flag& f = raise(FlagCode::ReplicateFarOff);
+        f.value = replicates.worst_z;
+        f.threshold = replicates.worst_limit;
+        f.count = static_cast<uint64_t>(replicates.far);
+        f.of = static_cast<uint64_t>(replicates.judged);
+        f.dof = replicates.worst_index; // which replicate (0-based)
+        f.se = l.has_exact ? 1.0 : 0.0; // 1: judged against the exact value
+        f.replicates_judged = replicates.judged;
+        f.replicate_misses = replicates.misses;
+        f.miss_allowance = replicates.allowance;
+    }
     // A random estimator whose own error bar is 0 while its replicates disagree: the runs saw
     // no variation (e.g. both points of every stratum on the same side of a discontinuity),
     // and their intervals are wrong. When every replicate agrees (f/p constant) 0 is right.
@@ -185,6 +270,7 @@ std::vector<Flag> level_flags(const LevelStats& l) {
             f.threshold = kUnstableSpread;
             f.p_value = p;
             f.of = reps;
+            record_evidence(f);
         }
     }
     const RunDiagnostics& d = l.diagnostics;
@@ -234,6 +320,7 @@ std::vector<Flag> level_flags(const LevelStats& l) {
         f.se = spread;
         const bool unsettled = !(spread <= kErrorBarSpread); // NaN (fewer than 2 runs) too
         f.severity = strongly_skewed || unsettled ? Severity::Warning : Severity::Info;
+        record_evidence(f);
     }
     // Kish's effective sample size: when a handful of samples carry the sum (a narrow peak
     // barely hit, a few huge weights), the estimate and its error bar rest on those few.

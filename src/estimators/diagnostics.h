@@ -38,6 +38,10 @@ enum class FlagCode {
     PixelErrorBars,      ///< too few pixels' 95% intervals cover the reference
     FewPixelErrors,      ///< a level's relative MSE rests on a few (pixel, image) errors
     RareLargeErrors,     ///< some levels rest on a few pixel errors: rare large errors
+    // Added with issue 37 (kept after the render codes: codes are names in results, the enum
+    // order is not).
+    ValuesUnderflow, ///< the estimates are below 1e-150: their squares underflow
+    ReplicateFarOff, ///< a replicate lies beyond 5 (t-widened) of its own standard errors
 };
 
 /// The stable code of a flag in results ("no_estimate", "heavy_tail", ...).
@@ -70,7 +74,26 @@ struct Flag {
     uint64_t count = 0, of = 0; ///< e.g. runs or samples concerned, out of how many
     int dof = 0;                ///< chi-square degrees of freedom (level drift)
     double p_value = std::numeric_limits<double>::quiet_NaN();
+    /// The replicates' own evidence (ReplicateCheck), where a flag's severity rests on it:
+    /// replicates judged (0: not consulted), how many missed their 95% interval, and how many
+    /// misses honest intervals give in 9 of 10 studies.
+    int replicates_judged = 0, replicate_misses = 0, miss_allowance = 0;
 };
+
+/// Each replicate against its own 95% interval: its estimate's distance from the exact value
+/// (when known) or from the mean of the other replicates (leave-one-out, with that mean's own
+/// uncertainty added), in its own standard errors, widened to normal-equivalent units by
+/// t_0.975(dof) / 1.96. Replicates without a finite, positive error bar are not judged.
+struct ReplicateCheck {
+    int judged = 0;
+    int misses = 0;           ///< outside their t_0.975(dof) interval
+    int far = 0;              ///< beyond kFarOffZ normal-equivalent standard errors
+    int worst_index = -1;     ///< the replicate farthest off (-1: none judged)
+    double worst_z = 0.0;     ///< its distance in its own standard errors
+    double worst_limit = 0.0; ///< kFarOffZ widened for its degrees of freedom
+    int allowance = 0;        ///< misses that honest 95% intervals exceed in < 1 study in 10
+};
+ReplicateCheck check_replicates(const LevelStats& level);
 
 // Thresholds (see the functions' comments for why).
 constexpr double kSkewnessRule = 25.0;  ///< skewed_weights below N = 25 g1^2 [Cochran77]
@@ -85,6 +108,14 @@ constexpr double kExactOutsideZ = 5.0;  ///< |mean - exact| beyond this many sta
 constexpr double kLevelDriftP = 1e-3;   ///< chi-square p-value below this flags
 constexpr double kHeavyTailAlpha = 2.0; ///< infinite variance below this tail index
 constexpr double kHeavyTail4Alpha = 4.0;
+/// A replicate this many (t-widened) standard errors off has an error bar far too small.
+constexpr double kFarOffZ = 5.0;
+/// From this many judged replicates their misses are evidence enough to overrule a warning
+/// that rests on the weights alone (skewed_weights, error_bars_unstable): with 20, an
+/// estimator whose intervals cover 85% shows more than the allowance in 6 studies of 10.
+constexpr int kEvidenceReplicates = 20;
+/// The allowance: the most misses that honest 95% intervals exceed with probability < 0.1.
+constexpr double kMissAllowanceP = 0.1;
 
 /// The flags of one level, from its replicates' statistics: no estimate (then nothing else),
 /// a non-finite mean or variance, wrong zero error bars, dropped samples, weights too skewed

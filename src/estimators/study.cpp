@@ -529,9 +529,31 @@ LevelStats summarise_level(const std::vector<RunResult>& runs, const Problem& pr
     } else {
         s.error = std::sqrt(s.variance);
     }
-    const double roundoff = 64.0 * 2.220446049250313e-16 * std::fabs(s.mean);
-    s.estimates_spread = std::isfinite(s.variance) && s.variance > roundoff * roundoff;
-    s.exact_to_roundoff = !s.estimates_spread && std::isfinite(s.mean) && s.mean != 0.0 &&
+    if (s.has_exact) s.exact = exact;
+    // Spread and agreement judged on the estimates themselves, never on their squares (which
+    // underflow below 1e-154: f = 1e-170 x would look exact).
+    double lowest = std::numeric_limits<double>::infinity(), highest = -lowest, largest = 0.0;
+    bool every_run_deterministic = !runs.empty();
+    for (const RunResult& r : runs) {
+        if (std::isfinite(r.estimate)) {
+            lowest = std::min(lowest, r.estimate);
+            highest = std::max(highest, r.estimate);
+            largest = std::max(largest, std::fabs(r.estimate));
+        }
+        // One deterministic point set reports no error bar (NaN) and no degrees of freedom.
+        if (!(std::isnan(r.std_error) && r.dof <= 0)) every_run_deterministic = false;
+    }
+    const double roundoff = 64.0 * 2.220446049250313e-16 * largest;
+    s.estimates_spread = highest - lowest > roundoff;
+    s.deterministic = every_run_deterministic;
+    s.values_underflow = largest > 0.0 && largest < kUnderflowScale;
+    // Exact: the replicates agree to round-off on a non-zero, finite mean from random runs with
+    // no dropped sample, and, when the exact value is known, on that value (agreement alone can
+    // be a shared wrong answer).
+    const bool matches_exact =
+        !s.has_exact || std::fabs(s.mean - exact) <= 1e-12 * std::fabs(exact) + roundoff;
+    s.exact_to_roundoff = !s.estimates_spread && !s.deterministic && !s.values_underflow &&
+                          matches_exact && std::isfinite(s.mean) && s.mean != 0.0 &&
                           s.diagnostics.nonfinite == 0 && s.diagnostics.zero_pdf == 0;
     if (s.no_estimate_runs > 0) {
         // No estimate: nothing derived from the (dropped) samples means anything.

@@ -13,6 +13,7 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -67,6 +68,10 @@ enum class LevelMeasure {
 /// "variance", "mse", "relative_mse".
 const char* level_measure_name(LevelMeasure m);
 
+/// Below this magnitude the squares of estimates and weights underflow double precision
+/// (sqrt(DBL_MIN) is 1.5e-154): variances and error bars of such values are 0 or wrong.
+constexpr double kUnderflowScale = 1e-150;
+
 struct LevelStats {
     uint64_t n = 0;
     int reps = 0;
@@ -110,14 +115,21 @@ struct LevelStats {
     double iteration_chi2 = 0.0;
     int iteration_dof = 0;
     int zero_error_runs = 0; ///< runs whose own standard error is 0 (to round-off, 64 eps |I_N|)
-    bool estimates_spread = false; ///< the replicates differ beyond round-off (variance >
-                                   ///< (64 eps |mean|)^2): a zero error bar is then wrong
+    bool estimates_spread = false; ///< the replicates differ beyond round-off (max - min >
+                                   ///< 64 eps max |estimate|): a zero error bar is then wrong
     /// An exact estimator at this N: the replicates agree to round-off (not estimates_spread)
     /// on a non-zero, finite mean with no dropped sample (f/p constant, as a matched importance
     /// density or an area by its own uniform density gives). Its z-scores, skewness and tail
     /// are round-off: no statistical flag applies, and tables show "exact".
     bool exact_to_roundoff = false;
-    std::vector<double> estimates, run_std_errors; ///< per replicate
+    /// Every run is one deterministic point set (no error bar): replicates agree by design,
+    /// which says nothing about the error (never exact_to_roundoff).
+    bool deterministic = false;
+    /// The estimates are so small that their squares underflow double precision (|estimate|
+    /// below kUnderflowScale): variances and error bars computed from them are 0 or wrong.
+    bool values_underflow = false;
+    double exact = std::numeric_limits<double>::quiet_NaN(); ///< the exact value when known
+    std::vector<double> estimates, run_std_errors;           ///< per replicate
     std::vector<int> run_dofs; ///< per replicate: the degrees of freedom of its error bar
 };
 

@@ -165,7 +165,9 @@ Json render_warnings(const RenderEstimatorStudy& s, double floor) {
         case FlagCode::ErrorBarsUnderstate:
         case FlagCode::ErrorBarsUnstable:
         case FlagCode::BiasDominates:
-        case FlagCode::ConservativeErrorBars: break;
+        case FlagCode::ConservativeErrorBars:
+        case FlagCode::ValuesUnderflow:
+        case FlagCode::ReplicateFarOff: break;
         }
     }
     sort_by_severity(w);

@@ -34,6 +34,8 @@ export const FLAG_TITLES = Object.freeze({
   iterations_disagree: 'The iterations disagree more than their error bars allow',
   error_bars_understate: 'The error bars are too small for the spread of the replicates',
   error_bars_unstable: 'The replicates\' error bars disagree with each other: some saw a feature others missed',
+  replicate_far_off: 'A replicate lies far outside its own error bar: its error bar is far too small',
+  values_underflow: 'The values are so small that their squares underflow: no error bar can be computed',
   bias_dominates: 'The bias dominates the error from some N on',
   conservative_error_bars: 'Conservative error bars: wider than the replicates\' spread',
   float32_accumulator: 'A single-precision accumulator limits the accuracy',
