@@ -429,8 +429,9 @@ std::vector<double> honest_errors(int n) {
 // The replicates' own evidence overrules a warning that rests on the weights alone, once there
 // are enough of them (20): with 32 replicates whose intervals miss as honest ones do (2 of 32;
 // up to 3 allowed, P(Bin(32, 0.05) >= 4) = 0.077 < 0.1), skewed_weights is info and carries the
-// counts; with 5 misses or more (P(Bin(32, 0.05) >= 5) = 0.026) it stays a warning; with 10 replicates (too few to tell 80%
-// coverage from 95%) the weights' rule stands alone. error_bars_unstable follows the same rule.
+// counts; with 5 misses or more (P(Bin(32, 0.05) >= 5) = 0.026) it stays a warning; with 10
+// replicates (too few to tell 80% coverage from 95%) the weights' rule stands alone.
+// error_bars_unstable follows the same rule.
 TEST(Diagnostics, ReplicatesThatCoverOverruleWarningsFromTheWeights) {
     LevelStats covered = replicates_level(honest_errors(32), true);
     std::optional<Flag> f = find(level_flags(covered), FlagCode::SkewedWeights);
@@ -561,5 +562,44 @@ TEST(Diagnostics, AgreementIsNotExactness) {
         EXPECT_TRUE(right.estimators[0].levels[i].exact_to_roundoff);
         EXPECT_FALSE(wrong.estimators[0].levels[i].exact_to_roundoff);
         EXPECT_TRUE(has(level_flags(wrong.estimators[0].levels[i]), FlagCode::ExactOutsideCi));
+    }
+}
+
+// The same rules on real studies of 32 replicates, both ways. A product of x^-0.3 in d = 4 (finite
+// variance, an infinite fourth moment: the sample skewness is erratic) at N = 16384, whose
+// intervals cover: no warning (skewness and unstable error bars are info, with the counts).
+// Genz's corner peak in d = 2 (c = 75 per axis) at N = 2048, where a run sees a handful of
+// points in the peak: the intervals fail, and skewed_weights stays a warning.
+TEST(Diagnostics, TheReplicatesDecideOnSkewedRealStudies) {
+    auto run = [](const Json& scene, uint64_t n, uint64_t seed) {
+        Made<SceneRequest> r =
+            build_request(scene, Json{{"n_min", n}, {"n_max", n}, {"reps", 32}, {"seed", seed}});
+        EXPECT_TRUE(r.ok()) << r.error;
+        return run_study(r.value.problem, r.value.estimators, r.value.settings);
+    };
+    const double a = 0.3;
+    const Json product = {{"name", "product"},
+                          {"domain", {{"type", "box"}, {"dim", 4}}},
+                          {"integrand", {{"type", "monomial"}, {"powers", {-a, -a, -a, -a}}}},
+                          {"exact", std::pow(1.0 / (1.0 - a), 4)},
+                          {"estimators", {"uniform", "sobol"}}};
+    StudyResult fine = run(product, 16384, 2);
+    for (const EstimatorStudy& e : fine.estimators) {
+        std::vector<Flag> flags = level_flags(e.levels.front());
+        for (const Flag& f : estimator_flags(e, fine.settings)) flags.push_back(f);
+        for (const Flag& f : flags)
+            EXPECT_EQ(f.severity, Severity::Info) << e.spec.name << " " << flag_code_name(f.code);
+    }
+    const Json peak = {
+        {"name", "corner"},
+        {"integrand", {{"type", "genz_corner_peak"}, {"a", {75.0, 75.0}}, {"u", {0.5, 0.5}}}},
+        {"estimators", {"uniform", "sobol"}}};
+    StudyResult failing = run(peak, 2048, 1);
+    for (const EstimatorStudy& e : failing.estimators) {
+        const std::optional<Flag> skew =
+            find(level_flags(e.levels.front()), FlagCode::SkewedWeights);
+        ASSERT_TRUE(skew.has_value()) << e.spec.name;
+        EXPECT_EQ(skew->severity, Severity::Warning) << e.spec.name;
+        EXPECT_GT(skew->replicate_misses, skew->miss_allowance) << e.spec.name;
     }
 }
