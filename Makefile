@@ -181,7 +181,7 @@ bench: build build-wasm site
 	node web/e2e/first_plot.bench.mjs $(SITE) all 3
 	node web/e2e/live_view.bench.mjs $(SITE) all 3 2
 	$(MAKE) --no-print-directory bench-genz
-	$(MAKE) --no-print-directory bench-flags
+	$(MAKE) --no-print-directory bench-flags FLAGS_NS=16384
 
 # ---------------------------------------------------------------------------
 # The accelerator beside Embree 3, the kernels under Mitsuba's llvm variants (docs/benchmarks.md):
@@ -240,12 +240,18 @@ bench-genz: deps deps-gsl $(BUILD)/CMakeCache.txt
 
 # ---------------------------------------------------------------------------
 # The flags judged both ways (docs/benchmarks.md): bench/calibrate.cpp runs studies through the
-# C API on Genz cases with the project's own random parameters and on every integration scene,
-# and reports the share of flagged cells where every interval covered and the confident wrong
-# answers; --recheck 40 runs 40 flagged and 40 unflagged fine cells again with 100 replicates,
-# to judge the alarms by what they claim. `make bench-flags FLAGS_ARGS=--quick` for a look.
+# C API, as the CLI and the page run them, and reports the share of fine cells that carry an
+# alarm and the confident wrong answers. Two runs:
+#  - held out: Genz's six families and singular products (finite and infinite variance) at
+#    d = 2, 4, 8, 16 with parameter seeds the rules were never tuned on (7001, 7002), each N of
+#    FLAGS_NS alone, R = 32 (the CLI's default), a cell fine by its coverage (29 of 32 within
+#    1.96 t se, none beyond 3.5); --recheck 20 runs 20 flagged and 20 unflagged fine cells again
+#    with 100 replicates, to judge the alarms by what they claim;
+#  - the integration scenes with an exact value, their own estimators and each preset, N ladder.
+# `make bench-flags FLAGS_NS=16384` for a look (about 5 minutes on 2 cores; 2^20 adds an hour).
 .PHONY: bench-flags
 FLAGS_ARGS ?=
+FLAGS_NS ?= 16384,1048576
 
 $(BUILD)/calibrate: bench/calibrate.cpp $(BUILD)/libmcplay_api.a $(BUILD)/libmcplay_core.a \
 		$(wildcard src/*/*.h)
@@ -255,8 +261,13 @@ $(BUILD)/calibrate: bench/calibrate.cpp $(BUILD)/libmcplay_api.a $(BUILD)/libmcp
 bench-flags: deps $(BUILD)/CMakeCache.txt
 	cmake --build $(BUILD) -j $(JOBS) --target mcplay_api
 	$(MAKE) --no-print-directory $(BUILD)/calibrate
-	set -o pipefail; $(BUILD)/calibrate --scenes scenes --json $(BUILD)/calibrate.jsonl --recheck 40 $(FLAGS_ARGS) \
-	  2>/dev/null | tee $(BUILD)/calibrate.txt
+	mkdir -p $(BUILD)/calibrate-empty
+	set -o pipefail; $(BUILD)/calibrate --singular --dims 2,4,8,16 --param-seeds 7001,7002 \
+	  --ns $(FLAGS_NS) --reps 32 --fine coverage --scenes $(BUILD)/calibrate-empty \
+	  --cells $(BUILD)/calibrate-heldout.jsonl --recheck 20 $(FLAGS_ARGS) 2>/dev/null \
+	  | tee $(BUILD)/calibrate-heldout.txt
+	set -o pipefail; $(BUILD)/calibrate --no-genz --scenes scenes --reps 32 --fine coverage \
+	  --json $(BUILD)/calibrate.jsonl $(FLAGS_ARGS) 2>/dev/null | tee $(BUILD)/calibrate.txt
 
 # ---------------------------------------------------------------------------
 # Randomized QMC beside QMCPy's and scipy's (docs/benchmarks.md): genz_compare writes the

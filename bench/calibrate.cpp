@@ -3,15 +3,17 @@
 // ignore flags; an estimate far off with no flag is a confident wrong answer.
 //
 //   calibrate [--quick] [--reps R] [--n-min N] [--n-max N] [--ns N1,N2] [--param-seeds 1,2,3]
-//             [--dims 2,4,8] [--families 1,..,6] [--singular] [--fine 3t|coverage]
+//             [--dims 2,4,8] [--families 1,..,6] [--no-genz] [--singular] [--fine 3t|coverage]
 //             [--scenes DIR] [--json FILE] [--cells FILE] [--list N]
 //             [--stopping REL [--stop-n-max N] [--max-seconds S]]
 //
+// --no-genz leaves Genz's families out (the scenes, and with --singular the products, alone).
 // --ns runs each listed N as a study of its own (instead of the ladder n_min..n_max).
 // --singular adds, per dimension and parameter seed, two products prod x_i^-a_i (monomial
 // integrands, exact prod 1 / (1 - a_i)): one of finite variance whose weights have an infinite
-// fourth moment (every a_i in (0.25, 0.35), tail index 1 / a_i near 3: the sample skewness is erratic), and one of
-// infinite variance (one a_i in (0.55, 0.85)); every cell of the latter must carry an alarm.
+// fourth moment (every a_i in (0.25, 0.35), tail index 1 / a_i near 3: the sample skewness is
+// erratic), and one of infinite variance (one a_i in (0.55, 0.85)); every cell of the latter must
+// carry an alarm.
 // --fine coverage judges a cell by its coverage instead of its worst replicate (use R = 32):
 // fine when at least R - floor(3 R / 32) replicates lie within 1.96 t of their own standard
 // error of the exact value (29 of 32) and none beyond 3.5 t.
@@ -73,6 +75,7 @@ struct Options {
     std::vector<uint64_t> ns; // --ns: these N, each a study of its own
     std::vector<int> families{1, 2, 3, 4, 5, 6};
     bool singular = false;         // --singular: singular products too
+    bool genz = true;              // --no-genz: the scenes (and products) alone
     bool fine_by_coverage = false; // --fine coverage
     std::string scenes_dir = "scenes", json_path, cells_path;
     int recheck = 0, recheck_reps = 100; // --recheck K: fine cells run again, per kind
@@ -86,7 +89,8 @@ struct Options {
     if (!msg.empty()) std::fprintf(stderr, "calibrate: %s\n", msg.c_str());
     std::fprintf(stderr, "usage: calibrate [--quick] [--reps R] [--n-min N] [--n-max N]\n"
                          "         [--ns N1,N2] [--param-seeds 1,2,3] [--dims 2,4,8]\n"
-                         "         [--families 1,..,6] [--singular] [--fine 3t|coverage]\n"
+                         "         [--families 1,..,6] [--no-genz] [--singular]\n"
+                         "         [--fine 3t|coverage]\n"
                          "         [--scenes DIR]\n"
                          "         [--json FILE] [--cells FILE] [--list N]\n"
                          "         [--stopping REL [--stop-n-max N] [--max-seconds S]]\n"
@@ -140,6 +144,8 @@ Options parse_options(int argc, char** argv) {
             for (uint64_t f : parse_list(value(), "--families", 1, 6)) o.families.push_back(int(f));
         } else if (a == "--singular")
             o.singular = true;
+        else if (a == "--no-genz")
+            o.genz = false;
         else if (a == "--fine") {
             const std::string v = value();
             if (v != "3t" && v != "coverage") usage("--fine: expected 3t or coverage");
@@ -193,7 +199,7 @@ std::vector<Case> genz_cases(const Options& o) {
     std::vector<Case> cases;
     Json presets = Json::array();
     for (const char* p : kPresets) presets.push_back(p);
-    for (int fam1 : o.families)
+    for (int fam1 : o.genz ? o.families : std::vector<int>())
         for (int d : o.dims)
             for (uint64_t seed : o.param_seeds) {
                 const int fam = fam1 - 1;
