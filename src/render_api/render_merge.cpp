@@ -170,7 +170,7 @@ bool image_summary_from_json(Ctx& c, const Json& j, const std::string& path,
         if (!x.is_number() || !(x.get<double>() >= 0.0) || !std::isfinite(x.get<double>()) ||
             (i > 0 && x.get<double>() > d.top.back()))
             return c.fail(sub(path, "top") + "[" + std::to_string(i) + "]",
-                          "expected a finite number >= 0, in decreasing order");
+                          "expected a number >= 0 (finite, in decreasing order)");
         d.top.push_back(x.get<double>());
     }
     return true;
@@ -306,6 +306,13 @@ bool merge_render_parts(Ctx& c, const Json& in, Json* out) {
         for (const char* key : {"version", "kind", "mcplay", "scene", "settings"})
             if (p.contains(key)) j[key] = p[key];
         if (j.contains("settings") && j["settings"].is_object()) j["settings"].erase("threads");
+        // The reference's timing and where it came from (rendered, or the cache) may differ;
+        // its numbers may not (reference_summary, above, and the rest of its description).
+        if (j.contains("scene") && j["scene"].is_object() && j["scene"].contains("reference") &&
+            j["scene"]["reference"].is_object()) {
+            j["scene"]["reference"].erase("seconds");
+            j["scene"]["reference"].erase("source");
+        }
         Json ests = Json::array();
         for (const Json& e : p["estimators"]) {
             Json x = e;
@@ -319,8 +326,19 @@ bool merge_render_parts(Ctx& c, const Json& in, Json* out) {
         return j;
     };
     const Json study0 = study_of(first);
+    auto names_of = [](const Json& p) {
+        std::string names;
+        for (const Json& e : p["estimators"])
+            names += (names.empty() ? "" : ", ") +
+                     (e.is_object() && e.contains("name") ? e["name"].dump() : std::string("?"));
+        return names;
+    };
     for (size_t i = 1; i < k; ++i) {
         const std::string pp = "part " + std::to_string(i);
+        if (names_of(*parts[i]) != names_of(first))
+            return c.fail(pp + ".estimators", "are " + names_of(*parts[i]) + ", part 0's are " +
+                                                  names_of(first) +
+                                                  ": the parts are not of one study");
         const Json study = study_of(*parts[i]);
         const std::string d = first_difference(study, study0, pp);
         if (!d.empty())
