@@ -595,6 +595,18 @@ TEST(RenderSplit, PartsMergeToTheWholeStudy) {
             << bad_merge.error;
         coverage["estimators"][0]["levels"][0]["images"][0]["coverage"] = 1;
         EXPECT_EQ(merge_text(json{{"parts", {p0, coverage}}}).status, MCP_OK);
+        // Progress lines (the page merges them level by level) carry no settings or scene: the
+        // replicates are counted from the images, and an emptied part is still refused.
+        json line0 = p0, line1 = p1;
+        for (json* p : {&line0, &line1}) {
+            p->erase("settings");
+            p->erase("scene");
+        }
+        EXPECT_EQ(merge_text(json{{"parts", {line0, line1}}}).status, MCP_OK);
+        line1["estimators"][0]["levels"][0]["images"] = json::array();
+        bad_merge = merge_text(json{{"parts", {line0, line1}}});
+        EXPECT_EQ(bad_merge.status, MCP_ERROR_ARGUMENT);
+        EXPECT_NE(bad_merge.error.find("images"), std::string::npos) << bad_merge.error;
         // What the merge reads: the part, its reference summary, the estimators' names, the
         // fields of an image (one element of its sample list), and the containers.
         std::vector<std::string> keys = {"/part",

@@ -186,9 +186,10 @@ bool merge_estimator(Ctx& c, const std::vector<const Json*>& parts, size_t e,
     for (const Json* part : parts) {
         const Json& est = (*part)["estimators"][e];
         const Json* ls = find(est, "levels");
-        if (!ls || !ls->is_array() || ls->size() > ladder.size())
+        const size_t most = ladder.empty() ? 64 : ladder.size();
+        if (!ls || !ls->is_array() || ls->size() > most)
             return c.fail(sub(path, "levels"), "expected an array of at most " +
-                                                   std::to_string(ladder.size()) +
+                                                   std::to_string(most) +
                                                    " levels (the spp ladder)");
         levels = std::min(levels, ls->size());
     }
@@ -197,18 +198,35 @@ bool merge_estimator(Ctx& c, const std::vector<const Json*>& parts, size_t e,
         const std::string lp = path + ".levels[" + std::to_string(i) + "]";
         std::vector<ImageSummary> images;
         const uint64_t of = parts.size();
+        // The level's image lists; their total is the replicate count when the parts carry no
+        // settings (the progress lines the page merges level by level).
+        std::vector<const Json*> lists(of, nullptr);
+        uint64_t total = 0;
         for (uint64_t index = 0; index < of; ++index) {
             const Json& level = (*parts[index])["estimators"][e]["levels"][i];
+            const Json* list = level.is_object() ? find(level, "images") : nullptr;
+            if (!list || !list->is_array() || list->size() > 1024)
+                return c.fail("part " + std::to_string(index) + ".estimators[" + std::to_string(e) +
+                                  "].levels[" + std::to_string(i) + "].images",
+                              "expected an array of at most 1024 images");
+            lists[index] = list;
+            total += list->size();
+        }
+        const uint64_t level_reps = reps ? reps : total;
+        if (level_reps < 2 || level_reps > 1024 || of > level_reps)
+            return c.fail(lp, std::to_string(total) + " images over " + std::to_string(of) +
+                                  " parts: expected reps (2..1024, at least one per part)");
+        for (uint64_t index = 0; index < of; ++index) {
+            const Json* list = lists[index];
             const std::string pl = "part " + std::to_string(index) + ".estimators[" +
                                    std::to_string(e) + "].levels[" + std::to_string(i) + "]";
-            const Json* list = level.is_object() ? find(level, "images") : nullptr;
             // Part index of K holds exactly the replicates r < reps with r % K == index.
-            const size_t want = part_replicate_count(reps, index, of);
-            if (!list || !list->is_array() || list->size() != want)
-                return c.fail(sub(pl, "images"), "expected the " + std::to_string(want) +
-                                                     " images of replicates r with r % " +
-                                                     std::to_string(of) + " = " +
-                                                     std::to_string(index));
+            const size_t want = part_replicate_count(level_reps, index, of);
+            if (list->size() != want)
+                return c.fail(sub(pl, "images"),
+                              "expected the " + std::to_string(want) +
+                                  " images of replicates r with r % " + std::to_string(of) + " = " +
+                                  std::to_string(index) + ", got " + std::to_string(list->size()));
             for (size_t k = 0; k < list->size(); ++k) {
                 ImageSummary im;
                 const std::string ip = pl + ".images[" + std::to_string(k) + "]";
@@ -216,14 +234,12 @@ bool merge_estimator(Ctx& c, const std::vector<const Json*>& parts, size_t e,
                 if (uint64_t(im.replicate) != index + k * of)
                     return c.fail(sub(ip, "replicate"),
                                   "expected replicate " + std::to_string(index + k * of));
-                if (im.spp != ladder[i])
+                if (!ladder.empty() && im.spp != ladder[i])
                     return c.fail(sub(ip, "spp"),
                                   "expected the level's " + std::to_string(ladder[i]) + " spp");
                 images.push_back(im);
             }
         }
-        if (images.size() != reps)
-            return c.fail(lp, "expected reps = " + std::to_string(reps) + " images over the parts");
         std::sort(images.begin(), images.end(), [](const ImageSummary& a, const ImageSummary& b) {
             return a.replicate < b.replicate;
         });
@@ -306,12 +322,13 @@ bool merge_render_parts(Ctx& c, const Json& in, Json* out) {
         for (const char* key : {"version", "kind", "mcplay", "scene", "settings"})
             if (p.contains(key)) j[key] = p[key];
         if (j.contains("settings") && j["settings"].is_object()) j["settings"].erase("threads");
-        // The reference's timing and where it came from (rendered, or the cache) may differ;
+        // The reference's timing and where it came from (rendered, a cache file) may differ;
         // its numbers may not (reference_summary, above, and the rest of its description).
         if (j.contains("scene") && j["scene"].is_object() && j["scene"].contains("reference") &&
             j["scene"]["reference"].is_object()) {
             j["scene"]["reference"].erase("seconds");
             j["scene"]["reference"].erase("source");
+            j["scene"]["reference"].erase("file");
         }
         Json ests = Json::array();
         for (const Json& e : p["estimators"]) {
@@ -346,27 +363,36 @@ bool merge_render_parts(Ctx& c, const Json& in, Json* out) {
                                  value_text(study0, d, pp) +
                                  ": the parts are not of one study (same scene and settings)");
     }
+    // A result carries its settings and scene; a progress line (the page merges them level by
+    // level) neither: then the replicates are counted from the images, and the spp and pixel
+    // bounds are the widest.
     const Json* settings = find(first, "settings");
     const Json* scene = find(first, "scene");
-    if (!settings || !settings->is_object()) return c.fail("part 0.settings", "missing");
-    if (!scene || !scene->is_object()) return c.fail("part 0.scene", "missing");
     uint64_t reps = 0, spp_min = 0, spp_max = 0;
     ImageShape shape;
-    if (!read_count(c, *settings, "reps", "part 0.settings", &reps) ||
-        !read_count(c, *settings, "n_min", "part 0.settings", &spp_min) ||
-        !read_count(c, *settings, "n_max", "part 0.settings", &spp_max) ||
-        !read_count(c, *scene, "width", "part 0.scene", &shape.width) ||
-        !read_count(c, *scene, "height", "part 0.scene", &shape.height))
-        return false;
-    if (reps < 2 || reps > 1024) return c.fail("part 0.settings.reps", "must be in 2..1024");
-    if (k > reps) return c.fail("parts", "more parts than reps = " + std::to_string(reps));
-    if (shape.width < 1 || shape.width > 4096 || shape.height < 1 || shape.height > 4096)
-        return c.fail("part 0.scene", "width and height must be in 1..4096");
-    if (spp_min < 1 || spp_max < spp_min || spp_max > (uint64_t(1) << 40))
-        return c.fail("part 0.settings.n_max", "expected 1 <= n_min <= n_max <= 2^40");
-    const std::vector<uint64_t> ladder = n_ladder(spp_min, spp_max);
-    if (ladder.empty())
-        return c.fail("part 0.settings.n_max", "no power of two between n_min and n_max");
+    std::vector<uint64_t> ladder;
+    if (settings) {
+        if (!settings->is_object()) return c.fail("part 0.settings", "expected an object");
+        if (!read_count(c, *settings, "reps", "part 0.settings", &reps) ||
+            !read_count(c, *settings, "n_min", "part 0.settings", &spp_min) ||
+            !read_count(c, *settings, "n_max", "part 0.settings", &spp_max))
+            return false;
+        if (reps < 2 || reps > 1024) return c.fail("part 0.settings.reps", "must be in 2..1024");
+        if (k > reps) return c.fail("parts", "more parts than reps = " + std::to_string(reps));
+        if (spp_min < 1 || spp_max < spp_min || spp_max > (uint64_t(1) << 40))
+            return c.fail("part 0.settings.n_max", "expected 1 <= n_min <= n_max <= 2^40");
+        ladder = n_ladder(spp_min, spp_max);
+        if (ladder.empty())
+            return c.fail("part 0.settings.n_max", "no power of two between n_min and n_max");
+    }
+    if (scene) {
+        if (!scene->is_object()) return c.fail("part 0.scene", "expected an object");
+        if (!read_count(c, *scene, "width", "part 0.scene", &shape.width) ||
+            !read_count(c, *scene, "height", "part 0.scene", &shape.height))
+            return false;
+        if (shape.width < 1 || shape.width > 4096 || shape.height < 1 || shape.height > 4096)
+            return c.fail("part 0.scene", "width and height must be in 1..4096");
+    }
     *out = first;
     out->erase("part");
     out->erase("reference_summary");
