@@ -72,8 +72,10 @@ inline int write_output(const std::string& out_path, const std::string& formatte
         std::fputs(formatted.c_str(), stdout);
         return kExitOk;
     }
+    errno = 0;
     if (write_file(out_path, formatted)) return kExitOk;
-    std::fprintf(stderr, "mcplay: cannot write '%s'\n", boundary::one_line(out_path).c_str());
+    std::fprintf(stderr, "mcplay: cannot write '%s'%s%s\n", boundary::one_line(out_path).c_str(),
+                 errno ? ": " : "", errno ? std::strerror(errno) : "");
     return kExitRuntime;
 }
 
