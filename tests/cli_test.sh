@@ -243,9 +243,73 @@ check merge-whole 2 'not a part of a split study' -- merge "$tmp/whole.json"
 check merge-nothing 2 'merge needs the JSON results of run --part' -- merge
 check merge-no-file 2 "cannot open '$tmp/none.json'" -- merge "$tmp/none.json"
 check part-bad 2 '--part: expected I/K' -- run quad_light_floor --part 3 --format json
-check part-table 2 '--part is for render scenes, with --format json' -- run quad_light_floor --part 0/2
-check part-integral 2 '--part is for render scenes' -- run exp_1d --part 0/2 --format json
+check part-table 2 '--part needs --format json' -- run quad_light_floor --part 0/2
 check part-too-many 2 'options.parts: must be in 1..reps = 3' -- run "${split[@]}" --part 0/4 --format json
+# Parts of one render study only: another seed is refused (named), the same seed accepted.
+check split-seed-1 0 '' -- run "${split[@]}" --seed 1 --part 0/2 --format json --out "$tmp/seed1.json"
+check split-seed-9 0 '' -- run "${split[@]}" --seed 9 --part 1/2 --format json --out "$tmp/seed9.json"
+check split-seed-1b 0 '' -- run "${split[@]}" --seed 1 --part 1/2 --format json --out "$tmp/seed1b.json"
+check merge-seeds 2 "part 1.settings.seed: is 9, part 0's is 1" -- merge "$tmp/seed1.json" "$tmp/seed9.json"
+check merge-same-seed 0 'fitted order' -- merge "$tmp/seed1.json" "$tmp/seed1b.json"
+sed 's/"coverage": [0-9][0-9.e+-]*/"coverage": 7/' "$tmp/seed1b.json" >"$tmp/coverage7.json"
+check merge-coverage-7 2 'coverage: out of range: expected 0..1, got 7' -- merge "$tmp/seed1.json" "$tmp/coverage7.json"
+# A render spp ladder with no power of two is refused, naming why; 4..4 has one level.
+check spp-ladder-empty 2 'spp_max: no power of two lies between spp_min = 3 and spp_max = 3' -- run quad_light_floor --n-min 3 --n-max 3 --reps 2 "${tiny[@]}" --quiet
+check spp-ladder-one 0 'light_area' -- run quad_light_floor --n-min 4 --n-max 4 --reps 2 --estimators light_area "${tiny[@]}" --quiet
+
+# Integration studies and stopping runs split the same way: merged parts are the whole study,
+# every number but the timing fields (wall_time_s, time_*, training_time_*, efficiency, seconds).
+strip_json_times() {  # the JSON on one line, each timing field (a number or an [lo, hi] pair) cut
+    tr -d ' \n' <"$1" | sed -E 's/"(wall_time_s|efficiency|time_[a-z0-9_]*|training_time_[a-z0-9_]*|[a-z_]*seconds[a-z_]*)":(\[[^]]*\]|[^],}]*),?//g'
+}
+for study in "exp_1d --n-min 16 --n-max 1024 --reps 5 --seed 3" \
+             "vegas_corner_peak --n-min 64 --n-max 1024 --reps 4" \
+             "exp_1d --rel-tol 1e-2 --reps 5 --estimators uniform,stratified"; do
+    read -r -a args <<<"$study --quiet"
+    name=${args[0]}-${#args[@]}
+    check "int-whole-$name" 0 '' -- run "${args[@]}" --format json --out "$tmp/int_whole.json"
+    for i in 0 1 2; do
+        check "int-part-$name-$i" 0 '' -- run "${args[@]}" --part "$i/3" --format json --out "$tmp/int$i.json"
+    done
+    check "int-merge-$name" 0 '' -- merge "$tmp/int2.json" "$tmp/int0.json" "$tmp/int1.json" --format json --out "$tmp/int_merged.json"
+    if [ "$(strip_json_times "$tmp/int_merged.json")" != "$(strip_json_times "$tmp/int_whole.json")" ]; then
+        echo "FAIL int-merge-equals-whole-$name: the merged parts differ from the whole study"
+        failed=$((failed + 1))
+    else
+        passed=$((passed + 1))
+    fi
+done
+check int-merge-table 0 'uniform' -- merge "$tmp/int0.json" "$tmp/int1.json" "$tmp/int2.json"
+check int-merge-missing 2 'part 2 of 3 is missing' -- merge "$tmp/int0.json" "$tmp/int1.json"
+check int-merge-twice 2 'part 1 of 3 is given twice' -- merge "$tmp/int0.json" "$tmp/int1.json" "$tmp/int1.json"
+check int-part-seed-9 0 '' -- run exp_1d --rel-tol 1e-2 --reps 5 --estimators uniform,stratified --seed 9 --part 2/3 --format json --out "$tmp/int_seed9.json"
+check int-merge-seeds 2 'options.seed: differs from parts\[0\]' -- merge "$tmp/int0.json" "$tmp/int1.json" "$tmp/int_seed9.json"
+check int-merge-render 2 'kind' -- merge "$tmp/int0.json" "$tmp/seed1b.json"
+check int-part-bad 2 'options.part: must be in 0..parts - 1 = 2' -- run exp_1d --part 3/3 --format json
+
+# A result that cannot be written is a failure: a full disk (--out, standard output) and a
+# closed standard output exit 1 with a message, never 0 with the result lost.
+if [ -w /dev/full ]; then
+    check out-dev-full 1 "cannot write '/dev/full'" -- run exp_1d "${small[@]}" --out /dev/full
+    $mcplay run exp_1d "${small[@]}" >/dev/full 2>"$tmp/err"
+    if [ $? = 1 ] && grep -q 'cannot write standard output' "$tmp/err"; then passed=$((passed + 1)); else
+        echo "FAIL stdout-full: $(cat "$tmp/err")"; failed=$((failed + 1)); fi
+    $mcplay merge "$tmp/int0.json" "$tmp/int1.json" "$tmp/int2.json" >/dev/full 2>"$tmp/err"
+    if [ $? = 1 ]; then passed=$((passed + 1)); else echo "FAIL merge-stdout-full"; failed=$((failed + 1)); fi
+fi
+case "$exe" in
+    *.js) ;; # node owns its standard output
+    *)
+        $mcplay run exp_1d "${small[@]}" >&- 2>"$tmp/err"
+        if [ $? = 1 ] && grep -q 'cannot write standard output' "$tmp/err"; then passed=$((passed + 1)); else
+            echo "FAIL stdout-closed: $(cat "$tmp/err")"; failed=$((failed + 1)); fi
+        ;;
+esac
+# --cache (or $MCPLAY_CACHE) naming a file is an error naming it; a folder is used.
+: >"$tmp/cachefile"
+check cache-file 2 "--cache: '$tmp/cachefile' is not a directory" -- run quad_light_floor --cache "$tmp/cachefile" --n-max 2 --reps 2 --width 8 --height 6 --quiet
+MCPLAY_CACHE="$tmp/cachefile" check cache-env-file 2 "MCPLAY_CACHE: '$tmp/cachefile' is not a directory" -- reference quad_light_floor --width 8 --height 6 --out "$tmp/ref.pfm"
+check cache-dir 0 '' -- run quad_light_floor --cache "$tmp/cachedir" --n-max 2 --reps 2 --width 8 --height 6 --estimators light_area --quiet
 
 # The sampler lab: points, analyze, warp-test (docs/sampler-lab.md).
 check points-csv 0 '^x1,x2,x3$' -- points sobol --n 16 --dim 3 --seed 2

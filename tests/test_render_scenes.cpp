@@ -571,6 +571,42 @@ TEST(RenderSplit, PartsMergeToTheWholeStudy) {
         p1 = run(o).result;
         for (json* p : {&p0, &p1})
             for (json& e : (*p)["estimators"]) e["levels"] = json::array({e["levels"][0]});
+        ASSERT_EQ(merge_text(json{{"parts", {p0, p1}}}).status, MCP_OK);
+        // Refused, naming the field: a part of another seed, a part whose images were emptied,
+        // an image's coverage out of 0..1.
+        o["seed"] = 9;
+        json seed9 = run(o).result;
+        for (json& e : seed9["estimators"]) e["levels"] = json::array({e["levels"][0]});
+        Call bad_merge = merge_text(json{{"parts", {p0, seed9}}});
+        EXPECT_EQ(bad_merge.status, MCP_ERROR_ARGUMENT);
+        EXPECT_NE(bad_merge.error.find("settings.seed: is 9, part 0's is 5"), std::string::npos)
+            << bad_merge.error;
+        json emptied = p1;
+        emptied["estimators"][0]["levels"][0]["images"] = json::array();
+        bad_merge = merge_text(json{{"parts", {p0, emptied}}});
+        EXPECT_EQ(bad_merge.status, MCP_ERROR_ARGUMENT);
+        EXPECT_NE(bad_merge.error.find("images: expected the 3 images"), std::string::npos)
+            << bad_merge.error;
+        json coverage = p1;
+        coverage["estimators"][0]["levels"][0]["images"][0]["coverage"] = 7;
+        bad_merge = merge_text(json{{"parts", {p0, coverage}}});
+        EXPECT_EQ(bad_merge.status, MCP_ERROR_ARGUMENT);
+        EXPECT_NE(bad_merge.error.find("coverage: out of range"), std::string::npos)
+            << bad_merge.error;
+        coverage["estimators"][0]["levels"][0]["images"][0]["coverage"] = 1;
+        EXPECT_EQ(merge_text(json{{"parts", {p0, coverage}}}).status, MCP_OK);
+        // Progress lines (the page merges them level by level) carry no settings or scene: the
+        // replicates are counted from the images, and an emptied part is still refused.
+        json line0 = p0, line1 = p1;
+        for (json* p : {&line0, &line1}) {
+            p->erase("settings");
+            p->erase("scene");
+        }
+        EXPECT_EQ(merge_text(json{{"parts", {line0, line1}}}).status, MCP_OK);
+        line1["estimators"][0]["levels"][0]["images"] = json::array();
+        bad_merge = merge_text(json{{"parts", {line0, line1}}});
+        EXPECT_EQ(bad_merge.status, MCP_ERROR_ARGUMENT);
+        EXPECT_NE(bad_merge.error.find("images"), std::string::npos) << bad_merge.error;
         // What the merge reads: the part, its reference summary, the estimators' names, the
         // fields of an image (one element of its sample list), and the containers.
         std::vector<std::string> keys = {"/part",

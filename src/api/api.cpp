@@ -1,5 +1,6 @@
 // The extern "C" boundary. The library is built without exceptions: every error is a value
 // returned up to here and turned into a status code plus a message (like sqlite3_errmsg).
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -9,6 +10,7 @@
 #include "api/mcplay.h"
 #include "api/report.h"
 #include "api/scene.h"
+#include "api/study_parts.h"
 #include "estimators/named_warps.h"
 #include "estimators/stopping.h"
 
@@ -55,6 +57,43 @@ int mcp_study_run(const char* scene_json, const char* options_json, mcp_progress
                   void* user, char** result_json) {
     if (!result_json) return fail(MCP_ERROR_ARGUMENT, "mcp_study_run: result_json is NULL");
     *result_json = nullptr;
+    // A part of a study split over processes (options.part of options.parts): the study
+    // without them, restricted to the replicates r with r % parts == part (study_parts.h).
+    mcp::Json options = mcp::Json::object();
+    if (options_json && *options_json) {
+        mcp::Made<mcp::Json> o = mcp::parse_json(options_json, "options");
+        if (!o.ok()) return fail(MCP_ERROR_ARGUMENT, o.error);
+        options = o.value;
+    }
+    if (options.is_object() && (options.contains("part") || options.contains("parts"))) {
+        mcp::Ctx c;
+        uint64_t part = 0, parts = 1;
+        if (!mcp::get_count(c, options, "part", "options", &part) ||
+            !mcp::get_count(c, options, "parts", "options", &parts))
+            return fail(MCP_ERROR_ARGUMENT, c.error);
+        options.erase("part");
+        options.erase("parts");
+        const std::string rest = options.dump();
+        mcp::SceneRequest req;
+        if (int st = load_request(scene_json, rest.c_str(), &req)) return st;
+        const int reps = req.settings.reps;
+        if (parts < 1 || parts > uint64_t(std::min(reps, mcp::kMaxStudyParts)))
+            return fail(MCP_ERROR_ARGUMENT,
+                        "options.parts: must be in 1..reps = " +
+                            std::to_string(std::min(reps, mcp::kMaxStudyParts)) + ", got " +
+                            std::to_string(parts));
+        if (part >= parts)
+            return fail(MCP_ERROR_ARGUMENT,
+                        "options.part: must be in 0..parts - 1 = " + std::to_string(parts - 1) +
+                            ", got " + std::to_string(part));
+        mcp::Made<mcp::Json> scene = mcp::parse_json(scene_json, "scene");
+        if (!scene.ok()) return fail(MCP_ERROR_SCENE, scene.error);
+        *result_json =
+            copy_out(dump(mcp::run_study_part(req, scene.value, options, int(part), int(parts))));
+        if (!*result_json) return fail(MCP_ERROR_INTERNAL, "out of memory writing the result");
+        g_last_error.clear();
+        return MCP_OK;
+    }
     mcp::SceneRequest req;
     if (int st = load_request(scene_json, options_json, &req)) return st;
 
@@ -78,6 +117,20 @@ int mcp_study_run(const char* scene_json, const char* options_json, mcp_progress
     *result_json = copy_out(dump(mcp::study_to_json(result)));
     if (!*result_json) return fail(MCP_ERROR_INTERNAL, "out of memory writing the result");
     if (result.cancelled) return fail(MCP_ERROR_CANCELLED, "study cancelled by the caller");
+    g_last_error.clear();
+    return MCP_OK;
+}
+
+int mcp_study_merge(const char* parts_json, char** result_json) {
+    if (!result_json) return fail(MCP_ERROR_ARGUMENT, "mcp_study_merge: result_json is NULL");
+    *result_json = nullptr;
+    mcp::Made<mcp::Json> in = mcp::parse_json(parts_json, "parts");
+    if (!in.ok()) return fail(MCP_ERROR_ARGUMENT, in.error);
+    mcp::Ctx c;
+    mcp::Json merged;
+    if (!mcp::merge_study_parts(c, in.value, &merged)) return fail(MCP_ERROR_ARGUMENT, c.error);
+    *result_json = copy_out(dump(merged));
+    if (!*result_json) return fail(MCP_ERROR_INTERNAL, "out of memory writing the result");
     g_last_error.clear();
     return MCP_OK;
 }

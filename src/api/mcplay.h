@@ -36,6 +36,18 @@ const char* mcp_last_error(void);
 int mcp_study_run(const char* scene_json, const char* options_json, mcp_progress_fn progress,
                   void* user, char** result_json);
 
+/* A study split over processes: each runs mcp_study_run with options.part = i of
+ * options.parts = K (1 <= K <= min(reps, 1024)), which runs only the replicates r with
+ * r % K == i and returns a part {"kind": "study_part" or "stopping_part", "part": {"index",
+ * "of"}, "scene", "options", "threads", "wall_time_s", "estimators": [every replicate's run,
+ * written exactly]} (no progress calls). parts_json is {"parts": [the K parts]}: same scene,
+ * same options but threads, each index once. The merge is the result mcp_study_run gives for
+ * the whole study, bit for bit but for the timing fields (wall_time_s, settings.threads: the
+ * parts' largest; the levels' time_*, training_time_mean and efficiency, from each replicate's
+ * own seconds). A part whose settings, replicates or numbers do not fit is refused with the
+ * field named (MCP_ERROR_ARGUMENT). */
+int mcp_study_merge(const char* parts_json, char** result_json);
+
 /* Validates a study exactly as mcp_study_run does (including the size limits: at most 2^40
  * integrand evaluations, sum over N of N x reps x estimators, and 2^21 replicate results) and
  * predicts its cost from a timed pilot of 4096 samples per estimator (a few ms), without running

@@ -5,7 +5,7 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
+#include <cstring>
 #include <string>
 
 #include "api/boundary.h"
@@ -44,20 +44,38 @@ inline bool parse_count(const std::string& text, unsigned long long* out) {
     return true;
 }
 
+/// Writes the bytes and closes the file, every step checked (a full disk fails at the close).
 inline bool write_file(const std::string& path, const std::string& bytes) {
-    std::ofstream out(path, std::ios::binary);
-    out << bytes;
-    return bool(out);
+    std::FILE* f = std::fopen(path.c_str(), "wb");
+    if (!f) return false;
+    const bool written = std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
+    const bool flushed = std::fflush(f) == 0;
+    return std::fclose(f) == 0 && written && flushed;
+}
+
+/// Flushes and closes standard output; false (with a message on standard error) when what was
+/// written to it is lost (a full disk, a closed pipe or descriptor). Every command ends here.
+inline bool close_stdout() {
+    const bool ok = std::fflush(stdout) == 0 && !std::ferror(stdout);
+    const int err = errno;
+    const bool closed = std::fclose(stdout) == 0;
+    if (ok && closed) return true;
+    std::fprintf(stderr, "mcplay: cannot write standard output: %s\n",
+                 std::strerror(ok ? errno : err));
+    return false;
 }
 
 /// Writes a formatted result to `out_path`, or to standard output when it is empty.
 inline int write_output(const std::string& out_path, const std::string& formatted) {
     if (out_path.empty()) {
+        // checked at the flush (close_stdout), where a full disk shows
         std::fputs(formatted.c_str(), stdout);
         return kExitOk;
     }
+    errno = 0;
     if (write_file(out_path, formatted)) return kExitOk;
-    std::fprintf(stderr, "mcplay: cannot write '%s'\n", boundary::one_line(out_path).c_str());
+    std::fprintf(stderr, "mcplay: cannot write '%s'%s%s\n", boundary::one_line(out_path).c_str(),
+                 errno ? ": " : "", errno ? std::strerror(errno) : "");
     return kExitRuntime;
 }
 

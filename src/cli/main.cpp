@@ -70,18 +70,23 @@ const char* kUsage =
     "  --format F           table (default), json or csv\n"
     "  --out FILE           write the result to FILE instead of standard output\n"
     "  --quiet              no progress lines on standard error\n"
+    "  --part I/K           run only replicates r with r % K == I (1 <= K <= reps), as JSON\n"
+    "                       for merge (needs --format json); integrals, stopping runs and\n"
+    "                       render studies alike\n"
+    "\n"
+    "merge PART.json...: the K parts of one study (any order; same scene and settings, each\n"
+    "  part once) give the whole study's result, every number as one run gives it but the\n"
+    "  timings; printed like run (--format, --out). Parts that do not fit are refused, the\n"
+    "  field named. A result that cannot be written (full disk, closed output) exits 1.\n"
     "\n"
     "render scenes (a scene JSON with a \"render\" object and a glTF file):\n"
     "  run studies relative MSE against spp (--n-min/--n-max are spp) against a reference\n"
     "  image, cached in --cache DIR (default $MCPLAY_CACHE, else ~/.cache/mcplay).\n"
     "  --width W, --height H  image size (default from the scene)\n"
-    "  --cache DIR | --no-cache  where high-spp references are kept\n"
+    "  --cache DIR | --no-cache  where high-spp references are kept (DIR must be a folder)\n"
     "  --pixel-sampler P    independent, stratified, sobol or padded_sobol: every\n"
     "                       estimator's pixel sampler (run and render; sobol needs a\n"
     "                       power-of-two spp)\n"
-    "  --part I/K           render only replicates r with r % K == I (K <= reps), as JSON\n"
-    "                       for merge: K such runs (on K machines) merged give the whole\n"
-    "                       study's numbers; merge prints them like run\n"
     "  render writes one image: --out FILE (.png tone-mapped sRGB, .hdr linear Radiance,\n"
     "  .pfm linear float32),\n"
     "  --error-out FILE (false-colour relative error against the reference, PNG),\n"
@@ -147,28 +152,38 @@ std::string dirname_of(const std::string& path) {
     return slash == std::string::npos ? std::string(".") : path.substr(0, slash);
 }
 
-// The reference cache folder: --cache, else $MCPLAY_CACHE, else $HOME/.cache/mcplay
-// (created on demand); "" when none can be made.
-std::string cache_dir(const std::string& given) {
-    std::string dir = given;
-    if (dir.empty()) {
-        if (const char* env = std::getenv("MCPLAY_CACHE"); env && *env)
-            dir = env;
-        else if (const char* home = std::getenv("HOME"); home && *home)
-            dir = std::string(home) + "/.cache/mcplay";
-        else
-            return "";
+// The reference cache folder: --cache, else $MCPLAY_CACHE, else $HOME/.cache/mcplay (created
+// on demand). A folder given (--cache or $MCPLAY_CACHE) that is not one or cannot be made is an
+// error naming it; the default one that cannot be made means no cache (*dir = "").
+bool cache_dir(const std::string& given, std::string* dir, std::string* error) {
+    std::string where = "--cache";
+    *dir = given;
+    if (dir->empty()) {
+        where = "$MCPLAY_CACHE";
+        if (const char* env = std::getenv("MCPLAY_CACHE"); env && *env) {
+            *dir = env;
+        } else if (const char* home = std::getenv("HOME"); home && *home) {
+            where.clear();
+            *dir = std::string(home) + "/.cache/mcplay";
+        } else {
+            return true;
+        }
     }
-    std::string partial;
-    std::stringstream ss(dir);
-    std::string part;
-    if (!dir.empty() && dir[0] == '/') partial = "";
+    std::string partial, part;
+    std::stringstream ss(*dir);
     while (std::getline(ss, part, '/')) {
         if (part.empty()) continue;
-        partial += (partial.empty() && dir[0] != '/' ? "" : "/") + part;
+        partial += (partial.empty() && (*dir)[0] != '/' ? "" : "/") + part;
         mkdir(partial.c_str(), 0755);
     }
-    return dir;
+    if (mcp::is_directory(*dir)) return true;
+    const std::string why = path_exists(*dir) ? "is not a directory" : "cannot be created";
+    if (where.empty()) {
+        dir->clear(); // the default folder: no cache
+        return true;
+    }
+    *error = where + ": '" + *dir + "' " + why + " (the reference cache needs a folder)";
+    return false;
 }
 
 // A .gltf or .glb given directly is a render scene of its own, its study settings in its
@@ -523,8 +538,8 @@ int cmd_run(const std::vector<std::string>& args) {
     if (!render_scene && (options.contains("width") || options.contains("height") ||
                           options.contains("pixel_sampler") || !cache_arg.empty()))
         return usage_error("--width, --height, --cache and --pixel-sampler are for render scenes");
-    if (options.contains("part") && (!render_scene || format != "json"))
-        return usage_error("--part is for render scenes, with --format json (the input of merge)");
+    if (options.contains("part") && format != "json")
+        return usage_error("--part needs --format json (its output is the input of merge)");
     OutputFile out_file{out_path};
     if (!out_file.check(&error)) return usage_error("--out: " + error);
 
@@ -540,7 +555,11 @@ int cmd_run(const std::vector<std::string>& args) {
             }
         options["base_dir"] = dirname_of(path);
         if (!no_cache) {
-            std::string dir = cache_dir(cache_arg);
+            std::string dir;
+            if (!cache_dir(cache_arg, &dir, &error)) {
+                out_file.discard();
+                return usage_error(error);
+            }
             if (!dir.empty()) options["cache_dir"] = dir;
         }
         const std::string opts = options.dump();
@@ -749,7 +768,8 @@ int cmd_render_progressive(ImageCommand& c) {
 
     options["base_dir"] = dirname_of(path);
     if (!c.no_cache) {
-        std::string cache = cache_dir(c.cache_arg);
+        std::string cache, why;
+        if (!cache_dir(c.cache_arg, &cache, &why)) return usage_error(why);
         if (!cache.empty()) options["cache_dir"] = cache;
     }
     options["live_reference"] = "obtain";
@@ -883,7 +903,12 @@ int cmd_render(const std::vector<std::string>& args) {
     }
     options["base_dir"] = dirname_of(path);
     if (!no_cache) {
-        std::string dir = cache_dir(cache_arg);
+        std::string dir;
+        if (!cache_dir(cache_arg, &dir, &error)) {
+            out_file.discard();
+            error_file.discard();
+            return usage_error(error);
+        }
         if (!dir.empty()) options["cache_dir"] = dir;
     }
     char* result = nullptr;
@@ -961,7 +986,11 @@ int cmd_reference(const std::vector<std::string>& args) {
     if (!out_file.check(&error)) return usage_error("--out: " + error);
     options["base_dir"] = dirname_of(path);
     if (!no_cache) {
-        std::string dir = cache_dir(cache_arg);
+        std::string dir;
+        if (!cache_dir(cache_arg, &dir, &error)) {
+            out_file.discard();
+            return usage_error(error);
+        }
         if (!dir.empty()) options["cache_dir"] = dir;
     }
     const bool show_progress = !quiet && isatty(fileno(stderr));
@@ -1021,7 +1050,7 @@ int cmd_merge(const std::vector<std::string>& args) {
     }
     if (files.empty()) return usage_error("merge needs the JSON results of run --part");
     if (files.size() > 1024) return usage_error("merge: at most 1024 parts");
-    std::string text = "{\"parts\":[", error;
+    std::string text = "{\"parts\":[", error, first_part;
     for (size_t i = 0; i < files.size(); ++i) {
         std::string part;
         if (!mcp::read_regular_file(files[i], mcp::kMaxJsonBytes / 4, &part, &error)) {
@@ -1041,12 +1070,19 @@ int cmd_merge(const std::vector<std::string>& args) {
             return kExitUsage;
         }
         text += (i ? "," : "") + part;
+        if (i == 0) first_part = std::move(part);
     }
     text += "]}";
     OutputFile out_file{out_path};
     if (!out_file.check(&error)) return usage_error("--out: " + error);
+    // Integration studies and stopping runs ("kind": "study_part" or "stopping_part") merge in
+    // the study API, render studies in the render API; each refuses the other's parts.
+    const nlohmann::json first = nlohmann::json::parse(first_part, nullptr, false);
+    const bool study_parts = first.is_object() && first.contains("kind") &&
+                             (first["kind"] == "study_part" || first["kind"] == "stopping_part");
     char* result = nullptr;
-    if (mcp_render_study_merge(text.c_str(), &result) != MCP_OK) {
+    if ((study_parts ? mcp_study_merge(text.c_str(), &result)
+                     : mcp_render_study_merge(text.c_str(), &result)) != MCP_OK) {
         std::fprintf(stderr, "mcplay: merge: %s\n", mcp_last_error());
         out_file.discard();
         return kExitUsage;
@@ -1066,7 +1102,7 @@ int cmd_merge(const std::vector<std::string>& args) {
 
 } // namespace
 
-int main(int argc, char** argv) {
+static int run_command(int argc, char** argv) {
     std::vector<std::string> args(argv + 1, argv + argc);
     if (args.empty()) {
         std::fputs(kUsage, stderr);
@@ -1096,4 +1132,12 @@ int main(int argc, char** argv) {
     if (cmd == "analyze") return mcp::cli::cmd_analyze(rest);
     if (cmd == "warp-test") return mcp::cli::cmd_warp_test(rest, load_scene);
     return usage_error("unknown command '" + cmd + "'");
+}
+
+int main(int argc, char** argv) {
+    const int rc = run_command(argc, argv);
+    // A result written to standard output is only delivered once flushed: a failed flush or
+    // close (a full disk, a closed descriptor) is a failed command.
+    if (!mcp::cli::close_stdout() && rc == kExitOk) return kExitRuntime;
+    return rc;
 }

@@ -25,6 +25,13 @@ class NeumaierSum {
     /// The running sum and its compensation, unrounded: value() is their rounded sum.
     double running_sum() const { return sum_; }
     double compensation() const { return comp_; }
+    /// A sum carried between processes (study parts): the running sum and its compensation.
+    static NeumaierSum from_parts(double running_sum, double compensation) {
+        NeumaierSum s;
+        s.sum_ = running_sum;
+        s.comp_ = compensation;
+        return s;
+    }
 
   private:
     double sum_ = 0.0;
@@ -64,6 +71,22 @@ class RunningMoments {
     double sum_cubed_deviations() const { return m3_; }
     /// Sample skewness g1 = sqrt(n) m3 / m2^(3/2) (0 without spread beyond round-off).
     double skewness() const;
+
+    /// The exact state, for carrying moments between processes (study parts) bit for bit.
+    struct State {
+        uint64_t n = 0;
+        double sum = 0.0, compensation = 0.0, mean = 0.0, m2 = 0.0, m3 = 0.0;
+    };
+    State state() const { return {n_, sum_.running_sum(), sum_.compensation(), mean_, m2_, m3_}; }
+    static RunningMoments from_state(const State& s) {
+        RunningMoments m;
+        m.n_ = s.n;
+        m.sum_ = NeumaierSum::from_parts(s.sum, s.compensation);
+        m.mean_ = s.mean;
+        m.m2_ = s.m2;
+        m.m3_ = s.m3;
+        return m;
+    }
 
   private:
     uint64_t n_ = 0;

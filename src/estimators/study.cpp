@@ -738,6 +738,23 @@ StudyPlan plan_study(const Problem& problem, const std::vector<EstimatorSpec>& e
     return plan;
 }
 
+EstimatorStudy begin_estimator_study(const Problem& problem, const EstimatorSpec& spec,
+                                     const StudySettings& settings) {
+    EstimatorStudy es;
+    es.spec = spec;
+    es.error_method = error_method_for(spec);
+    es.support = check_support(problem, spec, kSupportProbes, settings.seed);
+    es.weights_bounded = weights_bounded(problem, spec);
+    return es;
+}
+
+void add_level(EstimatorStudy& es, const std::vector<RunResult>& runs, const Problem& problem) {
+    es.levels.push_back(summarise_level(runs, problem));
+    es.fit = fit_convergence(es.levels);
+    es.mse_fit = fit_mse(es.levels);
+    es.consistency = level_consistency(es.levels);
+}
+
 StudyResult run_study(const Problem& problem, const std::vector<EstimatorSpec>& estimators,
                       const StudySettings& settings, const StudyProgress& progress) {
     const auto start = std::chrono::steady_clock::now();
@@ -745,14 +762,8 @@ StudyResult run_study(const Problem& problem, const std::vector<EstimatorSpec>& 
     result.problem = problem;
     result.settings = settings;
     result.threads_used = resolve_threads(settings.threads);
-    for (const EstimatorSpec& spec : estimators) {
-        EstimatorStudy es;
-        es.spec = spec;
-        es.error_method = error_method_for(spec);
-        es.support = check_support(problem, spec, kSupportProbes, settings.seed);
-        es.weights_bounded = weights_bounded(problem, spec);
-        result.estimators.push_back(es);
-    }
+    for (const EstimatorSpec& spec : estimators)
+        result.estimators.push_back(begin_estimator_study(problem, spec, settings));
     const std::vector<uint64_t> ladder = n_ladder(settings.n_min, settings.n_max);
     const size_t reps = static_cast<size_t>(settings.reps);
     std::vector<Workspace> workspaces(static_cast<size_t>(std::max(result.threads_used, 1)));
@@ -765,11 +776,7 @@ StudyResult run_study(const Problem& problem, const std::vector<EstimatorSpec>& 
         for (size_t e = 0; e < estimators.size(); ++e) {
             std::vector<RunResult> level_runs(runs.begin() + static_cast<long>(e * reps),
                                               runs.begin() + static_cast<long>((e + 1) * reps));
-            EstimatorStudy& es = result.estimators[e];
-            es.levels.push_back(summarise_level(level_runs, problem));
-            es.fit = fit_convergence(es.levels);
-            es.mse_fit = fit_mse(es.levels);
-            es.consistency = level_consistency(es.levels);
+            add_level(result.estimators[e], level_runs, problem);
         }
         result.wall_seconds =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -251,6 +251,14 @@ uint64_t replicate_stream(uint64_t seed, const std::string& estimator, uint64_t 
 /// The generator of one replicate: state and stream both derived from its key.
 Pcg32 replicate_rng(uint64_t seed, const std::string& estimator, uint64_t n, int rep);
 
+/// An estimator's study before its first level: its spec, error method, support check and
+/// whether its weights are bounded (what run_study and a merge of study parts start from).
+EstimatorStudy begin_estimator_study(const Problem& problem, const EstimatorSpec& spec,
+                                     const StudySettings& settings);
+/// Appends the level of these runs (replicate r at index r) and recomputes the estimator's
+/// fits and level consistency: what run_study does after each level, and a merge of parts.
+void add_level(EstimatorStudy& es, const std::vector<RunResult>& runs, const Problem& problem);
+
 StudyResult run_study(const Problem& problem, const std::vector<EstimatorSpec>& estimators,
                       const StudySettings& settings, const StudyProgress& progress = {});
 

@@ -11,6 +11,7 @@
 
 #include "api/report.h"
 #include "api/scene.h"
+#include "estimators/study.h" // n_ladder
 #include "render/render_study.h"
 #include "render_api/render_json.h"
 
@@ -28,7 +29,70 @@ bool read_number(Ctx& c, const Json& j, const char* key, const std::string& path
     }
     if (!v->is_number()) return c.fail(sub(path, key), "expected a number, got " + type_of(*v));
     *out = v->get<double>();
+    if (!std::isfinite(*out)) return c.fail(sub(path, key), "expected a finite number");
     return true;
+}
+
+/// A number read by read_number in lo..hi (null, NaN, passes: no value, e.g. a black reference).
+bool check_range(Ctx& c, const std::string& path, const char* key, double x, double lo, double hi) {
+    if (std::isnan(x) || (x >= lo && x <= hi)) return true;
+    return c.fail(sub(path, key), "out of range: expected " + fmt("%.17g", lo) + ".." +
+                                      fmt("%.17g", hi) + ", got " + fmt("%.17g", x));
+}
+
+/// The replicates of part `index` of `of`: r = index, index + of, ... below reps.
+size_t part_replicate_count(uint64_t reps, uint64_t index, uint64_t of) {
+    return index < reps ? size_t((reps - 1 - index) / of + 1) : 0;
+}
+
+/// The first key at which two JSON values differ, as a path ("" when equal).
+std::string first_difference(const Json& a, const Json& b, const std::string& path) {
+    if (a == b) return "";
+    if (a.is_object() && b.is_object()) {
+        for (auto it = a.begin(); it != a.end(); ++it) {
+            const std::string p = sub(path, it.key().c_str());
+            if (!b.contains(it.key())) return p;
+            const std::string d = first_difference(it.value(), b[it.key()], p);
+            if (!d.empty()) return d;
+        }
+        for (auto it = b.begin(); it != b.end(); ++it)
+            if (!a.contains(it.key())) return sub(path, it.key().c_str());
+    }
+    if (a.is_array() && b.is_array() && a.size() == b.size())
+        for (size_t i = 0; i < a.size(); ++i) {
+            const std::string d =
+                first_difference(a[i], b[i], path + "[" + std::to_string(i) + "]");
+            if (!d.empty()) return d;
+        }
+    return path;
+}
+
+/// A part's value at a path found by first_difference, for the message ("missing" if none).
+std::string value_text(const Json& root, const std::string& path, const std::string& prefix) {
+    if (path.compare(0, prefix.size(), prefix) != 0) return "?";
+    std::string rest = path.substr(prefix.size()), key;
+    const Json* at = &root;
+    for (size_t i = 0; i <= rest.size(); ++i) {
+        if (i == rest.size() || rest[i] == '.' || rest[i] == '[') {
+            if (!key.empty()) {
+                if (!at->is_object() || !at->contains(key)) return "missing";
+                at = &(*at)[key];
+            }
+            key.clear();
+            if (i < rest.size() && rest[i] == '[') {
+                const size_t close = rest.find(']', i);
+                if (close == std::string::npos) return "?";
+                const size_t k = std::stoul(rest.substr(i + 1, close - i - 1));
+                if (!at->is_array() || k >= at->size()) return "missing";
+                at = &(*at)[k];
+                i = close;
+            }
+        } else {
+            key += rest[i];
+        }
+    }
+    const std::string text = at->dump();
+    return text.size() > 60 ? text.substr(0, 57) + "..." : text;
 }
 
 bool read_count(Ctx& c, const Json& j, const char* key, const std::string& path, uint64_t* out) {
@@ -44,7 +108,13 @@ bool read_pixel(Ctx& c, const Json& j, const char* key, const std::string& path,
     return true;
 }
 
-bool image_summary_from_json(Ctx& c, const Json& j, const std::string& path, ImageSummary* im) {
+/// The image size of the parts (their scene's width and height), for checking the images.
+struct ImageShape {
+    uint64_t width = 4096, height = 4096;
+};
+
+bool image_summary_from_json(Ctx& c, const Json& j, const std::string& path,
+                             const ImageShape& shape, ImageSummary* im) {
     if (!j.is_object()) return c.fail(path, "expected an object, got " + type_of(j));
     ImageError& e = im->error;
     RenderDiagnostics& d = im->diagnostics;
@@ -71,6 +141,24 @@ bool image_summary_from_json(Ctx& c, const Json& j, const std::string& path, Ima
     if (replicate >= 1024) return c.fail(sub(path, "replicate"), "must be in 0..1023");
     if (im->spp < 1) return c.fail(sub(path, "spp"), "must be at least 1");
     if (!(im->seconds >= 0.0)) return c.fail(sub(path, "seconds"), "expected a number >= 0");
+    // Every number in its range: relative errors, sums of squares and standard errors are
+    // >= 0, a coverage and a share lie in 0..1, pixels in the image, counts within counts.
+    const double pixels = double(shape.width) * double(shape.height);
+    if (!check_range(c, path, "rel_mse", e.rel_mse, 0.0, INFINITY) ||
+        !check_range(c, path, "rel_mse_raw", e.rel_mse_raw, 0.0, INFINITY) ||
+        !check_range(c, path, "coverage", e.coverage, 0.0, 1.0) ||
+        !check_range(c, path, "mean_luminance_se", e.mean_luminance_se, 0.0, INFINITY) ||
+        !check_range(c, path, "worst_pixel_term", e.worst_pixel_term, 0.0, INFINITY) ||
+        !check_range(c, path, "pixel_term_squares", e.pixel_term_squares, 0.0, INFINITY) ||
+        !check_range(c, path, "max_sample_share", d.max_sample_share, 0.0, 1.0) ||
+        !check_range(c, path, "worst_x", e.worst_x, -1.0, double(shape.width) - 1.0) ||
+        !check_range(c, path, "worst_y", e.worst_y, -1.0, double(shape.height) - 1.0) ||
+        !check_range(c, path, "samples", double(d.samples), 0.0, double(im->spp) * pixels) ||
+        !check_range(c, path, "discarded_nonfinite", double(d.discarded_nonfinite), 0.0,
+                     double(d.samples)) ||
+        !check_range(c, path, "light_misses", double(d.light_misses), 0.0, double(d.rays)) ||
+        !check_range(c, path, "dominated_pixels", double(d.dominated_pixels), 0.0, pixels))
+        return false;
     im->replicate = int(replicate);
     const Json* top = find(j, "top");
     if (!top || !top->is_array() || top->size() > kTopWeights)
@@ -79,9 +167,10 @@ bool image_summary_from_json(Ctx& c, const Json& j, const std::string& path, Ima
     d.top.clear();
     for (size_t i = 0; i < top->size(); ++i) {
         const Json& x = (*top)[i];
-        if (!x.is_number() || !(x.get<double>() >= 0.0))
+        if (!x.is_number() || !(x.get<double>() >= 0.0) || !std::isfinite(x.get<double>()) ||
+            (i > 0 && x.get<double>() > d.top.back()))
             return c.fail(sub(path, "top") + "[" + std::to_string(i) + "]",
-                          "expected a number >= 0");
+                          "expected a number >= 0 (finite, in decreasing order)");
         d.top.push_back(x.get<double>());
     }
     return true;
@@ -90,35 +179,67 @@ bool image_summary_from_json(Ctx& c, const Json& j, const std::string& path, Ima
 /// Each estimator's levels, fit and warnings merged from the parts of a split study
 /// (mcp_render_study_merge): the images of every part at each level, by replicate.
 bool merge_estimator(Ctx& c, const std::vector<const Json*>& parts, size_t e,
-                     const ReferenceSummary& ref, Json* out) {
+                     const ReferenceSummary& ref, const ImageShape& shape,
+                     const std::vector<uint64_t>& ladder, uint64_t reps, Json* out) {
     const std::string path = "parts[*].estimators[" + std::to_string(e) + "]";
     size_t levels = SIZE_MAX;
     for (const Json* part : parts) {
         const Json& est = (*part)["estimators"][e];
         const Json* ls = find(est, "levels");
-        if (!ls || !ls->is_array() || ls->size() > 64)
-            return c.fail(sub(path, "levels"), "expected an array of at most 64 levels");
+        const size_t most = ladder.empty() ? 64 : ladder.size();
+        if (!ls || !ls->is_array() || ls->size() > most)
+            return c.fail(sub(path, "levels"), "expected an array of at most " +
+                                                   std::to_string(most) +
+                                                   " levels (the spp ladder)");
         levels = std::min(levels, ls->size());
     }
     RenderEstimatorStudy study;
     for (size_t i = 0; i < levels; ++i) {
         const std::string lp = path + ".levels[" + std::to_string(i) + "]";
         std::vector<ImageSummary> images;
-        for (const Json* part : parts) {
-            const Json& level = (*part)["estimators"][e]["levels"][i];
+        const uint64_t of = parts.size();
+        // The level's image lists; their total is the replicate count when the parts carry no
+        // settings (the progress lines the page merges level by level).
+        std::vector<const Json*> lists(of, nullptr);
+        uint64_t total = 0;
+        for (uint64_t index = 0; index < of; ++index) {
+            const Json& level = (*parts[index])["estimators"][e]["levels"][i];
             const Json* list = level.is_object() ? find(level, "images") : nullptr;
             if (!list || !list->is_array() || list->size() > 1024)
-                return c.fail(sub(lp, "images"), "expected an array of at most 1024 images");
+                return c.fail("part " + std::to_string(index) + ".estimators[" + std::to_string(e) +
+                                  "].levels[" + std::to_string(i) + "].images",
+                              "expected an array of at most 1024 images");
+            lists[index] = list;
+            total += list->size();
+        }
+        const uint64_t level_reps = reps ? reps : total;
+        if (level_reps < 2 || level_reps > 1024 || of > level_reps)
+            return c.fail(lp, std::to_string(total) + " images over " + std::to_string(of) +
+                                  " parts: expected reps (2..1024, at least one per part)");
+        for (uint64_t index = 0; index < of; ++index) {
+            const Json* list = lists[index];
+            const std::string pl = "part " + std::to_string(index) + ".estimators[" +
+                                   std::to_string(e) + "].levels[" + std::to_string(i) + "]";
+            // Part index of K holds exactly the replicates r < reps with r % K == index.
+            const size_t want = part_replicate_count(level_reps, index, of);
+            if (list->size() != want)
+                return c.fail(sub(pl, "images"),
+                              "expected the " + std::to_string(want) +
+                                  " images of replicates r with r % " + std::to_string(of) + " = " +
+                                  std::to_string(index) + ", got " + std::to_string(list->size()));
             for (size_t k = 0; k < list->size(); ++k) {
                 ImageSummary im;
-                if (!image_summary_from_json(c, (*list)[k],
-                                             lp + ".images[" + std::to_string(k) + "]", &im))
-                    return false;
+                const std::string ip = pl + ".images[" + std::to_string(k) + "]";
+                if (!image_summary_from_json(c, (*list)[k], ip, shape, &im)) return false;
+                if (uint64_t(im.replicate) != index + k * of)
+                    return c.fail(sub(ip, "replicate"),
+                                  "expected replicate " + std::to_string(index + k * of));
+                if (!ladder.empty() && im.spp != ladder[i])
+                    return c.fail(sub(ip, "spp"),
+                                  "expected the level's " + std::to_string(ladder[i]) + " spp");
                 images.push_back(im);
             }
         }
-        if (images.empty() || images.size() > 1024)
-            return c.fail(lp, "expected 1..1024 images over the parts");
         std::sort(images.begin(), images.end(), [](const ImageSummary& a, const ImageSummary& b) {
             return a.replicate < b.replicate;
         });
@@ -194,14 +315,83 @@ bool merge_render_parts(Ctx& c, const Json& in, Json* out) {
             return c.fail(sub(pp, "estimators"), "expected an array of 1..64 estimators");
     }
     const Json& first = *parts[0];
-    for (size_t i = 0; i < k; ++i) {
-        const Json& ests = (*parts[i])["estimators"];
-        if (ests.size() != first["estimators"].size())
-            return c.fail("parts", "the parts study different estimators");
-        for (size_t e = 0; e < ests.size(); ++e)
-            if (!ests[e].is_object() || !ests[e].contains("name") ||
-                ests[e]["name"] != first["estimators"][e]["name"])
-                return c.fail("parts", "the parts study different estimators");
+    // One study's parts: the same scene (image size, reference), settings (seed, spp range,
+    // reps; threads aside) and estimators (their settings; levels, fits and timings aside).
+    auto study_of = [](const Json& p) {
+        Json j = Json::object();
+        for (const char* key : {"version", "kind", "mcplay", "scene", "settings"})
+            if (p.contains(key)) j[key] = p[key];
+        if (j.contains("settings") && j["settings"].is_object()) j["settings"].erase("threads");
+        // The reference's timing and where it came from (rendered, a cache file) may differ;
+        // its numbers may not (reference_summary, above, and the rest of its description).
+        if (j.contains("scene") && j["scene"].is_object() && j["scene"].contains("reference") &&
+            j["scene"]["reference"].is_object()) {
+            j["scene"]["reference"].erase("seconds");
+            j["scene"]["reference"].erase("source");
+            j["scene"]["reference"].erase("file");
+        }
+        Json ests = Json::array();
+        for (const Json& e : p["estimators"]) {
+            Json x = e;
+            if (x.is_object())
+                for (const char* key :
+                     {"levels", "warnings", "fit", "rays_per_second", "preview_png", "error_png"})
+                    x.erase(key);
+            ests.push_back(x);
+        }
+        j["estimators"] = ests;
+        return j;
+    };
+    const Json study0 = study_of(first);
+    auto names_of = [](const Json& p) {
+        std::string names;
+        for (const Json& e : p["estimators"])
+            names += (names.empty() ? "" : ", ") +
+                     (e.is_object() && e.contains("name") ? e["name"].dump() : std::string("?"));
+        return names;
+    };
+    for (size_t i = 1; i < k; ++i) {
+        const std::string pp = "part " + std::to_string(i);
+        if (names_of(*parts[i]) != names_of(first))
+            return c.fail(pp + ".estimators", "are " + names_of(*parts[i]) + ", part 0's are " +
+                                                  names_of(first) +
+                                                  ": the parts are not of one study");
+        const Json study = study_of(*parts[i]);
+        const std::string d = first_difference(study, study0, pp);
+        if (!d.empty())
+            return c.fail(d, "is " + value_text(study, d, pp) + ", part 0's is " +
+                                 value_text(study0, d, pp) +
+                                 ": the parts are not of one study (same scene and settings)");
+    }
+    // A result carries its settings and scene; a progress line (the page merges them level by
+    // level) neither: then the replicates are counted from the images, and the spp and pixel
+    // bounds are the widest.
+    const Json* settings = find(first, "settings");
+    const Json* scene = find(first, "scene");
+    uint64_t reps = 0, spp_min = 0, spp_max = 0;
+    ImageShape shape;
+    std::vector<uint64_t> ladder;
+    if (settings) {
+        if (!settings->is_object()) return c.fail("part 0.settings", "expected an object");
+        if (!read_count(c, *settings, "reps", "part 0.settings", &reps) ||
+            !read_count(c, *settings, "n_min", "part 0.settings", &spp_min) ||
+            !read_count(c, *settings, "n_max", "part 0.settings", &spp_max))
+            return false;
+        if (reps < 2 || reps > 1024) return c.fail("part 0.settings.reps", "must be in 2..1024");
+        if (k > reps) return c.fail("parts", "more parts than reps = " + std::to_string(reps));
+        if (spp_min < 1 || spp_max < spp_min || spp_max > (uint64_t(1) << 40))
+            return c.fail("part 0.settings.n_max", "expected 1 <= n_min <= n_max <= 2^40");
+        ladder = n_ladder(spp_min, spp_max);
+        if (ladder.empty())
+            return c.fail("part 0.settings.n_max", "no power of two between n_min and n_max");
+    }
+    if (scene) {
+        if (!scene->is_object()) return c.fail("part 0.scene", "expected an object");
+        if (!read_count(c, *scene, "width", "part 0.scene", &shape.width) ||
+            !read_count(c, *scene, "height", "part 0.scene", &shape.height))
+            return false;
+        if (shape.width < 1 || shape.width > 4096 || shape.height < 1 || shape.height > 4096)
+            return c.fail("part 0.scene", "width and height must be in 1..4096");
     }
     *out = first;
     out->erase("part");
@@ -223,7 +413,8 @@ bool merge_render_parts(Ctx& c, const Json& in, Json* out) {
     if (out->contains("settings") && (*out)["settings"].is_object())
         (*out)["settings"]["threads"] = threads;
     for (size_t e = 0; e < first["estimators"].size(); ++e)
-        if (!merge_estimator(c, parts, e, ref, &(*out)["estimators"][e])) return false;
+        if (!merge_estimator(c, parts, e, ref, shape, ladder, reps, &(*out)["estimators"][e]))
+            return false;
     return true;
 }
 

@@ -9,6 +9,7 @@
 #include "api/report.h" // fmt
 #include "api/scene.h"  // parse_json
 #include "core/rng.h"
+#include "estimators/study.h" // n_ladder
 #include "render_api/gltf_scene.h"
 #include "render_api/image_io.h"
 
@@ -343,6 +344,15 @@ Made<std::shared_ptr<RenderRequest>> build_render_request(const Json& scene, con
         if (!live_image_size(r->scene->camera, scene_width, scene_height, int(long_side),
                              &r->settings.width, &r->settings.height, &why))
             return made_error<std::shared_ptr<RenderRequest>>(why);
+    }
+    // The spp ladder: powers of two in spp_min..spp_max; none is a study of no level.
+    if (n_ladder(r->settings.spp_min, r->settings.spp_max).empty()) {
+        const bool from_options = find(opts, "spp_min") || find(opts, "spp_max");
+        c.fail(from_options ? std::string("options.spp_max") : sub(rp, "spp_max"),
+               "no power of two lies between spp_min = " + std::to_string(r->settings.spp_min) +
+                   " and spp_max = " + std::to_string(r->settings.spp_max) +
+                   ": the spp ladder has no level");
+        return error();
     }
     // A part of a study split over processes (mcp_render_study_merge).
     uint64_t part = 0, parts = 1;
