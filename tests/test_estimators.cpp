@@ -704,6 +704,32 @@ TEST(EstimatorDiagnostics, AnOverflowedMeanIsFlaggedNotPrinted) {
     EXPECT_TRUE(level_to_json(l)["mean"].is_null());
 }
 
+// f = inf (exp(710 x) overflows for x > 0.99975) is f's fault, not the pdf's: counted as
+// non-finite samples, never as zero-pdf ones (the weights overwrite p in place, and the
+// overwritten p once blamed the pdf). f = -inf everywhere (log(x - x)) leaves no estimate,
+// never a mean of 0.
+TEST(EstimatorDiagnostics, InfiniteIntegrandValuesAreNonfiniteNotZeroPdf) {
+    const Json settings{{"n_min", 4096}, {"n_max", 4096}, {"reps", 4}};
+    for (const char* name : {"uniform", "stratified", "sobol"}) {
+        SCOPED_TRACE(name);
+        StudyResult over = run(request({{"f", "exp(710*x)"}, {"estimators", {name}}}, settings));
+        const LevelStats& o = over.estimators[0].levels[0];
+        EXPECT_GT(o.diagnostics.nonfinite, 0u);
+        EXPECT_EQ(o.diagnostics.zero_pdf, 0u);
+        EXPECT_TRUE(level_codes(o).count("nonfinite"));
+        EXPECT_FALSE(level_codes(o).count("zero_pdf_samples"));
+
+        StudyResult none = run(request({{"f", "log(x-x)"}, {"estimators", {name}}}, settings));
+        const LevelStats& l = none.estimators[0].levels[0];
+        EXPECT_EQ(l.diagnostics.nonfinite, 4u * 4096u);
+        EXPECT_EQ(l.diagnostics.zero_pdf, 0u);
+        EXPECT_EQ(l.no_estimate_runs, 4);
+        EXPECT_FALSE(std::isfinite(l.mean));
+        EXPECT_TRUE(level_to_json(l)["mean"].is_null());
+    }
+    // (A finite f where p = 0 is still zero_pdf: EstimatorDiagnostics on is_zero_pdf above.)
+}
+
 TEST(Study, SizeIsCheckedBeforeWork) {
     StudySettings s;
     s.n_min = 16;

@@ -151,6 +151,61 @@ TEST(RenderAnalytic, QuadLightFloorMatchesLambertsFormula) {
     }
 }
 
+// The same floor radiance in scaled copies of the scene, seen as scenes/quad_light_floor.gltf
+// sees it (from z = 1.6, 34 degrees down: the far rows send shadow rays at grazing angles):
+// everything (camera too) times 1e3 and 1e4, and the floor alone times 1e5 (its hit points
+// near the origin are interpolated from vertices at 2e5, and re-testing the floor from an
+// offset origin carries their rounding error; fixed-size ray offsets once left shadow rays
+// inside the floor: the far rows self-shadowed, 10-60% darker). Each pixel within its error
+// bar, as above.
+TEST(RenderAnalytic, ScaledQuadLightScenesMatchLambertsFormula) {
+    const double Le = 5.0, albedo = 0.5;
+    struct Scaling {
+        const char* name;
+        double all, floor;
+    };
+    const Scaling scalings[] = {
+        {"all x1e3", 1e3, 1.0}, {"all x1e4", 1e4, 1.0}, {"floor x1e5", 1.0, 1e5}};
+    const int W = 8, H = 8;
+    const int tests = W * H * int(std::size(kDirect)) * int(std::size(scalings));
+    const double z_max = -normal_quantile(0.5 * test::sidak_level(1e-3, tests));
+    for (const Scaling& scaling : scalings) {
+        Scene scene = test::quad_light_scene(Le);
+        for (Vec3& v : scene.mesh.position) {
+            if (v.y == 0.0) v = Vec3(v.x * scaling.floor, 0.0, v.z * scaling.floor);
+            v *= scaling.all;
+        }
+        const double tilt = 34.0 * kPi / 180.0;
+        const Vec3 eye(0.0, 0.95, 1.6);
+        scene.camera = test::look_at(
+            eye * scaling.all, (eye + Vec3(0.0, -std::sin(tilt), -std::cos(tilt))) * scaling.all,
+            {0, 1, 0}, 0.6);
+        RenderScene rs;
+        rs.build(scene);
+        Vec3 light[4] = {{-0.5, 1, -0.5}, {0.5, 1, -0.5}, {0.5, 1, 0.5}, {-0.5, 1, 0.5}};
+        for (Vec3& v : light) v *= scaling.all;
+        for (RadianceStrategy s : kDirect) {
+            RenderSettings st = settings(W, H, 1024, 91);
+            st.jitter_pixels = false;
+            RenderImage im = render_image(rs, estimator(s), st);
+            EXPECT_EQ(im.diagnostics.discarded_nonfinite, 0u);
+            for (int y = 0; y < H; ++y)
+                for (int x = 0; x < W; ++x) {
+                    Ray r = camera_ray(scene.camera, W, H, x + 0.5, y + 0.5);
+                    ASSERT_LT(r.direction.y, 0.0);
+                    Vec3 p = r.origin + r.direction * (-r.origin.y / r.direction.y);
+                    double F = lambert_polygon_form_factor(p, Vec3(0, 1, 0), light, 4);
+                    double expected = albedo * Le * F;
+                    size_t k = (size_t(y) * W + size_t(x)) * 3;
+                    double se = std::sqrt(im.variance[k]);
+                    EXPECT_LE(std::fabs(im.rgb[k] - expected), z_max * se + 1e-9 * expected)
+                        << scaling.name << " " << strategy_name(s) << " pixel " << x << "," << y
+                        << " expected " << expected << " got " << im.rgb[k] << " +/- " << se;
+                }
+        }
+    }
+}
+
 // A closed box every face of which emits Le and reflects with albedo rho: with direct light
 // only each point returns Le (1 + rho); with every bounce Le / (1 - rho). Cosine sampling of
 // the diffuse BRDF has weight rho Le for every direction, so it is exact when no ray escapes

@@ -788,6 +788,42 @@ TEST(RenderGltf, ManyPrimitivesShareOneMeshWithPerTriangleMaterials) {
     EXPECT_EQ(json::parse(r.extras_json), json({{"exposure", 2}}));
 }
 
+// Coordinates up to 1e9 load (a 1e3-unit scene is sane); beyond, the bad_cases below refuse
+// them naming the node.
+TEST(RenderGltf, LargeButBoundedCoordinatesLoad) {
+    for (double scale : {1e3, 1e8}) {
+        Doc d = triangle_doc();
+        d.j["nodes"][0]["scale"] = {scale, scale, scale};
+        d.j["nodes"][1]["translation"] = {0, 0, 5 * scale};
+        GltfLoadResult r = load(d);
+        ASSERT_TRUE(r.ok) << scale << ": " << r.error;
+        EXPECT_EQ(r.scene.camera.position, Vec3(0, 0, 5 * scale));
+    }
+}
+
+// extras.mcplay is read from the scene, else the root: a scene's extras without "mcplay" (other
+// tools' data) once hid the root's settings.
+TEST(RenderGltf, RootMcplayExtrasAreReadBesideOtherSceneExtras) {
+    const json root_settings = {{"mcplay", {{"spp", 3}}}, {"author", "x"}};
+    Doc d = triangle_doc();
+    d.j["extras"] = root_settings;
+    d.j["scenes"][0]["extras"] = {{"note", "from another tool"}};
+    GltfLoadResult r = load(d);
+    ASSERT_TRUE(r.ok) << r.error;
+    EXPECT_EQ(json::parse(r.extras_json), root_settings);
+    // The scene's own extras.mcplay wins over the root's.
+    d.j["scenes"][0]["extras"] = {{"mcplay", {{"spp", 5}}}};
+    r = load(d);
+    ASSERT_TRUE(r.ok) << r.error;
+    EXPECT_EQ(json::parse(r.extras_json), json({{"mcplay", {{"spp", 5}}}}));
+    // No extras.mcplay anywhere: the scene's extras, as before.
+    d.j["scenes"][0]["extras"] = {{"note", "x"}};
+    d.j["extras"] = {{"author", "x"}};
+    r = load(d);
+    ASSERT_TRUE(r.ok) << r.error;
+    EXPECT_EQ(json::parse(r.extras_json), json({{"note", "x"}}));
+}
+
 TEST(RenderGltf, CameraFromRotatedScaledNode) {
     Doc d = triangle_doc();
     // Rotated 90 degrees about y (looks along -x), with a non-uniform scale that must not leak
@@ -1173,6 +1209,19 @@ std::vector<BadCase> bad_cases() {
              });
          },
          {"nodes[0]", "accessors[0]", "infinity"}},
+        {"coordinates beyond 1e9",
+         [] { return mutated([](Doc& d) {
+                  d.j["nodes"][0]["scale"] = {1e30, 1, 1e30};
+              }); },
+         {"nodes[0]", "to a coordinate of", "beyond 1e9"}},
+        {"camera beyond 1e9",
+         [] {
+             return mutated([](Doc& d) {
+                 for (json& n : d.j["nodes"])
+                     if (n.contains("camera")) n["translation"] = {0, 0, 1e30};
+             });
+         },
+         {"the camera is at a coordinate of", "beyond 1e9"}},
         {"zero quaternion",
          [] { return mutated([](Doc& d) {
                   d.j["nodes"][0]["rotation"] = {0, 0, 0, 0};
@@ -1183,6 +1232,15 @@ std::vector<BadCase> bad_cases() {
                   d.j["materials"][0]["emissiveFactor"] = {1, -1, 0};
               }); },
          {"materials[0] (grey)", "emissiveFactor[1]"}},
+        {"emission beyond float32",
+         [] {
+             return mutated([](Doc& d) {
+                 d.j["materials"][0]["emissiveFactor"] = {1, 0, 0};
+                 d.j["materials"][0]["extensions"] = {
+                     {"KHR_materials_emissive_strength", {{"emissiveStrength", 1e300}}}};
+             });
+         },
+         {"materials[0] (grey)", "emissiveFactor[0]", "float32 range"}},
         {"emissive strength not a number",
          [] {
              return mutated([](Doc& d) {

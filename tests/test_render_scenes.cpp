@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 #include <sys/stat.h>
@@ -739,23 +740,51 @@ TEST(RenderHonesty, DegenerateLightsAreReported) {
     EXPECT_FALSE(has_code(info["warnings"], "no_lights"));
 }
 
-// emissiveStrength 1e308: the light's power overflows a double, but it is still sampled (no
-// light sample misses it) and the image is not black.
-TEST(RenderHonesty, HugeEmissionStillLights) {
-    json scene = quad_scene([](json& g) {
-        g["materials"][1]["extensions"]["KHR_materials_emissive_strength"]["emissiveStrength"] =
-            1e308;
-    });
+// Emission the float32 images cannot hold (1e308 once rendered every pixel as inf, black in the
+// PNG, with no warning) is refused naming the material; 1e30 on the small quad scene fits, is
+// still sampled (no light sample misses it) and gives finite pixels with no flag.
+TEST(RenderHonesty, EmissionBeyondFloat32IsRefusedAndLargeEmissionRenders) {
+    auto with_strength = [](double strength) {
+        return quad_scene([strength](json& g) {
+            g["materials"][1]["extensions"]["KHR_materials_emissive_strength"]["emissiveStrength"] =
+                strength;
+        });
+    };
     json options{{"width", 4}, {"height", 4}, {"spp", 4}, {"estimator", "light_area"}};
     char* out = nullptr;
-    ASSERT_EQ(mcp_render_image(scene.dump().c_str(), options.dump().c_str(), &out), MCP_OK)
+    EXPECT_NE(mcp_render_image(with_strength(1e308).dump().c_str(), options.dump().c_str(), &out),
+              MCP_OK);
+    const std::string error = mcp_last_error();
+    EXPECT_NE(error.find("materials[1]"), std::string::npos) << error;
+    EXPECT_NE(error.find("beyond the float32 range of the images (at most 3.4e38)"),
+              std::string::npos)
+        << error;
+    ASSERT_EQ(mcp_render_image(with_strength(1e30).dump().c_str(), options.dump().c_str(), &out),
+              MCP_OK)
         << mcp_last_error();
     json j = json::parse(out);
     mcp_free(out);
     EXPECT_EQ(j["scene"]["lights"], 2);
     EXPECT_EQ(j["diagnostics"]["light_misses"], 0) << j["diagnostics"].dump();
-    EXPECT_GT(j["diagnostics"]["samples"].get<double>(),
-              j["diagnostics"]["discarded_nonfinite"].get<double>());
+    EXPECT_EQ(j["diagnostics"]["discarded_nonfinite"], 0) << j["diagnostics"].dump();
+    EXPECT_EQ(j["diagnostics"]["pixels_beyond_float32"], 0) << j["diagnostics"].dump();
+    EXPECT_FALSE(has_code(j["warnings"], "nonfinite")) << j["warnings"].dump();
+}
+
+// A pixel finite in double but beyond float32 is counted (it is inf in the HDR/PFM images); a
+// discarded (NaN) pixel and the largest float are not.
+TEST(RenderHonesty, PixelsBeyondFloat32AreCounted) {
+    RenderImage im;
+    im.width = 2;
+    im.height = 2;
+    im.rgb.assign(12, 1.0);
+    im.variance.assign(12, 0.0);
+    EXPECT_EQ(pixels_beyond_float32(im), 0u);
+    im.rgb[1] = double(std::numeric_limits<float>::max()); // pixel 0: representable
+    im.rgb[3] = NAN;                                       // pixel 1: discarded
+    im.rgb[8] = 1e39;                                      // pixel 2: beyond
+    im.rgb[9] = -1e300;                                    // pixel 3: beyond
+    EXPECT_EQ(pixels_beyond_float32(im), 2u);
 }
 
 // The reference cache's file name is a hash alone: a scene name with "../" cannot place it
@@ -844,6 +873,26 @@ TEST(RenderHonesty, ReferenceCacheReaderChecksEverything) {
     double big = INFINITY;
     std::memcpy(&inf[40], &big, sizeof big);
     EXPECT_TRUE(rejected(inf)); // an infinite mean
+    // A NaN variance beside a finite mean (the renderer writes none at spp > 1) would be read
+    // as 0 by the relative MSE: refused, naming the pixel. Beside a NaN mean (every sample
+    // discarded) it is what the renderer writes, and accepted.
+    const size_t variances = 40 + 18 * sizeof(double);
+    const double nan = NAN;
+    std::string nan_var = good;
+    std::memcpy(&nan_var[variances + 4 * sizeof(double)], &nan, sizeof nan); // pixel 1, green
+    EXPECT_TRUE(rejected(nan_var));
+    std::string why;
+    RenderImage y;
+    EXPECT_FALSE(decode_reference(nan_var, key, &y, &why));
+    EXPECT_EQ(why, "pixel (1, 0) has a NaN variance (in channel 1)");
+    std::string discarded = nan_var;
+    std::memcpy(&discarded[40 + 4 * sizeof(double)], &nan, sizeof nan);
+    EXPECT_TRUE(decode_reference(discarded, key, &y));
+    // At 1 sample per pixel no pixel has a variance: NaN is what the renderer writes.
+    EXPECT_TRUE(decode_reference(with_header(3, 2, 1).replace(variances, sizeof nan,
+                                                              reinterpret_cast<const char*>(&nan),
+                                                              sizeof nan),
+                                 key, &y));
     EXPECT_TRUE(rejected(good.substr(0, 8) + std::string(8, 'k') + good.substr(16))); // other key
     RenderImage x;
     EXPECT_FALSE(read_reference_cache(dir, key, &x)); // a directory
@@ -951,6 +1000,19 @@ TEST(RenderHonesty, SuppliedReferencesAreUsedOnlyForTheirOwnSettings) {
         EXPECT_NE(c.status, MCP_OK);
         EXPECT_NE(c.error.find("options.reference_data"), std::string::npos) << c.error;
     }
+    // A NaN variance beside a finite mean is refused naming the pixel (it once moved the
+    // relative MSE silently): the last pixel's blue channel.
+    std::string nan_var = bytes;
+    const double nan = NAN;
+    std::memcpy(&nan_var[nan_var.size() - sizeof nan], &nan, sizeof nan);
+    json b = options;
+    b["reference_data"] = base64_encode(nan_var);
+    Call c = study_text(scene, b);
+    EXPECT_NE(c.status, MCP_OK);
+    EXPECT_NE(c.error.find("options.reference_data: a corrupt reference image: pixel ("),
+              std::string::npos)
+        << c.error;
+    EXPECT_NE(c.error.find("has a NaN variance (in channel 2)"), std::string::npos) << c.error;
 }
 
 // The reference image itself as PNG and HDR through mcp_render_image (the page's image exports):

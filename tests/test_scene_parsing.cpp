@@ -214,6 +214,43 @@ TEST(SceneParsing, DomainMeasuresOutsideTheDoubleRangeAreRefused) {
     EXPECT_EQ(*r.value.problem.exact, 1e-100 * 1e-100);
 }
 
+// A randomization count of 0 is refused by name with the allowed range (it once became the
+// default 16), on every sampler; a count in the range is used as given.
+TEST(SceneParsing, RandomizationCountsAreCheckedNotDefaulted) {
+    const std::string head = R"({"f": "x", "estimators": [)";
+    auto est = [&](const std::string& e) { return error_of(head + e + "]}"); };
+    EXPECT_EQ(est(R"({"name": "s", "sampler": "sobol", "randomizations": 0})"),
+              "scene.estimators[0].randomizations: must be a power of two from 2 to 1024 (the "
+              "error bar comes from the spread of the randomizations), got 0");
+    EXPECT_EQ(est(R"({"name": "s", "sampler": "sobol", "randomization": "none",
+                      "randomizations": 0})"),
+              "scene.estimators[0].randomizations: points without randomization are one "
+              "deterministic set (randomizations = 1, and the run has no error bar), got 0");
+    EXPECT_EQ(est(R"({"name": "s", "sampler": "independent", "randomizations": 0})"),
+              "scene.estimators[0].randomizations: applies to the quasi-Monte Carlo samplers only "
+              "(sobol, halton, lattice)");
+    Made<SceneRequest> ok =
+        build(head + R"({"name": "s", "sampler": "sobol", "randomizations": 4}]})");
+    ASSERT_TRUE(ok.ok()) << ok.error;
+    EXPECT_EQ(ok.value.estimators[0].randomizations, 4);
+}
+
+// "exact": null means the exact value is unknown (docs/scene-format.md), even for a Genz family
+// with a closed form; a missing key takes the closed form and a number is used as given.
+TEST(SceneParsing, ExactNullMeansUnknown) {
+    const std::string genz = R"("integrand": {"type": "genz_gaussian", "dim": 2})";
+    Made<SceneRequest> unknown = build("{" + genz + R"(, "exact": null})");
+    ASSERT_TRUE(unknown.ok()) << unknown.error;
+    EXPECT_FALSE(unknown.value.problem.exact.has_value());
+    Made<SceneRequest> closed = build("{" + genz + "}");
+    ASSERT_TRUE(closed.ok()) << closed.error;
+    EXPECT_TRUE(closed.value.problem.exact.has_value());
+    Made<SceneRequest> given = build("{" + genz + R"(, "exact": 0.5})");
+    ASSERT_TRUE(given.ok()) << given.error;
+    ASSERT_TRUE(given.value.problem.exact.has_value());
+    EXPECT_EQ(*given.value.problem.exact, 0.5);
+}
+
 // --- 4. count limits before work ----------------------------------------------------------
 
 TEST(SceneParsing, TableSizesAreCheckedBeforeAnyWork) {
@@ -361,8 +398,11 @@ TEST(SceneParsing, MisAndControlVariateFieldsAreChecked) {
     auto est = [&](const std::string& e) { return error_of(head + e + "]}"); };
     const std::string g = R"({"type": "gaussian", "mu": 0.5, "sigma": 0.1})";
     EXPECT_EQ(est(R"({"name": "m", "proposals": []})"),
+              "scene.estimators[0].proposals: is empty: multiple importance sampling needs at "
+              "least one proposal");
+    EXPECT_EQ(est(R"({"name": "m", "proposals": {}})"),
               "scene.estimators[0].proposals: expected an array of pdfs (or \"uniform\"), got an "
-              "array");
+              "object");
     EXPECT_EQ(est(R"({"name": "m", "proposals": [)" + g + R"(, "uniform"], "fractions": [1]})"),
               "scene.estimators[0].fractions: has 1 entries for 2 proposals");
     EXPECT_EQ(est(R"({"name": "m", "proposals": [)" + g + R"(, "uniform"], "fractions": [1, 0]})"),

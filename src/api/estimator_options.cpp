@@ -111,9 +111,12 @@ bool parse_mis_options(Ctx& c, const Json& j, const std::string& path, const Pro
     if (proposals) {
         if (pdf)
             return c.fail(sub(path, "pdf"), "an estimator has \"pdf\" or \"proposals\", not both");
-        if (!proposals->is_array() || proposals->empty())
+        if (!proposals->is_array())
             return c.fail(sub(path, "proposals"),
                           "expected an array of pdfs (or \"uniform\"), got " + type_of(*proposals));
+        if (proposals->empty())
+            return c.fail(sub(path, "proposals"),
+                          "is empty: multiple importance sampling needs at least one proposal");
         if (proposals->size() > static_cast<size_t>(kMaxMisTechniques))
             return c.fail(sub(path, "proposals"),
                           "has " + std::to_string(proposals->size()) + " entries; at most " +

@@ -77,7 +77,7 @@ std::string new_name_fields() {
 bool parse_estimator(Ctx& c, const Json& j, const std::string& path, const Problem& problem,
                      EstimatorSpec* out) {
     std::string name, sampler_name_str, warp, randomization;
-    int randomizations = 0; // 0: not given
+    int randomizations = -1; // -1: not given (0 is given, and refused below)
     const Json* pdf = nullptr;
     const KindFields* fields = nullptr; // the kind whose fields the object has
     if (j.is_string()) {
@@ -107,6 +107,7 @@ bool parse_estimator(Ctx& c, const Json& j, const std::string& path, const Probl
         if (find(j, "randomizations")) {
             uint64_t k = 0;
             if (!get_count(c, j, "randomizations", path, &k)) return false;
+            // Capped past the largest allowed count, so the range check below refuses it.
             randomizations = static_cast<int>(std::min<uint64_t>(k, 1u << 30));
         }
         pdf = find(j, "pdf");
@@ -151,7 +152,7 @@ bool parse_estimator(Ctx& c, const Json& j, const std::string& path, const Probl
                               "random_shift, none)");
         out->randomizations =
             out->randomization == QmcRandomization::None ? 1 : kDefaultRandomizations;
-        if (randomizations > 0) out->randomizations = randomizations;
+        if (randomizations >= 0) out->randomizations = randomizations;
         const std::string bad = check_sampler_options(out->sampler, out->sampler_options(),
                                                       problem.domain.sample_dim());
         if (!bad.empty()) {
@@ -161,7 +162,7 @@ bool parse_estimator(Ctx& c, const Json& j, const std::string& path, const Probl
                 return c.fail(sub(path, field.c_str()), bad.substr(colon + 2));
             return c.fail(path, bad);
         }
-    } else if (!randomization.empty() || randomizations > 0) {
+    } else if (!randomization.empty() || randomizations >= 0) {
         return c.fail(sub(path, randomization.empty() ? "randomizations" : "randomization"),
                       "applies to the quasi-Monte Carlo samplers only (sobol, halton, lattice)");
     }

@@ -88,7 +88,12 @@ Made<SceneRequest> build_request(const Json& scene, const Json& options) {
         return made_error<SceneRequest>(
             "scene.quantity: expected \"integral\" or \"mean\", got \"" + quantity + "\"");
 
-    if (const Json* e = find(scene, "exact"); e && !e->is_null()) {
+    // "exact": null says the exact value is unknown (docs/scene-format.md): no closed form is
+    // looked up, so bias, MSE and coverage stay null. Only a missing key takes the closed form.
+    const Json* exact_field = find(scene, "exact");
+    if (exact_field && exact_field->is_null()) {
+        pr.exact = std::nullopt;
+    } else if (exact_field) {
         double exact = 0.0;
         if (!get_number(c, scene, "exact", path, &exact)) return made_error<SceneRequest>(c.error);
         pr.exact = exact;

@@ -53,15 +53,44 @@ inline double fmax_inline(double a, double b) {
     return (a > b || b != b) ? a : b;
 }
 
-/// Moves a surface point off its surface, to the side `direction` points to, by a distance
-/// that scales with the point's magnitude: a few thousand ulps of the largest coordinate,
-/// which exceeds the rounding error of a double-precision hit point and its watertight
-/// triangle test (the float-ulp version is [WaechterBinder19], Ray Tracing Gems ch. 6).
-inline Vec3 offset_ray_origin(const Vec3& p, const Vec3& geometric_normal, const Vec3& direction) {
+/// gamma_n = n u / (1 - n u), u = 2^-53: bounds the relative error of n chained roundings
+/// [PBR4, 6.8.1].
+constexpr double rounding_gamma(int n) {
+    return n * 0x1p-53 / (1.0 - n * 0x1p-53);
+}
+
+/// Moves a surface point off its surface, to the side `direction` points to. The distance is
+/// the larger of two bounds: a few thousand ulps of the point's largest coordinate (the
+/// rounding of a hit point near its triangle's vertices, and of the watertight triangle test;
+/// [WaechterBinder19] is the float-ulp version), and the largest of `p_error`, the bound on
+/// the rounding error of the point's and its triangle's coordinates. pbrt-v4 offsets ray
+/// origins by such bounds [PBR4, 6.8.6]; here the largest coordinate's bound is used, not its
+/// projection on the normal, because a ray leaving the surface is tested against the same
+/// triangle again, and that test's t carries the error of every coordinate of the vertices
+/// translated to the ray origin (a floor in y = 0 whose vertices are at x, z = 2e4 has an
+/// exact y but a self-hit t off by 2e4 ulps). It matters when the point is far smaller than
+/// its vertices (a hit near the origin on a huge floor). Each coordinate is then rounded away
+/// from the surface, so the offset is never lost to rounding.
+inline Vec3 offset_ray_origin(const Vec3& p, const Vec3& p_error, const Vec3& geometric_normal,
+                              const Vec3& direction) {
     double scale = fmax_inline(fmax_inline(std::fabs(p.x), std::fabs(p.y)), std::fabs(p.z));
-    double eps = 0x1p-40 * (scale + 1.0); // ~1e-12 near the origin, relative beyond
-    Vec3 offset = geometric_normal * eps;
-    return glm::dot(direction, geometric_normal) < 0.0 ? p - offset : p + offset;
+    double relative = 0x1p-40 * (scale + 1.0); // ~1e-12 near the origin, relative beyond
+    double bounded = fmax_inline(fmax_inline(p_error.x, p_error.y), p_error.z);
+    Vec3 offset = geometric_normal * fmax_inline(relative, bounded);
+    if (glm::dot(direction, geometric_normal) < 0.0) offset = -offset;
+    Vec3 moved = p + offset;
+    for (int k = 0; k < 3; ++k) {
+        if (offset[k] > 0.0)
+            moved[k] = std::nextafter(moved[k], std::numeric_limits<double>::infinity());
+        else if (offset[k] < 0.0)
+            moved[k] = std::nextafter(moved[k], -std::numeric_limits<double>::infinity());
+    }
+    return moved;
+}
+
+/// The same for a point whose rounding is relative to its own coordinates (a light sample).
+inline Vec3 offset_ray_origin(const Vec3& p, const Vec3& geometric_normal, const Vec3& direction) {
+    return offset_ray_origin(p, Vec3(0.0), geometric_normal, direction);
 }
 
 /// Luminance of linear Rec. 709 / sRGB primaries (ITU-R BT.709).

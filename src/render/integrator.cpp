@@ -7,6 +7,8 @@
 #include <cmath>
 #include <cstring>
 
+#include <glm/common.hpp>
+
 #include "core/mis.h"
 
 namespace mcp {
@@ -91,6 +93,7 @@ template <bool kLambertian, bool kTextured> struct Surfaces {
 /// in the shading frame.
 struct ShadingPoint {
     Vec3 p, ng;
+    Vec3 p_error; ///< bound on the rounding error of each coordinate of p
     Frame frame;
     BsdfParams bsdf;
     Vec3 wo_local;
@@ -106,6 +109,12 @@ template <class S> ShadingPoint shade(const Scene& scene, const Ray& ray, const 
     const Vec3 &p0 = mesh.position[idx[0]], &p1 = mesh.position[idx[1]],
                &p2 = mesh.position[idx[2]];
     sp.p = b0 * p0 + hit.b1 * p1 + hit.b2 * p2;
+    // The barycentrics come from edge functions of the vertices translated by the ray origin,
+    // and b0 = 1 - b1 - b2: their absolute errors are a few ulps relative to |p_i| and |o|, so
+    // p's error is bounded by gamma_16 (|p0| + |p1| + |p2| + |o|) per coordinate (gamma_7 of
+    // sum |b_i p_i| in [PBR4, 6.8.5], widened for this test's barycentrics).
+    sp.p_error =
+        rounding_gamma(16) * (glm::abs(p0) + glm::abs(p1) + glm::abs(p2) + glm::abs(ray.origin));
     Vec3 wo = -glm::normalize(ray.direction);
     sp.ng = glm::normalize(glm::cross(p1 - p0, p2 - p0));
     if (glm::dot(sp.ng, wo) < 0.0) sp.ng = -sp.ng;
@@ -131,7 +140,7 @@ bool visible(const RenderScene& rs, const ShadingPoint& sp, const Vec3& light_po
              const Vec3& light_normal, SampleCounters& c) {
     Vec3 to_light = light_point - sp.p;
     Ray shadow;
-    shadow.origin = offset_ray_origin(sp.p, sp.ng, to_light);
+    shadow.origin = offset_ray_origin(sp.p, sp.p_error, sp.ng, to_light);
     Vec3 target = offset_ray_origin(light_point, light_normal, -to_light);
     shadow.direction = target - shadow.origin;
     shadow.t_max = 1.0;
@@ -141,7 +150,7 @@ bool visible(const RenderScene& rs, const ShadingPoint& sp, const Vec3& light_po
 
 Ray spawn_ray(const ShadingPoint& sp, const Vec3& direction) {
     Ray r;
-    r.origin = offset_ray_origin(sp.p, sp.ng, direction);
+    r.origin = offset_ray_origin(sp.p, sp.p_error, sp.ng, direction);
     r.direction = direction;
     return r;
 }

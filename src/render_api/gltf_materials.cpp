@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <utility>
 
 #include <stb_image.h>
@@ -137,6 +138,12 @@ bool Converter::convert_material(int index, Material* out, int* uv_set) {
             return log_.fail(where + ": emissiveFactor[" + num(k) +
                              "] x emissiveStrength = " + num(e) + " x " + num(strength) +
                              " overflows; the emitted radiance must be a finite number");
+        // The images are float32 (HDR, PFM, the page's pixels): a light brighter than float32
+        // holds would show as inf (black in the PNG) wherever it is seen.
+        if (out->emission[k] > double(std::numeric_limits<float>::max()))
+            return log_.fail(where + ": emissiveFactor[" + num(k) +
+                             "] x emissiveStrength = " + num(out->emission[k]) +
+                             " is beyond the float32 range of the images (at most 3.4e38)");
     }
     out->double_sided = mat.doubleSided;
 

@@ -79,6 +79,15 @@ bool Converter::build_mesh() {
                 if (!std::isfinite(w.x + w.y + w.z))
                     return log_.fail("nodes[" + num(inst.node) + "]: its transform takes " +
                                      pv.name + " element " + num(i) + " to infinity");
+                const double largest =
+                    std::fmax(std::fabs(w.x), std::fmax(std::fabs(w.y), std::fabs(w.z)));
+                if (largest > kGltfMaxCoordinate)
+                    return log_.fail("nodes[" + num(inst.node) + "]: its transform takes " +
+                                     pv.name + " element " + num(i) + " to a coordinate of " +
+                                     num(largest) +
+                                     ", beyond 1e9, the largest rendered right in "
+                                     "double precision (hit points carry about 2e-15 of their "
+                                     "vertices' coordinates in error): rescale the scene");
                 mesh.position.push_back(w);
             }
             if (use_normals_ && !append_normals(p, ref, n, normal_matrix)) return false;

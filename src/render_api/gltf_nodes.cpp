@@ -168,8 +168,17 @@ bool Converter::set_camera(int index, int node, const Mat4& world) {
     if (!(lb > 0.0 && lu > 0.0 && lr > 1e-9) || !std::isfinite(lb + lu + lr))
         return log_.fail("nodes[" + num(node) + "]: the camera's transform is singular");
     right /= lr;
+    const Vec3 position(world[3]);
+    const double largest =
+        std::fmax(std::fabs(position.x), std::fmax(std::fabs(position.y), std::fabs(position.z)));
+    if (!(largest <= kGltfMaxCoordinate))
+        return log_.fail("nodes[" + num(node) + "]: the camera is at a coordinate of " +
+                         num(largest) +
+                         ", beyond 1e9, the largest rendered right in double "
+                         "precision (hit points carry about 2e-15 of the coordinates in error): "
+                         "rescale the scene");
     Camera& cam = r_.scene.camera;
-    cam.position = Vec3(world[3]);
+    cam.position = position;
     cam.forward = forward;
     cam.right = right;
     cam.up = glm::cross(right, forward);

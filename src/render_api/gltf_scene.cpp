@@ -136,7 +136,14 @@ bool Converter::finish() {
                                             : "no triangles: the meshes of " + scene +
                                                   " have no non-degenerate triangle");
     }
-    if (scene_index_ >= 0 && m_.scenes[size_t(scene_index_)].extras.IsObject())
+    // extras.mcplay on the scene, else on the root (docs/render-scenes.md): a scene's extras
+    // without "mcplay" (a description, other tools' data) do not hide the root's. Without
+    // "mcplay" anywhere, the scene's extras (else the root's) are kept as they are.
+    const tinygltf::Value* scene_extras =
+        scene_index_ >= 0 ? &m_.scenes[size_t(scene_index_)].extras : nullptr;
+    const bool scene_has = scene_extras && scene_extras->IsObject() && scene_extras->Has("mcplay");
+    const bool root_has = m_.extras.IsObject() && m_.extras.Has("mcplay");
+    if (scene_has || (!root_has && scene_extras && scene_extras->IsObject()))
         r_.extras_json = m_.scenes[size_t(scene_index_)].extras_json_string;
     else if (m_.extras.IsObject())
         r_.extras_json = m_.extras_json_string;

@@ -36,6 +36,11 @@ constexpr uint64_t kGltfMaxTriangles = 10000000;       ///< triangles after flat
 constexpr uint64_t kGltfMaxBufferBytes = 256ull << 20; ///< all buffers together
 constexpr uint64_t kGltfMaxInputBytes = 384ull << 20;  ///< the .gltf/.glb itself (base64 buffers)
 constexpr uint64_t kGltfMaxTexels = 1ull << 24;        ///< all decoded base colour textures
+/// Largest |coordinate| of a vertex or the camera in world space (after the node transforms).
+/// A hit point is interpolated from its triangle's vertices and carries their rounding error,
+/// about 2e-15 of their magnitude (render/integrator.cpp): up to 1e9 that is below 1e-5, so a
+/// scene of metre-sized features renders right; a 1e15 floor under a 1 m light does not.
+constexpr double kGltfMaxCoordinate = 1e9;
 
 /// Loads a .gltf or .glb file; external buffers and images are resolved relative to its folder
 /// and must lie inside it.

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <vector>
 
@@ -277,6 +278,20 @@ bool decode_hdr(const std::string& bytes, RenderImage* out, std::string* error) 
     return true;
 }
 
+uint64_t pixels_beyond_float32(const RenderImage& image) {
+    const double float_max = double(std::numeric_limits<float>::max());
+    uint64_t count = 0;
+    for (size_t p = 0; p + 2 < image.rgb.size(); p += 3) {
+        bool beyond = false;
+        for (size_t c = 0; c < 3; ++c) {
+            const double v = std::fabs(image.rgb[p + c]);
+            beyond = beyond || (std::isfinite(v) && v > float_max);
+        }
+        count += beyond;
+    }
+    return count;
+}
+
 std::string encode_reference(const RenderImage& image, uint64_t key) {
     const int64_t header[3] = {image.width, image.height, int64_t(image.spp)};
     std::string out(kCacheMagic, sizeof kCacheMagic);
@@ -304,7 +319,8 @@ uint64_t encoded_reference_key(const std::string& bytes) {
     return key;
 }
 
-bool decode_reference(const std::string& bytes, uint64_t key, RenderImage* image) {
+bool decode_reference(const std::string& bytes, uint64_t key, RenderImage* image,
+                      std::string* why) {
     constexpr size_t kHead = kReferenceHead;
     // Made for another scene, size or reference estimator: not this reference.
     if (!is_encoded_reference(bytes) || encoded_reference_key(bytes) != key) return false;
@@ -321,11 +337,27 @@ bool decode_reference(const std::string& bytes, uint64_t key, RenderImage* image
     im.variance.resize(n);
     std::memcpy(im.rgb.data(), bytes.data() + kHead, n * sizeof(double));
     std::memcpy(im.variance.data(), bytes.data() + kHead + n * sizeof(double), n * sizeof(double));
-    // The renderer writes NaN only for a pixel whose every sample was discarded, never an
-    // infinite mean or a negative variance.
-    for (size_t k = 0; k < n; ++k)
-        if (std::isinf(im.rgb[k]) || im.variance[k] < 0.0 || std::isinf(im.variance[k]))
+    // The renderer writes a NaN mean only for a pixel whose every sample was discarded, and a
+    // NaN variance only beside it or at 1 sample per pixel (one kept sample has no variance);
+    // never an infinite mean or a negative or infinite variance. Any other NaN variance would
+    // be read as 0 by the relative MSE's reference term and move it silently.
+    for (size_t k = 0; k < n; ++k) {
+        const double mean = im.rgb[k], var = im.variance[k];
+        const char* bad = std::isinf(mean)  ? "an infinite mean"
+                          : var < 0.0       ? "a negative variance"
+                          : std::isinf(var) ? "an infinite variance"
+                          : std::isnan(var) && !std::isnan(mean) && im.spp > 1 ? "a NaN variance"
+                                                                               : nullptr;
+        if (bad) {
+            if (why) {
+                const size_t pixel = k / 3;
+                *why = "pixel (" + std::to_string(pixel % size_t(im.width)) + ", " +
+                       std::to_string(pixel / size_t(im.width)) + ") has " + bad + " (in channel " +
+                       std::to_string(k % 3) + ")";
+            }
             return false;
+        }
+    }
     *image = std::move(im);
     return true;
 }
@@ -342,12 +374,13 @@ bool write_reference_cache(const std::string& path, const RenderImage& image, ui
     return std::rename(tmp.c_str(), path.c_str()) == 0; // atomic: no half-written cache
 }
 
-bool read_reference_cache(const std::string& path, uint64_t key, RenderImage* image) {
+bool read_reference_cache(const std::string& path, uint64_t key, RenderImage* image,
+                          std::string* why) {
     // A regular file of bounded size, read whole; anything that is not exactly what
     // write_reference_cache writes is ignored (the caller renders the reference again).
     std::string bytes, error;
     if (!read_regular_file(path, kMaxCacheFileBytes, &bytes, &error)) return false;
-    return decode_reference(bytes, key, image);
+    return decode_reference(bytes, key, image, why);
 }
 
 std::string base64_encode(const std::string& bytes) {

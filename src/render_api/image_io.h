@@ -16,6 +16,9 @@ std::string encode_png(const RenderImage& image, double exposure);
 std::string encode_hdr(const RenderImage& image);
 /// Linear float32 RGB as a Portable Float Map (little-endian): no 8-bit mantissa, for measuring.
 std::string encode_pfm(const RenderImage& image);
+/// Pixels with a channel whose mean is finite in double but beyond the float32 range (above
+/// 3.4e38 in magnitude): the HDR, PFM and page images hold them as inf (black in the PNG).
+uint64_t pixels_beyond_float32(const RenderImage& image);
 /// False colour of the per-pixel relative error |I - R| / (R + eps) of luminance, on a log
 /// scale from 1e-3 (dark blue) to 1 and above (yellow); eps = 1e-2 of R's mean luminance.
 std::string encode_error_png(const RenderImage& image, const RenderImage& reference);
@@ -35,9 +38,11 @@ bool decode_hdr(const std::string& bytes, RenderImage* out, std::string* error);
 /// their variances as doubles, native (little-endian) byte order.
 std::string encode_reference(const RenderImage& image, uint64_t key);
 /// Reads what encode_reference wrote: the magic, the same `key`, sizes within the limits above,
-/// spp >= 1, exactly the bytes those sizes need, and no infinite mean or negative variance.
-/// Anything else is refused (false, `image` untouched).
-bool decode_reference(const std::string& bytes, uint64_t key, RenderImage* image);
+/// spp >= 1, exactly the bytes those sizes need, no infinite mean, no negative or infinite
+/// variance, and no NaN variance beside a finite mean when spp > 1. Anything else is refused
+/// (false, `image` untouched); for a refused pixel value `why` (when given) names the pixel.
+bool decode_reference(const std::string& bytes, uint64_t key, RenderImage* image,
+                      std::string* why = nullptr);
 /// Do the bytes start like encode_reference's (the magic and a whole header)?
 bool is_encoded_reference(const std::string& bytes);
 /// The key encode_reference stored (bytes accepted by is_encoded_reference).
@@ -48,7 +53,8 @@ bool write_reference_cache(const std::string& path, const RenderImage& image, ui
 /// Reads a cache file: a regular file of at most kMaxCacheFileBytes (api/files.h) that
 /// decode_reference accepts. Anything else is ignored (false, `image` untouched): the caller
 /// renders the reference again.
-bool read_reference_cache(const std::string& path, uint64_t key, RenderImage* image);
+bool read_reference_cache(const std::string& path, uint64_t key, RenderImage* image,
+                          std::string* why = nullptr);
 
 std::string base64_encode(const std::string& bytes);
 /// Standard padded base64 (RFC 4648); false on any other character, length or padding.

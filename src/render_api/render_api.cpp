@@ -191,12 +191,22 @@ int mcp_render_image(const char* scene_json, const char* options_json, char** re
               {"light_misses", d.light_misses},
               {"dominated_pixels", d.dominated_pixels},
               {"max_sample_share", num(d.max_sample_share)}};
+    // Finite in double yet inf in the float32 images (HDR, PFM, the page's pixels; black in
+    // the PNG): flagged beside the discarded samples, with the same code.
+    const uint64_t beyond_float32 = pixels_beyond_float32(image);
+    diag["pixels_beyond_float32"] = beyond_float32;
     Json warnings = Json::array();
     if (d.discarded_nonfinite)
         warnings.push_back(warning("nonfinite", Severity::Error,
                                    std::to_string(d.discarded_nonfinite) +
                                        " sample(s) with NaN/Inf radiance were "
                                        "discarded: the image is biased there"));
+    if (beyond_float32)
+        warnings.push_back(warning("nonfinite", Severity::Error,
+                                   std::to_string(beyond_float32) +
+                                       " pixel(s) exceed the float32 range of the images (above "
+                                       "3.4e38): they are inf in the HDR/PFM and black in the "
+                                       "PNG; lower the emission"));
     // Penumbrae legitimately have pixels where one sample of many sees the light; a share of
     // the image above 1% is fireflies.
     if (d.dominated_pixels * 100 > image.pixel_count())

@@ -102,10 +102,12 @@ bool obtain_reference(const LoadedRender& l, RenderImage* ref, Json* info, std::
         if (encoded_reference_key(r.supplied_reference) != key) {
             (*info)["supplied"] = "not used: it was made from another scene, image size, "
                                   "reference estimator, spp or seed, or by another version";
-        } else if (!decode_reference(r.supplied_reference, key, ref) || ref->width != s.width ||
-                   ref->height != s.height || ref->spp != r.reference.spp) {
-            *error = "options.reference_data: a corrupt reference image (its sizes, length or "
-                     "values are not what mcplay writes)";
+        } else if (std::string why; !decode_reference(r.supplied_reference, key, ref, &why) ||
+                                    ref->width != s.width || ref->height != s.height ||
+                                    ref->spp != r.reference.spp) {
+            *error = why.empty() ? "options.reference_data: a corrupt reference image (its sizes, "
+                                   "length or values are not what mcplay writes)"
+                                 : "options.reference_data: a corrupt reference image: " + why;
             return false;
         } else {
             (*info)["source"] = "supplied";
@@ -113,12 +115,16 @@ bool obtain_reference(const LoadedRender& l, RenderImage* ref, Json* info, std::
         }
     }
     const std::string cache_file = reference_cache_file(r);
-    if (!cache_file.empty() && read_reference_cache(cache_file, key, ref) &&
+    std::string cache_why;
+    if (!cache_file.empty() && read_reference_cache(cache_file, key, ref, &cache_why) &&
         ref->width == s.width && ref->height == s.height && ref->spp == r.reference.spp) {
         (*info)["source"] = "cache";
         (*info)["file"] = cache_file;
         return true;
     }
+    // A cache file with a bad pixel value is not used (the reference is rendered again, and the
+    // new one replaces it); the info says which file and pixel.
+    if (!cache_why.empty()) (*info)["cache"] = "not used: " + cache_file + ": " + cache_why;
     if (!may_render) {
         *ref = RenderImage();
         (*info)["source"] = "none";

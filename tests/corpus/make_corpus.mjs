@@ -125,6 +125,8 @@ scene('estimator_misspelt', withf({ estimators: ['stratifed'] }), "unknown estim
 scene('estimator_faure', withf({ estimators: ['faure'] }), "unknown estimator 'faure'");
 scene('estimator_sobol_permutation', withf({ estimators: [{ name: 'q', sampler: 'sobol', randomization: 'permutation' }] }), "does not apply to sobol");
 scene('estimator_lattice_too_many', withf({ estimators: ['lattice'], n_max: 2 ** 30 }), 'points are built for');
+scene('estimator_sobol_k0', withf({ estimators: [{ name: 'q', sampler: 'sobol', randomizations: 0 }] }), 'must be a power of two from 2 to 1024');
+scene('estimator_proposals_empty', withf({ estimators: [{ name: 'm', proposals: [] }] }), 'at least one proposal');
 scene('estimator_sobol_k3', withf({ estimators: [{ name: 'q', sampler: 'sobol', randomizations: 3 }] }), 'must be a power of two');
 scene('estimator_name_only', withf({ estimators: [{ name: 'mine' }] }), "unknown estimator 'mine'");
 scene('estimator_number', withf({ estimators: [5] }), 'scene.estimators[0]');
@@ -275,6 +277,17 @@ render('reference_wrong_size', { gltf: 'ok.gltf', width: 4, reference: { file: '
   g.materials[1].extensions = { KHR_materials_emissive_strength: { emissiveStrength: 1e308 } };
   g.materials[1].emissiveFactor = [5, 5, 5];
   render('emissive_overflow', { gltf: g }, 'materials[1]');
+}
+{
+  const g = clone(gltf);
+  g.materials[1].extensions = { KHR_materials_emissive_strength: { emissiveStrength: 1e300 } };
+  g.materials[1].emissiveFactor = [1, 1, 1];
+  render('emissive_beyond_float32', { gltf: g }, 'beyond the float32 range');
+}
+{
+  const g = clone(gltf);
+  g.nodes[0].scale = [1e30, 1, 1e30];
+  render('node_scale_1e30', { gltf: g }, 'beyond 1e9');
 }
 {
   const g = clone(gltf);
