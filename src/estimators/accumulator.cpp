@@ -44,22 +44,36 @@ void WeightAccumulator::keep_top() {
 void WeightAccumulator::add_block(uint64_t first, const double* f, const double* p, double* w,
                                   size_t count) {
     if (count == 0) return;
-    // One branch-free pass: sum |w|, max |w|, the non-zero count, and whether any weight needs
-    // the slow path (not finite, or p not > 0). It writes no weight: w may alias p, and the
-    // slow path classifies a bad sample by its p (an overwritten p once made every f = inf a
-    // "zero pdf" sample, and a run of them all an estimate of 0).
+    // One branch-free pass: the weights, sum |w|, max |w|, the non-zero count, and whether any
+    // weight needs the slow path (not finite, or p not > 0). Where w aliases p (the fixed and
+    // MIS estimators) the pass writes no weight, and a second one does when no sample is bad:
+    // the slow path classifies a bad sample by its p (an overwritten p once made every f = inf
+    // a "zero pdf" sample, and a run of them all an estimate of 0).
+    const bool aliased = w == p;
     double block_abs = 0.0, block_max = 0.0;
     uint64_t block_nonzero = 0, suspicious = 0;
-    for (size_t i = 0; i < count; ++i) {
-        const double a = std::fabs(f[i] / p[i]);
-        suspicious += !(a <= std::numeric_limits<double>::max()) | !(p[i] > 0.0);
-        block_abs += a;
-        block_max = a > block_max ? a : block_max;
-        block_nonzero += a != 0.0;
-    }
-    if (!suspicious) {
-        for (size_t i = 0; i < count; ++i) w[i] = f[i] / p[i];
+    if (aliased) {
+        for (size_t i = 0; i < count; ++i) {
+            const double a = std::fabs(f[i] / p[i]);
+            suspicious += !(a <= std::numeric_limits<double>::max()) | !(p[i] > 0.0);
+            block_abs += a;
+            block_max = a > block_max ? a : block_max;
+            block_nonzero += a != 0.0;
+        }
+        if (!suspicious)
+            for (size_t i = 0; i < count; ++i) w[i] = f[i] / p[i];
     } else {
+        for (size_t i = 0; i < count; ++i) {
+            const double wi = f[i] / p[i];
+            const double a = std::fabs(wi);
+            suspicious += !(a <= std::numeric_limits<double>::max()) | !(p[i] > 0.0);
+            w[i] = wi;
+            block_abs += a;
+            block_max = a > block_max ? a : block_max;
+            block_nonzero += a != 0.0;
+        }
+    }
+    if (suspicious) {
         // Rare path: classify, count and drop (contribute 0) the bad samples, then redo the sums.
         block_abs = block_max = 0.0;
         block_nonzero = 0;
