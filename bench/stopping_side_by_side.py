@@ -114,18 +114,27 @@ def main():
     ap.add_argument("--reps", type=int, default=5)
     ap.add_argument("--cli", default=os.environ.get("MCPLAY", "build/mcplay"))
     ap.add_argument("--qmcpy", help="JSON lines of QMCPy's runs on the same files")
+    ap.add_argument("--estimators", help="comma-separated subset of " +
+                    ",".join(e for e, _ in ESTIMATORS))
+    ap.add_argument("--only-qmcpy-cases", action="store_true",
+                    help="run only the integrals the --qmcpy file has runs of")
     args = ap.parse_args()
     files = sorted(f for d in args.dirs for f in glob.glob(os.path.join(d, "*.json")))
     params = [json.load(open(f)) for f in files]
+    if args.only_qmcpy_cases and args.qmcpy:
+        done = {json.loads(row)["case"] for row in open(args.qmcpy)}
+        params = [p for p in params if p["name"] in done]
+    chosen = [(e, t) for e, t in ESTIMATORS
+              if not args.estimators or e in args.estimators.split(",")]
     mine = collections.defaultdict(list)
     for p in params:
-        for estimator, tol in ESTIMATORS:
+        for estimator, tol in chosen:
             mine[(estimator, tol)] += run_mcplay(args.cli, p, estimator, tol, args.reps)
     print(f"{len(params)} integrals x {args.reps} runs; a run 'stops' when it ends before its "
           "budget (2^24 points)")
     print(f"  {'method':26s} {'runs':>5s} {'stopped':>8s} {'within, of those':>16s} {'within':>7s} "
           f"{'median evals':>12s} {'(stopped)':>12s}")
-    for estimator, tol in ESTIMATORS:
+    for estimator, tol in chosen:
         line(f"mcplay {estimator}, rel {tol:g}", mine[(estimator, tol)])
     if args.qmcpy:
         names = {p["name"] for p in params}
