@@ -374,8 +374,8 @@ TEST(Api, SceneInfoAndCatalog) {
          {"fixed", "vegas", "vegas_plus", "miser", "mis", "control_variates", "antithetic"})
         EXPECT_TRUE(kinds.count(k)) << k;
     for (const json& p : cat["estimators"]) EXPECT_TRUE(kinds.count(p["kind"].get<std::string>()));
-    EXPECT_EQ(cat["samplers"],
-              json({"independent", "stratified", "latin_hypercube", "sobol", "halton", "lattice"}));
+    EXPECT_EQ(cat["samplers"], json({"independent", "stratified", "latin_hypercube", "sobol",
+                                     "halton", "lattice"}));
     EXPECT_EQ(cat["randomizations"],
               json({{"sobol", {"owen", "lms_shift", "digital_shift", "none"}},
                     {"halton", {"owen", "permutation", "none"}},
