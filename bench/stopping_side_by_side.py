@@ -5,13 +5,22 @@
 
 PARAMS_DIR holds Genz test integrals as JSON ({"name", "family" 1-7, "d", "a", "u", "exact"}:
 the format of the Genz battery harness, docs/benchmarks.md). Each is run by mcplay's CLI to a
-relative tolerance, R replicates: Sobol' points (randomized, the "sobol" preset) at 1e-3, plain
-points ("uniform") at 1e-2, N doubling from 1024 to 2^24. With --qmcpy, JSON lines of QMCPy's
+relative tolerance, R replicates: randomized QMC (the "sobol", "lattice" and "halton" presets) at
+1e-3, plain points ("uniform") at 1e-2, N doubling from 1024 to 2^24. With --qmcpy, JSON lines of QMCPy's
 CubQMCNetG / CubMCCLT / CubMCG on the same files ({"method", "case", "tol", "met", "n"}, where
 "met" means |estimate - I| <= tol |I|) are read and summarised beside mcplay's. A run "stops"
 when it ends before the budget: what matters is how often such an answer is within the
-tolerance (the promise), and how often the tolerance is reached at all. Optional benchmark:
+tolerance (the promise), how often the tolerance is reached at all, and the median integrand
+evaluations per run (all runs, stopped or not: a run that does not stop costs its budget).
+Optional benchmark:
 not part of `make test`.
+
+  python3 bench/stopping_side_by_side.py --run-netg HARNESS_DIR PARAMS_DIR... > NETG.jsonl
+
+runs QMCPy's CubQMCNetG alone exactly as the harness's qmcpy_tol.py does (Sobol' with LMS and a
+digital shift, rel_tol 1e-3, n_limit 2^24, seeds 100 + r) and writes its JSON lines, for --qmcpy
+(the harness's script also runs two slow Monte Carlo cubatures). Needs qmcpy and the harness's
+genz.py.
 """
 import argparse, collections, glob, json, os, subprocess, sys, tempfile
 
@@ -32,6 +41,9 @@ def integrand(p):
     return {"type": GENZ[fam], "a": a, "u": u}
 
 
+ESTIMATORS = (("sobol", 1e-3), ("lattice", 1e-3), ("halton", 1e-3), ("uniform", 1e-2))
+
+
 def run_mcplay(cli, p, estimator, tol, reps):
     scene = {"name": p["name"], "domain": {"type": "box", "dim": p["d"]}, "integrand": integrand(p),
              "estimators": [estimator], "n_min": 1024, "reps": reps, "seed": 100, "threads": 1,
@@ -50,32 +62,80 @@ def run_mcplay(cli, p, estimator, tol, reps):
                  n=r["evaluations"], seconds=r["seconds"]) for r in runs]
 
 
+def median(values):
+    v = sorted(values)
+    if not v:
+        return float("nan")
+    m = len(v) // 2
+    return v[m] if len(v) % 2 else 0.5 * (v[m - 1] + v[m])
+
+
 def line(label, runs):
     stopped = [r for r in runs if r["stopped"]]
     kept = sum(r["within"] for r in stopped)
     within = sum(r["within"] for r in runs)
     promise = f"{kept}/{len(stopped)} ({100 * kept / len(stopped):.1f}%)" if stopped else "-"
-    print(f"  {label:26s} {len(runs):5d} {len(stopped):8d} {promise:>16s} {within:7d}")
+    evals = median([r["n"] for r in runs if r["n"] > 0])
+    evals_stopped = median([r["n"] for r in stopped])
+    print(f"  {label:26s} {len(runs):5d} {len(stopped):8d} {promise:>16s} {within:7d} "
+          f"{evals:12.3g} {evals_stopped:12.3g}")
+
+
+def run_netg(harness, dirs, reps):
+    """CubQMCNetG on every params file, as the harness's qmcpy_tol.py runs it."""
+    import time, warnings
+    sys.path.insert(0, harness)
+    import numpy as np, qmcpy as qp, genz
+    warnings.filterwarnings("ignore")
+    for path in sorted(f for d in dirs for f in glob.glob(os.path.join(d, "*.json"))):
+        p = json.load(open(path))
+        exact, f = p["exact"], (lambda x, p=p: genz.f_np(p, x))
+        for r in range(reps):
+            start = time.perf_counter()
+            try:
+                sol, data = qp.CubQMCNetG(qp.CustomFun(qp.Uniform(qp.DigitalNetB2(p["d"], seed=100 + r)),
+                                                       g=f), abs_tol=0, rel_tol=1e-3,
+                                          n_limit=2 ** 24).integrate()
+                est, n, err = float(np.squeeze(sol)), int(np.squeeze(data.n_total)), None
+            except Exception as e:  # the harness records a failed run, so does this
+                est, n, err = float("nan"), -1, str(e)[:120]
+            print(json.dumps(dict(method="qmcpy_netg", case=p["name"], tol=1e-3, est=est,
+                                  exact=exact, met=bool(abs(est - exact) <= 1e-3 * abs(exact)),
+                                  n=n, seconds=time.perf_counter() - start, error=err)),
+                  flush=True)
 
 
 def main():
+    if len(sys.argv) > 2 and sys.argv[1] == "--run-netg":
+        reps = int(os.environ.get("REPS", "5"))
+        return run_netg(sys.argv[2], sys.argv[3:], reps)
     ap = argparse.ArgumentParser()
     ap.add_argument("dirs", nargs="+")
     ap.add_argument("--reps", type=int, default=5)
     ap.add_argument("--cli", default=os.environ.get("MCPLAY", "build/mcplay"))
     ap.add_argument("--qmcpy", help="JSON lines of QMCPy's runs on the same files")
+    ap.add_argument("--estimators", help="comma-separated subset of " +
+                    ",".join(e for e, _ in ESTIMATORS))
+    ap.add_argument("--only-qmcpy-cases", action="store_true",
+                    help="run only the integrals the --qmcpy file has runs of")
     args = ap.parse_args()
     files = sorted(f for d in args.dirs for f in glob.glob(os.path.join(d, "*.json")))
     params = [json.load(open(f)) for f in files]
+    if args.only_qmcpy_cases and args.qmcpy:
+        done = {json.loads(row)["case"] for row in open(args.qmcpy)}
+        params = [p for p in params if p["name"] in done]
+    chosen = [(e, t) for e, t in ESTIMATORS
+              if not args.estimators or e in args.estimators.split(",")]
     mine = collections.defaultdict(list)
     for p in params:
-        for estimator, tol in (("sobol", 1e-3), ("uniform", 1e-2)):
+        for estimator, tol in chosen:
             mine[(estimator, tol)] += run_mcplay(args.cli, p, estimator, tol, args.reps)
     print(f"{len(params)} integrals x {args.reps} runs; a run 'stops' when it ends before its "
           "budget (2^24 points)")
-    print(f"  {'method':26s} {'runs':>5s} {'stopped':>8s} {'within, of those':>16s} {'within':>7s}")
-    line("mcplay sobol, rel 1e-3", mine[("sobol", 1e-3)])
-    line("mcplay uniform, rel 1e-2", mine[("uniform", 1e-2)])
+    print(f"  {'method':26s} {'runs':>5s} {'stopped':>8s} {'within, of those':>16s} {'within':>7s} "
+          f"{'median evals':>12s} {'(stopped)':>12s}")
+    for estimator, tol in chosen:
+        line(f"mcplay {estimator}, rel {tol:g}", mine[(estimator, tol)])
     if args.qmcpy:
         names = {p["name"] for p in params}
         theirs = collections.defaultdict(list)
@@ -83,7 +143,8 @@ def main():
             if row["case"] not in names:
                 continue
             stopped = row.get("error") is None and 0 < row["n"] < 2 ** 24
-            theirs[(row["method"], row["tol"])].append(dict(stopped=stopped, within=row["met"]))
+            theirs[(row["method"], row["tol"])].append(
+                dict(stopped=stopped, within=row["met"], n=row["n"]))
         for (method, tol), runs in sorted(theirs.items()):
             line(f"{method}, rel {tol:g}", runs)
 

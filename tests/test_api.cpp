@@ -145,7 +145,9 @@ TEST(Api, BadScenesGiveScenesErrorsNamingTheField) {
 // replicate with its half-width, target, reason and cost; every run of x^2 under stratified
 // sampling meets 1e-3 relative and lies within it; bad tolerances are named.
 TEST(Api, StoppingAtARequestedAccuracy) {
-    Outcome o = run(kSmall, R"({"rel_tol": 1e-3, "reps": 8, "estimators": ["stratified"]})");
+    // The scene's n_max (64) is the stopping budget: the options give a larger one.
+    Outcome o = run(kSmall, R"({"rel_tol": 1e-3, "reps": 8, "estimators": ["stratified"],
+                                "n_max": 16777216})");
     ASSERT_EQ(o.status, MCP_OK) << o.error;
     EXPECT_EQ(o.result["kind"], "stopping");
     EXPECT_EQ(o.result["stopping"]["rel_tol"], 1e-3);

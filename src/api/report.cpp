@@ -450,7 +450,15 @@ Json stopping_to_json(const StoppingStudy& st) {
                                  {"std_error", num(s.std_error)},
                                  {"half_width", num(s.half_width)},
                                  {"dof", s.dof},
-                                 {"trusted", s.trusted}});
+                                 {"trusted", s.trusted},
+                                 {"agrees", s.agrees},
+                                 {"flagged", s.flagged}});
+            Json flags = Json::array();
+            for (const Flag& f : r.flags)
+                flags.push_back({{"code", flag_code_name(f.code)},
+                                 {"severity", severity_name(f.severity)},
+                                 {"value", num(f.value)},
+                                 {"threshold", num(f.threshold)}});
             Json run{{"estimate", num(r.answer.estimate)},
                      {"std_error", num(r.answer.std_error)},
                      {"half_width", num(r.half_width)},
@@ -459,6 +467,8 @@ Json stopping_to_json(const StoppingStudy& st) {
                      {"reason", stop_reason_name(r.reason)},
                      {"n", r.answer.n},
                      {"evaluations", r.evaluations},
+                     {"extended", r.extended},
+                     {"flags", flags},
                      {"seconds", num(r.seconds)},
                      {"steps", steps}};
             if (p.exact) {
@@ -488,15 +498,19 @@ Json stopping_to_json(const StoppingStudy& st) {
                 reason == "no_error_bar"
                     ? "the estimator has no error bar (a point set without randomization), so "
                       "no tolerance can be judged"
+                : reason == "untrusted_error_bar"
+                    ? "their error bars met it, but a flag (heavy tail, skewed or few weights) "
+                      "or disagreement with earlier doublings said they cannot be trusted"
                 : reason == "n_max"
                     ? "n_max = " + std::to_string(set.n_max) + " was reached first"
                     : "the time budget (max_seconds = " + fmt("%.3g", set.max_seconds) +
                           ") ended first";
-            warnings.push_back(Json{{"code", "tolerance_not_met"},
-                                    {"severity", reason == "no_error_bar" ? "error" : "warning"},
-                                    {"message", std::to_string(count) + " of " +
-                                                    std::to_string(st.runs[e].size()) +
-                                                    " runs did not meet the tolerance: " + why}});
+            warnings.push_back(Json{
+                {"code", "tolerance_not_met"},
+                {"severity",
+                 reason == "no_error_bar" || reason == "untrusted_error_bar" ? "error" : "warning"},
+                {"message", std::to_string(count) + " of " + std::to_string(st.runs[e].size()) +
+                                " runs did not meet the tolerance: " + why}});
         }
         j["warnings"] = warnings;
         estimators.push_back(j);
@@ -508,19 +522,23 @@ Json stopping_to_json(const StoppingStudy& st) {
         {"seed", set.seed},
         {"accumulator", set.accumulator == Accumulator::Float32 ? "float32" : "compensated"},
         {"threads", 1}};
-    return Json{{"version", kResultSchemaVersion},
-                {"mcplay", MCPLAY_VERSION},
-                {"kind", "stopping"},
-                {"scene", scene_to_json(p)},
-                {"settings", settings},
-                {"stopping",
-                 {{"rel_tol", num(set.rel_tol)},
-                  {"abs_tol", num(set.abs_tol)},
-                  {"max_seconds", set.max_seconds > 0.0 ? num(set.max_seconds) : Json(nullptr)},
-                  {"rule", "95% half-width <= max(abs_tol, rel_tol |estimate|) at N, predicted by "
-                           "the independent run at N/2, the two agreeing, and N > 25 skewness^2"}}},
-                {"wall_time_s", num(st.wall_seconds)},
-                {"estimators", estimators}};
+    return Json{
+        {"version", kResultSchemaVersion},
+        {"mcplay", MCPLAY_VERSION},
+        {"kind", "stopping"},
+        {"scene", scene_to_json(p)},
+        {"settings", settings},
+        {"stopping",
+         {{"rel_tol", num(set.rel_tol)},
+          {"abs_tol", num(set.abs_tol)},
+          {"max_seconds", set.max_seconds > 0.0 ? num(set.max_seconds) : Json(nullptr)},
+          {"rule", "95% half-width <= max(abs_tol, rel_tol |estimate|) at N, trusted (N > 25 "
+                   "skewness^2, ESS, no warning or error flag), agreeing with N/2: randomized QMC "
+                   "extends its K sequences (t interval of the K batch means, paired N/2 check, "
+                   "skewness of the batch means), others run each N afresh with the run at N/2 "
+                   "predicting the tolerance"}}},
+        {"wall_time_s", num(st.wall_seconds)},
+        {"estimators", estimators}};
 }
 
 Json study_to_json(const StudyResult& r) {

@@ -236,11 +236,11 @@ Made<SceneRequest> build_request(const Json& scene, const Json& options) {
                                             bad.find(key) != std::string::npos);
         return made_error<SceneRequest>((from_options ? "options: " : "scene: ") + bad);
     }
-    // Stopping at a requested accuracy: the tolerances and the time budget. N may double to
-    // 2^24 (or the scene's n_max, if larger: a scene's n_max is its ladder's) unless the options
-    // set n_max.
-    if (s.stopping() && !(options.is_object() && find(options, "n_max")))
-        s.n_max = std::max(s.n_max, kStoppingDefaultNMax);
+    // Stopping at a requested accuracy: the tolerances and the time budget. N doubles up to the
+    // n_max the options or the scene give (the stopping budget), else up to 2^24.
+    if (s.stopping() && !(options.is_object() && find(options, "n_max")) &&
+        !(scene.is_object() && find(scene, "n_max")))
+        s.n_max = kStoppingDefaultNMax;
     if (s.stopping() || s.abs_tol != 0.0 || s.rel_tol != 0.0 || s.max_seconds != 0.0) {
         const bool from_options =
             options.is_object() &&

@@ -437,13 +437,32 @@ void announce_long_study(const std::string& scene, const std::string& options, b
     nlohmann::json p = nlohmann::json::parse(plan, nullptr, false);
     mcp_free(plan);
     if (p.is_discarded() || !p["predicted_seconds"].is_number()) return;
-    const double seconds = p["predicted_seconds"].get<double>();
+    double seconds = p["predicted_seconds"].get<double>();
+    // A stopping study (rel_tol or abs_tol, from the options or the scene) runs its estimates
+    // one at a time on one thread, and the plan's evaluations are its budget (every run to
+    // n_max): the prediction is the plan's single-thread seconds, an upper bound.
+    bool stopping = false;
+    for (const std::string* text : {&options, &scene}) {
+        const nlohmann::json j = nlohmann::json::parse(*text, nullptr, false);
+        for (const char* key : {"rel_tol", "abs_tol"})
+            stopping = stopping || (j.is_object() && j.contains(key) && j[key].is_number() &&
+                                    j[key].get<double>() > 0.0);
+    }
+    if (stopping && !render)
+        seconds *= std::max(1, p["threads"].is_number_integer() ? p["threads"].get<int>() : 1);
     if (seconds < 10.0) return;
     const std::string when = seconds < 120.0    ? fmt_number("%.0f s", seconds)
                              : seconds < 7200.0 ? fmt_number("%.0f min", seconds / 60.0)
                                                 : fmt_number("%.1f hours", seconds / 3600.0);
     const char* unit = render ? "samples" : "integrand evaluations";
     const nlohmann::json& count = render ? p["samples"] : p["evaluations"];
+    if (stopping && !render) {
+        std::fprintf(stderr,
+                     "mcplay: this stopping study may take up to about %s (at most %s %s on 1 "
+                     "thread, if no run meets the tolerance before n_max); Ctrl-C stops it\n",
+                     when.c_str(), fmt_number("%.4g", count.get<double>()).c_str(), unit);
+        return;
+    }
     std::fprintf(stderr,
                  "mcplay: this study is predicted to take about %s (%s %s on %s thread(s)); "
                  "Ctrl-C stops it\n",

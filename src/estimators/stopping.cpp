@@ -1,10 +1,14 @@
 #include "estimators/stopping.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 
+#include "core/qmc.h"
 #include "core/special.h"
 #include "estimators/diagnostics.h"
+#include "estimators/registry.h"
 #include "estimators/study.h"
 
 namespace mcp {
@@ -15,6 +19,7 @@ const char* stop_reason_name(StopReason r) {
     case StopReason::NMax: return "n_max";
     case StopReason::TimeBudget: return "max_seconds";
     case StopReason::NoErrorBar: return "no_error_bar";
+    case StopReason::UntrustedErrorBar: return "untrusted_error_bar";
     }
     return "?";
 }
@@ -51,11 +56,192 @@ bool error_bar_trusted(const RunResult& r) {
     return enough && std::isfinite(g1) && n >= kSkewnessRule * g1 * g1;
 }
 
+// Condition 5: the study's judgement of the answer as a level of one run, without the exact
+// value (the rule cannot know it). Returns the flags; *blocking says whether a warning or an
+// error is among them.
+std::vector<Flag> judge_answer(const RunResult& answer, const Problem& problem,
+                               const EstimatorSpec& spec, bool* blocking) {
+    Problem blind = problem;
+    blind.exact.reset();
+    LevelStats level = summarise_level({answer}, blind);
+    // One run has no spread of replicates: the level's variance is the run's own error bar
+    // (what the flags' "are the estimates spread, or exact to round-off" question asks of it).
+    const double se = answer.std_error;
+    level.variance = se * se;
+    level.std_error = se;
+    const double roundoff = 64.0 * 2.220446049250313e-16 * std::fabs(level.mean);
+    level.estimates_spread = std::isfinite(se) && se > roundoff;
+    level.exact_to_roundoff = !level.estimates_spread && std::isfinite(level.mean) &&
+                              level.mean != 0.0 && level.diagnostics.nonfinite == 0 &&
+                              level.diagnostics.zero_pdf == 0;
+    std::vector<Flag> flags = level_flags(level);
+    for (const Flag& f : tail_flags(level, weights_bounded(problem, spec))) flags.push_back(f);
+    *blocking = false;
+    for (const Flag& f : flags) {
+        // The K batch means of one run: the study's rule (K > 25 g1^2 on R K pooled means)
+        // would refuse about 15% of normal runs with K = 16 (a sample skewness of 16 values has
+        // sd 0.56); the extended rule's condition 3 judges them instead.
+        if (f.code == FlagCode::SkewedWeights && answer.diagnostics.batch_units) continue;
+        *blocking = *blocking || f.severity != Severity::Info;
+    }
+    return flags;
+}
+
+// The last doubling met the tolerance by its error bar but was not allowed to stop on it.
+StopReason unmet_reason(const StoppingResult& out, StopReason budget_reason) {
+    return out.half_width <= out.target ? StopReason::UntrustedErrorBar : budget_reason;
+}
+
+// Adaptive estimators (VEGAS, VEGAS+, MISER) learn where f is from their own points: a region
+// they have not found is a bias their error bar cannot show, and runs that all missed it agree
+// with each other. Their condition 2 asks the run at N/2 to meet the tolerance itself, so that
+// the answer stands on two runs that each found enough of f (MISER on a peak of width 1e-3 at
+// the bisection point found half of it, 0.5 +- 0.002 at N = 8192, and all of it at 16384).
+bool adaptive(const EstimatorSpec& spec) {
+    const std::string kind = kind_of(spec).name;
+    return kind == "vegas" || kind == "vegas_plus" || kind == "miser";
+}
+
+// Randomized QMC by extension (the header's first way): K accumulators, one per randomization,
+// each fed the points of its own randomized sequence in order.
+StoppingResult extend_to_tolerance(const Problem& problem, const EstimatorSpec& spec,
+                                   const Tolerance& tol, const StoppingBudget& budget,
+                                   uint64_t seed, int replicate, Workspace& ws) {
+    StoppingResult out;
+    out.extended = true;
+    const SamplerOptions options = spec.sampler_options();
+    const uint64_t k_count = static_cast<uint64_t>(options.randomizations);
+    const uint64_t longest = budget.n_max / k_count; // points of each sequence at most
+    Pcg32 rng = replicate_rng(seed, spec.name, 0, replicate);
+    const SamplerPlan all = make_sampler_plan(spec.sampler, problem.domain.sample_dim(),
+                                              longest * k_count, rng, options);
+    std::vector<SamplerPlan> plans(static_cast<size_t>(k_count));
+    std::vector<WeightAccumulator> acc(static_cast<size_t>(k_count));
+    for (size_t k = 0; k < plans.size(); ++k) {
+        plans[k].kind = all.kind;
+        plans[k].dim = all.dim;
+        plans[k].total = longest;
+        plans[k].randomizers = {all.randomizers[k]};
+        acc[k].reset(ErrorMethod::Iid, plans[k], false);
+    }
+    prepare_workspace(problem.domain, ws);
+    const double scale = quantity_scale(problem);
+    const double kd = static_cast<double>(k_count);
+    const double tk = t95(static_cast<int>(k_count) - 1);
+    std::vector<double> batch(plans.size()), previous_batch;
+    for (uint64_t n = budget.n_start;; n *= 2) {
+        const auto start = std::chrono::steady_clock::now();
+        const uint64_t m = n / k_count, done = out.steps.empty() ? 0 : m / 2;
+        for (size_t k = 0; k < plans.size(); ++k)
+            for (uint64_t first = done; first < m; first += kBlockSize) {
+                const size_t count = static_cast<size_t>(std::min<uint64_t>(kBlockSize, m - first));
+                const SampleBlock b =
+                    sample_block(problem, spec.proposal, plans[k], first, count, ws);
+                acc[k].add_block(b.first, b.f, b.pdf, b.pdf, b.count);
+            }
+        // The answer at N: the K batch means' t interval, the weights' diagnostics pooled.
+        RunResult r;
+        RunningMoments means;
+        std::vector<double> top;
+        double abs_sum = 0.0, max_abs = 0.0;
+        uint64_t nonfinite = 0;
+        for (size_t k = 0; k < plans.size(); ++k) {
+            const RunResult rk = acc[k].finish(1.0);
+            batch[k] = rk.estimate;
+            means.add(rk.estimate);
+            r.diagnostics.merge(rk.diagnostics);
+            nonfinite += rk.diagnostics.nonfinite;
+            top.insert(top.end(), rk.top.begin(), rk.top.end());
+            // sum |w| of the batch from its ESS and sum w^2 (Kish: ess = (sum |w|)^2 / sum w^2)
+            const RunningMoments& w = rk.diagnostics.weights;
+            const double sum_sq =
+                w.sum_squared_deviations() + static_cast<double>(w.count()) * w.mean() * w.mean();
+            const double batch_abs = std::sqrt(std::fmax(rk.diagnostics.ess, 0.0) * sum_sq);
+            abs_sum += batch_abs;
+            max_abs = std::fmax(max_abs, rk.diagnostics.max_weight_share * batch_abs);
+        }
+        std::sort(top.begin(), top.end(), std::greater<double>());
+        if (top.size() > kTopWeights) top.resize(kTopWeights);
+        r.top = top;
+        r.n = n;
+        r.estimate = means.mean() * scale;
+        r.std_error = std::sqrt(means.variance() / kd) * scale;
+        r.dof = static_cast<int>(k_count) - 1;
+        r.diagnostics.error_units = means;
+        r.diagnostics.batch_units = true;
+        r.diagnostics.max_weight_share = abs_sum > 0.0 ? max_abs / abs_sum : 0.0;
+        const RunningMoments& w = r.diagnostics.weights;
+        const double sum_sq =
+            w.sum_squared_deviations() + static_cast<double>(w.count()) * w.mean() * w.mean();
+        r.diagnostics.ess = sum_sq > 0.0 ? abs_sum * abs_sum / sum_sq : 0.0;
+        if (nonfinite == n) r.estimate = r.std_error = std::numeric_limits<double>::quiet_NaN();
+        r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        out.evaluations = n; // every point of every randomization once
+        out.seconds += r.seconds;
+
+        StoppingStep step;
+        step.n = n;
+        step.estimate = r.estimate;
+        step.std_error = r.std_error;
+        step.dof = r.dof;
+        step.seconds = r.seconds;
+        step.half_width = tk * r.std_error;
+        // Condition 3: the batch means' own skewness within three sampling sds of 0. (Cochran's
+        // rule on the N weights, in condition 4, is the rule K > 25 (g1_w / sqrt m)^2 on the
+        // skewness a batch mean of m weights would have from the weights' [Cochran77, 2.15].)
+        const double g1 = means.skewness();
+        step.trusted = error_bar_trusted(r) &&
+                       (!std::isfinite(g1) || std::fabs(g1) <= 3.0 * std::sqrt(6.0 / kd));
+        if (!previous_batch.empty()) {
+            RunningMoments d;
+            for (size_t k = 0; k < batch.size(); ++k) d.add(batch[k] - previous_batch[k]);
+            step.agrees = std::fabs(d.mean()) <= tk * std::sqrt(d.variance() / kd);
+        }
+        bool blocking = false;
+        out.flags = judge_answer(r, problem, spec, &blocking);
+        step.flagged = blocking;
+        out.steps.push_back(step);
+        out.answer = r;
+        out.half_width = step.half_width;
+        out.target = std::fmax(tol.abs, tol.rel * std::fabs(r.estimate));
+        if (!std::isfinite(r.std_error)) {
+            out.reason = StopReason::NoErrorBar;
+            return out;
+        }
+        if (step.half_width <= out.target && step.agrees && step.trusted && !blocking) {
+            out.met = true;
+            out.reason = StopReason::ToleranceMet;
+            return out;
+        }
+        previous_batch = batch;
+        if (n > budget.n_max / 2) {
+            out.reason = unmet_reason(out, StopReason::NMax);
+            return out;
+        }
+        if (out.seconds + 2.0 * r.seconds > budget.max_seconds) {
+            out.reason = unmet_reason(out, StopReason::TimeBudget);
+            return out;
+        }
+    }
+}
+
 } // namespace
+
+bool stopping_extends(const EstimatorSpec& spec, const StoppingBudget& budget,
+                      Accumulator accumulator) {
+    const SamplerOptions options = spec.sampler_options();
+    const uint64_t k = static_cast<uint64_t>(std::max(options.randomizations, 1));
+    return accumulator == Accumulator::Compensated && kind_of(spec).name == std::string("fixed") &&
+           is_qmc(spec.sampler) && error_method_for(spec) == ErrorMethod::Randomizations &&
+           k >= 8 && budget.n_start % k == 0 && budget.n_start / k >= 2 &&
+           budget.n_max / k <= qmc_max_points(qmc_kind_of(spec.sampler));
+}
 
 StoppingResult run_to_tolerance(const Problem& problem, const EstimatorSpec& spec,
                                 const Tolerance& tol, const StoppingBudget& budget, uint64_t seed,
                                 int replicate, Workspace& ws, Accumulator accumulator) {
+    if (stopping_extends(spec, budget, accumulator))
+        return extend_to_tolerance(problem, spec, tol, budget, seed, replicate, ws);
     StoppingResult out;
     for (uint64_t n = budget.n_start;; n *= 2) {
         Pcg32 rng = replicate_rng(seed, spec.name, n, replicate);
@@ -70,6 +256,9 @@ StoppingResult run_to_tolerance(const Problem& problem, const EstimatorSpec& spe
         step.seconds = r.seconds;
         step.half_width = t95(r.dof) * r.std_error;
         step.trusted = error_bar_trusted(r);
+        bool blocking = false;
+        out.flags = judge_answer(r, problem, spec, &blocking);
+        step.flagged = blocking;
         out.steps.push_back(step);
         const StoppingStep* previous =
             out.steps.size() >= 2 ? &out.steps[out.steps.size() - 2] : nullptr;
@@ -81,23 +270,25 @@ StoppingResult run_to_tolerance(const Problem& problem, const EstimatorSpec& spe
             return out;
         }
         const bool meets = step.half_width <= out.target;
-        const bool predicted =
-            previous && previous->dof >= 1 && previous->half_width / std::sqrt(2.0) <= out.target;
+        const double previous_width =
+            previous ? previous->half_width / (adaptive(spec) ? 1.0 : std::sqrt(2.0)) : 0.0;
+        const bool predicted = previous && previous->dof >= 1 && previous_width <= out.target;
         const bool agree = previous && std::fabs(step.estimate - previous->estimate) <=
                                            t95(std::min(step.dof, previous->dof)) *
                                                std::sqrt(step.std_error * step.std_error +
                                                          previous->std_error * previous->std_error);
-        if (meets && predicted && agree && step.trusted) {
+        out.steps.back().agrees = agree;
+        if (meets && predicted && agree && step.trusted && !blocking) {
             out.met = true;
             out.reason = StopReason::ToleranceMet;
             return out;
         }
         if (n > budget.n_max / 2) {
-            out.reason = StopReason::NMax;
+            out.reason = unmet_reason(out, StopReason::NMax);
             return out;
         }
         if (out.seconds + 2.0 * r.seconds > budget.max_seconds) {
-            out.reason = StopReason::TimeBudget;
+            out.reason = unmet_reason(out, StopReason::TimeBudget);
             return out;
         }
     }

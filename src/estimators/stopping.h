@@ -2,17 +2,40 @@
 // or relative tolerance, or a budget (largest N, seconds) ends.
 //
 // Stopping when an error bar first dips below the target picks the runs whose error bars
-// happen to be small, and their intervals then cover less than they say. The rule here keeps
-// its promise by asking for agreement of independent evidence before it stops at N:
+// happen to be small, and their intervals then cover less than they say. The rule asks for
+// evidence beyond the error bar itself before it stops at N, in one of two ways.
+//
+// Randomized quasi-Monte Carlo of the fixed kind (sobol, halton, lattice: K randomizations of a
+// point sequence, the Randomizations error method) EXTENDS its runs: the K randomized
+// sequences are drawn once for the largest N, and doubling evaluates only points [N/2K, N/K) of
+// each (the first 2^m points of a scrambled Sobol' sequence, or of a lattice sequence in
+// radical-inverse order, are a randomized net or lattice of their own [Owen95, Hickernell00]).
+// A run costs its final N evaluations, and the estimate at N/2 comes for free. It stops at N when
+//  1. the K-randomization t interval meets the tolerance: t_{K-1} s_b / sqrt K <= tol,
+//     tol = max(abs, rel |I_N|) [LEcuyerLemieux02];
+//  2. the N/2 and N estimates agree, judged with their dependence: they share the first half of
+//     every randomization, so the differences d_k = b_k(N) - b_k(N/2) of the K batch means are
+//     K independent draws, and |mean d| <= t_{K-1} sd(d) / sqrt K;
+//  3. the K batch means are not too skewed for a t interval: |g1| <= 3 sqrt(6 / K) (three
+//     sampling standard deviations of a normal sample's skewness), K >= 8 randomizations;
+//  4. the run's weights pass condition 4 below, and the study's flags raise nothing (5).
+// Every N is a fresh run otherwise (its own replicate stream, so the evidence at N/2 is
+// independent of the answer at N; the cost is at most twice the answer's evaluations):
 //  1. the run at N meets the tolerance: t_0.975(dof) se <= tol, tol = max(abs, rel |I_N|);
 //  2. the independent run at N/2 predicts it: its half-width over sqrt 2 (the 1/sqrt(N) rate of
-//     Monte Carlo, conservative for faster estimators) meets the tolerance too;
+//     Monte Carlo, conservative for faster estimators) meets the tolerance too; for the
+//     adaptive estimators (VEGAS, VEGAS+, MISER), whose runs can all miss a region of f and
+//     agree on it, its half-width itself meets it;
 //  3. the two runs agree: |I_N - I_{N/2}| <= t_0.975 sqrt(se_N^2 + se_{N/2}^2);
 //  4. the run's error bar can be trusted at its size: Cochran's rule on its weights,
 //     N > 25 g1^2 [Cochran77] (the rule of the skewed_weights flag), and an effective sample
 //     size of at least min(10, N/4) (the low_ess rule: not 0 +- 0 from points that never saw f).
-// Every N is a fresh run with its own replicate stream, so the evidence at N/2 is independent of
-// the answer at N; the answer is the run at N, and the cost is at most twice its evaluations.
+// In both ways (5) the answer carries the judgement a study level gets: level_flags and
+// tail_flags (estimators/diagnostics.h) of the answer as a level of one run, without the exact
+// value (a stopping rule cannot know it). A warning or an error among them (a heavy tail that
+// may mean infinite variance, too few effective samples, dropped samples) means the error bar
+// cannot be trusted, and the run does not stop "met": it doubles on, and if the budget ends with
+// the error bar meeting the tolerance but untrusted, the reason is untrusted_error_bar.
 // Any estimator with an error bar can be run this way (fixed, RQMC, VEGAS, MISER, MIS, control
 // variates: each N is a complete run of it); one without an error bar (a point set with no
 // randomization) cannot, and stops at once with StopReason::NoErrorBar.
@@ -24,6 +47,7 @@
 #include <vector>
 
 #include "estimators/block_driver.h"
+#include "estimators/diagnostics.h"
 #include "estimators/estimator.h"
 #include "estimators/problem.h"
 #include "estimators/study.h"
@@ -47,9 +71,11 @@ struct StoppingBudget {
     double max_seconds = std::numeric_limits<double>::infinity();
 };
 
-enum class StopReason { ToleranceMet, NMax, TimeBudget, NoErrorBar };
+/// UntrustedErrorBar: the budget ended while the error bar met the tolerance but a flag (or
+/// the agreement with earlier doublings) said it cannot be trusted.
+enum class StopReason { ToleranceMet, NMax, TimeBudget, NoErrorBar, UntrustedErrorBar };
 
-/// "tolerance_met", "n_max", "max_seconds", "no_error_bar".
+/// "tolerance_met", "n_max", "max_seconds", "no_error_bar", "untrusted_error_bar".
 const char* stop_reason_name(StopReason r);
 
 /// One doubling: the run at n.
@@ -57,7 +83,10 @@ struct StoppingStep {
     uint64_t n = 0;
     double estimate = 0.0, std_error = 0.0, half_width = 0.0, seconds = 0.0;
     int dof = 0;
-    bool trusted = false; ///< condition 4 (Cochran's rule on the run's error units)
+    bool trusted = false; ///< condition 4 (Cochran's rule on the run's weights, ESS) and 3
+                          ///< (skewness of the batch means) for extended runs
+    bool agrees = false;  ///< condition 2 (extended) or 3 (fresh runs): agrees with earlier N
+    bool flagged = false; ///< a warning or error flag of the study's judgement (condition 5)
 };
 
 struct StoppingResult {
@@ -66,16 +95,27 @@ struct StoppingResult {
     double target = 0.0;     ///< max(abs, rel |estimate|) at the answer
     bool met = false;
     StopReason reason = StopReason::NMax;
-    uint64_t evaluations = 0; ///< over every doubling
-    double seconds = 0.0;     ///< over every doubling
+    uint64_t evaluations = 0; ///< over every doubling (reused points counted once)
+    bool extended = false;    ///< the doublings extended one set of K randomized sequences
+    /// The study's flags of the answer (level_flags and tail_flags of it as a level of one
+    /// run, without the exact value); the run is not "met" with a warning or error among them.
+    std::vector<Flag> flags;
+    double seconds = 0.0; ///< over every doubling
     std::vector<StoppingStep> steps;
 };
 
 /// "" when the tolerance and budget can be used, else a message naming the field.
 std::string check_stopping(const Tolerance& tol, const StoppingBudget& budget);
 
+/// Whether run_to_tolerance extends the spec's runs (randomized QMC of the fixed kind with at
+/// least 8 randomizations, compensated sums, n_start a multiple of K and the sequences long
+/// enough for n_max / K points).
+bool stopping_extends(const EstimatorSpec& spec, const StoppingBudget& budget,
+                      Accumulator accumulator = Accumulator::Compensated);
+
 /// Runs the estimator at N = n_start, 2 n_start, ... (each run from
-/// replicate_rng(seed, spec.name, N, replicate)) until the rule above stops it or the budget
+/// replicate_rng(seed, spec.name, N, replicate); extended runs draw their K randomizations from
+/// replicate_rng(seed, spec.name, 0, replicate)) until the rule above stops it or the budget
 /// ends (the next N above n_max, or the next run, predicted at twice the last one's time,
 /// past max_seconds).
 StoppingResult run_to_tolerance(const Problem& problem, const EstimatorSpec& spec,
