@@ -28,14 +28,16 @@ struct VegasOptions {
     int increments = 0; ///< per axis; 0 chooses vegas_increments()
     /// Damping exponent of the refinement [Lepage78, Lepage21, eq. 22]: Lepage78 gives 1 to 2
     /// (GSL 1.5), vegas 0.5. At 0.5 the map converges too slowly for a sharp peak: on Genz's
-    /// product peak (a = 200 to 1000, d = 6, N = 2^20) 1.0 cut the RMSE 10-500x.
-    double alpha = 1.0;
+    /// product peak (a = 100 to 1000, d = 6, N = 2^20) alpha 1 with 20 settled iterations cut
+    /// the RMSE 3-16x (docs/benchmarks.md); not the default yet (it broke calibration tests).
+    double alpha = 0.5;
     double train_fraction = 0.25; ///< share of the N evaluations spent training the map
     /// The training share is split into this many iterations, at most: training stops when
     /// the map has settled (train_stop). More, smaller iterations converge on a sharp peak
     /// where 10 did not (the map needs steps more than points per step).
-    int train_iterations = 20;
-    VegasTrainStop train_stop = VegasTrainStop::Settled; ///< the calls left go to the estimate
+    int train_iterations = 10;
+    VegasTrainStop train_stop =
+        VegasTrainStop::Budget;  ///< Settled: the calls left go to the estimate
     double uniform_share = 0.05; ///< share of each axis's increments spread evenly
     VegasReport report = VegasReport::Frozen;
     int iterations = 5; ///< Iterations: the estimation share is split into this many
