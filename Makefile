@@ -61,6 +61,7 @@ help:
 	@echo "make check  everything CI runs: make test, then the ASan/UBSan suite and make fuzz-smoke"
 	@echo "make bench  samples per second natively and in wasm under Node, and their ratio; then bench-genz"
 	@echo "make bench-genz  mcplay beside GSL plain/MISER/VEGAS on Genz's families (GENZ_ARGS=--quick: 15 s)"
+	@echo "make bench-genz-peaks  vegas, vegas_plus beside GSL VEGAS on sharp product peaks (~4 min)"
 	@echo "make bench-flags  the flags judged both ways: false alarms where intervals covered, confident wrong answers"
 	@echo "make bench-qmc  mcplay's randomized QMC beside QMCPy's and scipy's on Genz 1, 4, 5 (pip venv in build/)"
 	@echo "make bench-mitsuba  the renderer beside Mitsuba 3.9.1 on three glTF scenes: time, relMSE, efficiency (ARGS: --quick, --sobol, --scalar, --widths)"
@@ -237,6 +238,12 @@ bench-genz: deps deps-gsl $(BUILD)/CMakeCache.txt
 	cmake --build $(BUILD) -j $(JOBS) --target mcplay_api
 	$(MAKE) --no-print-directory $(BUILD)/genz_compare
 	set -o pipefail; $(BUILD)/genz_compare --json $(GENZ_JSON) $(GENZ_ARGS) | tee $(BUILD)/genz_compare.txt
+
+# Sharp separable peaks: GSL's VEGAS beside mcplay's vegas and vegas_plus (docs/benchmarks.md).
+.PHONY: bench-genz-peaks
+bench-genz-peaks:
+	$(MAKE) --no-print-directory bench-genz GENZ_JSON=$(BUILD)/genz_peaks.jsonl \
+	  GENZ_ARGS="--peaks --gsl vegas --methods vegas,vegas_plus $(GENZ_ARGS)"
 
 # ---------------------------------------------------------------------------
 # The flags judged both ways (docs/benchmarks.md): bench/calibrate.cpp runs studies through the

@@ -5,7 +5,12 @@
 //   genz_compare [--quick] [--n N] [--reps R] [--dims 2,4,8,16] [--families 1,...,6]
 //                [--methods uniform,stratified,...] [--gsl plain,miser,vegas|none]
 //                [--param-seed S] [--seed S] [--params-dir DIR] [--json FILE]
-//                [--write-params DIR] [--external FILE.jsonl]
+//                [--write-params DIR] [--external FILE.jsonl] [--peaks]
+//
+// --peaks: instead of genz_random's cases, Genz's product peak with every a_j = a for a in
+// {100, 200, 500, 1000} and d in --dims (default 4, 6, 8), u_j the peak positions of
+// genz_random(product_peak, d, param seed): sharp separable peaks, where a VEGAS map should be
+// at its best (docs/benchmarks.md).
 //
 // Both sides evaluate mcplay's Genz code: GSL calls genz_evaluate_point (one point per call,
 // the only interface GSL has), mcplay runs its own block path (run_estimate ->
@@ -84,6 +89,7 @@ struct Options {
     uint64_t seed = 1;       // replicate seeds
     std::string params_dir, json_path, write_params_dir, external_path;
     bool quick = false;
+    bool peaks = false; // --peaks: the sharp product peaks instead of genz_random's cases
 };
 
 std::vector<std::string> split(const std::string& s, char separator = ',') {
@@ -102,7 +108,7 @@ std::vector<std::string> split(const std::string& s, char separator = ',') {
                  "         [--families 1,2,3,4,5,6 | oscillatory,...] [--methods PRESET,...]\n"
                  "         [--gsl plain,miser,vegas|none] [--param-seed S] [--seed S]\n"
                  "         [--params-dir DIR] [--json FILE] [--write-params DIR]\n"
-                 "         [--external FILE.jsonl]\n");
+                 "         [--external FILE.jsonl] [--peaks]\n");
     std::exit(2);
 }
 
@@ -178,6 +184,8 @@ Options parse_options(int argc, char** argv) {
             o.write_params_dir = value();
         else if (a == "--external")
             o.external_path = value();
+        else if (a == "--peaks")
+            o.peaks = true;
         else if (a == "-h" || a == "--help")
             usage(nullptr);
         else
@@ -188,6 +196,9 @@ Options parse_options(int argc, char** argv) {
         if (!reps_given) o.reps = 3;
     }
     if (o.reps < 2) usage("--reps must be at least 2");
+    if (o.peaks && !o.dims_given) o.dims = {4, 6, 8};
+    if (o.peaks && (o.families_given || !o.params_dir.empty()))
+        usage("--peaks makes its own cases: no --families or --params-dir with it");
     return o;
 }
 
@@ -215,6 +226,30 @@ std::vector<Case> random_cases(const Options& o) {
             c.label = std::string(kFamilyNames[fam - 1]) + " d=" + std::to_string(d);
             c.name = "f" + std::to_string(fam) + "_d" + std::to_string(d);
             c.source = "genz_random(" + std::string(kFamilyNames[fam - 1]) + ", " +
+                       std::to_string(d) + ", seed " + std::to_string(o.param_seed) + ")";
+            cases.push_back(c);
+        }
+    return cases;
+}
+
+/// --peaks: Genz's product peak f = prod_j 1 / (a^-2 + (x_j - u_j)^2) with every a_j = a, so
+/// the peak's width is 1/a on every axis; u from genz_random(product_peak, d, param seed).
+std::vector<Case> peak_cases(const Options& o) {
+    std::vector<Case> cases;
+    for (const double a : {100.0, 200.0, 500.0, 1000.0})
+        for (int d : o.dims) {
+            const GenzParams random = genz_random(GenzFamily::ProductPeak, d, o.param_seed);
+            Made<GenzParams> g =
+                make_genz(GenzFamily::ProductPeak, std::vector<double>(size_t(d), a), random.u);
+            if (!g.ok()) usage(("--peaks: " + g.error).c_str());
+            Case c;
+            c.family = 2;
+            c.params = g.value;
+            c.mcplay_exact = c.exact = genz_exact(c.params);
+            const std::string an = std::to_string(int(a));
+            c.label = "product_peak a=" + an + " d=" + std::to_string(d);
+            c.name = "pp" + an + "_d" + std::to_string(d);
+            c.source = "product peak a = " + an + ", u of genz_random(product_peak, " +
                        std::to_string(d) + ", seed " + std::to_string(o.param_seed) + ")";
             cases.push_back(c);
         }
@@ -591,8 +626,28 @@ double best_eff_sig(const std::vector<Cell>& cells, bool mcplay) {
 }
 
 /// A method is a preset name, optionally with a randomization and a count of randomizations:
-/// "sobol", "sobol:lms_shift", "sobol:owen:32".
+/// "sobol", "sobol:lms_shift", "sobol:owen:32"; or a VEGAS preset with options of its "vegas"
+/// object, numbers or words: "vegas/alpha=1.5/train_fraction=0.4", "vegas/report=iterations".
 Json estimator_for(const std::string& method) {
+    if (method.find('/') != std::string::npos) {
+        std::vector<std::string> parts = split(method, '/');
+        Json options = Json::object();
+        for (size_t i = 1; i < parts.size(); ++i) {
+            const size_t eq = parts[i].find('=');
+            const std::string key = parts[i].substr(0, eq);
+            const std::string value = eq == std::string::npos ? "" : parts[i].substr(eq + 1);
+            char* end = nullptr;
+            const double x = std::strtod(value.c_str(), &end);
+            if (!value.empty() && end && *end == 0 &&
+                value.find_first_of(".eE") == std::string::npos)
+                options[key] = static_cast<long long>(x);
+            else if (!value.empty() && end && *end == 0)
+                options[key] = x;
+            else
+                options[key] = value;
+        }
+        return {{"name", parts[0]}, {"vegas", options}};
+    }
     std::vector<std::string> parts = split(method, ':');
     if (parts.size() == 1) return method;
     Json e = {{"name", parts[0]}, {"randomization", parts[1]}};
@@ -639,15 +694,18 @@ int main(int argc, char** argv) {
                 (unsigned long long)o.n, o.reps,
                 from_files
                     ? ("parameters from " + o.params_dir + " (exact values from the files)").c_str()
-                    : ("parameters genz_random(family, d, seed " + std::to_string(o.param_seed) +
-                       "), exact values genz_exact")
+                    : ((o.peaks ? "--peaks: product peaks a = 100, 200, 500, 1000 at u of "
+                                  "genz_random(product_peak, d, seed "
+                                : "parameters genz_random(family, d, seed ") +
+                       std::to_string(o.param_seed) + "), exact values genz_exact")
                           .c_str());
     std::printf("  %s, %s %s; %s\n", date, un.machine, un.release,
                 o.quick ? "--quick" : "full run");
     std::printf("  VEGAS: warm-up 10^4 calls (stage 0), then the main run (stage 1) on the trained "
                 "grid; total calls = N (see docs/benchmarks.md)\n");
     std::fflush(stdout);
-    std::vector<Case> cases = from_files ? file_cases(o) : random_cases(o);
+    std::vector<Case> cases =
+        from_files ? file_cases(o) : (o.peaks ? peak_cases(o) : random_cases(o));
     if (cases.empty()) usage("no cases to run");
     if (!o.write_params_dir.empty()) {
         write_params(cases, o.write_params_dir);

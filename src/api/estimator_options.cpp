@@ -18,18 +18,19 @@ bool parse_vegas_options(Ctx& c, const Json& j, const std::string& path, int dim
                          VegasOptions* out) {
     if (!check_keys(c, j, path,
                     {"increments", "alpha", "train_fraction", "train_iterations", "uniform_share",
-                     "report", "iterations", "stratify", "beta"}))
+                     "report", "iterations", "stratify", "beta", "train_stop"}))
         return false;
     uint64_t increments = 0, iterations = static_cast<uint64_t>(out->train_iterations);
     uint64_t rounds = static_cast<uint64_t>(out->iterations);
-    std::string report;
+    std::string report, train_stop;
     if (!get_count(c, j, "increments", path, &increments) ||
         !get_number(c, j, "alpha", path, &out->alpha) ||
         !get_number(c, j, "train_fraction", path, &out->train_fraction) ||
         !get_number(c, j, "uniform_share", path, &out->uniform_share) ||
         !get_count(c, j, "train_iterations", path, &iterations) ||
         !get_count(c, j, "iterations", path, &rounds) ||
-        !get_string(c, j, "report", path, &report) || !get_number(c, j, "beta", path, &out->beta))
+        !get_string(c, j, "report", path, &report) || !get_number(c, j, "beta", path, &out->beta) ||
+        !get_string(c, j, "train_stop", path, &train_stop))
         return false;
     // The map holds dim x increments edges and sums: at most 2^22 of each.
     if (find(j, "increments") &&
@@ -39,7 +40,7 @@ bool parse_vegas_options(Ctx& c, const Json& j, const std::string& path, int dim
                           std::to_string((uint64_t(1) << 22) / static_cast<uint64_t>(dim)) +
                           " here), got " + std::to_string(increments));
     if (!(out->alpha >= 0.0 && out->alpha <= 4.0))
-        return c.fail(sub(path, "alpha"), "must be in [0, 4] (vegas uses 0.5, GSL 1.5)");
+        return c.fail(sub(path, "alpha"), "must be in [0, 4] (default 1; vegas uses 0.5, GSL 1.5)");
     if (!(out->train_fraction >= 0.0 && out->train_fraction <= 0.9))
         return c.fail(sub(path, "train_fraction"),
                       "must be in [0, 0.9]: the share of N that trains the map");
@@ -47,6 +48,15 @@ bool parse_vegas_options(Ctx& c, const Json& j, const std::string& path, int dim
         return c.fail(sub(path, "uniform_share"), "must be in [0, 1]");
     if (iterations < 1 || iterations > 1000)
         return c.fail(sub(path, "train_iterations"), "must be in [1, 1000]");
+    if (train_stop == "settled" || train_stop.empty())
+        out->train_stop = VegasTrainStop::Settled;
+    else if (train_stop == "budget")
+        out->train_stop = VegasTrainStop::Budget;
+    else
+        return c.fail(sub(path, "train_stop"), "expected \"settled\" (stop training once the map "
+                                               "has settled) or \"budget\" (train on the whole "
+                                               "train_fraction), got \"" +
+                                                   train_stop.substr(0, 64) + "\"");
     if (report == "iterations")
         out->report = VegasReport::Iterations;
     else if (report == "frozen" || report.empty())
@@ -301,8 +311,7 @@ bool parse_mis_fields(Ctx& c, const Json& j, const std::string& path, const Prob
 }
 
 bool parse_control_variate_fields(Ctx& c, const Json& j, const std::string& path,
-                                  const Problem& problem, const Json* /*pdf*/,
-                                  EstimatorSpec* out) {
+                                  const Problem& problem, const Json* /*pdf*/, EstimatorSpec* out) {
     out->kind = find_estimator_kind("control_variates");
     if (out->sampler != SamplerKind::Independent)
         return c.fail(sub(path, "sampler"), "control variates needs the independent sampler (its "

@@ -264,6 +264,13 @@ Made<SceneRequest> build_request(const Json& scene, const Json& options) {
         return made_error<SceneRequest>((from_options ? "options: " : "scene: ") + too_big);
     }
     for (const EstimatorSpec& e : req.estimators) {
+        const bool vegas_kind = e.kind && (std::string(e.kind->name) == "vegas" ||
+                                           std::string(e.kind->name) == "vegas_plus");
+        const std::string untrainable =
+            vegas_kind ? vegas_untrainable(e.vegas_options, s.n_max) : std::string();
+        if (!untrainable.empty())
+            return made_error<SceneRequest>("estimator '" + name_text(e.name) +
+                                            "': " + untrainable);
         if (e.per_stratum > 1 && s.n_min < e.per_stratum)
             return made_error<SceneRequest>("estimator '" + e.name + "': samples_per_stratum = " +
                                             std::to_string(e.per_stratum) +

@@ -12,6 +12,40 @@ int vegas_increments(int dim, uint64_t points_per_iteration) {
     return static_cast<int>(std::max<uint64_t>(2, std::min(most, points_per_iteration / 100)));
 }
 
+int vegas_trainable_increments(const VegasOptions& options, int dim,
+                               uint64_t points_per_iteration) {
+    if (options.increments <= 0) return vegas_increments(dim, points_per_iteration);
+    if (points_per_iteration == 0) return options.increments; // no training: the identity
+    const uint64_t most = std::max<uint64_t>(2, points_per_iteration / kVegasPointsPerIncrement);
+    return static_cast<int>(std::min<uint64_t>(static_cast<uint64_t>(options.increments), most));
+}
+
+std::string vegas_untrainable(const VegasOptions& options, uint64_t n_max) {
+    if (options.increments <= 0) return {};
+    const uint64_t train =
+        static_cast<uint64_t>(options.train_fraction * static_cast<double>(n_max));
+    uint64_t per_iteration = 0;
+    std::string what;
+    if (train >= 2) {
+        per_iteration = train / static_cast<uint64_t>(vegas_training_iterations(options, train));
+        what = "train_fraction x n_max / training iterations";
+    } else if (options.report == VegasReport::Iterations) {
+        per_iteration = n_max / static_cast<uint64_t>(std::max(options.iterations, 1));
+        what = "n_max / iterations";
+    } else {
+        return {}; // no training: the map stays the identity
+    }
+    const uint64_t increments = static_cast<uint64_t>(options.increments);
+    if (per_iteration >= kVegasPointsPerIncrement * increments) return {};
+    return "vegas.increments = " + std::to_string(increments) + " needs " +
+           std::to_string(kVegasPointsPerIncrement * increments) +
+           " points per training iteration (" + std::to_string(kVegasPointsPerIncrement) +
+           " per increment), but n_max = " + std::to_string(n_max) + " gives " +
+           std::to_string(per_iteration) + " (" + what + "): lower increments to at most " +
+           std::to_string(per_iteration / kVegasPointsPerIncrement) +
+           " or raise n_max; fewer points leave the map learning noise";
+}
+
 int vegas_training_iterations(const VegasOptions& options, uint64_t calls) {
     return static_cast<int>(
         std::min<uint64_t>(static_cast<uint64_t>(std::max(options.train_iterations, 1)),

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "core/points.h"
@@ -16,13 +17,28 @@ enum class VegasReport {
                ///< average with chi^2 / dof, as vegas and GSL do [Lepage78, eq. 6-8]
 };
 
+/// When VEGAS training stops.
+enum class VegasTrainStop {
+    Settled, ///< once the map has settled (TrainingStop, vegas_train.h), at most the budget
+    Budget   ///< after the whole training budget, train_fraction N in train_iterations
+};
+
 /// The options of a VEGAS estimator (scene field "vegas"; docs/scene-format.md).
 struct VegasOptions {
-    int increments = 0;           ///< per axis; 0 chooses vegas_increments()
-    double alpha = 0.5;           ///< damping exponent of the refinement [Lepage21, eq. 22]
+    int increments = 0; ///< per axis; 0 chooses vegas_increments()
+    /// Damping exponent of the refinement [Lepage78, Lepage21, eq. 22]: Lepage78 gives 1 to 2
+    /// (GSL 1.5), vegas 0.5. At 0.5 the map converges too slowly for a sharp peak: on Genz's
+    /// product peak (a = 100 to 1000, d = 6, N = 2^20) alpha 1 with 20 settled iterations cut
+    /// the RMSE 3-16x (docs/benchmarks.md); not the default yet (it broke calibration tests).
+    double alpha = 0.5;
     double train_fraction = 0.25; ///< share of the N evaluations spent training the map
-    int train_iterations = 10;    ///< the training share is split into this many iterations
-    double uniform_share = 0.05;  ///< share of each axis's increments spread evenly
+    /// The training share is split into this many iterations, at most: training stops when
+    /// the map has settled (train_stop). More, smaller iterations converge on a sharp peak
+    /// where 10 did not (the map needs steps more than points per step).
+    int train_iterations = 10;
+    VegasTrainStop train_stop =
+        VegasTrainStop::Budget;  ///< Settled: the calls left go to the estimate
+    double uniform_share = 0.05; ///< share of each axis's increments spread evenly
     VegasReport report = VegasReport::Frozen;
     int iterations = 5; ///< Iterations: the estimation share is split into this many
     /// VEGAS+ [Lepage21, sec. 3]: hypercubes of the y space, each sampled with n_h >= 2 points,
@@ -51,6 +67,21 @@ inline uint64_t part_of(uint64_t calls, int parts, int i) {
 /// N = 2^20, 1000 increments gave 1.7x the variance of 250), and at most 1000 up to d = 4,
 /// 500 up to d = 8, 200 above.
 int vegas_increments(int dim, uint64_t points_per_iteration);
+
+/// Fewest training points per increment per iteration that a map can learn from. With fewer,
+/// most increments see no point and the rest one or two: the map follows the noise, its
+/// Jacobian is a product of d axes' noisy factors, and in high d that product collapses (64-D,
+/// 65536 increments, 2,500 points per iteration: estimates of 1e-164 for an integral of 1).
+constexpr uint64_t kVegasPointsPerIncrement = 10;
+
+/// The increments a run uses: options.increments when given (vegas_increments() when 0), at
+/// most points_per_iteration / kVegasPointsPerIncrement (at least 2) when the map is trained.
+int vegas_trainable_increments(const VegasOptions& options, int dim, uint64_t points_per_iteration);
+
+/// Why options.increments cannot be trained even at the largest N of a study, n_max: fewer than
+/// kVegasPointsPerIncrement points per increment per training iteration (or per averaged
+/// iteration, without training). Empty when they can, or when increments are chosen (0).
+std::string vegas_untrainable(const VegasOptions& options, uint64_t n_max);
 
 /// The map of [Lepage21, sec. 2]: per axis j, K increments with edges 0 = e_0 < ... < e_K = 1;
 /// y in increment i = floor(K y) goes to u = e_i + (K y - i)(e_{i+1} - e_i), and the map's

@@ -13,7 +13,6 @@
 namespace mcp {
 namespace {
 
-
 // VEGAS [Lepage21]: training iterations of independent points through the current map adapt
 // it; then the map is frozen and N_final points of the spec's sampler, mapped, warped and
 // weighted, make an ordinary estimate with an ordinary error bar (iid, strata or
@@ -31,28 +30,15 @@ class VegasEstimator final : public EstimatorAlgorithm, private TrainingPoints {
         uint64_t train = static_cast<uint64_t>(o.train_fraction * static_cast<double>(n));
         iterations_ = vegas_training_iterations(o, train);
         if (train < 2) train = 0;
-        final_ = n - train;
-        // A net's randomizations are full nets when each holds a power of two points: the
-        // estimation share is rounded down to K 2^m, and training takes the rest.
-        const uint64_t k = static_cast<uint64_t>(std::max(spec_.randomizations, 1));
-        if (spec_.sampler == SamplerKind::Sobol && train > 0 && final_ >= k) {
-            uint64_t per = 1; // per k <= final_ throughout
-            while (2 * per * k <= final_) per *= 2;
-            final_ = per * k;
-        }
+        plan_final(n - train);
         train_ = n - final_;
         if (train_ == 0) iterations_ = 0;
-        // Iteration average: the estimation share in `iterations` parts (each at least 2 points).
-        rounds_ = 1;
-        if (o.report == VegasReport::Iterations)
-            rounds_ = static_cast<int>(std::max<uint64_t>(
-                1,
-                std::min<uint64_t>(static_cast<uint64_t>(std::max(o.iterations, 1)), final_ / 2)));
         round_ = 0;
         rounds_done_.clear();
-        const uint64_t per_iteration = iterations_ > 0 ? train_ / iterations_ : 0;
-        const int increments = spec_.vegas_options.increments;
-        stage_.reset(dim, increments > 0 ? increments : vegas_increments(dim, per_iteration));
+        // The map learns from the training iterations, or from the averaged rounds.
+        const uint64_t per_iteration =
+            iterations_ > 0 ? train_ / iterations_ : (rounds_ > 1 ? final_ / rounds_ : 0);
+        stage_.reset(dim, vegas_trainable_increments(o, dim, per_iteration));
         trained_ = false;
         next_ = 0;
         plan_ready_ = false;
@@ -66,8 +52,19 @@ class VegasEstimator final : public EstimatorAlgorithm, private TrainingPoints {
             prepared_ = true;
         }
         if (!trained_) {
-            train_map(stage_, spec_.vegas_options, problem_, spec_.proposal, iterations_, train_,
-                      *this, rng, ws, log_);
+            const TrainingSpent spent =
+                train_map(stage_, spec_.vegas_options, problem_, spec_.proposal, iterations_,
+                          train_, *this, rng, ws, log_);
+            if (spent.calls < train_) {
+                // Settled early: the calls left go to the estimate. A net's share is rounded
+                // to K 2^m again, and what that leaves is one more training iteration.
+                plan_final(total_ - spent.calls);
+                const uint64_t rest = total_ - spent.calls - final_;
+                if (rest > 0)
+                    train_map(stage_, budget_options(), problem_, spec_.proposal, 1, rest, *this,
+                              rng, ws, log_);
+                train_ = total_ - final_;
+            }
             trained_ = true;
         }
         if (!plan_ready_) {
@@ -115,6 +112,30 @@ class VegasEstimator final : public EstimatorAlgorithm, private TrainingPoints {
     }
 
   private:
+    // The estimation share: `left` calls, a net's rounded down to K 2^m (randomizations of
+    // full nets; the rest trains), split into the rounds of the iteration average.
+    void plan_final(uint64_t left) {
+        const VegasOptions& o = spec_.vegas_options;
+        final_ = left;
+        const uint64_t k = static_cast<uint64_t>(std::max(spec_.randomizations, 1));
+        if (spec_.sampler == SamplerKind::Sobol && left < total_ && final_ >= k) {
+            uint64_t per = 1; // per k <= final_ throughout
+            while (2 * per * k <= final_) per *= 2;
+            final_ = per * k;
+        }
+        // Iteration average: the estimation share in `iterations` parts (each at least 2).
+        rounds_ = 1;
+        if (o.report == VegasReport::Iterations)
+            rounds_ = static_cast<int>(std::max<uint64_t>(
+                1,
+                std::min<uint64_t>(static_cast<uint64_t>(std::max(o.iterations, 1)), final_ / 2)));
+    }
+    VegasOptions budget_options() const {
+        VegasOptions o = spec_.vegas_options;
+        o.train_stop = VegasTrainStop::Budget;
+        return o;
+    }
+
     // The training points (TrainingPoints, for train_map): independent points of the unit
     // cube, a fresh plan per iteration; their weights f / p as they are.
     void start(uint64_t calls, Pcg32& rng) override {
@@ -190,16 +211,15 @@ class VegasEstimator final : public EstimatorAlgorithm, private TrainingPoints {
     bool float32_;
     uint64_t total_ = 0, train_ = 0, final_ = 0, next_ = 0;
     TrainingLog log_;
-    int iterations_ = 0;                 // training iterations
+    int iterations_ = 0; // training iterations
     bool trained_ = false;
-    int rounds_ = 1, round_ = 0;         // estimation iterations (1 unless averaging)
+    int rounds_ = 1, round_ = 0; // estimation iterations (1 unless averaging)
     std::vector<RunResult> rounds_done_;
     bool plan_ready_ = false, prepared_ = false;
     MapStage stage_;   // the map and its buffers
     SamplerPlan plan_; // the training iteration's, then the estimation round's
     WeightAccumulator accumulator_;
 };
-
 
 } // namespace
 

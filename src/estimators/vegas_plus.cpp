@@ -50,10 +50,10 @@ class VegasPlusEstimator final : public EstimatorAlgorithm, private TrainingPoin
         if (train == 0) iterations_ = 0;
         final_ = n - train;
         train_ = train;
-        stage_.reset(dim_, o.increments > 0 ? o.increments
-                                            : vegas_increments(dim_, iterations_ > 0
-                                                                         ? train_ / iterations_
-                                                                         : final_));
+        stage_.reset(dim_,
+                     iterations_ > 0
+                         ? vegas_trainable_increments(o, dim_, train_ / iterations_)
+                         : (o.increments > 0 ? o.increments : vegas_increments(dim_, final_)));
         sigma_.assign(cubes_, 1.0); // uniform allocation first
         trained_ = false;
         planned_ = false;
@@ -71,8 +71,13 @@ class VegasPlusEstimator final : public EstimatorAlgorithm, private TrainingPoin
             prepared_ = true;
         }
         if (!trained_) {
-            train_map(stage_, spec_.vegas_options, problem_, spec_.proposal, iterations_, train_,
-                      *this, rng, ws, log_);
+            const TrainingSpent spent =
+                train_map(stage_, spec_.vegas_options, problem_, spec_.proposal, iterations_,
+                          train_, *this, rng, ws, log_);
+            if (spent.iterations < iterations_ && spent.calls < train_) {
+                final_ += train_ - spent.calls; // settled early: the calls left go to the estimate
+                train_ = spent.calls;
+            }
             trained_ = true;
         }
         if (!planned_) {

@@ -53,13 +53,51 @@ class TrainingPoints {
     virtual void finish() {}
 };
 
-/// Trains the stage's map [Lepage21, sec. 2.2]: `iterations` iterations of
+/// Least relative fall of the map's movement, or of the per-point variance, that counts as
+/// the map still improving.
+constexpr double kVegasSettleGain = 0.1;
+
+/// When training may stop (options.train_stop = Settled). Two signs are followed per iteration:
+/// the map's movement M, the mean over axes and edges of |new edge - old edge| in units of the
+/// mean increment 1 / K, which falls while the map converges and stays at its noise level once
+/// it has; and the per-point variance of the mapped weights, V = mean(c w^2) - mean(c w)^2 over
+/// the iteration's points (c their importance, 1 for uniform y), which the map minimises
+/// [Lepage21, sec. 2.2]. The map has settled when, for two successive iterations, neither M nor
+/// V fell below (1 - kVegasSettleGain) times its least value before, and the last two
+/// iterations' estimates mean(c w) agree within 3 standard errors:
+/// (I_i - I_{i-1})^2 <= 9 (V_i / n_i + V_{i-1} / n_{i-1}). A map whose first iterations miss a
+/// sharp peak sees V too small, but still moves as it finds the peak; a non-finite V or M never
+/// settles: training then runs its whole budget.
+class TrainingStop {
+  public:
+    /// Records a training iteration; true when the map has settled.
+    bool settled(double estimate, double variance, uint64_t points, double movement);
+
+  private:
+    double least_variance_ = -1.0, least_movement_ = -1.0; // < 0 before the first iteration
+    int stalled_ = 0; // successive iterations in which neither fell
+    double last_estimate_ = 0.0, last_se2_ = 0.0;
+    bool has_last_ = false;
+};
+
+/// The map's movement between two sets of edges (dim x (K + 1)): the mean |difference| times K.
+double vegas_movement(const VegasMap& before, const VegasMap& after);
+
+/// What train_map spent.
+struct TrainingSpent {
+    uint64_t calls = 0;
+    int iterations = 0;
+};
+
+/// Trains the stage's map [Lepage21, sec. 2.2]: up to `iterations` iterations of
 /// part_of(calls, iterations, i) points from `points`, each block mapped and warped
 /// (MapStage::warp), evaluated and weighed, its w^2 added to its increments; after each
-/// iteration the map adapts (options.alpha, options.uniform_share). The log counts the calls
-/// and records the map after each iteration.
-void train_map(MapStage& stage, const VegasOptions& options, const Problem& problem,
-               const Proposal& proposal, int iterations, uint64_t calls, TrainingPoints& points,
-               Pcg32& rng, Workspace& ws, TrainingLog& log);
+/// iteration the map adapts (options.alpha, options.uniform_share). With options.train_stop =
+/// Settled it stops early once TrainingStop says the map has settled; the calls left are the
+/// caller's (for the estimate). The log counts the calls and records the map after each
+/// iteration.
+TrainingSpent train_map(MapStage& stage, const VegasOptions& options, const Problem& problem,
+                        const Proposal& proposal, int iterations, uint64_t calls,
+                        TrainingPoints& points, Pcg32& rng, Workspace& ws, TrainingLog& log);
 
 } // namespace mcp
