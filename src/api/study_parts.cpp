@@ -193,7 +193,8 @@ bool run_from_json(Ctx& c, const Json& j, const std::string& path, uint64_t n, R
 }
 
 const StopReason kStopReasons[] = {StopReason::ToleranceMet, StopReason::NMax,
-                                   StopReason::TimeBudget, StopReason::NoErrorBar};
+                                   StopReason::TimeBudget, StopReason::NoErrorBar,
+                                   StopReason::UntrustedErrorBar};
 
 Json stopping_run_to_json(const StoppingResult& s) {
     Json steps = Json::array();
@@ -204,8 +205,11 @@ Json stopping_run_to_json(const StoppingResult& s) {
                          {"half_width", exact(st.half_width)},
                          {"seconds", exact(st.seconds)},
                          {"dof", st.dof},
-                         {"trusted", st.trusted}});
+                         {"trusted", st.trusted},
+                         {"agrees", st.agrees},
+                         {"flagged", st.flagged}});
     return Json{{"answer", run_to_json(s.answer)},
+                {"extended", s.extended},
                 {"half_width", exact(s.half_width)},
                 {"target", exact(s.target)},
                 {"met", s.met},
@@ -223,7 +227,8 @@ bool stopping_run_from_json(Ctx& c, const Json& j, const std::string& path,
         !read_exact(c, j, "target", path, &s->target) || !read_flag(c, j, "met", path, &s->met) ||
         !get_string(c, j, "reason", path, &reason) ||
         !read_count(c, j, "evaluations", path, &s->evaluations, kMaxStudyEvaluations) ||
-        !read_exact(c, j, "seconds", path, &s->seconds, false))
+        !read_exact(c, j, "seconds", path, &s->seconds, false) ||
+        !read_flag(c, j, "extended", path, &s->extended))
         return false;
     bool known = false;
     for (StopReason r : kStopReasons)
@@ -251,7 +256,9 @@ bool stopping_run_from_json(Ctx& c, const Json& j, const std::string& path,
             !read_exact(c, sj, "half_width", sp, &st.half_width) ||
             !read_exact(c, sj, "seconds", sp, &st.seconds, false) ||
             !read_count(c, sj, "dof", sp, &dof, kMaxRunDof) ||
-            !read_flag(c, sj, "trusted", sp, &st.trusted))
+            !read_flag(c, sj, "trusted", sp, &st.trusted) ||
+            !read_flag(c, sj, "agrees", sp, &st.agrees) ||
+            !read_flag(c, sj, "flagged", sp, &st.flagged))
             return false;
         st.dof = static_cast<int>(dof);
         if (!in_range(c, sp, "std_error", st.std_error, 0.0, INFINITY, true) ||
@@ -514,6 +521,10 @@ bool merge_study_parts(Ctx& c, const Json& in, Json* out) {
                                              "]";
                     if (!stopping_run_from_json(c, (*rs)[k], path, settings, &runs[r]))
                         return false;
+                    // The answer's flags are a function of its run: recomputed, not carried.
+                    bool blocking = false;
+                    runs[r].flags = stopping_answer_flags(runs[r].answer, rq.problem,
+                                                          rq.estimators[e], &blocking);
                 }
             }
             st.runs.push_back(std::move(runs));

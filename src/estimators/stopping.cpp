@@ -59,8 +59,8 @@ bool error_bar_trusted(const RunResult& r) {
 // Condition 5: the study's judgement of the answer as a level of one run, without the exact
 // value (the rule cannot know it). Returns the flags; *blocking says whether a warning or an
 // error is among them.
-std::vector<Flag> judge_answer(const RunResult& answer, const Problem& problem,
-                               const EstimatorSpec& spec, bool* blocking) {
+std::vector<Flag> judge_answer_in(const RunResult& answer, const Problem& problem,
+                                  const EstimatorSpec& spec, bool* blocking) {
     Problem blind = problem;
     blind.exact.reset();
     LevelStats level = summarise_level({answer}, blind);
@@ -198,7 +198,7 @@ StoppingResult extend_to_tolerance(const Problem& problem, const EstimatorSpec& 
             step.agrees = std::fabs(d.mean()) <= tk * std::sqrt(d.variance() / kd);
         }
         bool blocking = false;
-        out.flags = judge_answer(r, problem, spec, &blocking);
+        out.flags = stopping_answer_flags(r, problem, spec, &blocking);
         step.flagged = blocking;
         out.steps.push_back(step);
         out.answer = r;
@@ -226,6 +226,11 @@ StoppingResult extend_to_tolerance(const Problem& problem, const EstimatorSpec& 
 }
 
 } // namespace
+
+std::vector<Flag> stopping_answer_flags(const RunResult& answer, const Problem& problem,
+                                        const EstimatorSpec& spec, bool* blocking) {
+    return judge_answer_in(answer, problem, spec, blocking);
+}
 
 bool stopping_extends(const EstimatorSpec& spec, const StoppingBudget& budget,
                       Accumulator accumulator) {
@@ -257,7 +262,7 @@ StoppingResult run_to_tolerance(const Problem& problem, const EstimatorSpec& spe
         step.half_width = t95(r.dof) * r.std_error;
         step.trusted = error_bar_trusted(r);
         bool blocking = false;
-        out.flags = judge_answer(r, problem, spec, &blocking);
+        out.flags = stopping_answer_flags(r, problem, spec, &blocking);
         step.flagged = blocking;
         out.steps.push_back(step);
         const StoppingStep* previous =

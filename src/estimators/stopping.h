@@ -104,6 +104,12 @@ struct StoppingResult {
     std::vector<StoppingStep> steps;
 };
 
+/// Condition 5: the study's judgement of a stopping answer as a level of one run, without the
+/// exact value; *blocking says whether a warning or an error among the flags keeps it from
+/// "met" (a merge of split stopping runs recomputes the flags with it).
+std::vector<Flag> stopping_answer_flags(const RunResult& answer, const Problem& problem,
+                                        const EstimatorSpec& spec, bool* blocking);
+
 /// "" when the tolerance and budget can be used, else a message naming the field.
 std::string check_stopping(const Tolerance& tol, const StoppingBudget& budget);
 
