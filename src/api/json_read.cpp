@@ -227,4 +227,25 @@ Made<Json> parse_json(const char* text, const char* what) {
     return {j, {}};
 }
 
+std::string first_difference(const Json& a, const Json& b, const std::string& path) {
+    if (a == b) return "";
+    if (a.is_object() && b.is_object()) {
+        for (auto it = a.begin(); it != a.end(); ++it) {
+            const std::string p = sub(path, it.key().c_str());
+            if (!b.contains(it.key())) return p;
+            const std::string d = first_difference(it.value(), b[it.key()], p);
+            if (!d.empty()) return d;
+        }
+        for (auto it = b.begin(); it != b.end(); ++it)
+            if (!a.contains(it.key())) return sub(path, it.key().c_str());
+    }
+    if (a.is_array() && b.is_array() && a.size() == b.size())
+        for (size_t i = 0; i < a.size(); ++i) {
+            const std::string d =
+                first_difference(a[i], b[i], path + "[" + std::to_string(i) + "]");
+            if (!d.empty()) return d;
+        }
+    return path;
+}
+
 } // namespace mcp

@@ -46,6 +46,9 @@ bool check_keys(Ctx& c, const Json& obj, const std::string& path,
                 const std::vector<std::string>& known);
 const Json* find(const Json& obj, const char* key);
 std::string sub(const std::string& path, const char* key);
+/// The first path at which two JSON values differ (objects by key, arrays of one size by index),
+/// "" when they are equal: for messages that name the field two inputs disagree on.
+std::string first_difference(const Json& a, const Json& b, const std::string& path);
 // Optional fields: each leaves *out unchanged when the key is absent.
 bool get_number(Ctx& c, const Json& obj, const char* key, const std::string& path, double* out);
 bool get_count(Ctx& c, const Json& obj, const char* key, const std::string& path, uint64_t* out);

@@ -282,22 +282,6 @@ std::vector<int> part_replicates(int reps, int part, int parts) {
     return rs;
 }
 
-/// The first key at which two JSON values differ, as a path ("" when equal).
-std::string first_difference(const Json& a, const Json& b, const std::string& path) {
-    if (a == b) return "";
-    if (a.is_object() && b.is_object()) {
-        for (auto it = a.begin(); it != a.end(); ++it) {
-            const std::string p = sub(path, it.key().c_str());
-            if (!b.contains(it.key())) return p;
-            const std::string d = first_difference(it.value(), b[it.key()], p);
-            if (!d.empty()) return d;
-        }
-        for (auto it = b.begin(); it != b.end(); ++it)
-            if (!a.contains(it.key())) return sub(path, it.key().c_str());
-    }
-    return path;
-}
-
 } // namespace study_parts
 
 bool is_study_part(const Json& j) {

@@ -45,28 +45,6 @@ size_t part_replicate_count(uint64_t reps, uint64_t index, uint64_t of) {
     return index < reps ? size_t((reps - 1 - index) / of + 1) : 0;
 }
 
-/// The first key at which two JSON values differ, as a path ("" when equal).
-std::string first_difference(const Json& a, const Json& b, const std::string& path) {
-    if (a == b) return "";
-    if (a.is_object() && b.is_object()) {
-        for (auto it = a.begin(); it != a.end(); ++it) {
-            const std::string p = sub(path, it.key().c_str());
-            if (!b.contains(it.key())) return p;
-            const std::string d = first_difference(it.value(), b[it.key()], p);
-            if (!d.empty()) return d;
-        }
-        for (auto it = b.begin(); it != b.end(); ++it)
-            if (!a.contains(it.key())) return sub(path, it.key().c_str());
-    }
-    if (a.is_array() && b.is_array() && a.size() == b.size())
-        for (size_t i = 0; i < a.size(); ++i) {
-            const std::string d =
-                first_difference(a[i], b[i], path + "[" + std::to_string(i) + "]");
-            if (!d.empty()) return d;
-        }
-    return path;
-}
-
 /// A part's value at a path found by first_difference, for the message ("missing" if none).
 std::string value_text(const Json& root, const std::string& path, const std::string& prefix) {
     if (path.compare(0, prefix.size(), prefix) != 0) return "?";
