@@ -48,6 +48,18 @@ double t95(int dof) {
 // sd, sqrt(6 / K), is 0.6 for K = 16); the weights' rule is the conservative stand-in.
 // Also the low_ess rule: a run whose sum rests on a handful of weights, or on none (every weight
 // 0: no point saw f, and 0 +- 0 says nothing), is not evidence.
+// A doubling's record: the run at n and its half-width t r.std_error.
+StoppingStep step_of(const RunResult& r, uint64_t n, double t) {
+    StoppingStep step;
+    step.n = n;
+    step.estimate = r.estimate;
+    step.std_error = r.std_error;
+    step.dof = r.dof;
+    step.seconds = r.seconds;
+    step.half_width = t * r.std_error;
+    return step;
+}
+
 bool error_bar_trusted(const RunResult& r) {
     const RunningMoments& u = r.diagnostics.weights;
     const double g1 = u.skewness();
@@ -179,13 +191,7 @@ StoppingResult extend_to_tolerance(const Problem& problem, const EstimatorSpec& 
         out.evaluations = n; // every point of every randomization once
         out.seconds += r.seconds;
 
-        StoppingStep step;
-        step.n = n;
-        step.estimate = r.estimate;
-        step.std_error = r.std_error;
-        step.dof = r.dof;
-        step.seconds = r.seconds;
-        step.half_width = tk * r.std_error;
+        StoppingStep step = step_of(r, n, tk);
         // Condition 3: the batch means' own skewness within three sampling sds of 0. (Cochran's
         // rule on the N weights, in condition 4, is the rule K > 25 (g1_w / sqrt m)^2 on the
         // skewness a batch mean of m weights would have from the weights' [Cochran77, 2.15].)
@@ -253,13 +259,7 @@ StoppingResult run_to_tolerance(const Problem& problem, const EstimatorSpec& spe
         const RunResult r = run_estimate(problem, spec, n, rng, ws, accumulator);
         out.evaluations += r.n;
         out.seconds += r.seconds;
-        StoppingStep step;
-        step.n = n;
-        step.estimate = r.estimate;
-        step.std_error = r.std_error;
-        step.dof = r.dof;
-        step.seconds = r.seconds;
-        step.half_width = t95(r.dof) * r.std_error;
+        StoppingStep step = step_of(r, n, t95(r.dof));
         step.trusted = error_bar_trusted(r);
         bool blocking = false;
         out.flags = stopping_answer_flags(r, problem, spec, &blocking);
