@@ -200,7 +200,9 @@ TEST(Stopping, MiserThatMissedHalfAPeakIsNotMet) {
     EXPECT_EQ(smooth.met_outside, 0);
 }
 
-// A scene's n_max is the stopping budget; 2^24 only when neither the scene nor the options say.
+// A scene that asks for stopping has its n_max as the budget; 2^24 only when neither the scene
+// nor the options say. A scene without its own tolerance, given one from outside (the page's
+// race), keeps 2^24: its n_max is the top of its study ladder.
 TEST(Stopping, TheScenesNMaxIsTheBudget) {
     Json scene = scene_file("exp_1d");
     scene["rel_tol"] = 1e-3;
@@ -211,6 +213,11 @@ TEST(Stopping, TheScenesNMaxIsTheBudget) {
     Made<SceneRequest> o = build_request(scene, Json{{"n_max", 4096}});
     ASSERT_TRUE(o.ok()) << o.error;
     EXPECT_EQ(o.value.settings.n_max, 4096u);
+    Json ladder = scene_file("exp_1d");
+    ASSERT_TRUE(ladder.contains("n_max"));
+    Made<SceneRequest> raced = build_request(ladder, Json{{"rel_tol", 1e-3}});
+    ASSERT_TRUE(raced.ok()) << raced.error;
+    EXPECT_EQ(raced.value.settings.n_max, kStoppingDefaultNMax);
 }
 
 TEST(Stopping, BudgetsEndItUnmetAndAPointSetWithoutErrorBarCannotBeRun) {

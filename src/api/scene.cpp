@@ -237,9 +237,13 @@ Made<SceneRequest> build_request(const Json& scene, const Json& options) {
         return made_error<SceneRequest>((from_options ? "options: " : "scene: ") + bad);
     }
     // Stopping at a requested accuracy: the tolerances and the time budget. N doubles up to the
-    // n_max the options or the scene give (the stopping budget), else up to 2^24.
+    // n_max the options give, or the scene's when the scene itself asks for stopping (then its
+    // n_max is its budget); else up to 2^24 (a scene's n_max without its own tolerance is the top
+    // of its study ladder, not a budget for a tolerance given from outside, as the page's race).
+    const bool scene_stops =
+        scene.is_object() && (find(scene, "rel_tol") || find(scene, "abs_tol"));
     if (s.stopping() && !(options.is_object() && find(options, "n_max")) &&
-        !(scene.is_object() && find(scene, "n_max")))
+        !(scene_stops && find(scene, "n_max")))
         s.n_max = kStoppingDefaultNMax;
     if (s.stopping() || s.abs_tol != 0.0 || s.rel_tol != 0.0 || s.max_seconds != 0.0) {
         const bool from_options =
