@@ -104,6 +104,20 @@ StopReason unmet_reason(const StoppingResult& out, StopReason budget_reason) {
     return out.half_width <= out.target ? StopReason::UntrustedErrorBar : budget_reason;
 }
 
+// The budget ends the doubling: the next N would pass n_max, or the next run (predicted at
+// twice this one's seconds) max_seconds. Then out's reason says which (and whether the last
+// error bar met the tolerance untrusted).
+bool budget_ended(const StoppingBudget& budget, uint64_t n, double run_seconds,
+                  StoppingResult* out) {
+    if (n > budget.n_max / 2)
+        out->reason = unmet_reason(*out, StopReason::NMax);
+    else if (out->seconds + 2.0 * run_seconds > budget.max_seconds)
+        out->reason = unmet_reason(*out, StopReason::TimeBudget);
+    else
+        return false;
+    return true;
+}
+
 // Adaptive estimators (VEGAS, VEGAS+, MISER) learn where f is from their own points: a region
 // they have not found is a bias their error bar cannot show, and runs that all missed it agree
 // with each other. Their condition 2 asks the run at N/2 to meet the tolerance itself, so that
@@ -220,14 +234,7 @@ StoppingResult extend_to_tolerance(const Problem& problem, const EstimatorSpec& 
             return out;
         }
         previous_batch = batch;
-        if (n > budget.n_max / 2) {
-            out.reason = unmet_reason(out, StopReason::NMax);
-            return out;
-        }
-        if (out.seconds + 2.0 * r.seconds > budget.max_seconds) {
-            out.reason = unmet_reason(out, StopReason::TimeBudget);
-            return out;
-        }
+        if (budget_ended(budget, n, r.seconds, &out)) return out;
     }
 }
 
@@ -288,14 +295,7 @@ StoppingResult run_to_tolerance(const Problem& problem, const EstimatorSpec& spe
             out.reason = StopReason::ToleranceMet;
             return out;
         }
-        if (n > budget.n_max / 2) {
-            out.reason = unmet_reason(out, StopReason::NMax);
-            return out;
-        }
-        if (out.seconds + 2.0 * r.seconds > budget.max_seconds) {
-            out.reason = unmet_reason(out, StopReason::TimeBudget);
-            return out;
-        }
+        if (budget_ended(budget, n, r.seconds, &out)) return out;
     }
 }
 
