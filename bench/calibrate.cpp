@@ -4,11 +4,12 @@
 //
 //   calibrate [--quick] [--reps R] [--n-min N] [--n-max N] [--ns N1,N2] [--param-seeds 1,2,3]
 //             [--dims 2,4,8] [--families 1,..,6] [--no-genz] [--singular] [--fine 3t|coverage]
-//             [--scenes DIR] [--json FILE] [--cells FILE] [--list N]
+//             [--scenes DIR] [--json FILE] [--cells FILE] [--list N] [--presets a,b]
 //             [--stopping REL [--stop-n-max N] [--max-seconds S]]
 //
 // --no-genz leaves Genz's families out (the scenes, and with --singular the products, alone).
 // --ns runs each listed N as a study of its own (instead of the ladder n_min..n_max).
+// --presets runs these presets only (default: every preset of kPresets).
 // --singular adds, per dimension and parameter seed, two products prod x_i^-a_i (monomial
 // integrands, exact prod 1 / (1 - a_i)): one of finite variance whose weights have an infinite
 // fourth moment (every a_i in (0.25, 0.35), tail index 1 / a_i near 3: the sample skewness is
@@ -64,8 +65,9 @@ using namespace mcp;
 
 namespace {
 
-const char* const kPresets[] = {"uniform", "stratified", "latin_hypercube", "sobol",      "halton",
-                                "lattice", "vegas",      "vegas_sobol",     "vegas_plus", "miser"};
+const char* const kPresets[] = {
+    "uniform", "stratified", "latin_hypercube", "sobol",      "sobol_walsh", "halton",
+    "lattice", "vegas",      "vegas_sobol",     "vegas_plus", "miser"};
 
 struct Options {
     int reps = 10;
@@ -73,6 +75,7 @@ struct Options {
     std::vector<int> dims{2, 4, 8};
     std::vector<uint64_t> param_seeds{1, 2, 3};
     std::vector<uint64_t> ns; // --ns: these N, each a study of its own
+    std::vector<std::string> presets{std::begin(kPresets), std::end(kPresets)}; // --presets
     std::vector<int> families{1, 2, 3, 4, 5, 6};
     bool singular = false;         // --singular: singular products too
     bool genz = true;              // --no-genz: the scenes (and products) alone
@@ -92,7 +95,7 @@ struct Options {
                          "         [--families 1,..,6] [--no-genz] [--singular]\n"
                          "         [--fine 3t|coverage]\n"
                          "         [--scenes DIR]\n"
-                         "         [--json FILE] [--cells FILE] [--list N]\n"
+                         "         [--json FILE] [--cells FILE] [--list N] [--presets a,b]\n"
                          "         [--stopping REL [--stop-n-max N] [--max-seconds S]]\n"
                          "         [--recheck K [--recheck-reps R]]\n");
     std::exit(2);
@@ -142,6 +145,15 @@ Options parse_options(int argc, char** argv) {
         else if (a == "--families") {
             o.families.clear();
             for (uint64_t f : parse_list(value(), "--families", 1, 6)) o.families.push_back(int(f));
+        } else if (a == "--presets") {
+            o.presets.clear();
+            std::stringstream ss(value());
+            for (std::string item; std::getline(ss, item, ',');) {
+                if (std::find_if(std::begin(kPresets), std::end(kPresets),
+                                 [&](const char* p) { return item == p; }) == std::end(kPresets))
+                    usage("--presets: unknown preset '" + item + "'");
+                o.presets.push_back(item);
+            }
         } else if (a == "--singular")
             o.singular = true;
         else if (a == "--no-genz")
@@ -198,7 +210,7 @@ struct Case {
 std::vector<Case> genz_cases(const Options& o) {
     std::vector<Case> cases;
     Json presets = Json::array();
-    for (const char* p : kPresets) presets.push_back(p);
+    for (const std::string& p : o.presets) presets.push_back(p);
     for (int fam1 : o.genz ? o.families : std::vector<int>())
         for (int d : o.dims)
             for (uint64_t seed : o.param_seeds) {
@@ -262,7 +274,7 @@ std::vector<Case> scene_cases(const Options& o) {
         // after the study with its own estimators.
         if (!j.ok() || !j.value.is_object() || j.value.contains("render")) continue;
         cases.push_back(Case{p.stem().string(), j.value, Json::object()});
-        for (const char* preset : kPresets)
+        for (const std::string& preset : o.presets)
             cases.push_back(
                 Case{p.stem().string() + "+" + preset, j.value, {{"estimators", {preset}}}});
     }

@@ -41,7 +41,8 @@ def integrand(p):
     return {"type": GENZ[fam], "a": a, "u": u}
 
 
-ESTIMATORS = (("sobol", 1e-3), ("lattice", 1e-3), ("halton", 1e-3), ("uniform", 1e-2))
+ESTIMATORS = (("sobol", 1e-3), ("sobol_walsh", 1e-3), ("lattice", 1e-3), ("halton", 1e-3),
+              ("uniform", 1e-2))
 
 
 def run_mcplay(cli, p, estimator, tol, reps):
@@ -58,7 +59,8 @@ def run_mcplay(cli, p, estimator, tol, reps):
     if out.returncode:
         sys.exit(f"{p['name']}: mcplay failed: {out.stderr.strip()}")
     runs = json.loads(out.stdout)["estimators"][0]["runs"]
-    return [dict(stopped=r["met"], within=abs(r["estimate"] - p["exact"]) <= tol * abs(p["exact"]),
+    return [dict(case=p["name"], stopped=r["met"],
+                 within=abs(r["estimate"] - p["exact"]) <= tol * abs(p["exact"]),
                  n=r["evaluations"], seconds=r["seconds"]) for r in runs]
 
 
@@ -144,9 +146,21 @@ def main():
                 continue
             stopped = row.get("error") is None and 0 < row["n"] < 2 ** 24
             theirs[(row["method"], row["tol"])].append(
-                dict(stopped=stopped, within=row["met"], n=row["n"]))
+                dict(case=row["case"], stopped=stopped, within=row["met"], n=row["n"]))
         for (method, tol), runs in sorted(theirs.items()):
             line(f"{method}, rel {tol:g}", runs)
+    # Per integral: the median evaluations of each method (runs in brackets).
+    tables = [(f"mcplay {e}", mine[(e, t)]) for e, t in chosen]
+    if args.qmcpy:
+        tables += [(m, runs) for (m, _), runs in sorted(theirs.items())]
+    print("\nmedian evaluations per integral (runs)")
+    print(f"  {'integral':16s}" + "".join(f" {label[:22]:>22s}" for label, _ in tables))
+    for p in params:
+        cells = []
+        for _, runs in tables:
+            ns = [r["n"] for r in runs if r["case"] == p["name"] and r["n"] > 0]
+            cells.append(f"{median(ns):.3g} ({len(ns)})" if ns else "-")
+        print(f"  {p['name']:16s}" + "".join(f" {c:>22s}" for c in cells))
 
 
 if __name__ == "__main__":

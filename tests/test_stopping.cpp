@@ -133,6 +133,37 @@ TEST(Stopping, RandomizedQmcExtendsItsSequencesAndKeepsThePromise) {
                         Tolerance{0.0, 1e-3}, 100);
 }
 
+// One scrambled Sobol' sequence with its Walsh bound (sobol_walsh) extends one sequence, keeps
+// the promise on smooth and discontinuous integrands, and on a smooth d = 2 integrand stops
+// with fewer evaluations than 16 randomizations do (the whole N in one net: its error falls
+// as N^-a, not (N/16)^-a / 4).
+TEST(Stopping, OneSobolSequenceWithItsWalshBoundKeepsThePromiseAtLessCost) {
+    expect_promise_kept(genz_scene(GenzFamily::Oscillatory, 2, 4, "sobol_walsh"), "sobol_walsh",
+                        Tolerance{0.0, 1e-3}, 40);
+    expect_promise_kept(genz_scene(GenzFamily::Gaussian, 4, 3, "sobol_walsh"), "sobol_walsh",
+                        Tolerance{0.0, 1e-2}, 100);
+    expect_promise_kept(genz_scene(GenzFamily::Discontinuous, 2, 1, "sobol_walsh"), "sobol_walsh",
+                        Tolerance{0.0, 1e-2}, 100);
+    StoppingBudget budget;
+    budget.n_start = 1024;
+    Workspace ws;
+    std::vector<uint64_t> cost[2];
+    const char* names[2] = {"sobol_walsh", "sobol"};
+    for (int e = 0; e < 2; ++e) {
+        SceneRequest q = request(genz_scene(GenzFamily::Oscillatory, 2, 4, names[e]));
+        for (int k = 0; k < 5; ++k) {
+            const StoppingResult s = run_to_tolerance(q.problem, q.estimators.front(),
+                                                      Tolerance{0.0, 1e-3}, budget, 3, k, ws);
+            ASSERT_TRUE(s.met) << names[e] << " run " << k;
+            EXPECT_EQ(s.evaluations, s.steps.back().n); // one sequence, extended
+            cost[e].push_back(s.evaluations);
+        }
+        std::nth_element(cost[e].begin(), cost[e].begin() + 2, cost[e].end());
+    }
+    EXPECT_LT(cost[0][2], cost[1][2])
+        << "median evaluations: sobol_walsh " << cost[0][2] << ", sobol " << cost[1][2];
+}
+
 namespace {
 
 // Runs `reps` seeded replicates of each estimator and counts the runs that said "met" with an

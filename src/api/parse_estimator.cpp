@@ -72,20 +72,95 @@ std::string new_name_fields() {
     return s;
 }
 
+// The quasi-Monte Carlo options of an estimator: its randomization, the number K of them, and
+// where its error bar comes from ("randomizations", or "walsh": one linearly scrambled Sobol'
+// sequence and its Walsh coefficients, core/walsh_bound.h).
+bool parse_qmc_options(Ctx& c, const std::string& path, const Problem& problem,
+                       const EstimatorPreset* preset, const std::string& randomization,
+                       int randomizations, const std::string& error_bar, EstimatorSpec* out) {
+    const bool preset_walsh = preset && preset->walsh_bound;
+    if (!error_bar.empty() && error_bar != "walsh" && error_bar != "randomizations")
+        return c.fail(sub(path, "error_bar"),
+                      "expected \"randomizations\" (the spread of K independent randomizations) "
+                      "or \"walsh\" (one scrambled Sobol' sequence's Walsh coefficients), got \"" +
+                          error_bar.substr(0, 64) + "\"");
+    if (preset && !error_bar.empty() && (error_bar == "walsh") != preset_walsh)
+        return c.fail(sub(path, "error_bar"),
+                      "'" + std::string(preset->name) + "' is the preset with the " +
+                          (preset_walsh ? "Walsh" : "randomizations'") +
+                          " error bar; give the estimator another name for another");
+    const bool walsh = preset_walsh || error_bar == "walsh";
+    if (!is_qmc(out->sampler)) {
+        if (!randomization.empty() || randomizations >= 0 || !error_bar.empty()) {
+            const char* field = !randomization.empty() ? "randomization"
+                                : randomizations >= 0  ? "randomizations"
+                                                       : "error_bar";
+            return c.fail(
+                sub(path, field),
+                "applies to the quasi-Monte Carlo samplers only (sobol, halton, lattice)");
+        }
+        return true;
+    }
+    const QmcKind q = qmc_kind_of(out->sampler);
+    out->randomization = walsh ? QmcRandomization::LmsShift : default_randomization(q);
+    if (!randomization.empty() && !parse_randomization(randomization, &out->randomization))
+        return c.fail(sub(path, "randomization"),
+                      "unknown randomization '" + randomization +
+                          "' (known: owen, lms_shift, digital_shift, permutation, "
+                          "random_shift, none)");
+    out->randomizations =
+        out->randomization == QmcRandomization::None || walsh ? 1 : kDefaultRandomizations;
+    if (randomizations >= 0) out->randomizations = randomizations;
+    SamplerOptions checked = out->sampler_options();
+    if (walsh) {
+        // The bound reads the Walsh coefficients of a digital net: Sobol' points that a linear
+        // scramble or a digital shift keeps a (shifted) digital net, one sequence of them.
+        if (out->sampler != SamplerKind::Sobol)
+            return c.fail(sub(path, "error_bar"),
+                          std::string("the Walsh bound is for the sobol sampler (a base-2 digital "
+                                      "net), not ") +
+                              sampler_name(out->sampler));
+        if (out->randomization != QmcRandomization::LmsShift &&
+            out->randomization != QmcRandomization::DigitalShift)
+            return c.fail(sub(path, "randomization"),
+                          "the Walsh bound needs points that stay a digital net: lms_shift or "
+                          "digital_shift (owen scrambling is not linear, none is not random), "
+                          "got " +
+                              std::string(randomization_name(out->randomization)));
+        if (out->randomizations != 1)
+            return c.fail(sub(path, "randomizations"),
+                          "the Walsh bound is of one randomized sequence: randomizations must be "
+                          "1, got " +
+                              std::to_string(out->randomizations));
+        out->walsh_bound = true;
+        checked.randomizations = 2; // the sampler's own check asks K >= 2 of a spread's error bar
+    }
+    const std::string bad =
+        check_sampler_options(out->sampler, checked, problem.domain.sample_dim());
+    if (!bad.empty()) {
+        const size_t colon = bad.find(": ");
+        const std::string field = bad.substr(0, colon);
+        if (field == "randomization" || field == "randomizations")
+            return c.fail(sub(path, field.c_str()), bad.substr(colon + 2));
+        return c.fail(path, bad);
+    }
+    return true;
+}
+
 } // namespace
 
 bool parse_estimator(Ctx& c, const Json& j, const std::string& path, const Problem& problem,
                      EstimatorSpec* out) {
-    std::string name, sampler_name_str, warp, randomization;
+    std::string name, sampler_name_str, warp, randomization, error_bar;
     int randomizations = -1; // -1: not given (0 is given, and refused below)
     const Json* pdf = nullptr;
     const KindFields* fields = nullptr; // the kind whose fields the object has
     if (j.is_string()) {
         name = j.get<std::string>();
     } else if (j.is_object()) {
-        std::vector<std::string> known = {"name",          "sampler",       "pdf",
-                                          "warp",          "samples_per_stratum",
-                                          "randomization", "randomizations"};
+        std::vector<std::string> known = {
+            "name",          "sampler",        "pdf",      "warp", "samples_per_stratum",
+            "randomization", "randomizations", "error_bar"};
         for (const KindFields& k : kind_fields()) {
             for (const char* key : k.selecting) known.push_back(key);
             for (const char* key : k.extra) known.push_back(key);
@@ -102,7 +177,8 @@ bool parse_estimator(Ctx& c, const Json& j, const std::string& path, const Probl
         if (!get_string(c, j, "name", path, &name) ||
             !get_string(c, j, "sampler", path, &sampler_name_str) ||
             !get_string(c, j, "warp", path, &warp) ||
-            !get_string(c, j, "randomization", path, &randomization))
+            !get_string(c, j, "randomization", path, &randomization) ||
+            !get_string(c, j, "error_bar", path, &error_bar))
             return false;
         if (find(j, "randomizations")) {
             uint64_t k = 0;
@@ -117,9 +193,8 @@ bool parse_estimator(Ctx& c, const Json& j, const std::string& path, const Probl
             if (!selected) {
                 for (const char* key : k.extra)
                     if (find(j, key))
-                        return c.fail(sub(path, key), "applies with \"" +
-                                                          std::string(k.selecting[0]) +
-                                                          "\" only");
+                        return c.fail(sub(path, key),
+                                      "applies with \"" + std::string(k.selecting[0]) + "\" only");
                 continue;
             }
             if (fields)
@@ -142,30 +217,8 @@ bool parse_estimator(Ctx& c, const Json& j, const std::string& path, const Probl
                                                 "' (known: " + sampler_names() + ")");
     if (out->per_stratum != 1 && out->sampler != SamplerKind::Stratified)
         return c.fail(sub(path, "samples_per_stratum"), "applies to the stratified sampler only");
-    if (is_qmc(out->sampler)) {
-        const QmcKind q = qmc_kind_of(out->sampler);
-        out->randomization = default_randomization(q);
-        if (!randomization.empty() && !parse_randomization(randomization, &out->randomization))
-            return c.fail(sub(path, "randomization"),
-                          "unknown randomization '" + randomization +
-                              "' (known: owen, lms_shift, digital_shift, permutation, "
-                              "random_shift, none)");
-        out->randomizations =
-            out->randomization == QmcRandomization::None ? 1 : kDefaultRandomizations;
-        if (randomizations >= 0) out->randomizations = randomizations;
-        const std::string bad = check_sampler_options(out->sampler, out->sampler_options(),
-                                                      problem.domain.sample_dim());
-        if (!bad.empty()) {
-            const size_t colon = bad.find(": ");
-            const std::string field = bad.substr(0, colon);
-            if (field == "randomization" || field == "randomizations")
-                return c.fail(sub(path, field.c_str()), bad.substr(colon + 2));
-            return c.fail(path, bad);
-        }
-    } else if (!randomization.empty() || randomizations >= 0) {
-        return c.fail(sub(path, randomization.empty() ? "randomizations" : "randomization"),
-                      "applies to the quasi-Monte Carlo samplers only (sobol, halton, lattice)");
-    }
+    if (!parse_qmc_options(c, path, problem, preset, randomization, randomizations, error_bar, out))
+        return false;
     if (!warp.empty() && warp != "polar" && warp != "concentric")
         return c.fail(sub(path, "warp"), "unknown warp '" + warp + "' (known: polar, concentric)");
     if (!warp.empty() && problem.domain.kind != DomainKind::Disk)

@@ -238,9 +238,12 @@ std::string format_table(const Json& r) {
     const Json& ests = list(r, "estimators");
     for (const Json& e : ests) {
         out << "\n" << jstr(e, "name") << "  [sampler " << jstr(e, "sampler");
-        if (get(e, "randomization").is_string())
+        if (get(e, "randomization").is_string()) {
+            const double k = jnum(e, "randomizations");
             out << " (" << jstr(e, "randomization") << ", "
-                << fmt("%.0f", jnum(e, "randomizations")) << " randomizations)";
+                << (k == 1.0 ? std::string("one sequence") : fmt("%.0f", k) + " randomizations")
+                << ")";
+        }
         out << ", pdf " << jstr(e, "pdf") << ", per-run error: " << jstr(e, "error_method")
             << "]\n";
         out << padl("N", 9) << padl("mean", 17) << padl("variance", 13) << padl("rel.err", 10);

@@ -9,6 +9,7 @@
 
 #include "api/json_read.h"
 #include "api/scene_parsers.h"
+#include "core/walsh_bound.h"
 #include "estimators/registry.h"
 #include "estimators/stopping.h"
 
@@ -287,6 +288,32 @@ Made<SceneRequest> build_request(const Json& scene, const Json& options) {
                  : "scene: estimator '") +
             name_text(e.name) + "': ";
         const std::vector<uint64_t> ladder = n_ladder(s.n_min, s.n_max);
+        if (e.walsh_bound) {
+            // The bound transforms N = 2^m values, at most 2^kWalshMaxLog2 (its coefficients are
+            // kept); runs below 2^kWalshMinLog2 (where the cone's bands begin) have no error
+            // bar. Stopping doubles from n_min (raised to 2^kWalshMinLog2).
+            const uint64_t least = uint64_t(1) << kWalshMinLog2, most = uint64_t(1)
+                                                                        << kWalshMaxLog2;
+            if (s.n_max < least)
+                return made_error<SceneRequest>(
+                    who +
+                    "the Walsh bound needs N = 2^m points, at "
+                    "least " +
+                    std::to_string(least) + ": n_max must be at least " + std::to_string(least) +
+                    ", got " + std::to_string(s.n_max));
+            if (s.stopping() && (s.n_min & (s.n_min - 1)) != 0)
+                return made_error<SceneRequest>(who +
+                                                "the Walsh bound doubles N = 2^m: n_min "
+                                                "must be a power of two, got " +
+                                                std::to_string(s.n_min));
+            if (s.n_max > most)
+                return made_error<SceneRequest>(who +
+                                                "the Walsh bound keeps N coefficients: n_max "
+                                                "must be at most 2^" +
+                                                std::to_string(kWalshMaxLog2) + " = " +
+                                                std::to_string(most) + ", got " +
+                                                std::to_string(s.n_max));
+        }
         if (!ladder.empty() && ladder.front() < k)
             return made_error<SceneRequest>(
                 who + std::to_string(k) + " randomizations need n_min >= " + std::to_string(k) +

@@ -8,6 +8,8 @@ namespace mcp {
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kInvPi = 0.31830988618379067154;
 constexpr double kSqrt2 = 1.41421356237309504880;
+/// The standard normal's 0.975 quantile: the half-width of a 95% interval in standard errors.
+constexpr double kNormal975 = 1.95996398454005423552;
 
 /// Standard normal CDF Phi(x), accurate in both tails.
 double normal_cdf(double x);

@@ -5,6 +5,9 @@
 #include <functional>
 #include <limits>
 
+#include "core/special.h"
+#include "core/walsh_bound.h"
+
 namespace mcp {
 
 namespace {
@@ -29,6 +32,8 @@ void WeightAccumulator::reset(ErrorMethod method, const SamplerPlan& plan, bool 
     top_.reserve(kTopWeights + kBlockSize);
     top_threshold_ = -1.0;
     batch_sums_.assign(plan.batches(), NeumaierSum());
+    walsh_values_.clear();
+    if (method == ErrorMethod::WalshBound) walsh_values_.reserve(plan.total);
 }
 
 void WeightAccumulator::keep_top() {
@@ -148,6 +153,7 @@ void WeightAccumulator::add_block(uint64_t first, const double* f, const double*
         diffs_ += first == 0 ? count - 1 : count;
         break;
     }
+    case ErrorMethod::WalshBound: walsh_values_.insert(walsh_values_.end(), w, w + count); break;
     case ErrorMethod::Iid:
     case ErrorMethod::IidConservative:
     case ErrorMethod::PartsSum:
@@ -182,6 +188,8 @@ void WeightAccumulator::merge(const WeightAccumulator& later) {
     keep_top();
     for (size_t k = 0; k < batch_sums_.size() && k < later.batch_sums_.size(); ++k)
         batch_sums_[k].add(later.batch_sums_[k].value());
+    walsh_values_.insert(walsh_values_.end(), later.walsh_values_.begin(),
+                         later.walsh_values_.end());
 }
 
 RunResult WeightAccumulator::finish(double scale) const {
@@ -230,6 +238,20 @@ RunResult WeightAccumulator::finish(double scale) const {
         if (batches > 1) {
             variance_of_mean = batch_means.variance() / static_cast<double>(batches);
             result.dof = interval_dof(batches - 1);
+        }
+        break;
+    }
+    case ErrorMethod::WalshBound: {
+        // The run's N = 2^m weights are one Sobol' sequence in Gray-code order; the transform
+        // wants the net's natural order.
+        const uint64_t size = walsh_values_.size();
+        if (size == n && (size & (size - 1)) == 0 && size >= (uint64_t(1) << kWalshMinLog2) &&
+            size <= (uint64_t(1) << kWalshMaxLog2)) {
+            std::vector<double> natural(size);
+            for (uint64_t i = 0; i < size; ++i) natural[gray_natural_index(i)] = walsh_values_[i];
+            const double half_width = walsh_bound_of(natural).bound();
+            variance_of_mean = std::pow(half_width / kNormal975, 2);
+            result.dof = interval_dof(uint64_t(1) << 40); // the normal quantile: t = 1.96
         }
         break;
     }

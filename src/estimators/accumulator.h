@@ -2,7 +2,8 @@
 // block in one pass and merged exactly across threads: Welford/Chan moments with a compensated
 // sum [Welford62, Chan79, Neumaier74], the sum of |w|, the largest |w| (tail index), counts of
 // non-finite and zero-pdf samples, the squared differences of neighbouring or paired strata
-// [Cochran77], and the sums of each quasi-Monte Carlo randomization.
+// [Cochran77], the sums of each quasi-Monte Carlo randomization, and for the Walsh bound every
+// weight (its transform needs all of them).
 #pragma once
 
 #include <cstdint>
@@ -51,6 +52,7 @@ class WeightAccumulator {
     std::vector<double> top_; ///< candidates for the kTopWeights largest |w|
     double top_threshold_ = -1.0;
     std::vector<NeumaierSum> batch_sums_; ///< quasi-Monte Carlo: sum of w per randomization
+    std::vector<double> walsh_values_;    ///< WalshBound: every weight, in the run's order
 };
 
 } // namespace mcp

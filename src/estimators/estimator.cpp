@@ -32,6 +32,7 @@ const char* error_method_name(ErrorMethod m) {
     case ErrorMethod::None: return "none";
     case ErrorMethod::PartsSum: return "parts_sum";
     case ErrorMethod::Regression: return "regression";
+    case ErrorMethod::WalshBound: return "walsh_bound";
     }
     return "?";
 }
@@ -51,6 +52,8 @@ ErrorMethod sampler_error_method(const EstimatorSpec& spec) {
         return spec.per_stratum == 2 ? ErrorMethod::PairedStrata : ErrorMethod::CollapsedStrata;
     case SamplerKind::LatinHypercube: return ErrorMethod::IidConservative;
     case SamplerKind::Sobol:
+        if (spec.walsh_bound) return ErrorMethod::WalshBound;
+        [[fallthrough]];
     case SamplerKind::Halton:
     case SamplerKind::Lattice:
         return spec.randomization == QmcRandomization::None ? ErrorMethod::None

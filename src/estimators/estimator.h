@@ -44,6 +44,11 @@ enum class ErrorMethod {
     PartsSum,
     /// One-sample optimal MIS: residuals of the samples' own regression, N - K dof
     Regression,
+    /// One randomized Sobol' sequence (linear scramble or digital shift), N = 2^m: the bound
+    /// fudge(m) S_{m-4,m} from its own Walsh coefficients [HickernellJimenezRugama16], reported as
+    /// a 95% half-width (std_error = bound / 1.96, normal quantile). It holds for integrands whose
+    /// Walsh coefficients decay predictably (a cone); its coverage is measured, not promised.
+    WalshBound,
 };
 const char* error_method_name(ErrorMethod m);
 /// Whether the method's error bars are wider than the estimator's spread by design (collapsed

@@ -2,7 +2,7 @@
 // randomized quasi-Monte Carlo set), warped by one proposal, weighted f/p and summed by the
 // weight accumulator: I_N = (1/N) sum f(x_i) / p(x_i) [Owen13, ch. 2, 10, 17]. The kind "fixed"
 // covers the methods uniform, importance, stratified, stratified_importance, latin_hypercube,
-// qmc and rqmc (the spec's sampler and proposal say which).
+// qmc, rqmc and rqmc_walsh (the spec's sampler, proposal and error bar say which).
 #include <algorithm>
 
 #include "estimators/estimator_kind.h"
@@ -56,7 +56,10 @@ class FixedEstimator final : public EstimatorAlgorithm {
 };
 
 const char* fixed_method(const EstimatorSpec& spec) {
-    if (is_qmc(spec.sampler)) return spec.randomization == QmcRandomization::None ? "qmc" : "rqmc";
+    if (is_qmc(spec.sampler)) {
+        if (spec.randomization == QmcRandomization::None) return "qmc";
+        return spec.walsh_bound ? "rqmc_walsh" : "rqmc";
+    }
     const bool importance = spec.proposal.importance;
     switch (spec.sampler) {
     case SamplerKind::Stratified: return importance ? "stratified_importance" : "stratified";

@@ -157,6 +157,9 @@ struct EstimatorSpec {
     uint64_t per_stratum = 1; ///< stratified: points per cell; 2 gives an unbiased error bar
     QmcRandomization randomization = QmcRandomization::Owen; ///< quasi-Monte Carlo samplers
     int randomizations = kDefaultRandomizations; ///< quasi-Monte Carlo: K batches per run
+    /// Sobol' with a linear scramble or digital shift and one randomization: the error bar from
+    /// the run's own Walsh coefficients (core/walsh_bound.h) instead of K randomizations.
+    bool walsh_bound = false;
     Proposal proposal;
     /// The options of the kinds that have them (each read by its kind only). VEGAS and VEGAS+:
     /// the map of the unit cube composed before the proposal's warp (estimators/vegas.h).

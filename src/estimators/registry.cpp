@@ -7,19 +7,18 @@
 namespace mcp {
 
 // Each defined in its estimator's own file.
-const EstimatorKind& fixed_estimator_kind();            // estimators/fixed.cpp
-const EstimatorKind& vegas_estimator_kind();            // estimators/vegas_estimator.cpp
-const EstimatorKind& vegas_plus_estimator_kind();       // estimators/vegas_plus.cpp
-const EstimatorKind& miser_estimator_kind();            // estimators/miser.cpp
-const EstimatorKind& mis_estimator_kind();              // estimators/mis.cpp
-const EstimatorKind& control_variate_estimator_kind();  // estimators/control_variates.cpp
-const EstimatorKind& antithetic_estimator_kind();       // estimators/antithetic.cpp
+const EstimatorKind& fixed_estimator_kind();           // estimators/fixed.cpp
+const EstimatorKind& vegas_estimator_kind();           // estimators/vegas_estimator.cpp
+const EstimatorKind& vegas_plus_estimator_kind();      // estimators/vegas_plus.cpp
+const EstimatorKind& miser_estimator_kind();           // estimators/miser.cpp
+const EstimatorKind& mis_estimator_kind();             // estimators/mis.cpp
+const EstimatorKind& control_variate_estimator_kind(); // estimators/control_variates.cpp
+const EstimatorKind& antithetic_estimator_kind();      // estimators/antithetic.cpp
 
 const std::vector<const EstimatorKind*>& estimator_kinds() {
     static const std::vector<const EstimatorKind*> kinds = {
-        &fixed_estimator_kind(),      &vegas_estimator_kind(),
-        &vegas_plus_estimator_kind(), &miser_estimator_kind(),
-        &mis_estimator_kind(),        &control_variate_estimator_kind(),
+        &fixed_estimator_kind(),      &vegas_estimator_kind(), &vegas_plus_estimator_kind(),
+        &miser_estimator_kind(),      &mis_estimator_kind(),   &control_variate_estimator_kind(),
         &antithetic_estimator_kind(),
     };
     return kinds;
@@ -43,6 +42,10 @@ const std::vector<EstimatorPreset>& estimator_presets() {
          "Owen-scrambled Halton points: 16 randomizations of N/16 points"},
         {"lattice", "fixed", SamplerKind::Lattice, false,
          "randomly shifted rank-1 lattice: 16 shifts of N/16 points"},
+        {"sobol_walsh", "fixed", SamplerKind::Sobol, false,
+         "one linearly scrambled Sobol' sequence of N = 2^m points, its error bound from its own "
+         "Walsh coefficients",
+         true},
         {"vegas", "vegas", SamplerKind::Independent, false,
          "VEGAS: a map trained on a quarter of N, then frozen for independent points"},
         {"vegas_sobol", "vegas", SamplerKind::Sobol, false,

@@ -29,6 +29,8 @@ struct EstimatorPreset {
     SamplerKind sampler;
     bool needs_pdf; ///< samples the scene's pdf (an estimator object must give one)
     const char* summary;
+    /// Sobol' with one linear scramble (lms_shift) and the Walsh error bound (walsh_bound).
+    bool walsh_bound = false;
 };
 /// Every preset, in the order messages and the catalog list them.
 const std::vector<EstimatorPreset>& estimator_presets();

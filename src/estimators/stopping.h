@@ -19,6 +19,11 @@
 //  3. the K batch means are not too skewed for a t interval: |g1| <= 3 sqrt(6 / K) (three
 //     sampling standard deviations of a normal sample's skewness), K >= 8 randomizations;
 //  4. the run's weights pass condition 4 below, and the study's flags raise nothing (5).
+// One Sobol' sequence with the Walsh bound (error_bar "walsh", core/walsh_bound.h) EXTENDS its one
+// sequence from 2^10 points: each doubling evaluates the next net, points [N/2, N), and updates
+// the bound [HickernellJimenezRugama16]. It stops at N when the bound meets the tolerance, the
+// N/2 and N intervals overlap, the ESS rule of condition 4 holds (Cochran's rule is not asked:
+// the bound is not a normal approximation) and the flags of condition 5 raise nothing.
 // Every N is a fresh run otherwise (its own replicate stream, so the evidence at N/2 is
 // independent of the answer at N; the cost is at most twice the answer's evaluations):
 //  1. the run at N meets the tolerance: t_0.975(dof) se <= tol, tol = max(abs, rel |I_N|);
@@ -30,7 +35,7 @@
 //  4. the run's error bar can be trusted at its size: Cochran's rule on its weights,
 //     N > 25 g1^2 [Cochran77] (the rule of the skewed_weights flag), and an effective sample
 //     size of at least min(10, N/4) (the low_ess rule: not 0 +- 0 from points that never saw f).
-// In both ways (5) the answer carries the judgement a study level gets: level_flags and
+// In every way (5) the answer carries the judgement a study level gets: level_flags and
 // tail_flags (estimators/diagnostics.h) of the answer as a level of one run, without the exact
 // value (a stopping rule cannot know it). A warning or an error among them (a heavy tail that
 // may mean infinite variance, too few effective samples, dropped samples) means the error bar

@@ -524,7 +524,9 @@ LevelStats summarise_level(const std::vector<RunResult>& runs, const Problem& pr
         s.bias = s.mean - exact;
         s.mse = sq_err.value() / R;
         s.rmse = std::sqrt(s.mse);
-        s.coverage = static_cast<double>(covered) / R;
+        // Coverage of the runs' own intervals: none when no run had an error bar.
+        s.coverage =
+            se_count ? static_cast<double>(covered) / R : std::numeric_limits<double>::quiet_NaN();
         s.error = s.rmse;
     } else {
         s.error = std::sqrt(s.variance);
@@ -545,7 +547,9 @@ LevelStats summarise_level(const std::vector<RunResult>& runs, const Problem& pr
     }
     const double roundoff = 64.0 * 2.220446049250313e-16 * largest;
     s.estimates_spread = highest - lowest > roundoff;
-    s.deterministic = every_run_deterministic;
+    // (Runs without an error bar that differ are random runs too small for theirs: a Walsh
+    // bound below 2^10 points.)
+    s.deterministic = every_run_deterministic && !s.estimates_spread;
     s.values_underflow = largest > 0.0 && largest < kUnderflowScale;
     // Exact: the replicates agree to round-off on a non-zero, finite mean from random runs with
     // no dropped sample, and, when the exact value is known, on that value (agreement alone can

@@ -56,6 +56,12 @@ const METHODS = {
     order: () => 'up to N⁻³ (times log factors) for smooth f with scrambled nets; N⁻¹ at worst',
     look: 'A slope steeper than −1 on smooth integrands, in any dimension where f depends mostly on a few coordinates. The error bar comes from the K randomizations (K − 1 degrees of freedom).',
   },
+  rqmc_walsh: {
+    title: 'Randomized Sobol\' points with a Walsh error bound',
+    formula: 'I_N = (1/N) Σ f(xᵢ), one linearly scrambled Sobol\' sequence of N = 2^m points; error bound 5·2^−m Σ |ỹ_κ| over one band of its Walsh coefficients',
+    order: () => 'up to N⁻³ (times log factors) for smooth f; N⁻¹ at worst',
+    look: 'The whole N in one sequence, so its error falls faster than K randomizations of N/K points. The error bar is a bound read from the run\'s own Walsh coefficients (Hickernell and Jiménez Rugama): it holds when they decay steadily, and is usually wider than the error, so coverage near 1 is expected; a spike the points never saw escapes it.',
+  },
   qmc: {
     title: 'Quasi-Monte Carlo (not randomized)',
     formula: 'I_N = (1/N) Σ f(xᵢ), xᵢ a deterministic low-discrepancy point set',
