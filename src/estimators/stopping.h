@@ -22,8 +22,9 @@
 // One Sobol' sequence with the Walsh bound (error_bar "walsh", core/walsh_bound.h) EXTENDS its one
 // sequence from 2^10 points: each doubling evaluates the next net, points [N/2, N), and updates
 // the bound [HickernellJimenezRugama16]. It stops at N when the bound meets the tolerance, the
-// N/2 and N intervals overlap, the ESS rule of condition 4 holds (Cochran's rule is not asked:
-// the bound is not a normal approximation) and the flags of condition 5 raise nothing.
+// intervals of the last four doublings hold the answer (within the answer's bound: a bound the
+// later points contradict means the integrand is outside the bound's cone), condition 4 holds
+// and the flags of condition 5 raise nothing.
 // Every N is a fresh run otherwise (its own replicate stream, so the evidence at N/2 is
 // independent of the answer at N; the cost is at most twice the answer's evaluations):
 //  1. the run at N meets the tolerance: t_0.975(dof) se <= tol, tol = max(abs, rel |I_N|);
