@@ -47,7 +47,7 @@ DEP_PROBES := /usr/bin/cmake /usr/bin/g++ /usr/src/googletest/CMakeLists.txt \
 	/usr/include/gtest/gtest.h /usr/bin/em++ /usr/include/glm/glm.hpp /usr/include/stb/stb_image_write.h \
 	/usr/include/tiny_gltf.h /usr/include/nlohmann/json.hpp /usr/bin/chromium
 
-.PHONY: all deps deps-web build build-wasm site test test-native test-wasm test-compare test-web-core \
+.PHONY: all deps deps-web build build-wasm site test test-native test-wasm test-wasm-statistical test-compare test-web-core \
 	test-e2e test-sanitize test-suites check run cli bench bench-mitsuba bench-embree format clean help \
 	fuzz fuzz-build fuzz-smoke deps-fuzz
 
@@ -58,7 +58,8 @@ help:
 	@echo "make cli    build the native CLI and run it on $(SCENE)"
 	@echo "make test   the contributor's loop: install what is missing, build native + wasm, run the"
 	@echo "           native, wasm, Node and Chromium suites (independent ones at the same time)"
-	@echo "make check  everything CI runs: make test, then the ASan/UBSan suite and make fuzz-smoke"
+	@echo "make check  everything CI runs: make test, then the ASan/UBSan suite, make fuzz-smoke and the"
+	@echo "           statistical runs under Node (test-wasm-statistical)"
 	@echo "make bench  samples per second natively and in wasm under Node, and their ratio; then bench-genz"
 	@echo "make bench-genz  mcplay beside GSL plain/MISER/VEGAS on Genz's families (GENZ_ARGS=--quick: 15 s)"
 	@echo "make bench-genz-peaks  vegas, vegas_plus beside GSL VEGAS on sharp product peaks (~4 min)"
@@ -106,8 +107,14 @@ build-wasm: deps $(BUILD_WASM)/CMakeCache.txt
 test-native: build
 	ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS)
 
+# Under Node the statistical promise runs (label "statistical": test_stopping, hundreds of
+# stopping runs per estimator, the slowest module there) wait for `make check`; the native suite
+# runs them in every loop.
 test-wasm: build-wasm
-	ctest --test-dir $(BUILD_WASM) --output-on-failure -j $(JOBS)
+	ctest --test-dir $(BUILD_WASM) --output-on-failure -j $(JOBS) -LE statistical
+
+test-wasm-statistical: build-wasm
+	ctest --test-dir $(BUILD_WASM) --output-on-failure -j $(JOBS) -L statistical
 
 # The same study through the native CLI and the wasm CLI under Node must agree.
 test-compare: build build-wasm
@@ -153,7 +160,7 @@ test-suites: test-native test-wasm test-compare test-web-core test-e2e
 check:
 	@start=$$(date +%s); \
 	$(MAKE) --no-print-directory test && \
-	$(MAKE) --no-print-directory -j 2 test-sanitize fuzz-smoke && \
+	$(MAKE) --no-print-directory -j 2 test-sanitize fuzz-smoke test-wasm-statistical && \
 	echo "make check: all suites passed in $$(( $$(date +%s) - start )) s"
 
 run: build site
