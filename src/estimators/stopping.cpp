@@ -130,6 +130,29 @@ bool adaptive(const EstimatorSpec& spec) {
     return kind == "vegas" || kind == "vegas_plus" || kind == "miser";
 }
 
+// A doubling's answer recorded in out: the study's flags of it (condition 5), its target and
+// step. True when it ends the run: no error bar, or every condition met.
+bool record_answer(StoppingStep step, const RunResult& r, const Problem& problem,
+                   const EstimatorSpec& spec, const Tolerance& tol, StoppingResult* out) {
+    bool blocking = false;
+    out->flags = stopping_answer_flags(r, problem, spec, &blocking);
+    step.flagged = blocking;
+    out->steps.push_back(step);
+    out->answer = r;
+    out->half_width = step.half_width;
+    out->target = std::fmax(tol.abs, tol.rel * std::fabs(r.estimate));
+    if (!std::isfinite(r.std_error)) {
+        out->reason = StopReason::NoErrorBar;
+        return true;
+    }
+    if (step.half_width <= out->target && step.agrees && step.trusted && !blocking) {
+        out->met = true;
+        out->reason = StopReason::ToleranceMet;
+        return true;
+    }
+    return false;
+}
+
 // Randomized QMC by extension (the header's first way): K accumulators, one per randomization,
 // each fed the points of its own randomized sequence in order.
 StoppingResult extend_to_tolerance(const Problem& problem, const EstimatorSpec& spec,
@@ -219,22 +242,7 @@ StoppingResult extend_to_tolerance(const Problem& problem, const EstimatorSpec& 
             for (size_t k = 0; k < batch.size(); ++k) d.add(batch[k] - previous_batch[k]);
             step.agrees = std::fabs(d.mean()) <= tk * std::sqrt(d.variance() / kd);
         }
-        bool blocking = false;
-        out.flags = stopping_answer_flags(r, problem, spec, &blocking);
-        step.flagged = blocking;
-        out.steps.push_back(step);
-        out.answer = r;
-        out.half_width = step.half_width;
-        out.target = std::fmax(tol.abs, tol.rel * std::fabs(r.estimate));
-        if (!std::isfinite(r.std_error)) {
-            out.reason = StopReason::NoErrorBar;
-            return out;
-        }
-        if (step.half_width <= out.target && step.agrees && step.trusted && !blocking) {
-            out.met = true;
-            out.reason = StopReason::ToleranceMet;
-            return out;
-        }
+        if (record_answer(step, r, problem, spec, tol, &out)) return out;
         previous_batch = batch;
         if (budget_ended(budget, n, r.seconds, &out)) return out;
     }
@@ -298,22 +306,7 @@ StoppingResult walsh_to_tolerance(const Problem& problem, const EstimatorSpec& s
         for (size_t j = from; j < out.steps.size(); ++j)
             step.agrees = step.agrees && std::fabs(step.estimate - out.steps[j].estimate) <=
                                              step.half_width + out.steps[j].half_width;
-        bool blocking = false;
-        out.flags = stopping_answer_flags(r, problem, spec, &blocking);
-        step.flagged = blocking;
-        out.steps.push_back(step);
-        out.answer = r;
-        out.half_width = step.half_width;
-        out.target = std::fmax(tol.abs, tol.rel * std::fabs(r.estimate));
-        if (!std::isfinite(r.std_error)) {
-            out.reason = StopReason::NoErrorBar;
-            return out;
-        }
-        if (step.half_width <= out.target && step.agrees && step.trusted && !blocking) {
-            out.met = true;
-            out.reason = StopReason::ToleranceMet;
-            return out;
-        }
+        if (record_answer(step, r, problem, spec, tol, &out)) return out;
         if (budget_ended(budget, n, r.seconds, &out)) return out;
     }
 }
