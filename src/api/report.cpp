@@ -536,9 +536,9 @@ Json stopping_to_json(const StoppingStudy& st) {
                    "skewness^2, ESS, no warning or error flag), agreeing with N/2: randomized QMC "
                    "extends its K sequences (t interval of the K batch means, paired N/2 check, "
                    "skewness of the batch means), one Sobol' sequence with the Walsh bound "
-                   "extends it (the bound meets the tolerance, the last four doublings' bounds hold the "
-                   "answer, N > 25 skewness^2, ESS), "
-                   "others run each N afresh with the run at N/2 predicting the tolerance"}}},
+                   "extends it (the bound meets the tolerance, the last four doublings' bounds "
+                   "hold the answer, N > 25 skewness^2, ESS), others run each N afresh with the "
+                   "run at N/2 predicting the tolerance"}}},
         {"wall_time_s", num(st.wall_seconds)},
         {"estimators", estimators}};
 }

@@ -296,15 +296,13 @@ Made<SceneRequest> build_request(const Json& scene, const Json& options) {
                                                                         << kWalshMaxLog2;
             if (s.n_max < least)
                 return made_error<SceneRequest>(
-                    who +
-                    "the Walsh bound needs N = 2^m points, at "
-                    "least " +
+                    who + "the Walsh bound needs N = 2^m points, at least " +
                     std::to_string(least) + ": n_max must be at least " + std::to_string(least) +
                     ", got " + std::to_string(s.n_max));
             if (s.stopping() && (s.n_min & (s.n_min - 1)) != 0)
                 return made_error<SceneRequest>(who +
-                                                "the Walsh bound doubles N = 2^m: n_min "
-                                                "must be a power of two, got " +
+                                                "the Walsh bound doubles N = 2^m: n_min must "
+                                                "be a power of two, got " +
                                                 std::to_string(s.n_min));
             if (s.n_max > most)
                 return made_error<SceneRequest>(who +

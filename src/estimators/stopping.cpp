@@ -94,7 +94,6 @@ std::vector<Flag> judge_answer_in(const RunResult& answer, const Problem& proble
         // The K batch means of one run: the study's rule (K > 25 g1^2 on R K pooled means)
         // would refuse about 15% of normal runs with K = 16 (a sample skewness of 16 values has
         // sd 0.56); the extended rule's condition 3 judges them instead.
-        // The Walsh bound does not rest on a normal approximation of the weights' mean either.
         if (f.code == FlagCode::SkewedWeights && answer.diagnostics.batch_units) continue;
         *blocking = *blocking || f.severity != Severity::Info;
     }
