@@ -394,6 +394,68 @@ TEST(VegasTraining, TrainingStopRule) {
     for (int i = 0; i < 5; ++i) EXPECT_FALSE(broken.settled(1.0, std::nan(""), 1000, 0.01));
 }
 
+// A variance that jumps above kVegasSettleRise times its least (the iteration's points found a
+// peak the map had under-sampled; its few large weights also make the estimates "agree" within
+// their wide error bars) counts as the map still changing: two more flat iterations are needed.
+TEST(VegasTraining, AVarianceThatRisesIsNotSettled) {
+    TrainingStop stop;
+    EXPECT_FALSE(stop.settled(1.0, 1.0, 1000, 0.01));
+    EXPECT_FALSE(stop.settled(1.0, 0.99, 1000, 0.01));
+    EXPECT_FALSE(stop.settled(1.5, 30.0, 1000, 0.01)); // flat M, agreeing: settled without the rise
+    EXPECT_FALSE(stop.settled(1.0, 1.0, 1000, 0.01));
+    EXPECT_TRUE(stop.settled(1.0, 1.0, 1000, 0.01));
+    TrainingStop noise; // within the factor: stalled as before
+    EXPECT_FALSE(noise.settled(1.0, 1.0, 1000, 0.01));
+    EXPECT_FALSE(noise.settled(1.0, 1.0, 1000, 0.01));
+    EXPECT_TRUE(noise.settled(1.0, 1.9, 1000, 0.01));
+}
+
+// The defaults per estimator (vegas_resolved): the map alone (independent points, frozen)
+// trains with damping 1 for up to 20 iterations until settled; stratified or QMC points after
+// the map, VEGAS+ and the iteration average keep vegas's 0.5 and 10 whole iterations; a field
+// the scene sets is kept, and a "vegas" object that leaves train_stop out gets the default.
+TEST(VegasOptions, DefaultsPerEstimator) {
+    Made<SceneRequest> r = request(gaussian_scene(0.1, R"(["vegas", "vegas_sobol", "vegas_plus",
+                 {"name": "it", "vegas": {"report": "iterations"}},
+                 {"name": "strata", "sampler": "stratified", "vegas": {}},
+                 {"name": "a07", "vegas": {"alpha": 0.7}},
+                 {"name": "sobol_settled", "sampler": "sobol",
+                  "vegas": {"train_stop": "settled", "train_iterations": 30}}])"));
+    ASSERT_TRUE(r.ok()) << r.error;
+    struct Want {
+        double alpha;
+        int iterations;
+        VegasTrainStop stop;
+    } want[] = {{1.0, 20, VegasTrainStop::Settled}, {0.5, 10, VegasTrainStop::Budget},
+                {0.5, 10, VegasTrainStop::Budget},  {0.5, 10, VegasTrainStop::Budget},
+                {0.5, 10, VegasTrainStop::Budget},  {0.7, 20, VegasTrainStop::Settled},
+                {0.5, 30, VegasTrainStop::Settled}};
+    ASSERT_EQ(r.value.estimators.size(), 7u);
+    for (size_t e = 0; e < 7; ++e) {
+        const EstimatorSpec& spec = r.value.estimators[e];
+        const bool plus = std::string(spec.kind->name) == "vegas_plus";
+        const VegasOptions o = vegas_resolved(spec.vegas_options, spec.sampler, plus);
+        EXPECT_EQ(o.alpha, want[e].alpha) << spec.name;
+        EXPECT_EQ(o.train_iterations, want[e].iterations) << spec.name;
+        EXPECT_TRUE(o.train_stop == want[e].stop) << spec.name;
+    }
+}
+
+// The default increments are sized by the training share split in kVegasSizingIterations
+// (about 100 points per increment there), not by the actual iterations: 20 iterations of
+// 13107 points in d = 2 keep the 262 increments of 10 iterations; at most 1/10 of an
+// iteration's points, and the caps of vegas_increments, still hold.
+TEST(VegasOptions, IncrementsSizedByTheTrainingShare) {
+    const VegasOptions o;
+    EXPECT_EQ(vegas_trainable_increments(o, 2, 13107, 262144), 262);
+    EXPECT_EQ(vegas_trainable_increments(o, 2, 13107), 131);
+    EXPECT_EQ(vegas_trainable_increments(o, 2, 1000, 100000), 100); // 10 per increment
+    EXPECT_EQ(vegas_trainable_increments(o, 6, 100000, 4000000), 500);
+    VegasOptions given;
+    given.increments = 50;
+    EXPECT_EQ(vegas_trainable_increments(given, 2, 13107, 262144), 50);
+}
+
 // Error bars on a sharp product peak (a = 200, d = 4) cover: 100 seeded runs of 2^16 calls for
 // vegas and vegas_plus; under honest 95% intervals Binomial(100, 0.95) is 87 or fewer with
 // probability 0.0043, and the mean is within 4 standard errors of the exact value.

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/points.h"
+#include "core/samplers.h"
 
 namespace mcp {
 
@@ -19,6 +20,7 @@ enum class VegasReport {
 
 /// When VEGAS training stops.
 enum class VegasTrainStop {
+    Default, ///< the estimator's own (vegas_resolved)
     Settled, ///< once the map has settled (TrainingStop, vegas_train.h), at most the budget
     Budget   ///< after the whole training budget, train_fraction N in train_iterations
 };
@@ -27,17 +29,15 @@ enum class VegasTrainStop {
 struct VegasOptions {
     int increments = 0; ///< per axis; 0 chooses vegas_increments()
     /// Damping exponent of the refinement [Lepage78, Lepage21, eq. 22]: Lepage78 gives 1 to 2
-    /// (GSL 1.5), vegas 0.5. At 0.5 the map converges too slowly for a sharp peak: on Genz's
-    /// product peak (a = 100 to 1000, d = 6, N = 2^20) alpha 1 with 20 settled iterations cut
-    /// the RMSE 3-16x (docs/benchmarks.md); not the default yet (it broke calibration tests).
-    double alpha = 0.5;
+    /// (GSL 1.5), vegas 0.5. Negative: the estimator's default (vegas_resolved).
+    double alpha = -1.0;
     double train_fraction = 0.25; ///< share of the N evaluations spent training the map
     /// The training share is split into this many iterations, at most: training stops when
     /// the map has settled (train_stop). More, smaller iterations converge on a sharp peak
-    /// where 10 did not (the map needs steps more than points per step).
-    int train_iterations = 10;
+    /// where 10 did not (the map needs steps more than points per step). 0: the default.
+    int train_iterations = 0;
     VegasTrainStop train_stop =
-        VegasTrainStop::Budget;  ///< Settled: the calls left go to the estimate
+        VegasTrainStop::Default; ///< Settled: the calls left go to the estimate
     double uniform_share = 0.05; ///< share of each axis's increments spread evenly
     VegasReport report = VegasReport::Frozen;
     int iterations = 5; ///< Iterations: the estimation share is split into this many
@@ -47,6 +47,11 @@ struct VegasOptions {
     bool stratify = false;
     double beta = 0.75;
 };
+
+/// The options a run uses: `options` with the fields left to the estimator (alpha < 0,
+/// train_iterations 0, train_stop Default) filled in for its sampler, its report and whether
+/// it is VEGAS+ (`plus`: the estimator kind vegas_plus; docs/scene-format.md, VEGAS).
+VegasOptions vegas_resolved(const VegasOptions& options, SamplerKind sampler, bool plus);
 
 /// Least points per training iteration where the training share allows: fewer, and the map
 /// learns from noise (vegas's own examples train on 1000 points per iteration).
@@ -74,9 +79,17 @@ int vegas_increments(int dim, uint64_t points_per_iteration);
 /// 65536 increments, 2,500 points per iteration: estimates of 1e-164 for an integral of 1).
 constexpr uint64_t kVegasPointsPerIncrement = 10;
 
-/// The increments a run uses: options.increments when given (vegas_increments() when 0), at
-/// most points_per_iteration / kVegasPointsPerIncrement (at least 2) when the map is trained.
-int vegas_trainable_increments(const VegasOptions& options, int dim, uint64_t points_per_iteration);
+/// The training share's split that sizes the default increments: vegas_increments() sees
+/// training_calls / kVegasSizingIterations points per iteration however many iterations the
+/// training runs. Sized by the actual iterations, 20 iterations halved K against 10, and on
+/// smooth integrands in d = 2 (Genz's Gaussian, continuous) vegas_sobol's RMSE^2 grew 5-20x.
+constexpr int kVegasSizingIterations = 10;
+
+/// The increments a run uses: options.increments when given, else vegas_increments() of the
+/// larger of points_per_iteration and training_calls / kVegasSizingIterations; at most
+/// points_per_iteration / kVegasPointsPerIncrement (at least 2) when the map is trained.
+int vegas_trainable_increments(const VegasOptions& options, int dim, uint64_t points_per_iteration,
+                               uint64_t training_calls = 0);
 
 /// Why options.increments cannot be trained even at the largest N of a study, n_max: fewer than
 /// kVegasPointsPerIncrement points per increment per training iteration (or per averaged
