@@ -99,6 +99,36 @@ TEST(VegasMap, ConcentratesWhereTheMarginalHasItsMass) {
     }
 }
 
+// The even share is the whole map's: each axis spreads 1 - 0.95^(1/d) of its probability
+// evenly, so that a point is in the learnt part of every axis with probability 0.95, where an
+// even share of 0.05 per axis left 0.95^d of them there (0.77 in d = 5). One adaptation of the
+// identity map (K = 1000) to training data that is 1 on the first 20% of every axis and 0
+// elsewhere: [0.3, 1], beyond the smoothing's reach, holds 0.7 of the even share, up to the
+// map's resolution 1 / K (0.0071 in d = 5; 0.035 with the share per axis).
+TEST(VegasMap, TheEvenShareIsTheWholeMaps) {
+    const int k = 1000;
+    for (int dim : {1, 2, 5}) {
+        VegasMap m(dim, k);
+        std::vector<uint32_t> bins(static_cast<size_t>(dim) * kBlockSize);
+        std::vector<double> weight(kBlockSize);
+        for (int first = 0; first < k; first += static_cast<int>(kBlockSize)) {
+            const int count = std::min(k - first, static_cast<int>(kBlockSize));
+            for (int i = 0; i < count; ++i) {
+                for (int j = 0; j < dim; ++j)
+                    bins[static_cast<size_t>(j) * kBlockSize + i] =
+                        static_cast<uint32_t>(first + i);
+                weight[i] = first + i < k / 5 ? 1.0 : 0.0;
+            }
+            m.add_training(bins.data(), weight.data(), static_cast<size_t>(count));
+        }
+        m.adapt(1.0, 0.05);
+        const double even = 1.0 - std::pow(0.95, 1.0 / dim);
+        for (int j = 0; j < dim; ++j)
+            EXPECT_NEAR(map_probability(m, j, 0.3, 1.0), 0.7 * even, 1.0 / k)
+                << "d = " << dim << ", axis " << j;
+    }
+}
+
 TEST(VegasMap, AnAxisWithoutDataKeepsItsEdges) {
     VegasMap m(1, 10);
     std::vector<uint32_t> bins(kBlockSize, 3);

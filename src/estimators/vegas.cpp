@@ -125,6 +125,12 @@ void VegasMap::add_training(const uint32_t* bins, const double* weights, const d
 }
 
 void VegasMap::adapt(double alpha, double uniform_share) {
+    // The even share is the whole map's: each axis spreads 1 - (1 - share)^(1/d) of its
+    // increments evenly, so that a point is in the learnt part of every axis with probability
+    // 1 - share. With the share on each axis, 1 - 0.95^6 = 26% of the points in d = 6 fell in
+    // some axis's even part, far from a sharp product peak (near-zero weights); that alone put
+    // the relative variance of the mapped weights near 0.35 whatever the map learnt.
+    const double even = dim_ > 1 ? 1.0 - std::pow(1.0 - uniform_share, 1.0 / dim_) : uniform_share;
     std::vector<double> d(static_cast<size_t>(k_)), smooth(static_cast<size_t>(k_));
     std::vector<double> fresh(static_cast<size_t>(k_) + 1);
     for (int j = 0; j < dim_; ++j) {
@@ -156,14 +162,13 @@ void VegasMap::adapt(double alpha, double uniform_share) {
         }
         if (!(damped_total > 0.0)) continue;
         // A share of the increments spread evenly over the axis, whatever the training saw:
-        // no increment is wider than 1 / (share K), so the axis's Jacobian stays below
-        // 1 / share. Without it a region where f was seen as 0 collapses into one increment
+        // no increment is wider than 1 / (even K), so the axis's Jacobian stays below
+        // 1 / even. Without it a region where f was seen as 0 collapses into one increment
         // that also reaches into a region where f is large (a discontinuity), and the rare
         // points there carry huge weights (heavy tails, error bars that miss).
         const double* edge = edges(j);
         for (int i = 0; i < k_; ++i)
-            smooth[i] = (1.0 - uniform_share) * smooth[i] / damped_total +
-                        uniform_share * (edge[i + 1] - edge[i]);
+            smooth[i] = (1.0 - even) * smooth[i] / damped_total + even * (edge[i + 1] - edge[i]);
         damped_total = 1.0;
         // New edges: increment i of the old map holds a share smooth[i] of the total, spread
         // evenly over it; the new edges cut the total into K equal shares.

@@ -38,7 +38,10 @@ struct VegasOptions {
     int train_iterations = 0;
     VegasTrainStop train_stop =
         VegasTrainStop::Default; ///< Settled: the calls left go to the estimate
-    double uniform_share = 0.05; ///< share of each axis's increments spread evenly
+    /// Share of the map spread evenly: each axis spreads 1 - (1 - uniform_share)^(1/d) of its
+    /// increments evenly, so a point lies in the learnt part of every axis with probability
+    /// 1 - uniform_share (VegasMap::adapt).
+    double uniform_share = 0.05;
     VegasReport report = VegasReport::Frozen;
     int iterations = 5; ///< Iterations: the estimation share is split into this many
     /// VEGAS+ [Lepage21, sec. 3]: hypercubes of the y space, each sampled with n_h >= 2 points,
@@ -125,7 +128,8 @@ class VegasMap {
     /// Refines the map from the training data and clears it [Lepage21, sec. 2.2]: per axis the
     /// mean w^2 of each increment d_i is smoothed with its neighbours (weights 1, 6, 1 over 8;
     /// 7, 1 at the ends), normalised to sum 1, damped to ((1 - d_i) / ln(1 / d_i))^alpha, and
-    /// the new edges give every increment an equal share of the damped d. An axis with no
+    /// the new edges give every increment an equal share of the damped d, mixed with an even
+    /// spread of 1 - (1 - uniform_share)^(1/dim) of the axis. An axis with no
     /// non-zero data keeps its edges.
     void adapt(double alpha, double uniform_share);
 
