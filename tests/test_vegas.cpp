@@ -99,15 +99,22 @@ TEST(VegasMap, ConcentratesWhereTheMarginalHasItsMass) {
     }
 }
 
-// The even share is the whole map's: each axis spreads 1 - 0.95^(1/d) of its probability
-// evenly, so that a point is in the learnt part of every axis with probability 0.95, where an
-// even share of 0.05 per axis left 0.95^d of them there (0.77 in d = 5). One adaptation of the
-// identity map (K = 1000) to training data that is 1 on the first 20% of every axis and 0
-// elsewhere: [0.3, 1], beyond the smoothing's reach, holds 0.7 of the even share, up to the
-// map's resolution 1 / K (0.0071 in d = 5; 0.035 with the share per axis).
-TEST(VegasMap, TheEvenShareIsTheWholeMaps) {
+// The map alone's even share is 5% of the whole map: each axis spreads 1 - 0.95^(1/d) of its
+// probability evenly (vegas_resolved), so that a point is in the learnt part of every axis
+// with probability 0.95, where 0.05 per axis left 0.95^d of them there (0.77 in d = 5); the
+// other estimators keep 0.05 per axis. One adaptation of the identity map (K = 1000) to
+// training data that is 1 on the first 20% of every axis and 0 elsewhere: [0.3, 1], beyond the
+// smoothing's reach, holds 0.7 of the axis's share, up to the map's resolution 1 / K.
+TEST(VegasMap, TheMapAlonesEvenShareIsTheWholeMaps) {
     const int k = 1000;
     for (int dim : {1, 2, 5}) {
+        const double share =
+            vegas_resolved(VegasOptions(), SamplerKind::Independent, false, dim).uniform_share;
+        EXPECT_NEAR(std::pow(1.0 - share, dim), 0.95, 1e-12) << "d = " << dim;
+        EXPECT_EQ(vegas_resolved(VegasOptions(), SamplerKind::Sobol, false, dim).uniform_share,
+                  0.05);
+        EXPECT_EQ(vegas_resolved(VegasOptions(), SamplerKind::Independent, true, dim).uniform_share,
+                  0.05);
         VegasMap m(dim, k);
         std::vector<uint32_t> bins(static_cast<size_t>(dim) * kBlockSize);
         std::vector<double> weight(kBlockSize);
@@ -121,12 +128,14 @@ TEST(VegasMap, TheEvenShareIsTheWholeMaps) {
             }
             m.add_training(bins.data(), weight.data(), static_cast<size_t>(count));
         }
-        m.adapt(1.0, 0.05);
-        const double even = 1.0 - std::pow(0.95, 1.0 / dim);
+        m.adapt(1.0, share);
         for (int j = 0; j < dim; ++j)
-            EXPECT_NEAR(map_probability(m, j, 0.3, 1.0), 0.7 * even, 1.0 / k)
+            EXPECT_NEAR(map_probability(m, j, 0.3, 1.0), 0.7 * share, 1.0 / k)
                 << "d = " << dim << ", axis " << j;
     }
+    VegasOptions given;
+    given.uniform_share = 0.2;
+    EXPECT_EQ(vegas_resolved(given, SamplerKind::Independent, false, 5).uniform_share, 0.2);
 }
 
 TEST(VegasMap, AnAxisWithoutDataKeepsItsEdges) {
@@ -464,10 +473,12 @@ TEST(VegasOptions, DefaultsPerEstimator) {
     for (size_t e = 0; e < 7; ++e) {
         const EstimatorSpec& spec = r.value.estimators[e];
         const bool plus = std::string(spec.kind->name) == "vegas_plus";
-        const VegasOptions o = vegas_resolved(spec.vegas_options, spec.sampler, plus);
+        const VegasOptions o = vegas_resolved(spec.vegas_options, spec.sampler, plus, 2);
         EXPECT_EQ(o.alpha, want[e].alpha) << spec.name;
         EXPECT_EQ(o.train_iterations, want[e].iterations) << spec.name;
         EXPECT_TRUE(o.train_stop == want[e].stop) << spec.name;
+        const bool alone = want[e].stop == VegasTrainStop::Settled && want[e].alpha > 0.5;
+        EXPECT_DOUBLE_EQ(o.uniform_share, alone ? 1.0 - std::sqrt(0.95) : 0.05) << spec.name;
     }
 }
 

@@ -46,7 +46,7 @@ bool parse_vegas_options(Ctx& c, const Json& j, const std::string& path, int dim
     if (!(out->train_fraction >= 0.0 && out->train_fraction <= 0.9))
         return c.fail(sub(path, "train_fraction"),
                       "must be in [0, 0.9]: the share of N that trains the map");
-    if (!(out->uniform_share >= 0.0 && out->uniform_share <= 1.0))
+    if (find(j, "uniform_share") && !(out->uniform_share >= 0.0 && out->uniform_share <= 1.0))
         return c.fail(sub(path, "uniform_share"), "must be in [0, 1]");
     if (find(j, "train_iterations") && (iterations < 1 || iterations > 1000))
         return c.fail(sub(path, "train_iterations"), "must be in [1, 1000]");

@@ -7,7 +7,7 @@
 
 namespace mcp {
 
-VegasOptions vegas_resolved(const VegasOptions& options, SamplerKind sampler, bool plus) {
+VegasOptions vegas_resolved(const VegasOptions& options, SamplerKind sampler, bool plus, int dim) {
     VegasOptions o = options;
     // The trained map on its own (independent points, frozen): damping 1 and up to 20
     // iterations until settled, which a sharp peak needs. Where the frozen map's points are
@@ -21,6 +21,16 @@ VegasOptions vegas_resolved(const VegasOptions& options, SamplerKind sampler, bo
     if (o.train_iterations <= 0) o.train_iterations = map_alone ? 20 : 10;
     if (o.train_stop == VegasTrainStop::Default)
         o.train_stop = map_alone ? VegasTrainStop::Settled : VegasTrainStop::Budget;
+    // The even share: for the map alone 5% of the whole map, 1 - 0.95^(1/d) on each axis, so
+    // that a point is in the learnt part of every axis with probability 0.95. With 0.05 on
+    // each axis, 1 - 0.95^d of the points (26% in d = 6) fell in some axis's even part, far
+    // from a sharp product peak, with near-zero weights: that alone held the relative variance
+    // of the weights near 0.35-0.5 on Genz's product peaks whatever the map learnt. The others
+    // keep 0.05 per axis (their strata and nets spread over the even part; smaller shares cost
+    // vegas_sobol and vegas_plus 4-5x on discontinuous and corner-peak cases).
+    if (o.uniform_share < 0.0)
+        o.uniform_share = map_alone ? 1.0 - std::pow(1.0 - kVegasEvenShare, 1.0 / std::max(dim, 1))
+                                    : kVegasEvenShare;
     return o;
 }
 
@@ -125,12 +135,6 @@ void VegasMap::add_training(const uint32_t* bins, const double* weights, const d
 }
 
 void VegasMap::adapt(double alpha, double uniform_share) {
-    // The even share is the whole map's: each axis spreads 1 - (1 - share)^(1/d) of its
-    // increments evenly, so that a point is in the learnt part of every axis with probability
-    // 1 - share. With the share on each axis, 1 - 0.95^6 = 26% of the points in d = 6 fell in
-    // some axis's even part, far from a sharp product peak (near-zero weights); that alone put
-    // the relative variance of the mapped weights near 0.35 whatever the map learnt.
-    const double even = dim_ > 1 ? 1.0 - std::pow(1.0 - uniform_share, 1.0 / dim_) : uniform_share;
     std::vector<double> d(static_cast<size_t>(k_)), smooth(static_cast<size_t>(k_));
     std::vector<double> fresh(static_cast<size_t>(k_) + 1);
     for (int j = 0; j < dim_; ++j) {
@@ -162,13 +166,14 @@ void VegasMap::adapt(double alpha, double uniform_share) {
         }
         if (!(damped_total > 0.0)) continue;
         // A share of the increments spread evenly over the axis, whatever the training saw:
-        // no increment is wider than 1 / (even K), so the axis's Jacobian stays below
-        // 1 / even. Without it a region where f was seen as 0 collapses into one increment
+        // no increment is wider than 1 / (share K), so the axis's Jacobian stays below
+        // 1 / share. Without it a region where f was seen as 0 collapses into one increment
         // that also reaches into a region where f is large (a discontinuity), and the rare
         // points there carry huge weights (heavy tails, error bars that miss).
         const double* edge = edges(j);
         for (int i = 0; i < k_; ++i)
-            smooth[i] = (1.0 - even) * smooth[i] / damped_total + even * (edge[i + 1] - edge[i]);
+            smooth[i] = (1.0 - uniform_share) * smooth[i] / damped_total +
+                        uniform_share * (edge[i + 1] - edge[i]);
         damped_total = 1.0;
         // New edges: increment i of the old map holds a share smooth[i] of the total, spread
         // evenly over it; the new edges cut the total into K equal shares.

@@ -38,10 +38,9 @@ struct VegasOptions {
     int train_iterations = 0;
     VegasTrainStop train_stop =
         VegasTrainStop::Default; ///< Settled: the calls left go to the estimate
-    /// Share of the map spread evenly: each axis spreads 1 - (1 - uniform_share)^(1/d) of its
-    /// increments evenly, so a point lies in the learnt part of every axis with probability
-    /// 1 - uniform_share (VegasMap::adapt).
-    double uniform_share = 0.05;
+    /// Share of each axis's increments spread evenly; negative: the estimator's default
+    /// (vegas_resolved: 1 - (1 - kVegasEvenShare)^(1/d) for the map alone, else kVegasEvenShare).
+    double uniform_share = -1.0;
     VegasReport report = VegasReport::Frozen;
     int iterations = 5; ///< Iterations: the estimation share is split into this many
     /// VEGAS+ [Lepage21, sec. 3]: hypercubes of the y space, each sampled with n_h >= 2 points,
@@ -51,10 +50,14 @@ struct VegasOptions {
     double beta = 0.75;
 };
 
+/// The even share of the map: of each axis, or (the map alone) of the whole map.
+constexpr double kVegasEvenShare = 0.05;
+
 /// The options a run uses: `options` with the fields left to the estimator (alpha < 0,
-/// train_iterations 0, train_stop Default) filled in for its sampler, its report and whether
-/// it is VEGAS+ (`plus`: the estimator kind vegas_plus; docs/scene-format.md, VEGAS).
-VegasOptions vegas_resolved(const VegasOptions& options, SamplerKind sampler, bool plus);
+/// train_iterations 0, train_stop Default, uniform_share < 0) filled in for its sampler, its
+/// report, whether it is VEGAS+ (`plus`: the estimator kind vegas_plus) and the dimension of
+/// its unit cube (docs/scene-format.md, VEGAS).
+VegasOptions vegas_resolved(const VegasOptions& options, SamplerKind sampler, bool plus, int dim);
 
 /// Least points per training iteration where the training share allows: fewer, and the map
 /// learns from noise (vegas's own examples train on 1000 points per iteration).
@@ -128,8 +131,7 @@ class VegasMap {
     /// Refines the map from the training data and clears it [Lepage21, sec. 2.2]: per axis the
     /// mean w^2 of each increment d_i is smoothed with its neighbours (weights 1, 6, 1 over 8;
     /// 7, 1 at the ends), normalised to sum 1, damped to ((1 - d_i) / ln(1 / d_i))^alpha, and
-    /// the new edges give every increment an equal share of the damped d, mixed with an even
-    /// spread of 1 - (1 - uniform_share)^(1/dim) of the axis. An axis with no
+    /// the new edges give every increment an equal share of the damped d. An axis with no
     /// non-zero data keeps its edges.
     void adapt(double alpha, double uniform_share);
 

@@ -22,7 +22,8 @@ class VegasPlusEstimator final : public EstimatorAlgorithm, private TrainingPoin
   public:
     VegasPlusEstimator(const Problem& problem, const EstimatorSpec& spec, Accumulator accumulator)
         : problem_(problem), spec_(spec),
-          options_(vegas_resolved(spec.vegas_options, spec.sampler, true)),
+          options_(
+              vegas_resolved(spec.vegas_options, spec.sampler, true, problem.domain.sample_dim())),
           float32_(accumulator == Accumulator::Float32) {}
 
     void begin(uint64_t n, Pcg32& /*rng*/) override {
