@@ -87,8 +87,9 @@ constexpr uint64_t kVegasPointsPerIncrement = 10;
 
 /// The training share's split that sizes the default increments: vegas_increments() sees
 /// training_calls / kVegasSizingIterations points per iteration however many iterations the
-/// training runs. Sized by the actual iterations, 20 iterations halved K against 10, and on
-/// smooth integrands in d = 2 (Genz's Gaussian, continuous) vegas_sobol's RMSE^2 grew 5-20x.
+/// training runs, so that more, smaller iterations do not coarsen the map (sized by the actual
+/// iterations, 20 halved K against 10; on Genz's d = 2 families vegas with the map alone's
+/// defaults gained 2.3x in RMSE^2 before this and 2.6x after, geometric means of 6, R = 10).
 constexpr int kVegasSizingIterations = 10;
 
 /// The increments a run uses: options.increments when given, else vegas_increments() of the
