@@ -39,20 +39,23 @@ bool parse_vegas_options(Ctx& c, const Json& j, const std::string& path, int dim
                       "must be >= 1 and at most 4194304 / dimension (" +
                           std::to_string((uint64_t(1) << 22) / static_cast<uint64_t>(dim)) +
                           " here), got " + std::to_string(increments));
-    if (!(out->alpha >= 0.0 && out->alpha <= 4.0))
-        return c.fail(sub(path, "alpha"), "must be in [0, 4] (default 1; vegas uses 0.5, GSL 1.5)");
+    if (find(j, "alpha") && !(out->alpha >= 0.0 && out->alpha <= 4.0))
+        return c.fail(
+            sub(path, "alpha"),
+            "must be in [0, 4] (default 1 for the map alone, else 0.5 as in vegas; GSL 1.5)");
     if (!(out->train_fraction >= 0.0 && out->train_fraction <= 0.9))
         return c.fail(sub(path, "train_fraction"),
                       "must be in [0, 0.9]: the share of N that trains the map");
-    if (!(out->uniform_share >= 0.0 && out->uniform_share <= 1.0))
+    if (find(j, "uniform_share") && !(out->uniform_share >= 0.0 && out->uniform_share <= 1.0))
         return c.fail(sub(path, "uniform_share"), "must be in [0, 1]");
-    if (iterations < 1 || iterations > 1000)
+    if (find(j, "train_iterations") && (iterations < 1 || iterations > 1000))
         return c.fail(sub(path, "train_iterations"), "must be in [1, 1000]");
-    if (train_stop == "settled" || train_stop.empty())
+    // Left out: the estimator's default (vegas_resolved).
+    if (train_stop == "settled")
         out->train_stop = VegasTrainStop::Settled;
     else if (train_stop == "budget")
         out->train_stop = VegasTrainStop::Budget;
-    else
+    else if (!train_stop.empty())
         return c.fail(sub(path, "train_stop"), "expected \"settled\" (stop training once the map "
                                                "has settled) or \"budget\" (train on the whole "
                                                "train_fraction), got \"" +

@@ -269,10 +269,13 @@ Made<SceneRequest> build_request(const Json& scene, const Json& options) {
         return made_error<SceneRequest>((from_options ? "options: " : "scene: ") + too_big);
     }
     for (const EstimatorSpec& e : req.estimators) {
-        const bool vegas_kind = e.kind && (std::string(e.kind->name) == "vegas" ||
-                                           std::string(e.kind->name) == "vegas_plus");
+        const bool plus = e.kind && std::string(e.kind->name) == "vegas_plus";
+        const bool vegas_kind = plus || (e.kind && std::string(e.kind->name) == "vegas");
         const std::string untrainable =
-            vegas_kind ? vegas_untrainable(e.vegas_options, s.n_max) : std::string();
+            vegas_kind ? vegas_untrainable(vegas_resolved(e.vegas_options, e.sampler, plus,
+                                                          req.problem.domain.sample_dim()),
+                                           s.n_max)
+                       : std::string();
         if (!untrainable.empty())
             return made_error<SceneRequest>("estimator '" + name_text(e.name) +
                                             "': " + untrainable);

@@ -47,7 +47,7 @@ const std::vector<EstimatorPreset>& estimator_presets() {
          "Walsh coefficients",
          true},
         {"vegas", "vegas", SamplerKind::Independent, false,
-         "VEGAS: a map trained on a quarter of N, then frozen for independent points"},
+         "VEGAS: a map trained on up to a quarter of N until settled, then frozen"},
         {"vegas_sobol", "vegas", SamplerKind::Sobol, false,
          "VEGAS map trained, then frozen for 16 Owen-scrambled Sobol' nets"},
         {"miser", "miser", SamplerKind::Independent, false,

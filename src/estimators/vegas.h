@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/points.h"
+#include "core/samplers.h"
 
 namespace mcp {
 
@@ -19,6 +20,7 @@ enum class VegasReport {
 
 /// When VEGAS training stops.
 enum class VegasTrainStop {
+    Default, ///< the estimator's own (vegas_resolved)
     Settled, ///< once the map has settled (TrainingStop, vegas_train.h), at most the budget
     Budget   ///< after the whole training budget, train_fraction N in train_iterations
 };
@@ -27,18 +29,18 @@ enum class VegasTrainStop {
 struct VegasOptions {
     int increments = 0; ///< per axis; 0 chooses vegas_increments()
     /// Damping exponent of the refinement [Lepage78, Lepage21, eq. 22]: Lepage78 gives 1 to 2
-    /// (GSL 1.5), vegas 0.5. At 0.5 the map converges too slowly for a sharp peak: on Genz's
-    /// product peak (a = 100 to 1000, d = 6, N = 2^20) alpha 1 with 20 settled iterations cut
-    /// the RMSE 3-16x (docs/benchmarks.md); not the default yet (it broke calibration tests).
-    double alpha = 0.5;
+    /// (GSL 1.5), vegas 0.5. Negative: the estimator's default (vegas_resolved).
+    double alpha = -1.0;
     double train_fraction = 0.25; ///< share of the N evaluations spent training the map
     /// The training share is split into this many iterations, at most: training stops when
     /// the map has settled (train_stop). More, smaller iterations converge on a sharp peak
-    /// where 10 did not (the map needs steps more than points per step).
-    int train_iterations = 10;
+    /// where 10 did not (the map needs steps more than points per step). 0: the default.
+    int train_iterations = 0;
     VegasTrainStop train_stop =
-        VegasTrainStop::Budget;  ///< Settled: the calls left go to the estimate
-    double uniform_share = 0.05; ///< share of each axis's increments spread evenly
+        VegasTrainStop::Default; ///< Settled: the calls left go to the estimate
+    /// Share of each axis's increments spread evenly; negative: the estimator's default
+    /// (vegas_resolved: 1 - (1 - kVegasEvenShare)^(1/d) for the map alone, else kVegasEvenShare).
+    double uniform_share = -1.0;
     VegasReport report = VegasReport::Frozen;
     int iterations = 5; ///< Iterations: the estimation share is split into this many
     /// VEGAS+ [Lepage21, sec. 3]: hypercubes of the y space, each sampled with n_h >= 2 points,
@@ -47,6 +49,15 @@ struct VegasOptions {
     bool stratify = false;
     double beta = 0.75;
 };
+
+/// The even share of the map: of each axis, or (the map alone) of the whole map.
+constexpr double kVegasEvenShare = 0.05;
+
+/// The options a run uses: `options` with the fields left to the estimator (alpha < 0,
+/// train_iterations 0, train_stop Default, uniform_share < 0) filled in for its sampler, its
+/// report, whether it is VEGAS+ (`plus`: the estimator kind vegas_plus) and the dimension of
+/// its unit cube (docs/scene-format.md, VEGAS).
+VegasOptions vegas_resolved(const VegasOptions& options, SamplerKind sampler, bool plus, int dim);
 
 /// Least points per training iteration where the training share allows: fewer, and the map
 /// learns from noise (vegas's own examples train on 1000 points per iteration).
@@ -74,9 +85,18 @@ int vegas_increments(int dim, uint64_t points_per_iteration);
 /// 65536 increments, 2,500 points per iteration: estimates of 1e-164 for an integral of 1).
 constexpr uint64_t kVegasPointsPerIncrement = 10;
 
-/// The increments a run uses: options.increments when given (vegas_increments() when 0), at
-/// most points_per_iteration / kVegasPointsPerIncrement (at least 2) when the map is trained.
-int vegas_trainable_increments(const VegasOptions& options, int dim, uint64_t points_per_iteration);
+/// The training share's split that sizes the default increments: vegas_increments() sees
+/// training_calls / kVegasSizingIterations points per iteration however many iterations the
+/// training runs, so that more, smaller iterations do not coarsen the map (sized by the actual
+/// iterations, 20 halved K against 10; on Genz's d = 2 families vegas with the map alone's
+/// defaults gained 2.3x in RMSE^2 before this and 2.6x after, geometric means of 6, R = 10).
+constexpr int kVegasSizingIterations = 10;
+
+/// The increments a run uses: options.increments when given, else vegas_increments() of the
+/// larger of points_per_iteration and training_calls / kVegasSizingIterations; at most
+/// points_per_iteration / kVegasPointsPerIncrement (at least 2) when the map is trained.
+int vegas_trainable_increments(const VegasOptions& options, int dim, uint64_t points_per_iteration,
+                               uint64_t training_calls = 0);
 
 /// Why options.increments cannot be trained even at the largest N of a study, n_max: fewer than
 /// kVegasPointsPerIncrement points per increment per training iteration (or per averaged

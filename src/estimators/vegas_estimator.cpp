@@ -21,10 +21,13 @@ namespace {
 class VegasEstimator final : public EstimatorAlgorithm, private TrainingPoints {
   public:
     VegasEstimator(const Problem& problem, const EstimatorSpec& spec, Accumulator accumulator)
-        : problem_(problem), spec_(spec), float32_(accumulator == Accumulator::Float32) {}
+        : problem_(problem), spec_(spec),
+          options_(
+              vegas_resolved(spec.vegas_options, spec.sampler, false, problem.domain.sample_dim())),
+          float32_(accumulator == Accumulator::Float32) {}
 
     void begin(uint64_t n, Pcg32& /*rng*/) override {
-        const VegasOptions& o = spec_.vegas_options;
+        const VegasOptions& o = options_;
         const int dim = problem_.domain.sample_dim();
         total_ = n;
         uint64_t train = static_cast<uint64_t>(o.train_fraction * static_cast<double>(n));
@@ -38,7 +41,8 @@ class VegasEstimator final : public EstimatorAlgorithm, private TrainingPoints {
         // The map learns from the training iterations, or from the averaged rounds.
         const uint64_t per_iteration =
             iterations_ > 0 ? train_ / iterations_ : (rounds_ > 1 ? final_ / rounds_ : 0);
-        stage_.reset(dim, vegas_trainable_increments(o, dim, per_iteration));
+        stage_.reset(
+            dim, vegas_trainable_increments(o, dim, per_iteration, iterations_ > 0 ? train_ : 0));
         trained_ = false;
         next_ = 0;
         plan_ready_ = false;
@@ -52,9 +56,8 @@ class VegasEstimator final : public EstimatorAlgorithm, private TrainingPoints {
             prepared_ = true;
         }
         if (!trained_) {
-            const TrainingSpent spent =
-                train_map(stage_, spec_.vegas_options, problem_, spec_.proposal, iterations_,
-                          train_, *this, rng, ws, log_);
+            const TrainingSpent spent = train_map(stage_, options_, problem_, spec_.proposal,
+                                                  iterations_, train_, *this, rng, ws, log_);
             if (spent.calls < train_) {
                 // Settled early: the calls left go to the estimate. A net's share is rounded
                 // to K 2^m again, and what that leaves is one more training iteration.
@@ -90,8 +93,7 @@ class VegasEstimator final : public EstimatorAlgorithm, private TrainingPoints {
         if (next_ == plan_.total) {
             // One estimation iteration done: keep its result, adapt for the next.
             rounds_done_.push_back(finish_round());
-            if (averaging)
-                stage_.map().adapt(spec_.vegas_options.alpha, spec_.vegas_options.uniform_share);
+            if (averaging) stage_.map().adapt(options_.alpha, options_.uniform_share);
             ++round_;
             plan_ready_ = false;
         }
@@ -115,7 +117,7 @@ class VegasEstimator final : public EstimatorAlgorithm, private TrainingPoints {
     // The estimation share: `left` calls, a net's rounded down to K 2^m (randomizations of
     // full nets; the rest trains), split into the rounds of the iteration average.
     void plan_final(uint64_t left) {
-        const VegasOptions& o = spec_.vegas_options;
+        const VegasOptions& o = options_;
         final_ = left;
         const uint64_t k = static_cast<uint64_t>(std::max(spec_.randomizations, 1));
         if (spec_.sampler == SamplerKind::Sobol && left < total_ && final_ >= k) {
@@ -131,7 +133,7 @@ class VegasEstimator final : public EstimatorAlgorithm, private TrainingPoints {
                 std::min<uint64_t>(static_cast<uint64_t>(std::max(o.iterations, 1)), final_ / 2)));
     }
     VegasOptions budget_options() const {
-        VegasOptions o = spec_.vegas_options;
+        VegasOptions o = options_;
         o.train_stop = VegasTrainStop::Budget;
         return o;
     }
@@ -208,6 +210,7 @@ class VegasEstimator final : public EstimatorAlgorithm, private TrainingPoints {
 
     const Problem& problem_;
     const EstimatorSpec& spec_;
+    const VegasOptions options_; // spec_'s, the defaults filled in
     bool float32_;
     uint64_t total_ = 0, train_ = 0, final_ = 0, next_ = 0;
     TrainingLog log_;

@@ -21,10 +21,13 @@ constexpr uint64_t kMaxHypercubes = uint64_t(1) << 20;
 class VegasPlusEstimator final : public EstimatorAlgorithm, private TrainingPoints {
   public:
     VegasPlusEstimator(const Problem& problem, const EstimatorSpec& spec, Accumulator accumulator)
-        : problem_(problem), spec_(spec), float32_(accumulator == Accumulator::Float32) {}
+        : problem_(problem), spec_(spec),
+          options_(
+              vegas_resolved(spec.vegas_options, spec.sampler, true, problem.domain.sample_dim())),
+          float32_(accumulator == Accumulator::Float32) {}
 
     void begin(uint64_t n, Pcg32& /*rng*/) override {
-        const VegasOptions& o = spec_.vegas_options;
+        const VegasOptions& o = options_;
         dim_ = problem_.domain.sample_dim();
         total_ = n;
         uint64_t train = static_cast<uint64_t>(o.train_fraction * static_cast<double>(n));
@@ -52,7 +55,7 @@ class VegasPlusEstimator final : public EstimatorAlgorithm, private TrainingPoin
         train_ = train;
         stage_.reset(dim_,
                      iterations_ > 0
-                         ? vegas_trainable_increments(o, dim_, train_ / iterations_)
+                         ? vegas_trainable_increments(o, dim_, train_ / iterations_, train_)
                          : (o.increments > 0 ? o.increments : vegas_increments(dim_, final_)));
         sigma_.assign(cubes_, 1.0); // uniform allocation first
         trained_ = false;
@@ -71,9 +74,8 @@ class VegasPlusEstimator final : public EstimatorAlgorithm, private TrainingPoin
             prepared_ = true;
         }
         if (!trained_) {
-            const TrainingSpent spent =
-                train_map(stage_, spec_.vegas_options, problem_, spec_.proposal, iterations_,
-                          train_, *this, rng, ws, log_);
+            const TrainingSpent spent = train_map(stage_, options_, problem_, spec_.proposal,
+                                                  iterations_, train_, *this, rng, ws, log_);
             if (spent.iterations < iterations_ && spent.calls < train_) {
                 final_ += train_ - spent.calls; // settled early: the calls left go to the estimate
                 train_ = spent.calls;
@@ -168,7 +170,7 @@ class VegasPlusEstimator final : public EstimatorAlgorithm, private TrainingPoin
         std::vector<double> share(cubes_);
         double total = 0.0;
         for (uint64_t h = 0; h < cubes_; ++h) {
-            share[h] = std::pow(sigma_[h], spec_.vegas_options.beta);
+            share[h] = std::pow(sigma_[h], options_.beta);
             if (!std::isfinite(share[h])) share[h] = 0.0;
             total += share[h];
         }
@@ -179,7 +181,7 @@ class VegasPlusEstimator final : public EstimatorAlgorithm, private TrainingPoin
         // The even share (as for the map's increments): a hypercube whose training points all
         // saw f = 0 may still hold a sliver of a large f (a cut); with only its 2 points it would
         // mostly miss it and report a variance of 0.
-        const double even = spec_.vegas_options.uniform_share;
+        const double even = options_.uniform_share;
         for (uint64_t h = 0; h < cubes_; ++h)
             share[h] = (1.0 - even) * share[h] / total + even / static_cast<double>(cubes_);
         allocate_largest_remainders(rest, share, &allocation_);
@@ -229,6 +231,7 @@ class VegasPlusEstimator final : public EstimatorAlgorithm, private TrainingPoin
 
     const Problem& problem_;
     const EstimatorSpec& spec_;
+    const VegasOptions options_; // spec_'s, the defaults filled in
     bool float32_;
     int dim_ = 1;
     uint64_t total_ = 0, train_ = 0, final_ = 0, points_ = 0, accumulated_ = 0;

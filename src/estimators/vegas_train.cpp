@@ -41,9 +41,11 @@ bool TrainingStop::settled(double estimate, double variance, uint64_t points, do
         std::isfinite(estimate) && std::isfinite(variance) && std::isfinite(movement) && points > 0;
     bool improving = !finite;
     if (finite) {
+        const bool variance_rose =
+            least_variance_ >= 0.0 && variance > kVegasSettleRise * least_variance_;
         const bool variance_fell = fell(variance, &least_variance_);
         const bool movement_fell = fell(movement, &least_movement_);
-        improving = variance_fell || movement_fell;
+        improving = variance_fell || movement_fell || variance_rose;
     }
     stalled_ = improving ? 0 : stalled_ + 1;
     const double se2 = finite ? variance / static_cast<double>(points) : 0.0;

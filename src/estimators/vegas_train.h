@@ -56,6 +56,11 @@ class TrainingPoints {
 /// Least relative fall of the map's movement, or of the per-point variance, that counts as
 /// the map still improving.
 constexpr double kVegasSettleGain = 0.1;
+/// A per-point variance above this many times its least before counts as the map still
+/// changing: the iteration's points found what the map had under-sampled (a peak's true
+/// centre on some axis, a sliver), whose few large weights also widen the 3-standard-error
+/// agreement test enough to pass it.
+constexpr double kVegasSettleRise = 2.0;
 
 /// When training may stop (options.train_stop = Settled). Two signs are followed per iteration:
 /// the map's movement M, the mean over axes and edges of |new edge - old edge| in units of the
@@ -63,7 +68,8 @@ constexpr double kVegasSettleGain = 0.1;
 /// it has; and the per-point variance of the mapped weights, V = mean(c w^2) - mean(c w)^2 over
 /// the iteration's points (c their importance, 1 for uniform y), which the map minimises
 /// [Lepage21, sec. 2.2]. The map has settled when, for two successive iterations, neither M nor
-/// V fell below (1 - kVegasSettleGain) times its least value before, and the last two
+/// V fell below (1 - kVegasSettleGain) times its least value before, nor V rose above
+/// kVegasSettleRise times it, and the last two
 /// iterations' estimates mean(c w) agree within 3 standard errors:
 /// (I_i - I_{i-1})^2 <= 9 (V_i / n_i + V_{i-1} / n_{i-1}). A map whose first iterations miss a
 /// sharp peak sees V too small, but still moves as it finds the peak; a non-finite V or M never
