@@ -131,7 +131,7 @@ site: build build-wasm deps-web
 
 # The page in headless Chromium, checked against the native CLI; screenshots in build/e2e.
 test-e2e: build site
-	MCPLAY_SITE=$(SITE) MCPLAY_NATIVE=$(BUILD)/mcplay MCPLAY_SHOTS=$(BUILD)/e2e node --test web/e2e/playground.e2e.mjs web/e2e/lab.e2e.mjs web/e2e/live_view.e2e.mjs
+	MCPLAY_SITE=$(SITE) MCPLAY_NATIVE=$(BUILD)/mcplay MCPLAY_SHOTS=$(BUILD)/e2e node --test $(sort $(wildcard web/e2e/*.e2e.mjs))
 
 # The native suite again, built with g++ -fsanitize=address,undefined (CMake option MCPLAY_SANITIZE):
 # a leak, an out-of-bounds access or undefined behaviour fails the test that triggers it.
