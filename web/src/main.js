@@ -23,7 +23,7 @@ import {
 import { clockResolution, splitEstimators, splitRenderWork, splitCollector, partialResult, samplesCsv } from './series.js';
 import { CoreWorker } from './client.js';
 import { MSG } from './protocol.js';
-import { initPlots, renderPlots, plotPng, hiddenEstimators } from './plot.js';
+import { initPlots, renderPlots, plotPng, lastPngLegend, hiddenEstimators } from './plot.js';
 import { renderReport } from './report.js';
 import { mountImages, renderImages } from './images.js';
 import { base64Of, checkGltfBytes, sceneFromFiles } from './gltf_files.js';
@@ -777,6 +777,7 @@ ready.catch(() => {});
 window.mcplayDebug = Object.freeze({
   state: () => structuredClone(debugSnapshot(store.getState())),
   hidden: () => hiddenEstimators(),
+  pngLegend: () => lastPngLegend(),
   lab: () => structuredClone(labSnapshot(lab.store.getState())),
   live: () => structuredClone(live.snapshot()),
   ready,

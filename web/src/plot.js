@@ -11,12 +11,13 @@
 //   png.js           a chart as a PNG file
 import { dom, resizeAll, applyHiddenAll, drop, empty, setText } from './plot/chart.js';
 import { setLegend, toggleFromLegend } from './plot/legend.js';
-import { renderVariance, VARIANCE_NOTE } from './plot/variance.js';
+import { renderVariance } from './plot/variance.js';
+import { varianceNote } from './claims.js';
 import { renderTime } from './plot/time.js';
 import { renderCalibration, renderCoverage, COVERAGE_NOTE } from './plot/calibration.js';
 import { mountSampleControls, renderSampleViews } from './plot/samples.js';
 
-export { plotPng } from './plot/png.js';
+export { plotPng, lastPngLegend } from './plot/png.js';
 export { hiddenEstimators } from './plot/legend.js';
 
 let mounted = false;
@@ -42,7 +43,7 @@ export function initPlots(elements) {
 /** The titles and notes of the plots before a run, for the kind of scene shown. */
 function emptyTexts(render) {
   setText('variance-title', render ? 'Relative MSE against spp' : 'Variance against N');
-  setText('variance-note', VARIANCE_NOTE[render ? 'render' : 'integral']);
+  setText('variance-note', varianceNote(render ? 'render' : 'integral'));
   setText('time-title', render ? 'Error against time per image' : 'Error against run time');
   setText('coverage-note', COVERAGE_NOTE[render ? 'render' : 'integral']);
 }

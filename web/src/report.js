@@ -3,7 +3,8 @@
 // flagged cells sit next to the warning that concerns them (low_ess by the effective sample
 // size, heavy_tail by the tail index, level_drift by the consistency test, ...). A pure render
 // of the state, text only (never HTML from data).
-import { collectWarnings, fitText, fmt, severityOf, flagTitle, nText } from './series.js';
+import { collectWarnings, fmt, severityOf, nText } from './series.js';
+import { alarmSummary, densityWords, flagShort, flagTitle, orderClaim, pWords, tailWords } from './claims.js';
 import { colorAt } from './palette.js';
 import { el } from './dom.js';
 
@@ -51,8 +52,10 @@ function severityLabel(w) {
   return el('span', { className: `severity severity-${s}` }, s === 'info' ? 'info' : s.toUpperCase());
 }
 
+// A flag in the summary: plain words; the code and the core's sentence are in the list above.
 function badge(w) {
-  return el('span', { className: `badge badge-${severityOf(w)}`, title: `${severityOf(w)}: ${w.message}` }, w.code);
+  return el('span', { className: `badge badge-${severityOf(w)}`, title: `${severityOf(w)}: ${w.message}`,
+    dataset: { code: w.code } }, flagShort(w.code));
 }
 
 let lastSig = null;
@@ -78,18 +81,20 @@ export function renderReport(state, dom) {
   const hasRecords = run.order.some((n) => run.records[n]);
   dom.diagnosticsEmpty.textContent = !hasRecords ? 'Run a study to see its diagnostics.' : 'No warnings.';
   dom.diagnosticsEmpty.hidden = warnings.length > 0;
-  // Above the plots: how many errors and warnings, who has them, and a link down to them.
+  // Above the plots: the errors and warnings that persist (claims/alarms.js: a flag only at the
+  // smallest N, or isolated among many levels checked, is counted apart and does not turn it red),
+  // who has them, and a link down to them.
   if (dom.summary) {
-    const count = (sev) => warnings.filter((w) => w.severity === sev);
-    const errors = count('error');
-    const warns = count('warning');
-    const who = (list) => [...new Set(list.map((w) => w.estimator))].join(', ');
+    const alarm = alarmSummary(run.records, run.order, { ladder: run.ladder, nName: run.kind === 'render' ? 'spp' : 'N' });
     const parts = [];
-    if (errors.length) parts.push(el('span', { className: 'sev sev-error' }, `${errors.length} error${errors.length > 1 ? 's' : ''}`), ` (${who(errors)})`);
-    if (warns.length) parts.push(parts.length ? '; ' : '', el('span', { className: 'sev sev-warning' }, `${warns.length} warning${warns.length > 1 ? 's' : ''}`), ` (${who(warns)})`);
+    alarm.parts.forEach((p, i) => {
+      if (i) parts.push('; ');
+      parts.push(el('span', { className: `sev sev-${p.severity}` }, p.text), ` (${p.who})`);
+    });
     dom.summary.replaceChildren(...(parts.length ? ['Diagnostics: ', ...parts, ' · ', el('a', { href: '#diagnostics-title' }, 'read them')] : []));
     dom.summary.hidden = parts.length === 0;
-    dom.summary.dataset.errors = String(errors.length);
+    dom.summary.dataset.errors = String(alarm.counts.errors);
+    dom.summary.dataset.severity = alarm.severity || '';
   }
 
   // Keep the tables the reader opened open.
@@ -120,11 +125,12 @@ function estimatorTable(r, run, isOpen) {
   const summary = el('summary', {},
     el('span', { className: 'swatch', style: `background: ${color}` }),
     el('strong', {}, r.name), ...flags('name'),
-    el('span', { className: 'muted' }, run.kind === 'render' ? renderFacts(r) : `${r.sampler || ''}${r.pdf ? `, pdf ${r.pdf}` : ''}`),
-    el('span', {}, 'order ', el('span', { className: 'mono' }, fitText(r.fit))),
-    r.consistency ? el('span', {}, `level consistency p = ${fmt(r.consistency.p_value, 3)}`, ...flags('consistency')) : null,
+    el('span', { className: 'muted' }, run.kind === 'render' ? renderFacts(r) : `${r.sampler || ''}${densityWords(r) ? `, density ${densityWords(r)}` : ''}`),
+    el('span', {}, 'order ', el('span', { className: 'mono' }, orderClaim(r, { exact: run.kind === 'render' ? null : run.exact,
+      nName: run.kind === 'render' ? 'spp' : 'N', measure: run.kind === 'render' ? 'relative MSE' : 'variance' }).text)),
+    r.consistency ? el('span', {}, `level consistency ${pWords(r.consistency.p_value)}`, ...flags('consistency')) : null,
     r.support_check && r.importance ? el('span', {}, `pdf support: ${r.support_check.missed} of ${r.support_check.probes} probes missed`, ...flags('support')) : flags('support').length ? el('span', {}, ...flags('support')) : null,
-    last ? el('span', {}, `tail index at ${run.kind === 'render' ? 'spp' : 'N'}=${last.n}: ${fmt(last.tail_index, 3)}`, ...flags('tail')) : null,
+    last ? el('span', {}, `tail of the weights at ${run.kind === 'render' ? 'spp' : 'N'} = ${last.n}: ${tailWords(last.tail_index)}`, ...flags('tail')) : null,
     last && run.kind !== 'render' ? el('span', {}, `ESS at N=${last.n}: ${fmt(last.ess, 3)}`) : null,
     run.kind === 'render' && typeof r.rays_per_second === 'number' ? el('span', {}, `${fmt(r.rays_per_second, 3)} rays/s`) : null,
   );
@@ -136,12 +142,13 @@ function estimatorTable(r, run, isOpen) {
     for (const w of l.warnings || []) (flagged[LEVEL_COLUMN[w.code] || 'n'] ??= []).push(w);
     rows.push(el('tr', { dataset: { n: String(l.n) } }, ...columns.map(([key, , get]) => {
       const ws = flagged[key];
-      return el('td', ws ? { className: 'flag', title: ws.map((w) => `${severityOf(w)} ${w.code}: ${w.message}`).join('\n') } : {},
+      return el('td', ws ? { className: 'flag', title: ws.map((w) => `${severityOf(w)}: ${flagTitle(w.code)}`).join('\n') } : {},
         ws ? `⚠ ${get(l)}` : get(l));
     })));
     for (const w of l.warnings || []) {
       rows.push(el('tr', { className: 'warn-row' }, el('td', { colSpan: columns.length },
-        severityLabel(w), ' ', el('code', {}, w.code), ` ${run.kind === 'render' ? 'spp' : 'N'} = ${l.n}: ${w.message}`)));
+        severityLabel(w), ` ${run.kind === 'render' ? 'spp' : 'N'} = ${l.n}: `, el('span', { className: 'flag-title' }, flagTitle(w.code)),
+        ` (${w.message}) `, el('code', { className: 'flag-code' }, w.code))));
     }
   }
   const details = el('details', { dataset: { for: r.name } }, summary,

@@ -5,7 +5,7 @@ import assert from 'node:assert/strict';
 
 import {
   ladder, applyLevel, progressOf, mergeResults, varianceSeries, anchorOf, referenceLines, fitSlope,
-  timeSeries, clockResolution, runningEstimate, replayIsEstimator, conservativeErrorBars, CLOCK_STEPS_FITTED, zScores, histogram, normalDensity, calibrationSeries, coverageSeries, collectWarnings,
+  timeSeries, clockResolution, runningEstimate, replayIsEstimator, CLOCK_STEPS_FITTED, zScores, histogram, normalDensity, calibrationSeries, coverageSeries, collectWarnings,
   fixed3, fitText, fmt, decadeRange, splitEstimators, splitRenderWork, splitCollector, partialResult,
 } from '../src/series.js';
 
@@ -161,7 +161,7 @@ test('z-scores against the exact value, or each level\'s mean when it is unknown
   assert.deepEqual(mean.z, [-1, 1, 1.5]);
   assert.equal(mean.reference, 'mean');
   // A level exact to round-off gives no z (round-off over round-off), only a count.
-  const exact = [lvl(64, { mean: 2, exact_to_roundoff: true, replicates: { estimate: [2, 2, 2], std_error: [1e-16, 2e-16, 1e-16] } }), ...levels];
+  const exact = [lvl(64, { mean: 2, mse: 0, exact_to_roundoff: true, replicates: { estimate: [2, 2, 2], std_error: [1e-16, 2e-16, 1e-16] } }), ...levels];
   const withExact = zScores(exact, 2);
   assert.deepEqual(withExact.z, all.z);
   assert.equal(withExact.exactRuns, 3);
@@ -535,8 +535,8 @@ test('a cancelled render run exports its streamed levels with the render names',
   assert.equal('kind' in partialResult({ ...run, kind: 'integral' }, { name: 'q' }), false);
 });
 
-test('nText collapses the N of a diagnostic; flagTitle says each code in words', async () => {
-  const { nText, flagTitle, FLAG_TITLES } = await import('../src/series.js');
+test('nText collapses the N of a diagnostic', async () => {
+  const { nText } = await import('../src/series.js');
   const steps = [16, 32, 64, 128, 256];
   assert.equal(nText([16, 32, 64, 128, 256], steps), 'every N, 16 … 256');
   assert.equal(nText([32, 64, 128], steps), 'N = 32 … 128 (3 levels)');
@@ -544,30 +544,6 @@ test('nText collapses the N of a diagnostic; flagTitle says each code in words',
   assert.equal(nText([64], steps), 'N = 64');
   assert.equal(nText([1, 2, 4], [1, 2, 4], 'spp'), 'every spp, 1 … 4');
   assert.equal(nText([], steps), '');
-  assert.match(flagTitle('skewed_weights'), /not yet trustworthy/);
-  assert.equal(flagTitle('made_up'), 'made_up');
-  for (const [code, title] of Object.entries(FLAG_TITLES)) assert.ok(title.length > 10, code);
-});
-
-test('equalTimeVerdict: a winner only when the efficiencies differ beyond their uncertainty', async () => {
-  const { equalTimeVerdict } = await import('../src/series.js');
-  // variance and its chi-square interval, time and its spread over 32 replicates
-  const level = (variance, time, over = {}) => ({
-    n: 4096, reps: 32, variance, variance_ci95: [variance * 0.65, variance * 1.7], time_mean_s: time, time_std_s: time * 0.1, ...over,
-  });
-  const rec = (name, l) => ({ name, levels: [l], fit: null, warnings: [] });
-  const clear = equalTimeVerdict({ a: rec('a', level(1e-4, 1e-3)), b: rec('b', level(1e-6, 1e-3)) }, ['a', 'b']);
-  assert.equal(clear.winner, 'b');
-  assert.match(clear.text, /^Equal-time winner .*: b, 100× as efficient as the next, a \(z = /);
-  const close = equalTimeVerdict({ a: rec('a', level(1e-4, 1e-3)), b: rec('b', level(1.2e-4, 0.9e-3)) }, ['a', 'b']);
-  assert.equal(close.winner, null);
-  assert.match(close.text, /^No significant difference at equal time between/);
-  const exact = equalTimeVerdict({ a: rec('a', level(1e-4, 1e-3)), e: rec('e', level(0, 1e-3, { exact_to_roundoff: true })) }, ['a', 'e']);
-  assert.equal(exact.winner, 'e');
-  assert.match(exact.text, /e is exact/);
-  // with the exact value known, the MSE is what counts (a biased estimator's MSE is not its variance)
-  const biased = equalTimeVerdict({ a: rec('a', level(1e-4, 1e-3, { mse: 1e-4 })), b: rec('b', level(1e-6, 1e-3, { mse: 1e-2 })) }, ['a', 'b'], 1.0);
-  assert.equal(biased.winner, 'a');
 });
 
 test('samplesCsv: one row per point, u and x per coordinate, f, density and weight', async () => {
@@ -649,12 +625,3 @@ test('a box of d > 2 axes is shown on the chosen pair of axes', () => {
   assert.deepEqual(domainView(samples, null, [0, 9]).axes, [0, 1]);
 });
 
-test('conservative error bars are the ones the core calls so, named for their method', () => {
-  assert.match(conservativeErrorBars({ error_method: 'collapsed_strata', error_bars_conservative: true }), /conservative error bars \(collapsed strata/);
-  assert.match(conservativeErrorBars({ error_method: 'iid_conservative', error_bars_conservative: true }), /conservative/);
-  // a method these words do not know still says so
-  assert.match(conservativeErrorBars({ error_method: 'pairs_collapsed', error_bars_conservative: true }), /conservative error bars \(wider than the estimator's spread by design\)/);
-  for (const m of ['iid', 'paired_strata', 'randomizations', 'none', undefined]) assert.equal(conservativeErrorBars({ error_method: m, error_bars_conservative: false }), null, m);
-  assert.equal(conservativeErrorBars({ error_method: 'collapsed_strata' }), null, 'without the core\'s word');
-  assert.equal(conservativeErrorBars(undefined), null);
-});

@@ -1,7 +1,8 @@
 // The plots that check the error bars: the histogram of z = (estimate - exact) / std. error
 // over the replicates against the standard normal density, and the coverage of the 95%
 // intervals against N with its binomial band (render studies: the share of pixels covered).
-import { calibrationSeries, coverageSeries, conservativeErrorBars, fmt } from '../series.js';
+import { calibrationSeries, coverageSeries, fmt } from '../series.js';
+import { conservativeClaim, withinText, coverageText, coincidentGroups, coincidentNote } from '../claims.js';
 import { withAlpha } from '../palette.js';
 import { AXIS, runLabels, isRender } from './axes.js';
 import { uPlot, dom, draw, drop, empty, setText, logX, nTicks } from './chart.js';
@@ -26,6 +27,7 @@ export function renderCalibration(state, run, records) {
   let ymax = 0.45;
   for (const s of cs.series) for (const v of s.y) if (v !== null && v > ymax) ymax = v;
   const render = isRender(run);
+  const names = runLabels(run);
   const known = run.exact !== null && run.exact !== undefined;
   const sig = JSON.stringify([run.order, run.colors, render, known]);
   const zLabel = render ? 'z = (image mean luminance − mean of replicates) / std. error'
@@ -52,14 +54,15 @@ export function renderCalibration(state, run, records) {
     { name: 'N(0, 1)', color: '#000', ref: true, parts: [] },
     ...cs.series.map((s) => {
       const parts = [];
-      if (s.total) parts.push({ text: `${(100 * s.within2 / s.total).toFixed(0)}% within ±1.96 (${s.total} z)`, className: 'fit' });
+      const within = withinText(s, which, names.n);
+      if (within) parts.push({ text: within, className: 'fit' });
       else if (s.exactRuns) parts.push({ text: 'exact to round-off: no z', className: 'fit' });
       else parts.push('no replicates yet');
       if (s.total && s.exactRuns) parts.push({ text: `${s.exactRuns} runs exact to round-off (no z)`, className: 'fit' });
-      if (s.below + s.above) parts.push({ text: `${s.below + s.above} beyond ±5`, className: 'badge' });
+      if (s.below + s.above) parts.push({ text: `${s.below + s.above} intervals far too narrow (z beyond ±5)`, className: 'badge' });
       if (s.zeroSe) parts.push({ text: `${s.zeroSe} with a zero error bar`, className: 'badge' });
-      const wide = conservativeErrorBars(records[s.name]);
-      if (wide) parts.push({ text: `${wide}: z narrower than N(0, 1) by design`, className: 'fit' });
+      const wide = render ? null : conservativeClaim(records[s.name], { exact: run.exact, reps: run.settings ? run.settings.reps : null, nName: names.n });
+      if (wide) parts.push({ text: wide.text, className: wide.holds === false ? 'badge' : 'fit' });
       return { name: s.name, color: colorOf(run, s.name), parts };
     }),
   ]);
@@ -103,13 +106,17 @@ export function renderCoverage(state, run, records) {
       cursor: { drag: { x: false, y: false } },
     }), data, { xRange, yRange: [ymin, 1.0001] });
   }
+  // Curves that coincide (several estimators at 1.00) are drawn on top of each other: say so.
+  const groups = coincidentGroups(cs.series);
   setLegend('coverage', dom['legend-coverage'], cs.series.map((s) => {
-    const last = [...s.y].reverse().find((v) => v !== null);
+    const wide = render ? null : conservativeClaim(records[s.name], { exact: run.exact, reps, nName: names.n });
+    const same = coincidentNote(s.name, groups);
     return {
       name: s.name,
       color: colorOf(run, s.name),
-      parts: [{ text: last === undefined ? '—' : `${fmt(last, 3)} at the largest ${names.n}`, className: 'fit' },
-        conservativeErrorBars(records[s.name]) ? { text: `${conservativeErrorBars(records[s.name])}: above 0.95 by design`, className: 'fit' } : ''],
+      parts: [{ text: coverageText(cs.x, s.y, names.n), className: 'fit' },
+        wide && wide.coverageText ? { text: wide.coverageText, className: wide.holds === false ? 'badge' : 'fit' } : '',
+        same ? { text: same, className: 'fit' } : ''],
     };
   }));
 }

@@ -2,6 +2,7 @@
 // DOM, text only, never HTML from data) and the estimators the reader hid by clicking their
 // legend entry (every plot follows: chart.js applies the set to each chart). No uPlot here.
 import { severityOf, SEVERITIES } from '../series.js';
+import { flagShort, flagTitle } from '../claims.js';
 import { colorAt } from '../palette.js';
 import { el } from '../dom.js';
 
@@ -71,9 +72,12 @@ export function swatch(color, dashed = false) {
   });
 }
 
+// A flag beside its estimator: plain words (claims/words.js), the code and the core's sentence in
+// the diagnostics list below, which the words point to.
 function badge(w) {
   const severity = severityOf(w);
-  return el('span', { className: `badge${severity === 'error' ? ' badge-error' : ''}`, title: w.message, dataset: { severity } }, w.code);
+  return el('span', { className: `badge${severity === 'error' ? ' badge-error' : ''}`,
+    title: `${flagTitle(w.code)}: ${w.message}`, dataset: { severity, code: w.code } }, flagShort(w.code));
 }
 
 /** An estimator's level flags of severity error or warning (one per code) that its own

@@ -2,6 +2,7 @@
 // the plot's title, a subtitle naming the scene and the estimators, and its legend lines.
 import { devicePixelRatioNow, withPixelRatio } from '../pixel_ratio.js';
 import { charts, dom } from './chart.js';
+import { legendLines } from '../claims.js';
 
 /**
  * The chart `key` as a PNG data URL at `scale` times the device's resolution (drawn again at that
@@ -14,6 +15,12 @@ export async function plotPng(key, subtitle = '', scale = 2) {
   return withPixelRatio(scale * devicePixelRatioNow(), () => composePng(key, subtitle));
 }
 
+// The legend lines of the last PNG composed (window.mcplayDebug, for the e2e tests).
+let lastLegend = [];
+export function lastPngLegend() {
+  return lastLegend.slice();
+}
+
 function composePng(key, subtitle) {
   const c = charts[key];
   if (!c || !c.u) return null;
@@ -24,8 +31,15 @@ function composePng(key, subtitle) {
   const head = (subtitle ? 46 : 28) * px;
   const out = document.createElement('canvas');
   out.width = src.width;
-  out.height = head + src.height + (legendItems.length ? legendItems.length * line + 10 * px : 0);
+  // The legend's lines: hidden estimators left out, each entry wrapped to the image's width.
   const ctx = out.getContext('2d');
+  ctx.font = `${12 * px}px "DejaVu Sans", sans-serif`;
+  const lines = legendLines(legendItems.map((li) => ({
+    text: [...li.childNodes].map((n) => n.textContent.trim()).filter(Boolean).join('  '),
+    hidden: li.classList.contains('off'),
+  })), { measure: (t) => ctx.measureText(t).width, width: out.width - 42 * px });
+  lastLegend = lines.map((l) => l.text);
+  out.height = head + src.height + (lines.length ? lines.length * line + 10 * px : 0);
   ctx.fillStyle = '#fff';
   ctx.fillRect(0, 0, out.width, out.height);
   ctx.fillStyle = '#1b1f24';
@@ -40,14 +54,15 @@ function composePng(key, subtitle) {
   }
   ctx.drawImage(src, 0, head);
   ctx.font = `${12 * px}px "DejaVu Sans", sans-serif`;
-  legendItems.forEach((li, i) => {
+  lines.forEach((l, i) => {
     const y = head + src.height + 5 * px + (i + 0.5) * line;
-    const sw = li.querySelector('.swatch');
-    ctx.fillStyle = sw ? getComputedStyle(sw).backgroundColor : '#000';
-    ctx.fillRect(10 * px, y - 2 * px, 16 * px, 4 * px);
+    if (l.first) {
+      const sw = legendItems[l.item].querySelector('.swatch');
+      ctx.fillStyle = sw ? getComputedStyle(sw).backgroundColor : '#000';
+      ctx.fillRect(10 * px, y - 2 * px, 16 * px, 4 * px);
+    }
     ctx.fillStyle = '#1b1f24';
-    const text = [...li.childNodes].map((n) => n.textContent.trim()).filter(Boolean).join('  ');
-    ctx.fillText(text.replace(/\s+/g, ' '), 32 * px, y);
+    ctx.fillText(l.text, 32 * px, y);
   });
   return out.toDataURL('image/png');
 }

@@ -2,8 +2,9 @@
 // against its run time per estimate, on log-log axes: points joined in the order of N, each
 // timing's 95% interval, reference slopes t^-1/2 and t^-1, the times too short for the clock
 // shaded, adaptive estimators' time without training dashed; and under it the equal-time
-// verdict (series.equalTimeVerdict).
-import { timeSeries, equalTimeVerdict, CLOCK_STEPS_FITTED, decadeRange } from '../series.js';
+// verdict and each slope's words (claims/equal_time.js, claims/time_slope.js).
+import { timeSeries, CLOCK_STEPS_FITTED, decadeRange } from '../series.js';
+import { equalTimeClaim, timeSlopeClaim } from '../claims.js';
 import { AXIS, LOG10_AXIS, decadeLabel, lg, lgAll, log10Range, shortSeconds, runLabels, isRender } from './axes.js';
 import { uPlot, charts, dom, draw, drop, empty, setText, logX, log10Y, minorLogGrid } from './chart.js';
 import { colorOf, isHidden, setLegend } from './legend.js';
@@ -147,18 +148,21 @@ export function renderTime(state, run, records) {
         draw: [(u) => pathsInOrder(() => charts.time.lines)(u)] },
     }), data, { xRange, yRange, lines, floor, step });
   }
-  const slopeText = (s) => {
-    if (s.slope === null) return s.untimed ? 'no slope: too fast for the clock' : '';
-    return `error ∝ t^${s.slope.toFixed(2)}${s.untimed ? ` (fit at t ≥ ${shortSeconds(floor)})` : ''}`;
-  };
-  setLegend('time', dom['legend-time'], ts.series.map((s) => ({
-    name: s.name,
-    color: colorOf(run, s.name),
-    parts: [slopeText(s) ? { text: slopeText(s), className: 'fit' } : '',
-      s.trainingShare === null ? '' : { text: `training: ${Math.round(100 * s.trainingShare)}% of the time (dashed: without it)`, className: 'fit' }],
-  })));
-  // The equal-time statement, once the run is over (integrals: render studies have their own
-  // efficiency in the tables).
-  const verdict = run.status === 'running' || isRender(run) ? null : equalTimeVerdict(records, run.order, run.exact);
+  // Each slope with its uncertainty, only where a line fits the timed points (claims/time_slope.js).
+  const measure = known && !render ? 'mse' : 'variance';
+  const exactValue = render ? null : run.exact;
+  setLegend('time', dom['legend-time'], ts.series.map((s) => {
+    const slope = timeSlopeClaim(records[s.name], { exact: exactValue, floorSeconds: floor, measure });
+    const fitFrom = slope.slope !== null && s.untimed ? ` (t ≥ ${shortSeconds(floor)})` : '';
+    return {
+      name: s.name,
+      color: colorOf(run, s.name),
+      parts: [slope.text ? { text: `${slope.text}${fitFrom}`, className: 'fit' } : '',
+        s.trainingShare === null ? '' : { text: `training: ${Math.round(100 * s.trainingShare)}% of the time (dashed: without it)`, className: 'fit' }],
+    };
+  }));
+  // The equal-time statement, once the run is over: none from times the clock cannot resolve.
+  const verdict = run.status === 'running' ? null
+    : equalTimeClaim(records, run.order, { exact: exactValue, floorSeconds: floor, clockKnown: state.clockStep > 0, render });
   setText('time-verdict', verdict ? verdict.text : '');
 }

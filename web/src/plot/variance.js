@@ -2,21 +2,18 @@
 // study's relative MSE) against N on log-log axes, with its 95% band, the reference slopes
 // N^-1, N^-2, N^-3 (spp^-1 for renders), a run kept for comparison dashed, and the levels that
 // are exact to round-off marked along the bottom; its legend gives each estimator's fitted order.
-import { varianceSeries, anchorOf, referenceLines, fitText } from '../series.js';
+import { varianceSeries, anchorOf, referenceLines } from '../series.js';
+import { orderClaim, exactnessText, varianceNote } from '../claims.js';
 import { withAlpha } from '../palette.js';
 import { keptFor } from '../state.js';
 import { AXIS, LOG10_AXIS, sup, lgAll, log10Range, runLabels, isRender } from './axes.js';
 import { uPlot, dom, draw, setText, logX, log10Y, nTicks, minorLogGrid, labelHook } from './chart.js';
 import { colorOf, levelFlags, setLegend } from './legend.js';
 
-export const VARIANCE_NOTE = {
-  integral: 'Shaded: 95% interval of the variance (chi-square); dashed grey: reference slopes N⁻¹, N⁻², N⁻³ from the first point. Order = the core\'s least-squares fit of log variance on log N.',
-  render: 'Relative MSE of each estimator\'s images against the reference (mean over the replicates; shaded: its 95% interval from their spread); dashed grey: the reference slope spp⁻¹ of an unbiased estimator, from the first point. Order = the core\'s least-squares fit of log relative MSE on log spp.',
-};
-
 /** Marks the levels that are exact to round-off (no point on a log axis): a row of squares in
  *  the series' colour along the bottom of the plot, one row per such estimator (the legend
- *  says which). */
+ *  says which); filled where the replicates equal the exact value, hollow where they only agree
+ *  with each other (claims/exact.js). */
 function exactHook(rows) {
   return (u) => {
     if (!rows.length) return;
@@ -26,10 +23,13 @@ function exactHook(rows) {
     rows.forEach(({ color, exactAt }, r) => {
       const y = u.bbox.top + u.bbox.height - (7 + 11 * r) * px;
       ctx.fillStyle = color;
-      exactAt.forEach((isExact, i) => {
-        if (!isExact) return;
+      ctx.strokeStyle = color;
+      ctx.lineWidth = 1.5 * px;
+      exactAt.forEach((kind, i) => {
+        if (!kind) return;
         const x = u.valToPos(u.data[0][i], 'x', true);
-        ctx.fillRect(x - 3.5 * px, y - 3.5 * px, 7 * px, 7 * px);
+        if (kind === 'exact') ctx.fillRect(x - 3.5 * px, y - 3.5 * px, 7 * px, 7 * px);
+        else ctx.strokeRect(x - 3 * px, y - 3 * px, 6 * px, 6 * px);
       });
     });
     ctx.restore();
@@ -93,7 +93,7 @@ export function renderVariance(state, run, records) {
     title.textContent = render ? `${names.error[0].toUpperCase()}${names.error.slice(1)} against ${names.n}`
       : vs.quantity === 'mse' ? 'MSE against N (exact value known)' : 'Variance against N';
   }
-  setText('variance-note', VARIANCE_NOTE[render ? 'render' : 'integral']);
+  setText('variance-note', varianceNote(render ? 'render' : 'integral', records, run.order));
   const sig = JSON.stringify([vs.quantity, run.order, run.colors, run.kind, names.nAxis, quantity,
     keptSeries.map((k) => k.name)]);
   draw('variance', dom.variance, sig, (c) => ({
@@ -110,17 +110,22 @@ export function renderVariance(state, run, records) {
 
   setLegend('variance', dom['legend-variance'], vs.series.map((s) => {
     const r = records[s.name];
+    const exactValue = render ? null : run.exact;
+    const measure = render ? names.error : 'variance';
+    const order = orderClaim(r, { which: 'fit', exact: exactValue, nName: names.n, measure });
+    const mseOrder = vs.quantity === 'mse' && !render && !s.exact
+      ? orderClaim(r, { which: 'mse_fit', exact: exactValue, nName: names.n, measure: 'MSE' }) : null;
     return {
       name: s.name,
       color: colorOf(run, s.name),
       parts: [
         // The plotted MSE's own order, then the variance's (a flat MSE under a falling
-        // variance is a bias: bias_dominates says from which N).
-        ...(vs.quantity === 'mse' && !render && !s.exact
-          ? ['order of MSE', { text: fitText(r.mse_fit), className: 'fit' }] : []),
-        ...(s.exact ? [{ fit: 'exact: zero variance at every N (■ along the bottom)', name: s.name }] : [
+        // variance is a bias: bias_dominates says from which N). A number only where a power
+        // law holds (claims/fit.js).
+        ...(mseOrder ? ['order of MSE', { text: mseOrder.text, className: 'fit' }] : []),
+        ...(s.exact ? [{ fit: `${exactnessText(s.exact)} (${s.exact === 'exact' ? '■' : '□'} along the bottom)`, name: s.name }] : [
           render ? `order of ${names.error}` : vs.quantity === 'mse' ? 'of variance' : 'order of variance',
-          { fit: fitText(r.fit), name: s.name }]),
+          { fit: order.text, name: s.name }]),
         ...levelFlags(r).map((w) => ({ warning: w })),
         ...(r.warnings || []).map((w) => ({ warning: w })),
       ],
@@ -129,6 +134,6 @@ export function renderVariance(state, run, records) {
     name: `${k.name} (kept)`,
     color: withAlpha(colorOf(run, k.name), 0.7),
     dashed: true,
-    parts: [{ text: `${kept.label}: order ${fitText(k.fit)}`, className: 'fit' }],
+    parts: [{ text: `${kept.label}: order ${orderClaim(kept.records[k.name], { exact: render ? null : kept.exact, nName: names.n }).text}`, className: 'fit' }],
   }))));
 }

@@ -3,14 +3,15 @@
 // Pure: no DOM and no uPlot (web/test/series.test.mjs runs it under Node); web/src/series.js
 // re-exports it.
 import { unionSorted, round9 } from './numbers.js';
+import { levelExactness } from '../claims/exact.js';
 
 /**
  * z = (estimate - reference) / std_error of every replicate of `levels` (all of them, or the
  * one with n === which). The reference is the exact value, or when it is unknown each level's
  * mean of its replicates. Replicates with a zero or missing error bar are counted in zeroSe
  * (a zero error bar with a wrong estimate is the confident wrong answer), not in z. Levels exact
- * to round-off (exact_to_roundoff: f/p constant) are counted in exactRuns, not in z: their z is
- * round-off over round-off.
+ * to round-off and equal to the exact value (claims/exact.js) are counted in exactRuns, not in z:
+ * their z is round-off over round-off.
  */
 export function zScores(levels, exact = null, which = 'all') {
   const useExact = exact !== null && exact !== undefined && Number.isFinite(exact);
@@ -21,7 +22,9 @@ export function zScores(levels, exact = null, which = 'all') {
     if (which !== 'all' && l.n !== which) continue;
     const rep = l.replicates;
     if (!rep) continue;
-    if (l.exact_to_roundoff === true) {
+    // Only levels that equal the exact value (claims/exact.js): replicates that merely agree on a
+    // wrong value have z = error / 0, counted in zeroSe below.
+    if (levelExactness(l, useExact ? exact : null) === 'exact') {
       exactRuns += rep.estimate.length;
       continue;
     }

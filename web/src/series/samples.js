@@ -237,23 +237,6 @@ export function runningEstimate(weights) {
   return { mean, lo, hi };
 }
 
-/**
- * Why an estimator's error bars are wider than its estimates' spread, by design, or null: the
- * core's error_method (collapsed strata pair neighbouring cells [Cochran77, 5A.12]; the iid
- * formula on a Latin hypercube or similar design overstates its variance). Their z-scores are
- * narrower than N(0, 1) and their coverage above 95%: that is what conservative means.
- */
-export function conservativeErrorBars(record) {
-  // The core says which error bars are conservative (error_bars_conservative, from the error
-  // method); the words say why, for the methods that have words.
-  if (!record || record.error_bars_conservative !== true) return null;
-  const why = {
-    collapsed_strata: 'collapsed strata: neighbouring cells paired',
-    iid_conservative: 'the iid formula, wider than this design\'s spread',
-  }[record.error_method];
-  return `conservative error bars (${why || 'wider than the estimator\'s spread by design'})`;
-}
-
 /** Is the mean of the first k of an estimator's points its estimate at N = k (independent points)? */
 export function replayIsEstimator(e) {
   // The core says so per estimator (samples output replay_is_estimate, from its kind); without

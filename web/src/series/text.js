@@ -15,44 +15,6 @@ export function severityOf(w) {
  * once, level flags with the list of N where they were raised and the message of the first;
  * errors first, then warnings, then info (in record order within a severity).
  */
-/** Each diagnostic code in plain words: what it means for the reader (the code itself stays
- *  beside it, small, for searching the documentation). */
-export const FLAG_TITLES = Object.freeze({
-  no_estimate: 'No estimate: every replicate failed',
-  nonfinite_estimate: 'The estimate is not a number',
-  nonfinite_variance: 'The error bar is not a number',
-  zero_error_bar: 'An error bar of zero where the replicates disagree: the interval is wrong',
-  nonfinite: 'Samples that were not numbers were dropped',
-  zero_pdf_samples: 'Points where the density is zero but f is not: that mass is missed',
-  skewed_weights: 'Skewed weights: the error bar is not yet trustworthy at this N',
-  low_ess: 'Few effective samples: a handful of points carry the estimate',
-  exact_outside_ci: 'The exact value is outside the replicates\' interval: biased or wrong error bars',
-  heavy_tail: 'Heavy tail: the variance may be infinite',
-  heavy_tail_4: 'Heavy tail: the fourth moment may be infinite (the error bar\'s own error converges slowly)',
-  pdf_support: 'The density misses part of where f is non-zero: biased',
-  level_drift: 'The estimates drift across N more than their error bars allow',
-  iterations_disagree: 'The iterations disagree more than their error bars allow',
-  error_bars_understate: 'The error bars are too small for the spread of the replicates',
-  error_bars_unstable: 'The replicates\' error bars disagree with each other: some saw a feature others missed',
-  replicate_far_off: 'A replicate lies far outside its own error bar: its error bar is far too small',
-  values_underflow: 'The values are so small that their squares underflow: no error bar can be computed',
-  bias_dominates: 'The bias dominates the error from some N on',
-  conservative_error_bars: 'Conservative error bars: wider than the replicates\' spread',
-  float32_accumulator: 'A single-precision accumulator limits the accuracy',
-  below_reference_noise: 'The error is below the reference\'s own noise',
-  reference_noise: 'The reference is noisy',
-  slow_convergence: 'Slower convergence than an unbiased estimator\'s',
-  pixel_error_bars: 'The pixels\' error bars cover too rarely',
-  few_pixel_errors: 'A few pixel errors make this level\'s error: it rests on rare events',
-  rare_large_errors: 'Rare large pixel errors make the error: levels that missed them understate it',
-  tolerance_not_met: 'The requested accuracy was not reached',
-});
-
-/** The plain-language title of a diagnostic code (the code itself when unknown). */
-export function flagTitle(code) {
-  return FLAG_TITLES[code] || code;
-}
-
 /**
  * The N of a collapsed diagnostic as text: every level of the ladder ("every N, 16 … 65536"), a
  * run of consecutive ladder steps ("N = 16 … 1024, 7 levels") or a list.

@@ -1,9 +1,8 @@
 // Error against time: the time of a level, its interval, the clock's resolution, the error
-// against time series and the equal-time verdict.
+// against time series (the equal-time verdict is claims/equal_time.js).
 // Pure: no DOM and no uPlot (web/test/series.test.mjs runs it under Node); web/src/series.js
 // re-exports it.
 import { positive, unionSorted } from './numbers.js';
-import { fmt } from './text.js';
 import { fitSlope } from './variance.js';
 
 /** The seconds per estimate a level is plotted at: the replicates' median (robust to the one
@@ -87,56 +86,4 @@ export function timeSeries(records, order, clockFloor = 0) {
       untimed: pts[k].length - timed.length, estimating, trainingShare, whiskers };
   });
   return { x, series };
-}
-
-/**
- * Who wins at equal time: the efficiency 1 / (error² × seconds) of each estimator at the
- * largest N it reached (the MSE when the exact value is known, else the variance; the median
- * seconds), with its uncertainty in log space from the error's chi-square interval
- * (variance_ci95) and the timing's (timeInterval). The most efficient is named only when a
- * z test on the log efficiencies separates it from the next (|z| > 1.96); an estimator exact to
- * round-off wins at any time. Returns {text, ranked: [{name, efficiency, lo, hi, n}], winner}.
- */
-export function equalTimeVerdict(records, order, exact = null) {
-  const useMse = exact !== null && exact !== undefined && Number.isFinite(exact);
-  const rows = [];
-  const exactOnes = [];
-  for (const name of order) {
-    const r = records[name];
-    const l = r && r.levels.length ? r.levels[r.levels.length - 1] : null;
-    if (!l) continue;
-    if (l.exact_to_roundoff === true) {
-      exactOnes.push(name);
-      continue;
-    }
-    const v = l.variance;
-    const q = useMse && positive(l.mse) !== null ? l.mse : v;
-    const t = timeOf(l);
-    if (positive(q) === null || positive(t) === null) continue;
-    const ci = l.variance_ci95;
-    const seLogQ = ci && positive(ci[0]) !== null && positive(ci[1]) !== null
-      ? (Math.log(ci[1]) - Math.log(ci[0])) / (2 * 1.959963984540054) : null;
-    const tci = timeInterval(l);
-    const seLogT = tci ? (Math.log(tci[1]) - Math.log(tci[0])) / (2 * 1.959963984540054) : 0;
-    const logE = -Math.log(q) - Math.log(t);
-    const se = seLogQ === null ? null : Math.sqrt(seLogQ * seLogQ + seLogT * seLogT);
-    rows.push({ name, n: l.n, efficiency: Math.exp(logE), logE, se,
-      lo: se === null ? null : Math.exp(logE - 1.96 * se), hi: se === null ? null : Math.exp(logE + 1.96 * se) });
-  }
-  rows.sort((a, b) => b.logE - a.logE);
-  const what = useMse ? 'MSE' : 'variance';
-  if (exactOnes.length) {
-    return { winner: exactOnes[0], ranked: rows, text: `${exactOnes.join(' and ')} ${exactOnes.length > 1 ? 'are' : 'is'} exact (zero ${what} to round-off): nothing beats that at any time.` };
-  }
-  if (rows.length < 2) return { winner: rows.length ? rows[0].name : null, ranked: rows, text: '' };
-  const [a, b] = rows;
-  const lead = `at the largest N each reached (1 / (${what} × seconds); it grows with N for estimators steeper than N⁻¹)`;
-  if (a.se === null || b.se === null) {
-    return { winner: null, ranked: rows, text: `Most efficient ${lead}: ${a.name}, ${fmt(a.efficiency / b.efficiency, 2)}× ${b.name}; no uncertainty to test it.` };
-  }
-  const z = (a.logE - b.logE) / Math.sqrt(a.se * a.se + b.se * b.se);
-  if (z > 1.959963984540054) {
-    return { winner: a.name, ranked: rows, text: `Equal-time winner ${lead}: ${a.name}, ${fmt(a.efficiency / b.efficiency, 2)}× as efficient as the next, ${b.name} (z = ${fmt(z, 2)}, with the error's and the timing's uncertainty).` };
-  }
-  return { winner: null, ranked: rows, text: `No significant difference at equal time between ${a.name} and ${b.name} ${lead}: ${fmt(a.efficiency / b.efficiency, 2)}× (z = ${fmt(z, 2)} < 1.96).` };
 }

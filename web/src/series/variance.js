@@ -3,6 +3,7 @@
 // Pure: no DOM and no uPlot (web/test/series.test.mjs runs it under Node); web/src/series.js
 // re-exports it.
 import { ladder, positive, unionSorted } from './numbers.js';
+import { levelExactness, recordExactness } from '../claims/exact.js';
 
 /**
  * The variance plot: x = every N any estimator has reached; per estimator y = its MSE when
@@ -12,8 +13,10 @@ import { ladder, positive, unionSorted } from './numbers.js';
  * value. Values that cannot sit on a log axis (0, null) are null. `xs` (optional) fixes the x
  * values, e.g. the whole N ladder of a run that is still going.
  */
-// Each series also has exactAt (per x: that level is exact to round-off, so y is null there) and
-// exact (every level so far is).
+// Each series also has exactAt (per x: 'exact' when that level's replicates equal the exact value
+// to round-off, 'agree' when they only agree with each other (claims/exact.js), else false; y is
+// null at both, a variance of 0 having no place on a log axis) and exact ('exact' or 'agree' when
+// every level so far is, else null).
 export function varianceSeries(records, order, exact = null, xs = null) {
   const useMse = exact !== null && exact !== undefined && Number.isFinite(exact);
   const named = order.filter((n) => records[n]);
@@ -26,8 +29,9 @@ export function varianceSeries(records, order, exact = null, xs = null) {
     const exactAt = [];
     for (const n of x) {
       const l = byN.get(n);
-      exactAt.push(Boolean(l && l.exact_to_roundoff === true));
-      if (!l || l.exact_to_roundoff === true) {
+      const kind = l ? levelExactness(l, useMse ? exact : null) : 'no';
+      exactAt.push(kind === 'no' ? false : kind);
+      if (!l || kind !== 'no') {
         // an exact level (variance zero up to round-off) has no point on a log axis: the plot
         // marks it apart
         y.push(null); lo.push(null); hi.push(null);
@@ -41,9 +45,8 @@ export function varianceSeries(records, order, exact = null, xs = null) {
       lo.push(ci ? positive(ci[0] * scale) : null);
       hi.push(ci ? positive(ci[1] * scale) : null);
     }
-    const levels = records[name].levels;
-    const exact = levels.length > 0 && levels.every((l) => l.exact_to_roundoff === true);
-    return { name, y, lo, hi, exactAt, exact, fit: records[name].fit || null };
+    const all = recordExactness(records[name], useMse ? exact : null).all;
+    return { name, y, lo, hi, exactAt, exact: all, fit: records[name].fit || null };
   });
   return { quantity: useMse ? 'mse' : 'variance', x, series };
 }

@@ -4,20 +4,21 @@
 import { KIND, kindOf } from '../state.js';
 import { explainEstimator } from '../explain.js';
 import { colorAt } from '../palette.js';
-import { fitText } from '../series.js';
+import { orderClaim } from '../claims.js';
 import { el } from '../dom.js';
 
 const $ = (id) => document.getElementById(id);
 
 let lastSig = null;
 
-/** What the run measured for an estimator: its fitted order, or "exact", or nothing yet. */
-function measured(record) {
+/** What the run measured for an estimator: its fitted order where a power law holds, or why
+ *  there is none (claims/fit.js), or nothing yet. */
+function measured(record, exact) {
   if (!record || !Array.isArray(record.levels) || !record.levels.length) return null;
-  if (record.levels.every((l) => l.exact_to_roundoff)) return 'exact: zero variance up to round-off at every N';
-  const fit = record.fit;
-  if (!fit || !fit.valid) return fitText(fit);
-  return `variance ∝ N^(${fitText(fit)}), fitted over the N of the run`;
+  const c = orderClaim(record, { exact });
+  if (c.number === null) return c.text;
+  if (c.note && c.note.startsWith('from N')) return `variance ∝ N^(${c.number}) ${c.note}; ${c.text.slice(c.text.indexOf('(') + 1, -1)}`;
+  return `variance ∝ N^(${c.number}), fitted over the N of the run${c.holds === null ? ' (not checked for a power law)' : ''}`;
 }
 
 export function renderExplain(state) {
@@ -26,7 +27,7 @@ export function renderExplain(state) {
   const render = kindOf(info) === KIND.RENDER;
   const details = info && Array.isArray(info.estimator_details) ? info.estimator_details : [];
   const run = state.run;
-  const fits = state.selected.map((n) => measured(run.records[n]));
+  const fits = state.selected.map((n) => measured(run.records[n], run.exact));
   const sig = JSON.stringify([state.sceneId, render, state.selected, details.length, fits]);
   if (sig === lastSig) return;
   lastSig = sig;
@@ -40,7 +41,7 @@ export function renderExplain(state) {
       el('h3', {}, el('span', { className: 'swatch', style: `background:${colorAt(all.indexOf(name))}` }), ` ${name}: `,
         el('span', { className: 'method' }, x.title)),
       el('p', { className: 'formula' }, el('code', {}, x.formula)),
-      x.density ? el('p', { className: 'small muted' }, `density: ${x.density}`) : null,
+      x.density ? el('p', { className: 'small muted' }, `density: ${d.pdf_text || x.density}`) : null,
       el('p', {}, el('strong', {}, 'Should reach: '), `variance ∝ ${x.order}`),
       fits[i] ? el('p', { className: 'measured' }, el('strong', {}, 'Reached: '), fits[i]) : null,
       x.look ? el('p', { className: 'small' }, x.look) : null);

@@ -1,0 +1,29 @@
+// The notes of a render study's plots, true to its estimators: the reference slope spp^-1 is an
+// unbiased estimator's with independent pixel samples; stratified or Sobol' pixel samples fall
+// faster, and the note says which estimators use them.
+// Pure (no DOM): web/test/claims.test.mjs runs it under Node.
+
+/** The estimators of a render run whose pixel samples are not independent. */
+export function designedPixels(records, order) {
+  return order.filter((n) => records[n] && records[n].pixel_sampler && records[n].pixel_sampler !== 'independent');
+}
+
+/** The variance plot's note. */
+export function varianceNote(kind, records = {}, order = []) {
+  if (kind !== 'render') {
+    return 'Shaded: 95% interval of the variance (chi-square); dashed grey: reference slopes N⁻¹, N⁻², N⁻³ from the first point. Order = the core\'s least-squares fit of log variance on log N, stated only where the levels follow a line (chi-square test against their own noise).';
+  }
+  const designed = designedPixels(records, order);
+  const base = 'Relative MSE of each estimator\'s images against the reference (mean over the replicates; shaded: its 95% interval from their spread); dashed grey: spp⁻¹ from the first point, the slope of an unbiased estimator with independent pixel samples. Order = the core\'s least-squares fit of log relative MSE on log spp, stated only where the levels follow a line.';
+  if (!designed.length) return base;
+  const names = designed.map((n) => `${n} (${records[n].pixel_sampler})`).join(', ');
+  return `${base} ${names}: stratified or low-discrepancy pixel samples, so a slope steeper than spp⁻¹ is expected where the image is smooth.`;
+}
+
+/** The time plot's note (the clock's sentence is clock.js's). */
+export function timeNote(kind) {
+  if (kind === 'render') {
+    return 'Equal-time comparison: at a given cost (x), the lowest curve wins. Each point is the mean time of one image at that spp over the replicates, against its relative RMSE; whiskers: the 95% interval of that mean.';
+  }
+  return 'Equal-time comparison: at a given cost (x), the lowest curve wins. Each point is the replicates\' median time per estimate at one N (robust to a replicate a busy machine delayed), against its error; whiskers: its 95% interval (order statistics). Adaptive estimators (VEGAS, MISER) include their training or probing; dashed, without it.';
+}
