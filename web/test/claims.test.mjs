@@ -10,7 +10,7 @@ import {
   levelExactness, recordExactness, orderClaim, conservativeClaim, coverageText, coincidentGroups,
   coincidentNote, withinText, alarmSummary, flagPersistence, equalTimeClaim, seLogMse, timeSlopeClaim,
   varianceNote, timeNote, legendLines, FLAG_WORDS, flagTitle, flagShort, pWords, tailWords, densityWords,
-  methodWords, chi2Sf, trigamma, fitLine, infiniteVariance,
+  methodWords, inputErrorWords, chi2Sf, trigamma, fitLine, infiniteVariance,
 } from '../src/claims.js';
 import { collectWarnings, calibrationSeries, coverageSeries, varianceSeries, zScores } from '../src/series.js';
 
@@ -257,6 +257,11 @@ test('p-values, tail indices, densities and methods in words', () => {
   assert.match(tailWords(0), /no tail estimate/);
   assert.equal(densityWords({ pdf: 'exponential(rate=-0.8) on [0, 1]', pdf_text: 'exponential density ∝ e^(−0.8 x) on [0, 1]' }), 'exponential density ∝ e^(−0.8 x) on [0, 1]');
   assert.equal(densityWords({ pdf: 'uniform' }), 'uniform');
+  // the page's own scene path is not the reader's: the input is named instead
+  const e = inputErrorWords('scene.estimators[3].pdf.shape: at position 2: expected an expression', 'p');
+  assert.doesNotMatch(e, /scene|estimators\[/);
+  assert.match(e, /^p, the density: at position 2: expected an expression$/);
+  assert.match(inputErrorWords("scene.f: at position 7: unknown function 'sinn'", 'f'), /^f, the integrand: at position 7/);
   for (const m of ['iid', 'iid_conservative', 'collapsed_strata', 'paired_strata', 'randomizations', 'parts_sum', 'regression', 'walsh_bound', 'none']) {
     assert.doesNotMatch(methodWords(m), /_/, m);
   }

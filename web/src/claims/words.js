@@ -98,3 +98,16 @@ export const METHOD_WORDS = Object.freeze({
 export function methodWords(method) {
   return METHOD_WORDS[method] || (method ? String(method).replace(/_/g, ' ') : 'unknown');
 }
+
+const INPUT_NAMES = { f: 'f, the integrand', p: 'p, the density', exact: 'the exact value' };
+
+/**
+ * A core error about a typed expression in words: the scene path the core names
+ * ("scene.estimators[3].pdf.shape: at position 2: ...") is the page's own construction, not the
+ * reader's; the words name the input instead ("p, the density: at position 2: ...").
+ */
+export function inputErrorWords(message, field) {
+  const text = String(message || '');
+  const rest = text.replace(/^scene(\.[\w]+|\[\d+\])*:\s*/, '');
+  return `${INPUT_NAMES[field] || 'the input'}: ${rest}`;
+}

@@ -3,6 +3,8 @@
 // sync(state) shows the core's parse error inline: the message in #custom-error, the offending
 // field marked invalid, and the expression repeated under it with the reported position
 // highlighted.
+import { inputErrorWords } from '../claims.js';
+
 const $ = (id) => document.getElementById(id);
 
 export function mountCustom(store) {
@@ -42,7 +44,7 @@ export function syncCustom(state) {
   const err = c.error;
   if (err === shownError) return;
   shownError = err;
-  $('custom-error').textContent = err ? err.message : '';
+  $('custom-error').textContent = err ? inputErrorWords(err.message, err.field) : '';
   $('custom-exact').setAttribute('aria-invalid', String(Boolean(err && err.field === 'exact')));
   for (const field of ['f', 'p']) {
     const input = $(`custom-${field}`);
