@@ -898,6 +898,8 @@ export function debugSnapshot(state) {
   return {
     status: statusText(state),
     version: state.version,
+    clockStep: state.clockStep ?? null, // ms
+
     scene: state.sceneId,
     sceneInfo: state.sceneInfo,
     selected: state.selected.slice(),
