@@ -722,7 +722,7 @@ async function start() {
   runnersFor(1); // warm one run worker while the scene loads
   // The clock where the timings are taken: the run worker measures its own step and tells
   // whether the page is cross-origin isolated (claims/clock.js says what that allows).
-  const clockKnown = runners[0].loaded.then(
+  const clockKnown = loadedReply(runners[0]).then(
     ({ clockStepMs, isolated }) => dispatch({ type: 'clock/measured', payload: { ms: clockStepMs, isolated } }),
     () => {});
 
@@ -769,6 +769,19 @@ async function start() {
   await clockKnown;
   runnersFor(Math.min(CORES, (store.getState().sceneInfo?.estimators || []).length || 1));
   return ok;
+}
+
+/** A worker's READY payload; a worker restarted meanwhile (a scene change stops busy run
+ *  workers) answers its new load request instead. */
+async function loadedReply(worker) {
+  for (;;) {
+    const loaded = worker.loaded;
+    try {
+      return await loaded;
+    } catch (e) {
+      if (!(e && e.cancelled) || worker.loaded === loaded) throw e;
+    }
+  }
 }
 
 // Resolves once the core is loaded and the first scene is shown; rejects with the reason if not.
