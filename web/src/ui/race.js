@@ -102,11 +102,10 @@ function drawRace(state) {
     el('th', { scope: 'col' }, 'median evaluations'),
     el('th', { scope: 'col' }, 'median N'),
     el('th', { scope: 'col', title: 'median time over the fastest median the clock can time, and the rank-sum test p-value against it' }, 'vs fastest'));
-  const columns = race.exact === null ? 7 : 8;
   const floor = claim.evidence.floorSeconds;
   const refName = claim.evidence.fastestTimed;
   const colorOf = (name) => colorAt(Math.max(0, (state.sceneInfo?.estimators || []).indexOf(name)));
-  const body = verdict.ranked.flatMap((r) => {
+  const body = verdict.ranked.map((r) => {
     const ci = r.interval;
     let ciText;
     if (r.tooFast) {
@@ -121,7 +120,7 @@ function drawRace(state) {
     else if (r.name === refName) vs = claim.evidence.tooFast.length ? 'fastest timed' : 'fastest';
     else if (r.vsFastest === null) vs = '—';
     else vs = `${Number.isFinite(r.ratio) ? `${fmt(r.ratio, 2)}×` : 'not reached'} (p = ${fmt(r.vsFastest, 2)})`;
-    const row = el('tr', { className: r.name === verdict.winner ? 'winner' : '' },
+    return el('tr', { className: r.name === verdict.winner ? 'winner' : '' },
       el('th', { scope: 'row', className: 'left' },
         el('span', { className: 'swatch', style: `background:${colorOf(r.name)}` }), ` ${r.name}`),
       el('td', {}, stripSvg(axis, r, colorOf(r.name))),
@@ -132,16 +131,16 @@ function drawRace(state) {
       el('td', {}, fmt(r.evaluations, 3)),
       el('td', {}, r.n === null ? '—' : String(r.n)),
       el('td', {}, vs));
-    if (!r.notes.length) return [row];
-    // the row's notes, in words, right under it (read with the row, not on hover)
-    const note = el('tr', { className: 'race-note' },
-      el('td', { colSpan: columns, className: 'left' }, `${r.name}: ${r.notes.join('; ')}.`));
-    return [row, note];
   });
+  // Each row's notes, in words, right under the table in the rows' order (read, not hovered).
+  const notes = verdict.ranked.filter((r) => r.notes.length).map((r) => el('li', { dataset: { estimator: r.name } },
+    el('span', { className: 'swatch', style: `background:${colorOf(r.name)}` }), ' ',
+    el('strong', {}, r.name), `: ${r.notes.join('; ')}.`));
   const warnings = rows.flatMap((r) => r.warnings.map((w) => el('li', {},
     el('span', { className: `severity severity-${w.severity || 'warning'}` }, (w.severity || 'warning').toUpperCase()),
     ` ${r.name}: ${w.message}`)));
   const parts = [el('table', { className: 'levels race' }, el('thead', {}, head), el('tbody', {}, ...body))];
+  if (notes.length) parts.push(el('ul', { className: 'race-notes' }, ...notes));
   if (warnings.length) parts.push(el('ul', { className: 'diagnostics' }, ...warnings));
   table.replaceChildren(...parts);
 }
