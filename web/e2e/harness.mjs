@@ -24,13 +24,15 @@ async function waitForServer(url) {
 /**
  * Serves `site` and opens the playground: {url, context, page, close()}. `onContext(context)`
  * runs before the page opens (e.g. to record every request); `onPageError(message)` hears the
- * page's uncaught errors (they are printed either way).
+ * page's uncaught errors (they are printed either way). `isolation: false` serves the site
+ * without the cross-origin isolation headers (serve.mjs's MCPLAY_NO_ISOLATION=1), as a plain
+ * static host does.
  */
-export async function openPlayground({ site, viewport, profilePrefix = 'mcplay-chromium-', onContext, onPageError }) {
+export async function openPlayground({ site, viewport, profilePrefix = 'mcplay-chromium-', onContext, onPageError, isolation = true }) {
   const port = 20000 + Math.floor(Math.random() * 20000);
   const url = `http://127.0.0.1:${port}/`;
   const server = spawn(process.execPath, [join(here, '..', 'tools', 'serve.mjs'), site], {
-    env: { ...process.env, PORT: String(port), HOST: '127.0.0.1' },
+    env: { ...process.env, PORT: String(port), HOST: '127.0.0.1', MCPLAY_NO_ISOLATION: isolation ? '' : '1' },
     stdio: ['ignore', 'pipe', 'inherit'],
   });
   let context, profile;

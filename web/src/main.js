@@ -20,7 +20,7 @@ import {
   debugSnapshot, buildCustomScene, customError, parseExact, CUSTOM, WEIGHT_SAMPLES, KIND, kindOf, normalizeInfo,
   runSettings, studyOptions, urlProblems, USER_GLTF,
 } from './state.js';
-import { clockResolution, splitEstimators, splitRenderWork, splitCollector, partialResult, samplesCsv } from './series.js';
+import { splitEstimators, splitRenderWork, splitCollector, partialResult, samplesCsv } from './series.js';
 import { CoreWorker } from './client.js';
 import { MSG } from './protocol.js';
 import { initPlots, renderPlots, plotPng, lastPngLegend, hiddenEstimators } from './plot.js';
@@ -32,6 +32,7 @@ import { mountControls, syncControls } from './ui/controls.js';
 import { mountCustom, syncCustom } from './ui/custom.js';
 import { mountExports, syncExports } from './ui/exports.js';
 import { mountRace, syncRace } from './ui/race.js';
+import { syncClock } from './ui/clock.js';
 import { raceOptions, withoutStopping } from './race.js';
 import { startLab } from './lab/wiring.js';
 import { labSnapshot } from './lab/model.js';
@@ -150,6 +151,7 @@ store.subscribe((state) => {
   syncCustom(state);
   syncExports(state);
   syncRace(state);
+  syncClock(state);
   // When a run ends, its final plots and fitted orders are drawn before anything else happens,
   // so that whatever reads "done" in #status also finds the final numbers; otherwise later.
   const ended = lastStatus === 'running' && state.run.status !== 'running';
@@ -704,7 +706,6 @@ async function copyLink() {
 // Start-up: the core, the manifest, then the scene the URL names (or the first one).
 
 async function start() {
-  dispatch({ type: 'clock/measured', payload: { ms: clockResolution(() => performance.now()) } });
   service = new CoreWorker(WORKER_URL);
   const manifest = fetch('scenes/manifest.json').then((r) => {
     if (!r.ok) throw new Error(`scenes/manifest.json: HTTP ${r.status}`);
@@ -719,6 +720,11 @@ async function start() {
   }
   dispatch({ type: 'core/ready', payload: { version } });
   runnersFor(1); // warm one run worker while the scene loads
+  // The clock where the timings are taken: the run worker measures its own step and tells
+  // whether the page is cross-origin isolated (claims/clock.js says what that allows).
+  const clockKnown = loadedReply(runners[0]).then(
+    ({ clockStepMs, isolated }) => dispatch({ type: 'clock/measured', payload: { ms: clockStepMs, isolated } }),
+    () => {});
 
   let scenes;
   try {
@@ -760,8 +766,22 @@ async function start() {
   }
   urlReady = true;
   writeUrl(store.getState());
+  await clockKnown;
   runnersFor(Math.min(CORES, (store.getState().sceneInfo?.estimators || []).length || 1));
   return ok;
+}
+
+/** A worker's READY payload; a worker restarted meanwhile (a scene change stops busy run
+ *  workers) answers its new load request instead. */
+async function loadedReply(worker) {
+  for (;;) {
+    const loaded = worker.loaded;
+    try {
+      return await loaded;
+    } catch (e) {
+      if (!(e && e.cancelled) || worker.loaded === loaded) throw e;
+    }
+  }
 }
 
 // Resolves once the core is loaded and the first scene is shown; rejects with the reason if not.

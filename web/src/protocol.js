@@ -3,7 +3,7 @@
 // is one of MSG, `payload` is plain structured-cloneable data.
 //
 //   page -> worker                          worker -> page
-//   load     {}                             ready     {version}
+//   load     {}                             ready     {version, isolated, clockStepMs}
 //   validate {scene}                        validated {info}          (core.sceneInfo)
 //   run      {scene, options, warmup?}      level     {level}  x N    (after each N)
 //                                           result    {result}        (core.runStudy; with

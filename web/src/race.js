@@ -1,8 +1,8 @@
 // The "race" to a requested accuracy: what the page says about a stopping result (the C API's
 // "kind": "stopping", docs/result-schema.md). Each estimator ran R independent times, each time
 // doubling N until its error bar met the target or a budget ended; this module turns those runs
-// into a time to the target per estimator, with the uncertainty of that time, and states the
-// winner only when the data support it. Pure functions, no DOM: web/test/race.test.mjs.
+// into a time to the target per estimator, with the uncertainty of that time (the statistics);
+// claims/race.js decides what the card says of them. Pure functions, no DOM: web/test/race.test.mjs.
 //
 // A run that did not meet the target is censored: its time to the target is longer than what it
 // used, so it counts as +Infinity. Medians and rank tests stay valid with such values (a median
@@ -172,14 +172,16 @@ export function raceRows(result) {
     const evals = runs.filter((r) => r.met).map((r) => r.evaluations).sort((x, y) => x - y);
     const ns = runs.filter((r) => r.met).map((r) => r.n).sort((x, y) => x - y);
     const met = runs.filter((r) => r.met).length;
-    const known = runs.filter((r) => r.within_tolerance !== null && r.within_tolerance !== undefined);
+    // within the tolerance of the exact value: counted over the runs that met the target (the
+    // core also judges the runs that ran out)
+    const known = runs.filter((r) => r.met && typeof r.within_tolerance === 'boolean');
     const reasons = [...new Set(runs.filter((r) => !r.met).map((r) => r.reason))];
     rows.push({
       name: e.name,
       runs: runs.length,
       met,
       within: known.length ? known.filter((r) => r.within_tolerance).length : null,
-      withinOf: known.length ? known.filter((r) => r.met).length : null,
+      withinOf: known.length ? known.length : null,
       times,
       usedSeconds: used,
       median: median(times),
@@ -193,57 +195,8 @@ export function raceRows(result) {
   return rows;
 }
 
-/** The p-value below which the race names a winner. */
+/** The p-value below which the race names a winner (claims/race.js words the verdict). */
 export const RACE_ALPHA = 0.05;
-
-/**
- * Who reached the target first, from raceRows: the rows sorted by median time (those that did
- * not reach it in most runs last), each compared with the fastest by the rank-sum test, and a
- * sentence that names a winner only when it is significantly faster than every other estimator
- * (p < RACE_ALPHA for each comparison); otherwise it names those not distinguishable from it.
- */
-export function raceVerdict(rows) {
-  const finite = rows.filter((r) => Number.isFinite(r.median)).sort((x, y) => x.median - y.median);
-  const out = rows.filter((r) => !Number.isFinite(r.median));
-  const ranked = [...finite, ...out].map((r) => ({ ...r, vsFastest: null, ratio: null }));
-  if (!finite.length) {
-    return { winner: null, tied: [], ranked, text: rows.length ? 'No estimator reached the target in most of its runs within the budget.' : '' };
-  }
-  const best = ranked[0];
-  const tied = [];
-  for (const r of ranked.slice(1)) {
-    const t = mannWhitney(best.times, r.times);
-    r.vsFastest = t.p;
-    r.ratio = Number.isFinite(r.median) ? r.median / best.median : Infinity;
-    if (!(t.p < RACE_ALPHA)) tied.push(r.name);
-  }
-  if (ranked.length === 1) {
-    return { winner: best.name, tied, ranked, text: `${best.name} reached the target in ${best.met} of ${best.runs} runs.` };
-  }
-  if (!tied.length) {
-    const second = ranked[1];
-    const how = Number.isFinite(second.ratio)
-      ? `${formatRatio(second.ratio)} faster than the next, ${second.name} (rank-sum p = ${formatP(second.vsFastest)})`
-      : `the only one to reach it in most runs (${second.name} and the others did not)`;
-    return { winner: best.name, tied, ranked, text: `${best.name} reaches the target first: ${how}.` };
-  }
-  const names = [best.name, ...tied];
-  return {
-    winner: null,
-    tied: names,
-    ranked,
-    text: `No significant difference between ${names.join(', ')} (rank-sum p >= ${RACE_ALPHA} against the fastest median, ${best.name}).`,
-  };
-}
-
-function formatRatio(r) {
-  return `${r >= 10 ? Math.round(r) : Number(r.toPrecision(2))}×`;
-}
-
-function formatP(p) {
-  if (p === null || p === undefined) return '—';
-  return p < 1e-4 ? p.toExponential(0) : String(Number(p.toPrecision(2)));
-}
 
 /** A time in s, ms or µs with 2-3 significant digits ('—' when not finite). */
 export function formatSeconds(s) {

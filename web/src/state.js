@@ -446,7 +446,8 @@ export function initialState() {
     paramErrors: {},        // key -> message for an input that holds no valid value
     custom: { f: '', p: '', exact: '', error: null, pending: false, applied: null },
     userGltf: { name: null, error: null }, // a glTF file opened in the page (its file name), or why not
-    clockStep: null,        // ms: the step performance.now() rounds to here (times under 20 steps are not fitted)
+    clockStep: null,        // ms: the step performance.now() rounds to in a run worker (times under 20 steps are not fitted)
+    isolated: null,         // the run worker's crossOriginIsolated (null until it has answered)
     calibration: 'all',     // the histogram's level: 'all' (pooled) or an N
     notice: '',             // last export / scene-loading message
     run: emptyRun('loading'),
@@ -612,7 +613,7 @@ export function reducer(state, action) {
       };
     }
     case 'clock/measured':
-      return { ...state, clockStep: p.ms > 0 ? p.ms : null };
+      return { ...state, clockStep: p.ms > 0 ? p.ms : null, isolated: typeof p.isolated === 'boolean' ? p.isolated : null };
     case 'gltf/error':
       return { ...state, userGltf: { ...state.userGltf, error: p.message } };
     case 'scene/failed':
@@ -930,6 +931,7 @@ export function debugSnapshot(state) {
     }),
     result: r.result,
     // the race to a requested accuracy: its status and the stopping result so far
+    clock: { step: state.clockStep, isolated: state.isolated },
     kept: state.kept ? { sceneId: state.kept.sceneId, label: state.kept.label, order: state.kept.order.slice() } : null,
     race: { status: state.race.status, message: state.race.message, inputs: { ...state.race.inputs },
       order: state.race.order.slice(), result: raceResult(state.race) },

@@ -6,8 +6,13 @@ import assert from 'node:assert/strict';
 
 import {
   parsePositive, raceOptions, withoutStopping, sceneTolerance, medianInterval, normalUpperTail,
-  mannWhitney, raceRows, raceVerdict, formatSeconds,
+  mannWhitney, raceRows, formatSeconds,
 } from '../src/race.js';
+import { raceClaim } from '../src/claims/race.js';
+
+// The verdict's words (claims/race.js) with an isolated page's clock: 5 us steps, floor 100 us.
+const FINE = { stepMs: 0.005, isolated: true };
+const raceVerdict = (result) => raceClaim(result, { clock: FINE });
 
 // A fixed-seed uniform generator on (0, 1) (splitmix-style 32-bit hash of a counter).
 function rng(seed) {
@@ -146,28 +151,28 @@ test('raceRows: censored runs, medians, evaluations and the within-tolerance cou
   assert.deepEqual(out.reasons, ['max_seconds']);
 });
 
-test('raceVerdict: a clear winner, a tie, and nobody', () => {
+test('raceClaim with a fine clock: a clear winner, a tie, and nobody', () => {
   const u = rng(3);
   const times = (scale) => Array.from({ length: 12 }, () => [true, scale * (1 + u())]);
-  const clear = raceVerdict(raceRows({ estimators: [estimator('slow', times(0.1)), estimator('quick', times(0.01))] }));
+  const clear = raceVerdict({ estimators: [estimator('slow', times(0.1)), estimator('quick', times(0.01))] });
   assert.equal(clear.winner, 'quick');
   assert.deepEqual(clear.ranked.map((r) => r.name), ['quick', 'slow']);
   assert.ok(clear.ranked[1].ratio > 5);
   assert.match(clear.text, /^quick reaches the target first: [\d.]+× faster than the next, slow \(rank-sum p = /);
 
-  const tie = raceVerdict(raceRows({ estimators: [estimator('a', times(0.01)), estimator('b', times(0.01)), estimator('c', times(1))] }));
+  const tie = raceVerdict({ estimators: [estimator('a', times(0.01)), estimator('b', times(0.01)), estimator('c', times(1))] });
   assert.equal(tie.winner, null);
   assert.deepEqual(tie.tied.slice().sort(), ['a', 'b']);
   assert.match(tie.text, /^No significant difference between /);
 
-  const censored = raceVerdict(raceRows({ estimators: [
+  const censored = raceVerdict({ estimators: [
     estimator('never', Array.from({ length: 10 }, () => [false, 2])),
     estimator('only', times(0.5).slice(0, 10)),
-  ] }));
+  ] });
   assert.equal(censored.winner, 'only');
   assert.match(censored.text, /the only one to reach it in most runs/);
 
-  const none = raceVerdict(raceRows({ estimators: [estimator('never', [[false, 2], [false, 2]])] }));
+  const none = raceVerdict({ estimators: [estimator('never', [[false, 2], [false, 2]])] });
   assert.equal(none.winner, null);
   assert.match(none.text, /No estimator reached the target/);
 });

@@ -3,7 +3,8 @@
 //   PORT=8000 node web/tools/serve.mjs [DIR]          (DIR: the built site, default build/site)
 // Serves DIR on 127.0.0.1 with the MIME types the page needs (.wasm as application/wasm, so
 // the browser compiles it while it streams) and cross-origin isolation headers (finer timers),
-// never a file outside DIR.
+// never a file outside DIR. MCPLAY_NO_ISOLATION=1 leaves out COOP/COEP/CORP: the page is then
+// served as a plain static host (GitHub Pages) serves it, with the browser's coarse clock.
 import http from 'node:http';
 import fs from 'node:fs';
 import path from 'node:path';
@@ -14,6 +15,7 @@ const REPO = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '..', '.
 const ROOT = process.argv[2] ? path.resolve(process.argv[2]) : path.join(REPO, 'build', 'site');
 const PORT = Number(process.env.PORT || 8000);
 const HOST = '127.0.0.1';
+const ISOLATION = !['1', 'true', 'yes'].includes(String(process.env.MCPLAY_NO_ISOLATION || '').toLowerCase());
 
 const MIME = {
   '.html': 'text/html; charset=utf-8',
@@ -92,9 +94,11 @@ const server = http.createServer((req, res) => {
       'X-Content-Type-Options': 'nosniff',
       // Cross-origin isolation: browsers then time with performance.now() at ~5 us instead of
       // 100 us, which the wasm core's per-estimate timings (time_mean_s) need at small N.
-      'Cross-Origin-Opener-Policy': 'same-origin',
-      'Cross-Origin-Embedder-Policy': 'require-corp',
-      'Cross-Origin-Resource-Policy': 'same-origin',
+      ...(ISOLATION ? {
+        'Cross-Origin-Opener-Policy': 'same-origin',
+        'Cross-Origin-Embedder-Policy': 'require-corp',
+        'Cross-Origin-Resource-Policy': 'same-origin',
+      } : {}),
     });
     if (req.method === 'HEAD') {
       res.end();
@@ -109,5 +113,5 @@ server.on('error', (e) => {
   process.exit(1);
 });
 server.listen(PORT, HOST, () => {
-  console.log(`mcplay playground: http://localhost:${server.address().port}/`);
+  console.log(`mcplay playground: http://localhost:${server.address().port}/${ISOLATION ? '' : ' (not cross-origin isolated: MCPLAY_NO_ISOLATION)'}`);
 });

@@ -1,10 +1,14 @@
 // The race card: a target accuracy, how many runs and how long each may take; Race / Cancel;
 // then, per estimator, each run's time to the target on a shared log axis with the median and
-// its 95% interval, and the sentence that names the winner (race.js decides it). Events only
-// dispatch actions; syncRace(state) writes the state back (never into an input being typed in)
-// and redraws the table when the race's result changes. Text only, never HTML from data.
+// its 95% interval, and the sentence that names the winner. Every word of the table and the
+// verdict comes from raceClaim (claims/race.js: the clock's floor, the answers' accuracy,
+// conservative error bars, the reasons in words). Events only dispatch actions; syncRace(state)
+// writes the state back (never into an input being typed in) and redraws the table when the
+// race's result or the clock changes. Text only, never HTML from data.
 import { KIND, kindOf, raceResult } from '../state.js';
-import { raceOptions, raceRows, raceVerdict, formatSeconds } from '../race.js';
+import { raceOptions, formatSeconds } from '../race.js';
+import { raceClaim } from '../claims/race.js';
+import { clockText } from '../claims/clock.js';
 import { colorAt } from '../palette.js';
 import { fmt } from '../series.js';
 import { el } from '../dom.js';
@@ -24,6 +28,7 @@ export function mountRace(store) {
 
 let lastRace = null;
 let lastKind = null;
+let lastClock = null;
 
 export function syncRace(state) {
   const race = state.race;
@@ -46,8 +51,10 @@ export function syncRace(state) {
   const done = race.order.filter((n) => race.parts[n]).length;
   $('race-progress').value = race.order.length ? done / race.order.length : 0;
   $('race-status').textContent = raceStatus(race, done);
-  if (race !== lastRace) {
+  const clock = `${state.clockStep}|${state.isolated}`;
+  if (race !== lastRace || clock !== lastClock) {
     lastRace = race;
+    lastClock = clock;
     drawRace(state);
   }
 }
@@ -73,13 +80,14 @@ function drawRace(state) {
   const race = state.race;
   const table = $('race-table');
   const verdictEl = $('race-verdict');
-  const rows = raceRows(raceResult(race));
+  const claim = raceClaim(raceResult(race), { exact: race.exact, clock: { stepMs: state.clockStep, isolated: state.isolated } });
+  const rows = claim.ranked;
   if (!rows.length) {
     table.replaceChildren();
     verdictEl.textContent = race.status === 'running' ? `Racing to ${targetText(race)}…` : '';
     return;
   }
-  const verdict = raceVerdict(rows);
+  const verdict = claim;
   const pending = race.order.length - rows.length;
   verdictEl.textContent = `Target: ${targetText(race)} (95% half-width), ${race.options.reps} runs each. `
     + (pending ? `${pending} estimator${pending > 1 ? 's' : ''} still running. ` : '') + verdict.text;
@@ -93,31 +101,46 @@ function drawRace(state) {
     race.exact === null ? null : el('th', { scope: 'col', title: 'runs that reached the target and whose estimate is within the tolerance of the exact value' }, 'within tol.'),
     el('th', { scope: 'col' }, 'median evaluations'),
     el('th', { scope: 'col' }, 'median N'),
-    el('th', { scope: 'col', title: 'median time over the fastest median, and the rank-sum test p-value against the fastest' }, 'vs fastest'));
+    el('th', { scope: 'col', title: 'median time over the fastest median the clock can time, and the rank-sum test p-value against it' }, 'vs fastest'));
+  const floor = claim.evidence.floorSeconds;
+  const refName = claim.evidence.fastestTimed;
   const colorOf = (name) => colorAt(Math.max(0, (state.sceneInfo?.estimators || []).indexOf(name)));
-  const body = verdict.ranked.map((r, i) => {
+  const body = verdict.ranked.map((r) => {
     const ci = r.interval;
-    const ciText = Number.isFinite(r.median)
-      ? `${formatSeconds(r.median)} [${formatSeconds(ci.lo)} – ${Number.isFinite(ci.hi) ? formatSeconds(ci.hi) : 'not reached'}]${ci.level < 0.95 ? ` (${Math.round(ci.level * 100)}%)` : ''}`
-      : 'not reached in most runs';
-    const vs = i === 0 ? 'fastest' : `${Number.isFinite(r.ratio) ? `${fmt(r.ratio, 2)}×` : '—'} (p = ${fmt(r.vsFastest, 2)})`;
-    const reasons = r.reasons.length ? ` (${r.reasons.join(', ')})` : '';
+    let ciText;
+    if (r.tooFast) {
+      ciText = floor === null ? 'not timed (clock unknown)' : `under ${clockText(floor * 1000)} (too fast for this clock)`;
+    } else {
+      ciText = Number.isFinite(r.median)
+        ? `${formatSeconds(r.median)} [${formatSeconds(ci.lo)} – ${Number.isFinite(ci.hi) ? formatSeconds(ci.hi) : 'not reached'}]${ci.level < 0.95 ? ` (${Math.round(ci.level * 100)}%)` : ''}`
+        : 'not reached in most runs';
+    }
+    let vs;
+    if (r.tooFast) vs = 'not compared';
+    else if (r.name === refName) vs = claim.evidence.tooFast.length ? 'fastest timed' : 'fastest';
+    else if (r.vsFastest === null) vs = '—';
+    else vs = `${Number.isFinite(r.ratio) ? `${fmt(r.ratio, 2)}×` : 'not reached'} (p = ${fmt(r.vsFastest, 2)})`;
     return el('tr', { className: r.name === verdict.winner ? 'winner' : '' },
       el('th', { scope: 'row', className: 'left' },
         el('span', { className: 'swatch', style: `background:${colorOf(r.name)}` }), ` ${r.name}`),
       el('td', {}, stripSvg(axis, r, colorOf(r.name))),
       el('td', {}, ciText),
-      el('td', { className: r.met < r.runs ? 'flag' : '', title: r.met < r.runs ? `not reached${reasons}` : '' }, `${r.met}/${r.runs}`),
+      el('td', { className: r.met < r.runs ? 'flag' : '' }, r.reachedText),
       race.exact === null ? null : el('td', { className: r.within !== null && r.within < r.withinOf ? 'flag' : '' },
         r.within === null || !r.withinOf ? '—' : `${r.within}/${r.withinOf}`),
       el('td', {}, fmt(r.evaluations, 3)),
       el('td', {}, r.n === null ? '—' : String(r.n)),
       el('td', {}, vs));
   });
+  // Each row's notes, in words, right under the table in the rows' order (read, not hovered).
+  const notes = verdict.ranked.filter((r) => r.notes.length).map((r) => el('li', { dataset: { estimator: r.name } },
+    el('span', { className: 'swatch', style: `background:${colorOf(r.name)}` }), ' ',
+    el('strong', {}, r.name), `: ${r.notes.join('; ')}.`));
   const warnings = rows.flatMap((r) => r.warnings.map((w) => el('li', {},
     el('span', { className: `severity severity-${w.severity || 'warning'}` }, (w.severity || 'warning').toUpperCase()),
     ` ${r.name}: ${w.message}`)));
   const parts = [el('table', { className: 'levels race' }, el('thead', {}, head), el('tbody', {}, ...body))];
+  if (notes.length) parts.push(el('ul', { className: 'race-notes' }, ...notes));
   if (warnings.length) parts.push(el('ul', { className: 'diagnostics' }, ...warnings));
   table.replaceChildren(...parts);
 }
