@@ -13,3 +13,5 @@ export * from './claims/time_slope.js';
 export * from './claims/render.js';
 export * from './claims/legend_lines.js';
 export * from './claims/stats.js';
+export * from './claims/clock.js';
+export * from './claims/race.js';

@@ -12,7 +12,7 @@
 import { dom, resizeAll, applyHiddenAll, drop, empty, setText } from './plot/chart.js';
 import { setLegend, toggleFromLegend } from './plot/legend.js';
 import { renderVariance } from './plot/variance.js';
-import { varianceNote } from './claims.js';
+import { varianceNote, timeNote } from './claims.js';
 import { renderTime } from './plot/time.js';
 import { renderCalibration, renderCoverage, COVERAGE_NOTE } from './plot/calibration.js';
 import { mountSampleControls, renderSampleViews } from './plot/samples.js';
@@ -45,6 +45,8 @@ function emptyTexts(render) {
   setText('variance-title', render ? 'Relative MSE against spp' : 'Variance against N');
   setText('variance-note', varianceNote(render ? 'render' : 'integral'));
   setText('time-title', render ? 'Error against time per image' : 'Error against run time');
+  setText('time-kind-note', timeNote(render ? 'render' : 'integral').lead);
+  setText('time-adaptive-note', timeNote(render ? 'render' : 'integral').adaptive);
   setText('coverage-note', COVERAGE_NOTE[render ? 'render' : 'integral']);
 }
 

@@ -20,10 +20,13 @@ export function varianceNote(kind, records = {}, order = []) {
   return `${base} ${names}: stratified or low-discrepancy pixel samples, so a slope steeper than spp⁻¹ is expected where the image is smooth.`;
 }
 
-/** The time plot's note (the clock's sentence is clock.js's). */
+/** The time plot's note, for the kind of study: `lead` (what a point is) and `adaptive` (the
+ *  training cost of VEGAS and MISER, integration studies only); the clock's clause is clock.js's. */
 export function timeNote(kind) {
   if (kind === 'render') {
-    return 'Equal-time comparison: at a given cost (x), the lowest curve wins. Each point is the mean time of one image at that spp over the replicates, against its relative RMSE; whiskers: the 95% interval of that mean.';
+    return { lead: 'Equal-time comparison: at a given cost (x), the lowest curve wins. Each point is the mean time of one image at that spp over the replicates, against its relative RMSE; whiskers: the 95% interval of that mean.',
+      adaptive: '' };
   }
-  return 'Equal-time comparison: at a given cost (x), the lowest curve wins. Each point is the replicates\' median time per estimate at one N (robust to a replicate a busy machine delayed), against its error; whiskers: its 95% interval (order statistics). Adaptive estimators (VEGAS, MISER) include their training or probing; dashed, without it.';
+  return { lead: 'Equal-time comparison: at a given cost (x), the lowest curve wins. Each point is the replicates\' median time per estimate at one N (robust to a replicate a busy machine delayed), against its error; whiskers: its 95% interval (order statistics).',
+    adaptive: ' Adaptive estimators (VEGAS, MISER) spend part of each run learning (training iterations, probes): their dashed line is the same error at the time spent estimating only, and the gap to the solid line is what the learning cost.' };
 }

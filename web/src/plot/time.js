@@ -4,7 +4,7 @@
 // shaded, adaptive estimators' time without training dashed; and under it the equal-time
 // verdict and each slope's words (claims/equal_time.js, claims/time_slope.js).
 import { timeSeries, CLOCK_STEPS_FITTED, decadeRange } from '../series.js';
-import { equalTimeClaim, timeSlopeClaim } from '../claims.js';
+import { equalTimeClaim, timeSlopeClaim, timeNote } from '../claims.js';
 import { AXIS, LOG10_AXIS, decadeLabel, lg, lgAll, log10Range, shortSeconds, runLabels, isRender } from './axes.js';
 import { uPlot, charts, dom, draw, drop, empty, setText, logX, log10Y, minorLogGrid } from './chart.js';
 import { colorOf, isHidden, setLegend } from './legend.js';
@@ -132,6 +132,9 @@ export function renderTime(state, run, records) {
   const sig = JSON.stringify([run.order, run.colors, known, yLabel, names.timeAxis]);
   const title = document.getElementById('time-title');
   if (title) title.textContent = render ? 'Error against time per image' : 'Error against run time';
+  const note = timeNote(render ? 'render' : 'integral');
+  setText('time-kind-note', note.lead);
+  setText('time-adaptive-note', note.adaptive);
   if (!ts.x.length) {
     drop('time');
     empty(dom.time, run.status === 'running' ? 'Waiting for the first N…' : 'No timings.');

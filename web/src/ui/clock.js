@@ -2,7 +2,7 @@
 // the time plot (#time-clock-note) and the race card (#race-clock-note), from clockClaim
 // (claims/clock.js) of the run worker's measured step and cross-origin isolation. Written only
 // when the clock changes; before the worker has answered, the static texts stay.
-import { clockClaim } from '../claims/clock.js';
+import { clockClaim } from '../claims.js';
 
 let last = null;
 

@@ -7,8 +7,7 @@
 // race's result or the clock changes. Text only, never HTML from data.
 import { KIND, kindOf, raceResult } from '../state.js';
 import { raceOptions, formatSeconds } from '../race.js';
-import { raceClaim } from '../claims/race.js';
-import { clockText } from '../claims/clock.js';
+import { raceClaim, clockText, pWords } from '../claims.js';
 import { colorAt } from '../palette.js';
 import { fmt } from '../series.js';
 import { el } from '../dom.js';
@@ -119,7 +118,7 @@ function drawRace(state) {
     if (r.tooFast) vs = 'not compared';
     else if (r.name === refName) vs = claim.evidence.tooFast.length ? 'fastest timed' : 'fastest';
     else if (r.vsFastest === null) vs = '—';
-    else vs = `${Number.isFinite(r.ratio) ? `${fmt(r.ratio, 2)}×` : 'not reached'} (p = ${fmt(r.vsFastest, 2)})`;
+    else vs = `${Number.isFinite(r.ratio) ? `${fmt(r.ratio, 2)}×` : 'not reached'} (${pWords(r.vsFastest)})`;
     return el('tr', { className: r.name === verdict.winner ? 'winner' : '' },
       el('th', { scope: 'row', className: 'left' },
         el('span', { className: 'swatch', style: `background:${colorOf(r.name)}` }), ` ${r.name}`),
