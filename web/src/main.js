@@ -2,18 +2,19 @@
 // problems, running studies, exporting) react to the actions the UI dispatches; the views
 // re-render from the state (plots and tables once per animation frame).
 //
-// Workers: one "service" worker validates scenes and formats results (so it answers during a
-// run), and up to navigator.hardwareConcurrency run workers each study a subset of the selected
-// estimators (options.estimators); every estimator has its own random streams, so the split
-// changes no number, and the parts are merged (series.mergeResults). Cancel terminates the run
-// workers and starts new ones.
+// Workers (all of them Web Workers; none is a browser Service Worker): one helper worker
+// (`service` below) validates scenes and formats results (so it answers during a run), and up
+// to navigator.hardwareConcurrency run workers each study a subset of the selected estimators
+// (options.estimators); every estimator has its own random streams, so the split changes no
+// number, and the parts are merged (series.mergeResults). Cancel terminates the run workers and
+// starts new ones.
 //
 // Render scenes (a "render" object; state.kindOf) go the same way: the workers hand them to the
 // render core, which they import only then (so a page showing integrals never downloads
 // mcplay_render_web.wasm); each run worker renders the same reference, its estimators' images
 // and their PNGs (options.previews), shown by images.js as the levels come in. With fewer
 // estimators than cores, each estimator's replicates are split over several workers
-// (series.splitRenderWork; options.part / parts), and the service worker merges the parts'
+// (series.splitRenderWork; options.part / parts), and the helper worker merges the parts'
 // levels and results (MSG.MERGE, the render core's mergeParts) into what one worker would give.
 import {
   createStore, reducer, initialState, queryToState, stateToQuery, sceneDefaults, runBlocker,
@@ -71,7 +72,7 @@ mountControls(store);
 mountCustom(store);
 mountExports(store);
 mountRace(store);
-// The sampler lab (src/lab/): its own store and view, the same service worker; its inputs go
+// The sampler lab (src/lab/): its own store and view, the same helper worker; its inputs go
 // in the URL instead of the study's while it is shown.
 const lab = startLab({
   service: () => service,
@@ -209,7 +210,7 @@ store.subscribe((state, action) => {
 });
 
 // ---------------------------------------------------------------------------------------------
-// Sample points: core.samples in the service worker (a study's replicate 0 at N = n, same seed),
+// Sample points: core.samples in the helper worker (a study's replicate 0 at N = n, same seed),
 // asked for SAMPLES_DEBOUNCE_MS after the scene, the estimators, the seed or n last changed, and
 // at once when Run is pressed; the weight histograms get a second call with n = WEIGHT_SAMPLES.
 
@@ -368,7 +369,7 @@ function paramsFromUrl(fromUrl, info) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Render scenes: a quick image of the scene once it is loaded (the service worker, the first
+// Render scenes: a quick image of the scene once it is loaded (the helper worker, the first
 // estimator at a few spp and the chosen size), and the run workers import the render module
 // while the reader looks at it.
 
@@ -495,7 +496,7 @@ function startRun() {
 }
 
 /** The collector of one estimator split over `parts` workers: merged levels and result go to
- *  the store as an unsplit worker's would (the merges run in the service worker). */
+ *  the store as an unsplit worker's would (the merges run in the helper worker). */
 function splitRun(id, parts) {
   const live = () => activeRun === id;
   return splitCollector({
