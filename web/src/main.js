@@ -27,6 +27,7 @@ import { MSG } from './protocol.js';
 import { initPlots, renderPlots, plotPng, hiddenEstimators } from './plot.js';
 import { renderReport } from './report.js';
 import { mountImages, renderImages } from './images.js';
+import { sceneTitle } from './scene_title.js';
 import { base64Of, checkGltfBytes, sceneFromFiles } from './gltf_files.js';
 import { renderExplain } from './ui/explain.js';
 import { mountControls, syncControls } from './ui/controls.js';
@@ -675,7 +676,9 @@ async function exportResult({ format, plot, image, as }) {
     return;
   }
   if (format === 'png') {
-    const url = await plotPng(plot, `${s.run.sceneName || s.sceneId}: ${s.run.order.filter((n) => !hiddenEstimators().includes(n)).join(', ')}`);
+    const id = s.run.sceneName || s.sceneId;
+    const title = sceneTitle(id);
+    const url = await plotPng(plot, `${title && title !== id ? `${title} (${id})` : id}: ${s.run.order.filter((n) => !hiddenEstimators().includes(n)).join(', ')}`);
     if (!url) throw new Error(`the ${plot} plot is empty`);
     download(`${fileStem(s)}-${plot}.png`, url);
     return;
