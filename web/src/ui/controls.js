@@ -185,7 +185,13 @@ export function syncControls(state) {
   const list = $('estimator-list');
   if (eSig !== estimatorsSig) {
     estimatorsSig = eSig;
-    list.replaceChildren(...names.map((name, i) => {
+    // the presets the scene does not list (normalizeInfo: after its own) under a heading
+    const own = info && Array.isArray(info.defaultSelected) ? info.defaultSelected : names;
+    const firstMore = names.findIndex((n) => !own.includes(n));
+    const moreHead = document.createElement('p');
+    moreHead.className = 'more-head small muted';
+    moreHead.textContent = 'also offered (not in the scene file):';
+    list.replaceChildren(...names.flatMap((name, i) => {
       const box = document.createElement('input');
       box.type = 'checkbox';
       box.id = `est-${i}`;
@@ -198,7 +204,7 @@ export function syncControls(state) {
       sw.className = 'swatch';
       sw.style.background = colorAt(i);
       label.append(box, sw, name);
-      return label;
+      return i === firstMore && firstMore > 0 ? [moreHead, label] : [label];
     }));
   }
   const selected = new Set(state.selected);
