@@ -24,7 +24,7 @@ import {
 import { clockResolution, splitEstimators, splitRenderWork, splitCollector, partialResult, samplesCsv } from './series.js';
 import { CoreWorker } from './client.js';
 import { MSG } from './protocol.js';
-import { initPlots, renderPlots, plotPng, hiddenEstimators } from './plot.js';
+import { initPlots, renderPlots, plotPng, hiddenEstimators, guideLabels } from './plot.js';
 import { renderReport } from './report.js';
 import { mountImages, renderImages } from './images.js';
 import { sceneTitle } from './scene_title.js';
@@ -781,6 +781,8 @@ ready.catch(() => {});
 window.mcplayDebug = Object.freeze({
   state: () => structuredClone(debugSnapshot(store.getState())),
   hidden: () => hiddenEstimators(),
+  // where the time plot's guide labels were last drawn
+  guideLabels: () => guideLabels(),
   lab: () => structuredClone(labSnapshot(lab.store.getState())),
   live: () => structuredClone(live.snapshot()),
   ready,

@@ -18,6 +18,7 @@ import { mountSampleControls, renderSampleViews } from './plot/samples.js';
 
 export { plotPng } from './plot/png.js';
 export { hiddenEstimators } from './plot/legend.js';
+export { guideLabels } from './plot/time.js';
 
 let mounted = false;
 
