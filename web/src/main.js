@@ -24,9 +24,10 @@ import {
 import { clockResolution, splitEstimators, splitRenderWork, splitCollector, partialResult, samplesCsv } from './series.js';
 import { CoreWorker } from './client.js';
 import { MSG } from './protocol.js';
-import { initPlots, renderPlots, plotPng, hiddenEstimators, guideLabels } from './plot.js';
+import { initPlots, renderPlots, plotPng, hiddenEstimators, setHidden, guideLabels } from './plot.js';
 import { renderReport } from './report.js';
-import { mountImages, renderImages } from './images.js';
+import { mountImages, renderImages, imageView, setImageView } from './images.js';
+import { shareQuery, queryToView, hasView } from './share.js';
 import { sceneTitle } from './scene_title.js';
 import { base64Of, checkGltfBytes, sceneFromFiles } from './gltf_files.js';
 import { renderExplain } from './ui/explain.js';
@@ -694,8 +695,31 @@ async function exportResult({ format, plot, image, as }) {
   dispatch({ type: 'notice', payload: { message: `exported ${format.toUpperCase()}${result.cancelled ? ' (partial: the run did not finish)' : ''}` } });
 }
 
+/** How the plots are being looked at, for a shared link (share.js): run=1 when there are plots. */
+function currentView(s) {
+  const r = s.run;
+  const plotted = r.status !== 'running' && r.order.some((n) => r.records[n] && r.records[n].levels.length);
+  return { hidden: hiddenEstimators(), calibration: s.calibration, points: s.samples.n, imageView: imageView(),
+    race: s.race.inputs, run: plotted };
+}
+
+/** The link of the comparison and its view (a reader's glTF file cannot be in a link). */
+function shareUrl(s) {
+  const q = shareQuery(s, currentView(s));
+  return q ? `${window.location.origin}${window.location.pathname}${q}` : window.location.href;
+}
+
+/** A shared link's view once its scene is in: hidden estimators, the sample view's points,
+ *  the images' view and the race inputs now; the histogram's N once its run has started. */
+function applyView(view) {
+  if (view.hidden.length) setHidden(view.hidden);
+  if (view.points !== store.getState().samples.n) dispatch({ type: 'samples/n', payload: { n: view.points } });
+  setImageView(view.imageView);
+  for (const [field, value] of Object.entries(view.race)) dispatch({ type: 'race/edit', payload: { field, value } });
+}
+
 async function copyLink() {
-  const url = window.location.href;
+  const url = shareUrl(store.getState());
   try {
     await navigator.clipboard.writeText(url);
     dispatch({ type: 'notice', payload: { message: 'link copied' } });
@@ -754,12 +778,21 @@ async function start() {
       dispatch({ type: 'notice', payload: { message: `unknown scene '${q.scene}' in the link: showing ${scenes[0].name}` } });
     }
   }
-  // A shared link: name what it asked for that could not be used, and offer to run it.
+  // A shared link: name what it asked for that could not be used; restore how its plots were
+  // looked at, and run it when it was made with plots to show (run=1), else offer to.
   if (ok && new URLSearchParams(search).has('scene') && store.getState().sceneId === q.scene) {
     const st = store.getState();
     const problems = urlProblems(search, st.sceneInfo ? st.sceneInfo.estimators : null, kindOf(st.sceneInfo));
     const what = problems.length ? `The link's ${problems.join('; ')}: the defaults are used instead. ` : '';
-    dispatch({ type: 'notice', payload: { message: `${what}Press Run to draw this link's plots.` } });
+    const view = queryToView(search);
+    if (hasView(search)) applyView(view);
+    if (view.run && !runBlocker(store.getState())) {
+      dispatch({ type: 'notice', payload: { message: `${what}Running this link's study: its plots draw as each N ends.` } });
+      dispatch({ type: 'run/request' });
+      if (view.calibration !== 'all') dispatch({ type: 'calibration/set', payload: { value: view.calibration } });
+    } else {
+      dispatch({ type: 'notice', payload: { message: `${what}Press Run to draw this link's plots.` } });
+    }
     document.getElementById('run').focus({ preventScroll: true });
   }
   urlReady = true;
@@ -781,7 +814,8 @@ ready.catch(() => {});
 window.mcplayDebug = Object.freeze({
   state: () => structuredClone(debugSnapshot(store.getState())),
   hidden: () => hiddenEstimators(),
-  // where the time plot's guide labels were last drawn
+  // the link "Copy link" gives now, and where the time plot's guide labels were last drawn
+  shareUrl: () => shareUrl(store.getState()),
   guideLabels: () => guideLabels(),
   lab: () => structuredClone(labSnapshot(lab.store.getState())),
   live: () => structuredClone(live.snapshot()),
