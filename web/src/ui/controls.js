@@ -39,6 +39,14 @@ export function mountControls(store) {
     dispatch({ type: 'run/request' });
   });
   $('cancel').addEventListener('click', () => dispatch({ type: 'run/cancel', payload: { now: performance.now() } }));
+  // The page's first focusable element: one Tab and Enter reach Run (Cancel while a run goes on).
+  $('skip-to-run').addEventListener('click', (e) => {
+    e.preventDefault();
+    if ($('study-view').hidden) $('tab-study').click(); // from the sampler lab: back to the study
+    const target = !$('run').disabled ? $('run') : !$('cancel').disabled ? $('cancel') : $('run');
+    target.scrollIntoView({ block: 'nearest' });
+    target.focus();
+  });
   $('samples-n').addEventListener('change', (e) => {
     dispatch({ type: 'samples/n', payload: { n: Number(e.target.value) } });
   });
