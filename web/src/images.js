@@ -122,6 +122,21 @@ export function mountImages(dom, onExport = () => {}) {
   });
 }
 
+/** The view the images panel's "Show" choice gives: 'image', 'error' or 'both'. */
+export function imageView() {
+  const checked = document.querySelector('input[name="image-view"]:checked');
+  return checked ? checked.value : 'image';
+}
+
+/** Sets the "Show" choice (a shared link's): the radio button and what the cards show. */
+export function setImageView(value) {
+  const radio = [...document.querySelectorAll('input[name="image-view"]')].find((r) => r.value === value);
+  if (!radio) return;
+  radio.checked = true;
+  const grid = document.getElementById('render-images');
+  if (grid) grid.dataset.view = value;
+}
+
 /** Draws the images of state.run into dom.images (the #render-images grid). */
 export function renderImages(state, dom) {
   if (!dom.images) return;

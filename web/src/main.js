@@ -2,18 +2,19 @@
 // problems, running studies, exporting) react to the actions the UI dispatches; the views
 // re-render from the state (plots and tables once per animation frame).
 //
-// Workers: one "service" worker validates scenes and formats results (so it answers during a
-// run), and up to navigator.hardwareConcurrency run workers each study a subset of the selected
-// estimators (options.estimators); every estimator has its own random streams, so the split
-// changes no number, and the parts are merged (series.mergeResults). Cancel terminates the run
-// workers and starts new ones.
+// Workers (all of them Web Workers; none is a browser Service Worker): one helper worker
+// (`service` below) validates scenes and formats results (so it answers during a run), and up
+// to navigator.hardwareConcurrency run workers each study a subset of the selected estimators
+// (options.estimators); every estimator has its own random streams, so the split changes no
+// number, and the parts are merged (series.mergeResults). Cancel terminates the run workers and
+// starts new ones.
 //
 // Render scenes (a "render" object; state.kindOf) go the same way: the workers hand them to the
 // render core, which they import only then (so a page showing integrals never downloads
 // mcplay_render_web.wasm); each run worker renders the same reference, its estimators' images
 // and their PNGs (options.previews), shown by images.js as the levels come in. With fewer
 // estimators than cores, each estimator's replicates are split over several workers
-// (series.splitRenderWork; options.part / parts), and the service worker merges the parts'
+// (series.splitRenderWork; options.part / parts), and the helper worker merges the parts'
 // levels and results (MSG.MERGE, the render core's mergeParts) into what one worker would give.
 import {
   createStore, reducer, initialState, queryToState, stateToQuery, sceneDefaults, runBlocker,
@@ -23,9 +24,11 @@ import {
 import { splitEstimators, splitRenderWork, splitCollector, partialResult, samplesCsv } from './series.js';
 import { CoreWorker } from './client.js';
 import { MSG } from './protocol.js';
-import { initPlots, renderPlots, plotPng, lastPngLegend, hiddenEstimators } from './plot.js';
+import { initPlots, renderPlots, plotPng, lastPngLegend, hiddenEstimators, setHidden, guideLabels } from './plot.js';
 import { renderReport } from './report.js';
-import { mountImages, renderImages } from './images.js';
+import { mountImages, renderImages, imageView, setImageView } from './images.js';
+import { shareQuery, queryToView, hasView } from './share.js';
+import { sceneTitle } from './scene_title.js';
 import { base64Of, checkGltfBytes, sceneFromFiles } from './gltf_files.js';
 import { renderExplain } from './ui/explain.js';
 import { mountControls, syncControls } from './ui/controls.js';
@@ -72,7 +75,7 @@ mountControls(store);
 mountCustom(store);
 mountExports(store);
 mountRace(store);
-// The sampler lab (src/lab/): its own store and view, the same service worker; its inputs go
+// The sampler lab (src/lab/): its own store and view, the same helper worker; its inputs go
 // in the URL instead of the study's while it is shown.
 const lab = startLab({
   service: () => service,
@@ -211,7 +214,7 @@ store.subscribe((state, action) => {
 });
 
 // ---------------------------------------------------------------------------------------------
-// Sample points: core.samples in the service worker (a study's replicate 0 at N = n, same seed),
+// Sample points: core.samples in the helper worker (a study's replicate 0 at N = n, same seed),
 // asked for SAMPLES_DEBOUNCE_MS after the scene, the estimators, the seed or n last changed, and
 // at once when Run is pressed; the weight histograms get a second call with n = WEIGHT_SAMPLES.
 
@@ -370,7 +373,7 @@ function paramsFromUrl(fromUrl, info) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Render scenes: a quick image of the scene once it is loaded (the service worker, the first
+// Render scenes: a quick image of the scene once it is loaded (the helper worker, the first
 // estimator at a few spp and the chosen size), and the run workers import the render module
 // while the reader looks at it.
 
@@ -497,7 +500,7 @@ function startRun() {
 }
 
 /** The collector of one estimator split over `parts` workers: merged levels and result go to
- *  the store as an unsplit worker's would (the merges run in the service worker). */
+ *  the store as an unsplit worker's would (the merges run in the helper worker). */
 function splitRun(id, parts) {
   const live = () => activeRun === id;
   return splitCollector({
@@ -676,7 +679,9 @@ async function exportResult({ format, plot, image, as }) {
     return;
   }
   if (format === 'png') {
-    const url = await plotPng(plot, `${s.run.sceneName || s.sceneId}: ${s.run.order.filter((n) => !hiddenEstimators().includes(n)).join(', ')}`);
+    const id = s.run.sceneName || s.sceneId;
+    const title = sceneTitle(id);
+    const url = await plotPng(plot, `${title && title !== id ? `${title} (${id})` : id}: ${s.run.order.filter((n) => !hiddenEstimators().includes(n)).join(', ')}`);
     if (!url) throw new Error(`the ${plot} plot is empty`);
     download(`${fileStem(s)}-${plot}.png`, url);
     return;
@@ -692,8 +697,31 @@ async function exportResult({ format, plot, image, as }) {
   dispatch({ type: 'notice', payload: { message: `exported ${format.toUpperCase()}${result.cancelled ? ' (partial: the run did not finish)' : ''}` } });
 }
 
+/** How the plots are being looked at, for a shared link (share.js): run=1 when there are plots. */
+function currentView(s) {
+  const r = s.run;
+  const plotted = r.status !== 'running' && r.order.some((n) => r.records[n] && r.records[n].levels.length);
+  return { hidden: hiddenEstimators(), calibration: s.calibration, points: s.samples.n, imageView: imageView(),
+    race: s.race.inputs, run: plotted };
+}
+
+/** The link of the comparison and its view (a reader's glTF file cannot be in a link). */
+function shareUrl(s) {
+  const q = shareQuery(s, currentView(s));
+  return q ? `${window.location.origin}${window.location.pathname}${q}` : window.location.href;
+}
+
+/** A shared link's view once its scene is in: hidden estimators, the sample view's points,
+ *  the images' view and the race inputs now; the histogram's N once its run has started. */
+function applyView(view) {
+  if (view.hidden.length) setHidden(view.hidden);
+  if (view.points !== store.getState().samples.n) dispatch({ type: 'samples/n', payload: { n: view.points } });
+  setImageView(view.imageView);
+  for (const [field, value] of Object.entries(view.race)) dispatch({ type: 'race/edit', payload: { field, value } });
+}
+
 async function copyLink() {
-  const url = window.location.href;
+  const url = shareUrl(store.getState());
   try {
     await navigator.clipboard.writeText(url);
     dispatch({ type: 'notice', payload: { message: 'link copied' } });
@@ -756,12 +784,21 @@ async function start() {
       dispatch({ type: 'notice', payload: { message: `unknown scene '${q.scene}' in the link: showing ${scenes[0].name}` } });
     }
   }
-  // A shared link: name what it asked for that could not be used, and offer to run it.
+  // A shared link: name what it asked for that could not be used; restore how its plots were
+  // looked at, and run it when it was made with plots to show (run=1), else offer to.
   if (ok && new URLSearchParams(search).has('scene') && store.getState().sceneId === q.scene) {
     const st = store.getState();
     const problems = urlProblems(search, st.sceneInfo ? st.sceneInfo.estimators : null, kindOf(st.sceneInfo));
     const what = problems.length ? `The link's ${problems.join('; ')}: the defaults are used instead. ` : '';
-    dispatch({ type: 'notice', payload: { message: `${what}Press Run to draw this link's plots.` } });
+    const view = queryToView(search);
+    if (hasView(search)) applyView(view);
+    if (view.run && !runBlocker(store.getState())) {
+      dispatch({ type: 'notice', payload: { message: `${what}Running this link's study: its plots draw as each N ends.` } });
+      dispatch({ type: 'run/request' });
+      if (view.calibration !== 'all') dispatch({ type: 'calibration/set', payload: { value: view.calibration } });
+    } else {
+      dispatch({ type: 'notice', payload: { message: `${what}Press Run to draw this link's plots.` } });
+    }
     document.getElementById('run').focus({ preventScroll: true });
   }
   urlReady = true;
@@ -798,6 +835,9 @@ window.mcplayDebug = Object.freeze({
   state: () => structuredClone(debugSnapshot(store.getState())),
   hidden: () => hiddenEstimators(),
   pngLegend: () => lastPngLegend(),
+  // the link "Copy link" gives now, and where the time plot's guide labels were last drawn
+  shareUrl: () => shareUrl(store.getState()),
+  guideLabels: () => guideLabels(),
   lab: () => structuredClone(labSnapshot(lab.store.getState())),
   live: () => structuredClone(live.snapshot()),
   ready,

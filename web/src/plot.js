@@ -10,7 +10,7 @@
 //   samples.js, sample_panels.js, weights.js   the sample view and its charts
 //   png.js           a chart as a PNG file
 import { dom, resizeAll, applyHiddenAll, drop, empty, setText } from './plot/chart.js';
-import { setLegend, toggleFromLegend } from './plot/legend.js';
+import { setLegend, toggleFromLegend, setHiddenEstimators, isHidden } from './plot/legend.js';
 import { renderVariance } from './plot/variance.js';
 import { varianceNote, timeNote } from './claims.js';
 import { renderTime } from './plot/time.js';
@@ -19,6 +19,18 @@ import { mountSampleControls, renderSampleViews } from './plot/samples.js';
 
 export { plotPng, lastPngLegend } from './plot/png.js';
 export { hiddenEstimators } from './plot/legend.js';
+export { guideLabels } from './plot/time.js';
+
+/** Hides exactly the estimators `names` in every plot and legend (a shared link's view). */
+export function setHidden(names) {
+  setHiddenEstimators(names);
+  for (const item of document.querySelectorAll('.legend li[data-series]')) {
+    item.classList.toggle('off', isHidden(item.dataset.series));
+    const b = item.querySelector('button.toggle');
+    if (b) b.setAttribute('aria-pressed', String(!isHidden(item.dataset.series)));
+  }
+  applyHiddenAll();
+}
 
 let mounted = false;
 

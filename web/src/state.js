@@ -531,6 +531,20 @@ function orderedSelection(available, names) {
   return available.filter((n) => want.has(n));
 }
 
+/**
+ * The estimators a scene starts with selected, in the scene's order: those its stop of the tour
+ * names (manifest entry.select: a quasi-Monte Carlo stop selects sobol, halton and lattice,
+ * which the scene file does not list) that the scene offers, else the scene's own
+ * (info.defaultSelected), else every one of `available`.
+ */
+export function defaultSelection(available, info = null, entry = null) {
+  if (entry && Array.isArray(entry.select)) {
+    const chosen = orderedSelection(available, entry.select);
+    if (chosen.length) return chosen;
+  }
+  return orderedSelection(available, info && Array.isArray(info.defaultSelected) ? info.defaultSelected : available);
+}
+
 /** The reducer: (state, action) -> new state, never mutating its input. */
 export function reducer(state, action) {
   const p = action.payload || {};
@@ -551,9 +565,11 @@ export function reducer(state, action) {
       // and Run waits for that. Edits made meanwhile are kept.
       const entry = p.sceneId === CUSTOM ? null : state.scenes.find((sc) => sc.name === p.sceneId);
       if (!entry) return { ...state, notice: '', userGltf: { ...state.userGltf, error: null } };
+      // the tour's selection may name presets the scene does not list (offered after its own)
+      const extra = Array.isArray(entry.select) ? entry.select.filter((n) => !entry.estimators.includes(n)) : [];
       const info = {
         name: entry.name, description: entry.description, dimension: entry.dimension,
-        estimators: entry.estimators.slice(), n_min: entry.n_min, n_max: entry.n_max, provisional: true,
+        estimators: [...entry.estimators, ...extra], n_min: entry.n_min, n_max: entry.n_max, provisional: true,
         ...(kindOf(entry) === KIND.RENDER
           ? { kind: KIND.RENDER, reps: entry.reps, width: entry.width, height: entry.height } : {}),
       };
@@ -562,7 +578,7 @@ export function reducer(state, action) {
         sceneId: entry.name,
         scene: null,
         sceneInfo: info,
-        selected: info.estimators.slice(),
+        selected: defaultSelection(info.estimators, null, entry),
         params: { ...state.params, ...sceneDefaults(info) },
         paramErrors: {},
         custom: { ...state.custom, error: null, pending: false },
@@ -579,7 +595,7 @@ export function reducer(state, action) {
       const available = p.info.estimators || [];
       // the answer to a scene/request keeps what was chosen since
       const keep = !p.selected && !p.params && state.sceneId === p.sceneId && state.sceneInfo && state.sceneInfo.provisional;
-      const byDefault = p.info.defaultSelected || available;
+      const byDefault = defaultSelection(available, p.info, state.scenes.find((sc) => sc.name === p.sceneId));
       let selected = keep ? state.selected : p.selected ? p.selected : byDefault;
       selected = orderedSelection(available, selected);
       if (!selected.length && !keep) selected = byDefault.slice();

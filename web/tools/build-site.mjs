@@ -5,7 +5,7 @@
 // vendor/uPlot.esm.js + uPlot.min.css (+ its LICENSE) from web/node_modules/uplot/dist,
 // mcplay_web.mjs + .wasm and mcplay_render_web.mjs + .wasm from WASM_DIR, scenes/*.json and
 // scenes/manifest.json ([{file, name, description, kind, dimension, estimators, n_min, n_max,
-// group, look}], warp scenes also {warp: true} (kind 'warp' without an integrand; they need no
+// group, look, select?}], warp scenes also {warp: true} (kind 'warp' without an integrand; they need no
 // stop of the tour and come last unless it names them), render scenes also {reps, width, height, reference, live_reference}; read from the scene files themselves;
 // the page asks the core, sceneInfo, for the rest), in the order of the teaching path
 // web/tour.json, which gives each scene its group and what to look for. Its first scene is an
@@ -104,7 +104,8 @@ function estimatorName(e) {
 
 /**
  * The manifest in the order of the teaching path (web/tour.json): each entry gets its group's
- * title (`group`) and what to look for in it (`look`). Throws, naming them, when a scene is in
+ * title (`group`), what to look for in it (`look`) and, when the stop names them, the estimators
+ * the page starts with selected (`select`). Throws, naming them, when a scene is in
  * no group, in two, or when the tour names a scene that does not exist: the path and the folder
  * must agree.
  */
@@ -125,7 +126,13 @@ export function orderByTour(manifest, tour) {
       else if (seen.has(stop.name)) problems.push(`the tour names '${stop.name}' twice`);
       else {
         seen.add(stop.name);
-        out.push({ ...m, group: group.title, look: stop.look || '' });
+        // "select": the estimators the page starts with selected (a QMC stop selects its
+        // Sobol', Halton and lattice points, which the scene itself does not list)
+        if (stop.select !== undefined && !(Array.isArray(stop.select) && stop.select.length
+          && stop.select.every((n) => typeof n === 'string' && n))) {
+          problems.push(`the tour's '${stop.name}': select must be a list of estimator names`);
+        }
+        out.push({ ...m, group: group.title, look: stop.look || '', ...(Array.isArray(stop.select) ? { select: stop.select.slice() } : {}) });
       }
     }
   }

@@ -1,6 +1,6 @@
 // The sampler lab's wiring: its store, its view, and the effects that send its requests to the
-// service worker (protocol.js: warpTest, analyze, points, pixelPoints, integratePoints, curve) and put the
-// answers in the store. main.js starts it with the page's service worker, the manifest and the
+// helper Web Worker (protocol.js: warpTest, analyze, points, pixelPoints, integratePoints, curve) and put the
+// answers in the store. main.js starts it with the page's helper worker, the manifest and the
 // hooks it shares with the study (the URL, opening a warp scene's study).
 import { createStore } from '../state.js';
 import { MSG } from '../protocol.js';
@@ -11,7 +11,7 @@ import {
 import { mountLab, syncLab, renderLab } from './view.js';
 
 /**
- * Starts the lab. `page`: {service(): the CoreWorker of the service worker (null before the
+ * Starts the lab. `page`: {service(): the CoreWorker of the helper worker (null before the
  * core loads), scenes(): the manifest, fetchScene(entry): a scene's JSON, onChange(): the URL
  * may have changed, openStudy(name): show a scene in the study}. Returns {store, query()}.
  */
@@ -81,7 +81,7 @@ export function startLab(page, search) {
     }
   }
 
-  /** The rows of a renderer's pixel sampler (the render core, through the service worker). */
+  /** The rows of a renderer's pixel sampler (the render core, through the helper worker). */
   async function pixelRows(request) {
     return (await need().request(MSG.PIXEL_POINTS, { request })).points.points;
   }

@@ -21,9 +21,15 @@ export function hidesLabel(label) {
   return false;
 }
 
-/** The estimators hidden in the plots (for tests: window.mcplayDebug). */
+/** The estimators hidden in the plots (a shared link's; for tests: window.mcplayDebug). */
 export function hiddenEstimators() {
   return [...hiddenSeries];
+}
+
+/** Hides exactly the estimators `names` (a shared link's); the charts follow on their next draw. */
+export function setHiddenEstimators(names) {
+  hiddenSeries.clear();
+  for (const n of names) hiddenSeries.add(n);
 }
 
 /**

@@ -127,6 +127,33 @@ export function boxOutlines(p, boxes, d, [a, b] = [0, 1]) {
   ctx.stroke();
 }
 
+/**
+ * A randomized quasi-Monte Carlo set of K > 1 randomizations (e.randomizations): how many points
+ * its first randomization holds, or null for any other set (all its points are one design).
+ * The core gives the points randomization by randomization, so these are the first points;
+ * drawn together, K randomizations of a net look like independent points.
+ */
+export function firstRandomizationSize(e) {
+  const n = e && Array.isArray(e.u) && e.u.length ? e.u[0].length : 0;
+  const k = e ? e.randomizations : 0;
+  if (!(Number.isSafeInteger(k) && k > 1) || n < k) return null;
+  return Math.floor(n / k);
+}
+
+/**
+ * The cells of a Sobol' net drawn over its first two axes: 2^m points of one randomization
+ * (Owen scrambling and digital shifts keep the net) hold one point in each of 2^⌊m/2⌋ × 2^⌈m/2⌉
+ * cells (the first two Sobol' axes are a (0, 2)-sequence). [cells across, cells up], or null
+ * when the set is not a Sobol' set of a power of two points, or the axes are not the first two.
+ */
+export function sobolNetCells(e, points, axes = [0, 1]) {
+  if (!e || e.sampler !== 'sobol') return null;
+  if (axes[0] !== 0 || axes[1] !== 1) return null;
+  if (!(Number.isSafeInteger(points) && points >= 4 && (points & (points - 1)) === 0)) return null;
+  const m = Math.round(Math.log2(points));
+  return [2 ** Math.floor(m / 2), 2 ** Math.ceil(m / 2)];
+}
+
 /** What structure a point set has: strata, a VEGAS map, MISER boxes, randomized QMC sets. */
 export function strataText(e, d) {
   if (Array.isArray(e.map_edges) && e.map_edges.length) {

@@ -8,10 +8,11 @@ import { replayIsEstimator, domainView, mapFor, mappedGrid } from '../series.js'
 import { el } from '../dom.js';
 import { dom, empty } from './chart.js';
 import { sceneColor, swatch } from './legend.js';
-import { PANEL, panel, dots, strataLines, mapLines, boxOutlines, strataText, runningPanel } from './sample_panels.js';
+import { PANEL, panel, dots, strataLines, mapLines, boxOutlines, strataText, runningPanel, firstRandomizationSize, sobolNetCells } from './sample_panels.js';
 import { renderOverlay, renderMisWeights, renderWeights } from './weights.js';
 
 let samplesDrawn = null; // [data, weights, status, sceneInfo] last drawn
+const BIG_PANEL = 400;   // logical size of the panels of a randomized QMC set's one randomization
 
 // The replay of the sample view (presentation only, like VEGAS's training slider): the first k
 // points of each set (null: all), and the pair of axes a set of d > 2 is projected on.
@@ -119,17 +120,25 @@ function renderScatter(state, data) {
   const mapped = {};
   const cards = data.estimators.map((full) => {
     const color = sceneColor(state, full.name);
+    // A randomized QMC set of K randomizations: only the first one is drawn (all K on top of
+    // each other look like independent points); its points come first.
+    const total = full.u[0] ? full.u[0].length : 0;
+    const oneSet = firstRandomizationSize(full);
+    const drawn = oneSet ?? total;
+    const net = oneSet !== null || full.randomizations === 1 ? (d >= 2 ? sobolNetCells(full, drawn, [a, b]) : null) : null;
     // the first k points (the replay); the strata, map and boxes are the whole set's
-    const first = (arr) => (Array.isArray(arr) ? arr.slice(0, k) : arr);
+    const first = (arr) => (Array.isArray(arr) ? arr.slice(0, Math.min(k, drawn)) : arr);
     const e = { ...full, u: full.u.map(first), x: full.x.map(first), f: first(full.f), weight: first(full.weight) };
     const n = e.u[0] ? e.u[0].length : 0;
     // u space: the sampler's unit square (1D: u against the point's index)
-    const pu = panel(PANEL, PANEL, [0, 1], [0, 1]);
-    const uy = d >= 2 ? e.u[b] : e.u[0].map((_, i) => (i + 0.5) / full.u[0].length);
+    // one randomization's panels are drawn large (its card spans two columns where there is room)
+    const side = oneSet !== null ? BIG_PANEL : PANEL;
+    const pu = panel(side, side, [0, 1], [0, 1]);
+    const uy = d >= 2 ? e.u[b] : e.u[0].map((_, i) => (i + 0.5) / drawn);
     const drawU = (edges) => {
       pu.clear();
-      strataLines(pu, e.strata[a], 'x');
-      if (d >= 2) strataLines(pu, e.strata[b], 'y');
+      strataLines(pu, net ? net[0] : e.strata[a], 'x');
+      if (d >= 2) strataLines(pu, net ? net[1] : e.strata[b], 'y');
       if (edges) {
         mapLines(pu, edges[a], 'x');
         if (d >= 2 && edges[b]) mapLines(pu, edges[b], 'y');
@@ -138,7 +147,7 @@ function renderScatter(state, data) {
       pu.frame();
       pu.ctx.save();
       pu.clip();
-      dots(pu.ctx, e.u[a], uy, pu.X, pu.Y, color, full.u[0].length);
+      dots(pu.ctx, e.u[a], uy, pu.X, pu.Y, color, drawn);
       pu.ctx.restore();
     };
     drawU(e.map_edges);
@@ -160,7 +169,7 @@ function renderScatter(state, data) {
       const q = sorted[Math.floor(0.75 * (sorted.length - 1))];
       if (atEnd && hi > 20 * q && q > 0) hi = 20 * q;
       if (!(hi > lo)) hi = lo + 1;
-      px = panel(PANEL, PANEL, view.xRange, [lo, hi]);
+      px = panel(side, side, view.xRange, [lo, hi]);
       px.frame();
       px.ctx.save();
       px.clip();
@@ -184,7 +193,7 @@ function renderScatter(state, data) {
       px.ctx.stroke();
       px.ctx.restore();
     } else {
-      px = panel(PANEL, PANEL, view.xRange, view.yRange);
+      px = panel(side, side, view.xRange, view.yRange);
       px.ctx.save();
       px.clip();
       const o = view.outline;
@@ -211,18 +220,25 @@ function renderScatter(state, data) {
         px.ctx.stroke();
         mapped[e.name] = known.name;
       }
-      dots(px.ctx, e.x[view.axes[0]], e.x[view.axes[1]], px.X, px.Y, color, full.u[0].length);
+      dots(px.ctx, e.x[view.axes[0]], e.x[view.axes[1]], px.X, px.Y, color, drawn);
       px.ctx.restore();
       px.frame();
     }
     const facts = `${e.sampler}; p: ${e.pdf}; ${strataText(full, d)}`;
+    // what the two panels show of a randomized QMC set, said where the points are
+    const setCap = oneSet !== null
+      ? `randomization 1 of ${full.randomizations}: its ${drawn} points (the run of N = ${total} averages ${full.randomizations} such sets)`
+        + `${net ? `; grey: ${net[0]} × ${net[1]} cells, one point in each (a net)` : ''}`
+      : net ? `one randomized sequence of ${drawn} points; grey: ${net[0]} × ${net[1]} cells, one point in each (a net)` : '';
     const runningCap = running ? `${running.text}. ${replayIsEstimator(full)
       ? 'Independent points: the mean of the first k is the estimate at N = k; shaded: its 95% interval.'
       : `A designed set: only all ${full.u[0].length} points make the estimate (the first k are not a design of k points).`}` : '';
-    return el('div', { className: 'sample-card', dataset: { estimator: e.name, points: String(n) } },
-      el('h3', {}, swatch(color), e.name, el('span', { className: 'muted small' }, `${n} points`)),
+    return el('div', { className: `sample-card${oneSet !== null ? ' one-set' : ''}`,
+      dataset: { estimator: e.name, points: String(n), ...(oneSet !== null ? { randomizations: String(full.randomizations), shown: String(drawn) } : {}) } },
+      el('h3', {}, swatch(color), e.name, el('span', { className: 'muted small' }, oneSet !== null ? `${n} of ${total} points: one randomization of ${full.randomizations}` : `${n} points`)),
       el('p', { className: 'facts' }, facts),
       training,
+      setCap ? el('p', { className: 'set-cap' }, setCap) : null,
       el('div', { className: 'pair' },
         el('div', {}, pu.c, el('p', { className: 'cap' }, d === 1 ? 'u (across) by point index (up)' : d > 2 ? `u: axes ${a + 1} (across) and ${b + 1} (up) of ${d}` : 'u (unit square)')),
         el('div', {}, px.c, el('p', { className: 'cap' }, d === 1 ? 'x (across), f(x) (up); grey: f' : `x: ${view.labels.join(', ')}${view.note ? ` (${view.note})` : ''}${mapped[e.name] ? `; strata through the ${mapped[e.name]} map` : ''}`))),
@@ -231,12 +247,16 @@ function renderScatter(state, data) {
   });
   dom.samples.replaceChildren(...cards);
   const adaptive = data.estimators.find((e) => e.run_n > data.n);
+  const qmc = data.estimators.find((e) => firstRandomizationSize(e) !== null);
   if (dom.samplesNote) {
     dom.samplesNote.textContent = `The first ${data.n} points of each selected estimator (replicate 0 of the study at N = ${data.n}, seed ${data.seed}):`
       + ' left in the unit square of its sampler (u) with its strata grid, right in the domain (x)'
       + `${view.note ? `, ${view.note}` : ''}. A polar map squeezes the cells of u near r = 0; the concentric map keeps them even.`
       + (adaptive ? ` Adaptive estimators (VEGAS, MISER) learn from a run of N = ${adaptive.run_n} (replicate 0 at that N):`
-        + ` they show what it learnt and the first ${data.n} points of its estimate; the slider replays VEGAS's training.` : '');
+        + ` they show what it learnt and the first ${data.n} points of its estimate; the slider replays VEGAS's training.` : '')
+      + (qmc ? ` A randomized quasi-Monte Carlo estimator (${qmc.name}) splits N into K independent randomizations of N/K points:`
+        + ` its card draws the first randomization only (${firstRandomizationSize(qmc)} points of ${qmc.randomizations}`
+        + ` sets here), since K sets drawn together look like independent points; choose more points to see a larger set.` : '');
   }
 }
 

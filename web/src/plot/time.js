@@ -8,6 +8,7 @@ import { equalTimeClaim, timeSlopeClaim, timeNote } from '../claims.js';
 import { AXIS, LOG10_AXIS, decadeLabel, lg, lgAll, log10Range, shortSeconds, runLabels, isRender } from './axes.js';
 import { uPlot, charts, dom, draw, drop, empty, setText, logX, log10Y, minorLogGrid } from './chart.js';
 import { colorOf, isHidden, setLegend } from './legend.js';
+import { placeGuideLabels } from './guide_labels.js';
 
 /** Joins each series' points in the order of N (time is not monotone in N: uPlot's own
  *  lines would join them in the order of x). */
@@ -19,6 +20,7 @@ function pathsInOrder(getPaths) {
     ctx.beginPath();
     ctx.rect(u.bbox.left, u.bbox.top, u.bbox.width, u.bbox.height);
     ctx.clip();
+    const guides = []; // the reference lines' names: drawn last, apart
     for (const { name, color, points, dash = null, whiskers = [], width = null, label = null } of getPaths()) {
       if (isHidden(name)) continue;
       // each point's timing interval (95%, over the replicates), with end caps
@@ -47,18 +49,35 @@ function pathsInOrder(getPaths) {
       });
       ctx.stroke();
       if (label && points.length) {
-        // a reference line's name at its end (inside the plot)
+        // a reference line's name at its end (inside the plot), drawn once every line is
         const [x, y] = points[points.length - 1];
-        ctx.setLineDash([]);
-        ctx.fillStyle = '#555';
-        ctx.font = `${11 * px}px "DejaVu Sans", sans-serif`;
-        ctx.textAlign = 'right';
-        ctx.textBaseline = 'bottom';
-        ctx.fillText(label, Math.min(u.valToPos(x, 'x', true), u.bbox.left + u.bbox.width) - 2 * px, u.valToPos(y, 'y', true) - 2 * px);
+        guides.push({ label, x: Math.min(u.valToPos(x, 'x', true), u.bbox.left + u.bbox.width) - 2 * px, y: u.valToPos(y, 'y', true) - 2 * px });
       }
     }
+    drawGuideLabels(u, ctx, guides, px);
     ctx.restore();
   };
+}
+
+/** The guide lines' names, right-aligned at their ends, moved apart where they would overlap
+ *  (the t^-1/2 and t^-1 lines end close together on a short plot: a phone). */
+function drawGuideLabels(u, ctx, guides, px) {
+  if (!guides.length) return;
+  ctx.setLineDash([]);
+  ctx.fillStyle = '#555';
+  ctx.font = `${11 * px}px "DejaVu Sans", sans-serif`;
+  ctx.textAlign = 'right';
+  ctx.textBaseline = 'bottom';
+  const ys = placeGuideLabels(guides.map((g) => ({ x: g.x, y: g.y, width: ctx.measureText(g.label).width })),
+    { height: 13 * px, gap: 1 * px, top: u.bbox.top, bottom: u.bbox.top + u.bbox.height });
+  guides.forEach((g, i) => ctx.fillText(g.label, g.x, ys[i]));
+  lastGuideLabels = guides.map((g, i) => ({ label: g.label, x: g.x / px, y: ys[i] / px, wanted: g.y / px, height: 13 }));
+}
+
+// The guide labels as last drawn (CSS pixels): for tests (window.mcplayDebug.guideLabels).
+let lastGuideLabels = [];
+export function guideLabels() {
+  return lastGuideLabels.map((g) => ({ ...g }));
 }
 
 

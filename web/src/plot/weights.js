@@ -5,7 +5,13 @@ import { fmt, curveOverlay, misWeightCurves, weightBins, weightHistogram } from 
 import { AXIS, LOG10_AXIS, log10Ticks } from './axes.js';
 import { uPlot, dom, draw, drop, empty } from './chart.js';
 import { sceneColor, setLegend } from './legend.js';
+import { coincidences, COINCIDE_DASHES } from './coincide.js';
 
+// Curves closer than this share of the plot's height are drawn as one: the later one dashed.
+const SAME_CURVE = 0.004;
+const dashOf = (rank) => COINCIDE_DASHES[Math.min(rank, COINCIDE_DASHES.length - 1)];
+/** The legend's words for a curve drawn dashed over an identical one. */
+const sameText = (c, what) => ({ text: `same ${what} as ${c.of} (dashed over it)`, className: 'fit same-curve' });
 /** The 1D overlay (#plot-overlay): f / integral |f| against each estimator's density p(x). */
 export function renderOverlay(state, data) {
   const exact = state.sceneInfo && typeof state.sceneInfo.exact === 'number' ? state.sceneInfo.exact : null;
@@ -18,9 +24,12 @@ export function renderOverlay(state, data) {
     return;
   }
   const data2 = [ov.x, ov.f, ...ov.pdfs.map((p) => p.y)];
+  // a density equal to another one, or to f / ∫|f|, would hide it: dashed over it, and said
+  const same = coincidences([{ name: 'f / ∫|f|', y: ov.f }, ...ov.pdfs], SAME_CURVE, ov.yRange[1] - ov.yRange[0]).slice(1);
   const series = [{}, { label: 'f / ∫|f|', stroke: '#000', width: 2.5, points: { show: false } },
-    ...ov.pdfs.map((p) => ({ label: p.name, stroke: sceneColor(state, p.name), width: 1.5, points: { show: false } }))];
-  const sig = JSON.stringify(['overlay', ov.pdfs.map((p) => p.name)]);
+    ...ov.pdfs.map((p, i) => ({ label: p.name, stroke: sceneColor(state, p.name), width: same[i].rank ? 2 : 1.5,
+      dash: dashOf(same[i].rank), points: { show: false } }))];
+  const sig = JSON.stringify(['overlay', ov.pdfs.map((p) => p.name), same.map((c) => c.rank)]);
   draw('overlay', dom.overlay, sig, (c) => ({
     scales: { x: { time: false, range: () => c.xRange }, y: { range: () => c.yRange } },
     axes: [{ ...AXIS, label: 'x', space: 40 },
@@ -31,7 +40,9 @@ export function renderOverlay(state, data) {
   dom.overlay.dataset.drawn = 'true';
   setLegend('overlay', dom['legend-overlay'], [
     { name: 'f / ∫|f|', color: '#000', parts: [{ text: ov.areaFrom === 'exact' ? `∫f = ${fmt(ov.area, 4)} (exact; the grid gives ${fmt(ov.trapezoid, 4)})` : `∫|f| ≈ ${fmt(ov.area, 4)}`, className: 'fit' }] },
-    ...ov.pdfs.map((p) => ({ name: p.name, color: sceneColor(state, p.name), parts: [] })),
+    ...ov.pdfs.map((p, i) => ({ name: p.name, color: sceneColor(state, p.name), dashed: same[i].rank > 0,
+      data: { overlay: p.name, ...(same[i].of ? { same: same[i].of } : {}) },
+      parts: same[i].of ? [sameText(same[i], 'density')] : [] })),
   ]);
   if (dom.overlayNote) {
     dom.overlayNote.textContent = 'f divided by ∫|f| (black, unit area; trapezoid rule on the grid) against each estimator\'s'
@@ -80,6 +91,7 @@ export function renderWeights(state, weights) {
   }
   const bins = weightBins(weights.estimators.map((e) => e.weight));
   const hs = weights.estimators.map((e) => ({ name: e.name, h: weightHistogram(e.weight, bins) }));
+  let same = hs.map(({ name }) => ({ name, of: null, rank: 0 }));
   if (!bins) {
     drop('weights');
     empty(dom.weights, 'Every weight is 0 (or not finite).');
@@ -87,12 +99,14 @@ export function renderWeights(state, weights) {
     const x = bins.logEdges;
     const data = [x, ...hs.map(({ h }) => [...h.fraction, h.fraction[h.fraction.length - 1]].map((v) => (v > 0 ? Math.log10(v) : null)))];
     const stepped = uPlot.paths.stepped({ align: 1 });
-    const series = [{}, ...hs.map(({ name }) => {
+    // identical histograms would hide each other: the later ones dashed over the first
+    same = coincidences(hs.map(({ name }, i) => ({ name, y: data[i + 1] })), 1e-9);
+    const series = [{}, ...hs.map(({ name }, i) => {
       const color = sceneColor(state, name);
-      return { label: name, stroke: color, width: 2, paths: stepped, points: { show: false } };
+      return { label: name, stroke: color, width: 2, dash: dashOf(same[i].rank), paths: stepped, points: { show: false } };
     })];
     const lowest = Math.floor(Math.log10(1 / Math.max(...hs.map(({ h }) => h.total || 1))));
-    draw('weights', dom.weights, JSON.stringify(['weights', hs.map((h) => h.name)]), (c) => ({
+    draw('weights', dom.weights, JSON.stringify(['weights', hs.map((h) => h.name), same.map((c) => c.rank)]), (c) => ({
       scales: { x: { time: false, range: () => c.xRange }, y: { range: () => c.yRange } },
       axes: [{ ...AXIS, values: log10Ticks, incrs: LOG10_AXIS.incrs, label: '|w| = |f / p|', space: 30 },
         { ...AXIS, ...LOG10_AXIS, label: 'fraction of the points' }],
@@ -100,13 +114,15 @@ export function renderWeights(state, weights) {
       cursor: { drag: { x: false, y: false } },
     }), data, { xRange: [x[0], x[x.length - 1]], yRange: [lowest, 0.15] });
   }
-  setLegend('weights', dom['legend-weights'], hs.map(({ name, h }) => {
+  setLegend('weights', dom['legend-weights'], hs.map(({ name, h }, i) => {
     const parts = [{ text: h.tail === null ? 'max|w| / mean|w| = —' : `max|w| / mean|w| = ${fmt(h.tail, 3)}`, className: 'fit' }];
+    if (same[i].of) parts.push(sameText(same[i], 'histogram'));
     if (h.zeros) parts.push({ text: `${h.zeros} zero weights`, className: 'fit' });
     // the first edge may be a fractional power of ten (4 bins per decade)
     if (h.below) parts.push({ text: `${h.below} below ${fmt(10 ** bins.logEdges[0], 2)} (over 12 decades under the largest)`, className: 'fit' });
     if (h.negative) parts.push({ text: `${h.negative} negative`, className: 'fit' });
     if (h.nonFinite) parts.push({ text: `${h.nonFinite} not finite`, className: 'badge' });
-    return { name, color: sceneColor(state, name), data: { weights: name, zeros: String(h.zeros) }, parts };
+    return { name, color: sceneColor(state, name), dashed: same[i].rank > 0,
+      data: { weights: name, zeros: String(h.zeros), ...(same[i].of ? { same: same[i].of } : {}) }, parts };
   }));
 }

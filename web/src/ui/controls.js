@@ -7,6 +7,7 @@ import { CUSTOM, KIND, USER_GLTF, kindOf, paramRules, referenceText, runBlocker,
 import { colorAt } from '../palette.js';
 import { fmt } from '../series.js';
 import { renderFacts } from '../report.js';
+import { sceneOptionLabel } from '../scene_title.js';
 
 const $ = (id) => document.getElementById(id);
 
@@ -38,6 +39,14 @@ export function mountControls(store) {
     dispatch({ type: 'run/request' });
   });
   $('cancel').addEventListener('click', () => dispatch({ type: 'run/cancel', payload: { now: performance.now() } }));
+  // The page's first focusable element: one Tab and Enter reach Run (Cancel while a run goes on).
+  $('skip-to-run').addEventListener('click', (e) => {
+    e.preventDefault();
+    if ($('study-view').hidden) $('tab-study').click(); // from the sampler lab: back to the study
+    const target = !$('run').disabled ? $('run') : !$('cancel').disabled ? $('cancel') : $('run');
+    target.scrollIntoView({ block: 'nearest' });
+    target.focus();
+  });
   $('samples-n').addEventListener('change', (e) => {
     dispatch({ type: 'samples/n', payload: { n: Number(e.target.value) } });
   });
@@ -112,7 +121,8 @@ function sceneOptions(scenes, userGltf) {
     g.append(...items);
     return g;
   };
-  const label = (s) => (kindOf(s) === KIND.RENDER ? `${s.name}  (render)` : `${s.name}  (${s.dimension ?? '?'}D)`);
+  // the readable title (the identifier is shown under the list, #scene-id)
+  const label = (s) => sceneOptionLabel({ ...s, kind: kindOf(s) });
   const groups = new Map();
   // A warp without an integrand (kind 'warp') has no study: the sampler lab tests it.
   for (const s of scenes.filter((e) => e.kind !== 'warp')) {
@@ -123,6 +133,32 @@ function sceneOptions(scenes, userGltf) {
   return [...[...groups].map(([title, items]) => optgroup(title, items)),
     optgroup('Your own integral', [option(CUSTOM, 'custom: f and p typed below')]),
     ...(userGltf ? [optgroup('Your own glTF scene', [option(USER_GLTF, `your file: ${userGltf}`)])] : [])];
+}
+
+/** The identifier of the scene shown, as the CLI takes it (#scene-id), under its title. */
+function sceneIdentifier(state) {
+  const entry = state.scenes.find((sc) => sc.name === state.sceneId);
+  const box = $('scene-id');
+  if (!box) return;
+  let parts;
+  if (entry) {
+    parts = ['identifier ', ['code', entry.name], ' · in the CLI: ', ['code', `mcplay run scenes/${entry.file || `${entry.name}.json`}`]];
+  } else if (state.sceneId === CUSTOM) {
+    parts = ['identifier ', ['code', CUSTOM], ': the integral typed below'];
+  } else if (state.sceneId === USER_GLTF && state.userGltf.name) {
+    parts = ['your file ', ['code', state.userGltf.name]];
+  } else {
+    parts = [];
+  }
+  const sig = JSON.stringify(parts);
+  if (box.dataset.sig === sig) return;
+  box.dataset.sig = sig;
+  box.replaceChildren(...parts.map((p) => {
+    if (typeof p === 'string') return document.createTextNode(p);
+    const c = document.createElement(p[0]);
+    c.textContent = p[1];
+    return c;
+  }));
 }
 
 export function syncControls(state) {
@@ -142,6 +178,7 @@ export function syncControls(state) {
   const kind = kindOf(info);
   showKind(kind);
   $('scene-description').textContent = info ? info.description || '' : '';
+  sceneIdentifier(state);
   // The custom problem's form opens when it is the problem shown or holds an error.
   if ((state.sceneId === CUSTOM || state.custom.error) && !$('custom').open) $('custom').open = true;
   const entry = state.scenes.find((sc) => sc.name === state.sceneId);
@@ -156,7 +193,13 @@ export function syncControls(state) {
   const list = $('estimator-list');
   if (eSig !== estimatorsSig) {
     estimatorsSig = eSig;
-    list.replaceChildren(...names.map((name, i) => {
+    // the presets the scene does not list (normalizeInfo: after its own) under a heading
+    const own = info && Array.isArray(info.defaultSelected) ? info.defaultSelected : names;
+    const firstMore = names.findIndex((n) => !own.includes(n));
+    const moreHead = document.createElement('p');
+    moreHead.className = 'more-head small muted';
+    moreHead.textContent = 'also offered (not in the scene file):';
+    list.replaceChildren(...names.flatMap((name, i) => {
       const box = document.createElement('input');
       box.type = 'checkbox';
       box.id = `est-${i}`;
@@ -169,7 +212,7 @@ export function syncControls(state) {
       sw.className = 'swatch';
       sw.style.background = colorAt(i);
       label.append(box, sw, name);
-      return label;
+      return i === firstMore && firstMore > 0 ? [moreHead, label] : [label];
     }));
   }
   const selected = new Set(state.selected);
