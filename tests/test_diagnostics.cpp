@@ -8,6 +8,7 @@
 #include <optional>
 #include <sstream>
 
+#include "api/report.h"
 #include "api/scene.h"
 #include "core/rng.h"
 #include "core/special.h"
@@ -602,4 +603,37 @@ TEST(Diagnostics, TheReplicatesDecideOnSkewedRealStudies) {
         EXPECT_EQ(skew->severity, Severity::Warning) << e.spec.name;
         EXPECT_GT(skew->replicate_misses, skew->miss_allowance) << e.spec.name;
     }
+}
+
+// --- Messages never say "p = 0" ----------------------------------------------------------------
+
+// The one formatter of p-values in sentences: a p-value below 1e-300 (or 0 from underflow) is
+// "p < 1e-300", never "p = 0"; others keep their significant digits.
+TEST(PValueText, NeverZero) {
+    EXPECT_EQ(p_value_text(0.0), "p < 1e-300");
+    EXPECT_EQ(p_value_text(1e-310), "p < 1e-300"); // subnormal
+    EXPECT_EQ(p_value_text(1e-300), "p = 1e-300");
+    EXPECT_EQ(p_value_text(3.14159e-5), "p = 3.1e-05");
+    EXPECT_EQ(p_value_text(0.25, 3), "p = 0.25");
+    EXPECT_EQ(p_value_text(0.123456, 4), "p = 0.1235");
+    EXPECT_EQ(p_value_text(std::nan("")), "p = -");
+    EXPECT_EQ(p_value_text(chi_square_sf(5000.0, 3)), "p < 1e-300");
+}
+
+// Latin hypercube's iid bound on exp_1d is hundreds of times too wide: the F test's lower tail
+// underflows to 0, and the message says "p < 1e-300".
+TEST(PValueText, UnderflowedPValuesInMessages) {
+    const StudyResult s = study("exp_1d", Json{{"n_min", 256},
+                                               {"n_max", 1024},
+                                               {"reps", 32},
+                                               {"seed", 1},
+                                               {"estimators", {"latin_hypercube"}}});
+    const std::optional<Flag> wide =
+        find(level_flags(s.estimators[0].levels.front()), FlagCode::ConservativeErrorBars);
+    ASSERT_TRUE(wide.has_value());
+    EXPECT_EQ(wide->p_value, 0.0); // underflowed: the message must not print it as it is
+    const std::string text = study_to_json(s).dump();
+    EXPECT_EQ(text.find("p = 0)"), std::string::npos);
+    EXPECT_EQ(text.find("p = 0,"), std::string::npos);
+    EXPECT_NE(text.find("(F test, p < 1e-300)"), std::string::npos);
 }

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "api/report.h"
+#include "core/special.h"
 #include "estimators/diagnostics.h"
 #include "estimators/registry.h"
 #include "estimators/stopping.h"
@@ -92,8 +93,8 @@ Json level_warning(const Flag& f, const LevelStats& l) {
     case FlagCode::ErrorBarsUnderstate:
         return flag_warning(f, "the " + std::to_string(f.of) + " replicates" + at_n + " spread " +
                                    fmt("%.3g", std::sqrt(f.value)) +
-                                   " times more than their own standard errors say (F test, p = " +
-                                   fmt("%.2g", f.p_value) +
+                                   " times more than their own standard errors say (F test, " +
+                                   p_value_text(f.p_value) +
                                    "): the error bars are too small (too few strata, "
                                    "randomizations or points saw how f varies)");
     case FlagCode::NonfiniteSamples:
@@ -139,21 +140,21 @@ Json level_warning(const Flag& f, const LevelStats& l) {
     case FlagCode::ConservativeErrorBars:
         return flag_warning(f, "conservative error bars" + at_n + ": the " + std::to_string(f.of) +
                                    " replicates spread " + fmt("%.3g", f.value) +
-                                   " times less than their own error bars say (F test, p = " +
-                                   fmt("%.2g", f.p_value) +
+                                   " times less than their own error bars say (F test, " +
+                                   p_value_text(f.p_value) +
                                    "): the intervals cover, and are wider than they need be");
     case FlagCode::ErrorBarsUnstable:
         if (f.severity == Severity::Info)
             return flag_warning(f, "the replicates' own error bars differ by a factor " +
-                                       fmt("%.3g", f.value) + at_n +
-                                       " (Bartlett's test, p = " + fmt("%.2g", f.p_value) +
+                                       fmt("%.3g", f.value) + at_n + " (Bartlett's test, " +
+                                       p_value_text(f.p_value) +
                                        ", which assumes normal data), but their intervals "
                                        "missed " +
                                        replicate_evidence(f) +
                                        ": the error bars vary from run to run and still hold");
         return flag_warning(f, "the replicates' own error bars differ by a factor " +
-                                   fmt("%.3g", f.value) + at_n +
-                                   " (Bartlett's test, p = " + fmt("%.2g", f.p_value) +
+                                   fmt("%.3g", f.value) + at_n + " (Bartlett's test, " +
+                                   p_value_text(f.p_value) +
                                    "): some runs saw a feature (a sliver of a step, a rare peak) "
                                    "that others missed, and those others' error bars are far too "
                                    "small");
@@ -187,8 +188,8 @@ Json level_warning(const Flag& f, const LevelStats& l) {
         return flag_warning(f, "the iterations of the runs disagree beyond their error bars" +
                                    at_n + " (chi2 = " + fmt("%.1f", f.value) + " for " +
                                    std::to_string(f.dof) + " degrees of freedom over " +
-                                   std::to_string(f.of) +
-                                   " replicates, p = " + fmt("%.2g", f.p_value) +
+                                   std::to_string(f.of) + " replicates, " +
+                                   p_value_text(f.p_value) +
                                    "): the weighted average and its error bar are not "
                                    "trustworthy (the map was still changing, or the integrand "
                                    "has a feature the iterations saw differently)");
@@ -272,7 +273,7 @@ Json estimator_warnings(const EstimatorStudy& e, const StudySettings& s) {
                 flag_warning(f, "the means at different N disagree beyond their error bars "
                                 "(chi2 = " +
                                     fmt("%.1f", f.value) + " for " + std::to_string(f.dof) +
-                                    " degrees of freedom, p = " + fmt("%.2g", f.p_value) +
+                                    " degrees of freedom, " + p_value_text(f.p_value) +
                                     "): the error bars understate the error (heavy tails, too "
                                     "few samples, or bias)"));
             break;
