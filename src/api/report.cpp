@@ -361,13 +361,33 @@ Json level_to_json(const LevelStats& l) {
 }
 
 Json fit_to_json(const ConvergenceFit& f) {
+    Json suffix(nullptr);
+    if (f.suffix) {
+        const PowerLawSegment& s = *f.suffix;
+        suffix = Json{{"order", num(s.order)},
+                      {"order_se", num(s.order_se)},
+                      {"intercept", num(s.intercept)},
+                      {"levels_used", s.levels_used},
+                      {"chi2", num(s.chi2)},
+                      {"dof", s.dof},
+                      {"p_value", num(s.p_value)},
+                      {"n_first", s.n_first},
+                      {"n_last", s.n_last}};
+    }
+    const Json none(nullptr);
     return Json{{"valid", f.valid},
                 {"measure", level_measure_name(f.measure)},
-                {"order", f.valid ? num(f.order) : Json(nullptr)},
-                {"order_se", f.valid ? num(f.order_se) : Json(nullptr)},
-                {"intercept", f.valid ? num(f.intercept) : Json(nullptr)},
+                {"order", f.valid ? num(f.order) : none},
+                {"order_se", f.valid ? num(f.order_se) : none},
+                {"intercept", f.valid ? num(f.intercept) : none},
                 {"levels_used", f.levels_used},
-                {"note", f.note}};
+                {"note", f.note},
+                {"chi2", f.valid ? num(f.chi2) : none},
+                {"dof", f.valid ? Json(f.dof) : none},
+                {"p_value", f.valid ? num(f.p_value) : none},
+                {"n_first", f.valid ? Json(f.n_first) : none},
+                {"n_last", f.valid ? Json(f.n_last) : none},
+                {"suffix", suffix}};
 }
 
 namespace {
