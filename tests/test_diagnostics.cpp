@@ -765,3 +765,34 @@ TEST(PValueText, UnderflowedPValuesInMessages) {
     EXPECT_EQ(text.find("p = 0,"), std::string::npos);
     EXPECT_NE(text.find("(F test, p < 1e-300)"), std::string::npos);
 }
+
+// --- heavy_tail needs a tail ----------------------------------------------------------------
+
+// Points that never saw the peak of width 1e-8 (uniform): every weight is 0, Hill's index is 0
+// (fewer than k + 1 non-zero weights) and undefined, so no heavy_tail; the level's own flags
+// say what is wrong. A real tail index of 1.2 still raises it.
+TEST(Diagnostics, NoHeavyTailFromWeightsThatAreAllZero) {
+    LevelStats zero;
+    zero.n = 65536;
+    zero.tail_k = 64;
+    zero.tail_index = 0.0;
+    EXPECT_TRUE(tail_flags(zero).empty());
+    EXPECT_TRUE(tail_flags(zero, true).empty());
+    LevelStats heavy = zero;
+    heavy.tail_index = 1.2;
+    ASSERT_EQ(tail_flags(heavy).size(), 1u);
+    EXPECT_EQ(tail_flags(heavy)[0].code, FlagCode::HeavyTail);
+
+    const StudyResult s =
+        study("stiff_peak_1e-8", Json{{"n_min", 16}, {"n_max", 65536}, {"reps", 32}, {"seed", 1}});
+    for (const char* name : {"uniform", "stratified"}) {
+        const EstimatorStudy& e = named(s, name);
+        EXPECT_EQ(e.levels.back().tail_index, 0.0) << name;
+        const std::vector<Flag> flags = estimator_flags(e, s.settings);
+        EXPECT_FALSE(find(flags, FlagCode::HeavyTail)) << name;
+        EXPECT_FALSE(find(flags, FlagCode::HeavyTail4)) << name;
+        const std::vector<Flag> deepest = level_flags(e.levels.back());
+        EXPECT_TRUE(find(deepest, FlagCode::ExactOutsideCi)) << name;
+        EXPECT_TRUE(find(deepest, FlagCode::LowEss)) << name;
+    }
+}

@@ -360,7 +360,11 @@ std::vector<Flag> level_flags(const LevelStats& l) {
 
 std::vector<Flag> tail_flags(const LevelStats& deepest, bool bounded) {
     std::vector<Flag> flags;
-    if (!std::isfinite(deepest.tail_index) || deepest.tail_k <= 0 || deepest.exact_to_roundoff)
+    // A tail index of exactly 0 is Hill's answer when fewer than k + 1 weights are non-zero
+    // (hill_tail_index): points that never saw f have no tail to measure, and the level's own
+    // flags (exact_outside_ci, low_ess, zero_error_bar, ...) say what is wrong.
+    if (!std::isfinite(deepest.tail_index) || deepest.tail_k <= 0 || deepest.exact_to_roundoff ||
+        deepest.tail_index == 0.0)
         return flags;
     const double alpha = deepest.tail_index;
     const double se = alpha / std::sqrt(static_cast<double>(deepest.tail_k));

@@ -131,7 +131,8 @@ std::vector<Flag> level_flags(const LevelStats& level);
 /// reaches furthest into the tail): heavy_tail when alpha = 2 is within two standard errors
 /// (alpha / sqrt(k)) or above alpha, heavy_tail_4 when alpha < 4 [Hill75]. With `bounded`
 /// weights (every moment finite) heavy_tail is info: a pre-asymptotic tail, whose effect on the
-/// error bars skewed_weights judges, with the N from which they hold.
+/// error bars skewed_weights judges, with the N from which they hold. Nothing when alpha is 0:
+/// fewer than k + 1 weights are non-zero (points that never saw f), and the tail is undefined.
 std::vector<Flag> tail_flags(const LevelStats& deepest, bool bounded = false);
 
 /// The flags of an estimator over the whole study: the tail index at the deepest level, the
