@@ -766,6 +766,84 @@ TEST(PValueText, UnderflowedPValuesInMessages) {
     EXPECT_NE(text.find("(F test, p < 1e-300)"), std::string::npos);
 }
 
+// --- bias_dominates is not a heavy tail's shortfall --------------------------------------------
+
+namespace {
+
+// Five levels whose mean falls 0.1 short of the exact value 1, 10 standard errors away, with a
+// tail index `alpha` (64 weights) at the largest N; `misses_mass`: the support check found
+// mass the pdf misses.
+EstimatorStudy falling_short(double alpha, bool misses_mass) {
+    EstimatorStudy e;
+    for (int k = 0; k < 5; ++k) {
+        LevelStats l;
+        l.n = uint64_t(1024) << k;
+        l.reps = 32;
+        l.has_exact = true;
+        l.exact = 1.0;
+        l.mean = 0.9;
+        l.bias = -0.1;
+        l.variance = 1e-4;
+        l.std_error = std::sqrt(l.variance / l.reps);
+        l.mse = l.bias * l.bias + l.variance;
+        l.estimates_spread = true;
+        l.tail_index = alpha;
+        l.tail_k = 64;
+        e.levels.push_back(l);
+    }
+    if (misses_mass) {
+        e.support.flagged = true;
+        e.support.missed = 12;
+        e.support.f_nonzero = 60000;
+    }
+    return e;
+}
+
+} // namespace
+
+// Both ways on levels built to order: with an infinite variance (heavy_tail as a warning: tail
+// index 1.2) and no source of bias, no bias_dominates; the same shortfall with mass the pdf
+// misses, with dropped samples, with a finite-variance tail (5), or with bounded weights
+// (heavy_tail as info) keeps it.
+TEST(Diagnostics, BiasDominatesIsNotAHeavyTailsShortfall) {
+    const StudySettings settings;
+    const std::vector<Flag> heavy = estimator_flags(falling_short(1.2, false), settings);
+    ASSERT_TRUE(find(heavy, FlagCode::HeavyTail).has_value());
+    EXPECT_EQ(find(heavy, FlagCode::HeavyTail)->severity, Severity::Warning);
+    EXPECT_FALSE(find(heavy, FlagCode::BiasDominates).has_value());
+
+    EXPECT_TRUE(find(estimator_flags(falling_short(1.2, true), settings), FlagCode::BiasDominates));
+    EstimatorStudy dropped = falling_short(1.2, false);
+    dropped.levels[2].diagnostics.zero_pdf = 3;
+    EXPECT_TRUE(known_bias_source(dropped));
+    EXPECT_TRUE(find(estimator_flags(dropped, settings), FlagCode::BiasDominates));
+    EXPECT_TRUE(
+        find(estimator_flags(falling_short(5.0, false), settings), FlagCode::BiasDominates));
+    EstimatorStudy bounded = falling_short(1.2, false);
+    bounded.weights_bounded = true;
+    const std::vector<Flag> info = estimator_flags(bounded, settings);
+    EXPECT_EQ(find(info, FlagCode::HeavyTail)->severity, Severity::Info);
+    EXPECT_TRUE(find(info, FlagCode::BiasDominates));
+
+    // Real studies: x^-0.9 sampled uniformly, stratified or by x^-0.45 is unbiased with an
+    // infinite variance: no bias_dominates; a pdf that misses a quarter of the support
+    // (is_zero_pdf's importance_gap) keeps it.
+    const StudyResult s = study("singular_power_0.9",
+                                Json{{"n_min", 16}, {"n_max", 65536}, {"reps", 32}, {"seed", 1}});
+    for (const char* name : {"uniform", "stratified", "importance_half"}) {
+        const EstimatorStudy& e = named(s, name);
+        const std::vector<Flag> flags = estimator_flags(e, s.settings);
+        EXPECT_TRUE(find(flags, FlagCode::HeavyTail)) << name;
+        EXPECT_FALSE(find(flags, FlagCode::BiasDominates)) << name;
+        EXPECT_FALSE(known_bias_source(e)) << name;
+    }
+    const StudyResult z =
+        study("is_zero_pdf", Json{{"n_min", 256}, {"n_max", 16384}, {"reps", 16}, {"seed", 6}});
+    EXPECT_TRUE(known_bias_source(named(z, "importance_gap")));
+    EXPECT_TRUE(
+        find(estimator_flags(named(z, "importance_gap"), z.settings), FlagCode::BiasDominates));
+}
+
 // --- heavy_tail needs a tail ----------------------------------------------------------------
 
 // Points that never saw the peak of width 1e-8 (uniform): every weight is 0, Hill's index is 0
