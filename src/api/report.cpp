@@ -392,7 +392,7 @@ Json fit_to_json(const ConvergenceFit& f) {
 
 namespace {
 
-Json estimator_header(const EstimatorStudy& e, const StudySettings& s) {
+Json estimator_header(const EstimatorStudy& e, const StudySettings& s, const Domain& domain) {
     return Json{
         {"name", e.spec.name},
         {"kind", kind_of(e.spec).name},
@@ -400,6 +400,7 @@ Json estimator_header(const EstimatorStudy& e, const StudySettings& s) {
         {"sampler", sampler_name(e.spec.sampler)},
         {"samples_per_stratum", e.spec.per_stratum},
         {"pdf", describe_sampling(e.spec)},
+        {"pdf_text", describe_sampling_text(e.spec, domain)},
         {"importance", e.spec.proposal.importance || e.spec.has_techniques()},
         {"randomization",
          is_qmc(e.spec.sampler) ? Json(randomization_name(e.spec.randomization)) : Json(nullptr)},
@@ -458,7 +459,7 @@ Json stopping_to_json(const StoppingStudy& st) {
         EstimatorStudy header;
         header.spec = st.specs[e];
         header.error_method = error_method_for(st.specs[e]);
-        Json j = estimator_header(header, set);
+        Json j = estimator_header(header, set, p.domain);
         Json runs = Json::array();
         std::vector<double> seconds, evaluations;
         int met = 0, within = 0;
@@ -576,7 +577,7 @@ Json study_to_json(const StudyResult& r) {
         {"threads", r.threads_used}};
     Json estimators = Json::array();
     for (const EstimatorStudy& e : r.estimators) {
-        Json j = estimator_header(e, r.settings);
+        Json j = estimator_header(e, r.settings, p.domain);
         Json levels = Json::array();
         for (const LevelStats& l : e.levels) levels.push_back(level_to_json(l));
         j["levels"] = levels;
@@ -597,7 +598,7 @@ Json progress_to_json(const StudyResult& partial, size_t level_index) {
     Json estimators = Json::array();
     uint64_t n = 0;
     for (const EstimatorStudy& e : partial.estimators) {
-        Json j = estimator_header(e, partial.settings);
+        Json j = estimator_header(e, partial.settings, partial.problem.domain);
         if (level_index < e.levels.size()) {
             j["level"] = level_to_json(e.levels[level_index]);
             n = e.levels[level_index].n;
