@@ -1,7 +1,9 @@
 // The C API: documented result JSON, error codes and messages for bad input, progress and
 // cancellation, formatting.
+#include <dirent.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <map>
@@ -374,12 +376,112 @@ TEST(Api, SceneInfoAndCatalog) {
          {"fixed", "vegas", "vegas_plus", "miser", "mis", "control_variates", "antithetic"})
         EXPECT_TRUE(kinds.count(k)) << k;
     for (const json& p : cat["estimators"]) EXPECT_TRUE(kinds.count(p["kind"].get<std::string>()));
-    EXPECT_EQ(cat["samplers"], json({"independent", "stratified", "latin_hypercube", "sobol",
-                                     "halton", "lattice"}));
+    EXPECT_EQ(cat["samplers"],
+              json({"independent", "stratified", "latin_hypercube", "sobol", "halton", "lattice"}));
     EXPECT_EQ(cat["randomizations"],
               json({{"sobol", {"owen", "lms_shift", "digital_shift", "none"}},
                     {"halton", {"owen", "permutation", "none"}},
                     {"lattice", {"random_shift", "none"}}}));
+}
+
+namespace {
+
+// Every estimator's pdf_text in a scene info: beside each pdf, in words (no "=", no "_").
+std::vector<std::string> pdf_texts(const std::string& scene) {
+    char* out = nullptr;
+    std::vector<std::string> texts;
+    if (mcp_scene_info(scene.c_str(), &out) != MCP_OK) return texts;
+    const json info = json::parse(out);
+    mcp_free(out);
+    for (const json& d : info["estimator_details"]) {
+        EXPECT_TRUE(d.contains("pdf") && d.contains("pdf_text")) << d.dump();
+        const std::string text = d.value("pdf_text", "");
+        EXPECT_FALSE(text.empty()) << d.dump();
+        EXPECT_EQ(text.find_first_of("=_"), std::string::npos) << text;
+        texts.push_back(text);
+    }
+    return texts;
+}
+
+} // namespace
+
+// pdf_text beside pdf: in the scene info of every scene file and of scenes made to cover every
+// proposal (disks by both maps, triangle, sphere, hemisphere, products, 2D tables, warps,
+// mixtures, adaptive kinds), in a study's estimators and in the sample view's.
+TEST(Api, PdfTextBesidePdf) {
+    std::vector<std::string> all;
+    const std::string dir = std::string(MCPLAY_SOURCE_DIR) + "/scenes";
+    DIR* d = opendir(dir.c_str());
+    ASSERT_NE(d, nullptr);
+    int scenes = 0;
+    while (dirent* e = readdir(d)) {
+        const std::string name = e->d_name;
+        if (name.size() < 6 || name.substr(name.size() - 5) != ".json") continue;
+        std::ifstream in(dir + "/" + name);
+        std::stringstream ss;
+        ss << in.rdbuf();
+        const std::vector<std::string> texts = pdf_texts(ss.str());
+        scenes += !texts.empty();
+        all.insert(all.end(), texts.begin(), texts.end());
+    }
+    closedir(d);
+    EXPECT_GE(scenes, 20);
+    const char* made[] = {
+        R"({"domain": {"type": "disk", "radius": 2, "center": [1, 0]}, "f": "1",
+            "estimators": [{"name": "uniform", "warp": "polar"}, {"name": "stratified", "warp": "concentric"}]})",
+        R"({"domain": {"type": "triangle", "vertices": [[0, 0], [1, 0], [0, 1]]}, "f": "1",
+            "estimators": ["uniform"]})",
+        R"({"domain": {"type": "sphere"}, "integrand": {"type": "monomial", "powers": [0, 0, 2]},
+            "estimators": ["uniform"]})",
+        R"({"domain": {"type": "hemisphere"}, "integrand": {"type": "monomial", "powers": [0, 0, 2]},
+            "estimators": [{"name": "c", "pdf": {"type": "cosine_hemisphere"}}]})",
+        R"({"domain": {"type": "box", "dim": 2}, "f": "x * y", "estimators": ["uniform", "vegas",
+            "miser", {"name": "t", "pdf": {"type": "tabulated_2d", "bins": [4, 3], "shape": "integrand"}},
+            {"name": "pr", "pdf": {"type": "product", "factors": [{"type": "power", "k": 1},
+                                                                  {"type": "exponential", "rate": 2}]}},
+            {"name": "m", "heuristic": "power", "one_sample": true,
+             "proposals": ["uniform", {"type": "power", "k": 1}]}]})",
+        R"({"domain": {"type": "box", "dim": 3}, "f": "x", "estimators": ["uniform"]})",
+        R"({"warp": "concentric_disk", "f": "1", "estimators": ["warp"]})",
+        R"({"warp": {"name": "tabulated_1d", "values": [1, 2, 3]}, "f": "x", "estimators": ["warp"]})",
+    };
+    for (const char* scene : made) {
+        const std::vector<std::string> texts = pdf_texts(scene);
+        EXPECT_FALSE(texts.empty()) << scene << ": " << mcp_last_error();
+        all.insert(all.end(), texts.begin(), texts.end());
+    }
+    auto found = [&](const std::string& words) {
+        return std::any_of(all.begin(), all.end(), [&](const std::string& t) {
+            return t.find(words) != std::string::npos;
+        });
+    };
+    for (const char* words :
+         {"uniform on [0, 1]", "uniform on [0, 1]^2", "uniform on [0, 1]^3",
+          "uniform on the disk of radius 2 centred at (1, 0), by the polar map",
+          "by the concentric map", "uniform on the triangle with corners (0, 0), (1, 0), (0, 1)",
+          "uniform on the sphere of directions", "cos(theta) / pi on the upper hemisphere",
+          "piecewise-constant density on a 4 x 3 grid of cells over [0, 1] x [0, 1]",
+          "a product of one density per axis: x1: power-law density proportional to x1 on [0, 1]; "
+          "x2: exponential density proportional to e^(-2 x2) on [0, 1]",
+          "a mixture of 2 densities (multiple importance sampling, power heuristic, each point "
+          "from one density drawn at random): 50% from (uniform on [0, 1]^2); 50% from (a product "
+          "of "
+          "one density per axis: x1: power-law density proportional to x1 on [0, 1]; x2: "
+          "power-law density proportional to x2 on [0, 1])",
+          "reshaped by the VEGAS map the run learns", "within the boxes MISER's recursive",
+          "normal density of mean", "piecewise-constant density from a table on [0, 1]"})
+        EXPECT_TRUE(found(words)) << words;
+
+    // A study's estimators and the sample view's carry it too.
+    Outcome o = run(kSmall);
+    ASSERT_EQ(o.status, MCP_OK) << o.error;
+    for (const json& e : o.result["estimators"])
+        EXPECT_EQ(e["pdf_text"], "uniform on [0, 1]") << e.dump();
+    char* out = nullptr;
+    ASSERT_EQ(mcp_study_samples(kSmall, R"({"n": 16})", &out), MCP_OK) << mcp_last_error();
+    const json samples = json::parse(out);
+    mcp_free(out);
+    for (const json& e : samples["estimators"]) EXPECT_EQ(e["pdf_text"], "uniform on [0, 1]");
 }
 
 TEST(Api, TheKindsFactsReachTheJson) {

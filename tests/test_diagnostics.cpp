@@ -8,6 +8,7 @@
 #include <optional>
 #include <sstream>
 
+#include "api/report.h"
 #include "api/scene.h"
 #include "core/rng.h"
 #include "core/special.h"
@@ -601,5 +602,275 @@ TEST(Diagnostics, TheReplicatesDecideOnSkewedRealStudies) {
         ASSERT_TRUE(skew.has_value()) << e.spec.name;
         EXPECT_EQ(skew->severity, Severity::Warning) << e.spec.name;
         EXPECT_GT(skew->replicate_misses, skew->miss_allowance) << e.spec.name;
+    }
+}
+
+// --- Goodness of fit of the power-law fits (fit, mse_fit: chi2, dof, p_value, suffix) ---------
+
+namespace {
+
+// A variance ladder N = 16 .. 65536 (13 levels) whose sample variances follow factor(k) / N with
+// the noise of R normal replicates: (R - 1) s^2 / sigma^2 is chi-square with R - 1 degrees of
+// freedom, drawn here as a sum of R - 1 squared normals.
+std::vector<LevelStats> variance_ladder(Pcg32& rng, int reps, double (*factor)(size_t)) {
+    std::vector<LevelStats> levels(13);
+    for (size_t k = 0; k < levels.size(); ++k) {
+        double chi2 = 0.0;
+        for (int r = 0; r + 1 < reps; ++r) {
+            const double u1 = 1.0 - rng.next_double(), u2 = rng.next_double();
+            const double z = std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * kPi * u2);
+            chi2 += z * z;
+        }
+        LevelStats& l = levels[k];
+        l.n = uint64_t(16) << k;
+        l.reps = reps;
+        l.mean = 1.0;
+        l.variance = factor(k) / static_cast<double>(l.n) * chi2 / (reps - 1);
+        l.std_error = std::sqrt(l.variance / reps);
+        l.estimates_spread = true;
+    }
+    return levels;
+}
+
+double no_jump(size_t) {
+    return 1.0;
+}
+// Two jumps by 100: at level 3 (N = 128) and at level 6 (N = 1024).
+double two_jumps(size_t k) {
+    return k < 3 ? 1.0 : k < 6 ? 100.0 : 10000.0;
+}
+
+} // namespace
+
+// Ladders that follow N^-1 with the noise of R = 32 normal replicates: the chi-square of the
+// log-log line is nearly chi-square with 11 degrees of freedom (log s^2 is nearly normal, with
+// variance psi'((R - 1) / 2)). Its slight left skew makes p < 0.01 on 1.14% of ladders and
+// p < 1e-3 on 0.13% (20000 ladders of this generator). Of 400: 4.6 expected below 0.01, and 12
+// or more has binomial probability 0.005 (P(Bin(400, 0.0125) >= 12)); 0.5 expected below 1e-3,
+// 5 or more has probability 2.4e-4. Where the whole range passes, no suffix is looked for.
+TEST(PowerLawFit, LaddersThatFollowAPowerLawPass) {
+    Pcg32 rng(38, 1);
+    const int ladders = 400;
+    int rejected = 0, failed_whole = 0;
+    for (int i = 0; i < ladders; ++i) {
+        const ConvergenceFit fit = fit_convergence(variance_ladder(rng, 32, no_jump));
+        ASSERT_TRUE(fit.valid);
+        EXPECT_EQ(fit.dof, 11);
+        EXPECT_EQ(fit.n_first, 16u);
+        EXPECT_EQ(fit.n_last, 65536u);
+        EXPECT_NEAR(fit.p_value, chi_square_sf(fit.chi2, 11), 1e-15);
+        rejected += fit.p_value < 0.01;
+        failed_whole += fit.p_value < kPowerLawP;
+        if (fit.p_value >= kPowerLawP) {
+            EXPECT_FALSE(fit.suffix.has_value());
+        }
+    }
+    EXPECT_LE(rejected, 11) << "of " << ladders;
+    EXPECT_LE(failed_whole, 4) << "of " << ladders; // 0.4 expected; P(>= 5) = 8e-4
+}
+
+// Two jumps by 100 (at N = 128 and N = 1024): no power law (p < 1e-6), and the longest suffix
+// that is one starts after the second jump, at N = 1024, with the order -1 of the levels there.
+TEST(PowerLawFit, JumpsFailAndTheSuffixStartsAfterThem) {
+    Pcg32 rng(38, 2);
+    for (int i = 0; i < 20; ++i) {
+        const ConvergenceFit fit = fit_convergence(variance_ladder(rng, 32, two_jumps));
+        ASSERT_TRUE(fit.valid);
+        EXPECT_LT(fit.p_value, 1e-6);
+        ASSERT_TRUE(fit.suffix.has_value()) << i;
+        const PowerLawSegment& tail = *fit.suffix;
+        EXPECT_EQ(tail.n_first, 1024u) << i;
+        EXPECT_EQ(tail.n_last, 65536u);
+        EXPECT_EQ(tail.levels_used, 7) << i;
+        EXPECT_EQ(tail.dof, 5) << i;
+        EXPECT_GE(tail.p_value, kSuffixP);
+        EXPECT_NEAR(tail.order, -1.0, 4.0 * tail.order_se) << i;
+    }
+    // A ladder with no run of 4 levels on one line: every level 30x off its neighbours.
+    std::vector<FitPoint> zigzag;
+    for (int k = 0; k < 10; ++k) zigzag.push_back({uint64_t(16) << k, k % 2 ? 30.0 : 1.0, 0.25});
+    const ConvergenceFit none = fit_power_law(zigzag, LevelMeasure::Variance);
+    ASSERT_TRUE(none.valid);
+    EXPECT_LT(none.p_value, 1e-6);
+    EXPECT_FALSE(none.suffix.has_value());
+    // Unknown noise (sd_log 0: unit weights): no chi-square, no p-value, no suffix.
+    for (FitPoint& p : zigzag) p.sd_log = 0.0;
+    const ConvergenceFit unweighted = fit_power_law(zigzag, LevelMeasure::Variance);
+    ASSERT_TRUE(unweighted.valid);
+    EXPECT_TRUE(std::isnan(unweighted.chi2) && std::isnan(unweighted.p_value));
+    EXPECT_FALSE(unweighted.suffix.has_value());
+}
+
+// Real estimators: uniform sampling of a smooth 1-D integrand follows N^-1 (p >= 1e-3 at this
+// seed), stratified sampling of x^-0.9 (infinite variance) does not, and the JSON and the
+// table say so.
+TEST(PowerLawFit, RealEstimatorsAndTheirReports) {
+    const Json options{{"n_min", 16}, {"n_max", 65536}, {"reps", 32}, {"seed", 1}};
+    const StudyResult smooth = study("exp_1d", options);
+    const ConvergenceFit& uniform = named(smooth, "uniform").fit;
+    ASSERT_TRUE(uniform.valid);
+    EXPECT_GE(uniform.p_value, kPowerLawP);
+    EXPECT_FALSE(uniform.suffix.has_value());
+    EXPECT_EQ(uniform.n_first, 16u);
+    EXPECT_EQ(uniform.n_last, 65536u);
+    const StudyResult heavy = study("singular_power_0.9", options);
+    const ConvergenceFit& stratified = named(heavy, "stratified").fit;
+    ASSERT_TRUE(stratified.valid);
+    EXPECT_LT(stratified.p_value, 1e-6);
+
+    const Json j = fit_to_json(uniform);
+    for (const char* key : {"chi2", "dof", "p_value", "n_first", "n_last", "suffix"})
+        EXPECT_TRUE(j.contains(key)) << key;
+    EXPECT_TRUE(j["suffix"].is_null());
+    EXPECT_EQ(j["dof"], 11);
+    const std::string smooth_table = format_table(study_to_json(smooth));
+    const std::string heavy_table = format_table(study_to_json(heavy));
+    EXPECT_EQ(smooth_table.find("not a power law"), std::string::npos);
+    EXPECT_NE(heavy_table.find("not a power law: chi^2 p = "), std::string::npos) << heavy_table;
+    // An invalid fit has nulls, not numbers.
+    const Json invalid = fit_to_json(ConvergenceFit{});
+    for (const char* key : {"chi2", "dof", "p_value", "n_first", "n_last", "suffix"})
+        EXPECT_TRUE(invalid[key].is_null()) << key;
+}
+
+// --- Messages never say "p = 0" ----------------------------------------------------------------
+
+// The one formatter of p-values in sentences: a p-value below 1e-300 (or 0 from underflow) is
+// "p < 1e-300", never "p = 0"; others keep their significant digits.
+TEST(PValueText, NeverZero) {
+    EXPECT_EQ(p_value_text(0.0), "p < 1e-300");
+    EXPECT_EQ(p_value_text(1e-310), "p < 1e-300"); // subnormal
+    EXPECT_EQ(p_value_text(1e-300), "p = 1e-300");
+    EXPECT_EQ(p_value_text(3.14159e-5), "p = 3.1e-05");
+    EXPECT_EQ(p_value_text(0.25, 3), "p = 0.25");
+    EXPECT_EQ(p_value_text(0.123456, 4), "p = 0.1235");
+    EXPECT_EQ(p_value_text(std::nan("")), "p = -");
+    EXPECT_EQ(p_value_text(chi_square_sf(5000.0, 3)), "p < 1e-300");
+}
+
+// Latin hypercube's iid bound on exp_1d is hundreds of times too wide: the F test's lower tail
+// underflows to 0, and the message says "p < 1e-300".
+TEST(PValueText, UnderflowedPValuesInMessages) {
+    const StudyResult s = study("exp_1d", Json{{"n_min", 256},
+                                               {"n_max", 1024},
+                                               {"reps", 32},
+                                               {"seed", 1},
+                                               {"estimators", {"latin_hypercube"}}});
+    const std::optional<Flag> wide =
+        find(level_flags(s.estimators[0].levels.front()), FlagCode::ConservativeErrorBars);
+    ASSERT_TRUE(wide.has_value());
+    EXPECT_EQ(wide->p_value, 0.0); // underflowed: the message must not print it as it is
+    const std::string text = study_to_json(s).dump();
+    EXPECT_EQ(text.find("p = 0)"), std::string::npos);
+    EXPECT_EQ(text.find("p = 0,"), std::string::npos);
+    EXPECT_NE(text.find("(F test, p < 1e-300)"), std::string::npos);
+}
+
+// --- bias_dominates is not a heavy tail's shortfall --------------------------------------------
+
+namespace {
+
+// Five levels whose mean falls 0.1 short of the exact value 1, 10 standard errors away, with a
+// tail index `alpha` (64 weights) at the largest N; `misses_mass`: the support check found
+// mass the pdf misses.
+EstimatorStudy falling_short(double alpha, bool misses_mass) {
+    EstimatorStudy e;
+    for (int k = 0; k < 5; ++k) {
+        LevelStats l;
+        l.n = uint64_t(1024) << k;
+        l.reps = 32;
+        l.has_exact = true;
+        l.exact = 1.0;
+        l.mean = 0.9;
+        l.bias = -0.1;
+        l.variance = 1e-4;
+        l.std_error = std::sqrt(l.variance / l.reps);
+        l.mse = l.bias * l.bias + l.variance;
+        l.estimates_spread = true;
+        l.tail_index = alpha;
+        l.tail_k = 64;
+        e.levels.push_back(l);
+    }
+    if (misses_mass) {
+        e.support.flagged = true;
+        e.support.missed = 12;
+        e.support.f_nonzero = 60000;
+    }
+    return e;
+}
+
+} // namespace
+
+// Both ways on levels built to order: with an infinite variance (heavy_tail as a warning: tail
+// index 1.2) and no source of bias, no bias_dominates; the same shortfall with mass the pdf
+// misses, with dropped samples, with a finite-variance tail (5), or with bounded weights
+// (heavy_tail as info) keeps it.
+TEST(Diagnostics, BiasDominatesIsNotAHeavyTailsShortfall) {
+    const StudySettings settings;
+    const std::vector<Flag> heavy = estimator_flags(falling_short(1.2, false), settings);
+    ASSERT_TRUE(find(heavy, FlagCode::HeavyTail).has_value());
+    EXPECT_EQ(find(heavy, FlagCode::HeavyTail)->severity, Severity::Warning);
+    EXPECT_FALSE(find(heavy, FlagCode::BiasDominates).has_value());
+
+    EXPECT_TRUE(find(estimator_flags(falling_short(1.2, true), settings), FlagCode::BiasDominates));
+    EstimatorStudy dropped = falling_short(1.2, false);
+    dropped.levels[2].diagnostics.zero_pdf = 3;
+    EXPECT_TRUE(known_bias_source(dropped));
+    EXPECT_TRUE(find(estimator_flags(dropped, settings), FlagCode::BiasDominates));
+    EXPECT_TRUE(
+        find(estimator_flags(falling_short(5.0, false), settings), FlagCode::BiasDominates));
+    EstimatorStudy bounded = falling_short(1.2, false);
+    bounded.weights_bounded = true;
+    const std::vector<Flag> info = estimator_flags(bounded, settings);
+    EXPECT_EQ(find(info, FlagCode::HeavyTail)->severity, Severity::Info);
+    EXPECT_TRUE(find(info, FlagCode::BiasDominates));
+
+    // Real studies: x^-0.9 sampled uniformly, stratified or by x^-0.45 is unbiased with an
+    // infinite variance: no bias_dominates; a pdf that misses a quarter of the support
+    // (is_zero_pdf's importance_gap) keeps it.
+    const StudyResult s = study("singular_power_0.9",
+                                Json{{"n_min", 16}, {"n_max", 65536}, {"reps", 32}, {"seed", 1}});
+    for (const char* name : {"uniform", "stratified", "importance_half"}) {
+        const EstimatorStudy& e = named(s, name);
+        const std::vector<Flag> flags = estimator_flags(e, s.settings);
+        EXPECT_TRUE(find(flags, FlagCode::HeavyTail)) << name;
+        EXPECT_FALSE(find(flags, FlagCode::BiasDominates)) << name;
+        EXPECT_FALSE(known_bias_source(e)) << name;
+    }
+    const StudyResult z =
+        study("is_zero_pdf", Json{{"n_min", 256}, {"n_max", 16384}, {"reps", 16}, {"seed", 6}});
+    EXPECT_TRUE(known_bias_source(named(z, "importance_gap")));
+    EXPECT_TRUE(
+        find(estimator_flags(named(z, "importance_gap"), z.settings), FlagCode::BiasDominates));
+}
+
+// --- heavy_tail needs a tail ----------------------------------------------------------------
+
+// Points that never saw the peak of width 1e-8 (uniform): every weight is 0, Hill's index is 0
+// (fewer than k + 1 non-zero weights) and undefined, so no heavy_tail; the level's own flags
+// say what is wrong. A real tail index of 1.2 still raises it.
+TEST(Diagnostics, NoHeavyTailFromWeightsThatAreAllZero) {
+    LevelStats zero;
+    zero.n = 65536;
+    zero.tail_k = 64;
+    zero.tail_index = 0.0;
+    EXPECT_TRUE(tail_flags(zero).empty());
+    EXPECT_TRUE(tail_flags(zero, true).empty());
+    LevelStats heavy = zero;
+    heavy.tail_index = 1.2;
+    ASSERT_EQ(tail_flags(heavy).size(), 1u);
+    EXPECT_EQ(tail_flags(heavy)[0].code, FlagCode::HeavyTail);
+
+    const StudyResult s =
+        study("stiff_peak_1e-8", Json{{"n_min", 16}, {"n_max", 65536}, {"reps", 32}, {"seed", 1}});
+    for (const char* name : {"uniform", "stratified"}) {
+        const EstimatorStudy& e = named(s, name);
+        EXPECT_EQ(e.levels.back().tail_index, 0.0) << name;
+        const std::vector<Flag> flags = estimator_flags(e, s.settings);
+        EXPECT_FALSE(find(flags, FlagCode::HeavyTail)) << name;
+        EXPECT_FALSE(find(flags, FlagCode::HeavyTail4)) << name;
+        const std::vector<Flag> deepest = level_flags(e.levels.back());
+        EXPECT_TRUE(find(deepest, FlagCode::ExactOutsideCi)) << name;
+        EXPECT_TRUE(find(deepest, FlagCode::LowEss)) << name;
     }
 }

@@ -9,6 +9,7 @@
 #include <functional>
 #include <limits>
 #include <ostream>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -483,6 +484,46 @@ TEST(Distribution1D, Describe) {
               "tabulated(64 bins) on [0, 1]");
     EXPECT_EQ(make_exponential(-2.5, 1e-3, -1e-9).value.describe(),
               "exponential(rate=-1e-09) on [-2.5, 0.001]");
+}
+
+// The words beside the notation (results' "pdf_text"): every kind, no parameter names, no "="
+// and no "_".
+TEST(Distribution1D, DescribeText) {
+    const std::vector<std::pair<Distribution1D, std::string>> cases = {
+        {make_uniform(0, 1).value, "uniform on [0, 1]"},
+        {make_power(0, 1, 1).value, "power-law density proportional to x on [0, 1]"},
+        {make_power(0, 1, -0.45).value, "power-law density proportional to x^(-0.45) on [0, 1]"},
+        {make_power(1, 2, 2).value, "power-law density proportional to (x - 1)^2 on [1, 2]"},
+        {make_power(0, 1, 0).value, "uniform on [0, 1]"},
+        {make_exponential(0, 1, -0.8).value,
+         "exponential density proportional to e^(0.8 x) on [0, 1]"},
+        {make_exponential(0, 1, 1).value, "exponential density proportional to e^(-x) on [0, 1]"},
+        {make_exponential(0, 1, -1).value, "exponential density proportional to e^x on [0, 1]"},
+        {make_truncated_gaussian(0, 1, 0.5, 1e-8).value,
+         "normal density of mean 0.5 and standard deviation 1e-08, cut to [0, 1]"},
+        {make_cosine(-1, 1, 1, 0).value, "cosine density proportional to cos(x) on [-1, 1]"},
+        {make_cosine(0, 1, 3, 0.5).value,
+         "cosine density proportional to cos(3 (x - 0.5)) on [0, 1]"},
+        {make_cosine(-1, 1, 1, -0.25).value,
+         "cosine density proportional to cos(x + 0.25) on [-1, 1]"},
+        {make_tabulated(0, 1, std::vector<double>(64, 1.0)).value,
+         "piecewise-constant density on 64 equal bins of [0, 1]"},
+        {make_tabulated(0, 1, {1.0}).value, "piecewise-constant density on 1 equal bin of [0, 1]"},
+    };
+    std::set<Dist1DKind> kinds;
+    for (const auto& [d, text] : cases) {
+        kinds.insert(d.kind());
+        EXPECT_EQ(d.describe_text(), text);
+        EXPECT_EQ(d.describe_text().find_first_of("=_"), std::string::npos) << d.describe();
+    }
+    EXPECT_EQ(kinds.size(), 6u); // every Dist1DKind
+    EXPECT_EQ(make_power(0, 1, 2).value.describe_text("x2"),
+              "power-law density proportional to x2^2 on [0, 1]");
+    const Made<TabulatedDistribution2D> table =
+        make_tabulated_2d(0, 1, 0, 2, 4, 3, std::vector<double>(12, 1.0));
+    ASSERT_TRUE(table.ok()) << table.error;
+    EXPECT_EQ(table.value.describe_text(),
+              "piecewise-constant density on a 4 x 3 grid of cells over [0, 1] x [0, 2]");
 }
 
 TEST(Distribution1D, DefaultIsUniformOnUnitInterval) {

@@ -263,6 +263,7 @@ int mcp_study_samples(const char* scene_json, const char* options_json, char** s
              {"replay_is_estimate", kind.replay_is_estimate(spec)},
              {"sampler", mcp::sampler_name(spec.sampler)},
              {"pdf", mcp::describe_sampling(spec)},
+             {"pdf_text", mcp::describe_sampling_text(spec, domain)},
              {"strata", d.strata},
              {"samples_per_stratum", d.per_stratum},
              {"randomization", mcp::is_qmc(spec.sampler)
@@ -287,8 +288,9 @@ int mcp_study_samples(const char* scene_json, const char* options_json, char** s
             const mcp::MisOptions& m = spec.mis_options;
             mcp::Json techniques = mcp::Json::array();
             for (size_t k = 0; k < m.proposals.size(); ++k)
-                techniques.push_back(
-                    {{"pdf", m.proposals[k].describe()}, {"share", m.fractions[k]}});
+                techniques.push_back({{"pdf", m.proposals[k].describe()},
+                                      {"pdf_text", m.proposals[k].describe_text(domain)},
+                                      {"share", m.fractions[k]}});
             e["techniques"] = techniques;
             e["heuristic"] = m.optimal ? "optimal" : mcp::mis_heuristic_name(m.weighting.heuristic);
         }
@@ -381,13 +383,14 @@ int mcp_scene_info(const char* scene_json, char** info_json) {
     if (!req.ok()) return mcp::boundary::request_error(req.error);
     const mcp::Problem& p = req.value.problem;
     mcp::Json names = mcp::Json::array(), more = mcp::Json::array(), details = mcp::Json::array();
-    auto detail = [](const mcp::EstimatorSpec& e) {
+    auto detail = [&p](const mcp::EstimatorSpec& e) {
         return mcp::Json{{"name", e.name},
                          {"kind", mcp::kind_of(e).name},
                          {"summary", mcp::kind_of(e).summary},
                          {"method", mcp::estimator_method(e)},
                          {"sampler", mcp::sampler_name(e.sampler)},
-                         {"pdf", mcp::describe_sampling(e)}};
+                         {"pdf", mcp::describe_sampling(e)},
+                         {"pdf_text", mcp::describe_sampling_text(e, p.domain)}};
     };
     for (const mcp::EstimatorSpec& e : req.value.estimators) {
         names.push_back(e.name);

@@ -61,8 +61,8 @@ int mcp_study_plan(const char* scene_json, const char* options_json, char** plan
  * {"estimators": [names], "n": points (1..4096, default 256), "seed", "grid": 1D curve points
  * (default 256), "adaptive_n": calls of the adaptive estimators' run (1..2^20)}. Result:
  * {"version", "n", "estimators": [{"name", "kind", "method", "replay_is_estimate", "sampler",
- * "pdf", "strata", "samples_per_stratum", "randomization", "randomizations", "u": [per axis],
- * "x": [per axis], "f", "density", "weight"}],
+ * "pdf", "pdf_text" (the density in words), "strata", "samples_per_stratum", "randomization",
+ * "randomizations", "u": [per axis], "x": [per axis], "f", "density", "weight"}],
  * and for 1D box domains "curve": {"x", "f", "pdf": {name: density values}, "mis_weights":
  * {name: [per technique: weights]}}}. The points are those of replicate 0 of a study at N = n,
  * so the mean of "weight" is that replicate's estimate. "replay_is_estimate" (from the
@@ -71,7 +71,7 @@ int mcp_study_plan(const char* scene_json, const char* options_json, char** plan
  * at N = max(n, adaptive_n) ("run_n") and show the first n points of their estimate, with what
  * they learnt: "map_edges" (VEGAS's frozen map, per axis), "map_history" (the map's first two
  * axes before and after each training iteration, at most 65 edges each), "boxes" (MISER's
- * leaves). MIS estimators add "heuristic" and "techniques": [{"pdf", "share"}]. */
+ * leaves). MIS estimators add "heuristic" and "techniques": [{"pdf", "pdf_text", "share"}]. */
 int mcp_study_samples(const char* scene_json, const char* options_json, char** samples_json);
 
 /* Formats a study result as "table" (human), "csv" or "json" (pretty-printed). The result must
@@ -81,7 +81,8 @@ int mcp_result_format(const char* result_json, const char* format, char** text);
 
 /* Validates a scene and summarises it: {"name", "description", "domain", "dimension",
  * "exact", "estimators": [names], "more_estimators": [uniform-density presets it does not list],
- * "estimator_details": [{"name", "kind", "summary" (the kind's), "method", "sampler", "pdf"}],
+ * "estimator_details": [{"name", "kind", "summary" (the kind's), "method", "sampler", "pdf",
+ * "pdf_text" (the density in words)}],
  * settings}. */
 int mcp_scene_info(const char* scene_json, char** info_json);
 

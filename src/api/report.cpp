@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "api/report.h"
+#include "core/special.h"
 #include "estimators/diagnostics.h"
 #include "estimators/registry.h"
 #include "estimators/stopping.h"
@@ -92,8 +93,8 @@ Json level_warning(const Flag& f, const LevelStats& l) {
     case FlagCode::ErrorBarsUnderstate:
         return flag_warning(f, "the " + std::to_string(f.of) + " replicates" + at_n + " spread " +
                                    fmt("%.3g", std::sqrt(f.value)) +
-                                   " times more than their own standard errors say (F test, p = " +
-                                   fmt("%.2g", f.p_value) +
+                                   " times more than their own standard errors say (F test, " +
+                                   p_value_text(f.p_value) +
                                    "): the error bars are too small (too few strata, "
                                    "randomizations or points saw how f varies)");
     case FlagCode::NonfiniteSamples:
@@ -139,21 +140,21 @@ Json level_warning(const Flag& f, const LevelStats& l) {
     case FlagCode::ConservativeErrorBars:
         return flag_warning(f, "conservative error bars" + at_n + ": the " + std::to_string(f.of) +
                                    " replicates spread " + fmt("%.3g", f.value) +
-                                   " times less than their own error bars say (F test, p = " +
-                                   fmt("%.2g", f.p_value) +
+                                   " times less than their own error bars say (F test, " +
+                                   p_value_text(f.p_value) +
                                    "): the intervals cover, and are wider than they need be");
     case FlagCode::ErrorBarsUnstable:
         if (f.severity == Severity::Info)
             return flag_warning(f, "the replicates' own error bars differ by a factor " +
-                                       fmt("%.3g", f.value) + at_n +
-                                       " (Bartlett's test, p = " + fmt("%.2g", f.p_value) +
+                                       fmt("%.3g", f.value) + at_n + " (Bartlett's test, " +
+                                       p_value_text(f.p_value) +
                                        ", which assumes normal data), but their intervals "
                                        "missed " +
                                        replicate_evidence(f) +
                                        ": the error bars vary from run to run and still hold");
         return flag_warning(f, "the replicates' own error bars differ by a factor " +
-                                   fmt("%.3g", f.value) + at_n +
-                                   " (Bartlett's test, p = " + fmt("%.2g", f.p_value) +
+                                   fmt("%.3g", f.value) + at_n + " (Bartlett's test, " +
+                                   p_value_text(f.p_value) +
                                    "): some runs saw a feature (a sliver of a step, a rare peak) "
                                    "that others missed, and those others' error bars are far too "
                                    "small");
@@ -187,8 +188,8 @@ Json level_warning(const Flag& f, const LevelStats& l) {
         return flag_warning(f, "the iterations of the runs disagree beyond their error bars" +
                                    at_n + " (chi2 = " + fmt("%.1f", f.value) + " for " +
                                    std::to_string(f.dof) + " degrees of freedom over " +
-                                   std::to_string(f.of) +
-                                   " replicates, p = " + fmt("%.2g", f.p_value) +
+                                   std::to_string(f.of) + " replicates, " +
+                                   p_value_text(f.p_value) +
                                    "): the weighted average and its error bar are not "
                                    "trustworthy (the map was still changing, or the integrand "
                                    "has a feature the iterations saw differently)");
@@ -272,7 +273,7 @@ Json estimator_warnings(const EstimatorStudy& e, const StudySettings& s) {
                 flag_warning(f, "the means at different N disagree beyond their error bars "
                                 "(chi2 = " +
                                     fmt("%.1f", f.value) + " for " + std::to_string(f.dof) +
-                                    " degrees of freedom, p = " + fmt("%.2g", f.p_value) +
+                                    " degrees of freedom, " + p_value_text(f.p_value) +
                                     "): the error bars understate the error (heavy tails, too "
                                     "few samples, or bias)"));
             break;
@@ -360,18 +361,38 @@ Json level_to_json(const LevelStats& l) {
 }
 
 Json fit_to_json(const ConvergenceFit& f) {
+    Json suffix(nullptr);
+    if (f.suffix) {
+        const PowerLawSegment& s = *f.suffix;
+        suffix = Json{{"order", num(s.order)},
+                      {"order_se", num(s.order_se)},
+                      {"intercept", num(s.intercept)},
+                      {"levels_used", s.levels_used},
+                      {"chi2", num(s.chi2)},
+                      {"dof", s.dof},
+                      {"p_value", num(s.p_value)},
+                      {"n_first", s.n_first},
+                      {"n_last", s.n_last}};
+    }
+    const Json none(nullptr);
     return Json{{"valid", f.valid},
                 {"measure", level_measure_name(f.measure)},
-                {"order", f.valid ? num(f.order) : Json(nullptr)},
-                {"order_se", f.valid ? num(f.order_se) : Json(nullptr)},
-                {"intercept", f.valid ? num(f.intercept) : Json(nullptr)},
+                {"order", f.valid ? num(f.order) : none},
+                {"order_se", f.valid ? num(f.order_se) : none},
+                {"intercept", f.valid ? num(f.intercept) : none},
                 {"levels_used", f.levels_used},
-                {"note", f.note}};
+                {"note", f.note},
+                {"chi2", f.valid ? num(f.chi2) : none},
+                {"dof", f.valid ? Json(f.dof) : none},
+                {"p_value", f.valid ? num(f.p_value) : none},
+                {"n_first", f.valid ? Json(f.n_first) : none},
+                {"n_last", f.valid ? Json(f.n_last) : none},
+                {"suffix", suffix}};
 }
 
 namespace {
 
-Json estimator_header(const EstimatorStudy& e, const StudySettings& s) {
+Json estimator_header(const EstimatorStudy& e, const StudySettings& s, const Domain& domain) {
     return Json{
         {"name", e.spec.name},
         {"kind", kind_of(e.spec).name},
@@ -379,6 +400,7 @@ Json estimator_header(const EstimatorStudy& e, const StudySettings& s) {
         {"sampler", sampler_name(e.spec.sampler)},
         {"samples_per_stratum", e.spec.per_stratum},
         {"pdf", describe_sampling(e.spec)},
+        {"pdf_text", describe_sampling_text(e.spec, domain)},
         {"importance", e.spec.proposal.importance || e.spec.has_techniques()},
         {"randomization",
          is_qmc(e.spec.sampler) ? Json(randomization_name(e.spec.randomization)) : Json(nullptr)},
@@ -437,7 +459,7 @@ Json stopping_to_json(const StoppingStudy& st) {
         EstimatorStudy header;
         header.spec = st.specs[e];
         header.error_method = error_method_for(st.specs[e]);
-        Json j = estimator_header(header, set);
+        Json j = estimator_header(header, set, p.domain);
         Json runs = Json::array();
         std::vector<double> seconds, evaluations;
         int met = 0, within = 0;
@@ -555,7 +577,7 @@ Json study_to_json(const StudyResult& r) {
         {"threads", r.threads_used}};
     Json estimators = Json::array();
     for (const EstimatorStudy& e : r.estimators) {
-        Json j = estimator_header(e, r.settings);
+        Json j = estimator_header(e, r.settings, p.domain);
         Json levels = Json::array();
         for (const LevelStats& l : e.levels) levels.push_back(level_to_json(l));
         j["levels"] = levels;
@@ -576,7 +598,7 @@ Json progress_to_json(const StudyResult& partial, size_t level_index) {
     Json estimators = Json::array();
     uint64_t n = 0;
     for (const EstimatorStudy& e : partial.estimators) {
-        Json j = estimator_header(e, partial.settings);
+        Json j = estimator_header(e, partial.settings, partial.problem.domain);
         if (level_index < e.levels.size()) {
             j["level"] = level_to_json(e.levels[level_index]);
             n = e.levels[level_index].n;

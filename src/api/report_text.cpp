@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "api/report.h"
+#include "core/special.h"
 
 namespace mcp {
 
@@ -51,6 +52,14 @@ std::string jstr(const Json& j, const char* key) {
 bool jbool(const Json& j, const char* key) {
     const Json& v = get(j, key);
     return v.is_boolean() && v.get<bool>();
+}
+
+// After a fitted order: " (not a power law: chi^2 p = 3e-12)" when the fit's goodness of fit
+// rejects a straight line in log-log (p_value below kPowerLawP), else "".
+std::string power_law_note(const Json& fit) {
+    const double p = jnum(fit, "p_value");
+    if (!jbool(fit, "valid") || !(p < kPowerLawP)) return "";
+    return " (not a power law: chi^2 " + p_value_text(p) + ")";
 }
 
 } // namespace
@@ -141,7 +150,7 @@ std::string format_render_table(const Json& r) {
         const Json& fit = get(e, "fit");
         if (jbool(fit, "valid"))
             out << "  fitted order: relative MSE ~ spp^(" << fmt("%.3f", jnum(fit, "order"))
-                << " +/- " << fmt("%.3f", jnum(fit, "order_se")) << ")";
+                << " +/- " << fmt("%.3f", jnum(fit, "order_se")) << ")" << power_law_note(fit);
         else
             out << "  fitted order: none";
         if (!jstr(fit, "note").empty()) out << " (" << jstr(fit, "note") << ")";
@@ -289,14 +298,14 @@ std::string format_table(const Json& r) {
         const Json& fit = get(e, "fit");
         if (jbool(fit, "valid"))
             out << "  fitted order: variance ~ N^(" << fmt("%.3f", jnum(fit, "order")) << " +/- "
-                << fmt("%.3f", jnum(fit, "order_se")) << ")";
+                << fmt("%.3f", jnum(fit, "order_se")) << ")" << power_law_note(fit);
         else
             out << "  fitted order: none";
         if (!jstr(fit, "note").empty()) out << " (" << jstr(fit, "note") << ")";
         const Json& mse_fit = get(e, "mse_fit");
         if (jbool(mse_fit, "valid"))
             out << "; MSE ~ N^(" << fmt("%.3f", jnum(mse_fit, "order")) << " +/- "
-                << fmt("%.3f", jnum(mse_fit, "order_se")) << ")";
+                << fmt("%.3f", jnum(mse_fit, "order_se")) << ")" << power_law_note(mse_fit);
         out << "\n";
         for (const Json& w : level_shown) shown.push_back(w);
         print_warnings(out, shown);

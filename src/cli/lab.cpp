@@ -17,6 +17,7 @@
 #include "api/files.h"
 #include "api/mcplay.h"
 #include "cli/cli_support.h"
+#include "core/special.h"
 #include "render_api/mcplay_render.h"
 
 namespace mcp::cli {
@@ -158,7 +159,8 @@ std::string warp_table(const nlohmann::json& r) {
            num_or_dash(r["pdf_integral_error"], "%.2g") + ")\n";
     out += "chi-square " + num_or_dash(r["statistic"]) + " on " + r["dof"].dump() +
            " degrees of freedom (" + r["cells"].dump() + " cells; " + r["pooled_bins"].dump() +
-           " bins with fewer than 5 expected pooled), p = " + num_or_dash(r["p_value"], "%.4g") +
+           " bins with fewer than 5 expected pooled), " +
+           (r["p_value"].is_number() ? p_value_text(r["p_value"].get<double>(), 4) : "p = -") +
            ", level " + num_or_dash(r["level"], "%.4g") + "\n";
     out += "verdict: " + r["verdict"].get<std::string>() + "\n";
     const auto& worst = r["worst_bins"];

@@ -548,6 +548,59 @@ std::string Distribution1D::describe() const {
     return "uniform" + on;
 }
 
+namespace {
+
+// "x", "(x - 0.5)" or "(x + 1)": the variable measured from x0 (without the parentheses when
+// nothing multiplies it).
+std::string shifted_text(const std::string& x, double x0, bool parentheses = true) {
+    if (x0 == 0.0) return x;
+    const std::string d = x + (x0 > 0.0 ? " - " + num(x0) : " + " + num(-x0));
+    return parentheses ? "(" + d + ")" : d;
+}
+
+// "x", "-x", "0.8 x": c times the variable.
+std::string scaled_text(double c, const std::string& x) {
+    if (c == 1.0) return x;
+    if (c == -1.0) return "-" + x;
+    return num(c) + " " + x;
+}
+
+} // namespace
+
+std::string shortest_number_text(double v) {
+    return num(v);
+}
+
+std::string Distribution1D::describe_text(const std::string& x) const {
+    const std::string on = " on " + interval_text(a_, b_);
+    switch (kind_) {
+    case Dist1DKind::Power: {
+        if (p0_ == 0.0) return "uniform" + on;
+        const std::string base = shifted_text(x, a_);
+        const std::string power =
+            p0_ == 1.0 ? base : base + "^" + (p0_ < 0.0 ? "(" + num(p0_) + ")" : num(p0_));
+        return "power-law density proportional to " + power + on;
+    }
+    case Dist1DKind::Exponential: {
+        // p proportional to exp(-rate x).
+        const std::string arg = scaled_text(-p0_, x);
+        return "exponential density proportional to e^" + (arg == x ? arg : "(" + arg + ")") + on;
+    }
+    case Dist1DKind::TruncatedGaussian:
+        return "normal density of mean " + num(p0_) + " and standard deviation " + num(p1_) +
+               ", cut to " + interval_text(a_, b_);
+    case Dist1DKind::Cosine:
+        return "cosine density proportional to cos(" +
+               (p0_ == 1.0 ? shifted_text(x, p1_, false) : scaled_text(p0_, shifted_text(x, p1_))) +
+               ")" + on;
+    case Dist1DKind::Tabulated:
+        return "piecewise-constant density on " + std::to_string(func_.size()) + " equal bin" +
+               (func_.size() == 1 ? "" : "s") + " of " + interval_text(a_, b_);
+    case Dist1DKind::Uniform: break;
+    }
+    return "uniform" + on;
+}
+
 // --- Factories ---------------------------------------------------------------------------
 
 Made<Distribution1D> make_uniform(double a, double b) {
@@ -709,6 +762,11 @@ Made<Distribution1D> make_tabulated(double a, double b, const std::vector<double
 // --- TabulatedDistribution2D ------------------------------------------------------------
 // u2 drives the marginal in y (the row), u1 the conditional in x within that row, so
 // sample(u1, u2) keeps u1 <-> x and u2 <-> y, and invert returns u1 = F(x | row), u2 = F_y(y).
+
+std::string TabulatedDistribution2D::describe_text() const {
+    return "piecewise-constant density on a " + std::to_string(nx_) + " x " + std::to_string(ny_) +
+           " grid of cells over " + interval_text(x0_, x1_) + " x " + interval_text(y0_, y1_);
+}
 
 void TabulatedDistribution2D::sample(double u1, double u2, double* x, double* y,
                                      double* pdf_out) const {

@@ -48,6 +48,10 @@ class Distribution1D {
 
     /// A short description, e.g. "power(k=1) on [0, 1]".
     std::string describe() const;
+    /// The same in words for people, with `x` the variable's name, e.g. "power-law density
+    /// proportional to x on [0, 1]" or "exponential density proportional to e^(0.8 x) on
+    /// [0, 1]" (rate -0.8): no parameter names, no "=" and no "_".
+    std::string describe_text(const std::string& x = "x") const;
 
   private:
     friend struct Distribution1DFactory;
@@ -59,6 +63,9 @@ class Distribution1D {
     std::vector<double> cdf_;     // tabulated: cdf at bin edges, cdf_[0] = 0, back() = 1
     std::vector<uint32_t> guide_; // tabulated: the bin of u = g / bins, g < bins
 };
+
+/// The shortest "%g" text that reads back as the same double ("0.5", "1e-08").
+std::string shortest_number_text(double v);
 
 Made<Distribution1D> make_uniform(double a, double b);
 Made<Distribution1D> make_power(double a, double b, double k);
@@ -81,6 +88,9 @@ class TabulatedDistribution2D {
     void invert(double x, double y, double* u1, double* u2) const;
     void sample_block(const double* u1, const double* u2, double* x, double* y, double* pdf,
                       size_t n) const;
+
+    /// In words: "piecewise-constant density on a 16 x 16 grid of cells over [0, 1] x [0, 1]".
+    std::string describe_text() const;
 
     int nx() const { return nx_; }
     int ny() const { return ny_; }

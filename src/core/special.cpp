@@ -1,6 +1,7 @@
 #include "core/special.h"
 
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
 namespace mcp {
@@ -200,6 +201,14 @@ double f_sf(double f, double d1, double d2) {
     if (!(f > 0.0)) return 1.0;
     if (std::isinf(f)) return 0.0;
     return beta_regularized(0.5 * d2, 0.5 * d1, d2 / (d2 + d1 * f));
+}
+
+std::string p_value_text(double p, int digits) {
+    if (std::isnan(p)) return "p = -";
+    if (p < 1e-300) return "p < 1e-300";
+    char buf[48];
+    std::snprintf(buf, sizeof buf, "p = %.*g", digits, p);
+    return buf;
 }
 
 } // namespace mcp

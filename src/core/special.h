@@ -3,6 +3,8 @@
 // and the trigamma function (the variance of a log sample variance).
 #pragma once
 
+#include <string>
+
 namespace mcp {
 
 constexpr double kPi = 3.14159265358979323846;
@@ -49,5 +51,11 @@ double f_sf(double f, double d1, double d2);
 /// Trigamma psi'(x) for x > 0 (recurrence up to x >= 10, then the asymptotic series).
 /// Var[log s^2] = psi'((R - 1) / 2) for a sample variance of R normal values.
 double trigamma(double x);
+
+/// A p-value for a sentence: "p = 3.1e-05" (`digits` significant digits), and "p < 1e-300"
+/// below 1e-300, where a tail probability that underflowed to 0 would print as "p = 0" (a
+/// p-value is never 0); "p = -" when it is not a number. Every message that states a p-value
+/// formats it here.
+std::string p_value_text(double p, int digits = 2);
 
 } // namespace mcp

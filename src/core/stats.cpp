@@ -131,6 +131,7 @@ LineFit fit_weighted_line(const std::vector<double>& x, const std::vector<double
         const double r = (y[i] - (fit.intercept + fit.slope * x[i])) / sd[i];
         chi2 += r * r;
     }
+    fit.chi2 = chi2;
     fit.residual_variance = n > 2 ? chi2 / static_cast<double>(n - 2) : 0.0;
     fit.slope_se = std::sqrt(std::max(1.0, fit.residual_variance) / sxx);
     return fit;

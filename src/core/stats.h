@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 namespace mcp {
@@ -133,6 +134,10 @@ struct LineFit {
     double residual_variance = 0.0;
     double sxx = 0.0; ///< sum (x - mean x)^2
     int points = 0;
+    /// Weighted fits: the sum of the squared residuals over their standard deviations,
+    /// chi-square with points - 2 degrees of freedom when the line and the deviations are right;
+    /// NaN for unit weights (no deviations to measure the residuals by).
+    double chi2 = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// Fits a line through (x[i], y[i]); needs at least two distinct x.
@@ -140,9 +145,9 @@ LineFit fit_line(const std::vector<double>& x, const std::vector<double>& y);
 
 /// Weighted least squares through (x[i], y[i]) where y[i] has standard deviation sd[i] > 0
 /// (weights 1 / sd^2). slope_se is the slope's standard error from those deviations, inflated
-/// by sqrt(chi^2 / dof) when the residuals exceed them; residual_variance is chi^2 / dof and
-/// sxx the weighted sum of squares. With sd empty, or any sd not positive and finite, it is
-/// fit_line (unit weights, slope_se from the residuals alone).
+/// by sqrt(chi^2 / dof) when the residuals exceed them; residual_variance is chi^2 / dof, chi2
+/// the chi^2 itself, and sxx the weighted sum of squares. With sd empty, or any sd not positive and
+/// finite, it is fit_line (unit weights, slope_se from the residuals alone).
 LineFit fit_weighted_line(const std::vector<double>& x, const std::vector<double>& y,
                           const std::vector<double>& sd);
 

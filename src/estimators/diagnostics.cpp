@@ -360,7 +360,11 @@ std::vector<Flag> level_flags(const LevelStats& l) {
 
 std::vector<Flag> tail_flags(const LevelStats& deepest, bool bounded) {
     std::vector<Flag> flags;
-    if (!std::isfinite(deepest.tail_index) || deepest.tail_k <= 0 || deepest.exact_to_roundoff)
+    // A tail index of exactly 0 is Hill's answer when fewer than k + 1 weights are non-zero
+    // (hill_tail_index): points that never saw f have no tail to measure, and the level's own
+    // flags (exact_outside_ci, low_ess, zero_error_bar, ...) say what is wrong.
+    if (!std::isfinite(deepest.tail_index) || deepest.tail_k <= 0 || deepest.exact_to_roundoff ||
+        deepest.tail_index == 0.0)
         return flags;
     const double alpha = deepest.tail_index;
     const double se = alpha / std::sqrt(static_cast<double>(deepest.tail_k));
@@ -375,6 +379,18 @@ std::vector<Flag> tail_flags(const LevelStats& deepest, bool bounded) {
     if (bounded) f.severity = Severity::Info;
     flags.push_back(f);
     return flags;
+}
+
+bool known_bias_source(const EstimatorStudy& e) {
+    const SupportCheck& sc = e.support;
+    // flagged: a missed mass beyond kSupportTolerance of the integral of |f|; a mass that is not
+    // finite (|f| not integrable where p = 0) is missed too; so is any probe that found f != 0
+    // where p = 0.
+    const bool missed_mass = sc.method == "quadrature" && !std::isfinite(sc.missed_mass);
+    if (sc.flagged || sc.missed > 0 || missed_mass) return true;
+    for (const LevelStats& l : e.levels)
+        if (l.diagnostics.zero_pdf > 0 || l.diagnostics.nonfinite > 0) return true;
+    return false;
 }
 
 std::vector<Flag> estimator_flags(const EstimatorStudy& e, const StudySettings& settings) {
@@ -407,7 +423,14 @@ std::vector<Flag> estimator_flags(const EstimatorStudy& e, const StudySettings& 
         if (!dominated) break;
         --first;
     }
-    if (first < e.levels.size()) {
+    // Under an infinite variance (heavy_tail as a warning) the replicates' mean of an unbiased
+    // estimator falls short of the integral too: the rare huge weights that make up the rest
+    // are missed by most runs. Without a known source of bias (mass the pdf misses, dropped
+    // samples) that shortfall is the heavy tail's, which heavy_tail reports: no bias_dominates.
+    const bool infinite_variance = std::any_of(flags.begin(), flags.end(), [](const Flag& f) {
+        return f.code == FlagCode::HeavyTail && f.severity == Severity::Warning;
+    });
+    if (first < e.levels.size() && !(infinite_variance && !known_bias_source(e))) {
         const LevelStats& deepest = e.levels.back();
         Flag f(FlagCode::BiasDominates);
         f.n = e.levels[first].n;

@@ -131,13 +131,22 @@ std::vector<Flag> level_flags(const LevelStats& level);
 /// reaches furthest into the tail): heavy_tail when alpha = 2 is within two standard errors
 /// (alpha / sqrt(k)) or above alpha, heavy_tail_4 when alpha < 4 [Hill75]. With `bounded`
 /// weights (every moment finite) heavy_tail is info: a pre-asymptotic tail, whose effect on the
-/// error bars skewed_weights judges, with the N from which they hold.
+/// error bars skewed_weights judges, with the N from which they hold. Nothing when alpha is 0:
+/// fewer than k + 1 weights are non-zero (points that never saw f), and the tail is undefined.
 std::vector<Flag> tail_flags(const LevelStats& deepest, bool bounded = false);
+
+/// Whether the estimator has a known source of bias: the support check found mass the pdf
+/// misses (pdf_support, a probe with f != 0 where p = 0, or a missed mass by quadrature that is
+/// not finite), or some level dropped samples (f != 0 where p = 0, or f/p not finite).
+bool known_bias_source(const EstimatorStudy& e);
 
 /// The flags of an estimator over the whole study: the tail index at the deepest level, the
 /// support check, the consistency of the level means (p < 1e-3), float32 accumulation, and
 /// with an exact value a bias that dominates the MSE from some N to the largest (bias^2 above
 /// the variance of one estimate and |bias| beyond 3 of its standard errors at every such N).
+/// bias_dominates is not raised under an infinite variance (heavy_tail as a warning) without a
+/// known source of bias (known_bias_source): the mean of an unbiased estimator with infinite
+/// variance falls short of the integral in most studies, which is the heavy tail's doing.
 std::vector<Flag> estimator_flags(const EstimatorStudy& e, const StudySettings& settings);
 
 } // namespace mcp

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "core/special.h"
+#include "estimators/estimator_kind.h"
 #include "estimators/named_warps.h"
 
 namespace mcp {
@@ -167,6 +168,106 @@ std::string Proposal::describe() const {
     case ProposalKind::Warp: return "warp '" + (warp ? warp->name : std::string("?")) + "'";
     }
     return "?";
+}
+
+namespace {
+
+std::string point_text(Vec2 p) {
+    return "(" + shortest_number_text(p.x) + ", " + shortest_number_text(p.y) + ")";
+}
+
+std::string interval_words(double a, double b) {
+    return "[" + shortest_number_text(a) + ", " + shortest_number_text(b) + "]";
+}
+
+// A domain in words: "[0, 1]^2", "[0, 1] x [0, 2]", "the disk of radius 1 centred at (0, 0)".
+std::string domain_words(const Domain& d) {
+    switch (d.kind) {
+    case DomainKind::Box: {
+        bool cube = d.lo.size() > 1;
+        for (size_t j = 1; cube && j < d.lo.size(); ++j)
+            cube = d.lo[j] == d.lo[0] && d.hi[j] == d.hi[0];
+        if (cube) return interval_words(d.lo[0], d.hi[0]) + "^" + std::to_string(d.lo.size());
+        std::string s;
+        for (size_t j = 0; j < d.lo.size(); ++j)
+            s += (j ? " x " : "") + interval_words(d.lo[j], d.hi[j]);
+        return s;
+    }
+    case DomainKind::Disk:
+        return "the disk of radius " + shortest_number_text(d.radius) + " centred at " +
+               point_text(d.center);
+    case DomainKind::Triangle:
+        return "the triangle with corners " + point_text(d.v0) + ", " + point_text(d.v1) + ", " +
+               point_text(d.v2);
+    case DomainKind::Sphere: return "the sphere of directions";
+    case DomainKind::Hemisphere: return "the upper hemisphere of directions";
+    }
+    return "the domain";
+}
+
+// A named warp's density in words (named_warp_infos); another name with its underscores as
+// spaces.
+std::string warp_words(const Warp* warp, const Domain& d) {
+    const std::string name = warp ? warp->name : std::string();
+    const std::string on = domain_words(d);
+    if (name == "uniform" || name == "uniform_sphere" || name == "uniform_hemisphere" ||
+        name == "triangle")
+        return "uniform on " + on;
+    if (name == "polar_disk") return "uniform on " + on + ", by the polar map";
+    if (name == "concentric_disk") return "uniform on " + on + ", by the concentric map";
+    if (name == "cosine_hemisphere")
+        return "cosine-weighted density cos(theta) / pi on the upper hemisphere of directions";
+    if (name == "tabulated_1d" || name == "tabulated_2d")
+        return "piecewise-constant density from a table on " + on;
+    if (name == "ggx_visible_normals")
+        return "density of the GGX microfacet normals visible from a direction of view";
+    if (name == "spherical_triangle") return "uniform over the solid angle of a triangle";
+    if (name == "expression") return "the density of a warp given by expressions, on " + on;
+    std::string words = name.empty() ? std::string("a warp") : "the warp " + name;
+    std::replace(words.begin(), words.end(), '_', ' ');
+    return words + "'s density on " + on;
+}
+
+} // namespace
+
+std::string Proposal::describe_text(const Domain& domain) const {
+    switch (kind) {
+    case ProposalKind::UniformBox:
+    case ProposalKind::Triangle:
+    case ProposalKind::Sphere:
+    case ProposalKind::Hemisphere: return "uniform on " + domain_words(domain);
+    case ProposalKind::DiskPolar:
+        return "uniform on " + domain_words(domain) + ", by the polar map";
+    case ProposalKind::DiskConcentric:
+        return "uniform on " + domain_words(domain) + ", by the concentric map";
+    case ProposalKind::CosineHemisphere:
+        return "cosine-weighted density cos(theta) / pi on the upper hemisphere of directions";
+    case ProposalKind::Product1D: {
+        if (marginals.size() == 1) return marginals[0].describe_text("x");
+        bool uniform = true;
+        for (const Distribution1D& m : marginals)
+            uniform = uniform && m.kind() == Dist1DKind::Uniform;
+        if (uniform) {
+            Domain box;
+            box.lo.clear();
+            box.hi.clear();
+            for (const Distribution1D& m : marginals) {
+                box.lo.push_back(m.lower());
+                box.hi.push_back(m.upper());
+            }
+            return "uniform on " + domain_words(box);
+        }
+        std::string s = "a product of one density per axis: ";
+        for (size_t j = 0; j < marginals.size(); ++j) {
+            const std::string x = "x" + std::to_string(j + 1);
+            s += (j ? "; " : "") + x + ": " + marginals[j].describe_text(x);
+        }
+        return s;
+    }
+    case ProposalKind::Tabulated2D: return table.describe_text();
+    case ProposalKind::Warp: return warp_words(warp.get(), warp_domain);
+    }
+    return "a density on " + domain_words(domain);
 }
 
 Proposal uniform_proposal(const Domain& domain, bool disk_polar) {
@@ -412,6 +513,32 @@ void sampling_density_block(const EstimatorSpec& spec, const Domain& domain, con
         proposal_pdf_block(m.proposals[k], domain, x, one.data());
         for (size_t i = 0; i < x.n; ++i) pdf[i] += m.fractions[k] * one[i];
     }
+}
+
+std::string describe_sampling_text(const EstimatorSpec& spec, const Domain& domain) {
+    std::string s;
+    if (!spec.has_techniques()) {
+        s = spec.proposal.describe_text(domain);
+    } else {
+        const MisOptions& m = spec.mis_options;
+        s = "a mixture of " + std::to_string(m.proposals.size()) +
+            " densities (multiple importance sampling, " +
+            (m.optimal ? std::string("optimal weights")
+                       : std::string(mis_heuristic_name(m.weighting.heuristic)) + " heuristic") +
+            (m.one_sample ? ", each point from one density drawn at random" : "") + "): ";
+        for (size_t k = 0; k < m.proposals.size(); ++k) {
+            char share[32];
+            std::snprintf(share, sizeof share, "%.3g%% from (", 100.0 * m.fractions[k]);
+            s += (k ? "; " : "") + std::string(share) + m.proposals[k].describe_text(domain) + ")";
+        }
+    }
+    // The adaptive kinds reshape it during a run.
+    const std::string kind = spec.kind ? spec.kind->name : "";
+    if (kind == "vegas" || kind == "vegas_plus")
+        s += ", reshaped by the VEGAS map the run learns";
+    else if (kind == "miser")
+        s += ", within the boxes MISER's recursive bisection makes";
+    return s;
 }
 
 std::string describe_sampling(const EstimatorSpec& spec) {

@@ -91,6 +91,9 @@ struct Proposal {
     Domain warp_domain;                    ///< Warp: the domain it maps onto
     bool importance = false;               ///< true for a non-uniform density
     std::string describe() const;
+    /// In words for people, on `domain` (the one the proposal samples): "uniform on [0, 1]^2",
+    /// "power-law density proportional to x on [0, 1]"; no "=" and no "_".
+    std::string describe_text(const Domain& domain) const;
 };
 
 /// The uniform proposal of a domain; for disks, concentric unless polar is asked for.
@@ -195,5 +198,8 @@ void sampling_density_block(const EstimatorSpec& spec, const Domain& domain, con
 
 /// The density as a report names it: the proposal's, or "mis(balance: a 0.5, b 0.5)".
 std::string describe_sampling(const EstimatorSpec& spec);
+/// The same in words (results' "pdf_text"): Proposal::describe_text, a mixture's shares and
+/// heuristic, and for the adaptive kinds what reshapes the density during a run.
+std::string describe_sampling_text(const EstimatorSpec& spec, const Domain& domain);
 
 } // namespace mcp

@@ -582,23 +582,64 @@ const char* level_measure_name(LevelMeasure m) {
     return "variance";
 }
 
+namespace {
+
+// The weighted line through points[first..] and its chi-square; levels_used 0 when the line
+// cannot be drawn (fewer than 3 points, or one N).
+PowerLawSegment fit_segment(const std::vector<FitPoint>& points, size_t first) {
+    PowerLawSegment seg;
+    if (points.size() < first + 3) return seg;
+    std::vector<double> x, y, sd;
+    uint64_t lo = points[first].n, hi = points[first].n;
+    for (size_t i = first; i < points.size(); ++i) {
+        const FitPoint& p = points[i];
+        x.push_back(std::log(static_cast<double>(p.n)));
+        y.push_back(std::log(p.value));
+        sd.push_back(p.sd_log);
+        lo = std::min(lo, p.n);
+        hi = std::max(hi, p.n);
+    }
+    const LineFit line = fit_weighted_line(x, y, sd);
+    if (!(line.sxx > 0.0)) return seg;
+    seg.order = line.slope;
+    seg.intercept = line.intercept;
+    seg.order_se = line.slope_se;
+    seg.levels_used = static_cast<int>(x.size());
+    seg.dof = seg.levels_used - 2;
+    seg.chi2 = line.chi2; // NaN for unit weights
+    seg.p_value = std::isfinite(seg.chi2) ? chi_square_sf(seg.chi2, seg.dof) : seg.chi2;
+    seg.n_first = lo;
+    seg.n_last = hi;
+    return seg;
+}
+
+} // namespace
+
 ConvergenceFit fit_power_law(const std::vector<FitPoint>& points, LevelMeasure measure) {
     ConvergenceFit fit;
     fit.measure = measure;
     fit.levels_used = static_cast<int>(points.size());
-    if (points.size() < 3) return fit;
-    std::vector<double> x, y, sd;
-    for (const FitPoint& p : points) {
-        x.push_back(std::log(static_cast<double>(p.n)));
-        y.push_back(std::log(p.value));
-        sd.push_back(p.sd_log);
-    }
-    const LineFit line = fit_weighted_line(x, y, sd);
-    if (!(line.sxx > 0.0)) return fit;
+    const PowerLawSegment all = fit_segment(points, 0);
+    if (all.levels_used == 0) return fit;
     fit.valid = true;
-    fit.order = line.slope;
-    fit.intercept = line.intercept;
-    fit.order_se = line.slope_se;
+    fit.order = all.order;
+    fit.intercept = all.intercept;
+    fit.order_se = all.order_se;
+    fit.chi2 = all.chi2;
+    fit.dof = all.dof;
+    fit.p_value = all.p_value;
+    fit.n_first = all.n_first;
+    fit.n_last = all.n_last;
+    // Not one power law: the longest tail of the ladder that is one (a pre-asymptotic start,
+    // a map still learning), if any.
+    if (all.p_value < kPowerLawP)
+        for (size_t first = 1; first + kSuffixLevels <= points.size(); ++first) {
+            const PowerLawSegment tail = fit_segment(points, first);
+            if (tail.levels_used > 0 && tail.p_value >= kSuffixP) {
+                fit.suffix = tail;
+                break;
+            }
+        }
     return fit;
 }
 

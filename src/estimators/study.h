@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <functional>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -133,6 +134,29 @@ struct LevelStats {
     std::vector<int> run_dofs; ///< per replicate: the degrees of freedom of its error bar
 };
 
+/// A power law fitted over a run of levels, and how well it fits: chi2 is the sum of the
+/// squared residuals of log value over their sd_log, chi-square with dof = levels - 2 degrees
+/// of freedom when the levels follow a power law with the noise sd_log says; p_value is its
+/// upper tail (NaN, like chi2, when some level's sd_log is unknown). n_first and n_last are
+/// the smallest and largest N of the levels used.
+struct PowerLawSegment {
+    double order = 0.0;    ///< slope of log value against log N
+    double order_se = 0.0; ///< its standard error (inflated by the residuals, as in the fit)
+    double intercept = 0.0;
+    int levels_used = 0;
+    double chi2 = std::numeric_limits<double>::quiet_NaN();
+    int dof = 0;
+    double p_value = std::numeric_limits<double>::quiet_NaN();
+    uint64_t n_first = 0, n_last = 0;
+};
+
+/// Goodness of fit of the whole range: below this p-value the levels do not follow one power
+/// law (the CLI says "not a power law"), and a suffix that does is looked for.
+constexpr double kPowerLawP = 1e-3;
+/// A suffix of the levels passes from this p-value on, with at least kSuffixLevels levels.
+constexpr double kSuffixP = 0.01;
+constexpr int kSuffixLevels = 4;
+
 struct ConvergenceFit {
     bool valid = false;
     LevelMeasure measure = LevelMeasure::Variance; ///< what was fitted against N
@@ -141,6 +165,15 @@ struct ConvergenceFit {
     double intercept = 0.0;
     int levels_used = 0;
     std::string note; ///< why the fit is missing or partial
+    /// The goodness of fit over the levels used (PowerLawSegment), when valid.
+    double chi2 = std::numeric_limits<double>::quiet_NaN();
+    int dof = 0;
+    double p_value = std::numeric_limits<double>::quiet_NaN();
+    uint64_t n_first = 0, n_last = 0;
+    /// When the whole range fails (p_value < kPowerLawP): the longest run of at least
+    /// kSuffixLevels levels ending at the largest N whose own fit has p_value >= kSuffixP.
+    /// Empty when the whole range passes, its p-value is unknown, or no such run exists.
+    std::optional<PowerLawSegment> suffix;
 };
 
 /// One level in a convergence fit: value (> 0) at n, and the standard deviation of log value
@@ -155,6 +188,8 @@ struct FitPoint {
 /// least squares of log value on log n (weights 1 / sd_log^2; the slope's standard error from
 /// them, inflated by the residuals when they exceed them; unit weights and the residuals alone
 /// when an sd_log is unknown). Needs 3 points at 2 distinct n; levels_used = points.size().
+/// With every sd_log known it also gives the chi-square goodness of fit (PowerLawSegment) and,
+/// when that rejects a power law over the whole range, the suffix that follows one.
 ConvergenceFit fit_power_law(const std::vector<FitPoint>& points, LevelMeasure measure);
 
 /// Least-squares fit of log variance against log N over the levels with a positive finite

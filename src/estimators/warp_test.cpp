@@ -720,7 +720,7 @@ Made<WarpTestResult> run_warp_test(const Domain& domain, const Warp& warp,
     for (size_t s = 0; s < shown; ++s) r.worst.push_back(describe_bin(r, order[s]));
 
     const std::string stat = "chi-square " + fmt(r.chi_square, 6) + " on " + std::to_string(r.dof) +
-                             " degrees of freedom, p-value " + fmt(r.p_value, 3);
+                             " degrees of freedom, " + p_value_text(r.p_value, 3);
     const std::string integral = "the pdf integrates to " + fmt(r.pdf_integral, 7) + " (+- " +
                                  fmt(r.pdf_integral_error, 2) + ")";
     if (r.zero_bins_hit > 0) {
