@@ -122,7 +122,7 @@ export function explainEstimator(detail, dimension = null) {
       formula: 'I_N = (1/N) Σ f(xᵢ)/p(xᵢ)',
       order: ORDER_UNKNOWN,
       look: detail && typeof detail.summary === 'string' ? detail.summary : '',
-      density: detail && detail.pdf ? detail.pdf : '',
+      density: detail && (detail.pdf_text || detail.pdf) ? detail.pdf_text || detail.pdf : '',
     };
   }
   return {
@@ -130,6 +130,6 @@ export function explainEstimator(detail, dimension = null) {
     formula: m.formula,
     order: m.order(dimension),
     look: m.look,
-    density: detail.pdf || '',
+    density: detail.pdf_text || detail.pdf || '',
   };
 }

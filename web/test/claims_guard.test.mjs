@@ -23,7 +23,7 @@ const FORBIDDEN = [
   [/exact_to_roundoff/, 'exactness: use levelExactness / recordExactness'],
   [/by design/, 'a fixed "by design" label: conservativeClaim says it only where the run shows it'],
   [/,\s*w\.code\s*\)/, 'a flag code as text: use flagShort / flagTitle (the code goes in data-code or a <code> detail)'],
-  [/\$\{\s*r\.pdf\s*\}/, 'the core\'s pdf notation as words: use densityWords'],
+  [/\$\{\s*\w+\.pdf\s*\}/, 'the core\'s pdf notation as words: use densityWords'],
   [/tail index[^'`]*\$\{\s*fmt\(/, 'a raw Hill number: use tailWords'],
   [/p = \$\{\s*fmt\(/, 'a p-value that can print "p = 0": use pWords'],
 ];

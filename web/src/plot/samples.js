@@ -6,6 +6,7 @@
 // charts of weights.js from the same points.
 import { replayIsEstimator, domainView, mapFor, mappedGrid } from '../series.js';
 import { el } from '../dom.js';
+import { densityWords } from '../claims.js';
 import { dom, empty } from './chart.js';
 import { sceneColor, swatch } from './legend.js';
 import { PANEL, panel, dots, strataLines, mapLines, boxOutlines, strataText, runningPanel, firstRandomizationSize, sobolNetCells } from './sample_panels.js';
@@ -224,7 +225,7 @@ function renderScatter(state, data) {
       px.ctx.restore();
       px.frame();
     }
-    const facts = `${e.sampler}; p: ${e.pdf}; ${strataText(full, d)}`;
+    const facts = `${e.sampler}; p: ${densityWords(e)}; ${strataText(full, d)}`;
     // what the two panels show of a randomized QMC set, said where the points are
     const setCap = oneSet !== null
       ? `randomization 1 of ${full.randomizations}: its ${drawn} points (the run of N = ${total} averages ${full.randomizations} such sets)`

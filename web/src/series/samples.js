@@ -78,7 +78,7 @@ export function misWeightCurves(samples, order) {
     const techniques = (byName[name] && byName[name].techniques) || [];
     rows.forEach((y, k) => {
       const t = techniques[k];
-      const label = t ? `${t.pdf} (${fmt(t.share, 2)})` : `technique ${k + 1}`;
+      const label = t ? `${t.pdf_text || t.pdf} (${fmt(t.share, 2)})` : `technique ${k + 1}`;
       out.push({ name, k, label, y: y.map((v) => (Number.isFinite(v) ? v : null)) });
     });
   }
