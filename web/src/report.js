@@ -85,7 +85,7 @@ export function renderReport(state, dom) {
   // smallest N, or isolated among many levels checked, is counted apart and does not turn it red),
   // who has them, and a link down to them.
   if (dom.summary) {
-    const alarm = alarmSummary(run.records, run.order, { ladder: run.ladder, nName: run.kind === 'render' ? 'spp' : 'N' });
+    const alarm = alarmSummary(run.records, run.order, { nName: run.kind === 'render' ? 'spp' : 'N' });
     const parts = [];
     alarm.parts.forEach((p, i) => {
       if (i) parts.push('; ');

@@ -1,22 +1,24 @@
 // The banner above the plots: how many errors and warnings the run has, told apart by whether
 // they persist. A flag raised at the largest N an estimator reached, or at half its levels or
-// more, describes the estimator; one raised only at the smallest N of the ladder, or at a few
+// more, describes the estimator; one raised only in the lower half of its levels (small N), or at a few
 // scattered levels among many checked (a test at p < 1e-3 repeated over every level fires now
 // and then by chance), is listed below but does not turn the banner red.
 // Pure (no DOM): web/test/claims.test.mjs runs it under Node.
 import { collectWarnings } from '../series/text.js';
 
-/** Level flags raised only at N at or below the second rung of the ladder are "small N". */
-const SMALL_N_RUNGS = 2;
-
-/** Classifies each collected warning: 'persistent', 'small_n' or 'isolated'. */
-export function flagPersistence(w, record, ladder) {
+/**
+ * Classifies each collected warning: 'persistent' (estimator-level, raised at the largest N the
+ * estimator reached, or at half its levels or more), 'small_n' (every N it was raised at lies in
+ * the lower half of the estimator's levels: the start of the ladder, where few points see little
+ * of f) or 'isolated' (a few scattered levels above that).
+ */
+export function flagPersistence(w, record) {
   if (w.scope !== 'level') return 'persistent';
   const ns = (record.levels || []).map((l) => l.n);
   const largest = ns.length ? ns[ns.length - 1] : null;
   if (w.n.includes(largest) || w.n.length * 2 >= ns.length) return 'persistent';
-  const small = (ladder && ladder.length ? ladder : ns).slice(0, SMALL_N_RUNGS);
-  if (w.n.every((n) => small.includes(n))) return 'small_n';
+  const lowerHalf = ns.slice(0, Math.floor(ns.length / 2));
+  if (w.n.every((n) => lowerHalf.includes(n))) return 'small_n';
   return 'isolated';
 }
 
@@ -24,13 +26,13 @@ export function flagPersistence(w, record, ladder) {
  * The banner: {severity ('error', 'warning', 'note' or null when there is nothing), parts:
  * [{severity, text, who}], text, counts}. Only persistent errors make it an error.
  */
-export function alarmSummary(records, order, { ladder = [], nName = 'N' } = {}) {
+export function alarmSummary(records, order, { nName = 'N' } = {}) {
   const warnings = collectWarnings(records, order);
   const levelsChecked = order.reduce((k, name) => k + ((records[name] && records[name].levels.length) || 0), 0);
   const groups = { error: [], warning: [], small: [], isolated: [] };
   for (const w of warnings) {
     if (w.severity === 'info') continue;
-    const kind = flagPersistence(w, records[w.estimator], ladder);
+    const kind = flagPersistence(w, records[w.estimator]);
     if (kind === 'persistent') groups[w.severity === 'error' ? 'error' : 'warning'].push(w);
     else groups[kind === 'small_n' ? 'small' : 'isolated'].push(w);
   }
@@ -40,9 +42,8 @@ export function alarmSummary(records, order, { ladder = [], nName = 'N' } = {}) 
   if (groups.error.length) parts.push({ severity: 'error', text: plural(groups.error.length, 'error'), who: who(groups.error) });
   if (groups.warning.length) parts.push({ severity: 'warning', text: plural(groups.warning.length, 'warning'), who: who(groups.warning) });
   if (groups.small.length) {
-    const small = (ladder.length ? ladder : []).slice(0, SMALL_N_RUNGS);
-    const upTo = small.length ? ` (${nName} ≤ ${small[small.length - 1]})` : '';
-    parts.push({ severity: 'note', text: `${plural(groups.small.length, 'flag')} at small ${nName} only${upTo}`, who: who(groups.small) });
+    const upTo = Math.max(...groups.small.flatMap((w) => w.n));
+    parts.push({ severity: 'note', text: `${plural(groups.small.length, 'flag')} at small ${nName} only (${nName} ≤ ${upTo})`, who: who(groups.small) });
   }
   if (groups.isolated.length) {
     const levels = groups.isolated.reduce((k, w) => k + w.n.length, 0);
