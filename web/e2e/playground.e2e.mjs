@@ -716,6 +716,16 @@ test('a render scene: relative MSE against spp, fitted orders as the CLI, and th
   assert.deepEqual(state.run.settings, { n_min: 1, n_max: 8, reps: 4, seed: 1, width: 16, height: 16 });
   assert.match(state.query, /scene=quad_light_floor&estimators=bsdf,light_area,mis_power&n_min=1&n_max=8&reps=4&seed=1&width=16&height=16/);
   assert.match(await page.textContent('#variance-title'), /Relative MSE against spp/);
+  // the time plot speaks of images, not of an integral's estimates and VEGAS, and has a verdict
+  // (a winner, no significant difference, or why none is named)
+  const timeNote = await page.textContent('#time-kind-note') + await page.textContent('#time-adaptive-note');
+  assert.doesNotMatch(timeNote, /VEGAS|per estimate/);
+  assert.match(timeNote, /one image/);
+  assert.match(await page.textContent('#time-verdict'), /Equal-time winner|No significant difference|No winner|cannot|compared/);
+  // stratified or Sobol' pixels are named where the reference slope spp^-1 is explained
+  const pixelSamplers = state.estimators.filter((e) => e.pixel_sampler && e.pixel_sampler !== 'independent').map((e) => e.name);
+  const varianceNote = await page.textContent('#variance-note');
+  for (const name of pixelSamplers) assert.match(varianceNote, new RegExp(`${name} \\(`), `${name}'s pixel sampler is not named`);
   const cli = cliRender('quad_light_floor', estimators, settings);
   for (const name of estimators) {
     const est = state.estimators.find((e) => e.name === name);
