@@ -55,7 +55,7 @@ function severityLabel(w) {
 // A flag in the summary: plain words; the code and the core's sentence are in the list above.
 function badge(w) {
   return el('span', { className: `badge badge-${severityOf(w)}`, title: `${severityOf(w)}: ${w.message}`,
-    dataset: { code: w.code } }, flagShort(w.code));
+    dataset: { code: w.code } }, flagShort(w.code, severityOf(w)));
 }
 
 let lastSig = null;
@@ -74,7 +74,7 @@ export function renderReport(state, dom) {
   },
   severityLabel(w), ' ',
   el('strong', {}, w.estimator), ': ',
-  el('span', { className: 'flag-title' }, flagTitle(w.code)),
+  el('span', { className: 'flag-title' }, flagTitle(w.code, w.severity)),
   w.scope === 'level' && w.n.length ? el('span', {}, ` (${nText(w.n, run.ladder, run.kind === 'render' ? 'spp' : 'N')})`) : null,
   ' ', el('code', { className: 'flag-code' }, w.code),
   el('div', { className: 'flag-detail' }, w.message))));
@@ -142,12 +142,12 @@ function estimatorTable(r, run, isOpen) {
     for (const w of l.warnings || []) (flagged[LEVEL_COLUMN[w.code] || 'n'] ??= []).push(w);
     rows.push(el('tr', { dataset: { n: String(l.n) } }, ...columns.map(([key, , get]) => {
       const ws = flagged[key];
-      return el('td', ws ? { className: 'flag', title: ws.map((w) => `${severityOf(w)}: ${flagTitle(w.code)}`).join('\n') } : {},
+      return el('td', ws ? { className: 'flag', title: ws.map((w) => `${severityOf(w)}: ${flagTitle(w.code, severityOf(w))}`).join('\n') } : {},
         ws ? `⚠ ${get(l)}` : get(l));
     })));
     for (const w of l.warnings || []) {
       rows.push(el('tr', { className: 'warn-row' }, el('td', { colSpan: columns.length },
-        severityLabel(w), ` ${run.kind === 'render' ? 'spp' : 'N'} = ${l.n}: `, el('span', { className: 'flag-title' }, flagTitle(w.code)),
+        severityLabel(w), ` ${run.kind === 'render' ? 'spp' : 'N'} = ${l.n}: `, el('span', { className: 'flag-title' }, flagTitle(w.code, severityOf(w))),
         ` (${w.message}) `, el('code', { className: 'flag-code' }, w.code))));
     }
   }

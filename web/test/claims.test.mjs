@@ -71,7 +71,7 @@ test('the stiff peak: uniform is never called exact, in the series, the plots or
   const v = equalTimeClaim(forged, ['uniform', 'importance_matched'], { exact: stiff.exact, floorSeconds: 0 });
   assert.doesNotMatch(v.text, /uniform (and \w+ )?(is|are) exact/);
   assert.equal(v.winner, 'importance_matched');
-  assert.match(v.text, /^importance_matched is exact \(every replicate equals the exact value/);
+  assert.match(v.text, /^importance_matched is exact at every N \(every replicate equals the exact value/);
   const forgedSeries = varianceSeries(forged, ['uniform'], stiff.exact).series[0];
   assert.ok(forgedSeries.exactAt.every((k) => k === false));
   assert.ok(forgedSeries.y.every((y) => y > 0), 'its MSE is plotted');
@@ -290,14 +290,19 @@ test('alarmSummary: an error at every N is red', () => {
   assert.ok(a.parts[0].who.includes('uniform'));
   // a level flag at the largest N persists
   const r = { levels: [{ n: 16 }, { n: 32 }, { n: 64 }, { n: 128 }, { n: 256 }] };
-  assert.equal(flagPersistence({ scope: 'level', n: [256] }, r), 'persistent');
-  assert.equal(flagPersistence({ scope: 'level', n: [64] }, r), 'isolated');
-  assert.equal(flagPersistence({ scope: 'level', n: [16, 32] }, r), 'small_n');
+  assert.equal(flagPersistence({ scope: 'level', code: 'error_bars_understate', n: [256] }, r), 'persistent');
+  assert.equal(flagPersistence({ scope: 'level', code: 'error_bars_understate', n: [64] }, r), 'isolated');
+  assert.equal(flagPersistence({ scope: 'level', code: 'zero_error_bar', n: [16, 32] }, r), 'small_n');
+  // a fact is no chance: an exact value outside the interval at one level persists, as does a
+  // threshold test that fired at two levels
+  assert.equal(flagPersistence({ scope: 'level', code: 'exact_outside_ci', n: [64] }, r), 'persistent');
+  assert.equal(flagPersistence({ scope: 'level', code: 'exact_outside_ci', n: [16, 32] }, r), 'persistent');
   assert.equal(flagPersistence({ scope: 'level', n: [16, 64, 128] }, r), 'persistent', 'half the levels or more');
   // the first levels of a longer ladder are small N; one scattered level above them is isolated
   const long = { levels: [16, 32, 64, 128, 256, 512, 1024, 2048, 4096].map((n) => ({ n })) };
-  assert.equal(flagPersistence({ scope: 'level', n: [16, 32, 64] }, long), 'small_n');
-  assert.equal(flagPersistence({ scope: 'level', n: [1024] }, long), 'isolated');
+  assert.equal(flagPersistence({ scope: 'level', code: 'low_ess', n: [16, 32, 64] }, long), 'small_n');
+  assert.equal(flagPersistence({ scope: 'level', code: 'error_bars_understate', n: [1024] }, long), 'isolated');
+  assert.equal(flagPersistence({ scope: 'level', code: 'error_bars_understate', n: [512, 1024] }, long), 'persistent');
   const isolated = alarmSummary({ a: { levels: long.levels.map((l) => ({ ...l, warnings: l.n === 1024 ? [{ code: 'error_bars_understate', severity: 'error' }] : [] })) } }, ['a']);
   assert.equal(isolated.severity, 'note');
   assert.match(isolated.text, /1 isolated level flag among 9 levels checked/);
@@ -428,4 +433,40 @@ test('legendLines: hidden entries left out, every line within the width', () => 
   assert.equal(lines.filter((l) => l.first).length, 3, 'one swatch per entry');
   assert.equal(lines.filter((l) => l.item === 0).map((l) => l.text).join(' '), items[0].text);
   assert.equal(lines.filter((l) => l.item === 3).map((l) => l.text).join(''), items[3].text);
+});
+
+// ---------------------------------------------------------------------------------------------
+// Found by a review of the page against its data (each a case where the claim was false).
+
+test('equalTimeClaim: exact only from some N on is not "exact at any time"', () => {
+  const late = { name: 'late', warnings: [], levels: [
+    timedLevel(1e-5, 1e-3, { n: 1024, mean: 1.01, mse: 1e-4, exact_to_roundoff: false }),
+    timedLevel(0, 2e-3, { n: 2048, mean: 1, mse: 0, exact_to_roundoff: true }),
+  ] };
+  const v = equalTimeClaim({ late, a: rec('a', timedLevel(1e-4, 1e-3, { mse: 1e-4 })) }, ['a', 'late'], { exact: 1 });
+  assert.doesNotMatch(v.text, /any time/);
+  assert.match(v.text, /from N = 2048 on/);
+});
+
+test('timeSlopeClaim: one slow level is not a fixed cost', () => {
+  const jitter = [1.05, 0.97, 1.02, 0.99, 1.04, 0.96, 1.01];
+  const r = timedRecord(ns.map((n, i) => [n, (i === ns.length - 1 ? 4 : 1) * 1e-8 * n, jitter[i] / Math.sqrt(n)]));
+  const c = timeSlopeClaim(r, { floorSeconds: 5e-6 });
+  assert.doesNotMatch(c.text, /fixed cost/);
+  assert.match(c.text, /^error ∝ t\^-0\.\d{3} ± /);
+});
+
+test('conservativeClaim: nothing to claim for an estimator exact at every N; a zero error bar at small N is no failure', () => {
+  for (const name of diskQuarter.order) {
+    const r = diskQuarter.records[name];
+    if (recordExactness(r, diskQuarter.exact).all === 'exact') assert.equal(conservativeClaim(r, { exact: diskQuarter.exact, reps: 32 }), null, name);
+  }
+  const c = conservativeClaim(diskThird.records.stratified_concentric, { exact: diskThird.exact, reps: diskThird.reps });
+  assert.doesNotMatch(c.text, /too small at some N/);
+});
+
+test('a heavy tail at info is not worded as a possibly infinite variance', () => {
+  assert.doesNotMatch(flagShort('heavy_tail', 'info'), /infinite/);
+  assert.doesNotMatch(flagTitle('heavy_tail', 'info'), /may be infinite/);
+  assert.match(flagShort('heavy_tail', 'warning'), /infinite/);
 });

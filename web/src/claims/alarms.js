@@ -6,11 +6,20 @@
 // Pure (no DOM): web/test/claims.test.mjs runs it under Node.
 import { collectWarnings } from '../series/text.js';
 
+/** Level flags that describe too few points at a small N (the points saw little of f): at the
+ *  lower levels only, they are "small N". */
+const SMALL_N_CODES = new Set(['zero_error_bar', 'low_ess', 'skewed_weights', 'nonfinite']);
+/** Level flags from a test at a p-value threshold, repeated at every level: one such level among
+ *  many may be chance. Any other level flag (an exact value outside the interval, values that
+ *  underflow) is a fact at that level. */
+const CHANCE_CODES = new Set(['error_bars_understate', 'error_bars_unstable', 'iterations_disagree',
+  'conservative_error_bars', 'replicate_far_off']);
+
 /**
- * Classifies each collected warning: 'persistent' (estimator-level, raised at the largest N the
- * estimator reached, or at half its levels or more), 'small_n' (every N it was raised at lies in
- * the lower half of the estimator's levels: the start of the ladder, where few points see little
- * of f) or 'isolated' (a few scattered levels above that).
+ * Classifies each collected warning: 'persistent' (estimator-level; raised at the largest N the
+ * estimator reached, or at half its levels or more; or a fact that no chance explains),
+ * 'small_n' (a few-points flag raised only in the lower half of the levels) or 'isolated' (a
+ * threshold test that fired at a single level, not the largest).
  */
 export function flagPersistence(w, record) {
   if (w.scope !== 'level') return 'persistent';
@@ -18,8 +27,9 @@ export function flagPersistence(w, record) {
   const largest = ns.length ? ns[ns.length - 1] : null;
   if (w.n.includes(largest) || w.n.length * 2 >= ns.length) return 'persistent';
   const lowerHalf = ns.slice(0, Math.floor(ns.length / 2));
-  if (w.n.every((n) => lowerHalf.includes(n))) return 'small_n';
-  return 'isolated';
+  if (SMALL_N_CODES.has(w.code) && w.n.every((n) => lowerHalf.includes(n))) return 'small_n';
+  if (CHANCE_CODES.has(w.code) && w.n.length === 1) return 'isolated';
+  return 'persistent';
 }
 
 /**

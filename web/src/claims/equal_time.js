@@ -30,7 +30,7 @@ export function seLogMse(level) {
  * `floorSeconds`: times below it are not compared (20 clock steps); `clockKnown` false names no
  * winner at all; `render`: relative MSE per image.
  */
-export function equalTimeClaim(records, order, { exact = null, floorSeconds = 0, clockKnown = true, render = false } = {}) {
+export function equalTimeClaim(records, order, { exact = null, floorSeconds = 0, clockKnown = true, render = false, nName = render ? 'spp' : 'N' } = {}) {
   const useMse = !render && typeof exact === 'number' && Number.isFinite(exact);
   const what = render ? 'relative MSE' : useMse ? 'MSE' : 'variance';
   const rows = [];
@@ -42,7 +42,12 @@ export function equalTimeClaim(records, order, { exact = null, floorSeconds = 0,
     if (!l) continue;
     const kind = render ? 'no' : levelExactness(l, exact);
     if (kind === 'exact') {
-      exactOnes.push(name);
+      // Exact from which N on (every level after it is exact too): "at any time" only when
+      // exact at every N.
+      const kinds = r.levels.map((x) => levelExactness(x, exact));
+      let from = kinds.length - 1;
+      while (from > 0 && kinds[from - 1] === 'exact') from--;
+      exactOnes.push({ name, fromN: from === 0 ? null : r.levels[from].n });
       continue;
     }
     if (kind === 'agree') {
@@ -83,8 +88,14 @@ export function equalTimeClaim(records, order, { exact = null, floorSeconds = 0,
   rows.sort((a, b) => b.logE - a.logE);
   const leftText = left.length ? ` Not compared: ${left.map((x) => `${x.name} (${x.why})`).join('; ')}.` : '';
   if (exactOnes.length) {
-    return { winner: exactOnes[0], ranked: rows, left,
-      text: `${exactOnes.join(' and ')} ${exactOnes.length > 1 ? 'are' : 'is'} exact (every replicate equals the exact value to round-off): nothing beats that at any time.` };
+    const always = exactOnes.filter((e) => e.fromN === null).map((e) => e.name);
+    if (always.length) {
+      return { winner: always[0], ranked: rows, left,
+        text: `${always.join(' and ')} ${always.length > 1 ? 'are' : 'is'} exact at every ${nName} (every replicate equals the exact value to round-off): nothing beats that at any time.` };
+    }
+    const e = exactOnes[0];
+    return { winner: e.name, ranked: rows, left,
+      text: `${e.name} equals the exact value to round-off from ${nName} = ${e.fromN} on (below, it has an error): at the largest ${nName}, nothing with an error beats it.` };
   }
   if (!clockKnown) {
     return { winner: null, ranked: rows, left, text: 'The clock could not be measured: no timing is compared.' };
@@ -94,7 +105,7 @@ export function equalTimeClaim(records, order, { exact = null, floorSeconds = 0,
       text: left.length ? `Fewer than two estimators can be compared at equal time.${leftText}` : '' };
   }
   const [a, b] = rows;
-  const lead = `at the largest N each reached (1 / (${what} × seconds); it grows with N for estimators steeper than N⁻¹)`;
+  const lead = `at the largest ${nName} each reached (1 / (${what} × seconds); it grows with ${nName} for estimators steeper than ${nName}⁻¹)`;
   if (a.se === null || b.se === null) {
     return { winner: null, ranked: rows, left,
       text: `No winner named at equal time: ${a.name} is ${fmt(a.efficiency / b.efficiency, 2)}× ${b.name} ${lead}, but without an uncertainty of both (error and timing) the difference cannot be tested.${leftText}` };

@@ -25,7 +25,7 @@ export function coverageBandLow(reps) {
   return 0.95 - Z95 * Math.sqrt(0.95 * 0.05 / Math.max(reps, 1));
 }
 
-const FAILING = new Set(['exact_outside_ci', 'error_bars_understate', 'replicate_far_off', 'zero_error_bar']);
+const FAILING = new Set(['exact_outside_ci', 'error_bars_understate', 'replicate_far_off']);
 
 /**
  * The conservative-error-bar claim of an estimator, or null when its error bars are not
@@ -38,8 +38,11 @@ export function conservativeClaim(record, { exact = null, reps = null, nName = '
   if (!why) return null;
   const known = typeof exact === 'number' && Number.isFinite(exact);
   const levels = (record.levels || []).filter((l) => levelExactness(l, exact) === 'no');
+  // Exact (or only agreeing) at every level: no error bar to judge, nothing to claim.
+  if (!levels.length) return null;
   const zs = zScores(levels, known ? exact : null);
   const far = zs.z.filter((z) => Math.abs(z) > Z_FAR).length;
+  const flaggedAt = levels.filter((l) => (l.warnings || []).some((w) => FAILING.has(w.code))).map((l) => l.n);
   const flagged = [...new Set(levels.flatMap((l) => (l.warnings || []).map((w) => w.code)).filter((c) => FAILING.has(c)))];
   const low = [];
   let lowest = null;
@@ -55,7 +58,7 @@ export function conservativeClaim(record, { exact = null, reps = null, nName = '
   const shows = [];
   if (low.length) shows.push(`coverage ${fmt(lowest.coverage, 3)} at ${nName} = ${lowest.n}${low.length > 1 ? ` (below the 95% band at ${low.length} ${nName})` : ''}`);
   if (far) shows.push(`${far} z beyond ±${Z_FAR}`);
-  if (!shows.length && flagged.length) shows.push('the core flags its error bars as too small at some N');
+  if (!shows.length && flagged.length) shows.push(`the core flags its error bars as too small at ${nName} = ${flaggedAt.join(', ')}`);
   if (shows.length) {
     const text = `error bars meant to be conservative (${why}), but not in this run: ${shows.join(', ')}`;
     return { text, coverageText: text, holds: false, evidence };

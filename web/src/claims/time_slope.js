@@ -18,7 +18,7 @@ export const COST_PER_SAMPLE_SPREAD = 1.25;
  * points. `floorSeconds`: the clock's fitted floor; `measure`: 'mse' (RMSE plotted) or
  * 'variance'.
  */
-export function timeSlopeClaim(record, { exact = null, floorSeconds = 0, measure = 'mse' } = {}) {
+export function timeSlopeClaim(record, { exact = null, floorSeconds = 0, measure = 'mse', nName = 'N' } = {}) {
   const none = (text, evidence = {}) => ({ text, slope: null, se: null, p: null, holds: false, evidence });
   if (!record || !record.levels || !record.levels.length) return none('');
   const ex = recordExactness(record, exact);
@@ -31,14 +31,16 @@ export function timeSlopeClaim(record, { exact = null, floorSeconds = 0, measure
     return none(timed.length < pts.length ? 'no slope: too fast for the clock' : 'no slope: fewer than 3 timed points',
       { timed: timed.length, points: pts.length });
   }
-  const last = timed[timed.length - 1];
-  const perSample = last.t / last.n;
+  // The cost per sample the timed levels share: their median (one slow level, a busy machine,
+  // does not make the others look like a fixed cost).
+  const costs = timed.map((p) => p.t / p.n).sort((a, b) => a - b);
+  const perSample = costs[Math.floor((costs.length - 1) / 2)];
   const steady = timed.filter((p) => {
     const r = (p.t / p.n) / perSample;
     return r <= COST_PER_SAMPLE_SPREAD && r >= 1 / COST_PER_SAMPLE_SPREAD;
   });
   if (steady.length < 3) {
-    return none('no slope: the time does not grow in proportion to N (a fixed cost dominates it)',
+    return none(`no slope: the time does not grow in proportion to ${nName} (a fixed cost dominates it)`,
       { steady: steady.length });
   }
   // log error has the sampling noise of a chi-square variance: sd(log s^2) = sqrt(trigamma(k / 2)),

@@ -41,16 +41,30 @@ export const FLAG_WORDS = Object.freeze({
   gltf: { title: 'Parts of the glTF file were ignored', short: 'glTF features ignored' },
 });
 
-/** The plain-language title of a diagnostic code; an unknown code in words (its underscores
- *  as spaces), never the bare identifier. */
-export function flagTitle(code) {
-  if (FLAG_WORDS[code]) return FLAG_WORDS[code].title;
+/** The heavy-tail codes at severity info: the Hill estimate looks heavy but the weights are
+ *  bounded (or the sign is weak), so the words must not say the variance may be infinite. */
+const INFO_WORDS = Object.freeze({
+  heavy_tail: { title: 'The weights\' tail looks heavy, but the core finds no sign of an infinite variance (bounded weights, or too weak a sign)', short: 'tail looks heavy: no alarm' },
+  heavy_tail_4: { title: 'The weights\' tail looks heavy in the fourth moment, but the core finds no sign that the error bar is erratic', short: 'tail looks heavy: no alarm' },
+});
+
+function wordsOf(code, severity) {
+  if (severity === 'info' && INFO_WORDS[code]) return INFO_WORDS[code];
+  return FLAG_WORDS[code];
+}
+
+/** The plain-language title of a diagnostic code (at its severity); an unknown code in words
+ *  (its underscores as spaces), never the bare identifier. */
+export function flagTitle(code, severity = null) {
+  const w = wordsOf(code, severity);
+  if (w) return w.title;
   return `The core's flag "${String(code).replace(/_/g, ' ')}"`;
 }
 
 /** The chip text of a diagnostic code (plain words, short). */
-export function flagShort(code) {
-  if (FLAG_WORDS[code]) return FLAG_WORDS[code].short;
+export function flagShort(code, severity = null) {
+  const w = wordsOf(code, severity);
+  if (w) return w.short;
   return String(code).replace(/_/g, ' ');
 }
 

@@ -57,9 +57,10 @@ export function renderCalibration(state, run, records) {
       const within = withinText(s, which, names.n);
       if (within) parts.push({ text: within, className: 'fit' });
       else if (s.exactRuns) parts.push({ text: 'exact to round-off: no z', className: 'fit' });
-      else parts.push('no replicates yet');
+      else if (s.zeroSe) parts.push({ text: 'no z: every replicate has a zero error bar', className: 'fit' });
+      else parts.push(run.status === 'running' ? 'no replicates yet' : 'no z');
       if (s.total && s.exactRuns) parts.push({ text: `${s.exactRuns} runs exact to round-off (no z)`, className: 'fit' });
-      if (s.below + s.above) parts.push({ text: `${s.below + s.above} intervals far too narrow (z beyond ±5)`, className: 'badge' });
+      if (s.below + s.above) parts.push({ text: `${s.below + s.above} interval${s.below + s.above === 1 ? '' : 's'} far too narrow (z beyond ±5)`, className: 'badge' });
       if (s.zeroSe) parts.push({ text: `${s.zeroSe} with a zero error bar`, className: 'badge' });
       const wide = render ? null : conservativeClaim(records[s.name], { exact: run.exact, reps: run.settings ? run.settings.reps : null, nName: names.n });
       if (wide) parts.push({ text: wide.text, className: wide.holds === false ? 'badge' : 'fit' });

@@ -83,7 +83,7 @@ export function swatch(color, dashed = false) {
 function badge(w) {
   const severity = severityOf(w);
   return el('span', { className: `badge${severity === 'error' ? ' badge-error' : ''}`,
-    title: `${flagTitle(w.code)}: ${w.message}`, dataset: { severity, code: w.code } }, flagShort(w.code));
+    title: `${flagTitle(w.code, severity)}: ${w.message}`, dataset: { severity, code: w.code } }, flagShort(w.code, severity));
 }
 
 /** An estimator's level flags of severity error or warning (one per code) that its own

@@ -174,7 +174,7 @@ export function renderTime(state, run, records) {
   const measure = known && !render ? 'mse' : 'variance';
   const exactValue = render ? null : run.exact;
   setLegend('time', dom['legend-time'], ts.series.map((s) => {
-    const slope = timeSlopeClaim(records[s.name], { exact: exactValue, floorSeconds: floor, measure });
+    const slope = timeSlopeClaim(records[s.name], { exact: exactValue, floorSeconds: floor, measure, nName: names.n });
     const fitFrom = slope.slope !== null && s.untimed ? ` (t ≥ ${shortSeconds(floor)})` : '';
     return {
       name: s.name,
