@@ -10,14 +10,18 @@ const Z95 = 1.959963984540054;
 /** A z beyond this is an interval far too narrow, whatever the design. */
 export const Z_FAR = 5;
 
+/** The error methods whose bars are wider than the estimator's spread by design, in words
+ *  (the core's error_method_conservative). */
+export const CONSERVATIVE_METHOD_WORDS = Object.freeze({
+  collapsed_strata: 'collapsed strata: neighbouring cells paired',
+  iid_conservative: 'the iid formula, wider than this design\'s spread',
+});
+
 /** Why an estimator's error bars are wider than its spread by design (the core's
  *  error_bars_conservative and error_method), or null. */
 export function conservativeWhy(record) {
   if (!record || record.error_bars_conservative !== true) return null;
-  return {
-    collapsed_strata: 'collapsed strata: neighbouring cells paired',
-    iid_conservative: 'the independent-points formula, wider than this design\'s spread',
-  }[record.error_method] || 'wider than the estimator\'s spread by design';
+  return CONSERVATIVE_METHOD_WORDS[record.error_method] || 'wider than the estimator\'s spread by design';
 }
 
 /** The lower edge of the binomial 95% band of the coverage of R replicates around 0.95. */

@@ -14,6 +14,7 @@
 import { raceRows, mannWhitney, formatSeconds, RACE_ALPHA } from '../race.js';
 import { clockClaim, clockText } from './clock.js';
 import { CLOCK_STEPS_FITTED } from '../series/time.js';
+import { CONSERVATIVE_METHOD_WORDS } from './errorbars.js';
 
 /** The share of runs whose answer may miss the exact value by more than the tolerance by
  *  chance: the tolerance is a 95% half-width. */
@@ -53,10 +54,7 @@ export function reasonWords(code) {
   return REASON_WORDS[code] || String(code ?? 'unknown reason').replace(/_/g, ' ');
 }
 
-const METHOD_WORDS = Object.freeze({
-  collapsed_strata: 'collapsed strata: neighbouring cells paired',
-  iid_conservative: 'the iid formula, wider than this design\'s spread',
-});
+const METHOD_WORDS = CONSERVATIVE_METHOD_WORDS;
 
 /** Does the estimator's error bar overstate its spread by design (the core's word)? */
 export function conservativeBar(e) {

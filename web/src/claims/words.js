@@ -3,6 +3,7 @@
 // a detail (for searching docs/result-schema.md), never in their place.
 // Pure (no DOM): web/test/claims.test.mjs runs it under Node.
 import { fmt } from '../series/text.js';
+import { CONSERVATIVE_METHOD_WORDS } from './errorbars.js';
 
 /** Each diagnostic code: `title`, the sentence a reader needs, and `short`, the chip text. */
 export const FLAG_WORDS = Object.freeze({
@@ -99,8 +100,7 @@ export function densityWords(record) {
 /** How an error bar is computed, in words. */
 export const METHOD_WORDS = Object.freeze({
   iid: 'the sample variance of independent points',
-  iid_conservative: 'the independent-points formula, wider than this design\'s spread',
-  collapsed_strata: 'collapsed strata: neighbouring cells paired, wider than needed',
+  ...CONSERVATIVE_METHOD_WORDS,
   paired_strata: 'paired strata: two points per stratum',
   randomizations: 'the spread of independent randomizations',
   parts_sum: 'the sum of the strata\'s variances',
