@@ -16,6 +16,7 @@ export const IMAGE_VIEWS = Object.freeze(['image', 'error', 'both']);
 const RACE_KEYS = Object.freeze({ relTol: 'race_rel', absTol: 'race_abs', runs: 'race_runs', maxSeconds: 'race_seconds' });
 
 const NAME_RE = /^[A-Za-z0-9_.-]{1,100}$/;
+const MAX_HIDDEN = 64; // hidden names a link may carry (a scene has far fewer estimators)
 // What a race input may hold in a link (the race card checks the value itself).
 const RACE_TEXT_RE = /^[0-9eE+.-]{0,24}$/;
 
@@ -72,7 +73,8 @@ export function queryToView(search) {
     return out;
   }
   const hide = q.get('hide');
-  if (hide !== null) out.hidden = [...new Set(hide.split(',').map((s) => s.trim()).filter((s) => NAME_RE.test(s)))];
+  // At most MAX_HIDDEN names (a scene has far fewer estimators): a crafted link is bounded.
+  if (hide !== null) out.hidden = [...new Set(hide.split(',', MAX_HIDDEN).map((s) => s.trim()).filter((s) => NAME_RE.test(s)))];
   const cal = q.get('cal');
   if (cal !== null && /^\d{1,12}$/.test(cal)) {
     const n = Number(cal);
