@@ -8,6 +8,8 @@
 #ifndef MCPLAY_H
 #define MCPLAY_H
 
+#include <stdint.h>
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -17,7 +19,8 @@ typedef enum mcp_status {
     MCP_ERROR_ARGUMENT = 1,  /* a NULL pointer or a malformed options/format argument */
     MCP_ERROR_SCENE = 2,     /* the scene JSON is malformed or names something invalid */
     MCP_ERROR_CANCELLED = 3, /* the progress callback asked to stop (partial result given) */
-    MCP_ERROR_INTERNAL = 4   /* a bug: please report the message */
+    MCP_ERROR_INTERNAL = 4,  /* a bug: please report the message */
+    MCP_ERROR_FUNCTION = 5   /* a caller's function (mcp_function) returned non-zero */
 } mcp_status;
 
 /* Called after each completed N of a study with that level's results as JSON
@@ -133,6 +136,47 @@ int mcp_points_integrate(const char* scene_json, const char* request_json, char*
  * A failed test is a result (MCP_OK, "passed": false); a warp that cannot be tested (g leaves
  * the domain, p negative or NaN) is MCP_ERROR_SCENE naming the sample or the point. */
 int mcp_warp_test(const char* scene_json, const char* options_json, char** result_json);
+
+/* --- Functions given by the caller (a Python callable, a JavaScript function) ----------------
+ *
+ * A scene names a caller's function where it would give an expression: the integrand
+ * ("integrand" or "f": {"type": "function", "name": N}) and a typed warp's map and density
+ * ("warp": {"domain", "g": {"function": N, "sample_dim": k}, "p": {"function": N}}). The
+ * function gets a whole block of points at a time (never one call per point), row-major:
+ * x[i * in_dim + j] is coordinate j of point i (i < n), and it writes out[i * out_dim + k]
+ * (out_dim 1 for an integrand or a density, the domain's point dimension for a warp's map). It
+ * may be called from several of the call's threads at once. A return of non-zero stops the
+ * call that uses it within a block: no further calls are made, and the call fails with
+ * MCP_ERROR_FUNCTION (its message names the function); the function's owner keeps the reason.
+ * Calls that take no mcp_context refuse a scene naming a function. */
+typedef int (*mcp_batch_fn)(void* user, const double* x, uint64_t n, int in_dim, double* out,
+                            int out_dim);
+typedef struct mcp_function {
+    const char* name; /* as the scene names it: 1 to 64 characters */
+    mcp_batch_fn fn;
+    void* user;
+} mcp_function;
+
+/* Polled between blocks, from any of the call's threads: non-zero cancels the call (a study
+ * then ends with MCP_ERROR_CANCELLED and its partial result, as a cancelling progress callback
+ * does, but within a block rather than after a level). */
+typedef int (*mcp_cancel_fn)(void* user);
+
+typedef struct mcp_context {
+    const mcp_function* functions; /* may be NULL when function_count is 0 */
+    int function_count;            /* 0..16 */
+    mcp_cancel_fn cancel;          /* may be NULL */
+    void* cancel_user;
+} mcp_context;
+
+/* mcp_study_run, mcp_study_plan and mcp_warp_test with a context (ctx may be NULL: then they
+ * are the calls above). */
+int mcp_study_run_with(const char* scene_json, const char* options_json, const mcp_context* ctx,
+                       mcp_progress_fn progress, void* user, char** result_json);
+int mcp_study_plan_with(const char* scene_json, const char* options_json, const mcp_context* ctx,
+                        char** plan_json);
+int mcp_warp_test_with(const char* scene_json, const char* options_json, const mcp_context* ctx,
+                       char** result_json);
 
 /* Frees a string returned by this API. */
 void mcp_free(char* p);
