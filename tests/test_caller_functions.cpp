@@ -37,7 +37,7 @@ Outcome run_with(const json& scene, const json& options, const mcp_context* ctx,
 
 /// What a test function records of its calls.
 struct Calls {
-    std::atomic<uint64_t> calls{0}, points{0};
+    std::atomic<uint64_t> calls{0}, points{0}, smallest{UINT64_MAX};
     std::atomic<uint64_t> fail_at{0}; ///< fail on this call (1-based); 0: never
     std::atomic<int> bad_layout{0};   ///< a point outside the unit cube or a wrong dimension
     int expect_dim = 0;
@@ -49,6 +49,8 @@ int product_plus_first(void* user, const double* x, uint64_t n, int in_dim, doub
     Calls* c = static_cast<Calls*>(user);
     const uint64_t call = ++c->calls;
     c->points += n;
+    for (uint64_t s = c->smallest; n < s && !c->smallest.compare_exchange_weak(s, n);) {
+    }
     if (in_dim != c->expect_dim || out_dim != 1 || n == 0 || n > 4096) ++c->bad_layout;
     if (c->fail_at != 0 && call >= c->fail_at) return 1;
     for (uint64_t i = 0; i < n; ++i) {
@@ -122,6 +124,24 @@ TEST(CallerFunctions, SameNumbersAsTheSameExpression) {
     // Blocks, never single points: far fewer calls than points.
     EXPECT_LT(calls.calls.load() * 16, calls.points.load());
     EXPECT_EQ(by_function.result["scene"]["exact"], nullptr); // a function has no closed form
+}
+
+TEST(CallerFunctions, FixedEstimatorsCallOncePerBatchOfBlocks) {
+    // A Python callable costs microseconds per call: the fixed estimators (and the support
+    // check's probes) hand it kFunctionBatch = 4096 points at a time, not one block of 256.
+    Calls calls;
+    calls.expect_dim = 2;
+    const mcp_function fns[] = {{"f", product_plus_first, &calls}};
+    const mcp_context ctx = context_of(fns, 1);
+    const Outcome o = run_with(box_scene({{"type", "function"}, {"name", "f"}}, 2),
+                               {{"estimators", {"uniform", "sobol", "stratified"}},
+                                {"n_min", 4096},
+                                {"n_max", 16384},
+                                {"reps", 2}},
+                               &ctx);
+    ASSERT_EQ(o.status, MCP_OK) << o.error;
+    EXPECT_EQ(calls.smallest.load(), 4096u);
+    EXPECT_EQ(calls.bad_layout.load(), 0);
 }
 
 TEST(CallerFunctions, PointsArriveRowMajor) {
