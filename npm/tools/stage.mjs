@@ -5,7 +5,7 @@
 // the wasm build (mcplay_web.mjs/.wasm, mcplay_render_web.mjs/.wasm). It is written to --out
 // (emptied first), checked (every shipped module's imports resolve inside the package, the
 // version is CMake's project version), then `npm pack` writes mcplay-<version>.tgz into
-// --wasm-dir and the script prints that tarball's path as its last line.
+// --wasm-dir. What it did goes to stderr; stdout is the tarball's path alone.
 import { execFileSync } from 'node:child_process';
 import fs from 'node:fs';
 import path from 'node:path';
@@ -96,7 +96,7 @@ for (const [f, from] of sources) {
 const shippedPkg = Object.fromEntries(Object.entries(pkg).filter(([k]) => !DEV_FIELDS.includes(k)));
 fs.writeFileSync(path.join(args.out, 'package.json'), `${JSON.stringify(shippedPkg, null, 2)}\n`);
 checkImports(args.out, pkg.files);
-console.log(`stage: ${path.relative(ROOT, args.out)}: ${sources.size + 1} files, version ${pkg.version}`);
+console.error(`stage: ${path.relative(ROOT, args.out)}: ${sources.size + 1} files, version ${pkg.version}`);
 
 if (args.pack) {
   const packed = JSON.parse(execFileSync('npm', ['pack', '--json', '--ignore-scripts', '--pack-destination',
@@ -107,6 +107,6 @@ if (args.pack) {
   if (JSON.stringify(inTarball) !== JSON.stringify(expected)) {
     fail(`the tarball holds ${inTarball.join(', ')}; expected ${expected.join(', ')}`);
   }
-  console.log(`stage: packed ${files.length} files, ${(size / 1024).toFixed(0)} KB`);
+  console.error(`stage: packed ${files.length} files, ${(size / 1024).toFixed(0)} KB`);
   console.log(path.join(args.wasmDir, filename));
 }
