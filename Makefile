@@ -59,7 +59,7 @@ help:
 	@echo "make test   the contributor's loop: install what is missing, build native + wasm, run the"
 	@echo "           native, wasm, Node and Chromium suites (independent ones at the same time)"
 	@echo "make test-npm  the wasm core as the npm package mcplay: packed, installed from the tarball into an"
-	@echo "           empty folder, run there against the native CLI; its types checked (npm/README.md)"
+	@echo "           empty folder, run there against the native CLI and in Chromium; its types checked"
 	@echo "make check  everything CI runs: make test, then the ASan/UBSan suite, make fuzz-smoke and the"
 	@echo "           statistical runs under Node (test-wasm-statistical)"
 	@echo "make bench  samples per second natively and in wasm under Node, and their ratio; then bench-genz"
@@ -138,14 +138,17 @@ npm/node_modules/.package-lock.json: npm/package.json npm/package-lock.json | de
 # The wasm core as the npm package "mcplay" (npm/README.md): staged from npm/, web/core.js,
 # web/render_core.js and the wasm build, packed (build-wasm/mcplay-<version>.tgz), installed from
 # the tarball into an empty folder with no registry, and run there by its package name against
-# the native CLI (npm/test/installed.test.mjs); its .d.ts files type-checked with a user's code.
-test-npm: build build-wasm deps-npm
+# the native CLI (npm/test/installed.test.mjs) and by URL in headless Chromium, in a page and a
+# module Worker (npm/test/browser.test.mjs, playwright-core from deps-web); its .d.ts files
+# type-checked with a user's code (npm/test/types_usage.ts).
+test-npm: build build-wasm deps-npm deps-web
 	cd npm && npx --no-install tsc -p test/tsconfig.json
 	@tgz=$$(node npm/tools/stage.mjs --wasm-dir $(BUILD_WASM)) && \
 	tmp=$$(mktemp -d) && trap 'rm -rf "$$tmp"' EXIT && \
 	cp npm/test/installed.test.mjs "$$tmp"/ && cd "$$tmp" && \
 	npm install --no-audit --no-fund --offline --loglevel=error "$$tgz" && \
-	MCPLAY_ROOT=$(CURDIR) MCPLAY_NATIVE=$(abspath $(BUILD))/mcplay node --test installed.test.mjs
+	MCPLAY_ROOT=$(CURDIR) MCPLAY_NATIVE=$(abspath $(BUILD))/mcplay \
+	  node --test installed.test.mjs $(CURDIR)/npm/test/browser.test.mjs
 
 # The playground: page, wasm module, uPlot and the scenes with their manifest.
 site: build build-wasm deps-web
