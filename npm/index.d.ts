@@ -15,6 +15,8 @@ export declare const Status: Readonly<{
   SCENE: 2;
   CANCELLED: 3;
   INTERNAL: 4;
+  /** A caller's function failed (the C API's mcp_*_with calls; not exported to wasm yet). */
+  FUNCTION: 5;
 }>;
 
 /** One of the values of `Status`. */
@@ -26,7 +28,7 @@ export declare class McplayError extends Error {
   readonly name: 'McplayError';
   /** The C status code (`Status`). */
   readonly status: number;
-  /** Its name: "ARGUMENT", "SCENE", "CANCELLED", "INTERNAL". */
+  /** Its name: "ARGUMENT", "SCENE", "CANCELLED", "INTERNAL", "FUNCTION". */
   readonly statusName: string;
 }
 
