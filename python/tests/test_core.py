@@ -358,15 +358,18 @@ def test_progress_gets_each_level_and_its_exception_cancels() -> None:
     assert len(calls) < 64
 
 
-def needs_default_sigint() -> None:
-    if signal.getsignal(signal.SIGINT) is not signal.default_int_handler:
-        pytest.skip("SIGINT has a handler other than Python's default here")
+@pytest.fixture
+def default_sigint():
+    """Python's own SIGINT handler (KeyboardInterrupt) for the test, whatever the process
+    inherited (a background job starts with SIGINT ignored)."""
     if threading.current_thread() is not threading.main_thread():
         pytest.skip("signals reach only the main thread")
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, previous)
 
 
-def test_ctrl_c_from_a_timer_cancels_a_long_study_quickly() -> None:
-    needs_default_sigint()
+def test_ctrl_c_from_a_timer_cancels_a_long_study_quickly(default_sigint: None) -> None:
     timer = threading.Timer(0.5, signal.raise_signal, (signal.SIGINT,))
     start = time.perf_counter()
     timer.start()
@@ -379,8 +382,7 @@ def test_ctrl_c_from_a_timer_cancels_a_long_study_quickly() -> None:
     assert run_study(box_scene(2), FAST, {"f": lambda x: x.sum(1)})["estimators"]
 
 
-def test_ctrl_c_from_inside_the_callable_stops_within_blocks() -> None:
-    needs_default_sigint()
+def test_ctrl_c_from_inside_the_callable_stops_within_blocks(default_sigint: None) -> None:
     calls = []
 
     def f(x: np.ndarray) -> np.ndarray:
@@ -395,8 +397,7 @@ def test_ctrl_c_from_inside_the_callable_stops_within_blocks() -> None:
     assert calls[-1] - calls[2] < 1.0
 
 
-def test_ctrl_c_cancels_an_expression_study_too() -> None:
-    needs_default_sigint()
+def test_ctrl_c_cancels_an_expression_study_too(default_sigint: None) -> None:
     timer = threading.Timer(0.3, signal.raise_signal, (signal.SIGINT,))
     start = time.perf_counter()
     timer.start()
