@@ -7,6 +7,7 @@ Statistical checks use fixed seeds and tolerances in standard errors.
 
 from __future__ import annotations
 
+import base64
 import json
 import math
 import os
@@ -491,3 +492,63 @@ def test_hostile_callables_never_crash_the_interpreter(tmp_path: pathlib.Path) -
     assert lines[-1] == "done", done.stdout
     assert any(line.startswith("nested ok") for line in lines), done.stdout
     assert any(line.startswith("weird McplayError") for line in lines), done.stdout
+
+
+# --- Rendering ------------------------------------------------------------------------------
+
+def render_scene(scenes_dir: pathlib.Path) -> tuple[str, dict]:
+    """A small render scene (closed-form pixels) and options that keep it to milliseconds."""
+    scene = (scenes_dir / "quad_light_floor.json").read_text()
+    options = {"base_dir": str(scenes_dir), "width": 16, "height": 16, "spp_min": 1, "spp_max": 4,
+               "reps": 2, "estimators": ["light_area", "mis_balance"], "threads": 2}
+    return scene, options
+
+
+def test_render_study_run_with_progress(scenes_dir: pathlib.Path) -> None:
+    scene, options = render_scene(scenes_dir)
+    lines: list[dict] = []
+    result = json.loads(_core.render_study_run(scene, json.dumps(options),
+                                               lambda text: lines.append(json.loads(text))))
+    assert [e["name"] for e in result["estimators"]] == ["light_area", "mis_balance"]
+    assert lines, "progress was never called"
+
+    class Stop(Exception):
+        pass
+
+    def stop(text: str) -> None:
+        raise Stop()
+
+    with pytest.raises(Stop):
+        _core.render_study_run(scene, json.dumps(options), stop)
+
+
+def test_render_image_and_reference(scenes_dir: pathlib.Path) -> None:
+    scene, options = render_scene(scenes_dir)
+    image = json.loads(_core.call("render_image", scene,
+                                  json.dumps({**options, "estimator": "light_area", "spp": 2})))
+    assert image["kind"] == "render_image" and image["spp"] == 2
+    assert base64.b64decode(image["images"]["png"])[:4] == b"\x89PNG"
+    reference = json.loads(_core.render_reference(scene, json.dumps(options)))
+    assert reference["kind"] == "render_reference" and reference["reference_data"]
+
+
+def test_render_live_session(scenes_dir: pathlib.Path) -> None:
+    scene, options = render_scene(scenes_dir)
+    live = json.loads(_core.render_live_open(
+        scene, json.dumps({"base_dir": options["base_dir"], "long_side": 16,
+                           "estimators": ["light_area"], "pixels": True})))
+    session = live["session"]
+    try:
+        first = json.loads(_core.render_live_pass(session, json.dumps({"estimator": 0, "spp": 1,
+                                                                       "pixels": True})))
+        second = json.loads(_core.render_live_pass(session, json.dumps({"estimator": 0,
+                                                                        "spp": 4})))
+        assert (first["spp"], second["spp"]) == (1, 4)
+        pixels = np.frombuffer(base64.b64decode(first["rgb_f32"]), "<f4")
+        assert pixels.size == live["width"] * live["height"] * 3 and np.isfinite(pixels).all()
+        with pytest.raises(_core.McplayError):
+            _core.render_live_pass(session, json.dumps({"estimator": 0, "spp": 2}))  # not more
+    finally:
+        _core.render_live_close(session)
+    with pytest.raises(_core.McplayError):
+        _core.render_live_close(session)
