@@ -1,5 +1,5 @@
 // Functions given by the library's caller (mcp_context, api/mcplay.h): a scene names them, the
-// core calls them a block at a time, row-major, and stops within a block when one fails or the
+// core calls them a block at a time, column-major, and stops within a block when one fails or the
 // caller cancels.
 #include <gtest/gtest.h>
 
@@ -43,7 +43,7 @@ struct Calls {
     int expect_dim = 0;
 };
 
-/// f(x) = x1 * x2 + x1 (row-major x), the same doubles as the expression "x1 * x2 + x1".
+/// f(x) = x1 * x2 + x1 (column-major x), the same doubles as the expression "x1 * x2 + x1".
 int product_plus_first(void* user, const double* x, uint64_t n, int in_dim, double* out,
                        int out_dim) {
     Calls* c = static_cast<Calls*>(user);
@@ -54,18 +54,26 @@ int product_plus_first(void* user, const double* x, uint64_t n, int in_dim, doub
     if (in_dim != c->expect_dim || out_dim != 1 || n == 0 || n > 4096) ++c->bad_layout;
     if (c->fail_at != 0 && call >= c->fail_at) return 1;
     for (uint64_t i = 0; i < n; ++i) {
-        const double* p = x + i * static_cast<uint64_t>(in_dim);
         for (int j = 0; j < in_dim; ++j)
-            if (!(p[j] >= 0.0 && p[j] < 1.0)) ++c->bad_layout;
-        out[i] = p[0] * p[1] + p[0];
+            if (!(x[uint64_t(j) * n + i] >= 0.0 && x[uint64_t(j) * n + i] < 1.0)) ++c->bad_layout;
+        out[i] = x[i] * x[n + i] + x[i];
     }
     return 0;
 }
 
-/// f(x) = the second coordinate: integrates to 1/2 only if the layout is row-major as said.
+/// f(x) = x2 on the box [0, 1] x [10, 11] x [100, 101], checking that each of the block's
+/// columns holds one axis's coordinates (column-major, as mcplay.h says).
 int second_coordinate(void* user, const double* x, uint64_t n, int in_dim, double* out, int) {
-    static_cast<Calls*>(user)->calls++;
-    for (uint64_t i = 0; i < n; ++i) out[i] = 4.0 * x[i * static_cast<uint64_t>(in_dim) + 1];
+    Calls* c = static_cast<Calls*>(user);
+    c->calls++;
+    const double lower[] = {0.0, 10.0, 100.0};
+    for (uint64_t i = 0; i < n; ++i) {
+        for (int j = 0; j < in_dim && j < 3; ++j) {
+            const double v = x[uint64_t(j) * n + i];
+            if (!(v >= lower[j] && v <= lower[j] + 1.0)) ++c->bad_layout;
+        }
+        out[i] = x[n + i];
+    }
     return 0;
 }
 
@@ -144,18 +152,22 @@ TEST(CallerFunctions, FixedEstimatorsCallOncePerBatchOfBlocks) {
     EXPECT_EQ(calls.bad_layout.load(), 0);
 }
 
-TEST(CallerFunctions, PointsArriveRowMajor) {
+TEST(CallerFunctions, PointsArriveColumnMajor) {
     Calls calls;
     const mcp_function fns[] = {{"g", second_coordinate, &calls}};
     const mcp_context ctx = context_of(fns, 1);
-    const json options = {{"estimators", {"uniform"}}, {"n_max", 16384}, {"reps", 8}};
-    json scene = box_scene({{"type", "function"}, {"name", "g"}}, 3);
-    scene["exact"] = 2.0; // 4 * E[x2]
+    const json options = {{"estimators", {"uniform", "vegas"}}, {"n_max", 16384}, {"reps", 8}};
+    json scene = {{"integrand", {{"type", "function"}, {"name", "g"}}},
+                  {"domain", {{"type", "box"}, {"lower", {0, 10, 100}}, {"upper", {1, 11, 101}}}},
+                  {"exact", 10.5}};
     const Outcome o = run_with(scene, options, &ctx);
     ASSERT_EQ(o.status, MCP_OK) << o.error;
-    const json& top = o.result["estimators"][0]["levels"].back();
-    const double mean = top["mean"], se = top["std_error"];
-    EXPECT_LT(std::fabs(mean - 2.0), 5.0 * se) << mean << " +- " << se;
+    EXPECT_EQ(calls.bad_layout.load(), 0);
+    for (const json& e : o.result["estimators"]) {
+        const json& top = e["levels"].back();
+        const double mean = top["mean"], se = top["std_error"];
+        EXPECT_LT(std::fabs(mean - 10.5), 5.0 * se) << e["name"] << ": " << mean << " +- " << se;
+    }
 }
 
 TEST(CallerFunctions, AFailingFunctionStopsTheStudyWithinABlock) {
@@ -273,10 +285,10 @@ template <bool Right>
 int polar_disk(void*, const double* u, uint64_t n, int in_dim, double* x, int out_dim) {
     if (in_dim != 2 || out_dim != 2) return 1;
     for (uint64_t i = 0; i < n; ++i) {
-        const double r = Right ? std::sqrt(u[2 * i]) : u[2 * i];
-        const double phi = 2.0 * M_PI * u[2 * i + 1];
-        x[2 * i] = r * std::cos(phi);
-        x[2 * i + 1] = r * std::sin(phi);
+        const double r = Right ? std::sqrt(u[i]) : u[i];
+        const double phi = 2.0 * M_PI * u[n + i];
+        x[i] = r * std::cos(phi);
+        x[n + i] = r * std::sin(phi);
     }
     return 0;
 }

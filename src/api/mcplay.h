@@ -142,9 +142,10 @@ int mcp_warp_test(const char* scene_json, const char* options_json, char** resul
  * A scene names a caller's function where it would give an expression: the integrand
  * ("integrand" or "f": {"type": "function", "name": N}) and a typed warp's map and density
  * ("warp": {"domain", "g": {"function": N, "sample_dim": k}, "p": {"function": N}}). The
- * function gets a whole block of points at a time (never one call per point), row-major:
- * x[i * in_dim + j] is coordinate j of point i (i < n), and it writes out[i * out_dim + k]
- * (out_dim 1 for an integrand or a density, the domain's point dimension for a warp's map). It
+ * function gets a whole block of points at a time (never one call per point), column-major
+ * (structure of arrays, as the core holds them): x[j * n + i] is coordinate j of point i
+ * (i < n), and it writes out[k * n + i] (out_dim 1 for an integrand or a density, the domain's
+ * point dimension for a warp's map): numpy's order='F' (n, in_dim) array. It
  * may be called from several of the call's threads at once. A return of non-zero stops the
  * call that uses it within a block: no further calls are made, and the call fails with
  * MCP_ERROR_FUNCTION (its message names the function); the function's owner keeps the reason.

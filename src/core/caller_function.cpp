@@ -37,23 +37,25 @@ bool CallerFunction::evaluate(const PointBlock& x, int out_dim, double* out,
         zeros();
         return false;
     }
-    // Row-major copies of the block in and out: per block, reused by the thread.
-    thread_local std::vector<double> rows_in, rows_out;
+    // Contiguous copies of the block's columns in and out (the block's own columns are
+    // `capacity` apart): per block, reused by the thread.
+    thread_local std::vector<double> columns_in, columns_out;
     const size_t d = static_cast<size_t>(x.dim), m = static_cast<size_t>(out_dim);
-    if (rows_in.size() < n * d) rows_in.resize(n * d);
-    if (rows_out.size() < n * m) rows_out.resize(n * m);
+    if (columns_in.size() < n * d) columns_in.resize(n * d);
+    if (columns_out.size() < n * m) columns_out.resize(n * m);
     for (size_t j = 0; j < d; ++j) {
         const double* xj = x.coord(static_cast<int>(j));
-        for (size_t i = 0; i < n; ++i) rows_in[i * d + j] = xj[i];
+        std::copy(xj, xj + n, columns_in.begin() + static_cast<long>(j * n));
     }
-    std::fill(rows_out.begin(), rows_out.begin() + static_cast<long>(n * m), 0.0);
-    if (fn(user, rows_in.data(), n, x.dim, rows_out.data(), out_dim) != 0) {
+    std::fill(columns_out.begin(), columns_out.begin() + static_cast<long>(n * m), 0.0);
+    if (fn(user, columns_in.data(), n, x.dim, columns_out.data(), out_dim) != 0) {
         control->fail(name);
         zeros();
         return false;
     }
     for (size_t k = 0; k < m; ++k)
-        for (size_t i = 0; i < n; ++i) out[k * out_stride + i] = rows_out[i * m + k];
+        std::copy(columns_out.begin() + static_cast<long>(k * n),
+                  columns_out.begin() + static_cast<long>((k + 1) * n), out + k * out_stride);
     return true;
 }
 
