@@ -207,6 +207,7 @@ def test_callable_gets_blocks_of_read_only_points_in_the_domain() -> None:
 
     def f(x: np.ndarray) -> np.ndarray:
         assert x.dtype == np.float64 and x.ndim == 2 and not x.flags.writeable
+        assert x.flags.f_contiguous  # one array per coordinate, as the core holds them
         seen.append(x.copy())
         return x.sum(1)
 
@@ -554,3 +555,17 @@ def test_render_live_session(scenes_dir: pathlib.Path) -> None:
         _core.render_live_close(session)
     with pytest.raises(_core.McplayError):
         _core.render_live_close(session)
+
+
+def test_warp_map_non_finite_names_the_first_point() -> None:
+    def g(u: np.ndarray) -> np.ndarray:
+        x = polar_disk(u)
+        x[9, 1] = np.nan   # second coordinate of point 9
+        x[12, 0] = np.inf  # a later point
+        return x
+
+    with pytest.raises(_core.McplayError) as info:
+        _core.warp_test(json.dumps(warp_scene()), None,
+                        {"g": g, "p": lambda x: np.full(len(x), 1 / np.pi)})
+    assert "function 'g' on block 1 " in str(info.value)
+    assert "returned nan at point 9 of the block" in str(info.value), str(info.value)

@@ -28,11 +28,12 @@ std::string number_text(double value) {
     return ec == std::errc() ? std::string(buffer, end) : std::string("?");
 }
 
-/// "[0.1, 0.5]": a point's coordinates, the first kQuotedCoordinates of them.
-std::string point_text(const double* x, int dim) {
+/// "[0.1, 0.5]": the coordinates of point i of a column-major block x of n points (x[j * n + i]),
+/// the first kQuotedCoordinates of them.
+std::string point_text(const double* x, uint64_t n, uint64_t i, int dim) {
     std::string text = "[";
     for (int j = 0; j < dim && j < kQuotedCoordinates; ++j) {
-        text += (j ? ", " : "") + number_text(x[j]);
+        text += (j ? ", " : "") + number_text(x[static_cast<uint64_t>(j) * n + i]);
     }
     if (dim > kQuotedCoordinates) text += ", ... (" + std::to_string(dim) + " coordinates)";
     return text + "]";
@@ -232,8 +233,9 @@ CallState::InputArray CallState::take_input(Slot& slot, uint64_t n, int dim) {
         }
     }
     InputArray input;
-    input.array = numpy_.attr("empty")(nb::make_tuple(n, dim));
-    input.data = nb::cast<nb::ndarray<double, nb::c_contig, nb::device::cpu>>(input.array).data();
+    // Column-major, as the core gives the points: one contiguous array per coordinate.
+    input.array = numpy_.attr("empty")(nb::make_tuple(n, dim), nb::arg("order") = "F");
+    input.data = nb::cast<nb::ndarray<double, nb::f_contig, nb::device::cpu>>(input.array).data();
     input.array.attr("flags").attr("writeable") = false;
     input.n = n;
     input.dim = dim;
@@ -266,7 +268,7 @@ std::string CallState::evaluate(Slot& slot, const double* x, uint64_t n, int in_
         }
         cause = nb::borrow(e.value());
         std::string where = n == 0 ? "on an empty block"
-                                   : "at the block's first point " + point_text(x, in_dim);
+                                   : "at the block's first point " + point_text(x, n, 0, in_dim);
         return "raised " + exception_text(e.value()) + " " + where;
     }
     give_back(slot, std::move(input));
@@ -275,7 +277,8 @@ std::string CallState::evaluate(Slot& slot, const double* x, uint64_t n, int in_
 
 std::string CallState::store_values(nb::handle returned, const double* x, uint64_t n, int in_dim,
                                     double* out, int out_dim) {
-    using Values = nb::ndarray<const double, nb::c_contig, nb::device::cpu>;
+    // Column-major like the points: out[k * n + i] is value k of point i.
+    using Values = nb::ndarray<const double, nb::f_contig, nb::device::cpu>;
     const std::vector<size_t> expected =
         out_dim == 1 ? std::vector<size_t>{n} : std::vector<size_t>{n, size_t(out_dim)};
     const std::string expected_text =
@@ -284,7 +287,7 @@ std::string CallState::store_values(nb::handle returned, const double* x, uint64
 
     Values values;
     if (!nb::try_cast(returned, values, false)) {
-        // Not a C-contiguous float64 array: what numpy makes of it.
+        // Not a column-major float64 array: what numpy makes of it.
         nb::object array;
         try {
             array = numpy_.attr("asarray")(returned);
@@ -304,7 +307,7 @@ std::string CallState::store_values(nb::handle returned, const double* x, uint64
             return "returned " + what + (returned.is_none() ? "" : " of dtype " + dtype) +
                    ", expected real (float64) values of shape " + expected_text;
         }
-        array = numpy_.attr("asarray")(array, nb::arg("dtype") = "float64", nb::arg("order") = "C");
+        array = numpy_.attr("asarray")(array, nb::arg("dtype") = "float64", nb::arg("order") = "F");
         if (!nb::try_cast(array, values, false)) {
             return "returned values that could not be read as float64";
         }
@@ -321,12 +324,17 @@ std::string CallState::store_values(nb::handle returned, const double* x, uint64
 
     const double* v = values.data();
     const size_t count = static_cast<size_t>(n) * static_cast<size_t>(out_dim);
-    for (size_t i = 0; i < count; ++i) {
-        if (!std::isfinite(v[i])) {
-            const size_t point = i / static_cast<size_t>(out_dim);
-            const double* bad_point = x + point * static_cast<size_t>(in_dim);
-            return "returned " + number_text(v[i]) + " at point " + std::to_string(point) +
-                   " of the block, x = " + point_text(bad_point, in_dim);
+    bool finite = true;
+    for (size_t i = 0; i < count; ++i) finite &= std::isfinite(v[i]);
+    if (!finite) {
+        // The first point (not the first column) with a value that is not finite.
+        for (uint64_t point = 0; point < n; ++point) {
+            for (int k = 0; k < out_dim; ++k) {
+                const double value = v[static_cast<uint64_t>(k) * n + point];
+                if (std::isfinite(value)) continue;
+                return "returned " + number_text(value) + " at point " + std::to_string(point) +
+                       " of the block, x = " + point_text(x, n, point, in_dim);
+            }
         }
     }
     if (count > 0) std::memcpy(out, v, count * sizeof(double));

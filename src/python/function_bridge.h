@@ -49,7 +49,8 @@ public:
     void raise_failure(int status, const std::string& c_error);
 
 private:
-    /// A block of input points as a read-only float64 array the callable may keep.
+    /// A block of input points as a read-only (n, dim) float64 array in column-major order (as
+    /// the core gives them), which the callable may keep.
     struct InputArray {
         nanobind::object array;
         double* data = nullptr;
