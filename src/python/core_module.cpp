@@ -296,9 +296,8 @@ std::string render_live_reference(int session, const std::string& reference) {
 }
 
 void render_live_close(int session) {
-    if (mcp_render_live_close(session) != MCP_OK) {
-        raise_error(MCP_ERROR_ARGUMENT, mcp_last_error());
-    }
+    const int status = mcp_render_live_close(session);
+    if (status != MCP_OK) raise_error(status, mcp_last_error());
 }
 
 } // namespace
