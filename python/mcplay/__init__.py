@@ -20,7 +20,11 @@ it. Every number comes from the core: the package computes none of its own.
 
 from __future__ import annotations
 
-from . import _core
+# From a source tree the extension lives in the build folder's mcplay/ (CMake puts it in
+# build/python/mcplay): with both folders on PYTHONPATH this makes them one package.
+__path__ = __import__("pkgutil").extend_path(__path__, __name__)
+
+from . import _core  # noqa: E402
 from ._scenes import scene_names as scenes
 from ._scenes import scenes_dir
 from ._util import McplayError
