@@ -22,7 +22,7 @@ _STATUS_ARGUMENT = 1
 def argument_error(message: str) -> Exception:
     """An :class:`McplayError` for a bad argument caught before the core is called."""
     error = McplayError(message)
-    for name, value in (("status", _STATUS_ARGUMENT), ("status_name", "argument")):
+    for name, value in (("status", _STATUS_ARGUMENT), ("status_name", "ARGUMENT")):
         try:
             setattr(error, name, value)
         except AttributeError:  # an exception type whose attributes are read-only
