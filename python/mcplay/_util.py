@@ -62,7 +62,8 @@ def from_json(text: str) -> Any:
 
 
 def whole_number(value: Any, name: str, minimum: int | None = None) -> int:
-    """``value`` as an int (numpy integers too, never a bool or a float), else an error naming ``name``."""
+    """``value`` as an int (numpy integers too, never a bool or a float), else an error naming
+    ``name``."""
     if isinstance(value, bool) or not isinstance(value, numbers.Integral):
         raise argument_error(f"{name}: expected a whole number, got {_shown(value)}")
     value = operator.index(value)

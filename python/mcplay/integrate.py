@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 import textwrap
 from typing import Any, Callable, Mapping, Sequence
 
@@ -87,7 +88,8 @@ def integrate(
         ----------
         f
             A callable taking an ``(n, d)`` float64 array (one block of points, never one point at a
-            time) and returning ``n`` values; or an expression string in ``x1 .. xd`` (or ``x y z``),
+            time) and returning ``n`` values; or an expression string in ``x1 .. xd`` (or ``x y
+        z``),
             compiled by the core (e.g. ``"exp(-(x-0.5)^2/0.01)"``); or a scene integrand object
             (``{"type": "genz_gaussian", ...}``). A callable may be called from several of the
             core's threads at once; each call holds the GIL, so blocks of a Python callable run one
@@ -137,7 +139,8 @@ def integrate(
         Result
             ``.estimate``, ``.error_bar`` (95% half-width) and ``.stderr`` of the recommended
             estimator ``.best`` (the smallest error bar at the largest N among the estimators whose
-            flags do not say the bar is untrustworthy), each estimator by name (``result["sobol"]``),
+            flags do not say the bar is untrustworthy), each estimator by name
+        (``result["sobol"]``),
             ``.flags``, ``.levels``, ``.to_pandas()``, ``.plot()``, ``.stopping``, ``.raw``; its
             ``repr`` is the CLI's table.
 
@@ -218,7 +221,7 @@ def integrate(
 def _estimator_lines() -> str:
     """The presets and their one-line summaries, from the core's catalog."""
     try:
-        presets = from_json(_core.call("catalog", "{}"))["estimators"]
+        presets = from_json(_core.call("catalog", ""))["estimators"]
     except Exception as error:  # the docstring must not stop the import
         return f"        (the catalog could not be read: {error})\n"
     lines = []
@@ -236,4 +239,7 @@ def _estimator_lines() -> str:
 
 
 if integrate.__doc__:
-    integrate.__doc__ = integrate.__doc__.replace("{ESTIMATORS}\n", _estimator_lines())
+    _lines = _estimator_lines()
+    integrate.__doc__ = re.sub(
+        r"^[ \t]*\{ESTIMATORS\}\n", lambda _: _lines, integrate.__doc__, flags=re.M
+    )

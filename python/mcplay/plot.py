@@ -141,7 +141,7 @@ def _z_scores(e, exact: float | None) -> np.ndarray:
         reference = exact if exact is not None else level.get("mean")
         if not isinstance(reference, (int, float)):
             continue
-        for est, se in zip(rep.get("estimate") or [], rep.get("std_error") or []):
+        for est, se in zip(rep.get("estimate") or [], rep.get("std_error") or [], strict=False):
             if isinstance(est, (int, float)) and isinstance(se, (int, float)) and se > 0:
                 z.append((est - reference) / se)
     return np.array(z, dtype=float)

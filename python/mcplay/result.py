@@ -1,4 +1,4 @@
-"""The result of a study as Python objects: :class:`Result`, :class:`EstimatorResult`, :class:`Flag`.
+"""A study's result as Python objects: :class:`Result`, :class:`EstimatorResult`, :class:`Flag`.
 
 Every number is read from the core's result dict (``Result.raw``); nothing is recomputed but the
 95% half-width of an interval the core gives, (hi - lo) / 2.

@@ -233,7 +233,7 @@ def scene_info(scene: Any) -> dict:
 def catalog() -> dict:
     """What the core offers: estimator presets (name, kind, sampler, needs_pdf, summary), kinds,
     samplers, randomizations, pdfs, integrands, domains and named warps."""
-    return from_json(_core.call("catalog", "{}"))
+    return from_json(_core.call("catalog", ""))
 
 
 def estimators() -> list[dict]:
