@@ -47,8 +47,8 @@ DEP_PROBES := /usr/bin/cmake /usr/bin/g++ /usr/src/googletest/CMakeLists.txt \
 	/usr/include/gtest/gtest.h /usr/bin/em++ /usr/include/glm/glm.hpp /usr/include/stb/stb_image_write.h \
 	/usr/include/tiny_gltf.h /usr/include/nlohmann/json.hpp /usr/bin/chromium
 
-.PHONY: all deps deps-web build build-wasm site test test-native test-wasm test-wasm-statistical test-compare test-web-core \
-	test-e2e test-sanitize test-suites check run cli bench bench-mitsuba bench-embree format clean help \
+.PHONY: all deps deps-web deps-npm build build-wasm site test test-native test-wasm test-wasm-statistical test-compare test-web-core \
+	test-npm test-e2e test-sanitize test-suites check run cli bench bench-mitsuba bench-embree format clean help \
 	fuzz fuzz-build fuzz-smoke deps-fuzz
 
 all: build
@@ -58,6 +58,8 @@ help:
 	@echo "make cli    build the native CLI and run it on $(SCENE)"
 	@echo "make test   the contributor's loop: install what is missing, build native + wasm, run the"
 	@echo "           native, wasm, Node and Chromium suites (independent ones at the same time)"
+	@echo "make test-npm  the wasm core as the npm package mcplay: packed, installed from the tarball into an"
+	@echo "           empty folder, run there against the native CLI and in Chromium; its types checked"
 	@echo "make check  everything CI runs: make test, then the ASan/UBSan suite, make fuzz-smoke and the"
 	@echo "           statistical runs under Node (test-wasm-statistical)"
 	@echo "make bench  samples per second natively and in wasm under Node, and their ratio; then bench-genz"
@@ -68,6 +70,7 @@ help:
 	@echo "make bench-mitsuba  the renderer beside Mitsuba 3.9.1 on three glTF scenes: time, relMSE, efficiency (ARGS: --quick, --sobol, --scalar, --widths)"
 	@echo "make bench-embree  the accelerator beside Embree 3 (Debian's libembree-dev) on the same rays, one thread"
 	@echo "make format clang-format every C++ source"
+	@echo "make test-python  build the Python wheel, install it in a fresh venv, run python/tests (part of make check)"
 	@echo "make test-sanitize  the native ctest suite under ASan + UBSan ($(BUILD_ASAN); part of make check)"
 	@echo "make fuzz   libFuzzer targets, $(FUZZ_SECONDS) s each (FUZZ_TARGETS=\"$(FUZZ_TARGETS)\"); docs/fuzzing.md"
 	@echo "make fuzz-smoke  each fuzz target over its seed corpus only (seconds)"
@@ -91,14 +94,32 @@ web/node_modules/.package-lock.json: web/package.json web/package-lock.json | de
 	cd web && npm ci --no-audit --no-fund
 	@touch $@
 
+# ---------------------------------------------------------------------------
+# The Python package (pyproject.toml, src/python, python/). build/ also builds the extension
+# mcplay._core when the virtual environment $(PY_VENV) exists (`make deps-python`, which `make
+# test` runs first): ctest's python_smoke then imports it from the build tree. `make test-python`
+# (in `make check`) builds a wheel with pip, installs it in a fresh virtual environment with the
+# test extras and runs python/tests against the installed package.
+PY_VENV := $(BUILD)/py-venv
+PY_TEST_VENV := $(BUILD)/py-test-venv
+PY_WHEELHOUSE := $(BUILD)/wheelhouse
+# Expanded when a recipe runs, so that a venv made earlier in the same make counts.
+PY_CMAKE_FLAGS = $(if $(wildcard $(PY_VENV)/installed),-DMCPLAY_PYTHON=ON \
+	-DPython_EXECUTABLE=$(CURDIR)/$(PY_VENV)/bin/python \
+	-Dnanobind_DIR=$$($(PY_VENV)/bin/python -m nanobind --cmake_dir))
+
 # Order-only on deps: under make -j the configure step must wait for apt-get.
 $(BUILD)/CMakeCache.txt: | deps
-	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release
+	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release $(PY_CMAKE_FLAGS)
 
 $(BUILD_WASM)/CMakeCache.txt: | deps
 	emcmake cmake -S . -B $(BUILD_WASM) -DCMAKE_BUILD_TYPE=Release
 
 build: deps $(BUILD)/CMakeCache.txt
+	@if [ -e $(PY_VENV)/installed ] && ! grep -q '^MCPLAY_PYTHON:BOOL=ON' $(BUILD)/CMakeCache.txt; then \
+	  echo "build: $(PY_VENV) exists: configuring $(BUILD) with the Python extension"; \
+	  cmake -S . -B $(BUILD) $(PY_CMAKE_FLAGS); \
+	fi
 	cmake --build $(BUILD) -j $(JOBS)
 
 build-wasm: deps $(BUILD_WASM)/CMakeCache.txt
@@ -125,6 +146,29 @@ test-compare: build build-wasm
 test-web-core: build build-wasm deps-web
 	MCPLAY_WASM_DIR=$(BUILD_WASM) MCPLAY_NATIVE=$(BUILD)/mcplay node --test web/test/
 
+# TypeScript for checking the npm package's declarations, from npm/package-lock.json (a
+# devDependency of npm/ only: the package itself has no dependencies).
+deps-npm: npm/node_modules/.package-lock.json
+
+npm/node_modules/.package-lock.json: npm/package.json npm/package-lock.json | deps
+	cd npm && npm ci --no-audit --no-fund
+	@touch $@
+
+# The wasm core as the npm package "mcplay" (npm/README.md): staged from npm/, web/core.js,
+# web/render_core.js and the wasm build, packed (build-wasm/mcplay-<version>.tgz), installed from
+# the tarball into an empty folder with no registry, and run there by its package name against
+# the native CLI (npm/test/installed.test.mjs) and by URL in headless Chromium, in a page and a
+# module Worker (npm/test/browser.test.mjs, playwright-core from deps-web); its .d.ts files
+# type-checked with a user's code (npm/test/types_usage.ts).
+test-npm: build build-wasm deps-npm deps-web
+	cd npm && npx --no-install tsc -p test/tsconfig.json
+	@tgz=$$(node npm/tools/stage.mjs --wasm-dir $(BUILD_WASM)) && \
+	tmp=$$(mktemp -d) && trap 'rm -rf "$$tmp"' EXIT && \
+	cp npm/test/installed.test.mjs "$$tmp"/ && cd "$$tmp" && \
+	npm install --no-audit --no-fund --offline --loglevel=error "$$tgz" && \
+	MCPLAY_ROOT=$(CURDIR) MCPLAY_NATIVE=$(abspath $(BUILD))/mcplay \
+	  node --test installed.test.mjs $(CURDIR)/npm/test/browser.test.mjs
+
 # The playground: page, wasm module, uPlot and the scenes with their manifest.
 site: build build-wasm deps-web
 	node web/tools/build-site.mjs $(SITE) $(BUILD_WASM) $(BUILD)/mcplay
@@ -150,17 +194,18 @@ test-sanitize: deps $(BUILD_ASAN)/CMakeCache.txt
 TEST_JOBS ?= 2
 test:
 	@start=$$(date +%s); \
+	$(MAKE) --no-print-directory deps-python && \
 	$(MAKE) --no-print-directory -j $(TEST_JOBS) test-suites && \
 	echo "make test: all suites passed in $$(( $$(date +%s) - start )) s"
 
-test-suites: test-native test-wasm test-compare test-web-core test-e2e
+test-suites: test-native test-wasm test-compare test-web-core test-npm test-e2e
 
 # Everything: the loop, then the suites too slow for it (sanitizers; the fuzz targets, built with
 # clang, over their seed corpus and past findings). .ci/run runs this.
 check:
 	@start=$$(date +%s); \
 	$(MAKE) --no-print-directory test && \
-	$(MAKE) --no-print-directory -j 2 test-sanitize fuzz-smoke test-wasm-statistical && \
+	$(MAKE) --no-print-directory -j 2 test-sanitize fuzz-smoke test-wasm-statistical test-python && \
 	echo "make check: all suites passed in $$(( $$(date +%s) - start )) s"
 
 run: build site
@@ -304,6 +349,28 @@ deps-venv:
 	    echo "deps-venv: not root; run: sudo apt-get install -y --no-install-recommends python3-venv"; exit 1; \
 	  fi; \
 	fi
+
+# The build tree's Python: numpy, nanobind (the extension's build) and pytest.
+.PHONY: deps-python test-python
+deps-python: $(PY_VENV)/installed
+
+$(PY_VENV)/installed: | deps-venv
+	python3 -m venv $(PY_VENV)
+	$(PY_VENV)/bin/pip install -q numpy nanobind pytest
+	@touch $@
+
+# The wheel as a user gets it: built by pip from the project's own files (scikit-build-core and
+# nanobind from PyPI, in pip's isolated build environment; objects kept in build/skbuild), installed
+# with the test extras into a virtual environment made anew each run; pytest runs from a folder
+# outside the source tree, so `import mcplay` finds only the installed package.
+test-python: deps | deps-venv
+	rm -rf $(PY_TEST_VENV) $(PY_WHEELHOUSE)
+	python3 -m venv $(PY_TEST_VENV)
+	$(PY_TEST_VENV)/bin/pip wheel -q --no-deps -w $(PY_WHEELHOUSE) .
+	$(PY_TEST_VENV)/bin/pip install -q "$$(ls $(PY_WHEELHOUSE)/mcplay-*.whl)[test]"
+	mkdir -p $(BUILD)/py-test-run
+	cd $(BUILD)/py-test-run && MCPLAY_EXPECT_INSTALLED=1 $(CURDIR)/$(PY_TEST_VENV)/bin/python -m pytest \
+	  -p no:cacheprovider --import-mode=importlib --rootdir $(CURDIR) $(CURDIR)/python/tests
 
 $(QMC_VENV)/installed: | deps-venv
 	python3 -m venv $(QMC_VENV)
