@@ -13,6 +13,7 @@ import math
 import multiprocessing
 import os
 import pickle
+import signal
 import subprocess
 import sys
 from pathlib import Path
@@ -558,6 +559,21 @@ def test_errors_of_the_callable_name_the_block_and_keep_the_cause():
         mcplay.integrate(lambda x: x, dim=2, n=64, reps=2)
     with pytest.raises(mcplay.McplayError, match="nan"):
         mcplay.integrate(lambda x: np.full(len(x), np.nan), dim=2, n=64, reps=2)
+
+
+def test_ctrl_c_cancels_within_blocks():
+    calls = []
+
+    def f(x):
+        calls.append(len(x))
+        if len(calls) == 5:
+            signal.raise_signal(signal.SIGINT)  # as Ctrl-C does
+        return np.exp(x.sum(axis=1))
+
+    with pytest.raises(KeyboardInterrupt):
+        mcplay.integrate(f, dim=2, n=2**22, reps=32, estimators="uniform")
+    # the whole study would take 2^28 points; it stopped within a few blocks per thread
+    assert sum(calls) < 2**22
 
 
 def test_a_scene_may_name_the_callers_function():
