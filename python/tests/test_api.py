@@ -450,11 +450,6 @@ def test_progressive_sessions_close_when_dropped():
 # --- parts and merge -----------------------------------------------------------------------------
 
 
-def _part(args):
-    scene, kwargs, part = args
-    return mcplay.run(scene, part=part, **kwargs)
-
-
 STUDIES = [
     ("exp_1d", dict(n_max=512, reps=6)),
     ("exp_1d", dict(rel_tol=1e-2, reps=3, estimators=["uniform", "sobol"])),
@@ -482,9 +477,11 @@ def pool():
 @pytest.mark.parametrize("scene,kwargs", STUDIES, ids=["ladder", "stopping", "render"])
 def test_parts_over_a_process_pool_merge_bit_for_bit(pool, scene, kwargs):
     k = 3
-    parts = list(
-        pool.map(_part, [(str(SCENES / f"{scene}.json"), kwargs, (i, k)) for i in range(k)])
-    )
+    # mcplay.run itself goes to the workers (a function of the test module would not unpickle
+    # where pytest imports it under another name)
+    futures = [pool.submit(mcplay.run, str(SCENES / f"{scene}.json"), part=(i, k), **kwargs)
+               for i in range(k)]
+    parts = [future.result() for future in futures]
     assert all(p.get("part", {}).get("of") == k for p in parts)
     merged = mcplay.merge(reversed(parts))
     whole = mcplay.run(scene, **kwargs)
