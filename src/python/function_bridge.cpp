@@ -258,6 +258,12 @@ std::string CallState::evaluate(Slot& slot, const double* x, uint64_t n, int in_
     try {
         returned = slot.callable(input.array);
     } catch (nb::python_error& e) {
+        if (!e.matches(PyExc_Exception)) {
+            // KeyboardInterrupt, SystemExit: not the function's failure; raised as they are.
+            if (!pending_) pending_.emplace(std::move(e));
+            cancel_ = true;
+            return "was interrupted";
+        }
         cause = nb::borrow(e.value());
         std::string where = n == 0 ? "on an empty block"
                                    : "at the block's first point " + point_text(x, in_dim);
