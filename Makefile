@@ -363,13 +363,15 @@ $(PY_VENV)/installed: | deps-venv
 # nanobind from PyPI, in pip's isolated build environment; objects kept in build/skbuild), installed
 # with the test extras into a virtual environment made anew each run; pytest runs from a folder
 # outside the source tree, so `import mcplay` finds only the installed package.
-test-python: deps | deps-venv
+# The native CLI is built first: the tests compare the package's numbers with its output.
+test-python: build | deps-venv
 	rm -rf $(PY_TEST_VENV) $(PY_WHEELHOUSE)
 	python3 -m venv $(PY_TEST_VENV)
 	$(PY_TEST_VENV)/bin/pip wheel -q --no-deps -w $(PY_WHEELHOUSE) .
 	$(PY_TEST_VENV)/bin/pip install -q "$$(ls $(PY_WHEELHOUSE)/mcplay-*.whl)[test]"
 	mkdir -p $(BUILD)/py-test-run
-	cd $(BUILD)/py-test-run && MCPLAY_EXPECT_INSTALLED=1 $(CURDIR)/$(PY_TEST_VENV)/bin/python -m pytest \
+	cd $(BUILD)/py-test-run && MCPLAY_EXPECT_INSTALLED=1 MCPLAY_CLI=$(CURDIR)/$(BUILD)/mcplay \
+	  $(CURDIR)/$(PY_TEST_VENV)/bin/python -m pytest -rs \
 	  -p no:cacheprovider --import-mode=importlib --rootdir $(CURDIR) $(CURDIR)/python/tests
 
 $(QMC_VENV)/installed: | deps-venv
