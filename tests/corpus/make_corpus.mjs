@@ -136,6 +136,11 @@ scene('estimator_per_stratum_3', withf({ estimators: [{ name: 'a', sampler: 'str
 scene('estimator_per_stratum_indep', withf({ estimators: [{ name: 'a', sampler: 'independent', samples_per_stratum: 2 }] }), 'stratified sampler only');
 scene('estimator_warp_box', withf({ estimators: [{ name: 'a', sampler: 'independent', warp: 'polar' }] }), 'warp');
 scene('estimator_warp_bad', { f: '1', domain: { type: 'disk' }, estimators: [{ name: 'a', sampler: 'independent', warp: 'spiral' }] }, "unknown warp 'spiral'");
+// A caller's function reaches the core only through the library (Python, mcp_study_run_with).
+scene('function_integrand_no_functions', { integrand: { type: 'function', name: 'f' }, domain: { type: 'box', dim: 2 } }, 'given no functions');
+scene('function_integrand_no_name', { integrand: { type: 'function' }, domain: { type: 'box', dim: 2 } }, 'expected the name of a function');
+scene('function_integrand_dim_0', { integrand: { type: 'function', name: 'f', dim: 0 } }, 'expected 1 to 64');
+scene('function_warp_no_functions', { f: 'x', warp: { domain: { type: 'disk' }, g: { function: 'g' }, p: '1/pi' } }, 'given no functions');
 scene('importance_no_pdf', withf({ estimators: ['importance'] }), 'needs a pdf');
 // domains
 scene('domain_unknown', withf({ domain: { type: 'torus' } }), "unknown domain 'torus'");
