@@ -47,8 +47,8 @@ DEP_PROBES := /usr/bin/cmake /usr/bin/g++ /usr/src/googletest/CMakeLists.txt \
 	/usr/include/gtest/gtest.h /usr/bin/em++ /usr/include/glm/glm.hpp /usr/include/stb/stb_image_write.h \
 	/usr/include/tiny_gltf.h /usr/include/nlohmann/json.hpp /usr/bin/chromium
 
-.PHONY: all deps deps-web build build-wasm site test test-native test-wasm test-wasm-statistical test-compare test-web-core \
-	test-e2e test-sanitize test-suites check run cli bench bench-mitsuba bench-embree format clean help \
+.PHONY: all deps deps-web deps-npm build build-wasm site test test-native test-wasm test-wasm-statistical test-compare test-web-core \
+	test-npm test-e2e test-sanitize test-suites check run cli bench bench-mitsuba bench-embree format clean help \
 	fuzz fuzz-build fuzz-smoke deps-fuzz
 
 all: build
@@ -58,6 +58,8 @@ help:
 	@echo "make cli    build the native CLI and run it on $(SCENE)"
 	@echo "make test   the contributor's loop: install what is missing, build native + wasm, run the"
 	@echo "           native, wasm, Node and Chromium suites (independent ones at the same time)"
+	@echo "make test-npm  the wasm core as the npm package mcplay: packed, installed from the tarball into an"
+	@echo "           empty folder, run there against the native CLI and in Chromium; its types checked"
 	@echo "make check  everything CI runs: make test, then the ASan/UBSan suite, make fuzz-smoke and the"
 	@echo "           statistical runs under Node (test-wasm-statistical)"
 	@echo "make bench  samples per second natively and in wasm under Node, and their ratio; then bench-genz"
@@ -125,6 +127,29 @@ test-compare: build build-wasm
 test-web-core: build build-wasm deps-web
 	MCPLAY_WASM_DIR=$(BUILD_WASM) MCPLAY_NATIVE=$(BUILD)/mcplay node --test web/test/
 
+# TypeScript for checking the npm package's declarations, from npm/package-lock.json (a
+# devDependency of npm/ only: the package itself has no dependencies).
+deps-npm: npm/node_modules/.package-lock.json
+
+npm/node_modules/.package-lock.json: npm/package.json npm/package-lock.json | deps
+	cd npm && npm ci --no-audit --no-fund
+	@touch $@
+
+# The wasm core as the npm package "mcplay" (npm/README.md): staged from npm/, web/core.js,
+# web/render_core.js and the wasm build, packed (build-wasm/mcplay-<version>.tgz), installed from
+# the tarball into an empty folder with no registry, and run there by its package name against
+# the native CLI (npm/test/installed.test.mjs) and by URL in headless Chromium, in a page and a
+# module Worker (npm/test/browser.test.mjs, playwright-core from deps-web); its .d.ts files
+# type-checked with a user's code (npm/test/types_usage.ts).
+test-npm: build build-wasm deps-npm deps-web
+	cd npm && npx --no-install tsc -p test/tsconfig.json
+	@tgz=$$(node npm/tools/stage.mjs --wasm-dir $(BUILD_WASM)) && \
+	tmp=$$(mktemp -d) && trap 'rm -rf "$$tmp"' EXIT && \
+	cp npm/test/installed.test.mjs "$$tmp"/ && cd "$$tmp" && \
+	npm install --no-audit --no-fund --offline --loglevel=error "$$tgz" && \
+	MCPLAY_ROOT=$(CURDIR) MCPLAY_NATIVE=$(abspath $(BUILD))/mcplay \
+	  node --test installed.test.mjs $(CURDIR)/npm/test/browser.test.mjs
+
 # The playground: page, wasm module, uPlot and the scenes with their manifest.
 site: build build-wasm deps-web
 	node web/tools/build-site.mjs $(SITE) $(BUILD_WASM) $(BUILD)/mcplay
@@ -153,7 +178,7 @@ test:
 	$(MAKE) --no-print-directory -j $(TEST_JOBS) test-suites && \
 	echo "make test: all suites passed in $$(( $$(date +%s) - start )) s"
 
-test-suites: test-native test-wasm test-compare test-web-core test-e2e
+test-suites: test-native test-wasm test-compare test-web-core test-npm test-e2e
 
 # Everything: the loop, then the suites too slow for it (sanitizers; the fuzz targets, built with
 # clang, over their seed corpus and past findings). .ci/run runs this.

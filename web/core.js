@@ -12,9 +12,9 @@
 // (wasmBridge, instantiate) is shared with render_core.js, the wrapper of the render module.
 
 /** Status codes of src/api/mcplay.h (enum mcp_status). */
-export const Status = Object.freeze({ OK: 0, ARGUMENT: 1, SCENE: 2, CANCELLED: 3, INTERNAL: 4 });
+export const Status = Object.freeze({ OK: 0, ARGUMENT: 1, SCENE: 2, CANCELLED: 3, INTERNAL: 4, FUNCTION: 5 });
 
-const STATUS_NAMES = Object.freeze(['OK', 'ARGUMENT', 'SCENE', 'CANCELLED', 'INTERNAL']);
+const STATUS_NAMES = Object.freeze(['OK', 'ARGUMENT', 'SCENE', 'CANCELLED', 'INTERNAL', 'FUNCTION']);
 
 /** A failed C call: `status` is the C status code, `message` the C API's mcp_last_error(). */
 export class McplayError extends Error {

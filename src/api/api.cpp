@@ -21,8 +21,10 @@ using mcp::boundary::g_last_error;
 
 namespace {
 
-/// The start of a study call: the scene and the options parsed and turned into a request.
-int load_request(const char* scene_json, const char* options_json, mcp::SceneRequest* out) {
+/// The start of a study call: the scene and the options parsed and turned into a request (which
+/// may name the caller's functions).
+int load_request(const char* scene_json, const char* options_json, mcp::SceneRequest* out,
+                 const mcp::CallerFunctions* functions = nullptr) {
     mcp::Made<mcp::Json> scene = mcp::parse_json(scene_json, "scene");
     if (!scene.ok()) return fail(MCP_ERROR_SCENE, scene.error);
     mcp::Json options;
@@ -31,11 +33,24 @@ int load_request(const char* scene_json, const char* options_json, mcp::SceneReq
         if (!o.ok()) return fail(MCP_ERROR_ARGUMENT, o.error);
         options = o.value;
     }
-    mcp::Made<mcp::SceneRequest> req = mcp::build_request(scene.value, options);
+    mcp::Made<mcp::SceneRequest> req = mcp::build_request(scene.value, options, functions);
     if (!req.ok()) return mcp::boundary::request_error(req.error);
     *out = std::move(req.value);
     return MCP_OK;
 }
+
+/// The caller's functions of a context, or the status of a bad context.
+int load_functions(const mcp_context* ctx, mcp::CallerFunctions* out) {
+    mcp::Made<mcp::CallerFunctions> made = mcp::caller_functions(ctx);
+    if (!made.ok()) return fail(MCP_ERROR_ARGUMENT, made.error);
+    *out = std::move(made.value);
+    return MCP_OK;
+}
+
+int run_study_call(const char* scene_json, const char* options_json, const mcp_context* ctx,
+              mcp_progress_fn progress, void* user, char** result_json);
+int plan_study_call(const char* scene_json, const char* options_json, const mcp_context* ctx,
+               char** plan_json);
 
 } // namespace
 
@@ -55,8 +70,33 @@ void mcp_free(char* p) {
 
 int mcp_study_run(const char* scene_json, const char* options_json, mcp_progress_fn progress,
                   void* user, char** result_json) {
+    return run_study_call(scene_json, options_json, nullptr, progress, user, result_json);
+}
+
+int mcp_study_run_with(const char* scene_json, const char* options_json, const mcp_context* ctx,
+                       mcp_progress_fn progress, void* user, char** result_json) {
+    return run_study_call(scene_json, options_json, ctx, progress, user, result_json);
+}
+
+int mcp_study_plan(const char* scene_json, const char* options_json, char** plan_json) {
+    return plan_study_call(scene_json, options_json, nullptr, plan_json);
+}
+
+int mcp_study_plan_with(const char* scene_json, const char* options_json, const mcp_context* ctx,
+                        char** plan_json) {
+    return plan_study_call(scene_json, options_json, ctx, plan_json);
+}
+
+} // extern "C"
+
+namespace {
+
+int run_study_call(const char* scene_json, const char* options_json, const mcp_context* ctx,
+              mcp_progress_fn progress, void* user, char** result_json) {
     if (!result_json) return fail(MCP_ERROR_ARGUMENT, "mcp_study_run: result_json is NULL");
     *result_json = nullptr;
+    mcp::CallerFunctions functions;
+    if (int st = load_functions(ctx, &functions)) return st;
     // A part of a study split over processes (options.part of options.parts): the study
     // without them, restricted to the replicates r with r % parts == part (study_parts.h).
     mcp::Json options = mcp::Json::object();
@@ -75,7 +115,7 @@ int mcp_study_run(const char* scene_json, const char* options_json, mcp_progress
         options.erase("parts");
         const std::string rest = options.dump();
         mcp::SceneRequest req;
-        if (int st = load_request(scene_json, rest.c_str(), &req)) return st;
+        if (int st = load_request(scene_json, rest.c_str(), &req, &functions)) return st;
         const int reps = req.settings.reps;
         if (parts < 1 || parts > uint64_t(std::min(reps, mcp::kMaxStudyParts)))
             return fail(MCP_ERROR_ARGUMENT,
@@ -88,19 +128,24 @@ int mcp_study_run(const char* scene_json, const char* options_json, mcp_progress
                             ", got " + std::to_string(part));
         mcp::Made<mcp::Json> scene = mcp::parse_json(scene_json, "scene");
         if (!scene.ok()) return fail(MCP_ERROR_SCENE, scene.error);
-        *result_json =
-            copy_out(dump(mcp::run_study_part(req, scene.value, options, int(part), int(parts))));
+        const mcp::Json part_result =
+            mcp::run_study_part(req, scene.value, options, int(part), int(parts));
+        // A part cut short by the caller is no part: nothing to merge.
+        if (int st = mcp::caller_outcome(functions)) return st;
+        *result_json = copy_out(dump(part_result));
         if (!*result_json) return fail(MCP_ERROR_INTERNAL, "out of memory writing the result");
         g_last_error.clear();
         return MCP_OK;
     }
     mcp::SceneRequest req;
-    if (int st = load_request(scene_json, options_json, &req)) return st;
+    if (int st = load_request(scene_json, options_json, &req, &functions)) return st;
 
     if (req.settings.stopping()) {
         // Stopping at a requested accuracy: no N ladder, so no per-level progress.
         const mcp::StoppingStudy st =
             mcp::run_stopping_study(req.problem, req.estimators, req.settings);
+        // Answers cut short by the caller are no answers: no result.
+        if (int status = mcp::caller_outcome(functions)) return status;
         *result_json = copy_out(dump(mcp::stopping_to_json(st)));
         if (!*result_json) return fail(MCP_ERROR_INTERNAL, "out of memory writing the result");
         g_last_error.clear();
@@ -114,34 +159,29 @@ int mcp_study_run(const char* scene_json, const char* options_json, mcp_progress
         };
     }
     mcp::StudyResult result = mcp::run_study(req.problem, req.estimators, req.settings, on_level);
+    // A failed function's numbers are not the function's: no result. A cancel keeps the levels
+    // completed before it, as a cancelling progress callback does.
+    if (functions.control && functions.control->failed()) return mcp::caller_outcome(functions);
     *result_json = copy_out(dump(mcp::study_to_json(result)));
     if (!*result_json) return fail(MCP_ERROR_INTERNAL, "out of memory writing the result");
+    if (int st = mcp::caller_outcome(functions)) return st;
     if (result.cancelled) return fail(MCP_ERROR_CANCELLED, "study cancelled by the caller");
     g_last_error.clear();
     return MCP_OK;
 }
 
-int mcp_study_merge(const char* parts_json, char** result_json) {
-    if (!result_json) return fail(MCP_ERROR_ARGUMENT, "mcp_study_merge: result_json is NULL");
-    *result_json = nullptr;
-    mcp::Made<mcp::Json> in = mcp::parse_json(parts_json, "parts");
-    if (!in.ok()) return fail(MCP_ERROR_ARGUMENT, in.error);
-    mcp::Ctx c;
-    mcp::Json merged;
-    if (!mcp::merge_study_parts(c, in.value, &merged)) return fail(MCP_ERROR_ARGUMENT, c.error);
-    *result_json = copy_out(dump(merged));
-    if (!*result_json) return fail(MCP_ERROR_INTERNAL, "out of memory writing the result");
-    g_last_error.clear();
-    return MCP_OK;
-}
 
-int mcp_study_plan(const char* scene_json, const char* options_json, char** plan_json) {
+int plan_study_call(const char* scene_json, const char* options_json, const mcp_context* ctx,
+               char** plan_json) {
     if (!plan_json) return fail(MCP_ERROR_ARGUMENT, "mcp_study_plan: plan_json is NULL");
     *plan_json = nullptr;
+    mcp::CallerFunctions functions;
+    if (int st = load_functions(ctx, &functions)) return st;
     mcp::SceneRequest req;
-    if (int st = load_request(scene_json, options_json, &req)) return st;
+    if (int st = load_request(scene_json, options_json, &req, &functions)) return st;
     const mcp::StudySettings& s = req.settings;
     const mcp::StudyPlan plan = mcp::plan_study(req.problem, req.estimators, s);
+    if (int st = mcp::caller_outcome(functions)) return st;
     mcp::Json estimators = mcp::Json::array();
     for (const mcp::EstimatorPlan& e : plan.estimators)
         estimators.push_back({{"name", e.name},
@@ -162,6 +202,24 @@ int mcp_study_plan(const char* scene_json, const char* options_json, char** plan
                   {"estimators", estimators}};
     *plan_json = copy_out(dump(out));
     if (!*plan_json) return fail(MCP_ERROR_INTERNAL, "out of memory writing the plan");
+    g_last_error.clear();
+    return MCP_OK;
+}
+
+} // namespace
+
+extern "C" {
+
+int mcp_study_merge(const char* parts_json, char** result_json) {
+    if (!result_json) return fail(MCP_ERROR_ARGUMENT, "mcp_study_merge: result_json is NULL");
+    *result_json = nullptr;
+    mcp::Made<mcp::Json> in = mcp::parse_json(parts_json, "parts");
+    if (!in.ok()) return fail(MCP_ERROR_ARGUMENT, in.error);
+    mcp::Ctx c;
+    mcp::Json merged;
+    if (!mcp::merge_study_parts(c, in.value, &merged)) return fail(MCP_ERROR_ARGUMENT, c.error);
+    *result_json = copy_out(dump(merged));
+    if (!*result_json) return fail(MCP_ERROR_INTERNAL, "out of memory writing the result");
     g_last_error.clear();
     return MCP_OK;
 }

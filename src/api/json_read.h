@@ -29,9 +29,12 @@ std::string check_json_text(const char* text, size_t size, const char* root = "$
 /// message starts with `what`.
 Made<Json> parse_json(const char* text, const char* what);
 
-// Records the first error as "path: message".
+struct CallerFunctions; // api/caller_functions.h
+
+// Records the first error as "path: message"; carries the caller's functions a scene may name.
 struct Ctx {
     std::string error;
+    const CallerFunctions* functions = nullptr; ///< null: the call was given none
     bool fail(const std::string& path, const std::string& msg) {
         if (error.empty()) error = path + ": " + msg;
         return false;

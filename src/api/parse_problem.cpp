@@ -6,6 +6,7 @@
 #include <limits>
 #include <sstream>
 
+#include "api/caller_functions.h"
 #include "api/scene_parsers.h"
 #include "core/special.h"
 #include "integrands/expression.h"
@@ -204,7 +205,23 @@ namespace {
 
 constexpr const char* kIntegrandTypes =
     "constant, monomial, exponential, gaussian, indicator_ball, expression, genz_oscillatory, "
-    "genz_product_peak, genz_corner_peak, genz_gaussian, genz_continuous, genz_discontinuous";
+    "genz_product_peak, genz_corner_peak, genz_gaussian, genz_continuous, genz_discontinuous, "
+    "function (a caller's)";
+
+/// {"type": "function", "name": N, "dim"?}: the caller's function N (api/caller_functions.h).
+bool parse_function_integrand(Ctx& c, const Json& j, const std::string& path, int dim,
+                              Integrand* out) {
+    if (!check_keys(c, j, path, {"type", "name", "dim"})) return false;
+    std::shared_ptr<const CallerFunction> fn;
+    if (!find_caller_function(c, j, "name", path, &fn)) return false;
+    uint64_t given = 0;
+    if (!get_count(c, j, "dim", path, &given)) return false;
+    if (find(j, "dim") && given != static_cast<uint64_t>(dim))
+        return c.fail(sub(path, "dim"), "is " + std::to_string(given) + ", but the domain's points have " +
+                                            std::to_string(dim) + " coordinates");
+    *out = make_function_integrand(std::move(fn), dim);
+    return true;
+}
 
 bool parse_expression(Ctx& c, const Json& text, const std::string& path, int dim, Integrand* out) {
     if (!text.is_string())
@@ -299,6 +316,24 @@ bool parse_genz(Ctx& c, const Json& j, const std::string& path, GenzFamily famil
 
 } // namespace
 
+bool find_caller_function(Ctx& c, const Json& j, const char* key, const std::string& path,
+                          std::shared_ptr<const CallerFunction>* out) {
+    std::string name;
+    if (!get_string(c, j, key, path, &name)) return false;
+    if (name.empty()) return c.fail(sub(path, key), "expected the name of a function the caller gave");
+    if (!c.functions || c.functions->list.empty())
+        return c.fail(sub(path, key),
+                      "names the caller's function '" + name_text(name) +
+                          "', but this call was given no functions (a caller's function reaches "
+                          "mcplay through its library: Python's mcplay.integrate, or "
+                          "mcp_study_run_with in C)");
+    *out = c.functions->find(name);
+    if (!*out)
+        return c.fail(sub(path, key), "no function named '" + name_text(name) +
+                                          "' was given (given: " + c.functions->names() + ")");
+    return true;
+}
+
 bool parse_integrand(Ctx& c, const Json& j, const std::string& path, int dim, Integrand* out) {
     if (j.is_string()) return parse_expression(c, j, path, dim, out);
     if (!j.is_object())
@@ -307,6 +342,7 @@ bool parse_integrand(Ctx& c, const Json& j, const std::string& path, int dim, In
     if (!get_string(c, j, "type", path, &type)) return false;
     if (type.empty())
         return c.fail(path, std::string("missing \"type\" (") + kIntegrandTypes + ")");
+    if (type == "function") return parse_function_integrand(c, j, path, dim, out);
     if (type == "expression") {
         if (!check_keys(c, j, path, {"type", "f"})) return false;
         const Json* text = find(j, "f");
@@ -365,6 +401,15 @@ bool integrand_dimension(Ctx& c, const Json& j, const std::string& path, int* ou
     for (const char* key : kDimensionArrays)
         if (const Json* v = find(j, key); v && v->is_array() && !v->empty())
             *out = static_cast<int>(v->size());
+    if (const Json* type = find(j, "type"); type && *type == "function") {
+        uint64_t dim = 1;
+        if (!get_count(c, j, "dim", path, &dim)) return false;
+        if (dim < 1 || dim > uint64_t(kMaxDim))
+            return c.fail(sub(path, "dim"), "expected 1 to " + std::to_string(kMaxDim) + ", got " +
+                                                std::to_string(dim));
+        *out = static_cast<int>(dim);
+        return true;
+    }
     int dim = 0;
     bool given = false;
     if (!get_genz_dim(c, j, path, &dim, &given)) return false;

@@ -84,7 +84,8 @@ bool parse_warp(Ctx& c, const Json& j, const std::string& path, NamedWarp* out) 
         *out = std::move(w.value);
         return true;
     }
-    // Typed: {"domain", "g": [one expression per coordinate of x] (a string in 1-D), "p"}.
+    // Typed: {"domain", "g": [one expression per coordinate of x] (a string in 1-D), "p"}; g or
+    // p may instead name a caller's function ({"function": N}; g also "sample_dim").
     if (!check_keys(c, j, path, {"domain", "g", "p"})) return false;
     const Json* g = find(j, "g");
     const Json* p = find(j, "p");
@@ -93,7 +94,17 @@ bool parse_warp(Ctx& c, const Json& j, const std::string& path, NamedWarp* out) 
                             "(its density in x, y, z), or \"name\": one of " +
                                 named_warp_names());
     std::vector<std::string> g_texts;
-    if (g->is_string()) {
+    std::shared_ptr<const CallerFunction> g_function, p_function;
+    uint64_t g_sample_dim = 0;
+    if (g->is_object()) {
+        if (!check_keys(c, *g, sub(path, "g"), {"function", "sample_dim"}) ||
+            !find_caller_function(c, *g, "function", sub(path, "g"), &g_function) ||
+            !get_count(c, *g, "sample_dim", sub(path, "g"), &g_sample_dim))
+            return false;
+        if (!find(j, "domain"))
+            return c.fail(path, "a warp whose g is a function needs \"domain\" (where g's points "
+                                "land)");
+    } else if (g->is_string()) {
         g_texts.push_back(g->get<std::string>());
     } else if (g->is_array() && !g->empty() && g->size() <= size_t(kMaxWarpDim)) {
         for (size_t i = 0; i < g->size(); ++i) {
@@ -104,10 +115,17 @@ bool parse_warp(Ctx& c, const Json& j, const std::string& path, NamedWarp* out) 
         }
     } else {
         return c.fail(sub(path, "g"), "expected 1 to " + std::to_string(kMaxWarpDim) +
-                                          " expressions, one per coordinate of x");
+                                          " expressions, one per coordinate of x, or "
+                                          "{\"function\": name}");
     }
-    if (!p->is_string())
-        return c.fail(sub(path, "p"), "expected an expression string, got " + type_of(*p));
+    if (p->is_object()) {
+        if (!check_keys(c, *p, sub(path, "p"), {"function"}) ||
+            !find_caller_function(c, *p, "function", sub(path, "p"), &p_function))
+            return false;
+    } else if (!p->is_string()) {
+        return c.fail(sub(path, "p"),
+                      "expected an expression string or {\"function\": name}, got " + type_of(*p));
+    }
     Domain domain;
     if (const Json* d = find(j, "domain")) {
         if (!parse_domain(c, *d, sub(path, "domain"), static_cast<int>(g_texts.size()), &domain))
@@ -118,12 +136,19 @@ bool parse_warp(Ctx& c, const Json& j, const std::string& path, NamedWarp* out) 
         if (!unit.ok()) return c.fail(path, unit.error);
         domain = unit.value;
     }
-    if (static_cast<int>(g_texts.size()) != domain.point_dim())
+    if (g_function && g_sample_dim != 0 && g_sample_dim != uint64_t(domain.sample_dim()))
+        return c.fail(sub(sub(path, "g"), "sample_dim"),
+                      "is " + std::to_string(g_sample_dim) + ", but warps onto the " +
+                          domain.describe() + " read " + std::to_string(domain.sample_dim()) +
+                          " unit-cube coordinates");
+    if (!g_function && static_cast<int>(g_texts.size()) != domain.point_dim())
         return c.fail(sub(path, "g"), "has " + std::to_string(g_texts.size()) +
                                           " expressions, but points of the " + domain.describe() +
                                           " have " + std::to_string(domain.point_dim()) +
                                           " coordinates");
-    Made<Warp> w = make_expression_warp(domain, g_texts, p->get<std::string>());
+    Made<Warp> w = make_typed_warp(domain, g_texts, g_function, p_function ? std::string()
+                                                                         : p->get<std::string>(),
+                                   p_function);
     if (!w.ok()) return c.fail(path, w.error);
     out->warp = std::move(w.value);
     out->domain = domain;

@@ -24,9 +24,12 @@ Json warp_estimator(const Json& warp) {
 
 } // namespace
 
-Made<SceneRequest> build_request(const Json& scene, const Json& options) {
+Made<SceneRequest> build_request(const Json& scene, const Json& options,
+                                 const CallerFunctions* functions) {
     Ctx c;
+    c.functions = functions;
     SceneRequest req;
+    if (functions) req.problem.control = functions->control;
     const std::string path = "scene";
     if (!check_keys(c, scene, path,
                     {"name", "description", "domain", "integrand", "f", "quantity", "exact",

@@ -8,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "api/caller_functions.h"
 #include "api/json_read.h"
 #include "core/made.h"
 #include "estimators/diagnostics.h"
@@ -24,8 +25,10 @@ struct SceneRequest {
     StudySettings settings;
 };
 
-/// Builds a study request from a scene and optional overrides (either may be null JSON).
-Made<SceneRequest> build_request(const Json& scene, const Json& options);
+/// Builds a study request from a scene and optional overrides (either may be null JSON). With
+/// the caller's functions, the scene may name them, and the problem carries their control.
+Made<SceneRequest> build_request(const Json& scene, const Json& options,
+                                 const CallerFunctions* functions = nullptr);
 
 /// The estimator a preset name gives on a problem (as options.estimators would run it),
 /// without building the scene again; an error when it does not apply.

@@ -5,6 +5,7 @@
 // the JSON path of the offending field and what was expected. Internal to the C API.
 #pragma once
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -20,6 +21,10 @@ std::string number_text(double x);
 
 /// A "domain" object; `default_dim` for boxes without bounds.
 bool parse_domain(Ctx& c, const Json& j, const std::string& path, int default_dim, Domain* out);
+/// The caller's function that j[key] names (an error when the call was given none of that
+/// name).
+bool find_caller_function(Ctx& c, const Json& j, const char* key, const std::string& path,
+                          std::shared_ptr<const CallerFunction>* out);
 /// An integrand object or expression string over points of dimension `dim`.
 bool parse_integrand(Ctx& c, const Json& j, const std::string& path, int dim, Integrand* out);
 /// The dimension an integrand asks for when the scene gives no domain: the length of its

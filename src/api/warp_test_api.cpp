@@ -4,6 +4,7 @@
 #include <string>
 
 #include "api/boundary.h"
+#include "api/caller_functions.h"
 #include "api/json_read.h"
 #include "api/mcplay.h"
 #include "api/report.h"
@@ -107,8 +108,15 @@ Json warp_test_to_json(const WarpTestResult& r, const Warp& warp, const Domain& 
 } // namespace mcp
 
 extern "C" int mcp_warp_test(const char* scene_json, const char* options_json, char** result_json) {
+    return mcp_warp_test_with(scene_json, options_json, nullptr, result_json);
+}
+
+extern "C" int mcp_warp_test_with(const char* scene_json, const char* options_json,
+                                  const mcp_context* ctx, char** result_json) {
     if (!result_json) return fail(MCP_ERROR_ARGUMENT, "mcp_warp_test: result_json is NULL");
     *result_json = nullptr;
+    mcp::Made<mcp::CallerFunctions> functions = mcp::caller_functions(ctx);
+    if (!functions.ok()) return fail(MCP_ERROR_ARGUMENT, functions.error);
     mcp::Made<mcp::Json> scene = mcp::parse_json(scene_json, "scene");
     if (!scene.ok()) return fail(MCP_ERROR_SCENE, scene.error);
     mcp::Ctx c;
@@ -124,8 +132,11 @@ extern "C" int mcp_warp_test(const char* scene_json, const char* options_json, c
     if (!warp)
         return fail(MCP_ERROR_SCENE, "scene: no \"warp\" to test (docs/scene-format.md, Warps)");
     mcp::NamedWarp w;
+    c.functions = &functions.value;
     if (!mcp::parse_warp(c, *warp, "scene.warp", &w)) return fail(MCP_ERROR_SCENE, c.error);
     mcp::Made<mcp::WarpTestResult> r = mcp::run_warp_test(w.domain, w.warp, options);
+    // A function that failed (or a cancel) stopped the test: its numbers are not the warp's.
+    if (int st = mcp::caller_outcome(functions.value)) return st;
     if (!r.ok()) return fail(MCP_ERROR_SCENE, "scene.warp: " + r.error);
     *result_json = copy_out(dump(mcp::warp_test_to_json(r.value, w.warp, w.domain, options)));
     if (!*result_json) return fail(MCP_ERROR_INTERNAL, "out of memory writing the result");

@@ -25,10 +25,26 @@
 
 namespace mcp {
 
+/// Points per call of a caller's function (IntegrandKind::Function): a Python callable costs
+/// microseconds per call whatever its size, so its blocks are made ahead in batches of this many
+/// points and the function is called once per batch (FunctionBatch).
+constexpr size_t kFunctionBatch = 16 * kBlockSize;
+
+/// The batch of samples made ahead for a caller's function: the samples begin .. end - 1 of one
+/// run's plan, generated and warped block by block as sample_block makes them, then evaluated in
+/// one call.
+struct FunctionBatch {
+    PointBlock u, x;
+    std::vector<double> pdf, f;
+    uint64_t begin = 0, end = 0; ///< empty when begin == end
+    void clear() { begin = end = 0; }
+};
+
 /// Buffers reused across runs so that a run allocates nothing per block.
 struct Workspace {
     PointBlock u, x;
     std::vector<double> pdf, f;
+    FunctionBatch batch; ///< used for caller's functions only
 };
 
 /// One block of samples: unit-cube points u, domain points x, densities pdf, values f.
@@ -50,20 +66,29 @@ void prepare_workspace(const Domain& domain, Workspace& ws);
 SampleBlock sample_block(const Problem& problem, const Proposal& proposal, const SamplerPlan& plan,
                          uint64_t first, size_t count, Workspace& ws);
 
+/// sample_block for a run whose integrand may be a caller's function: the same samples, but for
+/// a function they come from a batch of kFunctionBatch made ahead (and evaluated in one call)
+/// starting at `first` when the batch does not hold them. Blocks must come in increasing order
+/// within a run, and ws.batch must be cleared when a run begins.
+SampleBlock sample_block_batched(const Problem& problem, const Proposal& proposal,
+                                 const SamplerPlan& plan, uint64_t first, size_t count,
+                                 Workspace& ws);
+
 /// The workspace's current buffers as the block of samples first .. first + count - 1.
 SampleBlock block_of(Workspace& ws, uint64_t first, size_t count);
 
-/// Samples 0 .. plan.total - 1 of the plan, block by block, calling consume(const SampleBlock&)
-/// for each.
+/// Samples 0 .. plan.total - 1 of the plan, block by block (a caller's function evaluated in
+/// batches), calling consume(const SampleBlock&) for each.
 template <class Consume>
 void for_each_block(const Problem& problem, const Proposal& proposal, const SamplerPlan& plan,
                     Workspace& ws, Consume&& consume) {
     prepare_workspace(problem.domain, ws);
+    ws.batch.clear();
     const uint64_t n = plan.total;
     for (uint64_t first = 0; first < n; first += kBlockSize) {
         const size_t count = static_cast<size_t>(std::min<uint64_t>(kBlockSize, n - first));
         consume(static_cast<const SampleBlock&>(
-            sample_block(problem, proposal, plan, first, count, ws)));
+            sample_block_batched(problem, proposal, plan, first, count, ws)));
     }
 }
 

@@ -27,11 +27,13 @@ class FixedEstimator final : public EstimatorAlgorithm {
         if (next_ >= plan_.total) return false;
         if (!prepared_) {
             prepare_workspace(problem_.domain, ws);
+            ws.batch.clear();
             prepared_ = true;
         }
         const size_t count =
             static_cast<size_t>(std::min<uint64_t>(kBlockSize, plan_.total - next_));
-        const SampleBlock b = sample_block(problem_, spec_.proposal, plan_, next_, count, ws);
+        const SampleBlock b =
+            sample_block_batched(problem_, spec_.proposal, plan_, next_, count, ws);
         notify(b);
         accumulator_.add_block(b.first, b.f, b.pdf, b.pdf, b.count); // weights overwrite p
         next_ += count;

@@ -381,37 +381,59 @@ Made<NamedWarp> make_named_warp(const std::string& name, const NamedWarpParams& 
 
 Made<Warp> make_expression_warp(const Domain& domain, const std::vector<std::string>& g,
                                 const std::string& p) {
+    return make_typed_warp(domain, g, nullptr, p, nullptr);
+}
+
+Made<Warp> make_typed_warp(const Domain& domain, const std::vector<std::string>& g_texts,
+                           std::shared_ptr<const CallerFunction> g_function,
+                           const std::string& p_text,
+                           std::shared_ptr<const CallerFunction> p_function) {
     const int point_dim = domain.point_dim(), sample_dim = domain.sample_dim();
+    const char* what = g_function || p_function ? "typed warp" : "expression warp";
     if (point_dim < 1 || point_dim > kMaxWarpDim)
-        return made_error<Warp>("expression warp: the domain has " + std::to_string(point_dim) +
-                                " coordinates; at most " + std::to_string(kMaxWarpDim));
-    if (g.size() != static_cast<size_t>(point_dim))
-        return made_error<Warp>("expression warp: the domain's points have " +
+        return made_error<Warp>(std::string(what) + ": the domain has " +
+                                std::to_string(point_dim) + " coordinates; at most " +
+                                std::to_string(kMaxWarpDim));
+    if (!g_function && g_texts.size() != static_cast<size_t>(point_dim))
+        return made_error<Warp>(std::string(what) + ": the domain's points have " +
                                 std::to_string(point_dim) + " coordinates, got " +
-                                std::to_string(g.size()) + " expressions for g");
-    std::vector<std::shared_ptr<const ExprProgram>> maps;
-    for (size_t k = 0; k < g.size(); ++k) {
-        auto made = compile_expression(g[k], sample_dim, ExprVariables::Unit);
-        if (!made.ok()) return made_error<Warp>("g" + std::to_string(k + 1) + ": " + made.error);
-        maps.push_back(made.value);
-    }
-    auto density = compile_expression(p, point_dim);
-    if (!density.ok()) return made_error<Warp>("p: " + density.error);
+                                std::to_string(g_texts.size()) + " expressions for g");
     Warp w;
-    w.name = "expression";
+    w.name = g_function || p_function ? "typed" : "expression";
     w.sample_dim = sample_dim;
-    w.map = [maps, sample_dim](const PointBlock& u, PointBlock& x) {
-        const double* vars[kMaxWarpDim];
-        for (int j = 0; j < sample_dim; ++j) vars[j] = u.coord(j);
-        for (size_t k = 0; k < maps.size(); ++k)
-            maps[k]->evaluate(vars, u.n, x.coord(static_cast<int>(k)));
-    };
-    const std::shared_ptr<const ExprProgram> pdf = density.value;
-    w.pdf = [pdf, point_dim](const PointBlock& x, double* out) {
-        const double* vars[kMaxWarpDim];
-        for (int j = 0; j < point_dim; ++j) vars[j] = x.coord(j);
-        pdf->evaluate(vars, x.n, out);
-    };
+    if (g_function) {
+        w.map = [g_function, point_dim](const PointBlock& u, PointBlock& x) {
+            g_function->evaluate(u, point_dim, x.coord(0), x.capacity);
+        };
+    } else {
+        std::vector<std::shared_ptr<const ExprProgram>> maps;
+        for (size_t k = 0; k < g_texts.size(); ++k) {
+            auto made = compile_expression(g_texts[k], sample_dim, ExprVariables::Unit);
+            if (!made.ok())
+                return made_error<Warp>("g" + std::to_string(k + 1) + ": " + made.error);
+            maps.push_back(made.value);
+        }
+        w.map = [maps, sample_dim](const PointBlock& u, PointBlock& x) {
+            const double* vars[kMaxWarpDim];
+            for (int j = 0; j < sample_dim; ++j) vars[j] = u.coord(j);
+            for (size_t k = 0; k < maps.size(); ++k)
+                maps[k]->evaluate(vars, u.n, x.coord(static_cast<int>(k)));
+        };
+    }
+    if (p_function) {
+        w.pdf = [p_function](const PointBlock& x, double* out) {
+            p_function->evaluate(x, 1, out, x.n);
+        };
+    } else {
+        auto density = compile_expression(p_text, point_dim);
+        if (!density.ok()) return made_error<Warp>("p: " + density.error);
+        const std::shared_ptr<const ExprProgram> pdf = density.value;
+        w.pdf = [pdf, point_dim](const PointBlock& x, double* out) {
+            const double* vars[kMaxWarpDim];
+            for (int j = 0; j < point_dim; ++j) vars[j] = x.coord(j);
+            pdf->evaluate(vars, x.n, out);
+        };
+    }
     return {w, {}};
 }
 

@@ -91,6 +91,15 @@ Made<NamedWarp> make_named_warp(const std::string& name, const NamedWarpParams& 
 Made<Warp> make_expression_warp(const Domain& domain, const std::vector<std::string>& g,
                                 const std::string& p);
 
+/// A warp typed by the library's caller: g and p each as expressions (as make_expression_warp
+/// takes them) or as a caller's function (core/caller_function.h: g gets the block's unit-cube
+/// points, k per point, and returns point_dim() coordinates per point; p gets domain points and
+/// returns one density per point). A null function takes the expressions beside it.
+Made<Warp> make_typed_warp(const Domain& domain, const std::vector<std::string>& g_texts,
+                           std::shared_ptr<const CallerFunction> g_function,
+                           const std::string& p_text,
+                           std::shared_ptr<const CallerFunction> p_function);
+
 /// A checked warp and its domain as an importance proposal (ProposalKind::Warp).
 Proposal warp_proposal(std::shared_ptr<const Warp> warp, const Domain& domain);
 

@@ -223,6 +223,7 @@ std::string warp_words(const Warp* warp, const Domain& d) {
         return "density of the GGX microfacet normals visible from a direction of view";
     if (name == "spherical_triangle") return "uniform over the solid angle of a triangle";
     if (name == "expression") return "the density of a warp given by expressions, on " + on;
+    if (name == "typed") return "the density of a warp given by the caller, on " + on;
     std::string words = name.empty() ? std::string("a warp") : "the warp " + name;
     std::replace(words.begin(), words.end(), '_', ' ');
     return words + "'s density on " + on;

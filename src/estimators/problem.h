@@ -60,7 +60,16 @@ struct Problem {
     Integrand integrand;
     Quantity quantity = Quantity::Integral;
     std::optional<double> exact;
+    /// The call's control when the problem (its integrand, or a warp it samples with) calls the
+    /// library caller's functions: runs stop within a block once it says stop. Null otherwise.
+    std::shared_ptr<CallControl> control;
 };
+
+/// Whether the call running the problem has been stopped (a caller's function failed, or the
+/// caller cancelled): runs then end early and their numbers are discarded.
+inline bool problem_stopped(const Problem& p) {
+    return call_stopped(p.control);
+}
 
 /// The factor from the integral to the reported quantity: 1, or 1 / measure for a mean.
 inline double quantity_scale(const Problem& p) {

@@ -95,7 +95,7 @@ RunResult run_estimate(const Problem& problem, const EstimatorSpec& spec, uint64
     const auto start = std::chrono::steady_clock::now();
     std::unique_ptr<EstimatorAlgorithm> estimator = make_estimator(problem, spec, accumulator);
     estimator->begin(n, rng);
-    while (estimator->run_block(rng, ws)) {
+    while (!problem_stopped(problem) && estimator->run_block(rng, ws)) {
     }
     RunResult result = estimator->result();
     result.seconds =

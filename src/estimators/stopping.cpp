@@ -243,7 +243,7 @@ StoppingResult extend_to_tolerance(const Problem& problem, const EstimatorSpec& 
         }
         if (record_answer(step, r, problem, spec, tol, &out)) return out;
         previous_batch = batch;
-        if (budget_ended(budget, n, r.seconds, &out)) return out;
+        if (budget_ended(budget, n, r.seconds, &out) || problem_stopped(problem)) return out;
     }
 }
 
@@ -306,7 +306,7 @@ StoppingResult walsh_to_tolerance(const Problem& problem, const EstimatorSpec& s
             step.agrees = step.agrees && std::fabs(step.estimate - out.steps[j].estimate) <=
                                              step.half_width + out.steps[j].half_width;
         if (record_answer(step, r, problem, spec, tol, &out)) return out;
-        if (budget_ended(budget, n, r.seconds, &out)) return out;
+        if (budget_ended(budget, n, r.seconds, &out) || problem_stopped(problem)) return out;
     }
 }
 
@@ -376,7 +376,7 @@ StoppingResult run_to_tolerance(const Problem& problem, const EstimatorSpec& spe
             out.reason = StopReason::ToleranceMet;
             return out;
         }
-        if (budget_ended(budget, n, r.seconds, &out)) return out;
+        if (budget_ended(budget, n, r.seconds, &out) || problem_stopped(problem)) return out;
     }
 }
 
@@ -402,7 +402,7 @@ StoppingStudy run_stopping_study(const Problem& problem, const std::vector<Estim
     Workspace ws;
     for (const EstimatorSpec& spec : specs) {
         std::vector<StoppingResult> runs;
-        for (int r = 0; r < settings.reps; ++r)
+        for (int r = 0; r < settings.reps && !problem_stopped(problem); ++r)
             runs.push_back(run_to_tolerance(problem, spec, tolerance_of(settings),
                                             budget_of(settings), settings.seed, r, ws,
                                             settings.accumulator));

@@ -809,6 +809,10 @@ StudyResult run_study(const Problem& problem, const std::vector<EstimatorSpec>& 
     result.threads_used = resolve_threads(settings.threads);
     for (const EstimatorSpec& spec : estimators)
         result.estimators.push_back(begin_estimator_study(problem, spec, settings));
+    if (problem_stopped(problem)) {
+        result.cancelled = true;
+        return result;
+    }
     const std::vector<uint64_t> ladder = n_ladder(settings.n_min, settings.n_max);
     const size_t reps = static_cast<size_t>(settings.reps);
     std::vector<Workspace> workspaces(static_cast<size_t>(std::max(result.threads_used, 1)));
@@ -818,6 +822,7 @@ StudyResult run_study(const Problem& problem, const std::vector<EstimatorSpec>& 
                             settings.accumulator);
     };
     auto end_level = [&](size_t level, const std::vector<RunResult>& runs) {
+        if (problem_stopped(problem)) return false; // the level's runs were cut short
         for (size_t e = 0; e < estimators.size(); ++e) {
             std::vector<RunResult> level_runs(runs.begin() + static_cast<long>(e * reps),
                                               runs.begin() + static_cast<long>((e + 1) * reps));

@@ -16,6 +16,7 @@ const char* integrand_kind_name(IntegrandKind kind) {
     case IntegrandKind::IndicatorBall: return "indicator_ball";
     case IntegrandKind::Expression: return "expression";
     case IntegrandKind::Genz: return "genz";
+    case IntegrandKind::Function: return "function";
     }
     return "?";
 }
@@ -106,6 +107,14 @@ Made<Integrand> make_expression_integrand(const std::string& text, int dim) {
     return {f, {}};
 }
 
+Integrand make_function_integrand(std::shared_ptr<const CallerFunction> function, int dim) {
+    Integrand f;
+    f.kind = IntegrandKind::Function;
+    f.dim = dim;
+    f.function = std::move(function);
+    return f;
+}
+
 Integrand make_genz_integrand(const GenzParams& params) {
     Integrand f;
     f.kind = IntegrandKind::Genz;
@@ -125,6 +134,7 @@ void evaluate_block(const Integrand& f, const PointBlock& x, double* out) {
         break;
     }
     case IntegrandKind::Genz: genz_evaluate_block(f.genz, x, out); break;
+    case IntegrandKind::Function: f.function->evaluate(x, 1, out, n); break;
     case IntegrandKind::Constant:
         for (size_t i = 0; i < n; ++i) out[i] = f.scale;
         break;
@@ -192,7 +202,8 @@ bool integrand_bounded(const Integrand& f) {
         for (double p : f.coeffs)
             if (p < 0.0) return false;
         return true;
-    case IntegrandKind::Expression: return false;
+    case IntegrandKind::Expression:
+    case IntegrandKind::Function: return false;
     }
     return false;
 }
@@ -203,7 +214,8 @@ double ball_volume(int dim, double r) {
 
 std::optional<double> exact_integral_over_box(const Integrand& f, const std::vector<double>& lo,
                                               const std::vector<double>& hi) {
-    if (f.kind == IntegrandKind::Expression) return std::nullopt;
+    if (f.kind == IntegrandKind::Expression || f.kind == IntegrandKind::Function)
+        return std::nullopt;
     if (f.kind == IntegrandKind::Genz) {
         for (int j = 0; j < f.dim; ++j)
             if (lo[static_cast<size_t>(j)] != 0.0 || hi[static_cast<size_t>(j)] != 1.0)
@@ -215,6 +227,7 @@ std::optional<double> exact_integral_over_box(const Integrand& f, const std::vec
         const double a = lo[static_cast<size_t>(j)], b = hi[static_cast<size_t>(j)];
         switch (f.kind) {
         case IntegrandKind::Expression:
+        case IntegrandKind::Function:
         case IntegrandKind::Genz: return std::nullopt; // handled above
         case IntegrandKind::Constant: result *= b - a; break;
         case IntegrandKind::Monomial: {
@@ -275,6 +288,7 @@ std::string describe_integrand(const Integrand& f) {
         break;
     case IntegrandKind::IndicatorBall: s << f.scale << " * [|x - c| < " << f.width << "]"; break;
     case IntegrandKind::Expression: s << f.expr->source(); break;
+    case IntegrandKind::Function: s << "the caller's function " << f.function->name; break;
     case IntegrandKind::Genz:
         s << genz_family_name(f.genz.family) << " (d = " << f.dim << ", sum a = ";
         {

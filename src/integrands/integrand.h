@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "core/caller_function.h"
 #include "core/made.h"
 #include "core/points.h"
 #include "integrands/expression.h"
@@ -21,6 +22,7 @@ enum class IntegrandKind {
     IndicatorBall, ///< f = scale * [|x - c| < r]
     Expression,    ///< a user-typed expression, compiled (integrands/expression.h)
     Genz,          ///< one of Genz's six test families on [0,1]^d (integrands/genz.h)
+    Function,      ///< a function given by the library's caller (core/caller_function.h)
 };
 
 struct Integrand {
@@ -32,6 +34,7 @@ struct Integrand {
     double width = 1.0;                      ///< Gaussian sigma or ball radius
     std::shared_ptr<const ExprProgram> expr; ///< Expression: shared, immutable
     GenzParams genz;                         ///< Genz: family, a, u
+    std::shared_ptr<const CallerFunction> function; ///< Function: the caller's, shared
 };
 
 const char* integrand_kind_name(IntegrandKind kind);
@@ -44,6 +47,9 @@ Made<Integrand> make_integrand(IntegrandKind kind, int dim, double scale,
 
 /// An integrand from an expression compiled for `dim` dimensions (error: "at position P: ...").
 Made<Integrand> make_expression_integrand(const std::string& text, int dim);
+
+/// An integrand that calls a caller's function on each block of points of dimension `dim`.
+Integrand make_function_integrand(std::shared_ptr<const CallerFunction> function, int dim);
 
 /// An integrand from validated Genz parameters.
 Integrand make_genz_integrand(const GenzParams& params);
@@ -59,7 +65,8 @@ std::optional<double> exact_integral_over_box(const Integrand& f, const std::vec
                                               const std::vector<double>& hi);
 
 /// Whether |f| is bounded on any bounded domain by what its kind and parameters say: every
-/// kind but an expression (unknown) and a monomial with a negative power (a singularity).
+/// kind but an expression or a caller's function (unknown) and a monomial with a negative power
+/// (a singularity).
 bool integrand_bounded(const Integrand& f);
 
 /// Volume of the d-dimensional ball of radius r: pi^(d/2) r^d / Gamma(d/2 + 1).
