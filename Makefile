@@ -397,3 +397,4 @@ fuzz-smoke: fuzz-build
 
 clean:
 	rm -rf $(BUILD) $(BUILD_WASM) $(BUILD_ASAN) $(BUILD_FUZZ)
+include bench/python.mk

@@ -14,19 +14,24 @@ bench/qmc_tools.py) is checked first: on the same points it gives the same estim
 core's own Genz integrand, and its estimate agrees with the exact value within 4 standard
 errors. Every tool then integrates that callable, wrapped in one counter of evaluations:
 
-- mcplay: replicates 2c and 2c + 1 are one call of ``mcplay.integrate(f, estimators=[...],
-  n=N, n_min=N, reps=2, threads=1, exact=...)`` with seed SEED * 10^5 + case * 1000 + c; the
+- mcplay: round k (of ROUNDS) is one call of ``mcplay.integrate(f, estimators=[...], n=N,
+  n_min=N, reps=R / ROUNDS, threads=1, exact=...)`` with seed SEED * 10^5 + case * 100 + k; the
   core gives each estimator's MSE against the exact value, the share of replicates whose own
-  95% interval covered it and the seconds per estimate (the core's timer: the callable's time
-  included, the call's setup not).
+  95% interval covered it, the seconds per estimate (the core's timer: the callable's time
+  included, the call's setup not) and its flags (the table shows in how many rounds each
+  warning or error was raised).
 - vegas: ``vegas.Integrator`` on the batch integrand, 5 iterations of training (discarded) then
   5 of estimation, neval per iteration set by a pilot so that the 10 iterations call f about N
-  times (training share 1/2); its error bar is 1.96 sdev; numpy's generator seeded
-  [SEED, case, r] drives replicate r.
+  times (training share 1/2); its error bar is 1.96 sdev, and the table counts the replicates
+  whose Q (vegas's p-value for the iterations' agreement) is below 0.05; numpy's generator
+  seeded [SEED, case, r] drives replicate r.
 - QMCPy: ``CubQMCNetG`` (in QMCPy 2.4 ``CubQMCSobolG`` is the same class) and
   ``CubQMCLatticeG`` with n_init = n_limit = N (one pass of N points, no early stop); the
   interval is the cubature's [comb_bound_low, comb_bound_high], a guaranteed-style bound for
   integrands in its cone, not a 95% confidence interval; seed SEED * 10^6 + case * 1000 + r.
+
+The tools take turns: round k of mcplay, then replicates k R / ROUNDS .. (k + 1) R / ROUNDS - 1
+of each anchor, so that the shared machine's load falls on all of them alike.
 
 Per (case, tool): relative RMSE over the R replicates, median seconds per estimate, efficiency
 1 / (relMSE x seconds), coverage of the tool's own interval, evaluations per estimate (counted).
@@ -73,6 +78,9 @@ GENZ_H_E = {"oscillatory": (110.0, 1.5), "product_peak": (600.0, 2.0),
 MCPLAY_CANDIDATES = ("uniform", "sobol", "sobol_walsh", "lattice", "vegas", "vegas_sobol",
                      "vegas_plus", "miser")
 Z95 = 1.959963984540054
+#: Flags about the replicates' mean against the exact value (a chance event at 5%, and not a
+#: judgement of an error bar): kept in the JSON lines, left out of the table.
+CHANCE_FLAGS = ("exact_outside_ci",)
 
 
 @dataclass
@@ -171,20 +179,15 @@ def check_case(mcplay, case: Case, seed: int) -> dict:
             "z_callable_vs_exact": z}
 
 
-#: Replicates per mcplay call (the core needs two for a variance); calls alternate with the
-#: anchors' replicates.
-MCPLAY_REPS_PER_CALL = 2
-
-
-def run_mcplay(mcplay, case: Case, n: int, seed: int) -> dict[str, dict]:
-    """Two replicates of each of mcplay's candidates on the case's callable (one study, one
-    thread): per estimator the core's mean squared error against the exact value, the share
-    of the replicates whose own 95% interval covered it, the median seconds per estimate."""
+def run_mcplay(mcplay, case: Case, n: int, reps: int, seed: int) -> dict[str, dict]:
+    """``reps`` replicates of each of mcplay's candidates on the case's callable (one study, one
+    thread): per estimator the core's mean squared error against the exact value, the share of
+    the replicates whose own 95% interval covered it, the median seconds per estimate and the
+    codes of its warning and error flags."""
     f = Counted(case.callable())
     wall = time.perf_counter()
     result = mcplay.integrate(f, dim=case.d, estimators=list(MCPLAY_CANDIDATES), n=n, n_min=n,
-                              reps=MCPLAY_REPS_PER_CALL, seed=seed, threads=1,
-                              exact=case.exact, name=case.name)
+                              reps=reps, seed=seed, threads=1, exact=case.exact, name=case.name)
     wall = time.perf_counter() - wall
     out = {}
     for name in MCPLAY_CANDIDATES:
@@ -193,25 +196,30 @@ def run_mcplay(mcplay, case: Case, n: int, seed: int) -> dict[str, dict]:
                      "seconds": float(level["time_median_s"]), "n": int(level["n"]),
                      "training_share": level.get("training_share"),
                      "error_method": result[name].error_method,
-                     "flags": [f"{fl.severity}:{fl.code}" for fl in result[name].flags]}
+                     "flags": sorted({fl.code for fl in result[name].flags if fl.untrusted})}
     out["_call"] = {"wall_s": wall, "evaluations": f.points}
     return out
 
 
-def mcplay_rows(case: Case, calls: list[dict[str, dict]]) -> list[Row]:
-    """The mcplay rows of a case from its calls (every number from the core): the MSE and
-    coverage averaged over the calls (each of the same replicates), the median seconds."""
+def mcplay_rows(case: Case, calls: list[dict[str, dict]], reps_per_call: int) -> list[Row]:
+    """The mcplay rows of a case from its rounds (every number from the core): MSE and
+    coverage averaged over the rounds (each of the same number of replicates), the median of
+    the rounds' median seconds, and in how many rounds each warning or error flag was raised."""
     rows = []
     for name in MCPLAY_CANDIDATES:
         per_call = [call[name] for call in calls]
-        flags = sorted({fl for c in per_call for fl in c["flags"]})
+        flags: dict[str, int] = {}
+        for c in per_call:
+            for code in c["flags"]:
+                flags[code] = flags.get(code, 0) + 1
         rows.append(Row(
-            case.name, "mcplay", name, len(per_call) * MCPLAY_REPS_PER_CALL,
+            case.name, "mcplay", name, len(per_call) * reps_per_call,
             float(np.mean([c["n"] for c in per_call])),
             math.sqrt(statistics.fmean(c["mse"] for c in per_call)) / abs(case.exact),
             statistics.median(c["seconds"] for c in per_call),
             statistics.fmean(c["covered"] for c in per_call), "own 95% interval",
-            {"error_method": per_call[0]["error_method"], "flags": flags,
+            {"error_method": per_call[0]["error_method"], "flag_rounds": flags,
+             "rounds": len(calls),
              "training_share": statistics.fmean(c["training_share"] or 0.0 for c in per_call),
              "call_wall_s_median": statistics.median(c["_call"]["wall_s"] for c in calls),
              "counted_evaluations_per_call": statistics.fmean(
@@ -231,6 +239,8 @@ class Replicates:
     highs: list[float] = field(default_factory=list)
     seconds: list[float] = field(default_factory=list)
     evaluations: list[int] = field(default_factory=list)
+    #: vegas only: each replicate's Q, the p-value of its iterations' agreement (chi-square).
+    vegas_q: list[float] = field(default_factory=list)
 
     def add(self, estimate: float, low: float, high: float, seconds: float, evaluations: int):
         self.estimates.append(estimate)
@@ -276,6 +286,7 @@ def run_vegas(vegas, case: Case, neval: int, seed: int, r: int, out: Replicates)
     seconds = time.perf_counter() - start
     out.add(result.mean, result.mean - Z95 * result.sdev, result.mean + Z95 * result.sdev,
             seconds, f.points)
+    out.vegas_q.append(float(result.Q))
 
 
 def run_qmcpy(qp, case: Case, n: int, seed: int, r: int, lattice: bool,
@@ -298,8 +309,17 @@ def run_qmcpy(qp, case: Case, n: int, seed: int, r: int, lattice: bool,
 
 
 def fmt_row(row: Row) -> str:
+    """A table line; the flags: mcplay's warning and error codes with the share of rounds that
+    raised them, vegas's replicates whose Q (iterations' agreement) is below 0.05."""
+    if "flag_rounds" in row.extra:
+        shown = {c: k for c, k in row.extra["flag_rounds"].items() if c not in CHANCE_FLAGS}
+        flags = " ".join(f"{c} {k}/{row.extra['rounds']}" for c, k in sorted(shown.items()))
+    elif "q_below_0.05" in row.extra:
+        flags = f"Q<0.05 {row.extra['q_below_0.05']}/{row.reps}"
+    else:
+        flags = ""
     return (f"  {row.label():<26} {row.evaluations:>8.0f} {row.rel_rmse:>10.3e} "
-            f"{row.seconds:>9.2e} {row.efficiency:>11.3e} {row.coverage:>6.2f}")
+            f"{row.seconds:>9.2e} {row.efficiency:>11.3e} {row.coverage:>6.2f}  {flags}")
 
 
 def compare(mcplay, o: argparse.Namespace, out) -> None:
@@ -320,19 +340,21 @@ def compare(mcplay, o: argparse.Namespace, out) -> None:
         anchors = [Replicates("vegas", "Integrator", "mean +- 1.96 sdev"),
                    Replicates("qmcpy", "CubQMCNetG", "guaranteed-style bound"),
                    Replicates("qmcpy", "CubQMCLatticeG", "guaranteed-style bound")]
-        replicates = []
-        # The tools take turns, two replicates at a time, so that the shared machine's load
+        rounds = []
+        per_round = o.reps // o.rounds
+        # The tools take turns, one round of replicates each, so that the shared machine's load
         # falls on all of them alike.
-        for call in range(o.reps // MCPLAY_REPS_PER_CALL):
-            seed = o.seed * 100_000 + case.index * 1000 + call
-            replicates.append(run_mcplay(mcplay, case, o.n, seed))
-            for r in range(call * MCPLAY_REPS_PER_CALL, (call + 1) * MCPLAY_REPS_PER_CALL):
+        for k in range(o.rounds):
+            seed = o.seed * 100_000 + case.index * 100 + k
+            rounds.append(run_mcplay(mcplay, case, o.n, per_round, seed))
+            for r in range(k * per_round, (k + 1) * per_round):
                 run_vegas(vegas, case, neval, o.seed, r, anchors[0])
                 run_qmcpy(qp, case, o.n, o.seed, r, False, anchors[1])
                 run_qmcpy(qp, case, o.n, o.seed, r, True, anchors[2])
-        rows = mcplay_rows(case, replicates)
+        rows = mcplay_rows(case, rounds, per_round)
+        q_low = sum(q < 0.05 for q in anchors[0].vegas_q)
         anchors = [a.row(case) for a in anchors]
-        anchors[0].extra["neval"] = neval
+        anchors[0].extra.update({"neval": neval, "q_below_0.05": q_low})
         best = max(rows, key=lambda r: r.efficiency)
         anchor = max(anchors, key=lambda r: r.efficiency)
         alone = {r.method: r.efficiency / anchor.efficiency for r in rows}
@@ -347,7 +369,7 @@ def compare(mcplay, o: argparse.Namespace, out) -> None:
               f"points: relative difference {checks['same_points_rel_diff']:.1e}; z against exact "
               f"{checks['z_callable_vs_exact']:+.2f})")
         print(f"  {'tool method':<26} {'evals':>8} {'rel.RMSE':>10} {'s/est':>9} "
-              f"{'efficiency':>11} {'cover':>6}")
+              f"{'efficiency':>11} {'cover':>6}  flags (rounds)")
         for row in rows + anchors:
             print(fmt_row(row) + ("  <- best mcplay" if row is best else "")
                   + ("  <- best anchor" if row is anchor else ""))
@@ -426,7 +448,9 @@ def speed(mcplay, o: argparse.Namespace, out) -> None:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--n", type=int, default=1 << 16, help="evaluations per estimate (2^16)")
-    ap.add_argument("--reps", type=int, default=20, help="replicates per (case, tool) (20)")
+    ap.add_argument("--reps", type=int, default=100, help="replicates per (case, tool) (100)")
+    ap.add_argument("--rounds", type=int, default=4,
+                    help="the tools take turns in this many rounds of reps / rounds replicates")
     ap.add_argument("--dims", default="4,8")
     ap.add_argument("--families", default="all", help="comma-separated, e.g. gaussian,continuous")
     ap.add_argument("--seed", type=int, default=47, help="the replicates' seeds derive from it")
@@ -438,8 +462,11 @@ def main() -> None:
     o = ap.parse_args()
     if o.callable_vs_expression:
         o.only = "speed"
-    if o.n < 1024 or o.n & (o.n - 1) or not 2 <= o.reps < 1000 or o.reps % 2:
-        ap.error("--n must be a power of two >= 1024 (QMCPy's nets), --reps even in 2..998")
+    if o.n < 1024 or o.n & (o.n - 1):
+        ap.error("--n must be a power of two >= 1024 (QMCPy's nets)")
+    if o.rounds < 1 or o.reps % o.rounds or o.reps // o.rounds < 2 or o.reps > 1000:
+        ap.error("--reps must be at most 1000 and a multiple of --rounds, with at least 2 "
+                 "replicates per round (mcplay's variance needs two)")
     unknown = set(o.families.split(",")) - set(FAMILIES) if o.families != "all" else set()
     if unknown:
         ap.error(f"--families: unknown {sorted(unknown)}; known: {', '.join(FAMILIES)}")
