@@ -70,6 +70,7 @@ help:
 	@echo "make bench-mitsuba  the renderer beside Mitsuba 3.9.1 on three glTF scenes: time, relMSE, efficiency (ARGS: --quick, --sobol, --scalar, --widths)"
 	@echo "make bench-embree  the accelerator beside Embree 3 (Debian's libembree-dev) on the same rays, one thread"
 	@echo "make format clang-format every C++ source"
+	@echo "make test-python  build the Python wheel, install it in a fresh venv, run python/tests (part of make check)"
 	@echo "make test-sanitize  the native ctest suite under ASan + UBSan ($(BUILD_ASAN); part of make check)"
 	@echo "make fuzz   libFuzzer targets, $(FUZZ_SECONDS) s each (FUZZ_TARGETS=\"$(FUZZ_TARGETS)\"); docs/fuzzing.md"
 	@echo "make fuzz-smoke  each fuzz target over its seed corpus only (seconds)"
@@ -93,14 +94,32 @@ web/node_modules/.package-lock.json: web/package.json web/package-lock.json | de
 	cd web && npm ci --no-audit --no-fund
 	@touch $@
 
+# ---------------------------------------------------------------------------
+# The Python package (pyproject.toml, src/python, python/). build/ also builds the extension
+# mcplay._core when the virtual environment $(PY_VENV) exists (`make deps-python`, which `make
+# test` runs first): ctest's python_smoke then imports it from the build tree. `make test-python`
+# (in `make check`) builds a wheel with pip, installs it in a fresh virtual environment with the
+# test extras and runs python/tests against the installed package.
+PY_VENV := $(BUILD)/py-venv
+PY_TEST_VENV := $(BUILD)/py-test-venv
+PY_WHEELHOUSE := $(BUILD)/wheelhouse
+# Expanded when a recipe runs, so that a venv made earlier in the same make counts.
+PY_CMAKE_FLAGS = $(if $(wildcard $(PY_VENV)/installed),-DMCPLAY_PYTHON=ON \
+	-DPython_EXECUTABLE=$(CURDIR)/$(PY_VENV)/bin/python \
+	-Dnanobind_DIR=$$($(PY_VENV)/bin/python -m nanobind --cmake_dir))
+
 # Order-only on deps: under make -j the configure step must wait for apt-get.
 $(BUILD)/CMakeCache.txt: | deps
-	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release
+	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release $(PY_CMAKE_FLAGS)
 
 $(BUILD_WASM)/CMakeCache.txt: | deps
 	emcmake cmake -S . -B $(BUILD_WASM) -DCMAKE_BUILD_TYPE=Release
 
 build: deps $(BUILD)/CMakeCache.txt
+	@if [ -e $(PY_VENV)/installed ] && ! grep -q '^MCPLAY_PYTHON:BOOL=ON' $(BUILD)/CMakeCache.txt; then \
+	  echo "build: $(PY_VENV) exists: configuring $(BUILD) with the Python extension"; \
+	  cmake -S . -B $(BUILD) $(PY_CMAKE_FLAGS); \
+	fi
 	cmake --build $(BUILD) -j $(JOBS)
 
 build-wasm: deps $(BUILD_WASM)/CMakeCache.txt
@@ -175,6 +194,7 @@ test-sanitize: deps $(BUILD_ASAN)/CMakeCache.txt
 TEST_JOBS ?= 2
 test:
 	@start=$$(date +%s); \
+	$(MAKE) --no-print-directory deps-python && \
 	$(MAKE) --no-print-directory -j $(TEST_JOBS) test-suites && \
 	echo "make test: all suites passed in $$(( $$(date +%s) - start )) s"
 
@@ -185,7 +205,7 @@ test-suites: test-native test-wasm test-compare test-web-core test-npm test-e2e
 check:
 	@start=$$(date +%s); \
 	$(MAKE) --no-print-directory test && \
-	$(MAKE) --no-print-directory -j 2 test-sanitize fuzz-smoke test-wasm-statistical && \
+	$(MAKE) --no-print-directory -j 2 test-sanitize fuzz-smoke test-wasm-statistical test-python && \
 	echo "make check: all suites passed in $$(( $$(date +%s) - start )) s"
 
 run: build site
@@ -329,6 +349,28 @@ deps-venv:
 	    echo "deps-venv: not root; run: sudo apt-get install -y --no-install-recommends python3-venv"; exit 1; \
 	  fi; \
 	fi
+
+# The build tree's Python: numpy, nanobind (the extension's build) and pytest.
+.PHONY: deps-python test-python
+deps-python: $(PY_VENV)/installed
+
+$(PY_VENV)/installed: | deps-venv
+	python3 -m venv $(PY_VENV)
+	$(PY_VENV)/bin/pip install -q numpy nanobind pytest
+	@touch $@
+
+# The wheel as a user gets it: built by pip from the project's own files (scikit-build-core and
+# nanobind from PyPI, in pip's isolated build environment; objects kept in build/skbuild), installed
+# with the test extras into a virtual environment made anew each run; pytest runs from a folder
+# outside the source tree, so `import mcplay` finds only the installed package.
+test-python: deps | deps-venv
+	rm -rf $(PY_TEST_VENV) $(PY_WHEELHOUSE)
+	python3 -m venv $(PY_TEST_VENV)
+	$(PY_TEST_VENV)/bin/pip wheel -q --no-deps -w $(PY_WHEELHOUSE) .
+	$(PY_TEST_VENV)/bin/pip install -q "$$(ls $(PY_WHEELHOUSE)/mcplay-*.whl)[test]"
+	mkdir -p $(BUILD)/py-test-run
+	cd $(BUILD)/py-test-run && MCPLAY_EXPECT_INSTALLED=1 $(CURDIR)/$(PY_TEST_VENV)/bin/python -m pytest \
+	  -p no:cacheprovider --import-mode=importlib --rootdir $(CURDIR) $(CURDIR)/python/tests
 
 $(QMC_VENV)/installed: | deps-venv
 	python3 -m venv $(QMC_VENV)

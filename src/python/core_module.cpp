@@ -29,6 +29,11 @@ using mcp::python::raise_error;
 
 namespace {
 
+// Parameter types in the signatures Python sees (help(), stubs).
+#define FUNCTIONS_T                                                                                \
+    "dict[str, collections.abc.Callable[[numpy.ndarray], numpy.typing.ArrayLike]]"
+#define PROGRESS_T "collections.abc.Callable[[str], object]"
+
 using OptionalText = std::optional<std::string>;
 
 /// The text a C call returned, copied and released.
@@ -117,7 +122,8 @@ std::string call(const std::string& fn, const std::string& request, const Option
     if (!entry) {
         std::string names;
         for (const CallEntry& e : kCalls) names += std::string(names.empty() ? "" : ", ") + e.name;
-        raise_error(MCP_ERROR_ARGUMENT, "call: unknown function '" + fn + "' (one of " + names + ")");
+        raise_error(MCP_ERROR_ARGUMENT,
+                    "call: unknown function '" + fn + "' (one of " + names + ")");
     }
     if (entry->arity == Arity::none && !request.empty()) {
         raise_error(MCP_ERROR_ARGUMENT, "call('" + fn + "'): takes no request (pass \"\")");
@@ -208,8 +214,8 @@ std::string study_run(const std::string& scene, const OptionalText& options,
     const char* scene_c = c_text(scene, "scene");
     const char* options_c = c_text(options, "options");
     return run_watched(state, [&](char** out) {
-        return mcp_study_run_with(scene_c, options_c, state.context(), CallState::progress_trampoline,
-                                  &state, out);
+        return mcp_study_run_with(scene_c, options_c, state.context(),
+                                  CallState::progress_trampoline, &state, out);
     });
 }
 
@@ -307,7 +313,6 @@ NB_MODULE(_core, m) {
 
     m.def("call", &call, nb::arg("fn"), nb::arg("request") = "",
           nb::arg("options") = nb::none(),
-          "call(fn, request='', options=None) -> str\n\n"
           "Runs one JSON-in, JSON-out C call that takes no callback, by name: 'catalog' (no "
           "request), 'scene_info', 'points', 'points_analyze', 'discrepancy_curve', "
           "'points_integrate' (request: the scene, options: the points request), "
@@ -317,57 +322,78 @@ NB_MODULE(_core, m) {
           "'render_pixel_points', 'render_study_plan' (scene, options). The GIL is released "
           "while it runs. Raises McplayError with the C API's message.");
 
-    m.def("study_run", &study_run, nb::arg("scene"), nb::arg("options") = nb::none(),
+    m.def("study_run", &study_run,
+          nb::sig(
+                "def study_run(scene: str, options: str | None = None, "
+                "functions: " FUNCTIONS_T " | None = None, "
+                "progress: " PROGRESS_T " | None = None) -> str"),
+          nb::arg("scene"), nb::arg("options") = nb::none(),
           nb::arg("functions") = nb::none(), nb::arg("progress") = nb::none(),
-          "study_run(scene, options=None, functions=None, progress=None) -> str\n\n"
           "A convergence study (mcp_study_run_with). functions maps the names the scene gives "
           "({'type': 'function', 'name': ...}) to callables f(x) -> values, x a read-only "
-          "(n, in_dim) float64 array of one block of points (valid only during the call), the "
+          "(n, in_dim) float64 array of one block of points (the callable may keep it), the "
           "values (n,) float64 (or (n, out_dim)). progress(level_json) is called after each N; "
           "an exception in it cancels the study and is raised. Ctrl-C cancels within a block "
           "(KeyboardInterrupt). A failing callable raises McplayError (status 'FUNCTION') "
           "naming the block and the point, from the callable's exception.");
 
-    m.def("study_plan", &study_plan, nb::arg("scene"), nb::arg("options") = nb::none(),
+    m.def("study_plan", &study_plan,
+          nb::sig(
+                "def study_plan(scene: str, options: str | None = None, "
+                "functions: " FUNCTIONS_T " | None = None) -> str"),
+          nb::arg("scene"), nb::arg("options") = nb::none(),
           nb::arg("functions") = nb::none(),
-          "study_plan(scene, options=None, functions=None) -> str\n\n"
           "A study's cost predicted from a short pilot (mcp_study_plan_with); functions as "
           "study_run's.");
 
-    m.def("warp_test", &warp_test, nb::arg("scene"), nb::arg("options") = nb::none(),
+    m.def("warp_test", &warp_test,
+          nb::sig(
+                "def warp_test(scene: str, options: str | None = None, "
+                "functions: " FUNCTIONS_T " | None = None) -> str"),
+          nb::arg("scene"), nb::arg("options") = nb::none(),
           nb::arg("functions") = nb::none(),
-          "warp_test(scene, options=None, functions=None) -> str\n\n"
           "Tests a warp against its density (mcp_warp_test_with); the warp's map g and density "
           "p may name callables in functions (g returns (n, dim) points, p (n,) densities).");
 
-    m.def("render_study_run", &render_study_run, nb::arg("scene"),
+    m.def("render_study_run", &render_study_run,
+          nb::sig(
+                "def render_study_run(scene: str, options: str | None = None, "
+                "progress: " PROGRESS_T " | None = None) -> str"),
+          nb::arg("scene"),
           nb::arg("options") = nb::none(), nb::arg("progress") = nb::none(),
-          "render_study_run(scene, options=None, progress=None) -> str\n\n"
           "A render convergence study (mcp_render_study_run); progress and Ctrl-C as "
           "study_run's.");
 
-    m.def("render_reference", &render_reference, nb::arg("scene"),
+    m.def("render_reference", &render_reference,
+          nb::sig(
+                "def render_reference(scene: str, options: str | None = None, "
+                "progress: " PROGRESS_T " | None = None) -> str"),
+          nb::arg("scene"),
           nb::arg("options") = nb::none(), nb::arg("progress") = nb::none(),
-          "render_reference(scene, options=None, progress=None) -> str\n\n"
           "A render study's reference image (mcp_render_reference).");
 
-    m.def("render_live_open", &render_live_open, nb::arg("scene"),
+    m.def("render_live_open", &render_live_open,
+          nb::sig(
+                "def render_live_open(scene: str, options: str | None = None, "
+                "progress: " PROGRESS_T " | None = None) -> str"),
+          nb::arg("scene"),
           nb::arg("options") = nb::none(), nb::arg("progress") = nb::none(),
-          "render_live_open(scene, options=None, progress=None) -> str\n\n"
           "Opens a live-view session (mcp_render_live_open); the result's 'session' is the "
           "id the other render_live_* calls take. Close it with render_live_close.");
 
-    m.def("render_live_pass", &render_live_pass, nb::arg("session"), nb::arg("pass_json"),
+    m.def("render_live_pass", &render_live_pass,
+          nb::sig(
+                "def render_live_pass(session: int, pass_json: str, "
+                "progress: " PROGRESS_T " | None = None) -> str"),
+          nb::arg("session"), nb::arg("pass_json"),
           nb::arg("progress") = nb::none(),
-          "render_live_pass(session, pass_json, progress=None) -> str\n\n"
           "Takes one estimator of a live session to more samples per pixel "
           "(mcp_render_live_pass).");
 
     m.def("render_live_reference", &render_live_reference, nb::arg("session"),
           nb::arg("reference_json"),
-          "render_live_reference(session, reference_json) -> str\n\n"
           "Gives a live session its reference (mcp_render_live_reference).");
 
     m.def("render_live_close", &render_live_close, nb::arg("session"),
-          "render_live_close(session) -> None\n\nFrees a live-view session.");
+          "Frees a live-view session.");
 }

@@ -258,6 +258,12 @@ std::string CallState::evaluate(Slot& slot, const double* x, uint64_t n, int in_
     try {
         returned = slot.callable(input.array);
     } catch (nb::python_error& e) {
+        if (!e.matches(PyExc_Exception)) {
+            // KeyboardInterrupt, SystemExit: not the function's failure; raised as they are.
+            if (!pending_) pending_.emplace(std::move(e));
+            cancel_ = true;
+            return "was interrupted";
+        }
         cause = nb::borrow(e.value());
         std::string where = n == 0 ? "on an empty block"
                                    : "at the block's first point " + point_text(x, in_dim);
@@ -283,8 +289,8 @@ std::string CallState::store_values(nb::handle returned, const double* x, uint64
         try {
             array = numpy_.attr("asarray")(returned);
         } catch (nb::python_error& e) {
-            return "returned a " + python_type_name(returned) + " that numpy cannot make an array of (" +
-                   exception_text(e.value()) + ")";
+            return "returned a " + python_type_name(returned) +
+                   " that numpy cannot make an array of (" + exception_text(e.value()) + ")";
         }
         const std::string kind = nb::cast<std::string>(array.attr("dtype").attr("kind"));
         if (kind != "b" && kind != "i" && kind != "u" && kind != "f") {
@@ -308,7 +314,8 @@ std::string CallState::store_values(nb::handle returned, const double* x, uint64
     for (size_t i = 0; i < values.ndim(); ++i) shape[i] = values.shape(i);
     const bool fits = shape == expected || (out_dim == 1 && shape == std::vector<size_t>{n, 1});
     if (!fits) {
-        const std::string what = shape.empty() ? "a scalar (shape ())" : "shape " + shape_text(shape);
+        const std::string what =
+            shape.empty() ? "a scalar (shape ())" : "shape " + shape_text(shape);
         return "returned " + what + ", expected " + expected_text;
     }
 
@@ -317,8 +324,9 @@ std::string CallState::store_values(nb::handle returned, const double* x, uint64
     for (size_t i = 0; i < count; ++i) {
         if (!std::isfinite(v[i])) {
             const size_t point = i / static_cast<size_t>(out_dim);
+            const double* bad_point = x + point * static_cast<size_t>(in_dim);
             return "returned " + number_text(v[i]) + " at point " + std::to_string(point) +
-                   " of the block, x = " + point_text(x + point * static_cast<size_t>(in_dim), in_dim);
+                   " of the block, x = " + point_text(bad_point, in_dim);
         }
     }
     if (count > 0) std::memcpy(out, v, count * sizeof(double));
