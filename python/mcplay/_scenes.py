@@ -79,7 +79,8 @@ def load(scene: Any, what: str = "scene") -> Scene:
 
 
 def _is_render_text(text: str) -> bool:
-    """A render scene has a "render" object; text that does not parse goes to the core, which says why."""
+    """Whether the text is a render scene (a "render" object); text that does not parse goes to
+    the core, which says why."""
     try:
         parsed = json.loads(text)
     except ValueError:

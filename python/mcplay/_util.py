@@ -22,7 +22,7 @@ _STATUS_ARGUMENT = 1
 def argument_error(message: str) -> Exception:
     """An :class:`McplayError` for a bad argument caught before the core is called."""
     error = McplayError(message)
-    for name, value in (("status", _STATUS_ARGUMENT), ("status_name", "argument")):
+    for name, value in (("status", _STATUS_ARGUMENT), ("status_name", "ARGUMENT")):
         try:
             setattr(error, name, value)
         except AttributeError:  # an exception type whose attributes are read-only
@@ -62,7 +62,8 @@ def from_json(text: str) -> Any:
 
 
 def whole_number(value: Any, name: str, minimum: int | None = None) -> int:
-    """``value`` as an int (numpy integers too, never a bool or a float), else an error naming ``name``."""
+    """``value`` as an int (numpy integers too, never a bool or a float), else an error naming
+    ``name``."""
     if isinstance(value, bool) or not isinstance(value, numbers.Integral):
         raise argument_error(f"{name}: expected a whole number, got {_shown(value)}")
     value = operator.index(value)

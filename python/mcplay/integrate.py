@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-import numbers
+import re
 import textwrap
 from typing import Any, Callable, Mapping, Sequence
 
@@ -35,8 +35,10 @@ def _domain(domain: Any, dim: Any) -> dict | None:
         return None if dim is None else {"type": "box", "dim": dim}
     if isinstance(domain, Mapping):
         return dict(domain)
-    if isinstance(domain, (str, bytes)) or not isinstance(domain, Sequence) and not hasattr(
-        domain, "tolist"
+    if (
+        isinstance(domain, (str, bytes))
+        or not isinstance(domain, Sequence)
+        and not hasattr(domain, "tolist")
     ):
         raise argument_error(
             "domain: expected None (the unit cube of dim), a sequence of (lo, hi) pairs or a "
@@ -47,7 +49,7 @@ def _domain(domain: Any, dim: Any) -> dict | None:
         raise argument_error("domain: no (lo, hi) pairs given")
     lower, upper = [], []
     for i, pair in enumerate(pairs):
-        if (isinstance(pair, (str, bytes)) or not isinstance(pair, Sequence) or len(pair) != 2):
+        if isinstance(pair, (str, bytes)) or not isinstance(pair, Sequence) or len(pair) != 2:
             raise argument_error(f"domain[{i}]: expected a pair (lo, hi), got {pair!r}")
         lower.append(real_number(pair[0], f"domain[{i}][0]"))
         upper.append(real_number(pair[1], f"domain[{i}][1]"))
@@ -77,89 +79,93 @@ def integrate(
 ) -> Result:
     """Integrate ``f`` with several estimators and say how far each can be trusted.
 
-    Every estimator runs at every power of two N from ``n_min`` to ``n`` with ``reps``
-    independent replicates (or, with ``rel_tol``/``abs_tol``, doubles N until its 95% error bar
-    meets the tolerance); the core measures variance, error bars, fitted order, time and the
-    diagnostics, exactly as ``mcplay run`` does for a scene.
+        Every estimator runs at every power of two N from ``n_min`` to ``n`` with ``reps``
+        independent replicates (or, with ``rel_tol``/``abs_tol``, doubles N until its 95% error bar
+        meets the tolerance); the core measures variance, error bars, fitted order, time and the
+        diagnostics, exactly as ``mcplay run`` does for a scene.
 
-    Parameters
-    ----------
-    f
-        A callable taking an ``(n, d)`` float64 array (one block of points, never one point at a
-        time) and returning ``n`` values; or an expression string in ``x1 .. xd`` (or ``x y z``),
-        compiled by the core (e.g. ``"exp(-(x-0.5)^2/0.01)"``); or a scene integrand object
-        (``{"type": "genz_gaussian", ...}``). A callable may be called from several of the
-        core's threads at once; each call holds the GIL, so blocks of a Python callable run one
-        at a time while the core's own work (points, warps, sums) runs in parallel.
-    dim
-        The dimension, for the unit cube [0, 1]^dim (a callable needs ``dim`` or ``domain``).
-    domain
-        ``None`` (the unit cube of ``dim``), a sequence of ``(lo, hi)`` pairs (a box) or a scene
-        domain dict (``{"type": "disk", "radius": 1}``, docs/scene-format.md).
-    estimators
-        Preset names or scene estimator objects (default ``("uniform", "sobol", "vegas")``).
-        An object adds a density or settings, e.g. importance sampling with a given pdf:
-        ``{"name": "importance", "pdf": {"type": "exponential", "rate": -1}}``, control variates
-        ``{"name": "cv", "control_variates": [{"g": "x", "integral": 0.5}]}``, VEGAS options
-        ``{"name": "v", "vegas": {"increments": 50}}``. The presets, from the core's catalog:
+        Parameters
+        ----------
+        f
+            A callable taking an ``(n, d)`` float64 array (one block of points, never one point at a
+            time) and returning ``n`` values; or an expression string in ``x1 .. xd`` (or ``x y
+        z``),
+            compiled by the core (e.g. ``"exp(-(x-0.5)^2/0.01)"``); or a scene integrand object
+            (``{"type": "genz_gaussian", ...}``). A callable may be called from several of the
+            core's threads at once; each call holds the GIL, so blocks of a Python callable run one
+            at a time while the core's own work (points, warps, sums) runs in parallel.
+        dim
+            The dimension, for the unit cube [0, 1]^dim (a callable needs ``dim`` or ``domain``).
+        domain
+            ``None`` (the unit cube of ``dim``), a sequence of ``(lo, hi)`` pairs (a box) or a scene
+            domain dict (``{"type": "disk", "radius": 1}``, docs/scene-format.md).
+        estimators
+            Preset names or scene estimator objects (default ``("uniform", "sobol", "vegas")``).
+            An object adds a density or settings, e.g. importance sampling with a given pdf:
+            ``{"name": "importance", "pdf": {"type": "exponential", "rate": -1}}``, control variates
+            ``{"name": "cv", "control_variates": [{"g": "x", "integral": 0.5}]}``, VEGAS options
+            ``{"name": "v", "vegas": {"increments": 50}}``. The presets, from the core's catalog:
 
-{ESTIMATORS}
-    n
-        The largest N (default 65536); with a tolerance, the budget of one run (default 2^24).
-    reps
-        Independent replicates per N (default 32; with a tolerance, runs, default 2: the first
-        is the answer reported).
-    rel_tol, abs_tol
-        Stop at a requested accuracy instead of running the N ladder: N doubles until the 95%
-        error bar is within max(abs_tol, rel_tol |estimate|), confirmed by the independent run
-        at N/2 and trusted (docs/result-schema.md, Stopping).
-    exact
-        The exact value, when known: bias, MSE, coverage and the calibration plot use it.
-    seed
-        The seed of every random stream: the same seed gives the same numbers on any number of
-        threads.
-    threads
-        Worker threads (default: every core; 0 = every core).
-    n_min
-        The smallest N (default 16; the randomized QMC presets need at least 16).
-    progress
-        Called with each completed level (a dict) as the study goes.
-    max_seconds
-        With a tolerance: give up an estimate after about this many seconds.
-    quantity
-        ``"integral"`` (default) or ``"mean"`` (the integral over the domain's measure).
-    name
-        The study's name in tables (default the callable's name).
+    {ESTIMATORS}
+        n
+            The largest N (default 65536); with a tolerance, the budget of one run (default 2^24).
+        reps
+            Independent replicates per N (default 32; with a tolerance, runs, default 2: the first
+            is the answer reported).
+        rel_tol, abs_tol
+            Stop at a requested accuracy instead of running the N ladder: N doubles until the 95%
+            error bar is within max(abs_tol, rel_tol |estimate|), confirmed by the independent run
+            at N/2 and trusted (docs/result-schema.md, Stopping).
+        exact
+            The exact value, when known: bias, MSE, coverage and the calibration plot use it.
+        seed
+            The seed of every random stream: the same seed gives the same numbers on any number of
+            threads.
+        threads
+            Worker threads (default: every core; 0 = every core).
+        n_min
+            The smallest N (default 16; the randomized QMC presets need at least 16).
+        progress
+            Called with each completed level (a dict) as the study goes.
+        max_seconds
+            With a tolerance: give up an estimate after about this many seconds.
+        quantity
+            ``"integral"`` (default) or ``"mean"`` (the integral over the domain's measure).
+        name
+            The study's name in tables (default the callable's name).
 
-    Returns
-    -------
-    Result
-        ``.estimate``, ``.error_bar`` (95% half-width) and ``.stderr`` of the recommended
-        estimator ``.best`` (the smallest error bar at the largest N among the estimators whose
-        flags do not say the bar is untrustworthy), each estimator by name (``result["sobol"]``),
-        ``.flags``, ``.levels``, ``.to_pandas()``, ``.plot()``, ``.stopping``, ``.raw``; its
-        ``repr`` is the CLI's table.
+        Returns
+        -------
+        Result
+            ``.estimate``, ``.error_bar`` (95% half-width) and ``.stderr`` of the recommended
+            estimator ``.best`` (the smallest error bar at the largest N among the estimators whose
+            flags do not say the bar is untrustworthy), each estimator by name
+        (``result["sobol"]``),
+            ``.flags``, ``.levels``, ``.to_pandas()``, ``.plot()``, ``.stopping``, ``.raw``; its
+            ``repr`` is the CLI's table.
 
-    Raises
-    ------
-    McplayError
-        A bad argument (named) before any work; an error of ``f`` (raised, wrong shape, NaN),
-        naming the block and the first bad point, with the original error as ``__cause__``.
-    KeyboardInterrupt
-        Ctrl-C cancels the study within a block.
+        Raises
+        ------
+        McplayError
+            A bad argument (named) before any work; an error of ``f`` (raised, wrong shape, NaN),
+            naming the block and the first bad point, with the original error as ``__cause__``.
+        KeyboardInterrupt
+            Ctrl-C cancels the study within a block.
 
-    Examples
-    --------
-    >>> import numpy as np, mcplay
-    >>> r = mcplay.integrate(lambda x: np.exp(x.sum(axis=1)), dim=4, exact=(np.e - 1) ** 4)
-    >>> abs(r.estimate - (np.e - 1) ** 4) < 5 * r.stderr
-    True
+        Examples
+        --------
+        >>> import numpy as np, mcplay
+        >>> r = mcplay.integrate(lambda x: np.exp(x.sum(axis=1)), dim=4, exact=(np.e - 1) ** 4)
+        >>> abs(r.estimate - (np.e - 1) ** 4) < 5 * r.stderr
+        True
     """
     functions: dict[str, Callable] = {}
     scene: dict[str, Any] = {}
     if callable(f):
         if dim is None and domain is None:
-            raise argument_error("dim: a callable f needs dim (the unit cube [0, 1]^dim) or a domain")
+            raise argument_error(
+                "dim: a callable f needs dim (the unit cube [0, 1]^dim) or a domain"
+            )
         functions[_FUNCTION_NAME] = f
         scene["integrand"] = {"type": "function", "name": _FUNCTION_NAME}
         default_name = getattr(f, "__name__", "f")
@@ -185,9 +191,7 @@ def integrate(
     scene["quantity"] = quantity
     if exact is not None:
         scene["exact"] = real_number(exact, "exact")
-    scene["estimators"] = estimator_list(
-        DEFAULT_ESTIMATORS if estimators is None else estimators
-    )
+    scene["estimators"] = estimator_list(DEFAULT_ESTIMATORS if estimators is None else estimators)
     stopping = rel_tol is not None or abs_tol is not None
     if rel_tol is not None:
         scene["rel_tol"] = real_number(rel_tol, "rel_tol", positive=True)
@@ -217,7 +221,7 @@ def integrate(
 def _estimator_lines() -> str:
     """The presets and their one-line summaries, from the core's catalog."""
     try:
-        presets = from_json(_core.call("catalog", "{}"))["estimators"]
+        presets = from_json(_core.call("catalog", ""))["estimators"]
     except Exception as error:  # the docstring must not stop the import
         return f"        (the catalog could not be read: {error})\n"
     lines = []
@@ -235,4 +239,7 @@ def _estimator_lines() -> str:
 
 
 if integrate.__doc__:
-    integrate.__doc__ = integrate.__doc__.replace("{ESTIMATORS}\n", _estimator_lines())
+    _lines = _estimator_lines()
+    integrate.__doc__ = re.sub(
+        r"^[ \t]*\{ESTIMATORS\}\n", lambda _: _lines, integrate.__doc__, flags=re.M
+    )

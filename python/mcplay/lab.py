@@ -39,15 +39,20 @@ def points(
     if sampler.startswith(_PIXEL_PREFIX):
         if randomization is not None:
             raise argument_error("randomization: the pixel samplers have their own")
-        request = {"pixel_sampler": sampler[len(_PIXEL_PREFIX):], "spp": n, "dim": dim,
-                   "seed": seed}
+        request = {
+            "pixel_sampler": sampler[len(_PIXEL_PREFIX) :],
+            "spp": n,
+            "dim": dim,
+            "seed": seed,
+        }
         result = from_json(_core.call("render_pixel_points", to_json(request, "request")))
     else:
         request = {"sampler": sampler, "n": n, "dim": dim, "seed": seed}
         if randomization is not None:
             if not isinstance(randomization, str):
                 raise argument_error(
-                    f"randomization: expected a name, got {type(randomization).__name__}")
+                    f"randomization: expected a name, got {type(randomization).__name__}"
+                )
             request["randomization"] = randomization
         result = from_json(_core.call("points", to_json(request, "request")))
     rows = result["points"]
@@ -58,23 +63,28 @@ def _point_rows(value: Any, what: str) -> list:
     """One point set, an ``(n, d)`` array of finite numbers, as rows for the request."""
     array = np.asarray(value, dtype=np.float64) if not isinstance(value, np.ndarray) else value
     if array.ndim != 2:
-        raise argument_error(f"{what}: expected an (n, d) array, got {array.ndim} dimension(s)"
-                             f" of shape {array.shape}")
+        raise argument_error(
+            f"{what}: expected an (n, d) array, got {array.ndim} dimension(s)"
+            f" of shape {array.shape}"
+        )
     if not np.issubdtype(array.dtype, np.number):
         raise argument_error(f"{what}: expected numbers, got dtype {array.dtype}")
     array = array.astype(np.float64, copy=False)
     bad = ~np.isfinite(array)
     if bad.any():
         row, column = (int(i) for i in np.argwhere(bad)[0])
-        raise argument_error(f"{what}: row {row}, column {column} is {array[row, column]!r}, "
-                             f"not a coordinate")
+        raise argument_error(
+            f"{what}: row {row}, column {column} is {float(array[row, column])}, not a coordinate"
+        )
     return array.tolist()
 
 
 def _point_sets(points_: Any) -> list:
     """One ``(n, d)`` set as rows, or K sets (a list of arrays, or a ``(K, n, d)`` array)."""
-    if isinstance(points_, (list, tuple)) and points_ and all(
-        isinstance(s, np.ndarray) for s in points_
+    if (
+        isinstance(points_, (list, tuple))
+        and points_
+        and all(isinstance(s, np.ndarray) for s in points_)
     ):
         return [_point_rows(s, f"points[{i}]") for i, s in enumerate(points_)]
     try:
@@ -82,7 +92,8 @@ def _point_sets(points_: Any) -> list:
     except (TypeError, ValueError):
         raise argument_error(
             "points: expected an (n, d) array of numbers or a list of such arrays of equal "
-            f"shape, got {type(points_).__name__}") from None
+            f"shape, got {type(points_).__name__}"
+        ) from None
     if array.ndim == 3:
         return [_point_rows(s, f"points[{i}]") for i, s in enumerate(array)]
     return _point_rows(array, "points")
@@ -141,8 +152,10 @@ class Analysis:
             wraparound_l2_discrepancy=number("wraparound_l2_discrepancy"),
             min_distance=number("min_distance"),
             min_distance_toroidal=number("min_distance_toroidal"),
-            expected_iid={k: (math.nan if v is None else float(v))
-                          for k, v in (raw.get("expected_iid") or {}).items()},
+            expected_iid={
+                k: (math.nan if v is None else float(v))
+                for k, v in (raw.get("expected_iid") or {}).items()
+            },
             per_set={k: _float_array(v) for k, v in (raw.get("per_set") or {}).items()},
             spectrum=spectrum,
             spectrum_axes=axes,
@@ -168,10 +181,12 @@ def analyze(
     """
     request: dict[str, Any] = {"points": _point_sets(points)}
     if spectrum:
-        if (isinstance(axes, (str, bytes)) or not isinstance(axes, Sequence) or len(axes) != 2):
+        if isinstance(axes, (str, bytes)) or not isinstance(axes, Sequence) or len(axes) != 2:
             raise argument_error(f"axes: expected a pair of 0-based axes, got {axes!r}")
-        request["spectrum"] = {"axes": [whole_number(a, "axes", 0) for a in axes],
-                               "size": whole_number(size, "size", 1)}
+        request["spectrum"] = {
+            "axes": [whole_number(a, "axes", 0) for a in axes],
+            "size": whole_number(size, "size", 1),
+        }
     else:
         request["spectrum"] = False
     if not isinstance(pairwise, bool):
@@ -257,7 +272,8 @@ def _warp_domain(domain: Any) -> dict | None:
         return None if domain is None else dict(domain)
     if isinstance(domain, (str, bytes)) or not isinstance(domain, Sequence):
         raise argument_error(
-            f"domain: expected a domain dict or (lo, hi) pairs, got {type(domain).__name__}")
+            f"domain: expected a domain dict or (lo, hi) pairs, got {type(domain).__name__}"
+        )
     pairs = list(domain)
     lower, upper = [], []
     for i, pair in enumerate(pairs):
@@ -301,7 +317,8 @@ def warp_test(
             warp = dict(g)
         else:
             raise argument_error(
-                "p: a warp given by g needs its density p (or give g as a named warp)")
+                "p: a warp given by g needs its density p (or give g as a named warp)"
+            )
         if domain is not None or sample_dim is not None:
             raise argument_error("domain: a named warp has its own domain and sample dimension")
     else:

@@ -54,8 +54,9 @@ def _reference_slopes(ax, n: np.ndarray, y: np.ndarray) -> None:
     n0, y0 = n[finite][0], y[finite][0]
     grid = np.array([n.min(), n.max()], dtype=float)
     for slope, style in ((-1, "--"), (-2, ":")):
-        ax.plot(grid, y0 * (grid / n0) ** slope, style, color="0.5", linewidth=1,
-                label=f"N^{slope}")
+        ax.plot(
+            grid, y0 * (grid / n0) ** slope, style, color="0.5", linewidth=1, label=f"N^{slope}"
+        )
 
 
 def _ladder(result: "Result", kind: str, ax):
@@ -68,17 +69,30 @@ def _ladder(result: "Result", kind: str, ax):
         y = t[measure]
         if not np.isfinite(y).any():
             continue
-        line, = ax.plot(t["n"], y, "o-", markersize=3,
-                        label=name + _fit_label(getattr(e, fit_key), measure))
+        (line,) = ax.plot(
+            t["n"], y, "o-", markersize=3, label=name + _fit_label(getattr(e, fit_key), measure)
+        )
         if kind == "variance":
-            ax.fill_between(t["n"], t["variance_lo"], t["variance_hi"], color=line.get_color(),
-                            alpha=0.15, linewidth=0)
+            ax.fill_between(
+                t["n"],
+                t["variance_lo"],
+                t["variance_hi"],
+                color=line.get_color(),
+                alpha=0.15,
+                linewidth=0,
+            )
         fit = getattr(e, fit_key)
         if isinstance(fit, dict) and fit.get("valid") and fit.get("intercept") is not None:
             lo, hi = fit.get("n_first") or t["n"][0], fit.get("n_last") or t["n"][-1]
             grid = np.array([lo, hi], dtype=float)
-            ax.plot(grid, np.exp(fit["intercept"]) * grid ** fit["order"], "-",
-                    color=line.get_color(), alpha=0.5, linewidth=3)
+            ax.plot(
+                grid,
+                np.exp(fit["intercept"]) * grid ** fit["order"],
+                "-",
+                color=line.get_color(),
+                alpha=0.5,
+                linewidth=3,
+            )
         if first is None:
             first = (t["n"].astype(float), y)
     if first is None:
@@ -104,7 +118,7 @@ def _time(result: "Result", ax):
         keep = np.isfinite(x) & np.isfinite(y) & (y > 0)
         if not keep.any():
             continue
-        line, = ax.plot(x[keep], y[keep], "o-", markersize=3, label=name)
+        (line,) = ax.plot(x[keep], y[keep], "o-", markersize=3, label=name)
         lo, hi = t["time_median_lo_s"][keep], t["time_median_hi_s"][keep]
         if np.isfinite(lo).all() and np.isfinite(hi).all():
             ax.hlines(y[keep], lo, hi, color=line.get_color(), alpha=0.4)
@@ -127,7 +141,7 @@ def _z_scores(e, exact: float | None) -> np.ndarray:
         reference = exact if exact is not None else level.get("mean")
         if not isinstance(reference, (int, float)):
             continue
-        for est, se in zip(rep.get("estimate") or [], rep.get("std_error") or []):
+        for est, se in zip(rep.get("estimate") or [], rep.get("std_error") or [], strict=False):
             if isinstance(est, (int, float)) and isinstance(se, (int, float)) and se > 0:
                 z.append((est - reference) / se)
     return np.array(z, dtype=float)
@@ -146,15 +160,22 @@ def _calibration(result: "Result", ax):
     exact = result.exact
     edges = np.arange(-5.0, 5.0 + 1e-9, 0.5)
     grid = np.linspace(-5, 5, 201)
-    hist_ax.plot(grid, np.exp(-0.5 * grid**2) / math.sqrt(2 * math.pi), "k-", linewidth=1.5,
-                 label="N(0, 1)")
+    hist_ax.plot(
+        grid, np.exp(-0.5 * grid**2) / math.sqrt(2 * math.pi), "k-", linewidth=1.5, label="N(0, 1)"
+    )
     for name, e in result.estimators.items():
         z = _z_scores(e, exact)
         if z.size:
             outside = int(np.sum(np.abs(z) >= 5))
             label = f"{name} ({z.size} runs" + (f", {outside} beyond ±5)" if outside else ")")
-            hist_ax.hist(np.clip(z, -5, 5 - 1e-9), bins=edges, density=True, histtype="step",
-                         linewidth=1.5, label=label)
+            hist_ax.hist(
+                np.clip(z, -5, 5 - 1e-9),
+                bins=edges,
+                density=True,
+                histtype="step",
+                linewidth=1.5,
+                label=label,
+            )
         t = e.levels
         if np.isfinite(t["coverage95"]).any():
             cover_ax.plot(t["n"], t["coverage95"], "o-", markersize=3, label=name)

@@ -40,9 +40,13 @@ class Render:
         return int(self.image.shape[0])
 
     def __repr__(self) -> str:
-        rel = "no reference" if self.relative_mse is None else f"relative MSE {self.relative_mse:.4g}"
-        return (f"<Render {self.estimator} at {self.spp} spp, {self.width}x{self.height}, {rel}, "
-                f"{self.seconds:.3g} s>")
+        rel = (
+            "no reference" if self.relative_mse is None else f"relative MSE {self.relative_mse:.4g}"
+        )
+        return (
+            f"<Render {self.estimator} at {self.spp} spp, {self.width}x{self.height}, {rel}, "
+            f"{self.seconds:.3g} s>"
+        )
 
 
 def _decode_pfm(data: bytes) -> np.ndarray:
@@ -123,8 +127,13 @@ def render(
     cache = reference_cache_dir(cache_dir)
     if cache is not None:
         opts["cache_dir"] = cache
-    for name, value in (("width", width), ("height", height), ("seed", seed),
-                        ("threads", threads), ("long_side", long_side)):
+    for name, value in (
+        ("width", width),
+        ("height", height),
+        ("seed", seed),
+        ("threads", threads),
+        ("long_side", long_side),
+    ):
         if value is not None:
             opts[name] = whole_number(value, name, 0)
     if pixel_sampler is not None:
@@ -133,7 +142,8 @@ def render(
         opts["pixel_sampler"] = pixel_sampler
     if estimator is not None and not isinstance(estimator, (str, Mapping)):
         raise argument_error(
-            f"estimator: expected a name or an estimator object, got {type(estimator).__name__}")
+            f"estimator: expected a name or an estimator object, got {type(estimator).__name__}"
+        )
     if estimator is not None:
         estimator = dict(estimator) if isinstance(estimator, Mapping) else estimator
     if spp is not None:
@@ -154,8 +164,11 @@ def render(
     raw = from_json(_core.call("render_image", loaded.text, to_json(opts, "options")))
     images = raw.pop("images", {})
     image = _decode_pfm(base64.b64decode(images["pfm"]))
-    name = raw.get("estimator", {}).get("name", "") if isinstance(raw.get("estimator"), dict) \
+    name = (
+        raw.get("estimator", {}).get("name", "")
+        if isinstance(raw.get("estimator"), dict)
         else str(raw.get("estimator", ""))
+    )
     return Render(
         image=image,
         relative_mse=_number(raw.get("relative_mse")),
@@ -183,16 +196,25 @@ class ProgressiveRender:
         self.width = int(info["width"])
         self.height = int(info["height"])
         estimators = info.get("estimators") or [{}]
-        self.estimator = str(estimators[0].get("name", "")) if isinstance(estimators[0], dict) \
+        self.estimator = (
+            str(estimators[0].get("name", ""))
+            if isinstance(estimators[0], dict)
             else str(estimators[0])
+        )
         self._next_spp = 1
 
     @classmethod
-    def _open(cls, scene_text: str, opts: dict, estimator: Any, spp: int | None,
-              reference: bool) -> "ProgressiveRender":
+    def _open(
+        cls, scene_text: str, opts: dict, estimator: Any, spp: int | None, reference: bool
+    ) -> "ProgressiveRender":
         if spp is None:
-            info = from_json(_core.call("render_scene_info", scene_text, to_json(
-                {"base_dir": opts["base_dir"]}, "options")))
+            info = from_json(
+                _core.call(
+                    "render_scene_info",
+                    scene_text,
+                    to_json({"base_dir": opts["base_dir"]}, "options"),
+                )
+            )
             spp = int(info["settings"]["n_max"])
         if spp & (spp - 1):
             raise argument_error(f"spp: a progressive render needs a power of two, got {spp}")
@@ -228,9 +250,14 @@ class ProgressiveRender:
             total = _number(error.get("sum"))
             if total is not None and math.isfinite(total):
                 relative_mse = total / float(error["terms"])
-        return Render(image=image, relative_mse=relative_mse,
-                      seconds=_number(raw.get("seconds")) or 0.0, spp=spp,
-                      estimator=self.estimator, raw=raw)
+        return Render(
+            image=image,
+            relative_mse=relative_mse,
+            seconds=_number(raw.get("seconds")) or 0.0,
+            spp=spp,
+            estimator=self.estimator,
+            raw=raw,
+        )
 
     def close(self) -> None:
         """Free the core's session (again is a no-op)."""

@@ -1,4 +1,4 @@
-"""The result of a study as Python objects: :class:`Result`, :class:`EstimatorResult`, :class:`Flag`.
+"""A study's result as Python objects: :class:`Result`, :class:`EstimatorResult`, :class:`Flag`.
 
 Every number is read from the core's result dict (``Result.raw``); nothing is recomputed but the
 95% half-width of an interval the core gives, (hi - lo) / 2.
@@ -239,10 +239,14 @@ class EstimatorResult:
         return True
 
     def __repr__(self) -> str:
-        order = "" if math.isnan(self.order) else f", order {self.order:.3f} +/- {self.order_se:.3f}"
+        order = (
+            "" if math.isnan(self.order) else f", order {self.order:.3f} +/- {self.order_se:.3f}"
+        )
         flags = f", {len(self.flags)} flag(s)" if self.flags else ""
-        return (f"<EstimatorResult {self.name}: {self.estimate:.10g} +/- {self.error_bar:.3g} "
-                f"(95%) at N = {self.n}{order}{flags}>")
+        return (
+            f"<EstimatorResult {self.name}: {self.estimate:.10g} +/- {self.error_bar:.3g} "
+            f"(95%) at N = {self.n}{order}{flags}>"
+        )
 
 
 def _is_number(value: Any) -> bool:
@@ -412,18 +416,20 @@ class Result:
 def _stopping_rows(name: str, raw: Mapping) -> list[dict]:
     rows = []
     for i, run in enumerate(raw.get("runs") or []):
-        rows.append({
-            "estimator": name,
-            "replicate": i,
-            "estimate": _number(run.get("estimate")),
-            "std_error": _number(run.get("std_error")),
-            "half_width": _number(run.get("half_width")),
-            "target": _number(run.get("target")),
-            "met": bool(run.get("met")),
-            "reason": run.get("reason"),
-            "n": int(run.get("n") or 0),
-            "evaluations": int(run.get("evaluations") or 0),
-            "seconds": _number(run.get("seconds")),
-            "within_tolerance": run.get("within_tolerance"),
-        })
+        rows.append(
+            {
+                "estimator": name,
+                "replicate": i,
+                "estimate": _number(run.get("estimate")),
+                "std_error": _number(run.get("std_error")),
+                "half_width": _number(run.get("half_width")),
+                "target": _number(run.get("target")),
+                "met": bool(run.get("met")),
+                "reason": run.get("reason"),
+                "n": int(run.get("n") or 0),
+                "evaluations": int(run.get("evaluations") or 0),
+                "seconds": _number(run.get("seconds")),
+                "within_tolerance": run.get("within_tolerance"),
+            }
+        )
     return rows

@@ -50,7 +50,9 @@ def reference_cache_dir(cache_dir: Any) -> str | None:
     try:
         folder.mkdir(parents=True, exist_ok=True)
     except OSError as error:
-        raise argument_error(f"cache_dir: '{folder}' cannot be created ({error.strerror})") from None
+        raise argument_error(
+            f"cache_dir: '{folder}' cannot be created ({error.strerror})"
+        ) from None
     if not folder.is_dir():
         raise argument_error(f"cache_dir: '{folder}' is not a folder")
     return str(folder)
@@ -68,7 +70,9 @@ def functions_dict(functions: Any) -> dict[str, Callable]:
         if not isinstance(name, str):
             raise argument_error(f"functions: names must be strings, got {name!r}")
         if not callable(fn):
-            raise argument_error(f"functions[{name!r}]: expected a callable, got {type(fn).__name__}")
+            raise argument_error(
+                f"functions[{name!r}]: expected a callable, got {type(fn).__name__}"
+            )
     return dict(functions)
 
 
@@ -129,8 +133,13 @@ def run(
     loaded = load(scene)
     opts: dict[str, Any] = {}
     put(opts, "estimators", estimator_list(estimators))
-    for name, value in (("n_min", n_min), ("n_max", n_max), ("reps", reps), ("seed", seed),
-                        ("threads", threads)):
+    for name, value in (
+        ("n_min", n_min),
+        ("n_max", n_max),
+        ("reps", reps),
+        ("seed", seed),
+        ("threads", threads),
+    ):
         if value is not None:
             opts[name] = whole_number(value, name, 0)
     for name, value in (("rel_tol", rel_tol), ("abs_tol", abs_tol)):
@@ -191,8 +200,13 @@ def merge(parts: Iterable[Any]) -> dict:
     return from_json(text)
 
 
-def plan(scene: Any, *, options: Mapping[str, Any] | None = None,
-         functions: Mapping[str, Callable] | None = None, cache_dir: Any = False) -> dict:
+def plan(
+    scene: Any,
+    *,
+    options: Mapping[str, Any] | None = None,
+    functions: Mapping[str, Callable] | None = None,
+    cache_dir: Any = False,
+) -> dict:
     """What a study of ``scene`` would cost, from a short timed pilot, without running it."""
     loaded = load(scene)
     opts = dict(options or {})
@@ -202,8 +216,9 @@ def plan(scene: Any, *, options: Mapping[str, Any] | None = None,
         if cache is not None:
             opts.setdefault("cache_dir", cache)
         return from_json(_core.call("render_study_plan", loaded.text, to_json(opts, "options")))
-    return from_json(_core.study_plan(loaded.text, to_json(opts, "options"),
-                                      functions_dict(functions)))
+    return from_json(
+        _core.study_plan(loaded.text, to_json(opts, "options"), functions_dict(functions))
+    )
 
 
 def scene_info(scene: Any) -> dict:
@@ -218,7 +233,7 @@ def scene_info(scene: Any) -> dict:
 def catalog() -> dict:
     """What the core offers: estimator presets (name, kind, sampler, needs_pdf, summary), kinds,
     samplers, randomizations, pdfs, integrands, domains and named warps."""
-    return from_json(_core.call("catalog", "{}"))
+    return from_json(_core.call("catalog", ""))
 
 
 def estimators() -> list[dict]:
