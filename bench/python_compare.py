@@ -413,27 +413,35 @@ def compare(mcplay, o: argparse.Namespace, out) -> None:
                           "coverage_min": {k: min(v) for k, v in coverage.items()}}) + "\n")
 
 
+def median_seconds(mcplay, fs: dict, runs: int, **kwargs) -> tuple[dict, dict]:
+    """Median wall seconds of ``runs`` calls of mcplay.integrate per entry of ``fs`` (the
+    entries take turns), and each entry's last (estimate, standard error)."""
+    times: dict[str, list[float]] = {key: [] for key in fs}
+    means = {}
+    for _ in range(runs):
+        for key, f in fs.items():
+            start = time.perf_counter()
+            r = mcplay.integrate(f, **kwargs)
+            times[key].append(time.perf_counter() - start)
+            means[key] = (r.estimate, r.stderr)
+    return {key: statistics.median(t) for key, t in times.items()}, means
+
+
 def speed(mcplay, o: argparse.Namespace, out) -> None:
-    """The callable path against the expression path, f = exp(x1 + x2 + x3 + x4)."""
+    """The callable path against the expression path, f = exp(x1 + x2 + x3 + x4), and where
+    the callable's time goes."""
     d, n, reps, runs = 4, 1 << 20, 4, 5
     paths = {"callable": lambda x: np.exp(x.sum(1)),
              "expression": "exp(" + " + ".join(f"x{i + 1}" for i in range(d)) + ")"}
+    common = dict(dim=d, n=n, n_min=n, reps=reps, seed=o.seed)
     print(f"\n# callable vs expression: exp(sum x) in d = {d}, N = {n}, {reps} replicates per "
-          f"call, median wall seconds of {runs} calls of mcplay.integrate")
+          f"call, median wall seconds of {runs} calls of mcplay.integrate (taking turns)")
     print(f"  {'estimator':<10} {'threads':>7} {'callable s':>11} {'expression s':>13} "
           f"{'ratio':>6} {'|mean diff|/se':>15}")
     for threads in (1, 2):
         for estimator in ("uniform", "sobol", "vegas"):
-            walls, means = {}, {}
-            for path, f in paths.items():
-                times = []
-                for _ in range(runs):
-                    start = time.perf_counter()
-                    r = mcplay.integrate(f, dim=d, estimators=[estimator], n=n, n_min=n,
-                                         reps=reps, seed=o.seed, threads=threads)
-                    times.append(time.perf_counter() - start)
-                walls[path] = statistics.median(times)
-                means[path] = (r.estimate, r.stderr)
+            walls, means = median_seconds(mcplay, paths, runs, estimators=[estimator],
+                                          threads=threads, **common)
             ratio = walls["callable"] / walls["expression"]
             diff = abs(means["callable"][0] - means["expression"][0]) / means["expression"][1]
             print(f"  {estimator:<10} {threads:>7} {walls['callable']:>11.3f} "
@@ -443,6 +451,29 @@ def speed(mcplay, o: argparse.Namespace, out) -> None:
                                   "callable_s": walls["callable"],
                                   "expression_s": walls["expression"], "ratio": ratio,
                                   "mean_diff_over_se": diff}) + "\n")
+
+    # Where the callable's time goes (uniform, one thread): a callable that returns a constant
+    # against the expression "1" (the cost of a call across the bridge), and numpy's own time
+    # for f on the same blocks, as the core passes them (C order, (4096, d)) and in column
+    # order (the core's coordinate arrays).
+    ones = np.ones(4096)
+    walls, _ = median_seconds(
+        mcplay, {"constant callable": lambda x: ones[: x.shape[0]].copy(),
+                 "constant expression": "1 + 0 * x1",
+                 "callable, copied to column order": lambda x: np.exp(
+                     np.asfortranarray(x).sum(1))},
+        runs, estimators=["uniform"], threads=1, **common)
+    block = np.random.default_rng(1).random((4096, d))
+    calls = reps * n // 4096
+    for order, x in (("C order", block), ("column order", np.asfortranarray(block))):
+        start = time.perf_counter()
+        for _ in range(calls):
+            paths["callable"](x)
+        walls[f"numpy alone, {order}"] = time.perf_counter() - start
+    print(f"\n# where the callable's time goes (uniform, 1 thread, {calls} blocks of 4096)")
+    for key, seconds in walls.items():
+        print(f"  {key:<34} {seconds:>7.3f} s")
+    out.write(json.dumps({"kind": "speed_detail", "calls": calls, **walls}) + "\n")
 
 
 def main() -> None:
