@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """mcplay from Python beside vegas and QMCPy on Genz's six families, one numpy callable per case.
 
-    python_compare.py [--n N] [--reps R] [--dims 4,8] [--jsonl PATH] [--only compare|speed]
+    python_compare.py [--n N] [--reps R] [--rounds K] [--dims 4,8] [--families F,...]
+                      [--jsonl PATH] [--only compare|speed] [--callable-vs-expression]
 
 `make bench-python` (bench/python.mk) installs the package and the anchors in a venv and runs it;
 docs/benchmarks.md, "From Python: beside vegas and QMCPy", has the figures.
@@ -36,15 +37,19 @@ of each anchor, so that the shared machine's load falls on all of them alike.
 Per (case, tool): relative RMSE over the R replicates, median seconds per estimate, efficiency
 1 / (relMSE x seconds), coverage of the tool's own interval, evaluations per estimate (counted).
 mcplay's best estimator per case is the most efficient of its candidates (a choice made after
-the fact, as for the anchors' best); mcplay's sobol alone is reported beside it.
+the fact, as for the anchors' best); the ratios of sobol and sobol_walsh alone (fixed choices)
+are reported beside it.
 
 The speed check (``--only speed``): f = exp(x1 + ... + x4) as a numpy callable and as an
 expression, N = 2^20, estimators uniform, sobol, vegas, threads 1 and 2, the same seeds; the
-median wall time of 5 calls of ``mcplay.integrate`` per (path, estimator, threads).
+median wall time of 5 calls of ``mcplay.integrate`` per (path, estimator, threads), taking
+turns; then where the callable's time goes (a constant callable against a constant expression,
+numpy's own time on C-order and column-order blocks).
 
 Every tool runs in this one process, one thread each (BLAS pinned to one thread before numpy
-loads; mcplay's threads = 1). The GIL: mcplay calls the callable from the core's worker
-threads, one block of points at a time, holding the GIL only while the callable runs.
+loads; mcplay's threads = 1). The GIL: the core calls the callable from its threads, one block
+of points per call, each call holding the GIL, so a second thread would only overlap the core's
+own work.
 """
 from __future__ import annotations
 
@@ -328,7 +333,7 @@ def compare(mcplay, o: argparse.Namespace, out) -> None:
     import vegas
 
     families = FAMILIES if o.families == "all" else tuple(o.families.split(","))
-    cases = draw_cases([int(d) for d in o.dims.split(",")], families, o.param_seed)
+    cases = draw_cases(o.dims, families, o.param_seed)
     print(f"# mcplay {mcplay.__version__}, vegas {vegas.__version__}, qmcpy {qp.__version__}, "
           f"numpy {np.__version__}; N = {o.n}, {o.reps} replicates, seed {o.seed}, "
           f"params seed {o.param_seed}; one thread each", flush=True)
@@ -476,17 +481,30 @@ def speed(mcplay, o: argparse.Namespace, out) -> None:
     out.write(json.dumps({"kind": "speed_detail", "calls": calls, **walls}) + "\n")
 
 
+def dims_list(text: str) -> list[int]:
+    """``--dims``: comma-separated dimensions, each 2..64 (Genz's discontinuous family uses two
+    coordinates)."""
+    try:
+        dims = [int(part) for part in text.split(",")]
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected integers like 4,8, got {text!r}") from None
+    if not dims or any(not 2 <= d <= 64 for d in dims):
+        raise argparse.ArgumentTypeError(f"each dimension must be in 2..64, got {text!r}")
+    return dims
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--n", type=int, default=1 << 16, help="evaluations per estimate (2^16)")
     ap.add_argument("--reps", type=int, default=100, help="replicates per (case, tool) (100)")
     ap.add_argument("--rounds", type=int, default=4,
                     help="the tools take turns in this many rounds of reps / rounds replicates")
-    ap.add_argument("--dims", default="4,8")
+    ap.add_argument("--dims", type=dims_list, default=[4, 8], help="comma-separated (4,8)")
     ap.add_argument("--families", default="all", help="comma-separated, e.g. gaussian,continuous")
     ap.add_argument("--seed", type=int, default=47, help="the replicates' seeds derive from it")
     ap.add_argument("--param-seed", type=int, default=2026, help="the Genz parameters' seed")
-    ap.add_argument("--jsonl", default="build/bench-python/compare.jsonl")
+    ap.add_argument("--jsonl", default="build/bench-python/compare.jsonl",
+                    help="where the JSON lines go (one per row, case, summary, speed cell)")
     ap.add_argument("--only", choices=("compare", "speed"), help="one part only")
     ap.add_argument("--callable-vs-expression", action="store_true",
                     help="the same as --only speed")

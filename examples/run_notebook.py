@@ -47,7 +47,7 @@ def main() -> int:
     ap.add_argument("notebook", type=Path)
     ap.add_argument("--timeout", type=float, default=300, help="seconds per cell (300)")
     ap.add_argument("--budget", type=float, default=240, help="seconds for the whole run (240)")
-    ap.add_argument("--workdir", type=Path, help="where the cells run (default: a temporary folder)")
+    ap.add_argument("--workdir", type=Path, help="where the cells run (default: a temporary dir)")
     ap.add_argument("--executed", type=Path, help="write the executed notebook here")
     ap.add_argument("--strip", action="store_true", help="strip outputs in place and stop")
     o = ap.parse_args()
