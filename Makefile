@@ -441,3 +441,5 @@ fuzz-smoke: fuzz-build
 
 clean:
 	rm -rf $(BUILD) $(BUILD_WASM) $(BUILD_ASAN) $(BUILD_FUZZ)
+include bench/python.mk
+include examples/notebook.mk
