@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import os
 import pathlib
+import signal
+import threading
 
 import pytest
 
@@ -27,3 +29,14 @@ def scenes_dir() -> pathlib.Path:
         if (candidate / "exp_1d.json").is_file():
             return candidate
     raise FileNotFoundError("no bundled scenes beside the package nor in the repository")
+
+
+@pytest.fixture
+def default_sigint():
+    """Python's own SIGINT handler (KeyboardInterrupt) for the test, whatever the process
+    inherited (a background job starts with SIGINT ignored)."""
+    if threading.current_thread() is not threading.main_thread():
+        pytest.skip("signals reach only the main thread")
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, previous)

@@ -558,7 +558,7 @@ def test_errors_of_the_callable_name_the_block_and_keep_the_cause():
         mcplay.integrate(lambda x: np.full(len(x), np.nan), dim=2, n=64, reps=2)
 
 
-def test_ctrl_c_cancels_within_blocks():
+def test_ctrl_c_cancels_within_blocks(default_sigint):
     calls = []
 
     def f(x):

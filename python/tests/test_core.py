@@ -360,17 +360,6 @@ def test_progress_gets_each_level_and_its_exception_cancels() -> None:
     assert len(calls) < 64
 
 
-@pytest.fixture
-def default_sigint():
-    """Python's own SIGINT handler (KeyboardInterrupt) for the test, whatever the process
-    inherited (a background job starts with SIGINT ignored)."""
-    if threading.current_thread() is not threading.main_thread():
-        pytest.skip("signals reach only the main thread")
-    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
-    yield
-    signal.signal(signal.SIGINT, previous)
-
-
 def test_ctrl_c_from_a_timer_cancels_a_long_study_quickly(default_sigint: None) -> None:
     timer = threading.Timer(0.5, signal.raise_signal, (signal.SIGINT,))
     start = time.perf_counter()
