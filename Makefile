@@ -71,6 +71,8 @@ help:
 	@echo "make bench-embree  the accelerator beside Embree 3 (Debian's libembree-dev) on the same rays, one thread"
 	@echo "make format clang-format every C++ source"
 	@echo "make test-python  build the Python wheel, install it in a fresh venv, run python/tests (part of make check)"
+	@echo "make test-notebook  run examples/mcplay_tour.ipynb headless with the installed wheel (part of make check)"
+	@echo "make bench-python  the Python package beside vegas and QMCPy on Genz's families; callable against expression"
 	@echo "make test-sanitize  the native ctest suite under ASan + UBSan ($(BUILD_ASAN); part of make check)"
 	@echo "make fuzz   libFuzzer targets, $(FUZZ_SECONDS) s each (FUZZ_TARGETS=\"$(FUZZ_TARGETS)\"); docs/fuzzing.md"
 	@echo "make fuzz-smoke  each fuzz target over its seed corpus only (seconds)"
@@ -201,11 +203,13 @@ test:
 test-suites: test-native test-wasm test-compare test-web-core test-npm test-e2e
 
 # Everything: the loop, then the suites too slow for it (sanitizers; the fuzz targets, built with
-# clang, over their seed corpus and past findings). .ci/run runs this.
+# clang, over their seed corpus and past findings; the Python wheel's tests and the notebook).
+# .ci/run runs this.
 check:
 	@start=$$(date +%s); \
 	$(MAKE) --no-print-directory test && \
 	$(MAKE) --no-print-directory -j 2 test-sanitize fuzz-smoke test-wasm-statistical test-python && \
+	$(MAKE) --no-print-directory test-notebook && \
 	echo "make check: all suites passed in $$(( $$(date +%s) - start )) s"
 
 run: build site
