@@ -37,25 +37,33 @@ bool CallerFunction::evaluate(const PointBlock& x, int out_dim, double* out,
         zeros();
         return false;
     }
-    // Contiguous copies of the block's columns in and out (the block's own columns are
-    // `capacity` apart): per block, reused by the thread.
+    // The block's columns are `capacity` apart: contiguous as the function wants them when the
+    // block is full (a batch of kFunctionBatch) or has one column; else copied, per block, into
+    // a buffer the thread reuses. The same for the values out.
     thread_local std::vector<double> columns_in, columns_out;
     const size_t d = static_cast<size_t>(x.dim), m = static_cast<size_t>(out_dim);
-    if (columns_in.size() < n * d) columns_in.resize(n * d);
-    if (columns_out.size() < n * m) columns_out.resize(n * m);
-    for (size_t j = 0; j < d; ++j) {
-        const double* xj = x.coord(static_cast<int>(j));
-        std::copy(xj, xj + n, columns_in.begin() + static_cast<long>(j * n));
+    const double* in = x.coord(0);
+    if (x.capacity != n && d > 1) {
+        if (columns_in.size() < n * d) columns_in.resize(n * d);
+        for (size_t j = 0; j < d; ++j) {
+            const double* xj = x.coord(static_cast<int>(j));
+            std::copy(xj, xj + n, columns_in.begin() + static_cast<long>(j * n));
+        }
+        in = columns_in.data();
     }
-    std::fill(columns_out.begin(), columns_out.begin() + static_cast<long>(n * m), 0.0);
-    if (fn(user, columns_in.data(), n, x.dim, columns_out.data(), out_dim) != 0) {
+    const bool direct_out = out_stride == n || m == 1;
+    if (!direct_out && columns_out.size() < n * m) columns_out.resize(n * m);
+    double* values = direct_out ? out : columns_out.data();
+    std::fill(values, values + n * m, 0.0);
+    if (fn(user, in, n, x.dim, values, out_dim) != 0) {
         control->fail(name);
         zeros();
         return false;
     }
-    for (size_t k = 0; k < m; ++k)
-        std::copy(columns_out.begin() + static_cast<long>(k * n),
-                  columns_out.begin() + static_cast<long>((k + 1) * n), out + k * out_stride);
+    if (!direct_out)
+        for (size_t k = 0; k < m; ++k)
+            std::copy(columns_out.begin() + static_cast<long>(k * n),
+                      columns_out.begin() + static_cast<long>((k + 1) * n), out + k * out_stride);
     return true;
 }
 
