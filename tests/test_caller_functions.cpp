@@ -37,7 +37,7 @@ Outcome run_with(const json& scene, const json& options, const mcp_context* ctx,
 
 /// What a test function records of its calls.
 struct Calls {
-    std::atomic<uint64_t> calls{0}, points{0}, smallest{UINT64_MAX};
+    std::atomic<uint64_t> calls{0}, points{0}, smallest{UINT64_MAX}, largest{0};
     std::atomic<uint64_t> fail_at{0}; ///< fail on this call (1-based); 0: never
     std::atomic<int> bad_layout{0};   ///< a point outside the unit cube or a wrong dimension
     int expect_dim = 0;
@@ -50,6 +50,8 @@ int product_plus_first(void* user, const double* x, uint64_t n, int in_dim, doub
     const uint64_t call = ++c->calls;
     c->points += n;
     for (uint64_t s = c->smallest; n < s && !c->smallest.compare_exchange_weak(s, n);) {
+    }
+    for (uint64_t l = c->largest; n > l && !c->largest.compare_exchange_weak(l, n);) {
     }
     if (in_dim != c->expect_dim || out_dim != 1 || n == 0 || n > 4096) ++c->bad_layout;
     if (c->fail_at != 0 && call >= c->fail_at) return 1;
@@ -150,6 +152,22 @@ TEST(CallerFunctions, FixedEstimatorsCallOncePerBatchOfBlocks) {
     ASSERT_EQ(o.status, MCP_OK) << o.error;
     EXPECT_EQ(calls.smallest.load(), 4096u);
     EXPECT_EQ(calls.bad_layout.load(), 0);
+}
+
+TEST(CallerFunctions, VegasEstimatesFromItsFrozenMapInBatches) {
+    // Training adapts the map block by block (256 points per call); the estimate from the frozen
+    // map comes in batches of 4096, and the numbers are the expression's (test above).
+    Calls calls;
+    calls.expect_dim = 2;
+    const mcp_function fns[] = {{"f", product_plus_first, &calls}};
+    const mcp_context ctx = context_of(fns, 1);
+    const Outcome o = run_with(box_scene({{"type", "function"}, {"name", "f"}}, 2),
+                               {{"estimators", {"vegas"}}, {"n_min", 65536}, {"n_max", 65536},
+                                {"reps", 2}},
+                               &ctx);
+    ASSERT_EQ(o.status, MCP_OK) << o.error;
+    EXPECT_EQ(calls.largest.load(), 4096u);
+    EXPECT_LT(calls.calls.load(), calls.points.load() / 512); // half the calls of 256 each
 }
 
 TEST(CallerFunctions, PointsArriveColumnMajor) {

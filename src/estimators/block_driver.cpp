@@ -35,49 +35,31 @@ SampleBlock sample_block(const Problem& problem, const Proposal& proposal, const
     return block_of(ws, first, count);
 }
 
-namespace {
-
-/// Copies points [from, from + count) of src into dst at index `at` (same dimension).
 void copy_points(const PointBlock& src, size_t from, PointBlock& dst, size_t at, size_t count) {
     for (int j = 0; j < src.dim; ++j)
         std::copy(src.coord(j) + from, src.coord(j) + from + count, dst.coord(j) + at);
 }
 
-} // namespace
+SampleBlock detail::block_from_batch(uint64_t first, size_t count, Workspace& ws) {
+    const FunctionBatch& b = ws.batch;
+    const size_t from = static_cast<size_t>(first - b.begin);
+    copy_points(b.u, from, ws.u, 0, count);
+    copy_points(b.x, from, ws.x, 0, count);
+    std::copy(b.pdf.begin() + static_cast<long>(from),
+              b.pdf.begin() + static_cast<long>(from + count), ws.pdf.begin());
+    std::copy(b.f.begin() + static_cast<long>(from), b.f.begin() + static_cast<long>(from + count),
+              ws.f.begin());
+    ws.u.n = ws.x.n = count;
+    return block_of(ws, first, count);
+}
 
 SampleBlock sample_block_batched(const Problem& problem, const Proposal& proposal,
                                  const SamplerPlan& plan, uint64_t first, size_t count,
                                  Workspace& ws) {
-    if (problem.integrand.kind != IntegrandKind::Function)
-        return sample_block(problem, proposal, plan, first, count, ws);
-    FunctionBatch& b = ws.batch;
-    if (first < b.begin || first + count > b.end) {
-        // Make the next batch: blocks of kBlockSize from `first`, as sample_block makes them.
-        b.begin = first;
-        b.end = std::min<uint64_t>(plan.total, first + kFunctionBatch);
-        const size_t total = static_cast<size_t>(b.end - b.begin);
-        if (b.u.dim != ws.u.dim || b.u.capacity != kFunctionBatch) b.u.reset(ws.u.dim, kFunctionBatch);
-        if (b.x.dim != ws.x.dim || b.x.capacity != kFunctionBatch) b.x.reset(ws.x.dim, kFunctionBatch);
-        b.pdf.resize(kFunctionBatch);
-        b.f.resize(kFunctionBatch);
-        for (size_t at = 0; at < total; at += kBlockSize) {
-            const size_t m = std::min(kBlockSize, total - at);
-            generate_block(plan, b.begin + at, m, ws.u);
-            warp_block(proposal, problem.domain, ws.u, ws.x, ws.pdf.data());
-            copy_points(ws.u, 0, b.u, at, m);
-            copy_points(ws.x, 0, b.x, at, m);
-            std::copy(ws.pdf.begin(), ws.pdf.begin() + static_cast<long>(m), b.pdf.begin() + static_cast<long>(at));
-        }
-        b.u.n = b.x.n = total;
-        evaluate_block(problem.integrand, b.x, b.f.data());
-    }
-    const size_t from = static_cast<size_t>(first - b.begin);
-    copy_points(b.u, from, ws.u, 0, count);
-    copy_points(b.x, from, ws.x, 0, count);
-    std::copy(b.pdf.begin() + static_cast<long>(from), b.pdf.begin() + static_cast<long>(from + count), ws.pdf.begin());
-    std::copy(b.f.begin() + static_cast<long>(from), b.f.begin() + static_cast<long>(from + count), ws.f.begin());
-    ws.u.n = ws.x.n = count;
-    return block_of(ws, first, count);
+    return batched_block(problem, first, count, plan.total, ws, [&](uint64_t at, size_t m) {
+        generate_block(plan, at, m, ws.u);
+        warp_block(proposal, problem.domain, ws.u, ws.x, ws.pdf.data());
+    });
 }
 
 double clock_seconds() {

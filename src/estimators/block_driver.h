@@ -57,6 +57,9 @@ struct SampleBlock {
     const double* f = nullptr;
 };
 
+/// Copies points [from, from + count) of src into dst from index `at` (same dimension).
+void copy_points(const PointBlock& src, size_t from, PointBlock& dst, size_t at, size_t count);
+
 /// Sizes the workspace's buffers for a domain (no allocation when they already fit).
 void prepare_workspace(const Domain& domain, Workspace& ws);
 
@@ -66,10 +69,18 @@ void prepare_workspace(const Domain& domain, Workspace& ws);
 SampleBlock sample_block(const Problem& problem, const Proposal& proposal, const SamplerPlan& plan,
                          uint64_t first, size_t count, Workspace& ws);
 
-/// sample_block for a run whose integrand may be a caller's function: the same samples, but for
-/// a function they come from a batch of kFunctionBatch made ahead (and evaluated in one call)
-/// starting at `first` when the batch does not hold them. Blocks must come in increasing order
-/// within a run, and ws.batch must be cleared when a run begins.
+/// The block of samples first .. first + count - 1 of a run of `total` whose points make(at, m)
+/// writes into ws.u, ws.x and ws.pdf (the m samples from `at`, m <= kBlockSize; they may depend
+/// only on their indices), evaluated: for a caller's function, from a batch of up to
+/// kFunctionBatch samples made ahead from `first` (when the batch does not hold them yet) and
+/// evaluated in one call; otherwise made and evaluated as one block. Blocks come in increasing
+/// order within a run; ws.batch is cleared when a run begins.
+template <class Make>
+SampleBlock batched_block(const Problem& problem, uint64_t first, size_t count, uint64_t total,
+                          Workspace& ws, Make&& make);
+
+/// sample_block for a run whose integrand may be a caller's function: the same samples, in
+/// batches for a function (batched_block).
 SampleBlock sample_block_batched(const Problem& problem, const Proposal& proposal,
                                  const SamplerPlan& plan, uint64_t first, size_t count,
                                  Workspace& ws);
@@ -90,6 +101,48 @@ void for_each_block(const Problem& problem, const Proposal& proposal, const Samp
         consume(static_cast<const SampleBlock&>(
             sample_block_batched(problem, proposal, plan, first, count, ws)));
     }
+}
+
+namespace detail {
+/// Fills ws.batch with the samples [first, min(total, first + kFunctionBatch)) made by `make`
+/// block by block through ws's buffers, then evaluates f on the whole batch.
+template <class Make>
+void fill_batch(const Problem& problem, uint64_t first, uint64_t total, Workspace& ws,
+                Make&& make) {
+    FunctionBatch& b = ws.batch;
+    b.begin = first;
+    b.end = std::min<uint64_t>(total, first + kFunctionBatch);
+    const size_t n = static_cast<size_t>(b.end - b.begin);
+    if (b.u.dim != ws.u.dim || b.u.capacity != kFunctionBatch) b.u.reset(ws.u.dim, kFunctionBatch);
+    if (b.x.dim != ws.x.dim || b.x.capacity != kFunctionBatch) b.x.reset(ws.x.dim, kFunctionBatch);
+    b.pdf.resize(kFunctionBatch);
+    b.f.resize(kFunctionBatch);
+    for (size_t at = 0; at < n; at += kBlockSize) {
+        const size_t m = std::min(kBlockSize, n - at);
+        make(b.begin + at, m);
+        copy_points(ws.u, 0, b.u, at, m);
+        copy_points(ws.x, 0, b.x, at, m);
+        std::copy(ws.pdf.begin(), ws.pdf.begin() + static_cast<long>(m),
+                  b.pdf.begin() + static_cast<long>(at));
+    }
+    b.u.n = b.x.n = n;
+    evaluate_block(problem.integrand, b.x, b.f.data());
+}
+/// Hands out the block [first, first + count) of ws.batch through ws's buffers.
+SampleBlock block_from_batch(uint64_t first, size_t count, Workspace& ws);
+} // namespace detail
+
+template <class Make>
+SampleBlock batched_block(const Problem& problem, uint64_t first, size_t count, uint64_t total,
+                          Workspace& ws, Make&& make) {
+    if (problem.integrand.kind != IntegrandKind::Function) {
+        make(first, count);
+        evaluate_block(problem.integrand, ws.x, ws.f.data());
+        return block_of(ws, first, count);
+    }
+    if (first < ws.batch.begin || first + count > ws.batch.end)
+        detail::fill_batch(problem, first, total, ws, make);
+    return detail::block_from_batch(first, count, ws);
 }
 
 /// What an adaptive estimator learnt in its last run, for looking at it (the sample view).

@@ -79,13 +79,21 @@ class VegasEstimator final : public EstimatorAlgorithm, private TrainingPoints {
             accumulator_.reset(sampler_error_method(spec_), plan_, float32_);
             plan_ready_ = true;
             next_ = 0;
+            ws.batch.clear();
         }
         const bool averaging = rounds_ > 1; // iteration average: the map keeps learning
         const size_t count =
             static_cast<size_t>(std::min<uint64_t>(kBlockSize, plan_.total - next_));
-        generate_block(plan_, next_, count, ws.u);
-        stage_.warp(problem_, spec_.proposal, ws, averaging);
-        evaluate_block(problem_.integrand, ws.x, ws.f.data());
+        auto make = [&](uint64_t at, size_t m) {
+            generate_block(plan_, at, m, ws.u);
+            stage_.warp(problem_, spec_.proposal, ws, averaging);
+        };
+        if (averaging) { // the map's bins of this very block are needed: one block at a time
+            make(next_, count);
+            evaluate_block(problem_.integrand, ws.x, ws.f.data());
+        } else { // a frozen map: a caller's function gets the samples in batches
+            batched_block(problem_, next_, count, plan_.total, ws, make);
+        }
         if (observer_) notify(block_of(ws, next_, count));
         accumulator_.add_block(next_, ws.f.data(), ws.pdf.data(), ws.pdf.data(), count);
         if (averaging) stage_.map().add_training(stage_.bins(), ws.pdf.data(), count); // weights
