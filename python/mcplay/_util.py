@@ -145,3 +145,24 @@ def put(target: dict, key: str, value: Any) -> None:
     """Sets ``target[key]`` when ``value`` is not None."""
     if value is not None:
         target[key] = value
+
+
+def box_domain(domain: Any) -> dict:
+    """A scene box domain from a sequence (or array) of ``(lo, hi)`` pairs, one per axis."""
+    if isinstance(domain, (str, bytes)) or not (
+        isinstance(domain, Sequence) or hasattr(domain, "tolist")
+    ):
+        raise argument_error(
+            "domain: expected a scene domain dict or a sequence of (lo, hi) pairs, got "
+            f"{type(domain).__name__}"
+        )
+    pairs = domain.tolist() if hasattr(domain, "tolist") else list(domain)
+    if not pairs:
+        raise argument_error("domain: no (lo, hi) pairs given")
+    lower, upper = [], []
+    for i, pair in enumerate(pairs):
+        if isinstance(pair, (str, bytes)) or not isinstance(pair, Sequence) or len(pair) != 2:
+            raise argument_error(f"domain[{i}]: expected a pair (lo, hi), got {pair!r}")
+        lower.append(real_number(pair[0], f"domain[{i}][0]"))
+        upper.append(real_number(pair[1], f"domain[{i}][1]"))
+    return {"type": "box", "lower": lower, "upper": upper}

@@ -4,11 +4,12 @@ from __future__ import annotations
 
 import re
 import textwrap
-from typing import Any, Callable, Mapping, Sequence
+from typing import Any, Callable, Mapping
 
 from . import _core
 from ._util import (
     argument_error,
+    box_domain,
     estimator_list,
     from_json,
     progress_adapter,
@@ -35,27 +36,12 @@ def _domain(domain: Any, dim: Any) -> dict | None:
         return None if dim is None else {"type": "box", "dim": dim}
     if isinstance(domain, Mapping):
         return dict(domain)
-    if (
-        isinstance(domain, (str, bytes))
-        or not isinstance(domain, Sequence)
-        and not hasattr(domain, "tolist")
-    ):
+    box = box_domain(domain)
+    if dim is not None and dim != len(box["lower"]):
         raise argument_error(
-            "domain: expected None (the unit cube of dim), a sequence of (lo, hi) pairs or a "
-            f"scene domain dict, got {type(domain).__name__}"
+            f"dim: {dim} does not match the domain's {len(box['lower'])} (lo, hi) pairs"
         )
-    pairs = domain.tolist() if hasattr(domain, "tolist") else list(domain)
-    if not pairs:
-        raise argument_error("domain: no (lo, hi) pairs given")
-    lower, upper = [], []
-    for i, pair in enumerate(pairs):
-        if isinstance(pair, (str, bytes)) or not isinstance(pair, Sequence) or len(pair) != 2:
-            raise argument_error(f"domain[{i}]: expected a pair (lo, hi), got {pair!r}")
-        lower.append(real_number(pair[0], f"domain[{i}][0]"))
-        upper.append(real_number(pair[1], f"domain[{i}][1]"))
-    if dim is not None and dim != len(pairs):
-        raise argument_error(f"dim: {dim} does not match the domain's {len(pairs)} (lo, hi) pairs")
-    return {"type": "box", "lower": lower, "upper": upper}
+    return box
 
 
 def integrate(

@@ -9,7 +9,7 @@ from typing import Any, Callable, Mapping, Sequence
 import numpy as np
 
 from . import _core
-from ._util import argument_error, from_json, put, real_number, to_json, whole_number
+from ._util import argument_error, box_domain, from_json, put, to_json, whole_number
 
 #: The renderer's per-pixel samplers, named as the CLI names them (``mcplay points pixel_sobol``).
 _PIXEL_PREFIX = "pixel_"
@@ -270,18 +270,7 @@ def _warp_part(value: Any, name: str, functions: dict, function_name: str) -> An
 def _warp_domain(domain: Any) -> dict | None:
     if domain is None or isinstance(domain, Mapping):
         return None if domain is None else dict(domain)
-    if isinstance(domain, (str, bytes)) or not isinstance(domain, Sequence):
-        raise argument_error(
-            f"domain: expected a domain dict or (lo, hi) pairs, got {type(domain).__name__}"
-        )
-    pairs = list(domain)
-    lower, upper = [], []
-    for i, pair in enumerate(pairs):
-        if isinstance(pair, (str, bytes)) or not isinstance(pair, Sequence) or len(pair) != 2:
-            raise argument_error(f"domain[{i}]: expected a pair (lo, hi), got {pair!r}")
-        lower.append(real_number(pair[0], f"domain[{i}][0]"))
-        upper.append(real_number(pair[1], f"domain[{i}][1]"))
-    return {"type": "box", "lower": lower, "upper": upper}
+    return box_domain(domain)
 
 
 def warp_test(
