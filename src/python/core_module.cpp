@@ -239,37 +239,32 @@ std::string warp_test(const std::string& scene, const OptionalText& options,
     });
 }
 
-std::string render_study_run(const std::string& scene, const OptionalText& options,
-                             const nb::object& progress) {
+/// A render call with progress (mcp_render_study_run, mcp_render_reference,
+/// mcp_render_live_open), run watched like the studies.
+using ProgressCall = int (*)(const char*, const char*, mcp_progress_fn, void*, char**);
+std::string run_with_progress(ProgressCall call, const std::string& scene,
+                              const OptionalText& options, const nb::object& progress) {
     CallState state(nb::none(), progress);
     const char* scene_c = c_text(scene, "scene");
     const char* options_c = c_text(options, "options");
     return run_watched(state, [&](char** out) {
-        return mcp_render_study_run(scene_c, options_c, CallState::progress_trampoline, &state,
-                                    out);
+        return call(scene_c, options_c, CallState::progress_trampoline, &state, out);
     });
+}
+
+std::string render_study_run(const std::string& scene, const OptionalText& options,
+                             const nb::object& progress) {
+    return run_with_progress(mcp_render_study_run, scene, options, progress);
 }
 
 std::string render_reference(const std::string& scene, const OptionalText& options,
                              const nb::object& progress) {
-    CallState state(nb::none(), progress);
-    const char* scene_c = c_text(scene, "scene");
-    const char* options_c = c_text(options, "options");
-    return run_watched(state, [&](char** out) {
-        return mcp_render_reference(scene_c, options_c, CallState::progress_trampoline, &state,
-                                    out);
-    });
+    return run_with_progress(mcp_render_reference, scene, options, progress);
 }
 
 std::string render_live_open(const std::string& scene, const OptionalText& options,
                              const nb::object& progress) {
-    CallState state(nb::none(), progress);
-    const char* scene_c = c_text(scene, "scene");
-    const char* options_c = c_text(options, "options");
-    return run_watched(state, [&](char** out) {
-        return mcp_render_live_open(scene_c, options_c, CallState::progress_trampoline, &state,
-                                    out);
-    });
+    return run_with_progress(mcp_render_live_open, scene, options, progress);
 }
 
 std::string render_live_pass(int session, const std::string& pass, const nb::object& progress) {
