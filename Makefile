@@ -98,8 +98,9 @@ web/node_modules/.package-lock.json: web/package.json web/package-lock.json | de
 
 # ---------------------------------------------------------------------------
 # The Python package (pyproject.toml, src/python, python/). build/ also builds the extension
-# mcplay._core when the virtual environment $(PY_VENV) exists (`make deps-python`, which `make
-# test` runs first): ctest's python_smoke then imports it from the build tree. `make test-python`
+# mcplay._core, with the virtual environment $(PY_VENV) (`make deps-python`: numpy, nanobind and
+# pytest from PyPI, made before build/ is configured, while the wasm build goes on under make -j):
+# ctest's python_smoke then imports it from the build tree. `make test-python`
 # (in `make check`) builds a wheel with pip, installs it in a fresh virtual environment with the
 # test extras and runs python/tests against the installed package.
 PY_VENV := $(BUILD)/py-venv
@@ -110,14 +111,14 @@ PY_CMAKE_FLAGS = $(if $(wildcard $(PY_VENV)/installed),-DMCPLAY_PYTHON=ON \
 	-DPython_EXECUTABLE=$(CURDIR)/$(PY_VENV)/bin/python \
 	-Dnanobind_DIR=$$($(PY_VENV)/bin/python -m nanobind --cmake_dir))
 
-# Order-only on deps: under make -j the configure step must wait for apt-get.
-$(BUILD)/CMakeCache.txt: | deps
+# Order-only on deps: under make -j the configure step must wait for apt-get (and the venv).
+$(BUILD)/CMakeCache.txt: | deps deps-python
 	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release $(PY_CMAKE_FLAGS)
 
 $(BUILD_WASM)/CMakeCache.txt: | deps
 	emcmake cmake -S . -B $(BUILD_WASM) -DCMAKE_BUILD_TYPE=Release
 
-build: deps $(BUILD)/CMakeCache.txt
+build: deps deps-python $(BUILD)/CMakeCache.txt
 	@if [ -e $(PY_VENV)/installed ] && ! grep -q '^MCPLAY_PYTHON:BOOL=ON' $(BUILD)/CMakeCache.txt; then \
 	  echo "build: $(PY_VENV) exists: configuring $(BUILD) with the Python extension"; \
 	  cmake -S . -B $(BUILD) $(PY_CMAKE_FLAGS); \
@@ -196,7 +197,6 @@ test-sanitize: deps $(BUILD_ASAN)/CMakeCache.txt
 TEST_JOBS ?= 2
 test:
 	@start=$$(date +%s); \
-	$(MAKE) --no-print-directory deps-python && \
 	$(MAKE) --no-print-directory -j $(TEST_JOBS) test-suites && \
 	echo "make test: all suites passed in $$(( $$(date +%s) - start )) s"
 
@@ -345,7 +345,8 @@ QMC_DIR := $(BUILD)/bench-qmc
 QMC_VENV := $(BUILD)/bench-venv
 QMC_CASES := --families 1,4,5 --dims 2,4,8,16
 
-deps-venv:
+# After deps: two apt-get runs at once fail (their package cache is shared).
+deps-venv: deps
 	@if ! python3 -c 'import ensurepip, venv' 2>/dev/null; then \
 	  if [ "$$(id -u)" = 0 ]; then \
 	    apt-get update -q && DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends python3-venv; \
