@@ -1,7 +1,8 @@
 """python_smoke (ctest, MCPLAY_PYTHON builds): the extension mcplay._core from the build tree.
 
 Imports the package (python/ and the build folder's python/ on PYTHONPATH), integrates a numpy
-callable in d = 2 against its exact value, and runs one bundled scene; a second or two.
+callable in d = 2 with mcplay.integrate against its exact value, and runs one bundled scene
+through the extension; a second or two.
 Usage: smoke.py SCENES_DIR
 """
 
@@ -12,6 +13,7 @@ import sys
 
 import numpy as np
 
+import mcplay
 from mcplay import _core
 
 # Fixed seeds; every check is a distance from the exact value in standard errors.
@@ -35,16 +37,14 @@ def main() -> None:
         return np.exp(x.sum(1))
 
     exact = (math.e - 1.0) ** 2
-    scene = {
-        "name": "smoke_callable",
-        "domain": {"type": "box", "lower": [0, 0], "upper": [1, 1]},
-        "integrand": {"type": "function", "name": "f"},
-    }
-    options = {"estimators": ["uniform", "sobol"], "n_min": 4096, "n_max": 4096, "reps": 8,
-               "seed": 7, "threads": 2}
-    result = json.loads(_core.study_run(json.dumps(scene), json.dumps(options), {"f": f}, None))
-    for estimator in result["estimators"]:
-        check_level(f"callable, {estimator['name']}", estimator["levels"][-1], exact)
+    # The public API, as a user calls it.
+    result = mcplay.integrate(f, dim=2, estimators=["uniform", "sobol"], n=4096, n_min=4096,
+                              reps=8, seed=7, threads=2, exact=exact)
+    for name, estimator in result.estimators.items():
+        mean, se = estimator.estimate, estimator.stderr
+        if not (se > 0 and abs(mean - exact) < TOLERANCE_SE * se):
+            sys.exit(f"python_smoke: callable, {name}: {mean} +- {se} is not within "
+                     f"{TOLERANCE_SE} se of {exact}")
     if calls == 0:
         sys.exit("python_smoke: the callable was never called")
 
