@@ -681,3 +681,37 @@ TEST(Api, ErrorMessagesStayOnOneLine) {
     EXPECT_NE(run(R"({"integrand": {"type": "a\nb"}})").error.find("unknown integrand 'a\\nb'"),
               std::string::npos);
 }
+
+// Issue 48: a typed warp that leaves its domain is refused by warp-test, and a study with it
+// as its proposal ran silently (g = 2u on [0, 1] with f = x reported 0.9968 +- 0.0013 for 0.5).
+// Every block of a typed warp is now checked: the study fails with an error naming the
+// estimator and the point, as warp-test does; the same study with a warp that stays inside (g =
+// u^2, p = 1 / (2 sqrt(x))) runs and covers 0.5 (within 5 standard errors: a fixed seed).
+TEST(Api, AStudyWhoseWarpLeavesItsDomainFailsNamingThePoint) {
+    auto scene = [](const char* g, const char* p, const char* extra) {
+        return std::string(R"({"warp": {"domain": {"type": "interval", "lower": 0, "upper": 1},
+            "g": [")") + g + R"("], "p": ")" + p + R"("}, "f": "x", "estimators": ["warp"],
+            "n_min": 64, "n_max": 1024, "reps": 4, "seed": 3)" + extra + "}";
+    };
+    const Outcome inside = run(scene("u^2", "0.5 / sqrt(x)", ""));
+    ASSERT_EQ(inside.status, MCP_OK) << inside.error;
+    const json& top = inside.result["estimators"][0]["levels"].back();
+    EXPECT_LT(std::fabs(top["mean"].get<double>() - 0.5), 5.0 * top["std_error"].get<double>());
+    for (const char* extra : {"", R"(, "rel_tol": 0.01)"}) {
+        const Outcome outside = run(scene("2*u", "0.5", extra));
+        EXPECT_EQ(outside.status, MCP_ERROR_SCENE) << extra;
+        EXPECT_TRUE(outside.result.is_null());
+        EXPECT_NE(outside.error.find("estimator 'warp': its warp put a point outside its domain"),
+                  std::string::npos)
+            << outside.error;
+        EXPECT_NE(outside.error.find(", outside its domain, the [0, 1]"), std::string::npos)
+            << outside.error;
+        EXPECT_EQ(outside.error.find('\n'), std::string::npos);
+    }
+    // Split into parts, each part is refused too.
+    char* out = nullptr;
+    EXPECT_EQ(mcp_study_run(scene("2*u", "0.5", "").c_str(), R"({"part": 0, "parts": 2})",
+                            nullptr, nullptr, &out),
+              MCP_ERROR_SCENE);
+    EXPECT_EQ(out, nullptr);
+}

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <optional>
 #include <sstream>
+#include <tuple>
 
 #include "api/report.h"
 #include "api/scene.h"
@@ -873,4 +874,112 @@ TEST(Diagnostics, NoHeavyTailFromWeightsThatAreAllZero) {
         EXPECT_TRUE(find(deepest, FlagCode::ExactOutsideCi)) << name;
         EXPECT_TRUE(find(deepest, FlagCode::LowEss)) << name;
     }
+}
+
+namespace {
+
+/// A level of 32 replicates of stiff_peak_1e-8 (scenes/), as `mcplay run stiff_peak_1e-8`
+/// (seed 1) gave it: every estimate 0 but those listed (replicate index, estimate, its standard
+/// error), the exact value 2.5066282746310004e-08.
+LevelStats stiff_level(uint64_t n, const std::vector<std::tuple<int, double, double>>& hits,
+                       bool underflow, double mean, double variance, double std_error) {
+    LevelStats l;
+    l.n = n;
+    l.reps = 32;
+    l.has_exact = true;
+    l.exact = 2.5066282746310004e-08;
+    l.estimates.assign(32, 0.0);
+    l.run_std_errors.assign(32, 0.0);
+    l.run_dofs.assign(32, int(n - 1));
+    for (const auto& [i, estimate, se] : hits) {
+        l.estimates[size_t(i)] = estimate;
+        l.run_std_errors[size_t(i)] = se;
+    }
+    l.zero_error_runs = 0;
+    for (double se : l.run_std_errors) l.zero_error_runs += se == 0.0;
+    l.estimates_spread = !hits.empty();
+    l.values_underflow = underflow;
+    l.mean = mean;
+    l.variance = variance;
+    l.std_error = std_error;
+    l.bias = mean - l.exact;
+    l.mean_run_variance = variance;
+    l.ess_mean = 1.0;
+    for (uint64_t i = 0; i < n; ++i) l.diagnostics.weights.add(0.0);
+    l.diagnostics.error_units = l.diagnostics.weights;
+    return l;
+}
+
+std::string message(const LevelStats& l, const char* code) {
+    const Json level = level_to_json(l);
+    for (const Json& w : level["warnings"])
+        if (w["code"] == code) return w["message"].get<std::string>();
+    return "";
+}
+
+} // namespace
+
+// Issue 48: the sentences never contradict themselves. stiff_peak_1e-8's uniform level at N =
+// 65536 (three replicates hit the peak's tail with estimates near 1e-213 whose squares
+// underflow) said "32 of 32 replicates reported a standard error of 0 ... although the
+// replicates differ (standard deviation 0)"; its stratified level at N = 65536 (one replicate
+// with an error bar) said "replicate 8 of 1 lies 1745710461143661828018334957940699564960403746
+// 193408.0 of its own standard errors". Now the standard deviation is the true one (computed in
+// long double here, whose range holds these squares), the count is of all 32, and numbers beyond
+// 1e6 are in scientific notation. Replicates that do not differ raise no zero_error_bar.
+TEST(Diagnostics, StiffPeakSentencesDoNotContradictThemselves) {
+    const LevelStats uniform = stiff_level(65536,
+                                           {{7, 2.4832149768102067e-243, 0.0},
+                                            {11, 2.256226285920717e-213, 0.0},
+                                            {25, 5.1702390876908826e-284, 0.0}},
+                                           true, 7.050707143502241e-215, 0.0, 0.0);
+    std::optional<Flag> f = find(level_flags(uniform), FlagCode::ZeroErrorBar);
+    ASSERT_TRUE(f.has_value());
+    long double sum = 0.0L, squares = 0.0L;
+    for (double x : uniform.estimates) sum += x;
+    const long double mean = sum / 32.0L;
+    for (double x : uniform.estimates) squares += (x - mean) * (x - mean);
+    const double sd = double(std::sqrt(squares / 31.0L));
+    EXPECT_NEAR(f->value, sd, 1e-12 * sd);
+    const std::string zero = message(uniform, "zero_error_bar");
+    EXPECT_NE(zero.find("32 of 32 replicates reported a standard error of 0 at N = 65536 although "
+                        "the replicates differ (standard deviation 3.99e-214, from 0 to "
+                        "2.26e-213): their error bars are wrong (the squares of values this "
+                        "small underflow"),
+              std::string::npos)
+        << zero;
+    EXPECT_EQ(zero.find("standard deviation 0)"), std::string::npos) << zero;
+
+    const LevelStats stratified =
+        stiff_level(65536, {{7, 1.4358676345789038e-59, 1.435878589504952e-59}}, false,
+                    4.4870863580590745e-61, 6.442862075097552e-120, 4.4870863580590745e-61);
+    const std::string far = message(stratified, "replicate_far_off");
+    EXPECT_NE(far.find("replicate 8 of 32 (1 of the 32 had an error bar to judge) lies 1.7e+51 "
+                       "of its own standard errors from the exact value at N = 65536"),
+              std::string::npos)
+        << far;
+    const std::string outside = message(stratified, "exact_outside_ci");
+    EXPECT_NE(outside.find("misses the exact value by 5.6e+52 standard errors"), std::string::npos)
+        << outside;
+
+    // Both ways: all 32 replicates judged print no count of the judged; every replicate 0 (they
+    // do not differ) raises no zero_error_bar.
+    std::vector<double> z = honest_errors(32);
+    z[7] = 5.6;
+    EXPECT_NE(message(replicates_level(z, true), "replicate_far_off")
+                  .find("replicate 8 of 32 lies 5.6 of its own standard errors"),
+              std::string::npos);
+    EXPECT_FALSE(find(level_flags(stiff_level(65536, {}, false, 0.0, 0.0, 0.0)),
+                      FlagCode::ZeroErrorBar));
+}
+
+// Every sentence writes a number beyond 1e6 or below 1e-4 (not 0) in scientific notation.
+TEST(Diagnostics, SentencesWriteLargeAndSmallNumbersInScientificNotation) {
+    EXPECT_EQ(fmt("%.1f", 1745710461143661828018334957940699564960403746193408.0), "1.7e+51");
+    EXPECT_EQ(fmt("%.1f", 999999.94), "999999.9");
+    EXPECT_EQ(fmt("%.1f", 1e6), "1.0e+06");
+    EXPECT_EQ(fmt("%.1f", 5e-5), "5.0e-05");
+    EXPECT_EQ(fmt("%.1f", 0.0), "0.0");
+    EXPECT_EQ(fmt("%.3g%%", 12.5), "12.5%");
+    EXPECT_EQ(fmt("%.2f%%", 2e7), "2.00e+07%");
 }

@@ -483,6 +483,48 @@ Call merge_text(const json& parts) {
     return c;
 }
 
+// Issue 48: a level's relative MSE is the raw one less the reference's noise, so it lies in
+// -floor..rel_mse_raw and goes negative once an image is closer to the truth than the reference
+// can tell (docs/render-scenes.md). The merge of a split study took any negative value for a
+// malformed part ("rel_mse: out of range: expected 0..-, got -2.1e-05"); now it accepts that
+// range and still refuses what lies outside it.
+TEST(RenderSplit, MergeAcceptsANegativeRelativeMseDownToTheFloor) {
+    const json scene = json::parse(read(kScenes + "/quad_light_floor.json"));
+    json o{{"base_dir", kScenes}, {"width", 8},  {"height", 6},
+           {"spp_min", 1},        {"spp_max", 2}, {"reps", 2},
+           {"seed", 3},           {"estimators", {"light_solid_angle"}},
+           {"reference", {{"spp", 16}}}};
+    json parts = json::array();
+    for (int i = 0; i < 2; ++i) {
+        o["part"] = i;
+        o["parts"] = 2;
+        const Call c = study_text(scene, o);
+        ASSERT_EQ(c.status, MCP_OK) << c.error;
+        parts.push_back(c.result);
+    }
+    const double floor = parts[0]["reference_summary"]["relative_mse_floor"].get<double>();
+    ASSERT_GT(floor, 0.0);
+    const double raw =
+        parts[0]["estimators"][0]["levels"][0]["images"][0]["rel_mse_raw"].get<double>();
+    auto merge_with = [&](double rel_mse) {
+        json p = parts;
+        p[0]["estimators"][0]["levels"][0]["images"][0]["rel_mse"] = rel_mse;
+        return merge_text(json{{"parts", p}});
+    };
+    // Right: negative down to -floor (an image at least as close as the reference's noise).
+    for (double rel_mse : {-0.5 * floor, -floor, std::min(raw, 0.0)}) {
+        const Call ok = merge_with(rel_mse);
+        EXPECT_EQ(ok.status, MCP_OK) << rel_mse << ": " << ok.error;
+    }
+    // Wrong: below -floor, or above the raw relative MSE it was corrected from.
+    for (double rel_mse : {-1.01 * floor - 1e-12, raw * 1.01 + 1e-12}) {
+        const Call bad = merge_with(rel_mse);
+        EXPECT_EQ(bad.status, MCP_ERROR_ARGUMENT) << rel_mse;
+        EXPECT_NE(bad.error.find("images[0].rel_mse: out of range"), std::string::npos)
+            << bad.error;
+    }
+}
+
 // A study split over processes (the page's workers) by replicate: its parts, merged, are the
 // whole study, every level's numbers, the fit and the warnings bit for bit; only seconds (and
 // what divides by them) are each run's own. Parts that do not belong together are refused.

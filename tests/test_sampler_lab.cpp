@@ -157,6 +157,35 @@ TEST(SamplerLabCsv, EachBadFileGetsOneLineNamingTheRow) {
     EXPECT_NE(analyze({{"csv", wide}}).error.find("at most 64"), std::string::npos);
 }
 
+// Issue 48: a header is a row none of whose fields is a number. A first row with one bad field
+// among numbers was dropped as a "header" without a word (a point lost); now it is an error
+// naming the field, a real header still reads, and a UTF-8 byte-order mark is skipped.
+TEST(SamplerLabCsv, AHeaderHasNoNumberAndAByteOrderMarkIsSkipped) {
+    auto points = [](const std::string& csv) {
+        Call c = analyze({{"csv", csv}, {"spectrum", false}});
+        return c.status == MCP_OK ? c.result["n"].get<int>() : -1;
+    };
+    EXPECT_EQ(points("x,y\n0.5,0.5\n0.25,0.75\n"), 2);
+    EXPECT_EQ(points("x,,y\n0.5,0.5,0.5\n"), 1); // a header with an unnamed column: no number
+    EXPECT_EQ(points("\xEF\xBB\xBF" "0.5,0.5\n0.25,0.75\n"), 2);
+    EXPECT_EQ(points("\xEF\xBB\xBF" "x,y\n0.5,0.5\n0.25,0.75\n"), 2);
+    struct Case {
+        const char* csv;
+        const char* message;
+    } cases[] = {
+        {"0.5e,0.5\n0.25,0.75\n", "row 1, column 1: '0.5e' is not a number (the row's other"},
+        {"0.5,,0.5\n0.25,0.5,0.75\n", "row 1, column 2: the field is empty"},
+        {"\xEF\xBB\xBF" "0.5,x\n", "row 1, column 2: 'x' is not a number"},
+        {"0.5,0.5\n0.25,\n", "row 2, column 2: the field is empty"},
+    };
+    for (const Case& k : cases) {
+        Call c = analyze({{"csv", k.csv}, {"spectrum", false}});
+        EXPECT_EQ(c.status, MCP_ERROR_ARGUMENT) << k.csv;
+        EXPECT_NE(c.error.find(k.message), std::string::npos) << c.error;
+        EXPECT_EQ(c.error.find('\n'), std::string::npos);
+    }
+}
+
 TEST(SamplerLabCsv, JsonRowsAndTheirErrors) {
     Call ok = analyze({{"points", {{0.25, 0.5}, {0.75, 0.0}}}, {"spectrum", false}});
     ASSERT_EQ(ok.status, MCP_OK) << ok.error;
@@ -238,6 +267,35 @@ TEST(SamplerLabIntegrate, OneSetIsARuleWithoutErrorBarKSetsGetTheTInterval) {
     EXPECT_NEAR(two.result["error_bar"]["standard_error"].get<double>(), se, 1e-12);
     EXPECT_NEAR(two.result["error_bar"]["half_width_95"].get<double>(),
                 mcp::student_t_quantile(0.975, 1.0) * se, 1e-12);
+}
+
+// Issue 48: the t interval of K sets never claims a certainty the sets cannot show. Identical
+// sets are no randomizations (no error bar, and the note says which); estimates near 1e-170,
+// whose squares underflow, keep their true standard error (it was 0); estimates that agree to
+// round-off (f constant) get no zero-width interval. The note says why in each case.
+TEST(SamplerLabIntegrate, NoZeroWidthErrorBar) {
+    const json a = {{0.25}, {0.75}}, b = {{0.0}, {0.70710678118654752}};
+    const json x2{{"name", "x2"}, {"f", "x*x"}};
+    Call twins = integrate(x2, {{"points", {a, b, a}}});
+    ASSERT_EQ(twins.status, MCP_OK) << twins.error;
+    EXPECT_TRUE(twins.result["error_bar"].is_null());
+    EXPECT_NE(twins.result["note"].get<std::string>().find(
+                  "sets 1 and 3 (counting from 1) are identical"),
+              std::string::npos)
+        << twins.result["note"];
+    // Tiny: the same two sets on 1e-170 x^2; its standard error is 1e-170 times x^2's.
+    Call plain = integrate(x2, {{"points", {a, b}}});
+    Call tiny = integrate({{"name", "tiny"}, {"f", "1e-170*x*x"}}, {{"points", {a, b}}});
+    ASSERT_EQ(tiny.status, MCP_OK) << tiny.error;
+    ASSERT_TRUE(tiny.result["error_bar"].is_object()) << tiny.result;
+    const double se = plain.result["error_bar"]["standard_error"].get<double>();
+    EXPECT_NEAR(tiny.result["error_bar"]["standard_error"].get<double>() / 1e-170, se,
+                1e-12 * se);
+    Call flat = integrate({{"name", "one"}, {"f", "1"}}, {{"points", {a, b}}});
+    ASSERT_EQ(flat.status, MCP_OK) << flat.error;
+    EXPECT_TRUE(flat.result["error_bar"].is_null());
+    EXPECT_NE(flat.result["note"].get<std::string>().find("agree to round-off"), std::string::npos)
+        << flat.result["note"];
 }
 
 TEST(SamplerLabIntegrate, RandomizedSetsCoverTheExactValue) {

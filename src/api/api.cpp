@@ -132,6 +132,8 @@ int run_study_call(const char* scene_json, const char* options_json, const mcp_c
             mcp::run_study_part(req, scene.value, options, int(part), int(parts));
         // A part cut short by the caller is no part: nothing to merge.
         if (int st = mcp::caller_outcome(functions)) return st;
+        if (std::string why = mcp::warp_escape_error(req); !why.empty())
+            return fail(MCP_ERROR_SCENE, why);
         *result_json = copy_out(dump(part_result));
         if (!*result_json) return fail(MCP_ERROR_INTERNAL, "out of memory writing the result");
         g_last_error.clear();
@@ -146,6 +148,8 @@ int run_study_call(const char* scene_json, const char* options_json, const mcp_c
             mcp::run_stopping_study(req.problem, req.estimators, req.settings);
         // Answers cut short by the caller are no answers: no result.
         if (int status = mcp::caller_outcome(functions)) return status;
+        if (std::string why = mcp::warp_escape_error(req); !why.empty())
+            return fail(MCP_ERROR_SCENE, why);
         *result_json = copy_out(dump(mcp::stopping_to_json(st)));
         if (!*result_json) return fail(MCP_ERROR_INTERNAL, "out of memory writing the result");
         g_last_error.clear();
@@ -162,6 +166,9 @@ int run_study_call(const char* scene_json, const char* options_json, const mcp_c
     // A failed function's numbers are not the function's: no result. A cancel keeps the levels
     // completed before it, as a cancelling progress callback does.
     if (functions.control && functions.control->failed()) return mcp::caller_outcome(functions);
+    // A warp that left its domain: its numbers average f where it is not defined.
+    if (std::string why = mcp::warp_escape_error(req); !why.empty())
+        return fail(MCP_ERROR_SCENE, why);
     *result_json = copy_out(dump(mcp::study_to_json(result)));
     if (!*result_json) return fail(MCP_ERROR_INTERNAL, "out of memory writing the result");
     if (int st = mcp::caller_outcome(functions)) return st;

@@ -219,7 +219,11 @@ std::string check_json_text(const char* text, size_t size, const char* root) {
 
 Made<Json> parse_json(const char* text, const char* what) {
     if (!text) return made_error<Json>(std::string(what) + ": no text (null pointer)");
-    const size_t size = std::strlen(text);
+    return parse_json(text, std::strlen(text), what);
+}
+
+Made<Json> parse_json(const char* text, size_t size, const char* what) {
+    if (!text) return made_error<Json>(std::string(what) + ": no text (null pointer)");
     std::string problem = check_json_text(text, size, what);
     if (!problem.empty()) return made_error<Json>(std::string(what) + ": invalid JSON: " + problem);
     Json j = Json::parse(text, text + size, nullptr, /*allow_exceptions=*/false);

@@ -26,8 +26,14 @@ constexpr uint64_t kMaxJsonBytes = 256ull << 20;
 std::string check_json_text(const char* text, size_t size, const char* root = "$");
 
 /// Parses JSON text (checked by check_json_text first) without exceptions; on failure the
-/// message starts with `what`.
+/// message starts with `what`. Every JSON text mcplay reads goes through here (the CLI's files
+/// and the C API's results included), so that no text can nest deep enough to exhaust a stack.
 Made<Json> parse_json(const char* text, const char* what);
+/// The same for `size` bytes (a file's contents, which may hold a NUL byte).
+Made<Json> parse_json(const char* text, size_t size, const char* what);
+inline Made<Json> parse_json(const std::string& text, const char* what) {
+    return parse_json(text.data(), text.size(), what);
+}
 
 struct CallerFunctions; // api/caller_functions.h
 

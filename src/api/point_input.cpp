@@ -53,6 +53,11 @@ std::string quoted(const std::string& field) {
     return "'" + (field.size() > 24 ? field.substr(0, 24) + "..." : field) + "'";
 }
 
+/// Why a field that read_number refused is not a coordinate.
+std::string not_a_number(const std::string& field) {
+    return field.empty() ? "the field is empty" : quoted(field) + " is not a number";
+}
+
 /// "" when v may be a coordinate, else why not.
 std::string check_coordinate(double v, const std::string& field) {
     if (std::isnan(v)) return "NaN is not a coordinate";
@@ -111,7 +116,8 @@ Made<UserPointSets> parse_points_csv(const std::string& text) {
     int set_column = -1; // the header's "set" column
     int columns = -1;    // fields per row
     bool header_seen = false, data_seen = false;
-    size_t line_no = 0, pos = 0;
+    // A UTF-8 byte-order mark (spreadsheets write one) is no part of the first field.
+    size_t line_no = 0, pos = text.compare(0, 3, "\xEF\xBB\xBF") == 0 ? 3 : 0;
     while (pos <= text.size()) {
         size_t end = text.find('\n', pos);
         if (end == std::string::npos) end = text.size();
@@ -126,10 +132,23 @@ Made<UserPointSets> parse_points_csv(const std::string& text) {
         }
         std::vector<std::string> fields = split_fields(line);
         if (!header_seen && !data_seen) {
+            // A header is a row none of whose fields is a number; a first row of numbers and
+            // text is a data row with a bad field, never a header (it would lose a point).
             double v = 0.0;
-            bool numeric = true;
-            for (const std::string& f : fields) numeric = numeric && read_number(f, &v);
-            if (!numeric) {
+            size_t numbers = 0, text_at = fields.size();
+            for (size_t k = 0; k < fields.size(); ++k) {
+                if (read_number(fields[k], &v))
+                    ++numbers;
+                else if (text_at == fields.size())
+                    text_at = k;
+            }
+            if (numbers > 0 && text_at < fields.size())
+                return made_error<UserPointSets>(
+                    row + ", column " + std::to_string(text_at + 1) + ": " +
+                    not_a_number(fields[text_at]) +
+                    " (the row's other fields are numbers, so it is no header: a header "
+                    "has no number in it)");
+            if (numbers == 0) {
                 header_seen = true;
                 for (size_t k = 0; k < fields.size(); ++k) {
                     std::string lower = fields[k];
@@ -183,7 +202,7 @@ Made<UserPointSets> parse_points_csv(const std::string& text) {
             double v = 0.0;
             const std::string col = ", column " + std::to_string(k + 1);
             if (!read_number(f, &v))
-                return made_error<UserPointSets>(row + col + ": " + quoted(f) + " is not a number");
+                return made_error<UserPointSets>(row + col + ": " + not_a_number(f));
             const std::string why = check_coordinate(v, f);
             if (!why.empty()) return made_error<UserPointSets>(row + col + ": " + why);
             values.push_back(v);

@@ -24,8 +24,10 @@ struct UserPointSets {
 constexpr size_t kMaxUserSets = 1024;
 
 /// Parses CSV text: fields separated by commas (or semicolons, tabs or spaces), one point per
-/// line, blank lines and lines starting with '#' skipped. A first line that is not all numbers
-/// is a header; its column "set" (any case) names the point set of each row. Values must be
+/// line, blank lines and lines starting with '#' skipped, a leading UTF-8 byte-order mark
+/// ignored. A first line none of whose fields is a number is a header (its column "set", any
+/// case, names the point set of each row); a first line of numbers and text is an error naming
+/// the field, not a header. Values must be
 /// finite numbers in [0, 1); at most kMaxAnalysisPoints points in all and kMaxAnalysisDim
 /// coordinates per point. Sets must have equal sizes.
 Made<UserPointSets> parse_points_csv(const std::string& text);

@@ -43,8 +43,19 @@ void sort_by_severity(Json& warnings) {
 
 std::string fmt(const char* f, double x) {
     if (!std::isfinite(x)) return "-";
+    // A fixed-point conversion ("%.1f") of a number beyond 1e6 or below 1e-4 (not 0) is written
+    // in scientific notation, "1.7e+51 standard errors", never 52 digits or "0.0".
+    std::string format = f;
+    const double magnitude = std::fabs(x);
+    if (magnitude >= 1e6 || (magnitude > 0.0 && magnitude < 1e-4)) {
+        const size_t percent = format.find('%');
+        const size_t conversion = percent == std::string::npos
+                                      ? std::string::npos
+                                      : format.find_first_not_of("0123456789.-+ #", percent + 1);
+        if (conversion != std::string::npos && format[conversion] == 'f') format[conversion] = 'e';
+    }
     char buf[64];
-    std::snprintf(buf, sizeof buf, f, x);
+    std::snprintf(buf, sizeof buf, format.c_str(), x);
     return buf;
 }
 
@@ -89,7 +100,15 @@ Json level_warning(const Flag& f, const LevelStats& l) {
                                    " replicates reported a standard error of 0" + at_n +
                                    " although the replicates differ (standard deviation " +
                                    fmt("%.3g", f.value) +
-                                   "): their error bars are wrong (too few samples to see f vary)");
+                                   (std::isfinite(f.threshold)
+                                        ? ", from " + fmt("%.3g", f.threshold) + " to " +
+                                              fmt("%.3g", f.se)
+                                        : std::string()) +
+                                   (l.values_underflow
+                                        ? "): their error bars are wrong (the squares of values "
+                                          "this small underflow: values_underflow)"
+                                        : "): their error bars are wrong (too few samples to see "
+                                          "f vary)"));
     case FlagCode::ErrorBarsUnderstate:
         return flag_warning(f, "the " + std::to_string(f.of) + " replicates" + at_n + " spread " +
                                    fmt("%.3g", std::sqrt(f.value)) +
@@ -171,7 +190,12 @@ Json level_warning(const Flag& f, const LevelStats& l) {
                                    "integrand up)");
     case FlagCode::ReplicateFarOff:
         return flag_warning(f, "replicate " + std::to_string(f.dof + 1) + " of " +
-                                   std::to_string(f.of) + " lies " + fmt("%.1f", f.value) +
+                                   std::to_string(f.of) +
+                                   (f.replicates_judged < int(f.of)
+                                        ? " (" + std::to_string(f.replicates_judged) + " of the " +
+                                              std::to_string(f.of) + " had an error bar to judge)"
+                                        : std::string()) +
+                                   " lies " + fmt("%.1f", f.value) +
                                    " of its own standard errors from " +
                                    (f.se > 0.0 ? "the exact value" : "the other replicates' mean") +
                                    at_n + " (beyond " + fmt("%.1f", f.threshold) +

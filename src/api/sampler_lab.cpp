@@ -512,8 +512,7 @@ int mcp_points_integrate(const char* scene_json, const char* request_json, char*
                             {"method", "t interval over the sets as independent randomizations"}};
     } else {
         out["error_bar"] = nullptr;
-        out["note"] = "one point set is a deterministic rule: its error is measured against the "
-                      "exact value, and no error bar is claimed";
+        out["note"] = e.no_error_bar;
     }
     *result_json = copy_out(dump(out));
     if (!*result_json) return fail(MCP_ERROR_INTERNAL, "out of memory writing the result");

@@ -10,6 +10,7 @@
 #include "api/json_read.h"
 #include "api/scene_parsers.h"
 #include "core/walsh_bound.h"
+#include "estimators/named_warps.h"
 #include "estimators/registry.h"
 #include "estimators/stopping.h"
 
@@ -332,6 +333,18 @@ Made<SceneRequest> build_request(const Json& scene, const Json& options,
                 " points are built for; lower n_max or raise randomizations");
     }
     return {req, {}};
+}
+
+std::string warp_escape_error(const SceneRequest& req) {
+    for (const EstimatorSpec& e : req.estimators)
+        for (const Proposal* p : proposals_of(e))
+            if (p->kind == ProposalKind::Warp && p->warp && p->warp->escape &&
+                p->warp->escape->seen())
+                return "estimator '" + e.name + "': its warp put a point outside its domain (" +
+                       p->warp->escape->describe(p->warp_domain) +
+                       "): a proposal must map the unit cube into the domain, so the study "
+                       "has no estimate (mcplay warp-test shows such points)";
+    return "";
 }
 
 } // namespace mcp

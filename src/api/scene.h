@@ -30,6 +30,10 @@ struct SceneRequest {
 Made<SceneRequest> build_request(const Json& scene, const Json& options,
                                  const CallerFunctions* functions = nullptr);
 
+/// "" when no typed warp among the estimators' proposals put a point outside its domain during
+/// the run just done, else the error naming the estimator and the point (WarpEscape).
+std::string warp_escape_error(const SceneRequest& req);
+
 /// The estimator a preset name gives on a problem (as options.estimators would run it),
 /// without building the scene again; an error when it does not apply.
 Made<EstimatorSpec> preset_estimator(const Problem& problem, const std::string& name);

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "api/boundary.h"
+#include "api/json_read.h"
 #include "api/mcplay.h"
 
 namespace mcp::cli {
@@ -24,6 +25,13 @@ inline int exit_code(int status) {
     if (status == MCP_ERROR_SCENE) return kExitScene;
     if (status == MCP_ERROR_ARGUMENT) return kExitUsage;
     return kExitRuntime;
+}
+
+/// A JSON text of the C API's (a result, a plan, a progress line) read back as every JSON text
+/// is, through the bounded reader (api/json_read.h); a discarded value when it is not JSON.
+inline Json api_json(const char* text) {
+    Made<Json> j = parse_json(text, "result");
+    return j.ok() ? std::move(j.value) : Json(Json::value_t::discarded);
 }
 
 inline int usage_error(const std::string& msg) {

@@ -31,6 +31,12 @@ int api_error(const char* command, int status) {
     return exit_code(status);
 }
 
+/// The C API returned a text that is not a JSON object (it never should).
+int bad_result() {
+    std::fprintf(stderr, "mcplay: internal error: the C API's result is not a JSON object\n");
+    return kExitRuntime;
+}
+
 std::string num(double v, const char* format = "%.6g") {
     char buf[64];
     std::snprintf(buf, sizeof buf, format, v);
@@ -212,8 +218,9 @@ int cmd_points(const std::vector<std::string>& args) {
     const int status = pixel ? mcp_render_pixel_points(request.dump().c_str(), &text)
                              : mcp_points(request.dump().c_str(), &text);
     if (status != MCP_OK) return api_error("points", status);
-    const nlohmann::json result = nlohmann::json::parse(text);
+    const nlohmann::json result = api_json(text);
     mcp_free(text);
+    if (!result.is_object()) return bad_result();
     // One point per row, 17 significant digits: the file reads back as the same doubles.
     std::string csv;
     const int dim = result["dim"].get<int>();
@@ -247,12 +254,15 @@ int cmd_analyze(const std::vector<std::string>& args) {
     nlohmann::json request;
     const bool json_file = path.size() > 5 && path.compare(path.size() - 5, 5, ".json") == 0;
     if (json_file) {
-        nlohmann::json points = nlohmann::json::parse(bytes, nullptr, false);
-        if (points.is_discarded()) {
-            std::fprintf(stderr, "mcplay: %s: not valid JSON\n", boundary::one_line(path).c_str());
+        // Read as every JSON text is (bounded nesting and size), so that no file can exhaust
+        // the stack here or in the request built from it.
+        Made<Json> points = parse_json(bytes, "points");
+        if (!points.ok()) {
+            std::fprintf(stderr, "mcplay: %s: %s\n", boundary::one_line(path).c_str(),
+                         boundary::one_line(points.error).c_str());
             return kExitUsage;
         }
-        request["points"] = std::move(points);
+        request["points"] = std::move(points.value);
     } else {
         request["csv"] = std::move(bytes);
     }
@@ -275,8 +285,9 @@ int cmd_analyze(const std::vector<std::string>& args) {
                      mcp_last_error());
         return exit_code(status);
     }
-    const nlohmann::json result = nlohmann::json::parse(text);
+    const nlohmann::json result = api_json(text);
     mcp_free(text);
+    if (!result.is_object()) return bad_result();
     if (const std::string* png = o.get("--spectrum-out")) {
         if (!result.contains("spectrum")) {
             std::fprintf(stderr, "mcplay: analyze: no spectrum to write\n");
@@ -329,8 +340,9 @@ int cmd_warp_test(const std::vector<std::string>& args, LoadScene load_scene) {
                      mcp_last_error());
         return exit_code(status);
     }
-    const nlohmann::json result = nlohmann::json::parse(text);
+    const nlohmann::json result = api_json(text);
     mcp_free(text);
+    if (!result.is_object()) return bad_result();
     if (format == "json") return write_output("", result.dump(2) + "\n");
     return write_output("", warp_table(result));
 }

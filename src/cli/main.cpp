@@ -203,9 +203,8 @@ bool scene_from_gltf(const std::string& path, std::string* text) {
 
 bool is_render_scene_text(const std::string& text) {
     // Checked first (nesting, size): a text that fails goes to mcp_study_run, which says why.
-    if (!mcp::check_json_text(text.data(), text.size()).empty()) return false;
-    nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
-    return !j.is_discarded() && j.is_object() && j.contains("render");
+    const mcp::Made<mcp::Json> j = mcp::parse_json(text, "scene");
+    return j.ok() && j.value.is_object() && j.value.contains("render");
 }
 
 std::string base64_decode(const std::string& in) {
@@ -359,8 +358,9 @@ int cmd_list(const std::vector<std::string>& args) {
                 std::printf("  %-28s INVALID: %s\n", f.c_str(), mcp_last_error());
                 continue;
             }
-            nlohmann::json j = nlohmann::json::parse(info);
+            nlohmann::json j = mcp::cli::api_json(info);
             mcp_free(info);
+            if (!j.is_object()) return kExitRuntime;
             std::string ests;
             for (auto& e : j["estimators"])
                 ests += (ests.empty() ? "" : ", ") + e["name"].get<std::string>();
@@ -375,8 +375,9 @@ int cmd_list(const std::vector<std::string>& args) {
             std::printf("  %-28s INVALID: %s\n", f.c_str(), mcp_last_error());
             continue;
         }
-        nlohmann::json j = nlohmann::json::parse(info);
+        nlohmann::json j = mcp::cli::api_json(info);
         mcp_free(info);
+        if (!j.is_object()) return kExitRuntime;
         std::string exact = j["exact"].is_number() ? j["exact"].dump() : "unknown";
         std::string ests;
         for (auto& e : j["estimators"]) ests += (ests.empty() ? "" : ", ") + e.get<std::string>();
@@ -387,8 +388,9 @@ int cmd_list(const std::vector<std::string>& args) {
     }
     char* catalog = nullptr;
     if (mcp_catalog(&catalog) == MCP_OK) {
-        nlohmann::json c = nlohmann::json::parse(catalog);
+        nlohmann::json c = mcp::cli::api_json(catalog);
         mcp_free(catalog);
+        if (!c.is_object()) return kExitRuntime;
         std::printf("\nestimator presets:\n");
         for (auto& p : c["estimators"])
             std::printf("  %-24s %s%s\n", p["name"].get<std::string>().c_str(),
@@ -407,8 +409,8 @@ int cmd_list(const std::vector<std::string>& args) {
 }
 
 int progress_line(const char* level_json, void*) {
-    nlohmann::json j = nlohmann::json::parse(level_json, nullptr, false);
-    if (j.is_discarded()) return 0;
+    nlohmann::json j = mcp::cli::api_json(level_json);
+    if (!j.is_object()) return 0;
     if (j["kind"] == "render_reference") {
         // A reference being rendered: one line per tenth of its rows (rows finish out of order
         // on several threads, so rows_done may step over a tenth).
@@ -434,7 +436,7 @@ void announce_long_study(const std::string& scene, const std::string& options, b
     const int status = render ? mcp_render_study_plan(scene.c_str(), options.c_str(), &plan)
                               : mcp_study_plan(scene.c_str(), options.c_str(), &plan);
     if (status != MCP_OK) return;
-    nlohmann::json p = nlohmann::json::parse(plan, nullptr, false);
+    nlohmann::json p = mcp::cli::api_json(plan);
     mcp_free(plan);
     if (p.is_discarded() || !p["predicted_seconds"].is_number()) return;
     double seconds = p["predicted_seconds"].get<double>();
@@ -443,7 +445,8 @@ void announce_long_study(const std::string& scene, const std::string& options, b
     // n_max): the prediction is the plan's single-thread seconds, an upper bound.
     bool stopping = false;
     for (const std::string* text : {&options, &scene}) {
-        const nlohmann::json j = nlohmann::json::parse(*text, nullptr, false);
+        const mcp::Made<mcp::Json> made = mcp::parse_json(*text, "scene");
+        const nlohmann::json& j = made.value;
         for (const char* key : {"rel_tol", "abs_tol"})
             stopping = stopping || (j.is_object() && j.contains(key) && j[key].is_number() &&
                                     j[key].get<double>() > 0.0);
@@ -800,7 +803,7 @@ int cmd_render_progressive(ImageCommand& c) {
                      mcp_last_error());
         return exit_code(status);
     }
-    nlohmann::json open = nlohmann::json::parse(result, nullptr, false);
+    nlohmann::json open = mcp::cli::api_json(result);
     mcp_free(result);
     if (open.is_discarded() || !open["session"].is_number_integer()) return kExitRuntime;
     LiveSession session{open["session"].get<int>()};
@@ -836,7 +839,7 @@ int cmd_render_progressive(ImageCommand& c) {
                              mcp::boundary::one_line(names[i]).c_str(), s, mcp_last_error());
                 return exit_code(status);
             }
-            nlohmann::json r = nlohmann::json::parse(result, nullptr, false);
+            nlohmann::json r = mcp::cli::api_json(result);
             mcp_free(result);
             if (r.is_discarded() || !r["images"].is_object()) return kExitRuntime;
             const std::string base = dir + "/" + stems[i] + "_" + std::to_string(s) + "spp";
@@ -939,9 +942,9 @@ int cmd_render(const std::vector<std::string>& args) {
         error_file.discard();
         return exit_code(status);
     }
-    nlohmann::json j = nlohmann::json::parse(result, nullptr, false);
+    nlohmann::json j = mcp::cli::api_json(result);
     mcp_free(result);
-    if (j.is_discarded()) return kExitRuntime;
+    if (!j.is_object()) return kExitRuntime;
     const nlohmann::json& images = j["images"];
     if (!out_path.empty()) {
         const char* key = ends_with(out_path, ".png")   ? "png"
@@ -1022,9 +1025,9 @@ int cmd_reference(const std::vector<std::string>& args) {
         out_file.discard();
         return exit_code(status);
     }
-    nlohmann::json j = nlohmann::json::parse(result, nullptr, false);
+    nlohmann::json j = mcp::cli::api_json(result);
     mcp_free(result);
-    if (j.is_discarded()) return kExitRuntime;
+    if (!j.is_object()) return kExitRuntime;
     if (!write_file(out_path, base64_decode(j["reference_data"].get<std::string>()))) {
         std::fprintf(stderr, "mcplay: cannot write '%s'\n", out_path.c_str());
         return kExitRuntime;
@@ -1096,7 +1099,7 @@ int cmd_merge(const std::vector<std::string>& args) {
     if (!out_file.check(&error)) return usage_error("--out: " + error);
     // Integration studies and stopping runs ("kind": "study_part" or "stopping_part") merge in
     // the study API, render studies in the render API; each refuses the other's parts.
-    const nlohmann::json first = nlohmann::json::parse(first_part, nullptr, false);
+    const nlohmann::json first = mcp::cli::api_json(first_part.c_str());
     const bool study_parts = first.is_object() && first.contains("kind") &&
                              (first["kind"] == "study_part" || first["kind"] == "stopping_part");
     char* result = nullptr;

@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "core/special.h"
+#include "core/stats.h"
 
 namespace mcp {
 
@@ -126,6 +128,33 @@ int miss_allowance(int n) {
 }
 } // namespace
 
+namespace {
+/// The finite estimates' standard deviation (n - 1), computed on them over their largest
+/// magnitude and scaled back, so that it survives estimates whose squares underflow; and
+/// their range.
+struct Spread {
+    double deviation = 0.0, lowest = 0.0, highest = 0.0;
+};
+Spread spread_of(const std::vector<double>& estimates) {
+    Spread s;
+    double largest = 0.0;
+    bool any = false;
+    for (double x : estimates)
+        if (std::isfinite(x)) {
+            s.lowest = any ? std::min(s.lowest, x) : x;
+            s.highest = any ? std::max(s.highest, x) : x;
+            largest = std::max(largest, std::fabs(x));
+            any = true;
+        }
+    if (!(largest > 0.0) || !std::isfinite(largest)) return s;
+    RunningMoments scaled;
+    for (double x : estimates)
+        if (std::isfinite(x)) scaled.add(x / largest);
+    s.deviation = largest * std::sqrt(scaled.variance());
+    return s;
+}
+} // namespace
+
 ReplicateCheck check_replicates(const LevelStats& l) {
     ReplicateCheck c;
     const size_t reps = std::min({l.estimates.size(), l.run_std_errors.size(), l.run_dofs.size()});
@@ -211,7 +240,7 @@ std::vector<Flag> level_flags(const LevelStats& l) {
         f.value = replicates.worst_z;
         f.threshold = replicates.worst_limit;
         f.count = static_cast<uint64_t>(replicates.far);
-        f.of = static_cast<uint64_t>(replicates.judged);
+        f.of = reps; // "replicate 3 of 32": of all of them, not of those judged
         f.dof = replicates.worst_index; // which replicate (0-based)
         f.se = l.has_exact ? 1.0 : 0.0; // 1: judged against the exact value
         f.replicates_judged = replicates.judged;
@@ -221,11 +250,22 @@ std::vector<Flag> level_flags(const LevelStats& l) {
     // A random estimator whose own error bar is 0 while its replicates disagree: the runs saw
     // no variation (e.g. both points of every stratum on the same side of a discontinuity),
     // and their intervals are wrong. When every replicate agrees (f/p constant) 0 is right.
-    if (l.zero_error_runs > 0 && l.estimates_spread) {
+    // The spread is measured on the estimates over their largest magnitude (their squares
+    // underflow below 1e-154, where l.variance reads 0 for replicates that differ), and the flag
+    // needs the replicates to differ by that measure too: never "differ (standard deviation 0)".
+    Spread replicate_spread = spread_of(l.estimates);
+    if (l.estimates.size() < 2) { // no replicates kept (one run judged alone): its variance
+        replicate_spread.deviation = std::sqrt(l.variance);
+        const double nan = std::numeric_limits<double>::quiet_NaN();
+        replicate_spread.lowest = replicate_spread.highest = nan;
+    }
+    if (l.zero_error_runs > 0 && l.estimates_spread && replicate_spread.deviation > 0.0) {
         Flag& f = raise(FlagCode::ZeroErrorBar);
         f.count = static_cast<uint64_t>(l.zero_error_runs);
         f.of = reps;
-        f.value = std::sqrt(l.variance);
+        f.value = replicate_spread.deviation;
+        f.threshold = replicate_spread.lowest; // the range the replicates span, for the sentence
+        f.se = replicate_spread.highest;
     }
     // The replicates' spread against their own error bars, with or without an exact value: each
     // run's se^2 estimates the variance of its estimate, so s^2 (across the R replicates) over

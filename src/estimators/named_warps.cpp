@@ -434,7 +434,33 @@ Made<Warp> make_typed_warp(const Domain& domain, const std::vector<std::string>&
             pdf->evaluate(vars, x.n, out);
         };
     }
+    w.escape = std::make_shared<WarpEscape>();
     return {w, {}};
+}
+
+void WarpEscape::record(const PointBlock& u, const PointBlock& x, size_t i) {
+    if (seen()) return;
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (seen_.load(std::memory_order_relaxed)) return;
+    for (int j = 0; j < u.dim; ++j) u_.push_back(u.coord(j)[i]);
+    for (int j = 0; j < x.dim; ++j) x_.push_back(x.coord(j)[i]);
+    seen_.store(true, std::memory_order_release);
+}
+
+std::string WarpEscape::describe(const Domain& domain) const {
+    if (!seen()) return "";
+    std::lock_guard<std::mutex> lock(mutex_);
+    auto tuple = [](const std::vector<double>& v) {
+        std::string t = "(";
+        char buf[32];
+        for (size_t j = 0; j < v.size(); ++j) {
+            std::snprintf(buf, sizeof buf, "%.6g", v[j]);
+            t += (j ? ", " : "") + std::string(buf);
+        }
+        return t + ")";
+    };
+    return "u = " + tuple(u_) + " gave x = " + tuple(x_) + ", outside its domain, the " +
+           domain.describe();
 }
 
 Proposal warp_proposal(std::shared_ptr<const Warp> warp, const Domain& domain) {

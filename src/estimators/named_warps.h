@@ -6,8 +6,10 @@
 // (ProposalKind::Warp, estimators/problem.h).
 #pragma once
 
+#include <atomic>
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -32,6 +34,24 @@ struct Warp {
     int sample_dim = 2;
     std::function<void(const PointBlock& u, PointBlock& x)> map;
     std::function<void(const PointBlock& x, double* pdf)> pdf;
+    /// Typed warps only (null for the named ones): the first point the warp put outside its
+    /// domain while it served as a proposal (warp_block checks each block).
+    std::shared_ptr<struct WarpEscape> escape;
+};
+
+/// The first point a typed warp put outside its domain in a study, as warp-test reports one:
+/// a study with such a point fails with this sentence instead of reporting a wrong number.
+struct WarpEscape {
+    /// Keeps point i of the block (u its unit-cube point, x where it landed) if it is the first.
+    void record(const PointBlock& u, const PointBlock& x, size_t i);
+    bool seen() const { return seen_.load(std::memory_order_acquire); }
+    /// "u = (0.75) gave x = (1.5), outside [0, 1]" (empty when none was seen).
+    std::string describe(const Domain& domain) const;
+
+  private:
+    std::atomic<bool> seen_{false};
+    mutable std::mutex mutex_; // guards u_ and x_ (written once)
+    std::vector<double> u_, x_;
 };
 
 /// A named warp and the domain it maps onto (set by its parameters).

@@ -8,6 +8,7 @@
 #include "core/special.h"
 #include "estimators/estimator_kind.h"
 #include "estimators/named_warps.h"
+#include "estimators/warp_test.h" // kWarpDomainTolerance
 
 namespace mcp {
 
@@ -439,9 +440,59 @@ void warp_block(const Proposal& p, const Domain& d, const PointBlock& u, PointBl
     case ProposalKind::Warp:
         p.warp->map(u, x);
         x.n = n;
+        // A typed warp's every block is checked (a few comparisons per point beside its
+        // expression's evaluation): one point outside the domain makes the study fail, as
+        // warp-test does, rather than average f where it is not defined.
+        if (p.warp->escape && !p.warp->escape->seen()) {
+            const size_t i = first_outside(p.warp_domain, x);
+            if (i < n) p.warp->escape->record(u, x, i);
+        }
         p.warp->pdf(x, pdf);
         break;
     }
+}
+
+size_t first_outside(const Domain& d, const PointBlock& x) {
+    constexpr double tol = kWarpDomainTolerance;
+    const size_t n = x.n;
+    switch (d.kind) {
+    case DomainKind::Box:
+        for (size_t i = 0; i < n; ++i)
+            for (size_t j = 0; j < d.lo.size(); ++j) {
+                const double t = (x.coord(int(j))[i] - d.lo[j]) / (d.hi[j] - d.lo[j]);
+                if (!(t >= -tol && t <= 1.0 + tol)) return i;
+            }
+        return n;
+    case DomainKind::Disk: {
+        const double limit = (1.0 + tol) * (1.0 + tol) * d.radius * d.radius;
+        for (size_t i = 0; i < n; ++i) {
+            const double dx = x.coord(0)[i] - d.center.x, dy = x.coord(1)[i] - d.center.y;
+            if (!(dx * dx + dy * dy <= limit)) return i;
+        }
+        return n;
+    }
+    case DomainKind::Triangle: {
+        // Barycentrics of (x, y) in (v0, v1, v2), each >= -tol.
+        const Vec2 e0 = d.v0 - d.v2, e1 = d.v1 - d.v2;
+        const double inv_det = 1.0 / (e0.x * e1.y - e1.x * e0.y);
+        for (size_t i = 0; i < n; ++i) {
+            const double px = x.coord(0)[i] - d.v2.x, py = x.coord(1)[i] - d.v2.y;
+            const double b0 = (px * e1.y - e1.x * py) * inv_det;
+            const double b1 = (e0.x * py - px * e0.y) * inv_det;
+            if (!(b0 >= -tol && b1 >= -tol && 1.0 - b0 - b1 >= -tol)) return i;
+        }
+        return n;
+    }
+    case DomainKind::Sphere:
+    case DomainKind::Hemisphere:
+        for (size_t i = 0; i < n; ++i) {
+            const double a = x.coord(0)[i], b = x.coord(1)[i], z = x.coord(2)[i];
+            if (!(std::fabs(a * a + b * b + z * z - 1.0) <= 2.0 * tol)) return i;
+            if (d.kind == DomainKind::Hemisphere && !(z >= -tol)) return i;
+        }
+        return n;
+    }
+    return n;
 }
 
 void proposal_pdf_block(const Proposal& p, const Domain& d, const PointBlock& x, double* pdf) {

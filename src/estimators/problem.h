@@ -118,6 +118,10 @@ std::string check_proposal(const Proposal& proposal, const Domain& domain);
 void warp_block(const Proposal& proposal, const Domain& domain, const PointBlock& u, PointBlock& x,
                 double* pdf);
 
+/// The index of the first of the x.n points outside the domain (beyond round-off, 1e-9 of its
+/// size: kWarpDomainTolerance; NaN is outside), or x.n when every point is inside.
+size_t first_outside(const Domain& domain, const PointBlock& x);
+
 /// pdf[i] = density of the proposal at the domain points x (0 outside its support): the
 /// scalar-free form of the densities warp_block returns, for points from anywhere.
 void proposal_pdf_block(const Proposal& proposal, const Domain& domain, const PointBlock& x,

@@ -91,8 +91,9 @@ struct ImageShape {
     uint64_t width = 4096, height = 4096;
 };
 
+/// `ref_floor`: the reference's relative MSE floor (reference_summary.relative_mse_floor).
 bool image_summary_from_json(Ctx& c, const Json& j, const std::string& path,
-                             const ImageShape& shape, ImageSummary* im) {
+                             const ImageShape& shape, double ref_floor, ImageSummary* im) {
     if (!j.is_object()) return c.fail(path, "expected an object, got " + type_of(j));
     ImageError& e = im->error;
     RenderDiagnostics& d = im->diagnostics;
@@ -119,11 +120,17 @@ bool image_summary_from_json(Ctx& c, const Json& j, const std::string& path,
     if (replicate >= 1024) return c.fail(sub(path, "replicate"), "must be in 0..1023");
     if (im->spp < 1) return c.fail(sub(path, "spp"), "must be at least 1");
     if (!(im->seconds >= 0.0)) return c.fail(sub(path, "seconds"), "expected a number >= 0");
-    // Every number in its range: relative errors, sums of squares and standard errors are
-    // >= 0, a coverage and a share lie in 0..1, pixels in the image, counts within counts.
+    // Every number in its range: raw relative errors, sums of squares and standard errors are
+    // >= 0, a coverage and a share lie in 0..1, pixels in the image, counts within counts. The
+    // relative MSE is the raw one less the reference's noise pixel by pixel (render_study.cpp,
+    // image_error): it lies in -floor..rel_mse_raw, negative once the image is closer to the
+    // truth than the reference can tell (docs/render-scenes.md), up to rounding.
     const double pixels = double(shape.width) * double(shape.height);
-    if (!check_range(c, path, "rel_mse", e.rel_mse, 0.0, INFINITY) ||
-        !check_range(c, path, "rel_mse_raw", e.rel_mse_raw, 0.0, INFINITY) ||
+    const double floor = std::isfinite(ref_floor) && ref_floor > 0.0 ? ref_floor : 0.0;
+    const double rounding = 1e-9 * (floor + std::fabs(e.rel_mse_raw));
+    if (!check_range(c, path, "rel_mse_raw", e.rel_mse_raw, 0.0, INFINITY) ||
+        !check_range(c, path, "rel_mse", e.rel_mse, -floor - rounding,
+                     std::isnan(e.rel_mse_raw) ? INFINITY : e.rel_mse_raw + rounding) ||
         !check_range(c, path, "coverage", e.coverage, 0.0, 1.0) ||
         !check_range(c, path, "mean_luminance_se", e.mean_luminance_se, 0.0, INFINITY) ||
         !check_range(c, path, "worst_pixel_term", e.worst_pixel_term, 0.0, INFINITY) ||
@@ -208,7 +215,8 @@ bool merge_estimator(Ctx& c, const std::vector<const Json*>& parts, size_t e,
             for (size_t k = 0; k < list->size(); ++k) {
                 ImageSummary im;
                 const std::string ip = pl + ".images[" + std::to_string(k) + "]";
-                if (!image_summary_from_json(c, (*list)[k], ip, shape, &im)) return false;
+                if (!image_summary_from_json(c, (*list)[k], ip, shape, ref.floor, &im))
+                    return false;
                 if (uint64_t(im.replicate) != index + k * of)
                     return c.fail(sub(ip, "replicate"),
                                   "expected replicate " + std::to_string(index + k * of));

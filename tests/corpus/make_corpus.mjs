@@ -97,6 +97,17 @@ scene('duplicate_nested', '{"f": "x", "domain": {"type": "box", "type": "disk"}}
 scene('deep_150000', '['.repeat(150000) + ']'.repeat(150000), 'nested more than 64 levels');
 scene('deep_8000_object', '{"a":'.repeat(8000) + '1' + '}'.repeat(8000), 'nested more than 64 levels');
 scene('deep_65', '{"f": "x", "notes": ' + '['.repeat(65) + ']'.repeat(65) + '}', 'nested more than 64 levels');
+// A typed warp that leaves its domain fails the study, naming the point (issue 48).
+scene('warp_outside_study', { warp: { domain: { type: 'interval', lower: 0, upper: 1 }, g: ['2*u'], p: '1' }, f: 'x', estimators: ['warp'], n_max: 64, reps: 4 }, 'its warp put a point outside its domain');
+// Every reader of JSON is bounded as run's is (issue 48): a point file for analyze, a part for
+// merge (analyze on this file crashed with exit 139).
+add('analyze_deep_150000', 2, ['analyze', 'scene/deep_150000.json'], 'nested more than 64 levels');
+add('merge_deep_150000', 2, ['merge', 'scene/deep_150000.json'], 'nested more than 64 levels');
+// A CSV's first row with one unparsable field is an error, not a header (issue 48).
+write('lab/first_row_e.csv', '0.5e,0.5\n0.25,0.75\n');
+add('analyze_first_row_e', 2, ['analyze', 'lab/first_row_e.csv'], "row 1, column 1: '0.5e' is not a number");
+write('lab/first_row_empty.csv', '\ufeff0.5,,0.5\n0.25,0.5,0.75\n');
+add('analyze_first_row_empty', 2, ['analyze', 'lab/first_row_empty.csv'], 'row 1, column 2: the field is empty');
 // Found by fuzz_scene: user text with control characters quoted in a message must keep it to
 // one line (fuzz/findings/scene/).
 scene('fuzz_multiline_key', '{"\\n"', 'invalid JSON');
