@@ -51,7 +51,8 @@ bool bounded(RadianceStrategy strategy, const LightContacts& c) {
 TEST(RenderBounds, ContactsAreFoundWhereLightsTouchWhatTheyLight) {
     // A wall light standing on the floor's edge z = 0 (the perpendicular plates): an edge
     // contact. Area sampling is unbounded there, solid-angle sampling is not.
-    const LightContacts plates = contacts_of(floor_and_light({0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}));
+    const LightContacts plates =
+        contacts_of(floor_and_light({0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}));
     ASSERT_TRUE(plates.checked);
     EXPECT_TRUE(plates.contact);
     EXPECT_FALSE(plates.interior_contact);
@@ -154,6 +155,48 @@ TEST(RenderBounds, AreaSamplingAtAContactEdgeIsFlagged) {
     EXPECT_EQ(heavy_tail_severity(area), "warning") << area["warnings"].dump();
     for (const char* name : {"light_solid_angle", "mis_power", "cosine_hemisphere"})
         EXPECT_NE(heavy_tail_severity(estimator(plates, name)), "warning") << name;
+}
+
+/// The result of a C API call that writes `out` (mcp_render_study_run, _merge), or the error.
+template <class F> json call(F&& f) {
+    char* out = nullptr;
+    const int status = f(&out);
+    json j = status == MCP_OK && out ? json::parse(out) : json{{"error", mcp_last_error()}};
+    mcp_free(out);
+    return j;
+}
+
+// A split study's parts carry the bound, and their merge keeps it (the page merges parts):
+// the perpendicular plates' area sampling stays unbounded, solid-angle sampling bounded. A
+// malformed bound in a part is refused, naming it.
+TEST(RenderBounds, MergedPartsKeepTheBound) {
+    const std::string scene = test::read(test::kScenes + "/perpendicular_plates.json");
+    json parts = json::array();
+    for (int part = 0; part < 2; ++part) {
+        const json options{{"base_dir", test::kScenes}, {"width", 8},     {"height", 8},
+                           {"spp_max", 4},              {"reps", 2},      {"part", part},
+                           {"parts", 2},                {"reference", {{"spp", 64}}},
+                           {"estimators", {"light_area", "light_solid_angle"}}};
+        parts.push_back(call([&](char** out) {
+            return mcp_render_study_run(scene.c_str(), options.dump().c_str(), nullptr, nullptr,
+                                        out);
+        }));
+        ASSERT_FALSE(parts.back().contains("error")) << parts.back()["error"];
+    }
+    auto merge = [&] {
+        const std::string text = json{{"parts", parts}}.dump();
+        return call([&](char** out) { return mcp_render_study_merge(text.c_str(), out); });
+    };
+    const json merged = merge();
+    ASSERT_FALSE(merged.contains("error")) << merged["error"];
+    EXPECT_FALSE(estimator(merged, "light_area")["contribution_bound"]["bounded"].get<bool>());
+    EXPECT_TRUE(
+        estimator(merged, "light_solid_angle")["contribution_bound"]["bounded"].get<bool>());
+    for (json& p : parts) p["estimators"][0]["contribution_bound"]["bounded"] = "yes";
+    const json refused = merge();
+    ASSERT_TRUE(refused.contains("error"));
+    EXPECT_NE(refused["error"].get<std::string>().find("contribution_bound"), std::string::npos)
+        << refused["error"];
 }
 
 } // namespace

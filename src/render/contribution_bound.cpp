@@ -152,7 +152,8 @@ LightContacts light_contacts(const RenderScene& rs) {
     };
     auto box_of = [&](size_t t, double widen) {
         const Triangle tri = triangle_of(mesh, t);
-        Box b{glm::min(tri[0], glm::min(tri[1], tri[2])), glm::max(tri[0], glm::max(tri[1], tri[2]))};
+        Box b{glm::min(tri[0], glm::min(tri[1], tri[2])),
+              glm::max(tri[0], glm::max(tri[1], tri[2]))};
         b.lo -= Vec3(widen);
         b.hi += Vec3(widen);
         return b;

@@ -19,8 +19,8 @@ namespace mcp {
 /// inside the light's edges (there solid-angle sampling's area fallback for solid angles within
 /// 1e-12 of 2 pi can be reached).
 struct LightContacts {
-    bool checked = false;         ///< false: more candidate pairs than kMaxContactPairs
-    bool contact = false;         ///< some light touches a surface
+    bool checked = false;          ///< false: more candidate pairs than kMaxContactPairs
+    bool contact = false;          ///< some light touches a surface
     bool interior_contact = false; ///< ... at a point inside the light, not on its edges
     size_t pairs = 0;              ///< (light, triangle) pairs whose boxes overlap
 };
