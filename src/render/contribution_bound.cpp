@@ -146,7 +146,7 @@ LightContacts light_contacts(const RenderScene& rs) {
     std::vector<size_t> light_triangles;
     for (size_t t = 0; t < mesh.triangle_count(); ++t)
         if (lights.light_index(uint32_t(t)) >= 0) light_triangles.push_back(t);
-    // Each light's box widened by tol, against every triangle's box; the exact test on overlaps.
+    // Boxes first (each light's widened by tol), the exact test where they overlap.
     struct Box {
         Vec3 lo, hi;
     };
@@ -158,15 +158,27 @@ LightContacts light_contacts(const RenderScene& rs) {
         b.hi += Vec3(widen);
         return b;
     };
+    auto overlap = [](const Box& a, const Box& b) {
+        return !(a.lo.x > b.hi.x || a.lo.y > b.hi.y || a.lo.z > b.hi.z || a.hi.x < b.lo.x ||
+                 a.hi.y < b.lo.y || a.hi.z < b.lo.z);
+    };
+    // The triangles near some light (one pass over the scene), then each light against them.
+    Box near_lights{Vec3(std::numeric_limits<double>::infinity()),
+                    Vec3(-std::numeric_limits<double>::infinity())};
+    for (size_t l : light_triangles) {
+        const Box b = box_of(l, tol);
+        near_lights.lo = glm::min(near_lights.lo, b.lo);
+        near_lights.hi = glm::max(near_lights.hi, b.hi);
+    }
+    std::vector<size_t> near;
+    for (size_t t = 0; t < mesh.triangle_count() && !light_triangles.empty(); ++t)
+        if (overlap(box_of(t, 0.0), near_lights)) near.push_back(t);
+    if (light_triangles.size() * near.size() > kMaxContactBoxTests) return out; // not checked
     std::vector<std::pair<size_t, size_t>> candidates;
     for (size_t l : light_triangles) {
         const Box bl = box_of(l, tol);
-        for (size_t t = 0; t < mesh.triangle_count(); ++t) {
-            if (t == l) continue;
-            const Box bt = box_of(t, 0.0);
-            if (bt.lo.x > bl.hi.x || bt.lo.y > bl.hi.y || bt.lo.z > bl.hi.z ||
-                bt.hi.x < bl.lo.x || bt.hi.y < bl.lo.y || bt.hi.z < bl.lo.z)
-                continue;
+        for (size_t t : near) {
+            if (t == l || !overlap(box_of(t, 0.0), bl)) continue;
             if (candidates.size() >= kMaxContactPairs) return out; // not checked
             candidates.emplace_back(l, t);
         }

@@ -19,7 +19,7 @@ namespace mcp {
 /// inside the light's edges (there solid-angle sampling's area fallback for solid angles within
 /// 1e-12 of 2 pi can be reached).
 struct LightContacts {
-    bool checked = false;          ///< false: more candidate pairs than kMaxContactPairs
+    bool checked = false;          ///< false: too many pairs to test (kMaxContact*)
     bool contact = false;          ///< some light touches a surface
     bool interior_contact = false; ///< ... at a point inside the light, not on its edges
     size_t pairs = 0;              ///< (light, triangle) pairs whose boxes overlap
@@ -31,6 +31,9 @@ constexpr double kContactDistance = 1e-4;
 constexpr double kCoplanarSine = 1e-9;
 /// The rounding of transformed vertices, generously: 1e-9 of the scene's extent.
 constexpr double kPlaneDistance = 1e-9;
+/// Beyond these many (light, nearby triangle) box tests, or exact tests of overlapping boxes,
+/// contacts are not checked (area and solid-angle sampling are left to the tail estimate).
+constexpr size_t kMaxContactBoxTests = size_t(1) << 26;
 constexpr size_t kMaxContactPairs = size_t(1) << 24;
 LightContacts light_contacts(const RenderScene& rs);
 
