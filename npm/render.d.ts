@@ -70,6 +70,9 @@ export interface RenderStudyResult extends JsonObject {
   estimators: Array<JsonObject & {
     name: string;
     strategy: string;
+    /** Whether each sample's reflected radiance is bounded by construction (then heavy_tail is
+     * info): docs/render-scenes.md, "Bounded contributions". */
+    contribution_bound: { bounded: boolean; reason: string };
     rays_per_second: number;
     warnings: Warning[];
     /** One per spp: `variance` is the relative MSE against the reference. */

@@ -235,12 +235,16 @@ Json tail_warning(const Flag& f, uint64_t pooled, const TailWording& words) {
                               std::to_string(pooled) + " " + words.unit + " at " + words.n_name +
                               " = " + std::to_string(f.n) + ")";
     if (f.code == FlagCode::HeavyTail && f.severity == Severity::Info)
-        return flag_warning(f, std::string(words.what) + " look heavy-tailed: tail index " +
-                                   fmt("%.2f", f.value) + " +/- " + fmt("%.2f", f.se) + where +
-                                   ", but they are bounded (f bounded, the density bounded "
-                                   "below), so every moment is finite: a pre-asymptotic tail "
-                                   "that fades as N grows (skewed_weights says from which N "
-                                   "the error bars hold)");
+        return flag_warning(
+            f, std::string(words.what) + " look heavy-tailed: tail index " + fmt("%.2f", f.value) +
+                   " +/- " + fmt("%.2f", f.se) + where + ", but they are bounded (" +
+                   (words.bounded_why ? std::string(words.bounded_why)
+                                      : "f bounded, the density bounded below") +
+                   "), so every moment is finite: a pre-asymptotic tail that fades as " +
+                   words.n_name + " grows" +
+                   (words.bounded_why ? ""
+                                      : " (skewed_weights says from which N the error bars "
+                                        "hold)"));
     if (f.code == FlagCode::HeavyTail)
         return flag_warning(f, std::string(words.what) + " are heavy-tailed: tail index " +
                                    fmt("%.2f", f.value) + " +/- " + fmt("%.2f", f.se) + where +

@@ -45,6 +45,9 @@ struct TailWording {
     const char* unit;
     const char* n_name;
     const char* variance;
+    /// Why the values are bounded, for heavy_tail as info (nullptr: the integration studies'
+    /// reason, f bounded and the density bounded below).
+    const char* bounded_why = nullptr;
 };
 /// Appends the `heavy_tail` / `heavy_tail_4` warnings for the tail index of a study's deepest
 /// level, estimated from `pooled` values (`bounded` weights: heavy_tail is info).

@@ -204,7 +204,7 @@ std::vector<Flag> render_flags(const RenderEstimatorStudy& s, double floor) {
         flags.push_back(f);
     }
     const LevelStats& deepest = s.levels.back();
-    for (const Flag& f : tail_flags(deepest)) flags.push_back(f);
+    for (const Flag& f : tail_flags(deepest, s.bound.bounded)) flags.push_back(f);
     if (s.fit.valid && s.fit.order > -1.0 + 3.0 * s.fit.order_se && s.fit.order > -0.8) {
         Flag f(FlagCode::SlowConvergence);
         f.value = s.fit.order;
@@ -378,9 +378,11 @@ RenderStudyResult run_render_study(const RenderScene& rs,
     result.threads_used = resolve_threads(settings.threads);
     result.reference_mean_luminance = mean_luminance(reference, nullptr);
     result.relative_mse_floor = relative_mse_floor(reference);
+    const LightContacts contacts = light_contacts(rs);
     for (const RenderEstimator& e : estimators) {
         RenderEstimatorStudy s;
         s.estimator = e;
+        s.bound = contribution_bound(e, contacts);
         result.estimators.push_back(s);
     }
     // The integration studies' loop (run_ladder), with an image as the estimate. Images run one

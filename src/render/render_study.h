@@ -35,6 +35,7 @@
 
 #include "estimators/diagnostics.h"
 #include "estimators/study.h"
+#include "render/contribution_bound.h"
 #include "render/renderer.h"
 
 namespace mcp {
@@ -126,6 +127,9 @@ struct RenderEstimatorStudy {
     std::vector<LevelStats> levels; ///< n = spp; see render_level_stats for the fields' meaning
     std::vector<ErrorConcentration> concentration; ///< one per level
     ConvergenceFit fit;                            ///< of relative MSE against spp
+    /// Whether its per-sample contributions are bounded by construction (contribution_bound):
+    /// then heavy_tail is info, a pre-asymptotic tail.
+    ContributionBound bound;
     RenderImage preview;                           ///< replicate 0 at the largest spp rendered
     /// Each level's images, kept by a part of a study split over processes (for the merge).
     std::vector<std::vector<ImageSummary>> images;
@@ -143,8 +147,9 @@ struct RenderStudyResult {
 
 /// The flags of a render estimator over its study (diagnostics as data, worded by the API):
 /// reference_noise (levels below the reference's floor: count, of), the tail flags of the
-/// deepest level, slow_convergence (fitted order above -1 by more than 3 standard errors and
-/// above -0.8), pixel_error_bars (under 85% of the pixels' own 95% intervals cover the
+/// deepest level (heavy_tail as info when s.bound says the contributions are bounded),
+/// slow_convergence (fitted order above -1 by more than 3 standard errors and above -0.8),
+/// pixel_error_bars (under 85% of the pixels' own 95% intervals cover the
 /// reference at the deepest spp, spp >= 16), rare_large_errors (levels whose relative MSE rests
 /// on a few (pixel, image) terms: count, of; the most concentrated level's n and terms).
 std::vector<Flag> render_flags(const RenderEstimatorStudy& s, double floor);

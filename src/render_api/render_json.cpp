@@ -101,7 +101,7 @@ Json estimator_to_json(const RenderEstimator& e) {
 Json render_warnings(const RenderEstimatorStudy& s, double floor) {
     Json w = Json::array();
     const TailWording tail_words{"the samples' reflected radiance values", "samples", "spp",
-                                 "the pixel variance"};
+                                 "the pixel variance", s.bound.reason.c_str()};
     for (const Flag& f : render_flags(s, floor)) {
         switch (f.code) {
         case FlagCode::ReferenceNoise:
@@ -282,6 +282,7 @@ Json estimator_study_to_json(const RenderEstimatorStudy& s, bool previews, doubl
                              const RenderImage* reference, double floor, bool all_levels,
                              size_t level) {
     Json j = estimator_to_json(s.estimator);
+    j["contribution_bound"] = Json{{"bounded", s.bound.bounded}, {"reason", s.bound.reason}};
     j["warnings"] = render_warnings(s, floor);
     if (all_levels) {
         Json levels = Json::array();

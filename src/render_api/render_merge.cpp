@@ -179,6 +179,17 @@ bool merge_estimator(Ctx& c, const std::vector<const Json*>& parts, size_t e,
         levels = std::min(levels, ls->size());
     }
     RenderEstimatorStudy study;
+    // Whether the contributions are bounded: the parts agree on it (one study), and a part
+    // without it (from before the field) leaves the tail estimate's verdict.
+    if (const Json* b = find((*parts[0])["estimators"][e], "contribution_bound")) {
+        const Json* bounded = b->is_object() ? find(*b, "bounded") : nullptr;
+        const Json* reason = b->is_object() ? find(*b, "reason") : nullptr;
+        if (!bounded || !bounded->is_boolean() || !reason || !reason->is_string() ||
+            reason->get<std::string>().size() > 1000)
+            return c.fail("part 0.estimators[" + std::to_string(e) + "].contribution_bound",
+                          "expected {\"bounded\": true or false, \"reason\": a string}");
+        study.bound = {bounded->get<bool>(), reason->get<std::string>()};
+    }
     for (size_t i = 0; i < levels; ++i) {
         const std::string lp = path + ".levels[" + std::to_string(i) + "]";
         std::vector<ImageSummary> images;
