@@ -143,6 +143,8 @@ test('the words: verdict, facts, measures with the independent-points expectatio
     'Failed: the samples do not follow p (p = 1e-300 < 0.01)');
   assert.equal(verdictText({ passed: true }), 'Passed: the samples agree with the density.');
   assert.equal(verdictText(null), '');
+  assert.equal(verdictText({ passed: null, outcome: 'unverified', verdict: 'could not verify: 1 bin(s) hold samples' }),
+    'Could not verify: 1 bin(s) hold samples');
   assert.equal(verdictText({ passed: false, verdict: 'rejected: the samples do not follow the pdf' }), 'Failed: the samples do not follow the pdf');
   assert.equal(verdictText({ passed: true, verdict: 'passed: chi-square 36.5 on 38 degrees of freedom' }), 'Passed: chi-square 36.5 on 38 degrees of freedom');
   const facts = Object.fromEntries(warpFacts({ pdf_integral: 1.0000001, pdf_integral_error: 2e-4, statistic: 1234.5, dof: 99, pooled_bins: 100, p_value: 1e-30, significance: 0.01 }));

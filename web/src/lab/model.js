@@ -541,9 +541,11 @@ export function problemChoices(scenes) {
 export function verdictText(result) {
   if (!result) return '';
   // the core's verdict starts with its own word for the outcome: said once, ours
-  const v = typeof result.verdict === 'string' ? result.verdict.replace(/^(passed|rejected|failed|accepted)\s*:\s*/i, '') : '';
+  const v = typeof result.verdict === 'string' ? result.verdict.replace(/^(passed|rejected|failed|accepted|could not verify)\s*:\s*/i, '') : '';
   if (result.passed === true) return v ? `Passed: ${v}` : 'Passed: the samples agree with the density.';
   if (result.passed === false) return v ? `Failed: ${v}` : 'Failed: the samples do not follow the density.';
+  // the third outcome: the core's quadrature could not settle the expected counts
+  if (result.outcome === 'unverified') return v ? `Could not verify: ${v}` : 'Could not verify the warp.';
   return v;
 }
 
