@@ -350,8 +350,10 @@ struct Probe {
 };
 /// Samples kept per bin (the first ones to fall in it) to find the bins to check again...
 constexpr int kProbesPerBin = 4;
-/// ... with every sample of theirs, up to this many in all.
-constexpr size_t kMaxSeeds = size_t(1) << 20;
+/// ... with their first samples, up to this many per bin: a part of the pdf the nodes missed
+/// that none of them reveals holds under 1/4096 of its bin's samples, its expected count E
+/// under E / 4096 (below sqrt(E) while E < 1.7e7).
+constexpr uint64_t kSeedsPerBin = 4096;
 /// A probe whose pdf exceeds this multiple of every node of its cell sits on a peak the nodes
 /// missed (a smooth pdf varies far less between a cell's nodes and any point of it).
 constexpr double kProbeRatio = 4.0;
@@ -899,11 +901,12 @@ Made<WarpTestResult> run_warp_test(const Domain& domain, const Warp& warp,
     integral.add(expectation.pdf_integral);
     error.add(expectation.pdf_integral_error);
     if (!again.empty()) {
-        // Second pass: every sample of those bins (up to kMaxSeeds) seeds the refinement.
+        // Second pass: the samples of those bins (up to kSeedsPerBin each) seed the refinement.
         std::vector<Probe> seeds;
+        std::vector<uint64_t> taken(nbins, 0);
         draw([&](size_t n, uint64_t start) {
             for (size_t i = 0; i < n; ++i)
-                if (flagged[bin[i]] && seeds.size() < kMaxSeeds) keep(seeds, i, start);
+                if (flagged[bin[i]] && taken[bin[i]]++ < kSeedsPerBin) keep(seeds, i, start);
         });
         if (std::string e = evaluate(seeds); !e.empty()) return made_error<WarpTestResult>(e);
         std::vector<uint32_t> seed_bin;
