@@ -106,7 +106,8 @@ Json warp_test_to_json(const WarpTestResult& r, const Warp& warp, const Domain& 
                 {"tests", options.tests},
                 {"level", r.level},
                 {"outcome", warp_test_outcome_name(r.outcome)},
-                {"passed", r.outcome == WarpTestOutcome::Unverified ? Json(nullptr) : Json(r.passed)},
+                {"passed", r.outcome == WarpTestOutcome::Unverified ? Json(nullptr)
+                                                                     : Json(r.passed)},
                 {"verdict", r.reason},
                 {"worst_bins", worst}};
 }

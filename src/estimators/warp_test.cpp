@@ -182,7 +182,8 @@ class Natural {
             t[1] = turns(x[0], x[1]);
             break;
         }
-        for (int j = 0; j < axes_; ++j) t[j] = std::min(std::max(t[j], 0.0), std::nextafter(1.0, 0.0));
+        const double below_one = std::nextafter(1.0, 0.0);
+        for (int j = 0; j < axes_; ++j) t[j] = std::min(std::max(t[j], 0.0), below_one);
     }
 
     /// Writes the flat bin of each of the n points of x; returns the index of the first point
@@ -441,7 +442,8 @@ Quadrature integrate_bins(const Domain& domain, const Warp& warp, const Natural&
     auto child_of = [&](const Cell& cell, const double* t) {
         size_t child = 0;
         for (int j = 0; j < k; ++j)
-            if (t[j] >= cell.lo[j] + std::ldexp(bin_width[j], -cell.level - 1)) child |= size_t(1) << j;
+            if (t[j] >= cell.lo[j] + std::ldexp(bin_width[j], -cell.level - 1))
+                child |= size_t(1) << j;
         return child;
     };
 
@@ -541,9 +543,9 @@ Quadrature integrate_bins(const Domain& domain, const Warp& warp, const Natural&
         const size_t affordable = std::min(static_cast<size_t>(left / (children * per_cell)),
                                            kMaxCellsPerLevel / children);
         if (split.size() > affordable) {
-            std::stable_sort(split.begin(), split.end(), [](const Candidate& a, const Candidate& b) {
-                return a.priority > b.priority;
-            });
+            std::stable_sort(
+                split.begin(), split.end(),
+                [](const Candidate& a, const Candidate& b) { return a.priority > b.priority; });
             for (size_t s = affordable; s < split.size(); ++s) {
                 const size_t c = split[s].cell;
                 double volume = measure;
@@ -946,7 +948,8 @@ Made<WarpTestResult> run_warp_test(const Domain& domain, const Warp& warp,
     // Not 1 whatever the quadrature's error, or 1 to within the tolerance beyond doubt.
     const double off = std::fabs(r.pdf_integral - 1.0);
     const bool integral_wrong = off > options.pdf_tolerance + r.pdf_integral_error;
-    r.pdf_integral_ok = off <= options.pdf_tolerance && r.pdf_integral_error <= options.pdf_tolerance;
+    r.pdf_integral_ok =
+        off <= options.pdf_tolerance && r.pdf_integral_error <= options.pdf_tolerance;
 
     // The statistic; its range under the quadrature's errors d_c of the cells' expected counts
     // E_c. With E'_c = E_c + e_c, |e_c| <= d_c, Cauchy-Schwarz bounds the cross term:

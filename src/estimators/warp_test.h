@@ -132,9 +132,10 @@ struct WarpTestExpectation {
 
 /// The default bins per axis for N samples on k natural axes: round(N^(2 / (k + 4)) / 4), at
 /// least 2. A smooth departure of relative size eps is seen through the noncentrality
-/// N eps^2 against the statistic's spread sqrt(2 m), m bins in all; binning loses the part of
-/// the departure finer than a bin, about N (w / h)^2 for bins of width h and a departure of
-/// slope w. Balancing the two, h^-2 ~ h^(-k/2), gives h ~ N^(-2 / (k + 4)): Mann and Wald's
+/// N eps^2 against the statistic's spread sqrt(2 m), m = h^-k bins of width h: the smallest
+/// departure seen has eps^2 ~ h^(-k/2) / N. Binning loses the part of it finer than a bin,
+/// about (w h)^2 for a slope w. Balancing the two, h^(2 + k/2) ~ 1 / N, gives
+/// h ~ N^(-2 / (k + 4)): Mann and Wald's
 /// N^(2/5) in 1-D [MannWald42]. The constant 1/4 makes the test see g = u^1.01 claimed uniform
 /// at N = 10^6 (63 bins: power ~1; 1024 bins: 0.43).
 int default_warp_test_bins(uint64_t samples, int axes);
