@@ -568,7 +568,7 @@ export function warpFacts(r) {
   if (r.warp !== undefined) add('warp', `${r.warp}${r.domain ? ` on the ${r.domain}` : ''}`);
   if (r.pdf_integral !== undefined) {
     add('∫ p over the domain (should be 1)', `${num(r.pdf_integral, 8)}${r.pdf_integral_error !== undefined ? ` ± ${num(r.pdf_integral_error, 2)}` : ''}` +
-      (r.pdf_integral_ok === false ? ' (not 1: p is not a density)' : ''));
+      (r.pdf_integral_ok === false ? (r.outcome === 'unverified' ? ' (the quadrature could not settle it)' : ' (not 1: p is not a density)') : ''));
   }
   if (r.statistic !== undefined) add('chi-square statistic', num(r.statistic, 6));
   if (r.dof !== undefined) add('degrees of freedom', String(r.dof));
