@@ -331,7 +331,7 @@ TEST(SamplerLabWarpTest, TheCourseNotesMistakeFailsAndItsFixPasses) {
 }
 
 // The three outcomes in JSON: "passed" true, false, or null with "outcome": "unverified" where
-// the quadrature could not settle the counts (GGX at alpha 0.001: a peak 1e-6 wide in 1 - z).
+// the test could not settle the verdict (here 4 samples: one cell after pooling).
 TEST(SamplerLabWarpTest, OutcomesPassedFailedUnverified) {
     Call good = warp_test({{"warp", kPolarDisk}}, {{"samples", 100000}, {"seed", 2}});
     ASSERT_EQ(good.status, MCP_OK) << good.error;
@@ -344,13 +344,12 @@ TEST(SamplerLabWarpTest, OutcomesPassedFailedUnverified) {
     ASSERT_EQ(bad.status, MCP_OK) << bad.error;
     EXPECT_EQ(bad.result["outcome"], "failed");
     EXPECT_EQ(bad.result["passed"], false);
-    Call ggx = warp_test({{"warp", {{"name", "ggx_visible_normals"}, {"alpha", 0.001}}}},
-                         {{"samples", 100000}});
-    ASSERT_EQ(ggx.status, MCP_OK) << ggx.error;
-    EXPECT_EQ(ggx.result["outcome"], "unverified") << ggx.result["verdict"];
-    EXPECT_TRUE(ggx.result["passed"].is_null());
-    EXPECT_EQ(ggx.result["verdict"].get<std::string>().rfind("could not verify: ", 0), 0u);
-    EXPECT_EQ(ggx.result["expected_error"].size(), ggx.result["expected"].size());
+    Call few = warp_test({{"warp", kPolarDisk}}, {{"samples", 4}});
+    ASSERT_EQ(few.status, MCP_OK) << few.error;
+    EXPECT_EQ(few.result["outcome"], "unverified") << few.result["verdict"];
+    EXPECT_TRUE(few.result["passed"].is_null());
+    EXPECT_EQ(few.result["verdict"].get<std::string>().rfind("could not verify: ", 0), 0u);
+    EXPECT_EQ(few.result["expected_error"].size(), few.result["expected"].size());
 }
 
 TEST(SamplerLabWarpTest, NamedWarpsTheirParametersAndErrors) {

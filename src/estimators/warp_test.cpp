@@ -1,8 +1,8 @@
 // The chi-square test of a warp: see warp_test.h. Three passes: the samples are drawn,
 // warped and binned block by block; the pdf is integrated over every bin by a pair of tensor
 // rules of degree 5 (Gauss-Legendre of 3 nodes per axis and an inset Gauss-Lobatto of 4),
-// cells where the two disagree being split in 2^k halves, level by level, so that steps and
-// peaks inside a bin are resolved (every level's nodes run through the pdf in blocks); then
+// cells where the two disagree being halved along the axes where they vary most, level by
+// level, so that steps, peaks and singular lines inside a bin are resolved (every level's nodes run through the pdf in blocks); then
 // the counts are pooled and the statistic, its p-value and the verdict computed.
 #include "estimators/warp_test.h"
 
@@ -334,11 +334,12 @@ std::vector<Node> rule_pair(int k) {
     return nodes;
 }
 
-/// A cell of the quadrature: a box of [0, 1)^k inside one bin, of width 2^-level of the bin's.
+/// A cell of the quadrature: a box of [0, 1)^k inside one bin, of width 2^-level[j] of the
+/// bin's along axis j.
 struct Cell {
     double lo[3];
     uint32_t bin;
-    uint16_t level;
+    uint16_t level[3];
     bool seeded; ///< it or a parent held a probe far above its nodes: it may go deeper
     uint32_t seed_begin, seed_end; ///< the probes inside it (a range of integrate_bins' seeds)
 };
@@ -382,10 +383,13 @@ Quadrature integrate_bins(const Domain& domain, const Warp& warp, const Natural&
     const std::vector<Node> nodes = rule_pair(k);
     const size_t per_cell = nodes.size();
     // 1-D refinement halves one cell per level towards a singular point (x^-0.9 keeps 8% of
-    // its mass below 1e-11), so it may go as deep as doubles resolve; a line or a surface of
-    // cells doubles per level in 2-D and 3-D. Seeded cells follow one probe each.
+    // its mass below 1e-11), so it may go as deep as doubles resolve; so may a cell split
+    // along one axis alone (a peak or a singular line across a bin). Split along every axis,
+    // a line or a surface of cells doubles per level in 2-D and 3-D: their depth (the least
+    // level over the axes) is bounded. Seeded cells follow one probe each.
     const int max_level = k == 1 ? 1100 : (k == 2 ? 12 : 7);
     const int max_seeded_level = k == 1 ? 1100 : (k == 2 ? 32 : 20);
+    const int max_axis_level = 1100;
     const double measure = domain.measure();
     double bin_width[3] = {1.0, 1.0, 1.0};
     for (int j = 0; j < k; ++j) bin_width[j] = 1.0 / bins[j];
@@ -394,15 +398,17 @@ Quadrature integrate_bins(const Domain& domain, const Warp& warp, const Natural&
     // f^((1-k)/k) cells of share f, so the cells along it accept errors that sum to about tol'
     // per unit of its length or area, at every level; in 1D the few cells of a step cost
     // little, and theirs is tol' / 1e6.
-    auto mass_threshold = [&](int level) {
-        const double share = std::ldexp(1.0 / static_cast<double>(nbins), -k * level);
+    auto mass_threshold = [&](const Cell& cell) {
+        int levels = 0;
+        for (int j = 0; j < k; ++j) levels += cell.level[j];
+        const double share = std::ldexp(1.0 / static_cast<double>(nbins), -levels);
         const double t = kIntegralAccuracy * tolerance;
         return k == 1 ? t * 1e-6 : t * std::pow(share, (k - 1.0) / k);
     };
     // A cell narrower than this share of its position cannot place distinct nodes.
     auto divisible = [&](const Cell& cell) {
         for (int j = 0; j < k; ++j) {
-            const double w = std::ldexp(bin_width[j], -cell.level);
+            const double w = std::ldexp(bin_width[j], -cell.level[j]);
             if (!(w > 1e-12 * (cell.lo[j] + w) && w > 1e-290)) return false;
         }
         return true;
@@ -426,7 +432,7 @@ Quadrature integrate_bins(const Domain& domain, const Warp& warp, const Natural&
             }
         }
         cell.bin = which[c];
-        cell.level = 0;
+        cell.level[0] = cell.level[1] = cell.level[2] = 0;
         cell.seeded = false;
         const auto range = std::equal_range(seed_bin.begin(), seed_bin.end(), which[c]);
         cell.seed_begin = static_cast<uint32_t>(range.first - seed_bin.begin());
@@ -438,13 +444,18 @@ Quadrature integrate_bins(const Domain& domain, const Warp& warp, const Natural&
             if (seeds[i].pdf > kProbeRatio * node_max) return true;
         return false;
     };
-    // The child (bit j: upper half along axis j) of a cell at `level` holding t.
-    auto child_of = [&](const Cell& cell, const double* t) {
+    // The child (bit j: upper half along axis j, of the axes in `axes`) of a cell holding t.
+    auto child_of = [&](const Cell& cell, unsigned axes, const double* t) {
         size_t child = 0;
         for (int j = 0; j < k; ++j)
-            if (t[j] >= cell.lo[j] + std::ldexp(bin_width[j], -cell.level - 1))
+            if ((axes >> j & 1u) && t[j] >= cell.lo[j] + std::ldexp(bin_width[j], -cell.level[j] - 1))
                 child |= size_t(1) << j;
         return child;
+    };
+    auto cell_volume = [&](const Cell& cell) {
+        double volume = measure;
+        for (int j = 0; j < k; ++j) volume *= std::ldexp(bin_width[j], -cell.level[j]);
+        return volume;
     };
 
     PointBlock x;
@@ -452,12 +463,16 @@ Quadrature integrate_bins(const Domain& domain, const Warp& warp, const Natural&
     double pdf[kBlockSize], w3[kBlockSize], w4[kBlockSize];
     uint32_t owner[kBlockSize];
     std::vector<double> q3, q4, qmax;
+    // Per cell and axis, the Gauss rule's sums over its three node planes along that axis.
+    std::vector<double> planes;
+    uint16_t node_of[kBlockSize];
     NeumaierSum integral, error;
     while (!cells.empty()) {
         // The cells' two rules, their nodes through the pdf a block at a time.
         q3.assign(cells.size(), 0.0);
         q4.assign(cells.size(), 0.0);
         qmax.assign(cells.size(), 0.0);
+        planes.assign(cells.size() * 9, 0.0);
         size_t fill = 0;
         auto flush = [&]() -> bool {
             x.n = fill;
@@ -474,6 +489,9 @@ Quadrature integrate_bins(const Domain& domain, const Warp& warp, const Natural&
                 }
                 q3[owner[i]] += w3[i] * pdf[i];
                 q4[owner[i]] += w4[i] * pdf[i];
+                if (w3[i] != 0.0)
+                    for (int j = 0, r = node_of[i]; j < k; ++j, r /= 3)
+                        planes[owner[i] * 9 + size_t(j) * 3 + size_t(r % 3)] += w3[i] * pdf[i];
                 qmax[owner[i]] = std::max(qmax[owner[i]], pdf[i]);
             }
             fill = 0;
@@ -482,8 +500,9 @@ Quadrature integrate_bins(const Domain& domain, const Warp& warp, const Natural&
         for (size_t c = 0; c < cells.size(); ++c) {
             const Cell& cell = cells[c];
             double width[3] = {1.0, 1.0, 1.0};
-            for (int j = 0; j < k; ++j) width[j] = std::ldexp(bin_width[j], -cell.level);
-            for (const Node& nd : nodes) {
+            for (int j = 0; j < k; ++j) width[j] = std::ldexp(bin_width[j], -cell.level[j]);
+            for (size_t ni = 0; ni < nodes.size(); ++ni) {
+                const Node& nd = nodes[ni];
                 double t[3] = {0.5, 0.5, 0.5}, at[3];
                 for (int j = 0; j < k; ++j) t[j] = cell.lo[j] + width[j] * nd.at[j];
                 natural.forward(t, at);
@@ -491,6 +510,7 @@ Quadrature integrate_bins(const Domain& domain, const Warp& warp, const Natural&
                 w3[fill] = nd.w3;
                 w4[fill] = nd.w4;
                 owner[fill] = static_cast<uint32_t>(c);
+                node_of[fill] = static_cast<uint16_t>(ni); // the Gauss rule's nodes come first
                 if (++fill == kBlockSize && !flush()) return q;
             }
         }
@@ -501,6 +521,27 @@ Quadrature integrate_bins(const Domain& domain, const Warp& warp, const Natural&
             size_t cell;
             double err, priority;
             bool seed;
+            unsigned axes; ///< bit j: split along axis j
+        };
+        // The axes along which the cell varies most (second differences and slopes of its
+        // node planes' sums): all of them for a seed or a cell flat in the Gauss nodes.
+        auto split_axes = [&](size_t c, bool seed) {
+            const unsigned all = (1u << k) - 1u;
+            if (seed || k == 1) return all;
+            double v[3] = {0.0, 0.0, 0.0}, most = 0.0;
+            for (int j = 0; j < k; ++j) {
+                // Each plane's sum over its own weight along j (5/18, 8/18, 5/18): the mean of
+                // the pdf over the plane, as the other axes' weights give it.
+                const double* p = &planes[c * 9 + size_t(j) * 3];
+                const double g[3] = {p[0] * 3.6, p[1] * 2.25, p[2] * 3.6};
+                v[j] = std::fabs(g[2] - g[0]) + std::fabs(g[0] - 2.0 * g[1] + g[2]);
+                most = std::max(most, v[j]);
+            }
+            if (!(most > 0.0)) return all;
+            unsigned axes = 0;
+            for (int j = 0; j < k; ++j)
+                if (v[j] >= 0.25 * most && cells[c].level[j] < max_axis_level) axes |= 1u << j;
+            return axes ? axes : all;
         };
         std::vector<Candidate> split;
         auto accept = [&](const Cell& cell, double mass, double err, bool seed) {
@@ -513,11 +554,12 @@ Quadrature integrate_bins(const Domain& domain, const Warp& warp, const Natural&
         for (size_t c = 0; c < cells.size(); ++c) {
             const Cell& cell = cells[c];
             q.max_pdf[cell.bin] = std::max(q.max_pdf[cell.bin], qmax[c]);
-            double volume = measure;
-            for (int j = 0; j < k; ++j) volume *= std::ldexp(bin_width[j], -cell.level);
+            const double volume = cell_volume(cell);
             const double m3 = volume * q3[c], m4 = volume * q4[c];
             const double err = kErrorSafety * std::fabs(m4 - m3);
-            if (cell.level == 0) bin_estimate[cell.bin] = n_samples * m3;
+            const int depth = *std::min_element(cell.level, cell.level + k);
+            if (depth == 0 && *std::max_element(cell.level, cell.level + k) == 0)
+                bin_estimate[cell.bin] = n_samples * m3;
             // Errors of every bin near this share of sqrt(expected) sum, in the statistic, to
             // a small part of one degree of freedom (see quadrature_chi_square).
             const double count_threshold =
@@ -526,11 +568,11 @@ Quadrature integrate_bins(const Domain& domain, const Warp& warp, const Natural&
                 n_samples;
             const bool seed = probe_above(cell, qmax[c]);
             const int deepest = cell.seeded || seed ? max_seeded_level : max_level;
-            const bool can_split = cell.level < deepest && divisible(cell);
+            const bool can_split = depth < deepest && divisible(cell);
             const bool refine =
-                can_split && (seed || err > std::min(count_threshold, mass_threshold(cell.level)));
+                can_split && (seed || err > std::min(count_threshold, mass_threshold(cell)));
             if (refine)
-                split.push_back({c, err, seed ? HUGE_VAL : err, seed});
+                split.push_back({c, err, seed ? HUGE_VAL : err, seed, split_axes(c, seed)});
             else
                 accept(cell, m3, err, seed);
         }
@@ -548,9 +590,7 @@ Quadrature integrate_bins(const Domain& domain, const Warp& warp, const Natural&
                 [](const Candidate& a, const Candidate& b) { return a.priority > b.priority; });
             for (size_t s = affordable; s < split.size(); ++s) {
                 const size_t c = split[s].cell;
-                double volume = measure;
-                for (int j = 0; j < k; ++j) volume *= std::ldexp(bin_width[j], -cells[c].level);
-                accept(cells[c], volume * q3[c], split[s].err, split[s].seed);
+                accept(cells[c], cell_volume(cells[c]) * q3[c], split[s].err, split[s].seed);
             }
             split.resize(affordable);
         }
@@ -562,17 +602,21 @@ Quadrature integrate_bins(const Domain& domain, const Warp& warp, const Natural&
             const auto first = seeds.begin() + parent.seed_begin;
             const auto last = seeds.begin() + parent.seed_end;
             std::stable_sort(first, last, [&](const Probe& a, const Probe& b) {
-                return child_of(parent, a.t) < child_of(parent, b.t);
+                return child_of(parent, s.axes, a.t) < child_of(parent, s.axes, b.t);
             });
             uint32_t at = parent.seed_begin;
             for (size_t child = 0; child < children; ++child) {
+                if (child & ~size_t(s.axes)) continue; // a bit of an axis not split
                 Cell c = parent;
-                c.level = static_cast<uint16_t>(parent.level + 1);
                 c.seeded = parent.seeded || s.seed;
-                for (int j = 0; j < k; ++j)
-                    if (child >> j & 1u) c.lo[j] += std::ldexp(bin_width[j], -c.level);
+                for (int j = 0; j < k; ++j) {
+                    if (!(s.axes >> j & 1u)) continue;
+                    c.level[j] = static_cast<uint16_t>(parent.level[j] + 1);
+                    if (child >> j & 1u) c.lo[j] += std::ldexp(bin_width[j], -c.level[j]);
+                }
                 c.seed_begin = at;
-                while (at < parent.seed_end && child_of(parent, seeds[at].t) == child) ++at;
+                while (at < parent.seed_end && child_of(parent, s.axes, seeds[at].t) == child)
+                    ++at;
                 c.seed_end = at;
                 next.push_back(c);
             }
