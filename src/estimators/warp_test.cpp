@@ -1,9 +1,11 @@
-// The chi-square test of a warp: see warp_test.h. Three passes: the samples are drawn,
-// warped and binned block by block; the pdf is integrated over every bin by a pair of tensor
-// rules of degree 5 (Gauss-Legendre of 3 nodes per axis and an inset Gauss-Lobatto of 4),
-// cells where the two disagree being halved along the axes where they vary most, level by
-// level, so that steps, peaks and singular lines inside a bin are resolved (every level's nodes run through the pdf in blocks); then
-// the counts are pooled and the statistic, its p-value and the verdict computed.
+// The chi-square test of a warp: see warp_test.h. The samples are drawn, warped and binned
+// block by block; the pdf is integrated over every bin by a pair of tensor rules of degree 5
+// (Gauss-Legendre of 3 nodes per axis and an inset Gauss-Lobatto of 4), cells where the two
+// disagree being halved along the axes where they vary most, level by level, so that steps,
+// peaks and singular lines inside a bin are resolved (every level's nodes run through the pdf
+// in blocks); bins where a sample's pdf stands far above the nodes are integrated again around
+// their samples; then the counts are pooled and the statistic, its range under the
+// quadrature's error and the verdict computed.
 #include "estimators/warp_test.h"
 
 #include <algorithm>
@@ -448,7 +450,8 @@ Quadrature integrate_bins(const Domain& domain, const Warp& warp, const Natural&
     auto child_of = [&](const Cell& cell, unsigned axes, const double* t) {
         size_t child = 0;
         for (int j = 0; j < k; ++j)
-            if ((axes >> j & 1u) && t[j] >= cell.lo[j] + std::ldexp(bin_width[j], -cell.level[j] - 1))
+            if ((axes >> j & 1u) &&
+                t[j] >= cell.lo[j] + std::ldexp(bin_width[j], -cell.level[j] - 1))
                 child |= size_t(1) << j;
         return child;
     };
