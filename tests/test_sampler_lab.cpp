@@ -388,6 +388,28 @@ TEST(SamplerLabWarpTest, TheCourseNotesMistakeFailsAndItsFixPasses) {
     EXPECT_TRUE(good.result["passed"].get<bool>()) << good.result["verdict"];
 }
 
+// The three outcomes in JSON: "passed" true, false, or null with "outcome": "unverified" where
+// the test could not settle the verdict (here 4 samples: one cell after pooling).
+TEST(SamplerLabWarpTest, OutcomesPassedFailedUnverified) {
+    Call good = warp_test({{"warp", kPolarDisk}}, {{"samples", 100000}, {"seed", 2}});
+    ASSERT_EQ(good.status, MCP_OK) << good.error;
+    EXPECT_EQ(good.result["outcome"], "passed") << good.result["verdict"];
+    EXPECT_EQ(good.result["passed"], true);
+    EXPECT_EQ(good.result["p_value_range"][0], good.result["p_value"]); // a constant pdf: exact
+    json wrong = kPolarDisk;
+    wrong["g"] = {"u1*cos(2*pi*u2)", "u1*sin(2*pi*u2)"};
+    Call bad = warp_test({{"warp", wrong}}, {{"samples", 100000}});
+    ASSERT_EQ(bad.status, MCP_OK) << bad.error;
+    EXPECT_EQ(bad.result["outcome"], "failed");
+    EXPECT_EQ(bad.result["passed"], false);
+    Call few = warp_test({{"warp", kPolarDisk}}, {{"samples", 4}});
+    ASSERT_EQ(few.status, MCP_OK) << few.error;
+    EXPECT_EQ(few.result["outcome"], "unverified") << few.result["verdict"];
+    EXPECT_TRUE(few.result["passed"].is_null());
+    EXPECT_EQ(few.result["verdict"].get<std::string>().rfind("could not verify: ", 0), 0u);
+    EXPECT_EQ(few.result["expected_error"].size(), few.result["expected"].size());
+}
+
 TEST(SamplerLabWarpTest, NamedWarpsTheirParametersAndErrors) {
     Call named = warp_test({{"warp", "cosine_hemisphere"}}, {{"samples", 100000}});
     ASSERT_EQ(named.status, MCP_OK) << named.error;

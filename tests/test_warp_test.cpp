@@ -225,7 +225,7 @@ TEST(WarpTest, DiskWithoutSquareRootFails) {
     EXPECT_EQ(r.worst[0].index[0], 0); // the innermost ring
     EXPECT_GT(r.worst[0].residual, 0.0);
     EXPECT_TRUE(contains(r.reason, "rejected: the samples do not follow the pdf")) << r.reason;
-    EXPECT_TRUE(contains(r.reason, "|x - c|^2 / R^2 in [0, 0.01613)")) << r.reason;
+    EXPECT_TRUE(contains(r.reason, "|x - c|^2 / R^2 in [0, 0.04)")) << r.reason;
 }
 
 // The cosine-weighted hemisphere by the polar map, without the square root: r = u1 and z =
@@ -325,7 +325,7 @@ TEST(WarpTest, ExpressionEqualToNamedWarpPasses) {
     const Domain line = make_box({0.0}, {1.0}).value;
     const WarpTestResult r = run(line, expression(line, {"sqrt(u)"}, "2*x"));
     EXPECT_TRUE(r.passed) << r.reason;
-    EXPECT_EQ(r.bins[0], 1024);
+    EXPECT_EQ(r.bins[0], 63);
 }
 
 TEST(WarpTest, ExpressionWarpErrors) {
@@ -584,4 +584,165 @@ TEST(WarpProposal, EstimatesThroughTheFixedEstimator) {
     const RunResult r = run_estimate(problem, spec, 100000, rng, ws);
     EXPECT_GT(r.std_error, 0.0);
     EXPECT_LT(std::fabs(r.estimate - 2.0 * kPi / 3.0), 5.0 * r.std_error);
+}
+
+// ---------------------------------------------------------------------------
+// Right both ways where the quadrature is hard (issue 48): a right warp passes or is
+// "unverified" with the reason, never failed; a wrong one fails. Fixed seeds.
+
+namespace {
+
+/// The map of `map_of` with the density of `pdf_of`.
+Warp crossed(const Warp& map_of, const Warp& pdf_of) {
+    Warp w = map_of;
+    w.pdf = pdf_of.pdf;
+    return w;
+}
+
+WarpTestResult run_n(const Domain& d, const Warp& w, uint64_t n, uint64_t seed = 1) {
+    WarpTestOptions o;
+    o.samples = n;
+    o.seed = seed;
+    WarpTestResult r = run(d, w, o);
+    std::printf("[ warp test ] %s, N = %llu: %s, p = %.3g in [%.3g, %.3g]: %s\n", w.name.c_str(),
+                static_cast<unsigned long long>(n), warp_test_outcome_name(r.outcome), r.p_value,
+                r.p_value_low, r.p_value_high, r.reason.c_str());
+    return r;
+}
+
+void expect_right(const WarpTestResult& r, const std::string& what) {
+    EXPECT_NE(r.outcome, WarpTestOutcome::Failed) << what << ": " << r.reason;
+    EXPECT_FALSE(contains(r.reason, "cannot")) << what << ": " << r.reason;
+    if (r.outcome == WarpTestOutcome::Unverified) {
+        EXPECT_TRUE(contains(r.reason, "could not verify: ")) << what << ": " << r.reason;
+    }
+}
+
+void expect_wrong(const WarpTestResult& r, const std::string& what) {
+    EXPECT_EQ(r.outcome, WarpTestOutcome::Failed) << what << ": " << r.reason;
+    EXPECT_FALSE(r.passed) << what;
+}
+
+} // namespace
+
+// Bins for power: g = u^1.01 claimed uniform differs from it by a smooth 1% (noncentrality
+// N int (p - 1)^2 ~ 96 at 10^6), which 63 bins see (critical excess 2.3 sqrt(2 * 62) ~ 26) and
+// 1024 bins mostly miss (~105). Its right density 0.990 x^-0.0099 passes.
+TEST(WarpTestBothWays, PowerOfOnePercentSmoothDepartures) {
+    EXPECT_EQ(default_warp_test_bins(1000000, 1), 63);
+    EXPECT_EQ(default_warp_test_bins(1000000, 2), 25);
+    EXPECT_EQ(default_warp_test_bins(1000000, 3), 13);
+    EXPECT_EQ(default_warp_test_bins(100, 1), 2);
+    const Domain line = make_box({0.0}, {1.0}).value;
+    const WarpTestResult wrong = run_n(line, expression(line, {"u^1.01"}, "1"), 1000000);
+    expect_wrong(wrong, "u^1.01 claimed uniform");
+    EXPECT_EQ(wrong.bins[0], 63);
+    EXPECT_LT(wrong.p_value, 1e-4);
+    const WarpTestResult right =
+        run_n(line, expression(line, {"u^1.01"}, "x^(1/1.01 - 1)/1.01"), 1000000);
+    expect_right(right, "u^1.01 with its density");
+}
+
+// GGX visible normals at alpha 0.001 and 0.002: the peak is 1e-6 wide in 1 - z, finer than the
+// quadrature's cells. The right pdf is never rejected; the pdf of alpha 50 times larger (3% of
+// its mass beyond the first ring of bins, where the map puts 1e-5) is. (The pdf of twice alpha
+// differs from the right one inside the first ring alone, which 25 x 25 bins cannot split.)
+TEST(WarpTestBothWays, GgxAtTinyAlpha) {
+    for (double alpha : {0.001, 0.002}) {
+        NamedWarpParams p;
+        p.alpha = alpha;
+        p.wo = {0.6, 0.0, 0.8};
+        const NamedWarp w = named("ggx_visible_normals", p);
+        expect_right(run_n(w.domain, w.warp, 1000000), "ggx alpha " + std::to_string(alpha));
+        p.alpha = 50.0 * alpha;
+        const NamedWarp other = named("ggx_visible_normals", p);
+        expect_wrong(run_n(w.domain, crossed(w.warp, other.warp), 1000000),
+                     "ggx map of alpha " + std::to_string(alpha) + ", pdf of 50 times it");
+    }
+}
+
+// Spherical triangles 0.01-0.03 across and 1e-6 to 1e-3 wide: the quadrature's nodes miss
+// them; the samples probe the pdf there, so a right warp is never accused of landing where
+// its pdf is 0. A triangle's map with its neighbour's density does land there.
+TEST(WarpTestBothWays, SmallAndThinSphericalTriangles) {
+    struct Tri {
+        double across, wide;
+    };
+    for (const Tri t : {Tri{0.01, 1e-3}, Tri{0.03, 1e-3}, Tri{0.02, 1e-6}, Tri{0.01, 1e-4}}) {
+        NamedWarpParams p;
+        p.a = {1.0, 0.0, 0.0};
+        p.b = {1.0, t.across, 0.0};
+        p.c = {1.0, 0.5 * t.across, t.wide};
+        const NamedWarp w = named("spherical_triangle", p);
+        const std::string what =
+            "triangle " + std::to_string(t.across) + " x " + std::to_string(t.wide);
+        const WarpTestResult right = run_n(w.domain, w.warp, 100000);
+        expect_right(right, what);
+        EXPECT_EQ(right.zero_pdf_samples, 0u) << what;
+        p.c = {1.0, 0.5 * t.across, -t.wide}; // the mirror image across the edge a b
+        const NamedWarp mirror = named("spherical_triangle", p);
+        const WarpTestResult wrong = run_n(w.domain, crossed(w.warp, mirror.warp), 100000);
+        expect_wrong(wrong, what + ", its mirror's pdf");
+        EXPECT_GT(wrong.zero_pdf_samples, 0u) << what;
+        EXPECT_TRUE(contains(wrong.reason, "lands where its pdf says it cannot")) << wrong.reason;
+    }
+}
+
+// Tables of 10^5 and 10^6 values (1-D) and 4096 x 256 (2-D): steps in every bin.
+TEST(WarpTestBothWays, LargeTables) {
+    for (int n : {100000, 1000000}) {
+        NamedWarpParams p;
+        p.expression = "1 + 0.5*sin(40*x) + 0.3*sin(977*x)";
+        p.nx = n;
+        const NamedWarp w = named("tabulated_1d", p);
+        expect_right(run_n(w.domain, w.warp, 1000000), "tabulated_1d of " + std::to_string(n));
+        p.expression = "1 + 0.5*sin(40*x + 0.2) + 0.3*sin(977*x)";
+        const NamedWarp other = named("tabulated_1d", p);
+        expect_wrong(run_n(w.domain, crossed(w.warp, other.warp), 1000000),
+                     "tabulated_1d of " + std::to_string(n) + ", a shifted table's pdf");
+    }
+    NamedWarpParams p;
+    p.expression = "1 + 0.5*sin(9*x)*cos(7*y) + 0.2*sin(300*x*y)";
+    p.nx = 4096;
+    p.ny = 256;
+    const NamedWarp w = named("tabulated_2d", p);
+    expect_right(run_n(w.domain, w.warp, 1000000), "tabulated_2d 4096 x 256");
+    p.expression = "1 + 0.5*sin(9*x + 0.3)*cos(7*y) + 0.2*sin(300*x*y)";
+    const NamedWarp other = named("tabulated_2d", p);
+    expect_wrong(run_n(w.domain, crossed(w.warp, other.warp), 1000000),
+                 "tabulated_2d 4096 x 256, a shifted table's pdf");
+}
+
+// Half the mass in a spike 1e-9 wide at x = 0.3: the nodes miss it (the first quadrature
+// reads 0.5 +- 0); the samples in it probe it and the refinement around them finds it. The
+// spike claimed 1e-8 to the right of where the samples go is wrong.
+TEST(WarpTestBothWays, HalfMassSpike) {
+    const Domain line = make_box({0.0}, {1.0}).value;
+    const std::string g = "step(0.5-u)*2*u + step(u-0.5)*(0.3 + 1e-9*(2*u-1))";
+    const WarpTestResult right =
+        run_n(line, expression(line, {g}, "0.5 + 5e8*step(x-0.3)*step(0.300000001-x)"), 1000000);
+    expect_right(right, "half-mass spike");
+    EXPECT_GT(right.probed_bins, 0);
+    EXPECT_NEAR(right.pdf_integral, 1.0, 1e-3 + right.pdf_integral_error);
+    const WarpTestResult wrong = run_n(
+        line, expression(line, {g}, "0.5 + 5e8*step(x-0.30000001)*step(0.300000011-x)"), 1000000);
+    expect_wrong(wrong, "half-mass spike claimed 1e-8 off");
+}
+
+// Integrable singularities: x = u^10 has the density 0.1 x^-0.9 (66% of the mass in the
+// first of 63 bins); the disk maps r = u1^2 and r = u1^4 have the densities
+// |x|^-3/2 / (4 pi) and |x|^-7/4 / (8 pi). Each with another's density is wrong.
+TEST(WarpTestBothWays, IntegrableSingularities) {
+    const Domain line = make_box({0.0}, {1.0}).value;
+    expect_right(run_n(line, expression(line, {"u^10"}, "0.1*x^-0.9"), 1000000), "u^10");
+    expect_wrong(run_n(line, expression(line, {"u^10"}, "0.2*x^-0.8"), 1000000),
+                 "u^10 with the density of u^5");
+    const Domain disk = make_disk({0.0, 0.0}, 1.0).value;
+    const std::string p2 = "(x^2+y^2)^-0.75/(4*pi)", p4 = "(x^2+y^2)^-0.875/(8*pi)";
+    const std::vector<std::string> g2 = {"u1^2*cos(2*pi*u2)", "u1^2*sin(2*pi*u2)"};
+    const std::vector<std::string> g4 = {"u1^4*cos(2*pi*u2)", "u1^4*sin(2*pi*u2)"};
+    expect_right(run_n(disk, expression(disk, g2, p2), 1000000), "disk r = u1^2");
+    expect_right(run_n(disk, expression(disk, g4, p4), 1000000), "disk r = u1^4");
+    expect_wrong(run_n(disk, expression(disk, g2, p4), 1000000), "disk r = u1^2, pdf of u1^4");
+    expect_wrong(run_n(disk, expression(disk, g4, p2), 1000000), "disk r = u1^4, pdf of u1^2");
 }

@@ -133,7 +133,9 @@ int mcp_points_integrate(const char* scene_json, const char* request_json, char*
 /* Tests a warp (docs/scene-format.md, "warp"): its density integrates to 1, and a chi-square
  * test of its samples against that density in equal-measure bins. options_json may be NULL or
  * {"samples", "seed", "significance", "tests" (Sidak), "bins": [per natural coordinate]}.
- * A failed test is a result (MCP_OK, "passed": false); a warp that cannot be tested (g leaves
+ * A failed test is a result (MCP_OK, "outcome": "failed", "passed": false), and so is one the
+ * quadrature could not settle ("outcome": "unverified", "passed": null, "verdict" says why:
+ * docs/result-schema.md, The sampler lab's results); a warp that cannot be tested (g leaves
  * the domain, p negative or NaN) is MCP_ERROR_SCENE naming the sample or the point. */
 int mcp_warp_test(const char* scene_json, const char* options_json, char** result_json);
 

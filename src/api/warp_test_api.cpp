@@ -86,6 +86,7 @@ Json warp_test_to_json(const WarpTestResult& r, const Warp& warp, const Domain& 
                 {"bins", bins},
                 {"observed", r.observed},
                 {"expected", r.expected},
+                {"expected_error", r.expected_error},
                 {"pdf_integral", finite_or_null(r.pdf_integral)},
                 {"pdf_integral_error", finite_or_null(r.pdf_integral_error)},
                 {"pdf_integral_ok", r.pdf_integral_ok},
@@ -95,11 +96,18 @@ Json warp_test_to_json(const WarpTestResult& r, const Warp& warp, const Domain& 
                 {"cells", r.cells},
                 {"pooled_bins", r.pooled_bins},
                 {"zero_bins_hit", r.zero_bins_hit},
+                {"zero_pdf_samples", r.zero_pdf_samples},
+                {"probed_bins", r.probed_bins},
+                {"unresolved_bins", r.unresolved_bins},
+                {"quadrature_chi_square", finite_or_null(r.quadrature_chi_square)},
                 {"p_value", r.p_value},
+                {"p_value_range", {r.p_value_low, r.p_value_high}},
                 {"significance", options.significance},
                 {"tests", options.tests},
                 {"level", r.level},
-                {"passed", r.passed},
+                {"outcome", warp_test_outcome_name(r.outcome)},
+                {"passed", r.outcome == WarpTestOutcome::Unverified ? Json(nullptr)
+                                                                     : Json(r.passed)},
                 {"verdict", r.reason},
                 {"worst_bins", worst}};
 }

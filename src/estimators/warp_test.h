@@ -4,7 +4,13 @@
 // domain's natural coordinates, where the domain is a unit square or cube of equal measure
 // everywhere; the expected count of each bin is N times the integral of the pdf over it, by an
 // adaptive quadrature. Bins with small expected counts are pooled, and the statistic's upper
-// tail probability compared with a Sidak-corrected level [Sidak67].
+// tail probability compared with a Sidak-corrected level [Sidak67]. The quadrature's error is
+// carried into the verdict: a warp is rejected only when it would be with any expected counts
+// within that error, passed only when it would pass with any, and otherwise "could not verify"
+// (outcome Unverified) with the reason. A few samples of every bin probe the pdf where the
+// quadrature's nodes did not look: a value far above every node near it (a peak the nodes
+// missed) refines the quadrature around that sample, and only a sample where the pdf is 0
+// itself says that the warp lands where its pdf says it cannot.
 //
 // Natural coordinates t in [0, 1)^k (each maps the domain's measure to a constant times
 // Lebesgue measure, so a uniform warp fills the bins equally):
@@ -44,9 +50,8 @@ constexpr double kWarpDomainTolerance = 1e-9;
 struct WarpTestOptions {
     uint64_t samples = 1000000; ///< N, 1 .. kMaxWarpTestSamples
     uint64_t seed = 1;          ///< PCG32's seed (its stream is fixed)
-    /// Bins per natural axis (unused axes ignored); 0: the default for N, about N / 256
-    /// bins in all (an expected count near 256 each for a uniform warp), per axis
-    /// floor((N / 256)^(1/k)) clamped to [2, 1024] (k = 1), [2, 64] (k = 2), [2, 16] (k = 3).
+    /// Bins per natural axis (unused axes ignored); 0: the default for N, chosen for power
+    /// (default_warp_test_bins): round(N^(2 / (k + 4)) / 4) per axis, at least 2.
     int bins[3] = {0, 0, 0};
     double significance = 0.01; ///< alpha, in (0, 1)
     /// The number of tests run together (1 .. 1e6): the level is Sidak's 1 - (1 - alpha)^(1 /
@@ -67,6 +72,11 @@ struct WarpTestBin {
     double residual = 0.0;
 };
 
+/// The three outcomes: the samples follow the pdf, they do not, or the quadrature could not
+/// settle which (the reason says why).
+enum class WarpTestOutcome { Passed, Failed, Unverified };
+const char* warp_test_outcome_name(WarpTestOutcome o); ///< "passed", "failed", "unverified"
+
 struct WarpTestResult {
     int axes = 0;                        ///< natural coordinates: 1 to 3
     std::vector<std::string> axis_names; ///< e.g. "(1 - z) / 2", "phi / 2 pi"
@@ -74,6 +84,9 @@ struct WarpTestResult {
     /// Per bin, flat index i0 + bins[0] (i1 + bins[1] i2) (axis 0 fastest).
     std::vector<uint64_t> observed;
     std::vector<double> expected; ///< N times the pdf's integral over the bin
+    /// Per bin, the quadrature's error estimate of `expected` (N times the summed differences
+    /// of its two rules over the bin's cells); N where a probe found a peak it never resolved.
+    std::vector<double> expected_error;
     uint64_t samples = 0;
     /// The integral of the pdf over the domain (should be 1), and an estimate of its
     /// quadrature error (the sum over the quadrature's cells of the difference of its two
@@ -85,10 +98,21 @@ struct WarpTestResult {
     int cells = 0;              ///< cells in the statistic after pooling
     int pooled_bins = 0;        ///< bins with expected count < 5 merged into pooled cells
     uint64_t zero_bins_hit = 0; ///< bins with expected count exactly 0 but samples in them
-    double p_value = 0.0;       ///< P(chi-square_dof >= statistic)
-    double level = 0.0;         ///< Sidak-corrected significance level
+    /// Samples where the pdf, evaluated at the sample itself, is 0 (among the probes).
+    uint64_t zero_pdf_samples = 0;
+    /// Bins refined around a probe sample where the pdf was far above the quadrature's nodes,
+    /// and those of them whose peak stayed unresolved.
+    int probed_bins = 0, unresolved_bins = 0;
+    double p_value = 0.0; ///< P(chi-square_dof >= statistic)
+    /// The p-values of the largest and smallest statistic that expected counts within the
+    /// quadrature's error allow (Cauchy-Schwarz, see warp_test.cpp); both p_value when exact.
+    double p_value_low = 0.0, p_value_high = 0.0;
+    /// sum over the cells of error^2 / expected: the quadrature's share of the statistic.
+    double quadrature_chi_square = 0.0;
+    double level = 0.0; ///< Sidak-corrected significance level
     bool pdf_integral_ok = false;
-    bool passed = false;
+    WarpTestOutcome outcome = WarpTestOutcome::Failed;
+    bool passed = false; ///< outcome == Passed
     std::string reason; ///< the verdict in plain words
     /// The bins with the largest |residual|, largest first.
     std::vector<WarpTestBin> worst;
@@ -100,10 +124,21 @@ struct WarpTestResult {
 struct WarpTestExpectation {
     int bins[3] = {1, 1, 1};
     uint64_t samples = 0;
-    std::vector<double> expected;
+    std::vector<double> expected, expected_error;
+    std::vector<double> max_pdf; ///< per bin, the largest pdf value at its quadrature nodes
     double pdf_integral = 0.0, pdf_integral_error = 0.0;
     uint64_t pdf_evaluations = 0;
 };
+
+/// The default bins per axis for N samples on k natural axes: round(N^(2 / (k + 4)) / 4), at
+/// least 2. A smooth departure of relative size eps is seen through the noncentrality
+/// N eps^2 against the statistic's spread sqrt(2 m), m = h^-k bins of width h: the smallest
+/// departure seen has eps^2 ~ h^(-k/2) / N. Binning loses the part of it finer than a bin,
+/// about (w h)^2 for a slope w. Balancing the two, h^(2 + k/2) ~ 1 / N, gives
+/// h ~ N^(-2 / (k + 4)): Mann and Wald's
+/// N^(2/5) in 1-D [MannWald42]. The constant 1/4 makes the test see g = u^1.01 claimed uniform
+/// at N = 10^6 (63 bins: power ~1; 1024 bins: 0.43).
+int default_warp_test_bins(uint64_t samples, int axes);
 
 /// The quadrature of run_warp_test alone (the seed is not read). Errors: those of
 /// run_warp_test but the samples'.
@@ -130,6 +165,11 @@ Made<WarpTestResult> run_warp_test(const Domain& domain, const Warp& warp,
 /// are left out. Sets chi_square, cells, dof = cells - 1 and pooled_bins.
 void pooled_chi_square(const std::vector<uint64_t>& observed, const std::vector<double>& expected,
                        double* chi_square, int* cells, int* pooled_bins);
+/// The same, and the quadrature's share: sum over the pooled cells of error^2 / expected and
+/// the largest error / expected of a cell (errors of a pool summed).
+void pooled_chi_square(const std::vector<uint64_t>& observed, const std::vector<double>& expected,
+                       const std::vector<double>& expected_error, double* chi_square, int* cells,
+                       int* pooled_bins, double* error_chi_square, double* max_relative_error);
 
 /// Sidak's level 1 - (1 - alpha)^(1 / tests) [Sidak67], computed without cancellation.
 double sidak_level(double alpha, int tests);

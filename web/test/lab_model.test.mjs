@@ -143,6 +143,8 @@ test('the words: verdict, facts, measures with the independent-points expectatio
     'Failed: the samples do not follow p (p = 1e-300 < 0.01)');
   assert.equal(verdictText({ passed: true }), 'Passed: the samples agree with the density.');
   assert.equal(verdictText(null), '');
+  assert.equal(verdictText({ passed: null, outcome: 'unverified', verdict: 'could not verify: 1 bin(s) hold samples' }),
+    'Could not verify: 1 bin(s) hold samples');
   assert.equal(verdictText({ passed: false, verdict: 'rejected: the samples do not follow the pdf' }), 'Failed: the samples do not follow the pdf');
   assert.equal(verdictText({ passed: true, verdict: 'passed: chi-square 36.5 on 38 degrees of freedom' }), 'Passed: chi-square 36.5 on 38 degrees of freedom');
   const facts = Object.fromEntries(warpFacts({ pdf_integral: 1.0000001, pdf_integral_error: 2e-4, statistic: 1234.5, dof: 99, pooled_bins: 100, p_value: 1e-30, significance: 0.01 }));
@@ -150,6 +152,11 @@ test('the words: verdict, facts, measures with the independent-points expectatio
   assert.equal(facts['bins pooled (expected < 5)'], '100');
   assert.equal(facts['p-value'], '1.000e-30');
   assert.equal(facts['∫ p over the domain (should be 1)'], '1.0000001 ± 2.0e-4');
+  // an integral the quadrature could not settle is not called "not a density"
+  const unsettled = Object.fromEntries(warpFacts({ pdf_integral: 0.67, pdf_integral_error: 9.6, pdf_integral_ok: false, outcome: 'unverified' }));
+  assert.equal(unsettled['∫ p over the domain (should be 1)'], '0.67 ± 9.6 (the quadrature could not settle it)');
+  const wrong = Object.fromEntries(warpFacts({ pdf_integral: 2, pdf_integral_error: 0, pdf_integral_ok: false, outcome: 'failed' }));
+  assert.equal(wrong['∫ p over the domain (should be 1)'], '2 ± 0 (not 1: p is not a density)');
   const a = { l2_star_discrepancy: 0.001, centered_l2_discrepancy: null, wraparound_l2_discrepancy: 0.002, min_distance: null,
     min_distance_toroidal: null, expected_iid: { l2_star_discrepancy: 0.01, wraparound_l2_discrepancy: 0.02 },
     skipped: { min_distance: 'the O(N^2 d) sums exceed the limit', spectrum: 'not asked for (spectrum: false)' } };

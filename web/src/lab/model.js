@@ -541,9 +541,11 @@ export function problemChoices(scenes) {
 export function verdictText(result) {
   if (!result) return '';
   // the core's verdict starts with its own word for the outcome: said once, ours
-  const v = typeof result.verdict === 'string' ? result.verdict.replace(/^(passed|rejected|failed|accepted)\s*:\s*/i, '') : '';
+  const v = typeof result.verdict === 'string' ? result.verdict.replace(/^(passed|rejected|failed|accepted|could not verify)\s*:\s*/i, '') : '';
   if (result.passed === true) return v ? `Passed: ${v}` : 'Passed: the samples agree with the density.';
   if (result.passed === false) return v ? `Failed: ${v}` : 'Failed: the samples do not follow the density.';
+  // the third outcome: the core's quadrature could not settle the expected counts
+  if (result.outcome === 'unverified') return v ? `Could not verify: ${v}` : 'Could not verify the warp.';
   return v;
 }
 
@@ -566,7 +568,7 @@ export function warpFacts(r) {
   if (r.warp !== undefined) add('warp', `${r.warp}${r.domain ? ` on the ${r.domain}` : ''}`);
   if (r.pdf_integral !== undefined) {
     add('∫ p over the domain (should be 1)', `${num(r.pdf_integral, 8)}${r.pdf_integral_error !== undefined ? ` ± ${num(r.pdf_integral_error, 2)}` : ''}` +
-      (r.pdf_integral_ok === false ? ' (not 1: p is not a density)' : ''));
+      (r.pdf_integral_ok === false ? (r.outcome === 'unverified' ? ' (the quadrature could not settle it)' : ' (not 1: p is not a density)') : ''));
   }
   if (r.statistic !== undefined) add('chi-square statistic', num(r.statistic, 6));
   if (r.dof !== undefined) add('degrees of freedom', String(r.dof));

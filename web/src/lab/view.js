@@ -299,7 +299,7 @@ function renderWarp(r) {
   const maps = $('warp-maps');
   const oneD = r && Array.isArray(r.bins) && r.bins.length === 1;
   $('warp-verdict').textContent = r ? verdictText(r) : '';
-  $('warp-verdict').className = `lab-verdict${r ? (r.passed ? ' pass' : ' fail') : ''}`;
+  $('warp-verdict').className = `lab-verdict${r ? (r.passed === true ? ' pass' : r.passed === false ? ' fail' : ' unverified') : ''}`;
   maps.hidden = !r || oneD;
   $('warp-scales').hidden = !r || oneD;
   $('warp-1d').hidden = !oneD;
