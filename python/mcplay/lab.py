@@ -199,12 +199,16 @@ def analyze(
 class WarpTest:
     """A warp tested against the density it claims (docs/sampler-lab.md, Warp tests).
 
-    ``passed`` is the verdict at the (Šidák-corrected) ``level``; ``verdict`` says it in words.
-    ``observed`` and ``expected`` are the counts in equal-measure bins of the domain's natural
-    coordinates, arrays of shape ``bins`` (index [i0, i1, ...] along ``coordinates``).
+    ``outcome`` is ``"passed"``, ``"failed"`` or ``"unverified"`` (the test's own quadrature of the
+    density could not settle the expected counts well enough to judge either way; ``verdict``
+    says why); ``passed`` is True, False, or None when unverified, at the (Šidák-corrected)
+    ``level``; ``verdict`` says it in words. ``observed`` and ``expected`` are the counts in
+    equal-measure bins of the domain's natural coordinates, arrays of shape ``bins`` (index
+    [i0, i1, ...] along ``coordinates``).
     """
 
-    passed: bool
+    outcome: str
+    passed: bool | None
     p_value: float
     verdict: str
     statistic: float
@@ -234,7 +238,8 @@ class WarpTest:
             return float(value) if isinstance(value, (int, float)) else math.nan
 
         return cls(
-            passed=bool(raw.get("passed")),
+            outcome=str(raw.get("outcome") or ("passed" if raw.get("passed") else "failed")),
+            passed=None if raw.get("passed") is None else bool(raw.get("passed")),
             p_value=number("p_value"),
             verdict=str(raw.get("verdict", "")),
             statistic=number("statistic"),

@@ -375,8 +375,10 @@ def test_warp_test_wrong_and_right():
     common = dict(p=uniform_disk_pdf, domain=disk, samples=100_000, sample_dim=2, seed=3)
     wrong = mcplay.warp_test(_disk(lambda u: u), **common)
     right = mcplay.warp_test(_disk(np.sqrt), **common)
-    assert not wrong.passed and wrong.p_value < 1e-10 and wrong.verdict.startswith("rejected")
-    assert right.passed and right.p_value > 0.01 and right.verdict.startswith("passed")
+    assert wrong.passed is False and wrong.outcome == "failed"
+    assert wrong.p_value < 1e-10 and wrong.verdict.startswith("rejected")
+    assert right.passed is True and right.outcome == "passed"
+    assert right.p_value > 0.01 and right.verdict.startswith("passed")
     # the counts pile up at small radius (the first natural coordinate, |x|^2) for r = u1
     assert wrong.observed.shape == wrong.expected.shape == tuple(wrong.raw["bins"])
     assert wrong.observed[0].sum() > 2 * wrong.expected[0].sum()
@@ -388,6 +390,16 @@ def test_warp_test_wrong_and_right():
     )
     assert not exprs.passed
     assert mcplay.warp_test("concentric_disk", samples=100_000).passed
+
+
+def test_warp_test_says_when_it_cannot_verify():
+    # A table of 4096 x 256 cells is more than the test's quadrature budget resolves: neither
+    # passed nor failed (docs/sampler-lab.md).
+    values = np.random.default_rng(5).random(4096 * 256).round(6).tolist()
+    t = mcplay.warp_test({"name": "tabulated_2d", "values": values, "nx": 4096, "ny": 256},
+                         samples=100_000, seed=1)
+    assert t.outcome == "unverified" and t.passed is None, t.verdict
+    assert t.verdict.startswith("could not verify")
 
 
 # --- render --------------------------------------------------------------------------------------
