@@ -9,6 +9,7 @@
 
 #include "api/json_read.h"
 #include "api/scene_parsers.h"
+#include "core/rng.h"
 #include "core/walsh_bound.h"
 #include "estimators/named_warps.h"
 #include "estimators/registry.h"
@@ -332,6 +333,23 @@ Made<SceneRequest> build_request(const Json& scene, const Json& options,
                 std::to_string(most) + " the " + sampler_name(e.sampler) +
                 " points are built for; lower n_max or raise randomizations");
     }
+    // A typed warp that leaves its domain is refused before any work when a probe of 256 points
+    // of its unit cube shows it (every block of the runs is checked as well: warp_block).
+    for (const EstimatorSpec& e : req.estimators)
+        for (const Proposal* p : proposals_of(e)) {
+            if (p->kind != ProposalKind::Warp || !p->warp || !p->warp->escape) continue;
+            PointBlock u, x;
+            u.reset(req.problem.domain.sample_dim(), kBlockSize);
+            x.reset(req.problem.domain.point_dim(), kBlockSize);
+            std::vector<double> pdf(kBlockSize);
+            Pcg32 probe(0x5eed, 47);
+            u.n = kBlockSize;
+            for (size_t i = 0; i < kBlockSize; ++i)
+                for (int j = 0; j < u.dim; ++j) u.coord(j)[i] = probe.next_double();
+            warp_block(*p, req.problem.domain, u, x, pdf.data());
+        }
+    if (std::string why = warp_escape_error(req); !why.empty())
+        return made_error<SceneRequest>("scene: " + why);
     return {req, {}};
 }
 
