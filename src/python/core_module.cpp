@@ -4,7 +4,7 @@
 //
 // Python callables become mcp_functions (function_bridge.h). The calls that may run long (studies,
 // warp tests, renders) run on a worker thread while the calling thread waits with the GIL
-// released, waking every 50 ms to let Python handle signals: Ctrl-C cancels the call within a
+// released, waking every 5 ms to let Python handle signals: Ctrl-C cancels the call within a
 // block and is raised as KeyboardInterrupt once the worker has stopped.
 
 #include <nanobind/nanobind.h>
@@ -149,9 +149,10 @@ std::string call(const std::string& fn, const std::string& request, const Option
 // --- Calls on a worker thread, watched for signals ------------------------------------------
 
 /// Runs c_call(&out) on a new thread while this one waits with the GIL released, checking for
-/// signals every 50 ms (a signal handler's exception cancels the call through `state`), and
-/// returns the call's result text or raises: the pending exception (Ctrl-C, a failing progress
-/// callable), a function's failure, or the C API's error.
+/// signals every 5 ms (a signal handler's exception cancels the call through `state`; at 50 ms a
+/// fast callable ran a thousand more batches after Ctrl-C), and returns the call's result text
+/// or raises: the pending exception (Ctrl-C, a failing progress callable), a function's failure,
+/// or the C API's error.
 template <class CCall> std::string run_watched(CallState& state, CCall&& c_call) {
     struct Outcome {
         std::mutex mutex;
@@ -194,7 +195,7 @@ template <class CCall> std::string run_watched(CallState& state, CCall&& c_call)
         {
             nb::gil_scoped_release release;
             std::unique_lock<std::mutex> lock(outcome.mutex);
-            done = outcome.finished.wait_for(lock, std::chrono::milliseconds(50),
+            done = outcome.finished.wait_for(lock, std::chrono::milliseconds(5),
                                              [&outcome] { return outcome.done; });
         }
         if (done) break;
@@ -219,24 +220,27 @@ std::string study_run(const std::string& scene, const OptionalText& options,
     });
 }
 
-std::string study_plan(const std::string& scene, const OptionalText& options,
-                       const nb::object& functions) {
+/// A call with the caller's functions and no progress (mcp_study_plan_with,
+/// mcp_warp_test_with), run watched like the studies.
+using FunctionsCall = int (*)(const char*, const char*, const mcp_context*, char**);
+std::string run_with_functions(FunctionsCall call, const std::string& scene,
+                               const OptionalText& options, const nb::object& functions) {
     CallState state(functions, nb::none());
     const char* scene_c = c_text(scene, "scene");
     const char* options_c = c_text(options, "options");
     return run_watched(state, [&](char** out) {
-        return mcp_study_plan_with(scene_c, options_c, state.context(), out);
+        return call(scene_c, options_c, state.context(), out);
     });
+}
+
+std::string study_plan(const std::string& scene, const OptionalText& options,
+                       const nb::object& functions) {
+    return run_with_functions(mcp_study_plan_with, scene, options, functions);
 }
 
 std::string warp_test(const std::string& scene, const OptionalText& options,
                       const nb::object& functions) {
-    CallState state(functions, nb::none());
-    const char* scene_c = c_text(scene, "scene");
-    const char* options_c = c_text(options, "options");
-    return run_watched(state, [&](char** out) {
-        return mcp_warp_test_with(scene_c, options_c, state.context(), out);
-    });
+    return run_with_functions(mcp_warp_test_with, scene, options, functions);
 }
 
 /// A render call with progress (mcp_render_study_run, mcp_render_reference,
