@@ -350,6 +350,18 @@ check analyze-missing 2 "cannot open '$tmp/none.csv'" -- analyze "$tmp/none.csv"
 check warp-pass 0 'verdict: passed' -- warp-test warp_disk_polar --samples 100000 --seed 2
 check warp-json-outcome 0 '"outcome": "failed"' -- warp-test warp_disk_polar_wrong --samples 100000 --format json
 check warp-fail 0 'verdict: rejected' -- warp-test warp_disk_polar_wrong --samples 100000
+# A failed test says where the mass is wrong and lists the bins farthest from the density; a
+# passed one lists no bins.
+check warp-fail-where 0 'too many samples near the centre .*in every direction' -- warp-test warp_disk_polar_wrong --samples 100000
+check warp-fail-bins 0 '^bins farthest from the density' -- warp-test warp_disk_polar_wrong --samples 100000
+$mcplay warp-test warp_disk_polar --samples 100000 --seed 2 >"$tmp/out" 2>&1
+if grep -q 'bins farthest' "$tmp/out"; then
+    echo "FAIL warp-pass-no-bins: a passed test lists bins"; failed=$((failed + 1))
+else
+    passed=$((passed + 1))
+fi
+# p = 2/pi with the right map: off by a constant (seed 2, as for warp_disk_polar above).
+check warp-constant 0 'the pdf is off by a constant factor 2 \(it integrates to 2 ' -- warp-test warp_pdf_off_by_constant --samples 100000 --seed 2
 check warp-json 0 '"passed": false' -- warp-test warp_disk_polar_wrong --samples 100000 --format json
 check warp-no-warp 3 'no "warp" to test' -- warp-test exp_1d
 printf '{"warp": {"domain": {"type": "disk"}, "g": ["2*sqrt(u1)*cos(2*pi*u2)", "2*sqrt(u1)*sin(2*pi*u2)"], "p": "1/pi"}}' >"$tmp/outside_warp.json"

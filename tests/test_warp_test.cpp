@@ -225,7 +225,7 @@ TEST(WarpTest, DiskWithoutSquareRootFails) {
     EXPECT_EQ(r.worst[0].index[0], 0); // the innermost ring
     EXPECT_GT(r.worst[0].residual, 0.0);
     EXPECT_TRUE(contains(r.reason, "rejected: the samples do not follow the pdf")) << r.reason;
-    EXPECT_TRUE(contains(r.reason, "|x - c|^2 / R^2 in [0, 0.04)")) << r.reason;
+    EXPECT_TRUE(contains(r.reason, "too many samples near the centre")) << r.reason;
 }
 
 // The cosine-weighted hemisphere by the polar map, without the square root: r = u1 and z =
@@ -251,7 +251,7 @@ TEST(WarpTest, PdfWrongByOnePercentOnAQuarterFails) {
     EXPECT_FALSE(r.passed);
     EXPECT_FALSE(r.pdf_integral_ok);
     EXPECT_NEAR(r.pdf_integral, 1.0025, 1e-9);
-    EXPECT_TRUE(contains(r.reason, "the pdf integrates to 1.0025")) << r.reason;
+    EXPECT_TRUE(contains(r.reason, "integrates to 1.0025")) << r.reason;
 }
 
 // The same error renormalised (the pdf integrates to 1) is a question for the statistic: with
@@ -286,7 +286,10 @@ TEST(WarpTest, PdfOffByAConstantFails) {
     EXPECT_NEAR(r.pdf_integral, 2.0, 1e-9);
     EXPECT_FALSE(r.pdf_integral_ok);
     EXPECT_FALSE(r.passed);
-    EXPECT_TRUE(contains(r.reason, "rejected: the pdf integrates to 2 ")) << r.reason;
+    EXPECT_TRUE(r.off_by_constant);
+    EXPECT_TRUE(contains(r.reason, "rejected: the pdf is off by a constant factor 2 (it "
+                                   "integrates to 2 +- "))
+        << r.reason;
 }
 
 // Samples where the pdf is 0 over a whole bin reject the warp outright.
@@ -745,4 +748,113 @@ TEST(WarpTestBothWays, IntegrableSingularities) {
     expect_right(run_n(disk, expression(disk, g4, p4), 1000000), "disk r = u1^4");
     expect_wrong(run_n(disk, expression(disk, g2, p4), 1000000), "disk r = u1^2, pdf of u1^4");
     expect_wrong(run_n(disk, expression(disk, g4, p2), 1000000), "disk r = u1^4, pdf of u1^2");
+}
+
+// ---------------------------------------------------------------------------
+// Where the mass is wrong, in words (WarpTestResult::where), judged both ways at fixed seeds.
+
+namespace {
+
+WarpTestResult run_seeded(const Domain& d, const Warp& w, uint64_t n, uint64_t seed) {
+    return run_n(d, w, n, seed);
+}
+
+bool says_where(const WarpTestResult& r) {
+    return !r.where.empty() || contains(r.reason, "too many") || contains(r.reason, "too few");
+}
+
+} // namespace
+
+// r = u1 on the disk puts half its samples at r < 1/2 where p = 1/pi puts a quarter, whatever
+// the azimuth: the verdict says so rather than naming one bin. r = sqrt(u1) says nothing.
+TEST(WarpTestWhere, TooManyNearTheCentreInEveryDirection) {
+    const Domain disk = make_disk({0.0, 0.0}, 1.0).value;
+    const WarpTestResult wrong =
+        run_seeded(disk, expression(disk, {"u1*cos(2*pi*u2)", "u1*sin(2*pi*u2)"}, "1/pi"),
+                   100000, 1);
+    expect_wrong(wrong, "r = u1");
+    EXPECT_EQ(wrong.where.rfind("too many samples near the centre (", 0), 0u) << wrong.where;
+    EXPECT_TRUE(contains(wrong.where, "too few")) << wrong.where;
+    EXPECT_TRUE(contains(wrong.where, "near the rim")) << wrong.where;
+    EXPECT_TRUE(contains(wrong.where, ", in every direction")) << wrong.where;
+    EXPECT_FALSE(contains(wrong.where, "azimuth")) << wrong.where;
+    EXPECT_TRUE(contains(wrong.reason, wrong.where)) << wrong.reason;
+    EXPECT_FALSE(contains(wrong.reason, "most deviant")) << wrong.reason;
+    // seed 2: seed 1 is one of the 1% of seeds where the right warp is rejected at 12 x 12 bins
+    const WarpTestResult right = run_seeded(
+        disk, expression(disk, {"sqrt(u1)*cos(2*pi*u2)", "sqrt(u1)*sin(2*pi*u2)"}, "1/pi"),
+        100000, 2);
+    EXPECT_EQ(right.outcome, WarpTestOutcome::Passed) << right.reason;
+    EXPECT_FALSE(says_where(right)) << right.reason;
+}
+
+// x = u1^1.2 claimed uniform on the square crowds the edge x = 0 and thins out towards x = 1,
+// whatever y: the verdict names x's ends and says nothing of y. The map with its density
+// x^(1/1.2 - 1) / 1.2 passes and says nothing.
+TEST(WarpTestWhere, SkewedAlongOneAxis) {
+    const Domain sq = unit_square();
+    const WarpTestResult wrong = run_seeded(sq, expression(sq, {"u1^1.2", "u2"}, "1"), 100000, 1);
+    expect_wrong(wrong, "x = u1^1.2 claimed uniform");
+    EXPECT_EQ(wrong.where.rfind("too many samples near the edge x = 0 (", 0), 0u) << wrong.where;
+    EXPECT_TRUE(contains(wrong.where, "near the edge x = 1 (")) << wrong.where;
+    EXPECT_TRUE(contains(wrong.where, "too few")) << wrong.where;
+    EXPECT_FALSE(contains(wrong.where, "edge y")) << wrong.where;
+    EXPECT_FALSE(contains(wrong.where, "y's range")) << wrong.where;
+    const WarpTestResult right =
+        run_seeded(sq, expression(sq, {"u1^1.2", "u2"}, "x^(1/1.2 - 1)/1.2"), 100000, 1);
+    EXPECT_EQ(right.outcome, WarpTestOutcome::Passed) << right.reason;
+    EXPECT_FALSE(says_where(right)) << right.reason;
+    // Along y, on the hemisphere's azimuth: phi = 2 pi u2^1.5 crowds the first quarter turn.
+    const Domain h = make_hemisphere();
+    const WarpTestResult turned = run_seeded(
+        h,
+        expression(h, {"sqrt(1-u1^2)*cos(2*pi*u2^1.5)", "sqrt(1-u1^2)*sin(2*pi*u2^1.5)", "u1"},
+                   "1/(2*pi)"),
+        100000, 1);
+    expect_wrong(turned, "phi = 2 pi u2^1.5");
+    EXPECT_EQ(turned.where.rfind("too many samples at azimuths phi in [0, 90) degrees (", 0), 0u)
+        << turned.where;
+    EXPECT_FALSE(contains(turned.where, "pole")) << turned.where;
+}
+
+// A departure between neighbouring bins moves no quarter's count: the verdict says it is local
+// and names the bin. The samples of [0.5, 0.52) moved into [0.52, 0.54) (50 bins of 0.02: one
+// bin emptied, its neighbour doubled, both in the middle half).
+TEST(WarpTestWhere, LocalDepartureNamesItsBin) {
+    const Domain line = make_box({0.0}, {1.0}).value;
+    WarpTestOptions o;
+    o.samples = 1000000;
+    o.bins[0] = 50;
+    const WarpTestResult r =
+        run(line, expression(line, {"u + 0.02*step(u-0.5)*step(0.52-u)"}, "1"), o);
+    expect_wrong(r, "a local shift");
+    EXPECT_EQ(r.where.rfind("the departure is local", 0), 0u) << r.where;
+    EXPECT_TRUE(contains(r.where, "most deviant bin (2")) << r.where;
+}
+
+// A pdf off by a constant: p = 1.2 / pi with the right disk map is called so; the right p is
+// not; the wrong map with 1.2 / pi is off in its shape too, and the verdict says where.
+TEST(WarpTestWhere, PdfOffByAConstantFactorIsCalledSo) {
+    const Domain disk = make_disk({0.0, 0.0}, 1.0).value;
+    const std::vector<std::string> right_map = {"sqrt(u1)*cos(2*pi*u2)", "sqrt(u1)*sin(2*pi*u2)"};
+    const WarpTestResult scaled =
+        run_seeded(disk, expression(disk, right_map, "1.2/pi"), 100000, 2);
+    expect_wrong(scaled, "p = 1.2 / pi");
+    EXPECT_TRUE(scaled.off_by_constant) << scaled.reason;
+    EXPECT_TRUE(contains(scaled.reason, "the pdf is off by a constant factor 1.2 (it integrates "
+                                        "to 1.2 +- "))
+        << scaled.reason;
+    EXPECT_FALSE(says_where(scaled)) << scaled.reason;
+    const WarpTestResult right = run_seeded(disk, expression(disk, right_map, "1/pi"), 100000, 2);
+    EXPECT_EQ(right.outcome, WarpTestOutcome::Passed) << right.reason;
+    EXPECT_FALSE(right.off_by_constant);
+    EXPECT_FALSE(contains(right.reason, "constant factor")) << right.reason;
+    const WarpTestResult both = run_seeded(
+        disk, expression(disk, {"u1*cos(2*pi*u2)", "u1*sin(2*pi*u2)"}, "1.2/pi"), 100000, 2);
+    expect_wrong(both, "r = u1, p = 1.2 / pi");
+    EXPECT_FALSE(both.off_by_constant);
+    EXPECT_FALSE(contains(both.reason, "constant factor")) << both.reason;
+    EXPECT_TRUE(contains(both.reason, "the pdf integrates to 1.2 ")) << both.reason;
+    EXPECT_TRUE(contains(both.reason, "do not follow its shape either")) << both.reason;
+    EXPECT_TRUE(contains(both.where, "too many samples near the centre")) << both.where;
 }

@@ -202,15 +202,20 @@ class WarpTest:
     ``outcome`` is ``"passed"``, ``"failed"`` or ``"unverified"`` (the test's own quadrature of the
     density could not settle the expected counts well enough to judge either way; ``verdict``
     says why); ``passed`` is True, False, or None when unverified, at the (Šidák-corrected)
-    ``level``; ``verdict`` says it in words. ``observed`` and ``expected`` are the counts in
-    equal-measure bins of the domain's natural coordinates, arrays of shape ``bins`` (index
-    [i0, i1, ...] along ``coordinates``).
+    ``level``; ``verdict`` says it in words. ``where`` says where the samples' mass departs
+    from the density when the test failed ("too many samples near the centre (...), in every
+    direction"; None otherwise); ``off_by_constant`` is True when the density integrates to a
+    constant c != 1 but the samples follow its shape. ``observed`` and ``expected`` are the
+    counts in equal-measure bins of the domain's natural coordinates, arrays of shape ``bins``
+    (index [i0, i1, ...] along ``coordinates``).
     """
 
     outcome: str
     passed: bool | None
     p_value: float
     verdict: str
+    where: str | None
+    off_by_constant: bool
     statistic: float
     dof: int
     level: float
@@ -242,6 +247,8 @@ class WarpTest:
             passed=None if raw.get("passed") is None else bool(raw.get("passed")),
             p_value=number("p_value"),
             verdict=str(raw.get("verdict", "")),
+            where=raw.get("where") if isinstance(raw.get("where"), str) else None,
+            off_by_constant=bool(raw.get("off_by_constant", False)),
             statistic=number("statistic"),
             dof=int(raw.get("dof") or 0),
             level=number("level"),

@@ -379,6 +379,10 @@ def test_warp_test_wrong_and_right():
     assert wrong.p_value < 1e-10 and wrong.verdict.startswith("rejected")
     assert right.passed is True and right.outcome == "passed"
     assert right.p_value > 0.01 and right.verdict.startswith("passed")
+    # where the mass is wrong, said for the wrong warp alone
+    assert wrong.where.startswith("too many samples near the centre"), wrong.where
+    assert wrong.where in wrong.verdict
+    assert right.where is None and not right.off_by_constant
     # the counts pile up at small radius (the first natural coordinate, |x|^2) for r = u1
     assert wrong.observed.shape == wrong.expected.shape == tuple(wrong.raw["bins"])
     assert wrong.observed[0].sum() > 2 * wrong.expected[0].sum()

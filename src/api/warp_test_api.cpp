@@ -109,6 +109,8 @@ Json warp_test_to_json(const WarpTestResult& r, const Warp& warp, const Domain& 
                 {"passed", r.outcome == WarpTestOutcome::Unverified ? Json(nullptr)
                                                                      : Json(r.passed)},
                 {"verdict", r.reason},
+                {"where", r.where.empty() ? Json(nullptr) : Json(r.where)},
+                {"off_by_constant", r.off_by_constant},
                 {"worst_bins", worst}};
 }
 

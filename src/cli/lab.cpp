@@ -169,8 +169,9 @@ std::string warp_table(const nlohmann::json& r) {
            (r["p_value"].is_number() ? p_value_text(r["p_value"].get<double>(), 4) : "p = -") +
            ", level " + num_or_dash(r["level"], "%.4g") + "\n";
     out += "verdict: " + r["verdict"].get<std::string>() + "\n";
+    // Which bins lie farthest from the density matters only when the samples do not follow it.
     const auto& worst = r["worst_bins"];
-    if (!worst.empty()) {
+    if (!worst.empty() && r.value("outcome", "") == "failed") {
         out += "bins farthest from the density (standardised residual (observed - expected) / "
                "sqrt(expected)):\n";
         for (const auto& b : worst) {

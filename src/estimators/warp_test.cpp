@@ -658,6 +658,143 @@ WarpTestBin describe_bin(const WarpTestResult& r, size_t flat) {
     return b;
 }
 
+/// The words for a natural axis's ranges: its low end, its high end and between; an azimuth
+/// (periodic) has none, its ranges being quarter turns.
+struct AxisWords {
+    std::string low, high, middle;
+    bool periodic = false;
+};
+
+AxisWords axis_words(const Domain& d, int axis, int axes) {
+    auto point = [](Vec2 v) { return "(" + fmt(v.x) + ", " + fmt(v.y) + ")"; };
+    switch (d.kind) {
+    case DomainKind::Box: {
+        const std::string name(1, "xyz"[axis]);
+        const std::string side = axes == 1 ? "" : (axes == 2 ? "the edge " : "the face ");
+        return {"near " + side + name + " = " + fmt(d.lo[size_t(axis)]),
+                "near " + side + name + " = " + fmt(d.hi[size_t(axis)]),
+                "in the middle of " + name + "'s range"};
+    }
+    case DomainKind::Disk:
+        if (axis == 0) return {"near the centre", "near the rim", "between the centre and the rim"};
+        break;
+    case DomainKind::Sphere:
+        if (axis == 0) return {"near the pole z = 1", "near the pole z = -1", "around the equator"};
+        break;
+    case DomainKind::Hemisphere:
+        if (axis == 0)
+            return {"near the pole z = 1", "near the horizon z = 0",
+                    "between the pole and the horizon"};
+        break;
+    case DomainKind::Triangle: {
+        const std::string v0 = point(d.v0), v1 = point(d.v1), v2 = point(d.v2);
+        if (axis == 0)
+            return {"near the vertex " + v0, "near the edge " + v1 + " " + v2,
+                    "between the vertex " + v0 + " and the opposite edge"};
+        return {"near the edge " + v0 + " " + v2, "near the edge " + v0 + " " + v1,
+                "between the edges from " + v0};
+    }
+    }
+    return {"", "", "", true};
+}
+
+/// WarpTestResult::where (see warp_test.h): "" when no range departs.
+std::string mass_departures(const Domain& d, const WarpTestResult& r) {
+    const size_t nbins = r.observed.size();
+    double total_e = 0.0, total_d = 0.0, n = 0.0;
+    for (size_t b = 0; b < nbins; ++b) {
+        n += static_cast<double>(r.observed[b]);
+        if (r.expected[b] > 0.0) {
+            total_e += r.expected[b];
+            total_d += r.expected_error[b];
+        }
+    }
+    if (!(total_e > 0.0) || !(n > 0.0)) return "";
+    const double scale = n / total_e; // p's shape: its expected counts summed to the samples'
+    struct Range {
+        std::string words;
+        double observed = 0.0, expected = 0.0, error = 0.0;
+    };
+    std::vector<std::vector<Range>> axes(size_t(r.axes));
+    size_t count = 0, stride = 1;
+    for (int j = 0; j < r.axes; stride *= size_t(r.bins[j]), ++j) {
+        const int nb = r.bins[j];
+        if (nb < 2) continue;
+        std::vector<double> o(size_t(nb), 0.0), e(size_t(nb), 0.0), err(size_t(nb), 0.0);
+        for (size_t b = 0; b < nbins; ++b) {
+            const size_t i = (b / stride) % size_t(nb);
+            o[i] += static_cast<double>(r.observed[b]);
+            e[i] += scale * r.expected[b];
+            err[i] += scale * r.expected_error[b];
+        }
+        const AxisWords w = axis_words(d, j, r.axes);
+        std::vector<std::pair<int, std::string>> starts; // first bin of each range, its words
+        if (w.periodic) {
+            const int g = std::min(nb, 4);
+            for (int q = 0; q < g; ++q) {
+                const int first = q * nb / g, last = (q + 1) * nb / g;
+                starts.push_back({first, "at azimuths phi in [" + fmt(360.0 * first / nb, 3) +
+                                             ", " + fmt(360.0 * last / nb, 3) + ") degrees"});
+            }
+        } else {
+            const int edge = std::max(1, static_cast<int>(std::lround(nb / 4.0)));
+            starts.push_back({0, w.low});
+            if (edge < nb - edge) starts.push_back({edge, w.middle});
+            starts.push_back({nb - edge, w.high});
+        }
+        for (size_t s = 0; s < starts.size(); ++s) {
+            Range range;
+            range.words = starts[s].second;
+            const int end = s + 1 < starts.size() ? starts[s + 1].first : nb;
+            for (int i = starts[s].first; i < end; ++i) {
+                range.observed += o[size_t(i)];
+                range.expected += e[size_t(i)];
+                range.error += err[size_t(i)];
+            }
+            // the total's error moves every range's share
+            range.error += range.expected * total_d / total_e;
+            axes[size_t(j)].push_back(range);
+            ++count;
+        }
+    }
+    // Each range's count is binomial (n, E / n) when the samples follow p: a departure beyond
+    // the quadrature's error is named at the level split over all the ranges.
+    const double level = r.level / static_cast<double>(std::max<size_t>(count, 1));
+    auto share = [&](double v) { return fmt(100.0 * v / n, 3) + "%"; };
+    std::vector<std::string> sentences;
+    bool radial = false, azimuthal = false;
+    for (int j = 0; j < r.axes; ++j) {
+        std::vector<std::string> many, few;
+        for (const Range& g : axes[size_t(j)]) {
+            const double excess = std::fabs(g.observed - g.expected) - g.error;
+            const double sd = std::sqrt(g.expected * std::max(1.0 - g.expected / n, 0.0));
+            if (!(excess > 0.0) || !(sd > 0.0)) continue;
+            const double z = excess / sd;
+            if (!(chi_square_sf(z * z, 1.0) < level)) continue;
+            (g.observed > g.expected ? many : few)
+                .push_back(g.words + " (" + share(g.observed) + " where p expects " +
+                           share(g.expected) + ")");
+        }
+        if (many.empty() && few.empty()) continue;
+        auto join = [](const std::vector<std::string>& v) {
+            std::string s;
+            for (size_t i = 0; i < v.size(); ++i) s += (i ? " and " : "") + v[i];
+            return s;
+        };
+        std::string s;
+        if (!many.empty()) s = "too many samples " + join(many);
+        if (!few.empty()) s += (s.empty() ? "too few samples " : ", too few ") + join(few);
+        (axis_words(d, j, r.axes).periodic ? azimuthal : radial) = true;
+        sentences.push_back(s);
+    }
+    const bool round = d.kind == DomainKind::Disk || d.kind == DomainKind::Sphere ||
+                       d.kind == DomainKind::Hemisphere;
+    if (round && radial && !azimuthal) sentences[0] += ", in every direction";
+    std::string out;
+    for (size_t i = 0; i < sentences.size(); ++i) out += (i ? "; " : "") + sentences[i];
+    return out;
+}
+
 std::string check_options(const WarpTestOptions& o, int axes) {
     if (o.samples < 1 || o.samples > kMaxWarpTestSamples)
         return "warp test: samples must be in 1.." + std::to_string(kMaxWarpTestSamples) +
@@ -1047,21 +1184,30 @@ Made<WarpTestResult> run_warp_test(const Domain& domain, const Warp& warp,
                                       " (+- " + fmt(r.pdf_integral_error, 2) + ")";
     // The statistic over the bins whose expected counts the quadrature settled (error under
     // kTrustedError sqrt(expected)), given the samples they hold: multinomial with the bins'
-    // shares of their expectation, whatever the other bins' counts or the pdf's integral.
-    auto settled_bins_reject = [&](std::string* text) {
+    // shares of their expectation, whatever the other bins' counts or the pdf's integral (so
+    // it tests p's shape). `p_high`: its largest p-value over the quadrature's error.
+    struct Shape {
+        bool ok = false;
+        double chi = 0.0, p_high = 1.0;
+        int dof = 0;
+        size_t bins = 0;
+        uint64_t samples = 0;
+    };
+    auto settled_shape = [&]() {
+        Shape sh;
         std::vector<size_t> trusted;
         double e_sum = 0.0, d_sum = 0.0;
-        uint64_t o_sum = 0;
         for (size_t b = 0; b < nbins; ++b)
             if (r.expected[b] > 0.0 &&
                 r.expected_error[b] <= kTrustedError * std::sqrt(r.expected[b])) {
                 trusted.push_back(b);
                 e_sum += r.expected[b];
                 d_sum += r.expected_error[b];
-                o_sum += r.observed[b];
+                sh.samples += r.observed[b];
             }
-        if (trusted.size() < 2 || o_sum == 0 || !(e_sum > d_sum)) return false;
-        const double scale = static_cast<double>(o_sum) / e_sum;
+        sh.bins = trusted.size();
+        if (trusted.size() < 2 || sh.samples == 0 || !(e_sum > d_sum)) return sh;
+        const double scale = static_cast<double>(sh.samples) / e_sum;
         std::vector<uint64_t> o;
         std::vector<double> e, d;
         for (size_t b : trusted) {
@@ -1070,20 +1216,41 @@ Made<WarpTestResult> run_warp_test(const Domain& domain, const Warp& warp,
             // The share's error: the bin's own and the total's.
             d.push_back(scale * (r.expected_error[b] + r.expected[b] * d_sum / (e_sum - d_sum)));
         }
-        double chi = 0.0, err_chi = 0.0, max_rel = 0.0;
+        double err_chi = 0.0, max_rel = 0.0;
         int cells = 0, pooled = 0;
-        pooled_chi_square(o, e, d, &chi, &cells, &pooled, &err_chi, &max_rel);
-        if (cells < 2 || !(max_rel < 1.0)) return false;
-        const double root = std::sqrt(chi), dd = std::sqrt(err_chi);
+        pooled_chi_square(o, e, d, &sh.chi, &cells, &pooled, &err_chi, &max_rel);
+        if (cells < 2 || !(max_rel < 1.0)) return sh;
+        const double root = std::sqrt(sh.chi), dd = std::sqrt(err_chi);
         const double low = std::max(root - dd, 0.0) * std::max(root - dd, 0.0) / (1.0 + max_rel);
-        const double p_high = chi_square_sf(low, cells - 1);
-        if (!(p_high < r.level)) return false;
-        *text = "rejected: the samples do not follow the pdf on the " +
-                std::to_string(trusted.size()) + " of " + std::to_string(nbins) +
-                " bins whose expected counts the quadrature settled (" + std::to_string(o_sum) +
-                " samples): chi-square " + fmt(chi, 6) + " on " + std::to_string(cells - 1) +
-                " degrees of freedom, " + p_value_text(p_high, 3) + " at most < level " +
-                fmt(r.level, 3);
+        sh.dof = cells - 1;
+        sh.p_high = chi_square_sf(low, sh.dof);
+        sh.ok = true;
+        return sh;
+    };
+    auto shape_text = [&](const Shape& sh) {
+        return "chi-square " + fmt(sh.chi, 6) + " on " + std::to_string(sh.dof) +
+               " degrees of freedom against p's shape, " + p_value_text(sh.p_high, 3) +
+               " at most";
+    };
+    // Where the mass is wrong, in words; a local departure names its most deviant bin.
+    auto where_text = [&]() {
+        std::string w = mass_departures(domain, r);
+        if (w.empty() && !r.worst.empty())
+            w = "the departure is local (no quarter of a coordinate's range holds too many or "
+                "too few samples): the most deviant " +
+                bin_text(r, r.worst[0]) + " has " + std::to_string(r.worst[0].observed) +
+                " samples where " + fmt(r.worst[0].expected, 6) + " are expected";
+        return w;
+    };
+    auto settled_bins_reject = [&](std::string* text) {
+        const Shape sh = settled_shape();
+        if (!sh.ok || !(sh.p_high < r.level)) return false;
+        r.where = where_text();
+        *text = "rejected: the samples do not follow the pdf on the " + std::to_string(sh.bins) +
+                " of " + std::to_string(nbins) +
+                " bins whose expected counts the quadrature settled (" +
+                std::to_string(sh.samples) + " samples): " + shape_text(sh) + " < level " +
+                fmt(r.level, 3) + "; " + r.where;
         return true;
     };
     std::string why_not; // why the test could not verify the warp, if it could not
@@ -1095,16 +1262,30 @@ Made<WarpTestResult> run_warp_test(const Domain& domain, const Warp& warp,
                    tuple(zero_probe->x, point_dim) +
                    ": the warp lands where its pdf says it cannot";
     } else if (integral_wrong) {
-        r.reason = "rejected: " + integral_text + " over the domain, not 1 (tolerance " +
-                   fmt(options.pdf_tolerance, 3) + "); " + stat;
+        // A constant factor alone, or a wrong shape besides.
+        const Shape sh = settled_shape();
+        r.off_by_constant = sh.ok && sh.p_high >= r.level;
+        if (r.off_by_constant) {
+            r.reason = "rejected: the pdf is off by a constant factor " + fmt(r.pdf_integral, 4) +
+                       " (it integrates to " + fmt(r.pdf_integral, 7) + " +- " +
+                       fmt(r.pdf_integral_error, 2) + ", tolerance " +
+                       fmt(options.pdf_tolerance, 3) + "): the samples follow its shape (" +
+                       shape_text(sh) + ")";
+        } else {
+            r.where = where_text();
+            r.reason = "rejected: " + integral_text + " over the domain, not 1 (tolerance " +
+                       fmt(options.pdf_tolerance, 3) + ")" +
+                       (sh.ok ? ", and the samples do not follow its shape either (" +
+                                    shape_text(sh) + ")"
+                              : "; " + stat) +
+                       (r.where.empty() ? "" : "; " + r.where);
+        }
     } else if (r.dof >= 1 && !(r.p_value_high >= r.level)) {
+        r.where = where_text();
         r.reason =
             "rejected: the samples do not follow the pdf: " + stat + " < level " + fmt(r.level, 3);
         if (r.p_value_high > r.p_value) r.reason += " (" + range + ")";
-        if (!r.worst.empty())
-            r.reason += "; the most deviant " + bin_text(r, r.worst[0]) + " has " +
-                        std::to_string(r.worst[0].observed) + " samples where " +
-                        fmt(r.worst[0].expected, 6) + " are expected";
+        if (!r.where.empty()) r.reason += "; " + r.where;
     } else if (r.unresolved_bins > 0) {
         why_not = std::to_string(r.unresolved_bins) +
                   " bin(s) hold samples where the pdf is far above every quadrature node "

@@ -114,6 +114,17 @@ struct WarpTestResult {
     WarpTestOutcome outcome = WarpTestOutcome::Failed;
     bool passed = false; ///< outcome == Passed
     std::string reason; ///< the verdict in plain words
+    /// Where the samples' mass departs from p's, in words, when the samples do not follow p
+    /// (empty otherwise): per natural axis, the samples against p's expected counts (rescaled
+    /// to the samples' total) in the quarters of its range summed over the other axes, the
+    /// middle quarters together (quarter turns of an azimuth); a range is named when its count
+    /// departs beyond its binomial noise and the quadrature's error at the level split over all
+    /// ranges (Bonferroni): "too many samples near the centre (50% where p expects 25%), too
+    /// few near the rim (13% where p expects 25%), in every direction". No such range: the
+    /// departure is local, and the most deviant bin is named.
+    std::string where;
+    /// p integrates to c beyond its quadrature error, and the samples follow p / c.
+    bool off_by_constant = false;
     /// The bins with the largest |residual|, largest first.
     std::vector<WarpTestBin> worst;
 };
