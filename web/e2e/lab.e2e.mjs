@@ -1,7 +1,9 @@
 // End-to-end test of the sampler lab in headless Chromium (Debian's chromium, driven by
 // playwright-core). Usage: MCPLAY_SITE=SITE_DIR MCPLAY_SHOTS=SHOT_DIR node --test web/e2e/lab.e2e.mjs
-// Serves SITE_DIR on a loopback port, opens the lab from the page's tabs, tests the wrong polar
-// disk warp (fails) and the right one (passes), a named warp with a parameter (GGX, alpha 0.3),
+// Serves SITE_DIR on a loopback port, opens the lab from the page's tabs (it tests its first
+// example at once, with its "what to look for"), tests the wrong polar disk warp (fails, says
+// where the mass is wrong, residuals on a fixed scale) and the right one (passes, pale map, no
+// bin list), opens a warp scene's study (it runs and is scrolled to), a named warp with a parameter (GGX, alpha 0.3),
 // analyses Sobol' points (spectrum and measures) and a renderer's Sobol' pixel (64 spp),
 // uploads a CSV with a value outside [0, 1) (the core's error line shown), draws discrepancy
 // curves, checks the URL round trip and runs axe-core on the lab; saves screenshots.
@@ -77,6 +79,35 @@ test('the lab opens from the page\'s tabs, by keyboard too, and puts itself in t
   await page.waitForSelector('#lab-view', { state: 'visible' });
 });
 
+// The residual map's pixels: the share whose every channel is above `pale` (|r| under about 2
+// on the fixed scale), and the colour at a point (x, y in [0, 1] of the canvas, y down).
+const residualPixels = (x, y) => page.$eval('#warp-residual', (c, [px, py]) => {
+  const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
+  let pale = 0;
+  for (let i = 0; i < d.length; i += 4) if (Math.min(d[i], d[i + 1], d[i + 2]) > 190) pale++;
+  const k = (Math.floor(py * (c.height - 1)) * c.width + Math.floor(px * (c.width - 1))) * 4;
+  return { paleShare: pale / (d.length / 4), at: [d[k], d[k + 1], d[k + 2]] };
+}, [x, y]);
+
+test('the lab opens on a running example, with its "what to look for"; the verdict says where the mass is wrong', async () => {
+  // opened by the first test: the first example (the wrong polar disk) is tested without a click
+  await page.waitForFunction(() => window.mcplayDebug.lab().warp.status === 'done', null, { timeout: 60000 });
+  const w = (await lab()).warp;
+  assert.equal(w.example, 'warp_disk_polar_wrong');
+  assert.equal(w.result.outcome, 'failed', w.result.verdict);
+  assert.equal(await page.isVisible('#warp-look'), true);
+  assert.match(await page.textContent('#warp-look'), /^What to look for: r = u₁ crowds the centre/);
+  const verdict = await page.textContent('#warp-verdict');
+  assert.match(verdict, /^Failed: .*too many samples near the centre \(.*in every direction/);
+  assert.equal(w.result.where.startsWith('too many samples near the centre'), true, w.result.where);
+  // a failed test lists the bins farthest from the density
+  assert.equal(await page.isVisible('#warp-worst'), true);
+  // the residual map on its fixed scale: the centre's column (left) full red
+  assert.match(await page.textContent('#warp-residual-text'), /fixed scale: −5 and below \(full blue\).*\+5 and above \(full red\)/);
+  assert.deepEqual((await residualPixels(0.01, 0.5)).at, [178, 24, 43]);
+  await page.screenshot({ path: join(shots, 'lab-opens-on-example.png'), fullPage: true });
+});
+
 test('warp test: the wrong polar disk (r = u1) fails, the right one (r = sqrt(u1)) passes', async () => {
   const wrong = await warpTest(['u1*cos(2*pi*u2)', 'u1*sin(2*pi*u2)']);
   assert.equal(wrong.status, 'done', wrong.message);
@@ -91,6 +122,12 @@ test('warp test: the wrong polar disk (r = u1) fails, the right one (r = sqrt(u1
   assert.equal(right.status, 'done', right.message);
   assert.equal(right.result.passed, true, right.result.verdict);
   assert.match(await page.textContent('#warp-verdict'), /^Passed/);
+  assert.doesNotMatch(await page.textContent('#warp-verdict'), /too many|too few/);
+  // a passed test lists no bins; its residual map is pale noise (|r| < 2 in ~95% of the bins)
+  assert.equal(await page.isVisible('#warp-worst'), false);
+  assert.equal(await page.isVisible('#warp-look'), false, 'a typed warp has no "what to look for"');
+  const { paleShare } = await residualPixels(0.5, 0.5);
+  assert.ok(paleShare > 0.85, `pale share ${paleShare}`);
   // the typed warp is in the link
   const q = new URLSearchParams(new URL(page.url()).search);
   assert.equal(q.get('warp'), 'typed');
@@ -138,12 +175,20 @@ test('a named warp with parameters: GGX visible normals with alpha 0.3 passes; a
   await page.screenshot({ path: join(shots, 'lab-warp-ggx.png'), fullPage: true });
 });
 
-test('a warp scene with an integrand opens its study', async () => {
+test('"Open its study" runs the warp scene\'s study and scrolls to it', async () => {
   await page.selectOption('#warp-example', 'warp_disk_polar');
   await page.waitForSelector('#warp-study', { state: 'visible' });
+  // the example's own "what to look for"
+  assert.match(await page.textContent('#warp-look'), /^What to look for: The fix, r = √u₁/);
   await page.click('#warp-study');
   await page.waitForSelector('#study-view', { state: 'visible' });
   await page.waitForFunction(() => window.mcplayDebug.state().sceneInfo?.name === 'warp_disk_polar', null, { timeout: 20000 });
+  // it runs without a press of Run, and its first plot is brought into view
+  await page.waitForFunction(() => ['running', 'done'].includes(window.mcplayDebug.state().run.status), null, { timeout: 20000 });
+  const top = await page.$eval('#plot-variance', (e) => e.closest('figure').getBoundingClientRect().top);
+  assert.ok(Math.abs(top) < 50, `the variance plot's figure at ${top} px from the top`);
+  await page.waitForFunction(() => window.mcplayDebug.state().run.status !== 'running', null, { timeout: 120000 });
+  assert.equal((await page.evaluate(() => window.mcplayDebug.state())).run.status, 'done');
   await page.click('#tab-lab');
   await page.waitForSelector('#lab-view', { state: 'visible' });
 });

@@ -50,6 +50,7 @@ const store = createStore(reducer, initialState());
 const { dispatch } = store;
 
 let service = null;   // validation and formatting
+let studyToRun = null; // a scene the lab opened: run when it has loaded
 const runners = [];   // run workers, reused between runs
 let activeRun = null; // id of the run in progress
 let sceneToken = 0;   // the latest scene request (older answers are dropped)
@@ -82,7 +83,10 @@ const lab = startLab({
   scenes: () => store.getState().scenes,
   fetchScene: (entry) => fetchScene(entry),
   onChange: () => writeUrl(store.getState()),
-  openStudy: (name) => dispatch({ type: 'scene/request', payload: { sceneId: name } }),
+  openStudy: (name) => {
+    studyToRun = name; // run once loaded (the lab's "Open its study")
+    dispatch({ type: 'scene/request', payload: { sceneId: name } });
+  },
 }, window.location.search);
 
 // The live view of render scenes (src/live/): the study's scene, its own pool of workers, the
@@ -188,6 +192,11 @@ store.subscribe((state, action) => {
     case 'scene/loaded':
       if (state.run.status !== 'running') stopRunners(); // a run of the previous problem, if any
       live.sceneChanged();
+      if (studyToRun !== null && p.sceneId === studyToRun) queueMicrotask(runOpenedStudy);
+      studyToRun = null;
+      break;
+    case 'scene/failed':
+      studyToRun = null;
       break;
     case 'run/request':
       // the study measures time: a live view running beside it would take its cores
@@ -212,6 +221,13 @@ store.subscribe((state, action) => {
     default:
   }
 });
+
+/** A study opened from the lab runs at once, its first plot scrolled into view. */
+function runOpenedStudy() {
+  if (runBlocker(store.getState())) return;
+  dispatch({ type: 'run/request' });
+  document.getElementById('plot-variance').closest('figure').scrollIntoView({ block: 'start' });
+}
 
 // ---------------------------------------------------------------------------------------------
 // Sample points: core.samples in the helper worker (a study's replicate 0 at N = n, same seed),

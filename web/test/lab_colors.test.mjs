@@ -3,7 +3,7 @@
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import {
-  heatGrid, gridPixels, sequentialColor, residualColor, residualLimit, residuals, sharedMax, spectrumBrightness,
+  heatGrid, gridPixels, sequentialColor, residualColor, RESIDUAL_SCALE, residuals, sharedMax, spectrumBrightness,
   spectrumPixels, NO_VALUE,
 } from '../src/lab/colors.js';
 import { curveSeries, radialSeries, density1d, binCentres } from '../src/lab/series.js';
@@ -30,14 +30,29 @@ test('colour scales: viridis from dark to yellow, residuals blue-white-red, clip
   assert.deepEqual(sequentialColor(2), [253, 231, 37]);
   assert.deepEqual(sequentialColor(NaN), [...NO_VALUE]);
   assert.deepEqual(residualColor(0), [247, 247, 247]);
-  const [r, , b] = residualColor(3, 4);
+  const [r, , b] = residualColor(3);
   assert.ok(r > b, 'positive residuals are red');
-  const [r2, , b2] = residualColor(-3, 4);
+  const [r2, , b2] = residualColor(-3);
   assert.ok(b2 > r2, 'negative residuals are blue');
-  assert.deepEqual(residualColor(100, 4), residualColor(4, 4));
   assert.deepEqual(residualColor(null), [...NO_VALUE]);
-  assert.equal(residualLimit([0.5, -1, null]), 3);
-  assert.equal(residualLimit([0.5, -7.2, 2]), 8);
+});
+
+test('residual colours on a fixed scale: noise pale, +-5 and beyond saturated, whatever the map\'s largest', () => {
+  assert.equal(RESIDUAL_SCALE, 5);
+  // structure saturates at the scale: 5 and 500 standard residuals are the same full red (blue)
+  assert.deepEqual(residualColor(5), [178, 24, 43]);
+  assert.deepEqual(residualColor(500), residualColor(5));
+  assert.deepEqual(residualColor(-5), [33, 102, 172]);
+  assert.deepEqual(residualColor(-500), residualColor(-5));
+  // noise stays pale: |r| <= 1 (68% of a right warp's bins) keeps every channel above 215,
+  // |r| = 2 above 190; 3 is already strong
+  for (const v of [-1, -0.5, 0.5, 1]) assert.ok(Math.min(...residualColor(v)) > 215, `${v}: ${residualColor(v)}`);
+  for (const v of [-2, 2]) assert.ok(Math.min(...residualColor(v)) > 190, `${v}: ${residualColor(v)}`);
+  assert.ok(Math.min(...residualColor(3)) < 160, `3: ${residualColor(3)}`);
+  // a bin's colour does not depend on the other bins (the old scale followed the largest |r|)
+  const quiet = gridPixels(heatGrid([2, 3], [2]), residualColor);
+  const wild = gridPixels(heatGrid([2, 80], [2]), residualColor);
+  assert.deepEqual([...quiet.slice(0, 4)], [...wild.slice(0, 4)]);
   assert.equal(sharedMax([1, 5, NaN], [7, null]), 7);
 });
 

@@ -5,7 +5,7 @@ import assert from 'node:assert/strict';
 import {
   initialLab, labReducer, labToQuery, queryToLab, typedWarpScene, typedDomain, fileRequest, pointSource, analyzeRequest,
   samplerRequest, curveRequest, verdictText, warpFacts, measureRows, integrateText, skippedLines, displayRows,
-  problemChoices, hasIntegrand, labSnapshot, TYPED, BUILTIN_WARPS,
+  problemChoices, hasIntegrand, labSnapshot, opensOnExample, TYPED, BUILTIN_WARPS,
 } from '../src/lab/model.js';
 
 const act = (state, type, payload = {}) => labReducer(state, { type, payload });
@@ -88,6 +88,28 @@ test('the manifest\'s warp scenes replace the built-in examples; the example sho
   s = act(s, 'lab/examples', { entries: [{ name: 'warp_x' }] });
   assert.equal(s.warp.example, TYPED);
   assert.deepEqual(act(initialLab(), 'lab/examples', { entries: [] }).examples, initialLab().examples);
+});
+
+test('every example carries its "what to look for": the built-in ones their own, the manifest\'s the tour\'s', () => {
+  for (const e of initialLab().examples) assert.ok(e.look && e.look.length > 20, e.name);
+  const s = act(initialLab(), 'lab/examples', { entries: [{ name: 'warp_a', look: 'red residuals near the centre' }, { name: 'warp_b' }] });
+  assert.equal(s.examples[0].look, 'red residuals near the centre');
+  assert.equal(s.examples[1].look, '');
+});
+
+test('the lab opens on a running example: once, in the warp test, with the examples and the core in', () => {
+  const ready = { examples: true, core: true };
+  const lab = act(initialLab(), 'lab/view', { view: 'lab' });
+  assert.equal(opensOnExample(lab, ready), true);
+  // not before the examples or the core, not in the study or the point sets
+  assert.equal(opensOnExample(lab, { examples: false, core: true }), false);
+  assert.equal(opensOnExample(lab, { examples: true, core: false }), false);
+  assert.equal(opensOnExample(initialLab(), ready), false);
+  assert.equal(opensOnExample(act(lab, 'lab/tab', { tab: 'points' }), ready), false);
+  // not again once a test has run or is running
+  const running = act(lab, 'lab/warp/start', { id: 1 });
+  assert.equal(opensOnExample(running, ready), false);
+  assert.equal(opensOnExample(act(running, 'lab/warp/done', { id: 1, result: { passed: true } }), ready), false);
 });
 
 test('the typed warp: a scene of the documented form, or a reason', () => {

@@ -27,18 +27,24 @@ export function sequentialColor(t) {
   return Number.isFinite(t) ? lerpStops(VIRIDIS, t) : NO_VALUE.slice();
 }
 
-/** A standardised residual to a diverging colour: 0 white, -limit and below full blue,
- *  +limit and above full red; not a number gives NO_VALUE. */
-export function residualColor(r, limit = 4) {
-  if (!Number.isFinite(r)) return NO_VALUE.slice();
-  return lerpStops(DIVERGING, 0.5 + r / (2 * limit));
+/** The residual map's fixed scale: |r| = RESIDUAL_SCALE standardised residuals and beyond are
+ *  full blue or red, whatever the largest residual of the map (noise stays pale beside a wild
+ *  bin, and two maps compare by colour). */
+export const RESIDUAL_SCALE = 5;
+
+/** Where a standardised residual sits on the diverging map, in [0, 1] (0.5: white): the signed
+ *  power |r / RESIDUAL_SCALE|^1.5, so that noise (|r| <= 2: 25% of the way) stays pale and
+ *  structure (|r| >= RESIDUAL_SCALE) saturates. */
+export function residualPosition(r) {
+  const a = Math.min(1, Math.abs(r) / RESIDUAL_SCALE) ** 1.5;
+  return 0.5 + 0.5 * Math.sign(r) * a;
 }
 
-/** The residual limit of a map: |r| = 3 at least (so noise stays pale), else the largest |r|. */
-export function residualLimit(residuals) {
-  let m = 3;
-  for (const r of residuals) if (Number.isFinite(r) && Math.abs(r) > m) m = Math.abs(r);
-  return Math.ceil(m);
+/** A standardised residual to a diverging colour on the fixed scale: 0 white, -RESIDUAL_SCALE
+ *  and below full blue, +RESIDUAL_SCALE and above full red; not a number gives NO_VALUE. */
+export function residualColor(r) {
+  if (!Number.isFinite(r)) return NO_VALUE.slice();
+  return lerpStops(DIVERGING, residualPosition(r));
 }
 
 /**

@@ -48,14 +48,16 @@ export const BUILTIN_WARPS = Object.freeze([
   {
     name: 'polar_disk_wrong',
     label: 'polar disk, r = u₁ (wrong: crowds the centre)',
+    look: 'r = u₁ crowds the centre but claims the uniform density 1/π: the test fails, the residual map is red in the first column (small |x|², the centre) and blue towards the rim, and the verdict says where the mass is wrong.',
     scene: { name: 'polar_disk_wrong', warp: { domain: { type: 'disk', radius: 1 }, g: ['u1*cos(2*pi*u2)', 'u1*sin(2*pi*u2)'], p: '1/pi' } },
   },
   {
     name: 'polar_disk_right',
     label: 'polar disk, r = √u₁ (uniform)',
+    look: 'The fix, r = √u₁: uniform on the disk; the test passes and the residual map is pale noise.',
     scene: { name: 'polar_disk_right', warp: { domain: { type: 'disk', radius: 1 }, g: ['sqrt(u1)*cos(2*pi*u2)', 'sqrt(u1)*sin(2*pi*u2)'], p: '1/pi' } },
   },
-  { name: 'concentric_disk', label: 'concentric disk (Shirley–Chiu, named)', scene: { name: 'concentric_disk', warp: 'concentric_disk' } },
+  { name: 'concentric_disk', label: 'concentric disk (Shirley–Chiu, named)', look: 'The core\'s named concentric map: uniform on the disk, so the test passes.', scene: { name: 'concentric_disk', warp: 'concentric_disk' } },
 ]);
 
 /** The value of the example select that stands for the typed warp. */
@@ -67,7 +69,7 @@ export function initialLab() {
   return {
     view: 'study', // 'study' | 'lab': which of the page's two views is shown
     tab: 'warp',   // 'warp' | 'points'
-    examples: BUILTIN_WARPS.map((w) => ({ name: w.name, label: w.label, builtin: true, hasIntegrand: false })),
+    examples: BUILTIN_WARPS.map((w) => ({ name: w.name, label: w.label, look: w.look, builtin: true, hasIntegrand: false })),
     warp: {
       example: BUILTIN_WARPS[0].name,
       typed: { domain: 'disk', params: '"radius": 1', g1: 'sqrt(u1)*cos(2*pi*u2)', g2: 'sqrt(u1)*sin(2*pi*u2)', g3: '', p: '1/pi', named: '', wp: {} },
@@ -133,7 +135,8 @@ export function labReducer(state, action) {
     case 'lab/examples': {
       // {entries: manifest entries with a warp}: added after the built-in ones
       const more = (p.entries || []).filter((e) => e && NAME_RE.test(e.name))
-        .map((e) => ({ name: e.name, label: e.description ? `${e.name}: ${e.description}` : e.name, file: e.file, builtin: false, hasIntegrand: Boolean(e.hasIntegrand) }));
+        .map((e) => ({ name: e.name, label: e.description ? `${e.name}: ${e.description}` : e.name, file: e.file, builtin: false,
+          hasIntegrand: Boolean(e.hasIntegrand), look: typeof e.look === 'string' ? e.look : '' }));
       // The page's own examples stand in until the site brings warp scenes.
       const examples = more.length ? more : state.examples.filter((e) => e.builtin);
       const known = state.warp.example === TYPED || examples.some((e) => e.name === state.warp.example);
@@ -426,6 +429,14 @@ export function typedWarpScene(typed) {
   if (!p) return { error: 'type p, the density the warp claims, in x, y, z' };
   // one coordinate (an interval): g is a single expression, as in the scene files
   return { scene: { name: 'typed_warp', warp: { domain: d.domain, g: g.length === 1 ? g[0] : g, p } } };
+}
+
+/** The lab opens on a running example: true when the warp test's view is first shown with the
+ *  examples in and the core loaded, and no test has run yet (a link's chosen example or typed
+ *  warp is the one run). `ready`: {examples, core} loaded. */
+export function opensOnExample(lab, ready) {
+  return lab.view === 'lab' && lab.tab === 'warp' && Boolean(ready.examples && ready.core) &&
+    lab.warp.status === 'idle' && !lab.warp.result;
 }
 
 /** The options of a warp test from the lab's state: {options} or {error}. */

@@ -7,7 +7,7 @@ import {
   measureRows, skippedLines,
   verdictText, warpFacts, integrateText, num, displayRows, problemChoices,
 } from './model.js';
-import { heatGrid, sequentialColor, residualColor, residualLimit, residuals, sharedMax, mapCounts } from './colors.js';
+import { heatGrid, sequentialColor, residualColor, RESIDUAL_SCALE, residuals, sharedMax, mapCounts } from './colors.js';
 import { drawHeat, drawColorBar, drawSpectrum, drawScatter } from './draw.js';
 import { renderCurve, renderRadial, renderDensity1d } from './charts.js';
 import { colorAt } from '../palette.js';
@@ -208,6 +208,9 @@ export function syncLab(lab, scenes, dispatch = null) {
   $('warp-status').textContent = w.status === 'running' ? 'testing…' : w.status === 'done' ? 'done' : '';
   const ex = lab.examples.find((e) => e.name === w.example);
   $('warp-study').hidden = !(ex && ex.hasIntegrand);
+  const look = w.example !== TYPED && ex && ex.look ? ex.look : '';
+  $('warp-look').hidden = !look;
+  $('warp-look-text').textContent = look;
 
   const pt = lab.points;
   for (const r of document.querySelectorAll('input[name=points-source]')) r.checked = r.value === pt.source;
@@ -295,6 +298,9 @@ export function renderLab(lab) {
   }
 }
 
+/** The test rejected the warp (not passed, and not "could not verify"). */
+const failed = (r) => r.outcome ? r.outcome === 'failed' : r.passed === false;
+
 function renderWarp(r) {
   const maps = $('warp-maps');
   const oneD = r && Array.isArray(r.bins) && r.bins.length === 1;
@@ -307,7 +313,8 @@ function renderWarp(r) {
   const facts = $('warp-facts');
   const worst = $('warp-worst');
   facts.hidden = !r;
-  worst.hidden = !r || !Array.isArray(r.worst_bins) || !r.worst_bins.length;
+  // the bins farthest from the density say something only when the samples do not follow it
+  worst.hidden = !r || !failed(r) || !Array.isArray(r.worst_bins) || !r.worst_bins.length;
   $('warp-axes').textContent = oneD ? `Samples per bin over ${r.coordinates ? r.coordinates[0] : 'the coordinate'} (${r.bins[0]} bins of equal measure): orange, observed; dashed black, expected from p.` : '';
   if (!r) return;
   facts.tBodies[0].replaceChildren(...warpFacts(r).map(([k, v]) => el('tr', {}, el('th', { scope: 'row' }, k), el('td', {}, v))));
@@ -325,14 +332,15 @@ function renderWarp(r) {
   const top = sharedMax(m.observed, m.expected) || 1;
   const countColor = (v) => sequentialColor(v / top);
   const res = residuals(m);
-  const limit = residualLimit(res);
+  const scale = RESIDUAL_SCALE;
   drawHeat($('warp-observed'), heatGrid(m.observed, m.bins), countColor);
   drawHeat($('warp-expected'), heatGrid(m.expected, m.bins), countColor);
-  drawHeat($('warp-residual'), heatGrid(res, m.bins), (v) => residualColor(v, limit));
+  drawHeat($('warp-residual'), heatGrid(res, m.bins), residualColor);
   drawColorBar($('warp-count-bar'), (v) => sequentialColor(v / top), 0, top, 160);
-  drawColorBar($('warp-residual-bar'), (v) => residualColor(v, limit), -limit, limit, 160);
+  drawColorBar($('warp-residual-bar'), residualColor, -scale, scale, 160);
   $('warp-count-text').textContent = `samples per bin: 0 (left) to ${num(top, 4)} (right), the same scale for observed and expected`;
-  $('warp-residual-text').textContent = `residual: −${limit} and below (blue) · 0 (white) · +${limit} and above (red); grey: no expected samples`;
+  $('warp-residual-text').textContent = `residual on a fixed scale: −${scale} and below (full blue) · 0 (white) · +${scale} and above (full red); ` +
+    'noise, |r| ≤ 2, stays pale; grey: no expected samples';
   const [cx, cy] = coords;
   $('warp-axes').textContent = `Horizontal: ${cx ?? 'first coordinate'} (${r.bins[0]} bins), vertical: ${cy ?? 'second coordinate'} (${r.bins[1]} bins), growing up.` +
     (m.summed ? ` Summed over ${coords[2] ?? 'the third coordinate'} (${r.bins[2]} bins): the maps show the marginal counts.` : '');

@@ -6,7 +6,7 @@ import { createStore } from '../state.js';
 import { MSG } from '../protocol.js';
 import {
   labReducer, queryToLab, labToQuery, TYPED, BUILTIN_WARPS, typedWarpScene, warpOptions, analyzeRequest,
-  samplerRequest, fileRequest, pointSource, curveRequest, displayRows, isPixelSampler,
+  samplerRequest, fileRequest, pointSource, curveRequest, displayRows, isPixelSampler, opensOnExample,
 } from './model.js';
 import { mountLab, syncLab, renderLab } from './view.js';
 
@@ -169,8 +169,16 @@ export function startLab(page, search) {
     }
   }
 
+  // The lab opens on a running example (its "what to look for" beside it): the first time the
+  // warp test is shown once the examples and the core are in.
+  let examplesIn = false;
+  const openOnExample = () => {
+    if (opensOnExample(store.getState(), { examples: examplesIn, core: Boolean(page.service()) })) runWarp();
+  };
+
   store.subscribe((state, action) => {
     const p = action.payload || {};
+    if (action.type === 'lab/view' || action.type === 'lab/tab') openOnExample();
     switch (action.type) {
       case 'lab/warp/request': runWarp(); break;
       case 'lab/points/request': runAnalysis(); break;
@@ -185,6 +193,8 @@ export function startLab(page, search) {
   function scenesLoaded(scenes) {
     const entries = scenes.filter((e) => e.warp).map((e) => ({ ...e, hasIntegrand: e.kind !== 'warp' }));
     dispatch({ type: 'lab/examples', payload: { entries } });
+    examplesIn = true;
+    openOnExample();
   }
 
   syncLab(store.getState(), [], dispatch);
