@@ -206,7 +206,8 @@ export function minorLogGrid(u) {
   ctx.restore();
 }
 
-/** Draws labels at the last visible point of the given series (reference lines). */
+/** Draws labels at the last visible point of the given series (reference lines), left-aligned
+ *  there and kept within the plot (shortened where it is narrower than the label). */
 export function labelHook(items) {
   return (u) => {
     const ctx = u.ctx;
@@ -214,6 +215,7 @@ export function labelHook(items) {
     ctx.save();
     ctx.font = `${textPx(11) * px}px "DejaVu Sans", sans-serif`;
     ctx.fillStyle = '#555';
+    ctx.textAlign = 'left';
     ctx.textBaseline = 'bottom';
     const { min: ymin, max: ymax } = u.scales.y;
     for (const { idx, label } of items) {
@@ -222,11 +224,13 @@ export function labelHook(items) {
       let last = -1;
       for (let i = 0; i < ys.length; i++) if (ys[i] !== null && ys[i] >= ymin && ys[i] <= ymax) last = i;
       if (last < 0) continue;
-      const w = ctx.measureText(label).width;
+      // within the plot's width: shortened as axis titles are where it does not fit (a phone)
+      const text = fitAxisTitle(label, (t) => ctx.measureText(t).width <= u.bbox.width - 4 * px);
+      const w = ctx.measureText(text).width;
       let x = u.valToPos(u.data[0][last], 'x', true) + 4 * px;
-      x = Math.min(x, u.bbox.left + u.bbox.width - w - 2 * px);
+      x = Math.max(u.bbox.left + 2 * px, Math.min(x, u.bbox.left + u.bbox.width - w - 2 * px));
       const y = Math.max(u.bbox.top + (textPx(11) + 1) * px, u.valToPos(ys[last], 'y', true) - 2 * px);
-      ctx.fillText(label, x, y);
+      ctx.fillText(text, x, y);
     }
     ctx.restore();
   };
