@@ -345,6 +345,8 @@ export function startLive(page) {
     store,
     sceneChanged,
     snapshot: () => ({ ...liveSnapshot(store.getState()), size: px.width ? { width: px.width, height: px.height } : null, bands: px.bands,
+      // passes sent and not yet answered (Pause lets them finish)
+      inFlight: run && run.workerState ? run.workerState.reduce((a, x) => a + x.outstanding, 0) : 0,
       canvases: [...document.querySelectorAll('#live-section canvas.live-canvas')].map((c) => ({ key: c.dataset.live || c.id, width: c.width, height: c.height, spp: c.dataset.spp || null })) }),
     active: () => liveActive(store.getState()),
   };
