@@ -1,10 +1,11 @@
 // The page's text sizes and axis titles in headless Chromium (issue 48, item 6). Usage:
 // MCPLAY_SITE=SITE_DIR MCPLAY_SHOTS=SHOT_DIR node --test web/e2e/layout.e2e.mjs
 // At 1024 x 768 (a projector) the large-text toggle says what it does, is remembered, and with it
-// no visible text of the study, the live view or the lab is below 16 px: every text node (by its
-// element's computed font size), every SVG text (times its scale on screen) and every text drawn
-// on a canvas (the font it was drawn with, times the canvas's scale on screen; fillText is
-// recorded from the page's first script on). At 390 x 844 (a phone), in either mode, no text
+// no visible text of the study (a run, its tables and a race), the live view or the lab is below
+// 16 px: every text node (by its element's computed font size), every SVG text (times its scale
+// on screen) and every text drawn on a canvas (the font it was drawn with, times the canvas's
+// scale on screen; fillText is recorded from the page's first script on). Without the mode the
+// same measure finds small text (it can fail). At 390 x 844 (a phone), in either mode, no text
 // drawn on a canvas, the axis titles included, reaches past its canvas (its bounding box from
 // measureText and the transform it was drawn with), and no SVG text past its SVG.
 import { mkdirSync } from 'node:fs';
@@ -144,6 +145,15 @@ async function runStudy() {
   await studyTab();
   await page.click('#run');
   await page.waitForFunction(() => document.querySelector('#status')?.textContent.startsWith('done'), null, { timeout: 120000 });
+  // the race card too (its time axis is an SVG): a short race of the scene's estimators
+  if (await page.isVisible('#race-start')) {
+    await page.fill('#race-rel', '1e-2');
+    await page.fill('#race-abs', '');
+    await page.fill('#race-runs', '4');
+    await page.fill('#race-seconds', '5');
+    await page.click('#race-start');
+    await page.waitForFunction(() => ['done', 'error', 'cancelled'].includes(window.mcplayDebug.state().race.status), null, { timeout: 120000 });
+  }
   // the tables of levels too
   await page.evaluate(() => document.querySelectorAll('#study-view details').forEach((d) => { d.open = true; }));
   await frames();
@@ -210,8 +220,9 @@ test('1024 x 768, large text: no visible text of the study below 16 px, canvas t
   const small = await page.evaluate(smallTexts, { root: 'body', min: MIN_PX });
   await page.screenshot({ path: join(shots, 'large-text-study.png'), fullPage: true });
   assert.deepEqual(small, []);
-  // the plots drew their ticks: the canvas texts were measured
+  // the plots drew their ticks and the race its axis: they were measured
   assert.ok((await page.evaluate(() => window.canvasTexts().filter((t) => t.where === 'plot-variance').length)) > 3);
+  assert.ok((await page.$$('#race-card svg text')).length > 1);
 });
 
 test('1024 x 768, large text: the live view', async () => {
