@@ -125,10 +125,19 @@ function clippedTexts() {
 before(async () => {
   mkdirSync(shots, { recursive: true });
   browser = await openPlayground({ site, viewport: { width: 1024, height: 768 }, profilePrefix: 'mcplay-layout-chromium-',
-    onPageError: (message) => pageErrors.push(message),
-    onContext: (context) => context.addInitScript(recordCanvasText) });
+    onPageError: (message) => pageErrors.push(message) });
   ({ page } = browser);
+  // the recorder in place before the page's first script: added, then the page loaded again
+  await browser.context.addInitScript(recordCanvasText);
+  await reload();
 });
+
+async function reload() {
+  await page.reload();
+  await page.waitForFunction(() => window.mcplayDebug !== undefined);
+  await page.evaluate(() => window.mcplayDebug.ready);
+  assert.equal(await page.evaluate(() => typeof window.canvasTexts), 'function');
+}
 
 after(async () => {
   await browser?.close();
@@ -208,9 +217,7 @@ test('the large-text toggle says what it gives, and is remembered', async () => 
   assert.ok((await page.evaluate(smallTexts, { root: 'body', min: MIN_PX })).length > 0);
   await page.check('#large-text');
   assert.equal(await page.evaluate(() => document.documentElement.classList.contains('large-text')), true);
-  await page.reload();
-  await page.waitForFunction(() => window.mcplayDebug !== undefined);
-  await page.evaluate(() => window.mcplayDebug.ready);
+  await reload();
   assert.equal(await page.isChecked('#large-text'), true);
   assert.equal(await page.evaluate(() => document.documentElement.classList.contains('large-text')), true);
 });

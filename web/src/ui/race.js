@@ -193,7 +193,9 @@ function axisSvg(axis) {
     const x = axis.x(10 ** d);
     s.append(svg('line', { x1: x, x2: x, y1: h - 5, y2: h, stroke: '#999' }));
     if ((d - axis.a) % axis.step) continue;
-    const label = svg('text', { x, y: size + 1, 'text-anchor': 'middle', 'font-size': size, fill: '#555' });
+    // the first label starts at its tick, so that it stays inside the axis at any text size
+    const anchor = d === axis.a ? 'start' : 'middle';
+    const label = svg('text', { x, y: size + 1, 'text-anchor': anchor, 'font-size': size, fill: '#555' });
     label.textContent = formatSeconds(10 ** d);
     s.append(label);
   }
