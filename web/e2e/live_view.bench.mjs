@@ -1,7 +1,7 @@
 // Benchmark (not a test): the live view of a render scene in headless Chromium, 2 workers, the
-// scene's default estimators (its first four) at the default size. For each of three page loads
-// (the page opened with ?scene=SCENE&live_workers=2, Start pressed as soon as the live view
-// shows), the time from pressing Start to the first full image drawn (every band of one
+// scene's default estimators (live/model.js defaultEstimators) at the default size. For each of
+// three page loads (the page opened with ?scene=SCENE&live_workers=2, Start pressed as soon as
+// the live view shows), the time from pressing Start to the first full image drawn (every band of one
 // estimator at 1 spp, on its canvas) and to 64 spp of every estimator (drawn); prints the
 // medians as one line per scene:
 //   SCENE: first image WxH at T ms; 64 spp at T ms

@@ -1,11 +1,13 @@
 // End-to-end test of the live view in headless Chromium (Debian's chromium, driven by
 // playwright-core). Usage: MCPLAY_SITE=SITE_DIR MCPLAY_SHOTS=SHOT_DIR node --test web/e2e/live_view.e2e.mjs
-// Opens Veach's MIS scene, chooses MIS (mis_power), light sampling and BSDF sampling, starts the
-// live view and waits for 16 spp (the animation frames keep coming meanwhile); checks the
-// canvases' sizes are the core's live size, that the reference shipped with the site is used
-// and the relative-MSE curves have points, that zoom and the error maps redraw, moves the wipe
-// (its clip follows), pauses and resumes, cancels (no pass arrives after), shows one clear line
-// for a size the core refuses, and runs axe-core on the view.
+// Opens Veach's MIS scene (its MIS estimators and what they combine chosen at first), chooses MIS
+// (mis_power), light sampling and BSDF sampling, starts the live view and waits for 16 spp (the
+// animation frames keep coming meanwhile); checks the canvases' sizes are the core's live size,
+// that the reference shipped with the site is used and the relative-MSE curves have points, that
+// zoom and the error maps redraw, moves the wipe (its clip follows), pauses and resumes, cancels
+// (no pass arrives after), shows one clear line for a size the core refuses, takes mis_balance
+// to 64 spp, below the reference's noise (no number on its card or curve, a ratio "at least"),
+// and runs axe-core on the view.
 import { mkdirSync, readFileSync } from 'node:fs';
 import { join, resolve, dirname } from 'node:path';
 import { fileURLToPath } from 'node:url';
@@ -41,8 +43,17 @@ const CHOSEN = ['mis_power', 'light_area', 'bsdf'];
 test('Veach\'s scene: three estimators converge to 16 spp at the core\'s live size, with curves', async () => {
   await page.selectOption('#scene', 'veach_mis');
   await page.waitForSelector('#live-section', { state: 'visible' });
-  // the scene's first four are chosen; choose MIS, light sampling and BSDF sampling instead
-  // (four are chosen: the others are disabled until one is unchosen)
+  // chosen at first, from the scene's list by strategy: every MIS estimator, and what they
+  // combine (BSDF sampling, light sampling by solid angle), not light_area
+  const details = await page.evaluate(() => window.mcplayDebug.state().sceneInfo.estimatorDetails);
+  const mis = details.filter((e) => /^mis_/.test(e.strategy)).map((e) => e.name);
+  assert.deepEqual(mis, ['mis_balance', 'mis_power']);
+  await page.waitForFunction(() => window.mcplayDebug.live().choice.estimators?.length > 0);
+  assert.deepEqual((await live()).choice.estimators, ['bsdf', 'light_solid_angle', 'mis_balance', 'mis_power']);
+  const checked = await page.$$eval('#live-estimators input:checked', (bs) => bs.map((b) => b.value));
+  assert.deepEqual(checked, ['bsdf', 'light_solid_angle', 'mis_balance', 'mis_power']);
+  // choose MIS, light sampling by area and BSDF sampling instead (four are chosen: the others
+  // are disabled until one is unchosen)
   for (const wantOn of [false, true]) {
     for (const box of await page.$$('#live-estimators input')) {
       const want = CHOSEN.includes(await box.getAttribute('value'));
@@ -153,16 +164,14 @@ test('Pause sends no more passes (those sent finish), Resume goes on from there'
   await page.click('#live-pause');
   assert.equal((await live()).status, 'paused');
   assert.equal(await page.textContent('#live-pause'), 'Resume');
-  // the levels stop growing once the passes already sent are in
-  let before = levelsOf(await live());
-  for (let i = 0; i < 60; ++i) {
-    await page.waitForTimeout(1500);
-    const now = levelsOf(await live());
-    if (now === before) break;
-    before = now;
-  }
+  // the levels stop growing once the passes already sent are in (however slow a loaded machine
+  // makes them), and none is sent after
+  await page.waitForFunction(() => window.mcplayDebug.live().inFlight === 0, null, { timeout: 120000 });
+  const before = levelsOf(await live());
   await page.waitForTimeout(1500);
-  assert.equal(levelsOf(await live()), before, 'no level while paused');
+  const still = await live();
+  assert.equal(still.inFlight, 0, 'no pass sent while paused');
+  assert.equal(levelsOf(still), before, 'no level while paused');
   await page.click('#live-pause');
   await page.waitForFunction((was) => {
     const v = window.mcplayDebug.live();
@@ -214,6 +223,41 @@ test('a size the core refuses: one clear line, and the view stays usable', async
   assert.equal(Math.max(s.size.width, s.size.height), 128);
   await page.waitForFunction(() => document.getElementById('live-error').textContent === '');
   await page.click('#live-cancel');
+});
+
+test('a level below the reference\'s noise has no number: its card, its curve and the comparison', async () => {
+  // Veach's scene at its fixed seed: mis_balance goes below the shipped reference's noise by
+  // 64 spp (issue 48: 1.0e-4 against a floor of 2.8e-3), bsdf stays far above it
+  await page.selectOption('#live-size', '256');
+  await page.selectOption('#live-max', '64');
+  for (const box of await page.$$('#live-estimators input:checked')) await box.click();
+  for (const n of ['bsdf', 'mis_balance']) await page.check(`#live-estimators input[value="${n}"]`);
+  await page.click('#live-start');
+  await page.waitForFunction(() => ['done', 'error'].includes(window.mcplayDebug.live().status), null, { timeout: 300000 });
+  const s = await live();
+  assert.equal(s.status, 'done', s.message);
+  const { floor } = s.reference;
+  assert.ok(floor > 0, `floor ${floor}`);
+  const noisy = s.order.flatMap((n) => s.estimators[n].points.filter((p) => p.relmse < floor).map((p) => ({ n, ...p })));
+  assert.ok(noisy.some((p) => p.n === 'mis_balance' && p.spp === 64), JSON.stringify(s.estimators.mis_balance.points));
+  // the card: no number, the floor named
+  const facts = await page.textContent('[data-facts="mis_balance"]');
+  assert.match(facts, /relMSE at the reference's noise \(below \d/);
+  const mis = s.estimators.mis_balance.points.find((p) => p.spp === 64).relmse;
+  assert.equal(facts.includes(String(+mis.toPrecision(3))), false, facts);
+  assert.match(await page.textContent('[data-facts="bsdf"]'), /relMSE \d/);
+  // the curves: every level at the noise a ring on the floor, no number drawn under it
+  for (const id of ['#live-plot-spp', '#live-plot-seconds']) {
+    assert.equal(Number(await page.getAttribute(id, 'data-noise')), noisy.length, id);
+    assert.ok(Number(await page.getAttribute(id, 'data-lowest')) >= floor, id);
+  }
+  // the comparison: at least bsdf / floor, not bsdf / mis_balance
+  const bsdf = s.estimators.bsdf.points.find((p) => p.spp === 64).relmse;
+  const compare = await page.textContent('#live-compare');
+  assert.match(compare, /^At 64 spp mis_balance is at the reference's noise: its relative MSE is at least (\d+)× lower than bsdf's/);
+  assert.equal(Number(/at least (\d+)×/.exec(compare)[1]), Math.round(bsdf / floor));
+  assert.ok(bsdf / mis > 2 * (bsdf / floor), 'the ratio a number would have claimed is larger');
+  await page.screenshot({ path: join(shots, 'live-view-noise.png'), fullPage: true });
 });
 
 test('axe-core finds no violations in the live view, and the page threw nothing', async () => {

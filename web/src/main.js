@@ -36,6 +36,7 @@ import { mountCustom, syncCustom } from './ui/custom.js';
 import { mountExports, syncExports } from './ui/exports.js';
 import { mountRace, syncRace } from './ui/race.js';
 import { syncClock } from './ui/clock.js';
+import { mountLargeText, onTextSize } from './ui/text_size.js';
 import { raceOptions, withoutStopping } from './race.js';
 import { startLab } from './lab/wiring.js';
 import { labSnapshot } from './lab/model.js';
@@ -71,6 +72,12 @@ initPlots({
   'legend-misweights': $('legend-misweights'),
   'legend-overlay': $('legend-overlay'), 'legend-weights': $('legend-weights'),
   samplesNote: $('samples-note'), overlayNote: $('overlay-note'), weightsNote: $('weights-note'),
+});
+// The large-text mode (a projector): remembered, and every plot and strip redrawn in it
+mountLargeText($('large-text'));
+onTextSize(() => {
+  renderHeavy();
+  syncRace(store.getState());
 });
 mountControls(store);
 mountCustom(store);

@@ -7,6 +7,7 @@ import {
   splitRows, workerOfBand, nextSpp, createCollector, relativeMse, estimatorSeconds, toneMap, srgbEncode,
   errorColor, errorMap, wipeFromPointer, wipeClip, commonSpp, zoomStep, fitZoom, predictionText, predictSeconds,
   duration, oneLine, liveWorkers, alignPoints, PREDICT_AT, defaultEstimators, sessionOptions, initialLive, liveReducer, liveActive, LONG_SECONDS,
+  belowReferenceNoise, relmseText, relmseRatio, compareText, shortNumber,
 } from '../src/live/model.js';
 
 test('row bands cover every row exactly once, in order, sizes within one row', () => {
@@ -209,8 +210,92 @@ test('the curves: every estimator\'s points on the x values of all, null where i
     a: { points: [{ spp: 2, seconds: 0.1, relmse: 1 }, { spp: 4, seconds: 0.3, relmse: 0.5 }] },
     b: { points: [{ spp: 4, seconds: 0.2, relmse: 0.25 }, { spp: 8, seconds: 0.4, relmse: 0 }] },
   };
-  assert.deepEqual(alignPoints(['a', 'b'], estimators, 'spp'), { xs: [2, 4, 8], ys: [[1, 0.5, null], [null, 0.25, null]] });
+  // a relative MSE of 0 is at the reference's noise: no number, a ring (its x index listed)
+  assert.deepEqual(alignPoints(['a', 'b'], estimators, 'spp'),
+    { xs: [2, 4, 8], ys: [[1, 0.5, null], [null, 0.25, null]], noise: [[], [2]] });
   assert.deepEqual(alignPoints(['a', 'b'], estimators, 'seconds'),
-    { xs: [0.1, 0.2, 0.3, 0.4], ys: [[1, null, 0.5, null], [null, 0.25, null, null]] });
-  assert.deepEqual(alignPoints(['c'], estimators, 'spp'), { xs: [], ys: [[]] });
+    { xs: [0.1, 0.2, 0.3, 0.4], ys: [[1, null, 0.5, null], [null, 0.25, null, null]], noise: [[], [3]] });
+  assert.deepEqual(alignPoints(['c'], estimators, 'spp'), { xs: [], ys: [[]], noise: [[]] });
+});
+
+// Synthetic levels shaped as Veach's scene gave them (issue 48): mis_balance 3.4e-3 at 32 spp,
+// then 1.0e-4 at 64 spp, 28x under a floor of 2.8e-3; bsdf 1.1 and 0.55.
+const FLOOR = 2.8e-3;
+function veachLike() {
+  let s = initialLive();
+  s = liveReducer(s, { type: 'live/start', payload: { id: 1, order: ['bsdf', 'mis_balance'], colors: {}, workers: 2, startedAt: 0 } });
+  s = liveReducer(s, { type: 'live/reference', payload: { id: 1, reference: { status: 'ready', floor: FLOOR } } });
+  for (const [estimator, spp, relmse] of [['bsdf', 32, 1.1], ['mis_balance', 32, 3.4e-3], ['bsdf', 64, 0.55], ['mis_balance', 64, 1.0e-4]]) {
+    s = liveReducer(s, { type: 'live/level', payload: { id: 1, estimator, spp, seconds: spp / 10, relmse, now: 1 } });
+  }
+  return s;
+}
+
+test('a relative MSE below the reference\'s noise is never a number, on either side of the floor', () => {
+  // the rule both ways: above the floor a number, below it (or at or below zero) none
+  assert.equal(belowReferenceNoise(3.4e-3, FLOOR), false);
+  assert.equal(belowReferenceNoise(1.0e-4, FLOOR), true);
+  assert.equal(belowReferenceNoise(-2e-5, FLOOR), true);
+  assert.equal(belowReferenceNoise(0, null), true);
+  assert.equal(belowReferenceNoise(1e-9, null), false); // no floor known: only non-positive values
+  assert.equal(belowReferenceNoise(null, FLOOR), false);
+  assert.equal(relmseText(3.4e-3, FLOOR), '0.0034');
+  assert.equal(relmseText(1.0e-4, FLOOR), 'at the reference\'s noise (below 0.0028)');
+  assert.equal(relmseText(-2e-5, FLOOR), 'at the reference\'s noise (below 0.0028)');
+  assert.equal(relmseText(-2e-5, null), 'at the reference\'s noise');
+  assert.equal(relmseText(1.0e-4, 2.8e-5), '1.00e-4');
+  assert.doesNotMatch(relmseText(1.0e-4, FLOOR), /1\.0*e-4|0\.0001/);
+  assert.equal(shortNumber(2.8e-7, 2), '2.8e-7');
+  assert.equal(shortNumber(1234567, 3), '1.23e+6');
+});
+
+test('a ratio against a level at the reference\'s noise is "at least" the ratio to the floor; none from a level at the noise', () => {
+  assert.deepEqual(relmseRatio(3.4e-3, 1.1, FLOOR), { factor: 1.1 / 3.4e-3, atLeast: false });
+  const r = relmseRatio(1.0e-4, 0.55, FLOOR);
+  assert.equal(r.atLeast, true);
+  assert.ok(Math.abs(r.factor - 0.55 / FLOOR) < 1e-9, String(r.factor)); // 196, not 5500
+  assert.equal(relmseRatio(0.55, 1.0e-4, FLOOR), null);
+  assert.equal(relmseRatio(1e-4, 2e-4, FLOOR), null);
+});
+
+test('Veach-like levels: the facts, the curves and the comparison say only what the reference supports', () => {
+  const s = veachLike();
+  const { floor } = s.reference;
+  const { xs, ys, noise } = alignPoints(s.order, s.estimators, 'spp', floor);
+  assert.deepEqual(xs, [32, 64]);
+  assert.deepEqual(ys, [[1.1, 0.55], [3.4e-3, null]]);
+  assert.deepEqual(noise, [[], [1]]);
+  // no value drawn as a number lies under the floor
+  assert.ok(ys.flat().filter((v) => v !== null).every((v) => v >= floor));
+  const text = compareText(s.order, s.estimators, floor);
+  assert.equal(text, 'At 64 spp mis_balance is at the reference\'s noise: its relative MSE is at least 196× lower than bsdf\'s; ' +
+    'by how much more, the reference cannot tell.');
+  assert.doesNotMatch(text, /5500/);
+  // one level earlier both are measured: a plain ratio
+  const at32 = { bsdf: { points: s.estimators.bsdf.points.slice(0, 1) }, mis_balance: { points: s.estimators.mis_balance.points.slice(0, 1) } };
+  assert.match(compareText(s.order, at32, floor), /^At 32 spp mis_balance's relative MSE is 324× lower than bsdf's/);
+  // both at the reference's noise: no ratio at all
+  const both = { a: { points: [{ spp: 8, relmse: 1e-4 }] }, b: { points: [{ spp: 8, relmse: -1e-5 }] } };
+  assert.equal(compareText(['a', 'b'], both, floor), 'At 8 spp every image is at the reference\'s noise: the reference cannot tell them apart.');
+  assert.equal(compareText(['a'], both, floor), '');
+});
+
+test('the default estimators: the scene\'s MIS estimators and the strategies they combine, from its list', () => {
+  const e = (name, strategy, more = {}) => ({ name, strategy, light_selection: 'power', light_sampling: 'solid_angle', ...more });
+  // Veach's list: bsdf, light_solid_angle, light_area, mis_balance, mis_power
+  const veach = [e('bsdf', 'bsdf'), e('light_solid_angle', 'light_solid_angle'), e('light_area', 'light_area'),
+    e('mis_balance', 'mis_balance'), e('mis_power', 'mis_power')];
+  assert.deepEqual(defaultEstimators(veach), ['bsdf', 'light_solid_angle', 'mis_balance', 'mis_power']);
+  // any names: the rule reads the strategies; light sampling of the MIS's own kind (area here)
+  const renamed = [e('h', 'cosine_hemisphere'), e('x', 'bsdf'), e('y', 'light_solid_angle'), e('u', 'light_area', { light_selection: 'uniform' }),
+    e('z', 'light_area'), e('m', 'mis_power', { light_sampling: 'area' })];
+  assert.deepEqual(defaultEstimators(renamed), ['x', 'y', 'z', 'm']);
+  // one MIS estimator: it, BSDF and both light samplings before the hemisphere
+  const one = [e('cosine_hemisphere', 'cosine_hemisphere'), e('bsdf', 'bsdf'), e('light_area', 'light_area'),
+    e('light_solid_angle', 'light_solid_angle'), e('mis_power', 'mis_power')];
+  assert.deepEqual(defaultEstimators(one), ['bsdf', 'light_area', 'light_solid_angle', 'mis_power']);
+  // no MIS: the scene's first four, as before; names alone too
+  assert.deepEqual(defaultEstimators(['a', 'b', 'c', 'd', 'e']), ['a', 'b', 'c', 'd']);
+  assert.deepEqual(defaultEstimators([e('p', 'path'), e('q', 'path')]), ['p', 'q']);
+  assert.deepEqual(defaultEstimators(null), []);
 });

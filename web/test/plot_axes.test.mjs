@@ -5,6 +5,7 @@ import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import {
   sup, decadeLabel, nTickLabels, lg, lgAll, log10Range, log10Ticks, shortSeconds, runLabels, isRender,
+  fitAxisTitle,
 } from '../src/plot/axes.js';
 
 test('superscripts and decade labels', () => {
@@ -73,4 +74,21 @@ test('axis texts of an integration run and of a render run', () => {
   assert.equal(runLabels({ errorName: 'mean_abs_error' }).error, 'mean abs error');
   assert.equal(isRender({ kind: 'render' }), true);
   assert.equal(isRender({ kind: 'integral' }), false);
+});
+
+test('axis titles fit their axis: whole where they fit, else without asides, else cut with an ellipsis', () => {
+  const width = (t) => t.length * 7; // a font of 7 px a character
+  const fitsIn = (px) => (t) => width(t) <= px;
+  const title = 'seconds per image (its bands\' seconds / workers)';
+  assert.equal(fitAxisTitle(title, fitsIn(1000)), title);
+  assert.equal(fitAxisTitle(title, fitsIn(200)), 'seconds per image');
+  assert.equal(fitAxisTitle('spp [samples per pixel]', fitsIn(100)), 'spp');
+  const cut = fitAxisTitle(title, fitsIn(70));
+  assert.equal(cut, 'seconds…');
+  assert.ok(width(cut) <= 70);
+  // every result fits, down to a single character and an ellipsis
+  for (const px of [7, 14, 50, 90, 130, 400]) {
+    const t = fitAxisTitle(title, fitsIn(px));
+    assert.ok(width(t) <= Math.max(px, 14), `${px}: ${t}`);
+  }
 });

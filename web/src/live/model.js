@@ -37,9 +37,27 @@ export function liveWorkers(cores, override = null) {
   return Math.max(1, Math.min(MAX_LIVE_WORKERS, Number.isFinite(n) ? Math.floor(n) : 1));
 }
 
-/** The estimators chosen by default: the scene's list, first four. */
-export function defaultEstimators(names) {
-  return (Array.isArray(names) ? names : []).slice(0, MAX_LIVE_ESTIMATORS);
+/**
+ * The estimators chosen by default, from the scene's list (names, or the scene info's estimator
+ * objects {name, strategy, light_selection, light_sampling}): at most four, in the scene's order.
+ * When the scene has MIS estimators (strategy mis_*), they come first, then the strategies they
+ * combine [Veach97, 9.2]: BSDF sampling and the light sampling of their kind (light_sampling,
+ * light_selection), then other light sampling, then the rest; otherwise the scene's first four.
+ */
+export function defaultEstimators(list) {
+  const all = (Array.isArray(list) ? list : []).map((e) => (typeof e === 'string' ? { name: e } : e))
+    .filter((e) => e && typeof e.name === 'string');
+  const mis = all.filter((e) => /^mis_/.test(e.strategy || ''));
+  const combined = (e) => e.strategy === 'bsdf' || mis.some((m) => e.strategy === `light_${m.light_sampling}` &&
+    (e.light_selection || 'power') === (m.light_selection || 'power'));
+  const rank = (e) => {
+    if (!mis.length || mis.includes(e)) return 0;
+    if (combined(e)) return 1;
+    return /^light_/.test(e.strategy || '') ? 2 : 3;
+  };
+  const chosen = new Set(all.map((e, i) => [rank(e), i, e.name]).sort((a, b) => a[0] - b[0] || a[1] - b[1])
+    .slice(0, MAX_LIVE_ESTIMATORS).map((x) => x[2]));
+  return all.map((e) => e.name).filter((n) => chosen.has(n));
 }
 
 /**
@@ -254,18 +272,89 @@ export function fitZoom(w, count, box) {
 // ---------------------------------------------------------------------------------------------
 // Curves
 
+/** Is a relative MSE (the reference's noise subtracted, as the core gives it) below what the
+ *  reference can resolve: not positive, or below the floor (the reference's own relative MSE)?
+ *  The study's rule (src/render/render_study.cpp, below_reference_noise; docs/render-scenes.md). */
+export function belowReferenceNoise(relmse, floor) {
+  return Number.isFinite(relmse) && (!(relmse > 0) || (Number.isFinite(floor) && relmse < floor));
+}
+
+/** A positive number in `digits` significant digits, in scientific notation below 1e-3 or
+ *  from 1e6 on: 0.0034, 2.8e-5. */
+export function shortNumber(v, digits = 3) {
+  const a = Math.abs(v);
+  return a >= 1e-3 && a < 1e6 ? String(+v.toPrecision(digits)) : v.toExponential(digits - 1);
+}
+
+/** A relative MSE in words: its number, or, below the reference's noise, no number: "at the
+ *  reference's noise (below <floor>)". Empty when there is none. */
+export function relmseText(relmse, floor) {
+  if (relmse === null || relmse === undefined || !Number.isFinite(relmse)) return '';
+  if (!belowReferenceNoise(relmse, floor)) return shortNumber(relmse, 3);
+  return Number.isFinite(floor) && floor > 0 ? `at the reference's noise (below ${shortNumber(floor, 2)})` : 'at the reference\'s noise';
+}
+
+/**
+ * How many times lower relative MSE `a` is than `b`, as far as the reference can tell:
+ * {factor, atLeast}. Both measured: b / a. `a` at the reference's noise and `b` measured: at
+ * least b / floor (a is below the floor, by how much the reference cannot say). `b` at the
+ * reference's noise: null (no ratio can be formed from it).
+ */
+export function relmseRatio(a, b, floor) {
+  if (!Number.isFinite(a) || !Number.isFinite(b) || belowReferenceNoise(b, floor)) return null;
+  if (!belowReferenceNoise(a, floor)) return { factor: b / a, atLeast: false };
+  return Number.isFinite(floor) && floor > 0 ? { factor: b / floor, atLeast: true } : null;
+}
+
+/** A factor for people: 3.4, 28, 1200. */
+const times = (f) => (f >= 10 ? String(Math.round(f)) : String(+f.toPrecision(2)));
+
+/**
+ * The live view's comparison: at the largest spp at which at least two of the chosen
+ * estimators have a relative MSE, the lowest against the highest, a ratio only as far as the
+ * reference tells (relmseRatio). '' when there is nothing to compare.
+ */
+export function compareText(order, estimators, floor) {
+  const at = (n, spp) => {
+    const p = (estimators[n] ? estimators[n].points : []).find((q) => q.spp === spp);
+    return p && Number.isFinite(p.relmse) ? p.relmse : null;
+  };
+  const spps = [...new Set(order.flatMap((n) => (estimators[n] ? estimators[n].points : []).map((p) => p.spp)))]
+    .sort((x, y) => y - x);
+  const spp = spps.find((k) => order.filter((n) => at(n, k) !== null).length >= 2);
+  if (spp === undefined) return '';
+  const have = order.filter((n) => at(n, spp) !== null).sort((x, y) => at(x, spp) - at(y, spp));
+  const best = have[0];
+  const worst = have[have.length - 1];
+  const r = relmseRatio(at(best, spp), at(worst, spp), floor);
+  if (!r) return `At ${spp} spp every image is at the reference's noise: the reference cannot tell them apart.`;
+  if (!r.atLeast) {
+    return `At ${spp} spp ${best}'s relative MSE is ${times(r.factor)}× lower than ${worst}'s (one image each: the study ` +
+      'gives error bars).';
+  }
+  return `At ${spp} spp ${best} is at the reference's noise: its relative MSE is at least ${times(r.factor)}× lower than ` +
+    `${worst}'s; by how much more, the reference cannot tell.`;
+}
+
 /** The x values of every estimator's points (sorted, once each) and each estimator's y at
- *  them (null where it has no point): the shape uPlot wants. Pure (web/test). */
-export function alignPoints(order, estimators, key) {
+ *  them: its relative MSE where measured, null where it has no point or is at the reference's
+ *  noise (belowReferenceNoise against `floor`), those x indices listed in `noise` (drawn on the
+ *  floor, never as a number). The shape uPlot wants. Pure (web/test). */
+export function alignPoints(order, estimators, key, floor = null) {
   const xs = [...new Set(order.flatMap((n) => (estimators[n] ? estimators[n].points : []).map((p) => p[key])))]
     .filter((x) => x > 0).sort((a, b) => a - b);
   const at = new Map(xs.map((x, i) => [x, i]));
-  const ys = order.map((n) => {
+  const noise = order.map(() => []);
+  const ys = order.map((n, k) => {
     const y = new Array(xs.length).fill(null);
-    for (const p of (estimators[n] ? estimators[n].points : [])) if (at.has(p[key]) && p.relmse > 0) y[at.get(p[key])] = p.relmse;
+    for (const p of (estimators[n] ? estimators[n].points : [])) {
+      if (!at.has(p[key]) || !Number.isFinite(p.relmse)) continue;
+      if (belowReferenceNoise(p.relmse, floor)) noise[k].push(at.get(p[key]));
+      else y[at.get(p[key])] = p.relmse;
+    }
     return y;
   });
-  return { xs, ys };
+  return { xs, ys, noise };
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -7,7 +7,7 @@ import { el } from '../dom.js';
 import { colorAt } from '../palette.js';
 import {
   LONG_SIDES, LIVE_SAMPLERS, SAMPLER_WHY, MAX_SPP_CHOICES, MAX_LIVE_ESTIMATORS, toneMap, errorMap, wipeClip,
-  wipeFromPointer, commonSpp, zoomStep, duration, liveActive,
+  wipeFromPointer, commonSpp, zoomStep, duration, liveActive, relmseText, compareText,
 } from './model.js';
 import { renderLiveCharts } from './charts.js';
 
@@ -227,9 +227,9 @@ export function renderLive(live, px, dom) {
       const e = live.estimators[key];
       const last = e && e.points.length ? e.points[e.points.length - 1] : null;
       const rel = last && last.spp === e.spp ? last.relmse : null;
-      // the relative MSE less the reference's own variance: at or below 0 the image is as close
-      // to the truth as the reference can tell
-      const relText = rel === null ? '' : rel > 0 ? ` · relMSE ${rel.toPrecision(3)}` : ' · relMSE below the reference\'s noise';
+      // the relative MSE less the reference's own variance: below the reference's own noise the
+      // image is as close to the truth as the reference can tell, and has no number
+      const relText = rel === null ? '' : ` · relMSE ${relmseText(rel, ref.floor)}`;
       text = e && e.spp ? `${e.spp} spp · ${duration(e.seconds)}${relText}` : 'waiting…';
     }
     if (facts.textContent !== text) facts.textContent = text;
@@ -264,8 +264,13 @@ export function renderLive(live, px, dom) {
   $('live-wipe-line').style.left = `${live.view.wipe}%`;
   // the curves and their legend
   const counts = renderLiveCharts(dom, live);
-  $('live-plot-spp').dataset.points = String(counts.spp);
-  $('live-plot-seconds').dataset.points = String(counts.seconds);
+  for (const [id, c] of [['live-plot-spp', counts.spp], ['live-plot-seconds', counts.seconds]]) {
+    $(id).dataset.points = String(c.points);
+    $(id).dataset.noise = String(c.noise);
+    $(id).dataset.lowest = c.lowest === null ? '' : String(c.lowest);
+  }
+  const compare = compareText(live.order, live.estimators, ref.floor);
+  if ($('live-compare').textContent !== compare) $('live-compare').textContent = compare;
   const legendSig = JSON.stringify(live.order);
   if ($('live-legend').dataset.sig !== legendSig) {
     $('live-legend').dataset.sig = legendSig;

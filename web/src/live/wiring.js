@@ -321,7 +321,8 @@ export function startLive(page) {
   });
 
   /** The study's scene changed: a running view of another scene stops; the estimators chosen
-   *  become the new scene's first four; the pool is started (render module loaded) early. */
+   *  become the new scene's defaults (model.js: its MIS estimators and what they combine); the
+   *  pool is started (render module loaded) early. */
   function sceneChanged() {
     const { scene, info, sceneId } = page.study();
     const render = Boolean(info && info.kind === 'render');
@@ -330,7 +331,7 @@ export function startLive(page) {
     sceneKey = next;
     sceneShown = scene;
     if (run) cancel();
-    const chosen = render ? defaultEstimators(info.estimators) : null;
+    const chosen = render ? defaultEstimators(info.estimatorDetails || info.estimators) : null;
     dispatch({ type: 'live/choose', payload: { estimators: chosen } });
     if (render) {
       page.liveReference(page.study().entry); // fetched while the reader looks
@@ -344,6 +345,8 @@ export function startLive(page) {
     store,
     sceneChanged,
     snapshot: () => ({ ...liveSnapshot(store.getState()), size: px.width ? { width: px.width, height: px.height } : null, bands: px.bands,
+      // passes sent and not yet answered (Pause lets them finish)
+      inFlight: run && run.workerState ? run.workerState.reduce((a, x) => a + x.outstanding, 0) : 0,
       canvases: [...document.querySelectorAll('#live-section canvas.live-canvas')].map((c) => ({ key: c.dataset.live || c.id, width: c.width, height: c.height, spp: c.dataset.spp || null })) }),
     active: () => liveActive(store.getState()),
   };

@@ -1,12 +1,23 @@
-// The plots' axes, without uPlot or the DOM (so web/test can import it): fonts and axis style,
+// The plots' axes, without uPlot or the DOM (so web/test can import it): fonts and axis style
+// (larger in large-text mode),
 // tick labels of log axes (10⁻³, N as 2¹⁷), the log10 transform of the y values of the
 // variance and error plots, short durations, and the axis texts of a run (N or spp, variance
 // or relative MSE).
 import { decadeRange } from '../series.js';
+import { textPx } from '../ui/text_size.js';
 
-const FONT = '12px "DejaVu Sans", system-ui, sans-serif';
-const LABEL_FONT = 'bold 12px "DejaVu Sans", system-ui, sans-serif';
-export const AXIS = { stroke: '#1b1f24', font: FONT, labelFont: LABEL_FONT, grid: { stroke: '#e3e7eb', width: 1 }, ticks: { stroke: '#b8c0c8', width: 1 } };
+/** The axes' font size in CSS pixels (16 in large-text mode: ui/text_size.js). */
+export const axisPx = () => textPx(12);
+const FAMILY = '"DejaVu Sans", system-ui, sans-serif';
+/** The style every axis shares; its fonts read when a chart is built (spread), so that a chart
+ *  built in large-text mode gets the large fonts (chart.js gives them the room they need). */
+export const AXIS = {
+  stroke: '#1b1f24',
+  get font() { return `${axisPx()}px ${FAMILY}`; },
+  get labelFont() { return `bold ${axisPx()}px ${FAMILY}`; },
+  grid: { stroke: '#e3e7eb', width: 1 },
+  ticks: { stroke: '#b8c0c8', width: 1 },
+};
 const SUPERSCRIPT = { '-': '⁻', 0: '⁰', 1: '¹', 2: '²', 3: '³', 4: '⁴', 5: '⁵', 6: '⁶', 7: '⁷', 8: '⁸', 9: '⁹' };
 
 /** An integer in superscript digits: -3 -> "⁻³". */
@@ -33,7 +44,7 @@ export function nTickLabels(width, splits) {
   const powers = 2 ** last > 999999;
   // Labels on every `every`-th split (counted from the last), as many as fit side by side
   // (about 8.5 px a character of the axis font, and a gap).
-  const need = (powers ? 3 : String(2 ** last).length) * 8.5 + 10;
+  const need = (powers ? 3 : String(2 ** last).length) * 8.5 * (axisPx() / 12) + 10;
   const step = width / Math.max(1, shown.length - 1);
   let every = 1;
   while (every * step < need && every < shown.length) every *= 2;
@@ -64,6 +75,23 @@ export function log10Ticks(u, splits) {
 }
 
 export const LOG10_AXIS = { values: log10Ticks, incrs: [1, 2, 3, 4, 5, 10, 20, 50, 100], size: 62, space: 22 };
+
+/**
+ * An axis title that fits along its axis: `fits(text)` says whether a text fits; the title is the
+ * whole title where it fits the plot's width (x) or height (y), else the title without its
+ * parenthesised and bracketed asides, else that cut (at a word where it can) with an ellipsis;
+ * never clipped by the canvas (a phone's narrow plots).
+ */
+export function fitAxisTitle(title, fits) {
+  if (fits(title)) return title;
+  const plain = title.replace(/\s*[([][^()[\]]*[)\]]/g, '').trim();
+  if (plain && fits(plain)) return plain;
+  let t = plain || title;
+  // whole words first, then characters
+  while (t.includes(' ') && !fits(`${t}…`)) t = t.slice(0, t.lastIndexOf(' ')).trimEnd();
+  while (t.length > 1 && !fits(`${t}…`)) t = t.slice(0, -1).trimEnd();
+  return `${t}…`;
+}
 
 /** A duration in seconds, short: 0.1 ms, 25 us, 1.5 s. */
 export function shortSeconds(t) {

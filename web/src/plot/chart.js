@@ -8,8 +8,9 @@ import '../pixel_ratio.js';
 import uPlot from '../../vendor/uPlot.esm.js';
 import { fmt } from '../series.js';
 import { el } from '../dom.js';
-import { nTickLabels } from './axes.js';
+import { nTickLabels, axisPx, fitAxisTitle } from './axes.js';
 import { hidesLabel } from './legend.js';
+import { textPx, onTextSize } from '../ui/text_size.js';
 
 export { uPlot };
 
@@ -56,16 +57,53 @@ export function drop(key) {
   }
 }
 
+const fittedTitle = (title) => (u, i) => {
+  const along = u.axes[i].side % 2 === 0 ? u.bbox.width : u.bbox.height;
+  return fitAxisTitle(title, (t) => u.ctx.measureText(t).width <= along);
+};
+
+/** The axes of a chart in the current text size: room for larger ticks and titles in
+ *  large-text mode (sizes and spacing scaled with the font), titles fitted to their axis. */
+function sizedAxes(axes) {
+  const k = axisPx() / 12;
+  return axes.map((a) => {
+    const b = { ...a };
+    if (typeof b.label === 'string') b.label = fittedTitle(b.label);
+    if (k === 1) return b;
+    if (typeof b.size !== 'function') b.size = Math.round((b.size ?? 50) * k);
+    b.labelSize = Math.round((b.labelSize ?? 30) * k);
+    if (typeof b.space === 'number') b.space = Math.round(b.space * k);
+    return b;
+  });
+}
+
+function build(key, c, data) {
+  const opts = c.makeOpts(c);
+  const hooks = { ...(opts.hooks || {}), setCursor: [...((opts.hooks && opts.hooks.setCursor) || []), readout(key)] };
+  if (opts.axes) opts.axes = sizedAxes(opts.axes);
+  c.u = new uPlot({ ...plotSize(c.el), legend: { show: false }, padding: [14, 36, 0, 0], ...opts, hooks }, data, c.el);
+}
+
+/** Builds every chart again with its data (the text size changed: fonts and room). */
+export function rebuildAll() {
+  for (const [key, c] of Object.entries(charts)) {
+    const { data } = c.u;
+    c.u.destroy();
+    c.el.replaceChildren();
+    build(key, c, data);
+    applyHidden(c);
+  }
+}
+onTextSize(rebuildAll);
+
 /** Creates or updates chart `key` in `el`: `sig` changes when the series change. */
 export function draw(key, el, sig, makeOpts, data, ranges) {
   let c = charts[key];
   if (!c || c.sig !== sig || c.el !== el) {
     drop(key);
     el.replaceChildren();
-    c = { sig, el, ...ranges };
-    const opts = makeOpts(c);
-    const hooks = { ...(opts.hooks || {}), setCursor: [...((opts.hooks && opts.hooks.setCursor) || []), readout(key)] };
-    c.u = new uPlot({ ...plotSize(el), legend: { show: false }, padding: [14, 36, 0, 0], ...opts, hooks }, data, el);
+    c = { sig, el, makeOpts, ...ranges };
+    build(key, c, data);
     charts[key] = c;
   } else {
     Object.assign(c, ranges);
@@ -168,14 +206,16 @@ export function minorLogGrid(u) {
   ctx.restore();
 }
 
-/** Draws labels at the last visible point of the given series (reference lines). */
+/** Draws labels at the last visible point of the given series (reference lines), left-aligned
+ *  there and kept within the plot (shortened where it is narrower than the label). */
 export function labelHook(items) {
   return (u) => {
     const ctx = u.ctx;
     const px = uPlot.pxRatio || 1;
     ctx.save();
-    ctx.font = `${11 * px}px "DejaVu Sans", sans-serif`;
+    ctx.font = `${textPx(11) * px}px "DejaVu Sans", sans-serif`;
     ctx.fillStyle = '#555';
+    ctx.textAlign = 'left';
     ctx.textBaseline = 'bottom';
     const { min: ymin, max: ymax } = u.scales.y;
     for (const { idx, label } of items) {
@@ -184,11 +224,13 @@ export function labelHook(items) {
       let last = -1;
       for (let i = 0; i < ys.length; i++) if (ys[i] !== null && ys[i] >= ymin && ys[i] <= ymax) last = i;
       if (last < 0) continue;
-      const w = ctx.measureText(label).width;
+      // within the plot's width: shortened as axis titles are where it does not fit (a phone)
+      const text = fitAxisTitle(label, (t) => ctx.measureText(t).width <= u.bbox.width - 4 * px);
+      const w = ctx.measureText(text).width;
       let x = u.valToPos(u.data[0][last], 'x', true) + 4 * px;
-      x = Math.min(x, u.bbox.left + u.bbox.width - w - 2 * px);
-      const y = Math.max(u.bbox.top + 12 * px, u.valToPos(ys[last], 'y', true) - 2 * px);
-      ctx.fillText(label, x, y);
+      x = Math.max(u.bbox.left + 2 * px, Math.min(x, u.bbox.left + u.bbox.width - w - 2 * px));
+      const y = Math.max(u.bbox.top + (textPx(11) + 1) * px, u.valToPos(ys[last], 'y', true) - 2 * px);
+      ctx.fillText(text, x, y);
     }
     ctx.restore();
   };

@@ -4,13 +4,19 @@
 // what structure a point set has (strataText).
 import { runningEstimate, fmt } from '../series.js';
 import { withAlpha } from '../palette.js';
+import { textPx, largeText } from '../ui/text_size.js';
 
 export const PANEL = 240; // logical size of a scatter panel (CSS scales it to the card)
 const PAD = { l: 38, r: 6, t: 6, b: 18 };
 
+/** The panels' label size in logical pixels: 10, or in large-text mode 16 / 0.8, so that the
+ *  labels stay at least 16 CSS pixels on a canvas the page shows down to 0.8 of its size. */
+const labelPx = () => (largeText() ? textPx(10) / 0.8 : 10);
+
 /** A canvas of w x h logical pixels with a plot area mapping [xr] x [yr]; returns helpers. */
 export function panel(w, h, xr, yr, padLeft = PAD.l) {
-  const P = { ...PAD, l: padLeft };
+  const k = labelPx() / 10; // room for the labels
+  const P = { ...PAD, l: Math.round(padLeft * k), b: Math.round(PAD.b * k) };
   const px = window.devicePixelRatio || 1;
   const c = document.createElement('canvas');
   c.width = Math.round(w * px);
@@ -28,7 +34,7 @@ export function panel(w, h, xr, yr, padLeft = PAD.l) {
     ctx.lineWidth = 1;
     ctx.strokeRect(P.l + 0.5, P.t + 0.5, iw - 1, ih - 1);
     ctx.fillStyle = '#5a6470';
-    ctx.font = '10px "DejaVu Sans", sans-serif';
+    ctx.font = `${labelPx()}px "DejaVu Sans", sans-serif`;
     ctx.textBaseline = 'top';
     ctx.textAlign = 'left';
     ctx.fillText(fmt(xr[0], 3), P.l, P.t + ih + 3);
@@ -240,7 +246,7 @@ export function runningPanel(e, k, exact, color, band = true) {
   p.ctx.fillStyle = '#fff';
   p.ctx.fillRect(P.l, p.ih + P.t + 1, p.iw, P.b - 1);
   p.ctx.fillStyle = '#5a6470';
-  p.ctx.font = '10px "DejaVu Sans", sans-serif';
+  p.ctx.font = `${labelPx()}px "DejaVu Sans", sans-serif`;
   p.ctx.textBaseline = 'top';
   p.ctx.textAlign = 'left';
   p.ctx.fillText('1', P.l, P.t + p.ih + 3);

@@ -11,6 +11,7 @@ import { dom, empty } from './chart.js';
 import { sceneColor, swatch } from './legend.js';
 import { PANEL, panel, dots, strataLines, mapLines, boxOutlines, strataText, runningPanel, firstRandomizationSize, sobolNetCells } from './sample_panels.js';
 import { renderOverlay, renderMisWeights, renderWeights } from './weights.js';
+import { largeText } from '../ui/text_size.js';
 
 let samplesDrawn = null; // [data, weights, status, sceneInfo] last drawn
 const BIG_PANEL = 400;   // logical size of the panels of a randomized QMC set's one randomization
@@ -86,7 +87,7 @@ export function renderSampleViews(state) {
   if (!dom.samples) return;
   replay.state = state;
   const smp = state.samples;
-  const sig = [smp.data, smp.weights, smp.status, state.sceneInfo, smp.message];
+  const sig = [smp.data, smp.weights, smp.status, state.sceneInfo, smp.message, largeText()];
   if (samplesDrawn && sig.every((v, i) => v === samplesDrawn[i])) return;
   if (!samplesDrawn || samplesDrawn[0] !== smp.data) {
     clearInterval(replay.timer);

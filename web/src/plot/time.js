@@ -9,6 +9,7 @@ import { AXIS, LOG10_AXIS, decadeLabel, lg, lgAll, log10Range, shortSeconds, run
 import { uPlot, charts, dom, draw, drop, empty, setText, logX, log10Y, minorLogGrid } from './chart.js';
 import { colorOf, isHidden, setLegend } from './legend.js';
 import { placeGuideLabels } from './guide_labels.js';
+import { textPx } from '../ui/text_size.js';
 
 /** Joins each series' points in the order of N (time is not monotone in N: uPlot's own
  *  lines would join them in the order of x). */
@@ -65,13 +66,14 @@ function drawGuideLabels(u, ctx, guides, px) {
   if (!guides.length) return;
   ctx.setLineDash([]);
   ctx.fillStyle = '#555';
-  ctx.font = `${11 * px}px "DejaVu Sans", sans-serif`;
+  const size = textPx(11);
+  ctx.font = `${size * px}px "DejaVu Sans", sans-serif`;
   ctx.textAlign = 'right';
   ctx.textBaseline = 'bottom';
   const ys = placeGuideLabels(guides.map((g) => ({ x: g.x, y: g.y, width: ctx.measureText(g.label).width })),
-    { height: 13 * px, gap: 1 * px, top: u.bbox.top, bottom: u.bbox.top + u.bbox.height });
+    { height: (size + 2) * px, gap: 1 * px, top: u.bbox.top, bottom: u.bbox.top + u.bbox.height });
   guides.forEach((g, i) => ctx.fillText(g.label, g.x, ys[i]));
-  lastGuideLabels = guides.map((g, i) => ({ label: g.label, x: g.x / px, y: ys[i] / px, wanted: g.y / px, height: 13 }));
+  lastGuideLabels = guides.map((g, i) => ({ label: g.label, x: g.x / px, y: ys[i] / px, wanted: g.y / px, height: size + 2 }));
 }
 
 // The guide labels as last drawn (CSS pixels): for tests (window.mcplayDebug.guideLabels).
@@ -94,7 +96,7 @@ function clockBandHook(floor, stepSeconds) {
     ctx.fillStyle = 'rgba(120, 128, 138, 0.10)';
     ctx.fillRect(x0, u.bbox.top, Math.min(x1, u.bbox.left + u.bbox.width) - x0, u.bbox.height);
     ctx.fillStyle = '#5a6470';
-    ctx.font = `${10 * px}px "DejaVu Sans", sans-serif`;
+    ctx.font = `${textPx(10) * px}px "DejaVu Sans", sans-serif`;
     ctx.textBaseline = 'bottom';
     ctx.textAlign = 'left';
     const text = `under ${CLOCK_STEPS_FITTED} clock steps (${shortSeconds(stepSeconds)}): not fitted`;

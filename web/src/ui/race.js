@@ -11,6 +11,7 @@ import { raceClaim, clockText, pWords } from '../claims.js';
 import { colorAt } from '../palette.js';
 import { fmt } from '../series.js';
 import { el } from '../dom.js';
+import { textPx, largeText } from './text_size.js';
 
 const $ = (id) => document.getElementById(id);
 
@@ -28,6 +29,7 @@ export function mountRace(store) {
 let lastRace = null;
 let lastKind = null;
 let lastClock = null;
+let lastLarge = null;
 
 export function syncRace(state) {
   const race = state.race;
@@ -51,9 +53,10 @@ export function syncRace(state) {
   $('race-progress').value = race.order.length ? done / race.order.length : 0;
   $('race-status').textContent = raceStatus(race, done);
   const clock = `${state.clockStep}|${state.isolated}`;
-  if (race !== lastRace || clock !== lastClock) {
+  if (race !== lastRace || clock !== lastClock || largeText() !== lastLarge) {
     lastRace = race;
     lastClock = clock;
+    lastLarge = largeText();
     drawRace(state);
   }
 }
@@ -182,16 +185,21 @@ function svg(tag, attrs = {}, ...children) {
 }
 
 function axisSvg(axis) {
-  const s = svg('svg', { width: STRIP_W, height: 18, class: 'race-axis', role: 'img', 'aria-label': 'time to the target, log scale' });
+  // the labels' size (16 in large-text mode) sets the axis's height: ticks below the labels
+  const size = textPx(10);
+  const h = size + 8;
+  const s = svg('svg', { width: STRIP_W, height: h, class: 'race-axis', role: 'img', 'aria-label': 'time to the target, log scale' });
   for (let d = axis.a; d <= axis.b; ++d) {
     const x = axis.x(10 ** d);
-    s.append(svg('line', { x1: x, x2: x, y1: 13, y2: 18, stroke: '#999' }));
+    s.append(svg('line', { x1: x, x2: x, y1: h - 5, y2: h, stroke: '#999' }));
     if ((d - axis.a) % axis.step) continue;
-    const label = svg('text', { x, y: 11, 'text-anchor': 'middle', 'font-size': 10, fill: '#555' });
+    // the first label starts at its tick, so that it stays inside the axis at any text size
+    const anchor = d === axis.a ? 'start' : 'middle';
+    const label = svg('text', { x, y: size + 1, 'text-anchor': anchor, 'font-size': size, fill: '#555' });
     label.textContent = formatSeconds(10 ** d);
     s.append(label);
   }
-  const miss = svg('text', { x: axis.censoredX, y: 11, 'text-anchor': 'end', 'font-size': 10, fill: '#555' });
+  const miss = svg('text', { x: axis.censoredX, y: size + 1, 'text-anchor': 'end', 'font-size': size, fill: '#555' });
   miss.textContent = '∞';
   s.append(miss);
   return s;
