@@ -16,7 +16,9 @@ import { infiniteVariance } from '../claims/fit.js';
  */
 // Under an infinite variance (the core's heavy_tail at warning or error: claims/fit.js) lo and hi
 // are null: a chi-square interval describes a finite variance, and the plotted level of an
-// infinite one is only the largest weight seen so far (`infinite` true).
+// infinite one is dominated by the largest weights seen so far (`infinite` true).
+// noiseAt (per x): a render level at the reference's noise (below_reference_noise), whose value
+// the page shows in words (claims/reference_noise.js).
 // Each series also has exactAt (per x: 'exact' when that level's replicates equal the exact value
 // to round-off, 'agree' when they only agree with each other (claims/exact.js), else false; y is
 // null at both, a variance of 0 having no place on a log axis) and exact ('exact' or 'agree' when
@@ -32,8 +34,10 @@ export function varianceSeries(records, order, exact = null, xs = null) {
     const lo = [];
     const hi = [];
     const exactAt = [];
+    const noiseAt = [];
     for (const n of x) {
       const l = byN.get(n);
+      noiseAt.push(Boolean(l && l.below_reference_noise === true));
       const kind = l ? levelExactness(l, useMse ? exact : null) : 'no';
       exactAt.push(kind === 'no' ? false : kind);
       if (!l || kind !== 'no') {
@@ -51,7 +55,7 @@ export function varianceSeries(records, order, exact = null, xs = null) {
       hi.push(ci ? positive(ci[1] * scale) : null);
     }
     const all = recordExactness(records[name], useMse ? exact : null).all;
-    return { name, y, lo, hi, exactAt, exact: all, infinite, fit: records[name].fit || null };
+    return { name, y, lo, hi, exactAt, noiseAt, exact: all, infinite, fit: records[name].fit || null };
   });
   return { quantity: useMse ? 'mse' : 'variance', x, series };
 }
