@@ -98,7 +98,7 @@ export function timeSlopeClaim(record, { exact = null, floorSeconds = 0, measure
       return none(`no slope: the time does not grow in proportion to ${nName} (a fixed cost dominates it)`,
         { steady: steady.length, fixedCost: cost });
     }
-    return none(`no slope: the time per sample scatters ${fmt(costs[costs.length - 1] / costs[0], 2)}× between levels (timing noise; no fixed cost shows)`,
+    return none(`no slope: the time per sample varies ${fmt(costs[costs.length - 1] / costs[0], 2)}× between levels, and no fixed cost shows in it`,
       { steady: steady.length, fixedCost: cost });
   }
   // log error has the sampling noise of a chi-square variance: sd(log s^2) = sqrt(trigamma(k / 2)),
