@@ -439,6 +439,10 @@ test('claims hold on singular_power_0.9: no order under an infinite variance, no
     const text = await page.textContent(`[data-fit="${name}"]`);
     assert.doesNotMatch(text, /\d\.\d{3} ±/, `${name}: an order under an infinite variance`);
     assert.match(text, /infinite/);
+    // the time legend follows the same rule (it said "t^-0.120 ± 0.089")
+    const time = await page.textContent(`#legend-time li[data-series="${name}"]`);
+    assert.doesNotMatch(time, /t\^|\d\.\d{3} ±/, `${name}: a time order under an infinite variance: "${time}"`);
+    assert.match(time, /infinite/);
   }
   const coverage = await page.textContent('#legend-coverage');
   assert.doesNotMatch(coverage, /above 0\.95 by design|as designed/);
@@ -811,6 +815,36 @@ test('one render estimator is split over the workers by replicate and merged as 
   });
   assertOrderShown(await page.textContent('[data-fit="mis_power"]'), native.fit, 'mis_power', 0.0015);
   assert.deepEqual(state.images.estimators.mis_power, { preview: true, error: true, n: 8 });
+});
+
+// Veach's scene: the MIS estimators' contributions are bounded, so the core's heavy_tail is at
+// info and the page keeps their lesson (issue 48): an order in the legend, a place in the
+// equal-time comparison, tail words that do not call their variance infinite, and a time legend
+// that speaks as the relative-MSE legend does.
+test('veach_mis: bounded MIS keeps its order, tail words and equal-time comparison in the page', async () => {
+  const estimators = ['bsdf', 'mis_balance', 'mis_power'];
+  await configure('veach_mis', estimators, { nMin: 1, nMax: 16, reps: 4, seed: 1 });
+  await page.click('#run');
+  await page.waitForFunction(() => document.querySelector('#status')?.textContent.startsWith('done'), null,
+    { timeout: 120000 });
+  const state = await page.evaluate(() => window.mcplayDebug.state());
+  for (const name of ['mis_balance', 'mis_power']) {
+    const est = state.estimators.find((e) => e.name === name);
+    assert.equal(est.contribution_bound?.bounded, true, `${name}: bounded on Veach's scene`);
+    assert.ok(!est.warnings.some((w) => w.code === 'heavy_tail' && w.severity !== 'info'), `${name}: heavy_tail above info`);
+    const fit = await page.textContent(`[data-fit="${name}"]`);
+    assert.doesNotMatch(fit, /infinite/, `${name}: "${fit}"`);
+    const time = await page.textContent(`#legend-time li[data-series="${name}"]`);
+    assert.doesNotMatch(time, /infinite|fixed cost dominates/, `${name}: "${time}"`);
+    console.log(`# ${name}: time legend "${time}"; seconds per image ${est.levels.map((l) => l.time_mean_s.toExponential(2)).join(', ')}`);
+    const summary = await page.textContent(`#levels details[data-for="${name}"] summary`);
+    assert.match(summary, /tail of the weights at spp = 16: /);
+    assert.doesNotMatch(summary, /heavy: infinite variance/, `${name}: "${summary}"`);
+  }
+  const verdict = await page.textContent('#time-verdict');
+  assert.doesNotMatch(verdict, /Fewer than two|infinite variance/, verdict);
+  assert.match(verdict, /mis_balance|mis_power/);
+  await page.screenshot({ path: join(shots, 'render_veach_mis.png'), fullPage: true });
 });
 
 // A bundled render scene at its own size: the reference the site ships is used (the page

@@ -4,7 +4,8 @@
 // size, heavy_tail by the tail index, level_drift by the consistency test, ...). A pure render
 // of the state, text only (never HTML from data).
 import { collectWarnings, fmt, severityOf, nText } from './series.js';
-import { alarmSummary, densityWords, flagShort, flagTitle, orderClaim, pWords, tailWords } from './claims.js';
+import { alarmSummary, densityWords, flagShort, flagTitle, orderClaim, pWords, tailText, relativeMseText,
+  referenceFloorOf } from './claims.js';
 import { colorAt } from './palette.js';
 import { el } from './dom.js';
 
@@ -38,11 +39,27 @@ const RENDER_LABELS = {
   n: 'spp', mean: 'mean luminance', variance: 'relative MSE', vci: 'relative MSE 95% CI',
   error: 'relative RMSE', coverage: 'pixel coverage95', time: 'time/image [s]', share: 'max sample share',
 };
-const RENDER_COLUMNS = COLUMNS.filter(([key]) => key !== 'ess')
-  .map(([key, label, get]) => [key, RENDER_LABELS[key] || label, get]);
+// A relative MSE at the reference's noise is words, never a number (claims/reference_noise.js):
+// its value, interval and root.
+function renderColumns(floor) {
+  const below = (l) => l.below_reference_noise === true;
+  const noise = {
+    variance: (l) => relativeMseText(l.variance, { floor, below: below(l) }),
+    vci: (l, get) => (below(l) ? '—' : get(l)),
+    error: (l) => relativeMseText(l.error, { floor, below: below(l), root: true }),
+  };
+  return COLUMNS.filter(([key]) => key !== 'ess')
+    .map(([key, label, get]) => [key, RENDER_LABELS[key] || label,
+      noise[key] ? (l) => noise[key](l, get) : get]);
+}
+
+/** The reference's relative-MSE floor of a render run: the merged result's, else a worker's. */
+function runFloor(run) {
+  return referenceFloorOf(run.result) ?? (run.partials || []).map(referenceFloorOf).find((v) => v !== null) ?? null;
+}
 
 function columnsOf(run) {
-  return run.kind === 'render' ? RENDER_COLUMNS : COLUMNS;
+  return run.kind === 'render' ? renderColumns(runFloor(run)) : COLUMNS;
 }
 
 
@@ -130,7 +147,7 @@ function estimatorTable(r, run, isOpen) {
       nName: run.kind === 'render' ? 'spp' : 'N', measure: run.kind === 'render' ? 'relative MSE' : 'variance' }).text)),
     r.consistency ? el('span', {}, `level consistency ${pWords(r.consistency.p_value)}`, ...flags('consistency')) : null,
     r.support_check && r.importance ? el('span', {}, `pdf support: ${r.support_check.missed} of ${r.support_check.probes} probes missed`, ...flags('support')) : flags('support').length ? el('span', {}, ...flags('support')) : null,
-    last ? el('span', {}, `tail of the weights at ${run.kind === 'render' ? 'spp' : 'N'} = ${last.n}: ${tailWords(last.tail_index)}`, ...flags('tail')) : null,
+    last ? el('span', {}, `tail of the weights at ${run.kind === 'render' ? 'spp' : 'N'} = ${last.n}: ${tailText(r, last)}`, ...flags('tail')) : null,
     last && run.kind !== 'render' ? el('span', {}, `ESS at N=${last.n}: ${fmt(last.ess, 3)}`) : null,
     run.kind === 'render' && typeof r.rays_per_second === 'number' ? el('span', {}, `${fmt(r.rays_per_second, 3)} rays/s`) : null,
   );

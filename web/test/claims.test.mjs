@@ -10,7 +10,8 @@ import {
   levelExactness, recordExactness, orderClaim, conservativeClaim, coverageText, coincidentGroups,
   coincidentNote, withinText, alarmSummary, flagPersistence, equalTimeClaim, seLogMse, timeSlopeClaim,
   varianceNote, timeNote, legendLines, FLAG_WORDS, flagTitle, flagShort, pWords, tailWords, densityWords,
-  methodWords, inputErrorWords, chi2Sf, trigamma, fitLine, infiniteVariance,
+  methodWords, inputErrorWords, chi2Sf, trigamma, fitLine, infiniteVariance, fixedCost, tailText,
+  relativeMseText, atReferenceNoise, referenceNoiseWords, referenceFloorOf,
 } from '../src/claims.js';
 import { collectWarnings, calibrationSeries, coverageSeries, varianceSeries, zScores } from '../src/series.js';
 
@@ -469,4 +470,145 @@ test('a heavy tail at info is not worded as a possibly infinite variance', () =>
   assert.doesNotMatch(flagShort('heavy_tail', 'info'), /infinite/);
   assert.doesNotMatch(flagTitle('heavy_tail', 'info'), /may be infinite/);
   assert.match(flagShort('heavy_tail', 'warning'), /infinite/);
+});
+
+// ---------------------------------------------------------------------------------------------
+// Issue 48, item 2 (the study page): each rule where it must be said and where it must not.
+
+/** A copy of a record with its heavy_tail flag at `severity` (none: removed). */
+function withHeavyTail(r, severity) {
+  const warnings = (r.warnings || []).filter((w) => w.code !== 'heavy_tail');
+  if (severity) warnings.push({ code: 'heavy_tail', severity, message: 'tail index 1.2' });
+  return { ...r, warnings };
+}
+
+test('time legend: no order under an infinite variance, as the MSE legend; an order at info', () => {
+  for (const name of ['uniform', 'stratified', 'importance_half']) {
+    const r = singular.records[name];
+    const c = timeSlopeClaim(r, { exact: singular.exact, floorSeconds: 0, measure: 'mse' });
+    assert.equal(c.slope, null, name);
+    assert.doesNotMatch(c.text, /t\^/, `${name}: ${c.text}`);
+    assert.match(c.text, /MSE is infinite/);
+    assert.equal(c.text, orderClaim(r, { exact: singular.exact, measure: 'MSE' }).text, 'the same words as the MSE legend');
+  }
+  // the same points without the flag at warning (at info) get their slope
+  const jitter = [1.05, 0.97, 1.02, 0.99, 1.04, 0.96, 1.01];
+  const r = timedRecord(ns.map((n, i) => [n, 1e-8 * n, jitter[i] / Math.sqrt(n)]), { warnings: [{ code: 'heavy_tail', severity: 'info' }] });
+  assert.match(timeSlopeClaim(r, { floorSeconds: 5e-6 }).text, /^error ∝ t\^-0\.\d{3} ± /);
+  assert.doesNotMatch(timeSlopeClaim(withHeavyTail(r, 'warning'), { floorSeconds: 5e-6 }).text, /t\^/);
+});
+
+test('variance plot: no chi-square band around an infinite variance; the band where it is finite', () => {
+  const bands = (records, order) => varianceSeries(records, order, singular.exact).series;
+  for (const s of bands(singular.records, ['uniform', 'stratified'])) {
+    assert.equal(s.infinite, true);
+    assert.ok(s.y.some((v) => v !== null), `${s.name} keeps its points`);
+    assert.ok(s.lo.every((v) => v === null) && s.hi.every((v) => v === null), `${s.name}: no band`);
+  }
+  const finite = { uniform: withHeavyTail(singular.records.uniform, 'info') };
+  const [s] = bands(finite, ['uniform']);
+  assert.equal(s.infinite, false);
+  assert.ok(s.lo.some((v) => v !== null) && s.hi.some((v) => v !== null), 'a finite variance keeps its band');
+});
+
+/** Timed levels at N = ns: seconds t(n, i), error 1/sqrt(n), and a 95% timing interval of
+ *  +-`rel` (none when rel is null, as render levels have). */
+function timedLevels(t, rel = 0.05) {
+  return { warnings: [], levels: ns.map((n, i) => {
+    const s = t(n, i);
+    return { n, reps: 32, time_median_s: s, time_mean_s: s, error: 1 / Math.sqrt(n), mean: 1,
+      ...(rel === null ? {} : { time_median_ci95_s: [s * (1 - rel), s * (1 + rel)] }) };
+  }) };
+}
+// The per-sample cost of levels that merely scatter (timing noise on a busy machine), a fixed
+// sequence: up to 4x apart, no trend in N.
+const SCATTER = [1, 2.5, 0.6, 1.8, 0.7, 2.2, 1.0];
+const WOBBLE = [1.04, 0.97, 1.02, 0.99, 1.03, 0.96, 1.01];
+
+test('fixedCost: shown where the time at small N is flat and above the proportional line, not where it scatters', () => {
+  for (const rel of [0.05, null]) {
+    const fixed = timedLevels((n, i) => (1e-3 + 1e-9 * n) * WOBBLE[i], rel);
+    const c = timeSlopeClaim(fixed, { floorSeconds: 1e-4 });
+    assert.equal(c.slope, null);
+    assert.match(c.text, /a fixed cost dominates/, `intervals ${rel}`);
+    assert.ok(c.evidence.fixedCost.z > 3);
+    // the timings merely scatter: no fixed cost named, whatever the intervals say
+    for (const seq of [SCATTER, SCATTER.slice().reverse()]) {
+      const noisy = timedLevels((n, i) => 1e-8 * n * seq[i], rel);
+      const d = timeSlopeClaim(noisy, { floorSeconds: 1e-7 });
+      assert.equal(d.slope, null);
+      assert.doesNotMatch(d.text, /fixed cost dominates/, `intervals ${rel}: ${d.text}`);
+      assert.match(d.text, /varies 4.2× between levels, and no fixed cost shows/);
+      assert.equal(d.evidence.fixedCost.shown, false);
+    }
+  }
+  // one slow level at the smallest N is no fixed cost either
+  const pts = (f) => ns.map((n, i) => ({ n, t: f(n, i), sdLog: null }));
+  assert.equal(fixedCost(pts((n, i) => 1e-8 * n * (i === 0 ? 3 : WOBBLE[i]))).shown, false);
+  assert.equal(fixedCost(pts((n, i) => 1e-8 * n * WOBBLE[i])).shown, false, 'proportional time');
+  assert.equal(fixedCost(pts((n, i) => (2e-5 + 1e-8 * n) * WOBBLE[i])).shown, true, 'dominant at N = 1024 only');
+  assert.equal(fixedCost(pts((n, i) => (2e-6 + 1e-8 * n) * WOBBLE[i])).shown, false, 'a fixed cost that never dominates');
+});
+
+test('tail words follow the core\'s severity, not the tail index alone', () => {
+  const level = { n: 64, tail_index: 1.3 };
+  const bounded = { contribution_bound: { bounded: true, reason: 'multiple importance sampling with BSDF sampling' } };
+  // at info (bounded contributions): finite, with the reason
+  const info = { ...bounded, warnings: [{ code: 'heavy_tail', severity: 'info' }] };
+  assert.doesNotMatch(tailText(info, level), /infinite variance/);
+  assert.match(tailText(info, level), /variance is finite: the contributions are bounded \(multiple importance/);
+  assert.doesNotMatch(tailText({ warnings: [] }, level), /^heavy: infinite/);
+  assert.match(tailText({ warnings: [] }, level), /no alarm/);
+  // at warning: infinite
+  assert.match(tailText({ warnings: [{ code: 'heavy_tail', severity: 'warning' }] }, level), /heavy: infinite variance/);
+  // the 4th moment likewise
+  assert.match(tailText({ warnings: [{ code: 'heavy_tail_4', severity: 'warning' }] }, { tail_index: 3 }), /infinite 4th moment/);
+  assert.match(tailText({ warnings: [{ code: 'heavy_tail_4', severity: 'info' }] }, { tail_index: 3 }), /no alarm/);
+  assert.match(tailText(info, { tail_index: 52200 }), /light/);
+  // and the order and the equal-time verdict: an info flag keeps both
+  const r = { ...info, levels: [timedLevel(1e-6, 1e-3)], fit: ladderFit(null, { p: 0.3 }) };
+  assert.notEqual(orderClaim(r).number, null);
+  assert.equal(orderClaim(withHeavyTail(r, 'warning')).number, null);
+  const v = equalTimeClaim({ a: rec('a', timedLevel(1e-4, 1e-3)), b: { ...r, name: 'b' } }, ['a', 'b']);
+  assert.ok(!v.left.some((x) => x.name === 'b'), 'an info flag does not leave b out');
+  const w = equalTimeClaim({ a: rec('a', timedLevel(1e-4, 1e-3)), b: withHeavyTail({ ...r, name: 'b' }, 'warning') }, ['a', 'b']);
+  assert.ok(w.left.some((x) => x.name === 'b'));
+});
+
+test('reference noise: a relative MSE below the reference\'s noise is words, never a number', () => {
+  const floor = 1.6e-3;
+  assert.equal(relativeMseText(-2.1e-5, { floor, below: true }), 'at the reference\'s noise (below 0.0016)');
+  assert.equal(relativeMseText(1e-4, { floor, below: true }), 'at the reference\'s noise (below 0.0016)');
+  assert.equal(relativeMseText(0.013, { floor, below: false }), '0.013');
+  // the core's verdict wins; without it, the value against the floor
+  assert.equal(atReferenceNoise(1e-4, { floor }), true);
+  assert.equal(atReferenceNoise(-1e-6, {}), true);
+  assert.equal(atReferenceNoise(0.01, { floor }), false);
+  assert.equal(atReferenceNoise(1e-4, { floor, below: false }), false);
+  // the root: relative RMSE below sqrt(floor)
+  assert.equal(relativeMseText(0.01, { floor, root: true }), 'at the reference\'s noise (below 0.04)');
+  assert.equal(relativeMseText(0.1, { floor, root: true }), '0.1');
+  assert.equal(referenceNoiseWords(null), 'at the reference\'s noise');
+  assert.equal(referenceFloorOf({ scene: { reference: { relative_mse_floor: floor } } }), floor);
+  assert.equal(referenceFloorOf({ reference_summary: { relative_mse_floor: floor } }), floor);
+  assert.equal(referenceFloorOf({ scene: { reference: { relative_mse_floor: null } } }), null);
+});
+
+test('equal time in a render study: levels at the reference\'s noise have no efficiency', () => {
+  const lvl = (n, v, below, t) => ({ n, reps: 4, variance: v, mse: v, time_mean_s: t, time_std_s: 0.1 * t,
+    variance_ci95: [v * 0.7, v * 1.4], below_reference_noise: below });
+  // mis reaches the reference's noise at 64 spp: compared at 32, never from its number at 64
+  const mis = { name: 'mis', warnings: [], levels: [lvl(16, 0.05, false, 0.2), lvl(32, 0.025, false, 0.4), lvl(64, -1e-4, true, 0.8)] };
+  const bsdf = { name: 'bsdf', warnings: [], levels: [lvl(16, 5, false, 0.1), lvl(32, 2.5, false, 0.2), lvl(64, 1.2, false, 0.4)] };
+  const v = equalTimeClaim({ mis, bsdf }, ['mis', 'bsdf'], { render: true, referenceFloor: 1.6e-3 });
+  assert.equal(v.ranked.find((x) => x.name === 'mis').n, 32);
+  assert.equal(v.ranked.find((x) => x.name === 'bsdf').n, 64);
+  assert.match(v.text, /above the reference's noise/);
+  assert.doesNotMatch(v.text, /zero relative MSE/);
+  // at the noise at every spp: left out in those words
+  const flat = { name: 'flat', warnings: [], levels: [lvl(16, 1e-5, true, 0.2)] };
+  const w = equalTimeClaim({ flat, bsdf }, ['flat', 'bsdf'], { render: true, referenceFloor: 1.6e-3 });
+  assert.match(w.text, /flat \(relative MSE at the reference's noise \(below 0\.0016\) at every spp\)/);
+  // none at the noise: the words stay as they were
+  assert.doesNotMatch(equalTimeClaim({ bsdf, b2: { ...bsdf, name: 'b2' } }, ['bsdf', 'b2'], { render: true }).text, /reference's noise/);
 });

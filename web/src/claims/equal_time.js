@@ -1,13 +1,16 @@
 // Who wins at equal time, said only where the data and the clock support it: the efficiency
 // 1 / (error^2 x seconds) at the largest N each estimator reached, with its uncertainty in log
 // space; no winner from times the clock cannot resolve, from an infinite variance, from
-// replicates that merely agree, or without an uncertainty to test the difference.
+// replicates that merely agree, or without an uncertainty to test the difference. A render
+// level at the reference's noise has no efficiency (its relative MSE is no number the data
+// support: claims/reference_noise.js): a render estimator is compared at its largest spp above it.
 // Pure (no DOM): web/test/claims.test.mjs runs it under Node.
 import { positive } from '../series/numbers.js';
 import { fmt } from '../series/text.js';
 import { timeOf, timeInterval } from '../series/time.js';
 import { levelExactness } from './exact.js';
 import { infiniteVariance } from './fit.js';
+import { referenceNoiseWords } from './reference_noise.js';
 
 const Z95 = 1.959963984540054;
 
@@ -28,18 +31,29 @@ export function seLogMse(level) {
 /**
  * The equal-time claim: {text, winner (a name or null), ranked, left: [{name, why}]}.
  * `floorSeconds`: times below it are not compared (20 clock steps); `clockKnown` false names no
- * winner at all; `render`: relative MSE per image.
+ * winner at all; `render`: relative MSE per image, `referenceFloor` the reference's relative-MSE
+ * floor (for the words).
  */
-export function equalTimeClaim(records, order, { exact = null, floorSeconds = 0, clockKnown = true, render = false, nName = render ? 'spp' : 'N' } = {}) {
+export function equalTimeClaim(records, order, { exact = null, floorSeconds = 0, clockKnown = true, render = false,
+  nName = render ? 'spp' : 'N', referenceFloor = null } = {}) {
   const useMse = !render && typeof exact === 'number' && Number.isFinite(exact);
   const what = render ? 'relative MSE' : useMse ? 'MSE' : 'variance';
   const rows = [];
   const exactOnes = [];
   const left = [];
+  const belowNoise = [];
   for (const name of order) {
     const r = records[name];
-    const l = r && r.levels.length ? r.levels[r.levels.length - 1] : null;
-    if (!l) continue;
+    // a render study's largest level above the reference's noise
+    const usable = r ? (render ? r.levels.filter((x) => x.below_reference_noise !== true) : r.levels) : [];
+    const l = usable.length ? usable[usable.length - 1] : null;
+    if (!l) {
+      if (r && r.levels.length) {
+        left.push({ name, why: `relative MSE ${referenceNoiseWords(referenceFloor)} at every ${nName}` });
+      }
+      continue;
+    }
+    if (render && l !== r.levels[r.levels.length - 1]) belowNoise.push(name);
     const kind = render ? 'no' : levelExactness(l, exact);
     if (kind === 'exact') {
       // Exact from which N on (every level after it is exact too): "at any time" only when
@@ -105,7 +119,8 @@ export function equalTimeClaim(records, order, { exact = null, floorSeconds = 0,
       text: left.length ? `Fewer than two estimators can be compared at equal time.${leftText}` : '' };
   }
   const [a, b] = rows;
-  const lead = `at the largest ${nName} each reached (1 / (${what} × seconds); it grows with ${nName} for estimators steeper than ${nName}⁻¹)`;
+  const above = render && belowNoise.length ? ' above the reference\'s noise' : '';
+  const lead = `at the largest ${nName} each reached${above} (1 / (${what} × seconds); it grows with ${nName} for estimators steeper than ${nName}⁻¹)`;
   if (a.se === null || b.se === null) {
     return { winner: null, ranked: rows, left,
       text: `No winner named at equal time: ${a.name} is ${fmt(a.efficiency / b.efficiency, 2)}× ${b.name} ${lead}, but without an uncertainty of both (error and timing) the difference cannot be tested.${leftText}` };

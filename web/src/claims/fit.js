@@ -10,11 +10,25 @@ import { recordExactness } from './exact.js';
 /** A whole-range fit is a power law when its chi-square p is at least this. */
 export const FIT_P_WHOLE = 1e-3;
 
-/** Does the estimator carry a heavy_tail flag of severity warning or error: tail index <= 2,
- *  an infinite variance, which has no order? */
+/** The core's heavy_tail flag on an estimator at severity warning or error, else null. The
+ *  core alone judges the tail (persistence over the levels, bounded contributions of a render
+ *  estimator: src/render/contribution_bound.*); a tail index at or below 2 with the flag at
+ *  info, or without it, is no infinite variance. */
+export function heavyTailAlarm(record) {
+  return ((record && record.warnings) || []).find((w) => w.code === 'heavy_tail'
+    && (w.severity === 'warning' || w.severity === 'error')) || null;
+}
+
+/** Does the estimator carry a heavy_tail flag of severity warning or error: an infinite
+ *  variance, which has no order? */
 export function infiniteVariance(record) {
-  return ((record && record.warnings) || []).some((w) => w.code === 'heavy_tail'
-    && (w.severity === 'warning' || w.severity === 'error'));
+  return heavyTailAlarm(record) !== null;
+}
+
+/** Why an infinite variance has no order, in words (the MSE legend's and the time legend's). */
+export function infiniteVarianceText(record, measure = 'variance') {
+  const w = heavyTailAlarm(record);
+  return `no order: the core flags a heavy tail of the weights (heavy_tail, ${w ? w.severity : 'warning'}), so the ${measure} is infinite and has no slope`;
 }
 
 function rangeText(n0, n1, nName) {
@@ -36,8 +50,7 @@ export function orderClaim(record, { which = 'fit', exact = null, nName = 'N', m
     return { text: 'zero spread at every N: nothing to fit', number: null, note: 'agree', holds: false, evidence };
   }
   if (infiniteVariance(record)) {
-    return { text: `no order: the weights have a heavy tail (tail index at most 2), so the ${measure} is infinite and has no slope`,
-      number: null, note: 'heavy tail', holds: false, evidence };
+    return { text: infiniteVarianceText(record, measure), number: null, note: 'heavy tail', holds: false, evidence };
   }
   if (!fit || !fit.valid || typeof fit.order !== 'number') {
     const text = fitText(fit);

@@ -8,13 +8,16 @@ export function designedPixels(records, order) {
   return order.filter((n) => records[n] && records[n].pixel_sampler && records[n].pixel_sampler !== 'independent');
 }
 
+/** Under an infinite variance the plot shows points without a band and the legends no order. */
+const INFINITE_NOTE = 'Where the core flags an infinite variance (heavy tail), no band and no order: each point is dominated by the largest weights seen so far.';
+
 /** The variance plot's note. */
 export function varianceNote(kind, records = {}, order = []) {
   if (kind !== 'render') {
-    return 'Shaded: 95% interval of the variance (chi-square); dashed grey: reference slopes N⁻¹, N⁻², N⁻³ from the first point. Order = the core\'s least-squares fit of log variance on log N, stated only where the levels follow a line (chi-square test against their own noise).';
+    return `Shaded: 95% interval of the variance (chi-square); dashed grey: reference slopes N⁻¹, N⁻², N⁻³ from the first point. Order = the core's least-squares fit of log variance on log N, stated only where the levels follow a line (chi-square test against their own noise). ${INFINITE_NOTE}`;
   }
   const designed = designedPixels(records, order);
-  const base = 'Relative MSE of each estimator\'s images against the reference (mean over the replicates; shaded: its 95% interval from their spread); dashed grey: spp⁻¹ from the first point, the slope of an unbiased estimator with independent pixel samples. Order = the core\'s least-squares fit of log relative MSE on log spp, stated only where the levels follow a line.';
+  const base = `Relative MSE of each estimator's images against the reference (mean over the replicates; shaded: its 95% interval from their spread); dashed grey: spp⁻¹ from the first point, the slope of an unbiased estimator with independent pixel samples. Order = the core's least-squares fit of log relative MSE on log spp, stated only where the levels follow a line. ${INFINITE_NOTE}`;
   if (!designed.length) return base;
   const names = designed.map((n) => `${n} (${records[n].pixel_sampler})`).join(', ');
   return `${base} ${names}: stratified or low-discrepancy pixel samples, so a slope steeper than spp⁻¹ is expected where the image is smooth.`;

@@ -117,7 +117,8 @@ export function draw(key, el, sig, makeOpts, data, ranges) {
 const LOG10_Y = new Set(['variance', 'time', 'live-spp', 'live-seconds']);
 
 /** The hover readout of a chart: the x under the cursor and each shown estimator's value there
- *  (bands, references and hidden series left out), in a box in the plot's corner. */
+ *  (bands, references and hidden series left out), in a box in the plot's corner; a chart's
+ *  `readoutWords(series, index)` (given with its ranges) may put words in a value's place. */
 function readout(key) {
   return (u) => {
     let box = u.root.querySelector('.readout');
@@ -136,7 +137,9 @@ function readout(key) {
       if (k === 0 || !ser.show || typeof ser.label !== 'string' || / 95% |^N|^spp|normal|exact/.test(ser.label)) return;
       const v = u.data[k][i];
       if (v === null || v === undefined || !Number.isFinite(v)) return;
-      lines.push(`${ser.label}: ${fmt(LOG10_Y.has(key) ? 10 ** v : v, 3)}`);
+      // a value the chart shows in words (a relative MSE at the reference's noise)
+      const words = charts[key] && charts[key].readoutWords ? charts[key].readoutWords(k, i) : null;
+      lines.push(`${ser.label}: ${words || fmt(LOG10_Y.has(key) ? 10 ** v : v, 3)}`);
     });
     if (!lines.length) {
       box.hidden = true;

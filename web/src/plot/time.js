@@ -4,7 +4,7 @@
 // shaded, adaptive estimators' time without training dashed; and under it the equal-time
 // verdict and each slope's words (claims/equal_time.js, claims/time_slope.js).
 import { timeSeries, CLOCK_STEPS_FITTED, decadeRange } from '../series.js';
-import { equalTimeClaim, timeSlopeClaim, timeNote } from '../claims.js';
+import { equalTimeClaim, timeSlopeClaim, timeNote, referenceFloorOf } from '../claims.js';
 import { AXIS, LOG10_AXIS, decadeLabel, lg, lgAll, log10Range, shortSeconds, runLabels, isRender } from './axes.js';
 import { uPlot, charts, dom, draw, drop, empty, setText, logX, log10Y, minorLogGrid } from './chart.js';
 import { colorOf, isHidden, setLegend } from './legend.js';
@@ -176,7 +176,8 @@ export function renderTime(state, run, records) {
   const measure = known && !render ? 'mse' : 'variance';
   const exactValue = render ? null : run.exact;
   setLegend('time', dom['legend-time'], ts.series.map((s) => {
-    const slope = timeSlopeClaim(records[s.name], { exact: exactValue, floorSeconds: floor, measure, nName: names.n });
+    const measureName = render ? names.error : measure === 'mse' ? 'MSE' : 'variance';
+    const slope = timeSlopeClaim(records[s.name], { exact: exactValue, floorSeconds: floor, measure, nName: names.n, measureName });
     const fitFrom = slope.slope !== null && s.untimed ? ` (t ≥ ${shortSeconds(floor)})` : '';
     return {
       name: s.name,
@@ -187,6 +188,7 @@ export function renderTime(state, run, records) {
   }));
   // The equal-time statement, once the run is over: none from times the clock cannot resolve.
   const verdict = run.status === 'running' ? null
-    : equalTimeClaim(records, run.order, { exact: exactValue, floorSeconds: floor, clockKnown: state.clockStep > 0, render });
+    : equalTimeClaim(records, run.order, { exact: exactValue, floorSeconds: floor, clockKnown: state.clockStep > 0, render,
+      referenceFloor: render ? referenceFloorOf(run.result) : null });
   setText('time-verdict', verdict ? verdict.text : '');
 }

@@ -3,7 +3,7 @@
 // N^-1, N^-2, N^-3 (spp^-1 for renders), a run kept for comparison dashed, and the levels that
 // are exact to round-off marked along the bottom; its legend gives each estimator's fitted order.
 import { varianceSeries, anchorOf, referenceLines } from '../series.js';
-import { orderClaim, exactnessText, varianceNote } from '../claims.js';
+import { orderClaim, exactnessText, varianceNote, referenceFloorOf, referenceNoiseWords } from '../claims.js';
 import { withAlpha } from '../palette.js';
 import { keptFor } from '../state.js';
 import { AXIS, LOG10_AXIS, sup, lgAll, log10Range, runLabels, isRender } from './axes.js';
@@ -54,9 +54,11 @@ export function renderVariance(state, run, records) {
   const data = [vs.x];
   const series = [{}];
   const bands = [];
+  const noiseAt = new Map(); // data index of a series -> its levels at the reference's noise
   vs.series.forEach((s) => {
     const color = colorOf(run, s.name);
     const yi = data.length;
+    noiseAt.set(yi, s.noiseAt);
     data.push(lgAll(s.y), lgAll(s.hi), lgAll(s.lo));
     series.push(
       { label: s.name, stroke: color, width: 2, points: { show: true, size: 6, fill: color } },
@@ -94,6 +96,8 @@ export function renderVariance(state, run, records) {
       : vs.quantity === 'mse' ? 'MSE against N (exact value known)' : 'Variance against N';
   }
   setText('variance-note', varianceNote(render ? 'render' : 'integral', records, run.order));
+  // A render level at the reference's noise: its value in words in the hover readout.
+  const noiseWords = render ? referenceNoiseWords(referenceFloorOf(run.result)) : null;
   const sig = JSON.stringify([vs.quantity, run.order, run.colors, run.kind, names.nAxis, quantity,
     keptSeries.map((k) => k.name)]);
   draw('variance', dom.variance, sig, (c) => ({
@@ -106,7 +110,7 @@ export function renderVariance(state, run, records) {
     bands,
     cursor: { drag: { x: false, y: false } },
     hooks: { drawAxes: [minorLogGrid], draw: [(u) => labelHook(refItems)(u), (u) => exactHook(exactRows)(u)] },
-  }), data, { xRange, yRange });
+  }), data, { xRange, yRange, readoutWords: (k, i) => (noiseAt.has(k) && noiseAt.get(k)[i] ? noiseWords : null) });
 
   setLegend('variance', dom['legend-variance'], vs.series.map((s) => {
     const r = records[s.name];

@@ -4,6 +4,7 @@
 // re-exports it.
 import { ladder, positive, unionSorted } from './numbers.js';
 import { levelExactness, recordExactness } from '../claims/exact.js';
+import { infiniteVariance } from '../claims/fit.js';
 
 /**
  * The variance plot: x = every N any estimator has reached; per estimator y = its MSE when
@@ -13,6 +14,11 @@ import { levelExactness, recordExactness } from '../claims/exact.js';
  * value. Values that cannot sit on a log axis (0, null) are null. `xs` (optional) fixes the x
  * values, e.g. the whole N ladder of a run that is still going.
  */
+// Under an infinite variance (the core's heavy_tail at warning or error: claims/fit.js) lo and hi
+// are null: a chi-square interval describes a finite variance, and the plotted level of an
+// infinite one is dominated by the largest weights seen so far (`infinite` true).
+// noiseAt (per x): a render level at the reference's noise (below_reference_noise), whose value
+// the page shows in words (claims/reference_noise.js).
 // Each series also has exactAt (per x: 'exact' when that level's replicates equal the exact value
 // to round-off, 'agree' when they only agree with each other (claims/exact.js), else false; y is
 // null at both, a variance of 0 having no place on a log axis) and exact ('exact' or 'agree' when
@@ -23,12 +29,15 @@ export function varianceSeries(records, order, exact = null, xs = null) {
   const x = xs ? xs.slice() : unionSorted(named.flatMap((n) => records[n].levels.map((l) => l.n)));
   const series = named.map((name) => {
     const byN = new Map(records[name].levels.map((l) => [l.n, l]));
+    const infinite = infiniteVariance(records[name]);
     const y = [];
     const lo = [];
     const hi = [];
     const exactAt = [];
+    const noiseAt = [];
     for (const n of x) {
       const l = byN.get(n);
+      noiseAt.push(Boolean(l && l.below_reference_noise === true));
       const kind = l ? levelExactness(l, useMse ? exact : null) : 'no';
       exactAt.push(kind === 'no' ? false : kind);
       if (!l || kind !== 'no') {
@@ -40,13 +49,13 @@ export function varianceSeries(records, order, exact = null, xs = null) {
       const variance = l.variance;
       const v = useMse && l.mse !== null && l.mse !== undefined ? l.mse : variance;
       y.push(positive(v));
-      const ci = l.variance_ci95;
+      const ci = infinite ? null : l.variance_ci95;
       const scale = v === variance ? 1 : (positive(variance) ? v / variance : NaN);
       lo.push(ci ? positive(ci[0] * scale) : null);
       hi.push(ci ? positive(ci[1] * scale) : null);
     }
     const all = recordExactness(records[name], useMse ? exact : null).all;
-    return { name, y, lo, hi, exactAt, exact: all, fit: records[name].fit || null };
+    return { name, y, lo, hi, exactAt, noiseAt, exact: all, infinite, fit: records[name].fit || null };
   });
   return { quantity: useMse ? 'mse' : 'variance', x, series };
 }
