@@ -3,13 +3,18 @@
 // ignore flags; an estimate far off with no flag is a confident wrong answer.
 //
 //   calibrate [--quick] [--reps R] [--n-min N] [--n-max N] [--ns N1,N2] [--param-seeds 1,2,3]
-//             [--dims 2,4,8] [--families 1,..,6] [--no-genz] [--singular] [--fine 3t|coverage]
+//             [--dims 2,4,8] [--families 1,..,6] [--no-genz] [--singular] [--border]
+//             [--blind] [--fine 3t|coverage]
 //             [--scenes DIR] [--json FILE] [--cells FILE] [--list N] [--presets a,b]
 //             [--stopping REL [--stop-n-max N] [--max-seconds S]]
 //
 // --no-genz leaves Genz's families out (the scenes, and with --singular the products, alone).
 // --ns runs each listed N as a study of its own (instead of the ladder n_min..n_max).
 // --presets runs these presets only (default: every preset of kPresets).
+// --border adds, per dimension and parameter seed, two products on either side of an infinite
+// variance (tail index 1 / a_1 in (2.22, 2.5) and (1.67, 1.92); add_border_products).
+// --blind runs the generated cases (Genz, --singular, --border) without telling the studies
+// their exact value ("exact": null), as a user's own integrand is run; judged against it still.
 // --singular adds, per dimension and parameter seed, two products prod x_i^-a_i (monomial
 // integrands, exact prod 1 / (1 - a_i)): one of finite variance whose weights have an infinite
 // fourth moment (every a_i in (0.25, 0.35), tail index 1 / a_i near 3: the sample skewness is
@@ -49,6 +54,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <set>
 #include <sstream>
@@ -78,6 +84,8 @@ struct Options {
     std::vector<std::string> presets{std::begin(kPresets), std::end(kPresets)}; // --presets
     std::vector<int> families{1, 2, 3, 4, 5, 6};
     bool singular = false;         // --singular: singular products too
+    bool border = false;           // --border: products whose tail index is near 2 too
+    bool blind = false;            // --blind: the studies are not told the exact value
     bool genz = true;              // --no-genz: the scenes (and products) alone
     bool fine_by_coverage = false; // --fine coverage
     std::string scenes_dir = "scenes", json_path, cells_path;
@@ -92,7 +100,8 @@ struct Options {
     if (!msg.empty()) std::fprintf(stderr, "calibrate: %s\n", msg.c_str());
     std::fprintf(stderr, "usage: calibrate [--quick] [--reps R] [--n-min N] [--n-max N]\n"
                          "         [--ns N1,N2] [--param-seeds 1,2,3] [--dims 2,4,8]\n"
-                         "         [--families 1,..,6] [--no-genz] [--singular]\n"
+                         "         [--families 1,..,6] [--no-genz] [--singular] [--border]\n"
+                         "         [--blind]\n"
                          "         [--fine 3t|coverage]\n"
                          "         [--scenes DIR]\n"
                          "         [--json FILE] [--cells FILE] [--list N] [--presets a,b]\n"
@@ -156,6 +165,10 @@ Options parse_options(int argc, char** argv) {
             }
         } else if (a == "--singular")
             o.singular = true;
+        else if (a == "--border")
+            o.border = true;
+        else if (a == "--blind")
+            o.blind = true;
         else if (a == "--no-genz")
             o.genz = false;
         else if (a == "--fine") {
@@ -205,7 +218,43 @@ struct Case {
     Json scene;
     Json options;                   // mcp_study_run options (estimators for the Genz cases)
     bool infinite_variance = false; // every cell must carry an alarm
+    double exact = std::numeric_limits<double>::quiet_NaN(); // the generated cases' value
 };
+
+// --border: products prod x_i^-a_i whose weights' tail index 1 / a_1 lies on either side of 2,
+// the variance's border (x^-0.45 y^-0.2 has a finite variance, x^-0.55 y^-0.1 z^-0.1 an
+// infinite one): one a_1 in (0.40, 0.45) or (0.52, 0.60), the others in (0.05, 0.2) (they
+// leave the tail index 1 / a_1: E x^-a_i/a_1 is finite).
+void add_border_products(const Options& o, std::vector<Case>* cases) {
+    for (int d : o.dims)
+        for (uint64_t seed : o.param_seeds)
+            for (const bool infinite_variance : {false, true}) {
+                Pcg32 rng(seed, hash_string(infinite_variance ? "border_iv" : "border_fv"));
+                std::vector<double> powers(static_cast<size_t>(d));
+                double exact = 1.0;
+                for (size_t i = 0; i < powers.size(); ++i) {
+                    const double u = rng.next_double();
+                    const double a = i > 0 ? 0.05 + 0.15 * u
+                                     : infinite_variance ? 0.52 + 0.08 * u
+                                                         : 0.40 + 0.05 * u;
+                    powers[i] = -a;
+                    exact /= 1.0 - a;
+                }
+                Case c;
+                c.name = std::string(infinite_variance ? "border_infvar" : "border_finvar") +
+                         "_d" + std::to_string(d) + "_s" + std::to_string(seed);
+                c.infinite_variance = infinite_variance;
+                Json presets = Json::array();
+                for (const std::string& p : o.presets) presets.push_back(p);
+                c.scene = {{"name", c.name},
+                           {"domain", {{"type", "box"}, {"dim", d}}},
+                           {"integrand", {{"type", "monomial"}, {"powers", powers}}},
+                           {"exact", exact},
+                           {"estimators", presets}};
+                c.exact = exact;
+                cases->push_back(c);
+            }
+}
 
 std::vector<Case> genz_cases(const Options& o) {
     std::vector<Case> cases;
@@ -224,8 +273,10 @@ std::vector<Case> genz_cases(const Options& o) {
                             {{"type", genz_family_name(GenzFamily(fam))}, {"a", g.a}, {"u", g.u}}},
                            {"exact", genz_exact(g)},
                            {"estimators", presets}};
+                c.exact = genz_exact(g);
                 cases.push_back(c);
             }
+    if (o.border) add_border_products(o, &cases);
     if (!o.singular) return cases;
     // Singular products prod x_i^-a_i: E f^k is finite iff every k a_i < 1.
     for (int d : o.dims)
@@ -250,6 +301,7 @@ std::vector<Case> genz_cases(const Options& o) {
                            {"integrand", {{"type", "monomial"}, {"powers", powers}}},
                            {"exact", exact},
                            {"estimators", presets}};
+                c.exact = exact;
                 cases.push_back(c);
             }
     return cases;
@@ -597,7 +649,9 @@ int main(int argc, char** argv) {
             options["seed"] = o.seed + ci + 7919 * ri;
             options["threads"] = 0;
             char* out = nullptr;
-            const int status = mcp_study_run(c.scene.dump().c_str(), options.dump().c_str(),
+            Json run_scene = c.scene;
+            if (o.blind && ci < genz_count) run_scene["exact"] = nullptr;
+            const int status = mcp_study_run(run_scene.dump().c_str(), options.dump().c_str(),
                                              nullptr, nullptr, &out);
             if (status == MCP_ERROR_SCENE && c.options.contains("estimators")) {
                 auto& [count, reason] =
@@ -618,12 +672,13 @@ int main(int argc, char** argv) {
                 continue;
             }
             const Json& scene = r.value["scene"];
-            if (!scene.contains("exact") || !scene["exact"].is_number()) {
+            const bool told = !(o.blind && ci < genz_count);
+            if (told && (!scene.contains("exact") || !scene["exact"].is_number())) {
                 std::printf("  %s: no exact value, skipped\n", c.name.c_str());
                 no_exact.insert(base);
                 continue;
             }
-            const double exact = scene["exact"].get<double>();
+            const double exact = told ? scene["exact"].get<double>() : c.exact;
             Tally& t = ci < genz_count ? genz : scenes;
             const size_t before = wrong.size();
             judge(o, c, ci, r.value, exact, &t, &wrong, &fine_cells, cells);

@@ -504,6 +504,108 @@ TEST(Diagnostics, AReplicateFarOutsideItsIntervalIsAnAlarm) {
     EXPECT_NEAR(f->threshold, 5.0 * student_t_quantile(0.975, 3.0) / 1.959963984540054, 1e-9);
 }
 
+// Replicates judged one by one against their own error bars (Cochran's Q, replicate_scatter),
+// without the exact value: 28 runs whose error bars are 14 times too small (se 1, estimates
+// spread 14) beside 4 runs with error bars of 60 that cover. The 4 large se^2 carry the mean
+// se^2 (450, the replicates' variance about 640): the F test sees an F of 1.4 and nothing, and
+// the leave-one-out check of each replicate finds none beyond 5 standard errors. Q does, and
+// error_bars_unstable is not demoted by replicates that only seem to cover. The other way: the
+// same error bars with estimates that honour them raise no understatement.
+TEST(Diagnostics, ReplicatesScatteringBeyondTheirOwnErrorBarsAreAnAlarm) {
+    const std::vector<double> z = honest_errors(32);
+    LevelStats l = replicates_level(z, false);
+    for (size_t i = 0; i < z.size(); ++i) {
+        const bool wide = i % 8 == 3;
+        l.run_std_errors[i] = wide ? 60.0 : 1.0;
+        l.estimates[i] = (wide ? 60.0 : 14.0) * z[i];
+    }
+    auto summarise = [](LevelStats* level) {
+        RunningMoments m, se2;
+        for (double x : level->estimates) m.add(x);
+        for (double s : level->run_std_errors) se2.add(s * s);
+        level->mean = m.mean();
+        level->variance = m.variance();
+        level->mean_run_variance = se2.mean();
+    };
+    summarise(&l);
+    EXPECT_LT(l.variance / l.mean_run_variance, 2.0); // the F test's ratio: nothing there
+    const ScatterTest scatter = replicate_scatter(l);
+    EXPECT_EQ(scatter.judged, 32);
+    EXPECT_LT(scatter.p_value, 1e-6);
+    std::vector<Flag> flags = level_flags(l);
+    std::optional<Flag> f = find(flags, FlagCode::ErrorBarsUnderstate);
+    ASSERT_TRUE(f.has_value());
+    EXPECT_EQ(f->severity, Severity::Error);
+    EXPECT_EQ(f->count, 32u); // the replicate-by-replicate test, not the F test
+    EXPECT_NEAR(f->value, scatter.q / 32.0, 1e-12);
+    f = find(flags, FlagCode::ErrorBarsUnstable);
+    ASSERT_TRUE(f.has_value());
+    EXPECT_EQ(f->severity, Severity::Warning);
+
+    // The same error bars, honoured: Q near its mean 32 (p >= 0.05, no sign of scatter), no
+    // understatement, and Bartlett's finding that the error bars lie 60 times apart is info:
+    // the replicates show they hold.
+    for (size_t i = 0; i < z.size(); ++i) l.estimates[i] = l.run_std_errors[i] * z[i];
+    summarise(&l);
+    EXPECT_GT(replicate_scatter(l).p_value, 0.05);
+    flags = level_flags(l);
+    EXPECT_FALSE(find(flags, FlagCode::ErrorBarsUnderstate));
+    f = find(flags, FlagCode::ErrorBarsUnstable);
+    ASSERT_TRUE(f.has_value());
+    EXPECT_EQ(f->severity, Severity::Info);
+    // Against an exact value honest replicates pass and scattered ones do not.
+    for (size_t i = 0; i < z.size(); ++i) l.estimates[i] = l.run_std_errors[i] * z[i];
+    l.has_exact = true;
+    l.exact = 0.0;
+    EXPECT_GT(replicate_scatter(l).p_value, 0.05);
+    for (size_t i = 0; i < z.size(); ++i) l.estimates[i] = 3.0 * l.run_std_errors[i] * z[i];
+    EXPECT_LT(replicate_scatter(l).p_value, 1e-6);
+}
+
+// heavy_tail judged both ways on products of powers, for estimators whose sampling density is
+// bounded above and below (their variance is finite exactly where int f^2 is): x^-0.45 y^-0.2
+// (tail index 1 / 0.45 = 2.22, a finite variance) raised heavy_tail at warning in 6 of 8 cells
+// from the weights' Hill index at k = 64 (standard error 0.28); x^-0.55 y^-0.1 z^-0.1 (1.82, an
+// infinite variance) went unflagged by MISER at one N of two, its boxes making the weights' tail
+// look light. The integrand's tail at 2^15 uniform points, Hill's k = 2048 (standard error
+// 0.05), tells them apart at every N, for every such estimator.
+TEST(Diagnostics, HeavyTailFollowsTheIntegrandWhereTheDensityIsBounded) {
+    auto product = [](std::vector<double> powers) {
+        double exact = 1.0;
+        for (double a : powers) exact /= 1.0 + a;
+        return Json{{"name", "product"},
+                    {"domain", {{"type", "box"}, {"dim", powers.size()}}},
+                    {"integrand", {{"type", "monomial"}, {"powers", powers}}},
+                    {"exact", exact},
+                    {"estimators", {"uniform", "sobol", "miser", "vegas", "vegas_plus"}}};
+    };
+    auto run = [](const Json& scene, uint64_t n) {
+        Made<SceneRequest> r = build_request(
+            scene, Json{{"n_min", n}, {"n_max", n}, {"reps", 32}, {"seed", 5}, {"threads", 1}});
+        EXPECT_TRUE(r.ok()) << r.error;
+        return run_study(r.value.problem, r.value.estimators, r.value.settings);
+    };
+    for (uint64_t n : {uint64_t(4096), uint64_t(16384)}) {
+        const StudyResult finite = run(product({-0.45, -0.2}), n);
+        for (const EstimatorStudy& e : finite.estimators) {
+            const std::optional<Flag> f =
+                find(estimator_flags(e, finite.settings), FlagCode::HeavyTail);
+            EXPECT_FALSE(f.has_value()) << e.spec.name << " N = " << n << ": tail index "
+                                        << (f ? f->value : 0.0);
+            const double se = 2.22 / std::sqrt(2048.0);
+            EXPECT_NEAR(e.integrand.alpha, 1.0 / 0.45, 4.0 * se) << e.spec.name;
+        }
+        const StudyResult infinite = run(product({-0.55, -0.1, -0.1}), n);
+        for (const EstimatorStudy& e : infinite.estimators) {
+            const std::optional<Flag> f =
+                find(estimator_flags(e, infinite.settings), FlagCode::HeavyTail);
+            ASSERT_TRUE(f.has_value()) << e.spec.name << " N = " << n;
+            EXPECT_EQ(f->severity, Severity::Warning) << e.spec.name;
+            EXPECT_EQ(f->of, kTailProbes); // judged on the integrand's uniform probes
+        }
+    }
+}
+
 // Agreement is not exactness. A deterministic point set (Sobol' without randomization) gives
 // the same wrong answer in every replicate: not exact, and with the exact value known an error.
 // Values whose squares underflow (1e-170 x) agree in their variances (0) while the estimates

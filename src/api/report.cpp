@@ -110,6 +110,16 @@ Json level_warning(const Flag& f, const LevelStats& l) {
                                         : "): their error bars are wrong (too few samples to see "
                                           "f vary)"));
     case FlagCode::ErrorBarsUnderstate:
+        if (f.count > 0) // Cochran's Q: each replicate in its own standard errors
+            return flag_warning(
+                f, "the " + std::to_string(f.count) + " replicates" + at_n + " lie " +
+                       fmt("%.3g", std::sqrt(f.value)) +
+                       " times farther from " + (l.has_exact ? "the exact value" : "their mean") +
+                       " than their own standard errors say (chi-square " +
+                       fmt("%.4g", f.value * f.dof) + " on " + std::to_string(f.dof) + " dof, " +
+                       p_value_text(f.p_value) +
+                       "): runs with small error bars scatter far beyond them, and the error "
+                       "bars are too small");
         return flag_warning(f, "the " + std::to_string(f.of) + " replicates" + at_n + " spread " +
                                    fmt("%.3g", std::sqrt(f.value)) +
                                    " times more than their own standard errors say (F test, " +
@@ -231,6 +241,20 @@ Json warnings_for(const LevelStats& l) {
 } // namespace
 
 Json tail_warning(const Flag& f, uint64_t pooled, const TailWording& words) {
+    if (f.of > 0) { // the integrand's tail at uniform probes (tail_flags)
+        const std::string where = " (from the " + std::to_string(f.count) + " largest of |f| at " +
+                                  std::to_string(f.of) +
+                                  " uniform points; the sampling density is bounded above and "
+                                  "below, so the weights' variance is finite where int f^2 is)";
+        if (f.code == FlagCode::HeavyTail)
+            return flag_warning(f, "f is heavy-tailed: tail index " + fmt("%.2f", f.value) +
+                                       " +/- " + fmt("%.2f", f.se) + where +
+                                       ", and below 2 the variance is infinite: the error bars "
+                                       "are not trustworthy");
+        return flag_warning(f, "f has a heavy tail: tail index " + fmt("%.2f", f.value) + where +
+                                   " is below 4, so the variance is finite but its estimate is "
+                                   "unreliable and the error bars may be too small");
+    }
     const std::string where = " (from the " + std::to_string(f.count) + " largest of " +
                               std::to_string(pooled) + " " + words.unit + " at " + words.n_name +
                               " = " + std::to_string(f.n) + ")";
@@ -257,8 +281,9 @@ Json tail_warning(const Flag& f, uint64_t pooled, const TailWording& words) {
 }
 
 void add_tail_warnings(Json& w, const LevelStats& deepest, uint64_t pooled,
-                       const TailWording& words, bool bounded) {
-    for (const Flag& f : tail_flags(deepest, bounded)) w.push_back(tail_warning(f, pooled, words));
+                       const TailWording& words, bool bounded, const IntegrandTail* integrand) {
+    for (const Flag& f : tail_flags(deepest, bounded, integrand))
+        w.push_back(tail_warning(f, pooled, words));
 }
 
 namespace {
@@ -269,7 +294,7 @@ Json estimator_warnings(const EstimatorStudy& e, const StudySettings& s) {
         const LevelStats& deepest = e.levels.back();
         add_tail_warnings(w, deepest, deepest.n * static_cast<uint64_t>(deepest.reps),
                           TailWording{"the weights f/p", "weights", "N", "the variance"},
-                          e.weights_bounded);
+                          e.weights_bounded, e.integrand.k > 0 ? &e.integrand : nullptr);
     }
     const SupportCheck& sc = e.support;
     for (const Flag& f : estimator_flags(e, s)) {
@@ -551,6 +576,11 @@ Json stopping_to_json(const StoppingStudy& st) {
                 : reason == "untrusted_error_bar"
                     ? "their error bars met it, but a flag (heavy tail, skewed or few weights) "
                       "or disagreement with earlier doublings said they cannot be trusted"
+                : reason == "all_zero"
+                    ? "every point of two doublings in a row gave f = 0, so the estimate is 0 "
+                      "+- 0: a relative tolerance of a 0 estimate is 0 and cannot be met, and "
+                      "points alone cannot show f = 0 where none fell (doubling on would "
+                      "only repeat it; an absolute tolerance does not make 0 +- 0 evidence)"
                 : reason == "n_max"
                     ? "n_max = " + std::to_string(set.n_max) + " was reached first"
                     : "the time budget (max_seconds = " + fmt("%.3g", set.max_seconds) +

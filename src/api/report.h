@@ -52,7 +52,8 @@ struct TailWording {
 /// Appends the `heavy_tail` / `heavy_tail_4` warnings for the tail index of a study's deepest
 /// level, estimated from `pooled` values (`bounded` weights: heavy_tail is info).
 void add_tail_warnings(Json& warnings, const LevelStats& deepest, uint64_t pooled,
-                       const TailWording& words, bool bounded);
+                       const TailWording& words, bool bounded,
+                       const IntegrandTail* integrand = nullptr);
 /// The sentence of one heavy_tail / heavy_tail_4 flag (estimators/diagnostics.h).
 Json tail_warning(const Flag& flag, uint64_t pooled, const TailWording& words);
 

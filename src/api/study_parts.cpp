@@ -155,9 +155,9 @@ bool run_from_json(Ctx& c, const Json& j, const std::string& path, uint64_t n, R
         !in_range(c, path, "iteration_chi2", r->iteration_chi2, 0.0, INFINITY, true))
         return false;
     const Json* top = find(j, "top");
-    if (!top || !top->is_array() || top->size() > kTopWeights)
+    if (!top || !top->is_array() || top->size() > kTailWeights)
         return c.fail(sub(path, "top"),
-                      "expected an array of at most " + std::to_string(kTopWeights) + " weights");
+                      "expected an array of at most " + std::to_string(kTailWeights) + " weights");
     r->top.clear();
     for (size_t i = 0; i < top->size(); ++i) {
         const std::string at = sub(path, "top") + "[" + std::to_string(i) + "]";
@@ -194,7 +194,7 @@ bool run_from_json(Ctx& c, const Json& j, const std::string& path, uint64_t n, R
 
 const StopReason kStopReasons[] = {StopReason::ToleranceMet, StopReason::NMax,
                                    StopReason::TimeBudget, StopReason::NoErrorBar,
-                                   StopReason::UntrustedErrorBar};
+                                   StopReason::UntrustedErrorBar, StopReason::AllZero};
 
 Json stopping_run_to_json(const StoppingResult& s) {
     Json steps = Json::array();
@@ -507,8 +507,12 @@ bool merge_study_parts(Ctx& c, const Json& in, Json* out) {
                         return false;
                     // The answer's flags are a function of its run: recomputed, not carried.
                     bool blocking = false;
+                    runs[r].integrand =
+                        stopping_integrand_tail(rq.problem, rq.estimators[e], settings.seed);
+                    const IntegrandTail* tail =
+                        runs[r].integrand.k > 0 ? &runs[r].integrand : nullptr;
                     runs[r].flags = stopping_answer_flags(runs[r].answer, rq.problem,
-                                                          rq.estimators[e], &blocking);
+                                                          rq.estimators[e], &blocking, tail);
                 }
             }
             st.runs.push_back(std::move(runs));

@@ -29,7 +29,7 @@ void WeightAccumulator::reset(ErrorMethod method, const SamplerPlan& plan, bool 
     first_w_ = last_w_ = 0.0;
     diagnostics_ = RunDiagnostics();
     top_.clear();
-    top_.reserve(kTopWeights + kBlockSize);
+    top_.reserve(kTailWeights + kBlockSize);
     top_threshold_ = -1.0;
     batch_sums_.assign(plan.batches(), NeumaierSum());
     walsh_values_.clear();
@@ -37,13 +37,13 @@ void WeightAccumulator::reset(ErrorMethod method, const SamplerPlan& plan, bool 
 }
 
 void WeightAccumulator::keep_top() {
-    // Keep the kTopWeights largest: an O(n) selection per block instead of a heap update per
+    // Keep the kTailWeights largest: an O(n) selection per block instead of a heap update per
     // sample (an increasing integrand would otherwise replace a heap's root every time).
-    if (top_.size() <= kTopWeights) return;
-    std::nth_element(top_.begin(), top_.begin() + static_cast<long>(kTopWeights) - 1, top_.end(),
+    if (top_.size() <= kTailWeights) return;
+    std::nth_element(top_.begin(), top_.begin() + static_cast<long>(kTailWeights) - 1, top_.end(),
                      std::greater<double>());
-    top_.resize(kTopWeights);
-    top_threshold_ = top_[kTopWeights - 1];
+    top_.resize(kTailWeights);
+    top_threshold_ = top_[kTailWeights - 1];
 }
 
 void WeightAccumulator::add_block(uint64_t first, const double* f, const double* p, double* w,
@@ -277,7 +277,7 @@ RunResult WeightAccumulator::finish(double scale) const {
     result.diagnostics.ess = sum_sq > 0.0 ? total_abs * total_abs / sum_sq : 0.0;
     result.top = top_;
     std::sort(result.top.begin(), result.top.end(), std::greater<double>());
-    if (result.top.size() > kTopWeights) result.top.resize(kTopWeights);
+    if (result.top.size() > kTailWeights) result.top.resize(kTailWeights);
     return result;
 }
 

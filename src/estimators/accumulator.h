@@ -49,7 +49,7 @@ class WeightAccumulator {
     uint64_t diffs_ = 0, nonzero_ = 0;
     double first_w_ = 0.0, last_w_ = 0.0; ///< for the difference across a merge
     RunDiagnostics diagnostics_;
-    std::vector<double> top_; ///< candidates for the kTopWeights largest |w|
+    std::vector<double> top_; ///< candidates for the kTailWeights largest |w|
     double top_threshold_ = -1.0;
     std::vector<NeumaierSum> batch_sums_; ///< quasi-Monte Carlo: sum of w per randomization
     std::vector<double> walsh_values_;    ///< WalshBound: every weight, in the run's order

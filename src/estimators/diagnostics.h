@@ -95,6 +95,21 @@ struct ReplicateCheck {
 };
 ReplicateCheck check_replicates(const LevelStats& level);
 
+/// The replicates against their own error bars, one by one: Q = sum_i z_i^2, z_i the distance
+/// of replicate i from the exact value (when known) or from the replicates' plain mean (over
+/// the sd of that difference, sqrt(se_i^2 (1 - 2/R) + sum_j se_j^2 / R^2)), each z_i taken from
+/// Student t with the run's dof to the normal quantile of the same tail. Q has mean R and is
+/// about chi^2_R under honest error bars (Cochran's Q of a meta-analysis [Cochran54]). Unlike
+/// the F test of the mean se^2, it sees runs with tiny error bars that scatter far beyond them
+/// beside a few runs with large ones. Replicates without a finite, positive error bar and a
+/// dof >= 1 are left out; fewer than 4: not judged (judged = 0, p NaN).
+struct ScatterTest {
+    int judged = 0;
+    double q = 0.0;
+    double p_value = std::numeric_limits<double>::quiet_NaN();
+};
+ScatterTest replicate_scatter(const LevelStats& level);
+
 // Thresholds (see the functions' comments for why).
 constexpr double kSkewnessRule = 25.0;  ///< skewed_weights below N = 25 g1^2 [Cochran77]
 constexpr double kErrorBarSpread = 2.0; ///< runs' max se / min se above this: unsettled
@@ -133,7 +148,12 @@ std::vector<Flag> level_flags(const LevelStats& level);
 /// weights (every moment finite) heavy_tail is info: a pre-asymptotic tail, whose effect on the
 /// error bars skewed_weights judges, with the N from which they hold. Nothing when alpha is 0:
 /// fewer than k + 1 weights are non-zero (points that never saw f), and the tail is undefined.
-std::vector<Flag> tail_flags(const LevelStats& deepest, bool bounded = false);
+/// With `integrand` measured (an estimator whose variance follows the integrand's,
+/// variance_follows_integrand), the tail index is the integrand's at its uniform probes
+/// instead (the flag's `of` says how many probes): an adaptive estimator's own weights can look
+/// light-tailed under an infinite variance, or heavy under a finite one.
+std::vector<Flag> tail_flags(const LevelStats& deepest, bool bounded = false,
+                             const IntegrandTail* integrand = nullptr);
 
 /// Whether the estimator has a known source of bias: the support check found mass the pdf
 /// misses (pdf_support, a probe with f != 0 where p = 0, or a missed mass by quadrature that is

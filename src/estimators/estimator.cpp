@@ -69,6 +69,33 @@ int hill_order(uint64_t samples) {
     return k < 8 ? 0 : static_cast<int>(k);
 }
 
+int tail_order(uint64_t samples) {
+    const uint64_t k = std::min<uint64_t>(kTailOrder, samples / 16);
+    return k < 8 ? 0 : static_cast<int>(k);
+}
+
+double stable_tail_index(const std::vector<double>& top, int k_max, int* k) {
+    *k = 0;
+    if (k_max <= 0) return std::numeric_limits<double>::quiet_NaN();
+    int kept = std::min(64, k_max);
+    double alpha = hill_tail_index(top, kept);
+    *k = kept;
+    // No tail to follow: none measured (NaN), fewer than k + 1 non-zero weights (0), or equal
+    // top values (infinite).
+    if (!(alpha > 0.0) || !std::isfinite(alpha)) return alpha;
+    while (kept < k_max) {
+        const int next = std::min(2 * kept, k_max);
+        const double a = hill_tail_index(top, next);
+        if (!(a > 0.0) || !std::isfinite(a)) break;
+        const double sd = (1.0 / a) * std::sqrt(1.0 / kept - 1.0 / next);
+        if (1.0 / alpha - 1.0 / a > 3.0 * sd) break; // the body, not the tail
+        kept = next;
+        alpha = a;
+    }
+    *k = kept;
+    return alpha;
+}
+
 double hill_tail_index(const std::vector<double>& top, int k) {
     if (k < 1 || static_cast<int>(top.size()) < k + 1)
         return std::numeric_limits<double>::quiet_NaN();

@@ -8,6 +8,7 @@
 #include "core/special.h"
 #include "estimators/estimator_kind.h"
 #include "estimators/named_warps.h"
+#include "estimators/registry.h"
 #include "estimators/warp_test.h" // kWarpDomainTolerance
 
 namespace mcp {
@@ -540,6 +541,13 @@ bool weights_bounded(const Problem& problem, const EstimatorSpec& spec) {
     for (const Proposal* p : proposals_of(spec))
         if (density_bounded_below(*p)) return true; // MIS: the mixture is at least c_k p_k
     return false;
+}
+
+bool variance_follows_integrand(const EstimatorSpec& spec) {
+    if (spec.has_techniques() || !spec.control_variate_options.variates.empty()) return false;
+    const std::string kind = kind_of(spec).name;
+    const bool kept = kind == "fixed" || kind == "vegas" || kind == "vegas_plus" || kind == "miser";
+    return kept && density_bounded_below(spec.proposal); // uniform: bounded above too
 }
 
 std::vector<const Proposal*> proposals_of(const EstimatorSpec& spec) {

@@ -200,6 +200,12 @@ struct EstimatorSpec {
 /// Bounded weights have every moment finite: a heavy-looking tail is pre-asymptotic.
 bool weights_bounded(const Problem& problem, const EstimatorSpec& spec);
 
+/// Whether the variance of the estimator's weights is finite exactly when int f^2 is: its
+/// sampling density is bounded above and below on the domain (uniform points, stratified,
+/// Latin hypercube or randomized QMC, MISER's boxes, a VEGAS map's bins), with neither MIS nor
+/// control variates (whose weights mix other functions in).
+bool variance_follows_integrand(const EstimatorSpec& spec);
+
 /// The proposals an estimator draws from: its one proposal, or its MIS techniques.
 std::vector<const Proposal*> proposals_of(const EstimatorSpec& spec);
 

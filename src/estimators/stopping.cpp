@@ -21,6 +21,7 @@ const char* stop_reason_name(StopReason r) {
     case StopReason::TimeBudget: return "max_seconds";
     case StopReason::NoErrorBar: return "no_error_bar";
     case StopReason::UntrustedErrorBar: return "untrusted_error_bar";
+    case StopReason::AllZero: return "all_zero";
     }
     return "?";
 }
@@ -58,6 +59,9 @@ StoppingStep step_of(const RunResult& r, uint64_t n, double t) {
     step.dof = r.dof;
     step.seconds = r.seconds;
     step.half_width = t * r.std_error;
+    const RunDiagnostics& d = r.diagnostics;
+    step.all_zero = r.n > 0 && r.estimate == 0.0 && d.nonzero == 0 && d.nonfinite == 0 &&
+                    d.zero_pdf == 0;
     return step;
 }
 
@@ -73,7 +77,8 @@ bool error_bar_trusted(const RunResult& r) {
 // value (the rule cannot know it). Returns the flags; *blocking says whether a warning or an
 // error is among them.
 std::vector<Flag> judge_answer_in(const RunResult& answer, const Problem& problem,
-                                  const EstimatorSpec& spec, bool* blocking) {
+                                  const EstimatorSpec& spec, bool* blocking,
+                                  const IntegrandTail* integrand) {
     Problem blind = problem;
     blind.exact.reset();
     LevelStats level = summarise_level({answer}, blind);
@@ -88,7 +93,8 @@ std::vector<Flag> judge_answer_in(const RunResult& answer, const Problem& proble
                               level.mean != 0.0 && level.diagnostics.nonfinite == 0 &&
                               level.diagnostics.zero_pdf == 0;
     std::vector<Flag> flags = level_flags(level);
-    for (const Flag& f : tail_flags(level, weights_bounded(problem, spec))) flags.push_back(f);
+    for (const Flag& f : tail_flags(level, weights_bounded(problem, spec), integrand))
+        flags.push_back(f);
     *blocking = false;
     for (const Flag& f : flags) {
         // The K batch means of one run: the study's rule (K > 25 g1^2 on R K pooled means)
@@ -98,6 +104,14 @@ std::vector<Flag> judge_answer_in(const RunResult& answer, const Problem& proble
         *blocking = *blocking || f.severity != Severity::Info;
     }
     return flags;
+}
+
+// The last two doublings saw f/p = 0 at every point, the last at N >= kAllZeroMinN (a few
+// thousand points: a scene's n_min of 16 is no evidence): StopReason::AllZero.
+constexpr uint64_t kAllZeroMinN = 4096;
+bool zero_twice(const std::vector<StoppingStep>& steps) {
+    return steps.size() >= 2 && steps.back().all_zero && steps[steps.size() - 2].all_zero &&
+           steps.back().n >= kAllZeroMinN;
 }
 
 // The last doubling met the tolerance by its error bar but was not allowed to stop on it.
@@ -134,7 +148,8 @@ bool adaptive(const EstimatorSpec& spec) {
 bool record_answer(StoppingStep step, const RunResult& r, const Problem& problem,
                    const EstimatorSpec& spec, const Tolerance& tol, StoppingResult* out) {
     bool blocking = false;
-    out->flags = stopping_answer_flags(r, problem, spec, &blocking);
+    out->flags = stopping_answer_flags(r, problem, spec, &blocking,
+                                       out->integrand.k > 0 ? &out->integrand : nullptr);
     step.flagged = blocking;
     out->steps.push_back(step);
     out->answer = r;
@@ -142,6 +157,10 @@ bool record_answer(StoppingStep step, const RunResult& r, const Problem& problem
     out->target = std::fmax(tol.abs, tol.rel * std::fabs(r.estimate));
     if (!std::isfinite(r.std_error)) {
         out->reason = StopReason::NoErrorBar;
+        return true;
+    }
+    if (zero_twice(out->steps)) {
+        out->reason = StopReason::AllZero;
         return true;
     }
     if (step.half_width <= out->target && step.agrees && step.trusted && !blocking) {
@@ -159,6 +178,7 @@ StoppingResult extend_to_tolerance(const Problem& problem, const EstimatorSpec& 
                                    uint64_t seed, int replicate, Workspace& ws) {
     StoppingResult out;
     out.extended = true;
+    out.integrand = stopping_integrand_tail(problem, spec, seed);
     const SamplerOptions options = spec.sampler_options();
     const uint64_t k_count = static_cast<uint64_t>(options.randomizations);
     const uint64_t longest = budget.n_max / k_count; // points of each sequence at most
@@ -211,7 +231,7 @@ StoppingResult extend_to_tolerance(const Problem& problem, const EstimatorSpec& 
             max_abs = std::fmax(max_abs, rk.diagnostics.max_weight_share * batch_abs);
         }
         std::sort(top.begin(), top.end(), std::greater<double>());
-        if (top.size() > kTopWeights) top.resize(kTopWeights);
+        if (top.size() > kTailWeights) top.resize(kTailWeights);
         r.top = top;
         r.n = n;
         r.estimate = means.mean() * scale;
@@ -254,6 +274,7 @@ StoppingResult walsh_to_tolerance(const Problem& problem, const EstimatorSpec& s
                                   int replicate, Workspace& ws) {
     StoppingResult out;
     out.extended = true;
+    out.integrand = stopping_integrand_tail(problem, spec, seed);
     Pcg32 rng = replicate_rng(seed, spec.name, 0, replicate);
     const SamplerPlan plan = make_sampler_plan(spec.sampler, problem.domain.sample_dim(),
                                                budget.n_max, rng, spec.sampler_options());
@@ -312,9 +333,16 @@ StoppingResult walsh_to_tolerance(const Problem& problem, const EstimatorSpec& s
 
 } // namespace
 
+IntegrandTail stopping_integrand_tail(const Problem& problem, const EstimatorSpec& spec,
+                                      uint64_t seed) {
+    if (!variance_follows_integrand(spec) || weights_bounded(problem, spec)) return {};
+    return integrand_tail(problem, kTailProbes, seed);
+}
+
 std::vector<Flag> stopping_answer_flags(const RunResult& answer, const Problem& problem,
-                                        const EstimatorSpec& spec, bool* blocking) {
-    return judge_answer_in(answer, problem, spec, blocking);
+                                        const EstimatorSpec& spec, bool* blocking,
+                                        const IntegrandTail* integrand) {
+    return judge_answer_in(answer, problem, spec, blocking, integrand);
 }
 
 bool stopping_extends(const EstimatorSpec& spec, const StoppingBudget& budget,
@@ -342,6 +370,7 @@ StoppingResult run_to_tolerance(const Problem& problem, const EstimatorSpec& spe
         return walsh_to_tolerance(problem, spec, tol, walsh, seed, replicate, ws);
     }
     StoppingResult out;
+    out.integrand = stopping_integrand_tail(problem, spec, seed);
     for (uint64_t n = budget.n_start;; n *= 2) {
         Pcg32 rng = replicate_rng(seed, spec.name, n, replicate);
         const RunResult r = run_estimate(problem, spec, n, rng, ws, accumulator);
@@ -350,7 +379,8 @@ StoppingResult run_to_tolerance(const Problem& problem, const EstimatorSpec& spe
         StoppingStep step = step_of(r, n, t95(r.dof));
         step.trusted = error_bar_trusted(r);
         bool blocking = false;
-        out.flags = stopping_answer_flags(r, problem, spec, &blocking);
+        out.flags = stopping_answer_flags(r, problem, spec, &blocking,
+                                          out.integrand.k > 0 ? &out.integrand : nullptr);
         step.flagged = blocking;
         out.steps.push_back(step);
         const StoppingStep* previous =
@@ -360,6 +390,10 @@ StoppingResult run_to_tolerance(const Problem& problem, const EstimatorSpec& spe
         out.target = std::fmax(tol.abs, tol.rel * std::fabs(r.estimate));
         if (r.dof < 1 || !std::isfinite(r.std_error)) {
             out.reason = StopReason::NoErrorBar;
+            return out;
+        }
+        if (zero_twice(out.steps)) {
+            out.reason = StopReason::AllZero;
             return out;
         }
         const bool meets = step.half_width <= out.target;

@@ -42,6 +42,10 @@
 // may mean infinite variance, too few effective samples, dropped samples) means the error bar
 // cannot be trusted, and the run does not stop "met": it doubles on, and if the budget ends with
 // the error bar meeting the tolerance but untrusted, the reason is untrusted_error_bar.
+// For estimators whose density is bounded above and below (variance_follows_integrand) the
+// heavy_tail of (5) judges the integrand's tail at uniform points, not the answer's weights
+// (a VEGAS+ map makes them look light-tailed under an infinite variance). Two doublings in a row
+// that saw f/p = 0 at every point stop the run unmet (StopReason::AllZero).
 // Any estimator with an error bar can be run this way (fixed, RQMC, VEGAS, MISER, MIS, control
 // variates: each N is a complete run of it); one without an error bar (a point set with no
 // randomization) cannot, and stops at once with StopReason::NoErrorBar.
@@ -78,10 +82,13 @@ struct StoppingBudget {
 };
 
 /// UntrustedErrorBar: the budget ended while the error bar met the tolerance but a flag (or
-/// the agreement with earlier doublings) said it cannot be trusted.
-enum class StopReason { ToleranceMet, NMax, TimeBudget, NoErrorBar, UntrustedErrorBar };
+/// the agreement with earlier doublings) said it cannot be trusted. AllZero: two doublings in a
+/// row, the last at N >= 4096, saw f/p = 0 at every point: the estimate is 0 +- 0, which meets
+/// no relative tolerance (the target rel |0| is 0) and cannot show that f is 0 where no point
+/// fell, so doubling on would only repeat it (to n_max: 2^25 evaluations by default).
+enum class StopReason { ToleranceMet, NMax, TimeBudget, NoErrorBar, UntrustedErrorBar, AllZero };
 
-/// "tolerance_met", "n_max", "max_seconds", "no_error_bar", "untrusted_error_bar".
+/// "tolerance_met", "n_max", "max_seconds", "no_error_bar", "untrusted_error_bar", "all_zero".
 const char* stop_reason_name(StopReason r);
 
 /// One doubling: the run at n.
@@ -93,6 +100,7 @@ struct StoppingStep {
                           ///< (skewness of the batch means) for extended runs
     bool agrees = false;  ///< condition 2 (extended) or 3 (fresh runs): agrees with earlier N
     bool flagged = false; ///< a warning or error flag of the study's judgement (condition 5)
+    bool all_zero = false; ///< every point's f/p was 0 (none dropped): the estimate is 0 +- 0
 };
 
 struct StoppingResult {
@@ -108,13 +116,25 @@ struct StoppingResult {
     std::vector<Flag> flags;
     double seconds = 0.0; ///< over every doubling
     std::vector<StoppingStep> steps;
+    /// The integrand's tail at kTailProbes uniform points (not counted in evaluations), for
+    /// estimators whose variance follows the integrand's (variance_follows_integrand).
+    IntegrandTail integrand;
 };
 
 /// Condition 5: the study's judgement of a stopping answer as a level of one run, without the
 /// exact value; *blocking says whether a warning or an error among the flags keeps it from
 /// "met" (a merge of split stopping runs recomputes the flags with it).
+/// With `integrand` (the integrand's tail at uniform points, measured by run_to_tolerance
+/// when variance_follows_integrand), heavy_tail judges it rather than the answer's weights.
 std::vector<Flag> stopping_answer_flags(const RunResult& answer, const Problem& problem,
-                                        const EstimatorSpec& spec, bool* blocking);
+                                        const EstimatorSpec& spec, bool* blocking,
+                                        const IntegrandTail* integrand = nullptr);
+
+/// The integrand's tail that run_to_tolerance judges heavy_tail by: integrand_tail at
+/// kTailProbes uniform points from `seed` when variance_follows_integrand(spec) and the weights
+/// are not bounded, else not measured (probes 0). The same for every replicate and part.
+IntegrandTail stopping_integrand_tail(const Problem& problem, const EstimatorSpec& spec,
+                                      uint64_t seed);
 
 /// "" when the tolerance and budget can be used, else a message naming the field.
 std::string check_stopping(const Tolerance& tol, const StoppingBudget& budget);

@@ -260,6 +260,32 @@ bool zero_set(const Proposal& p, const Domain& d, std::vector<Rect>* rects, doub
 
 } // namespace
 
+IntegrandTail integrand_tail(const Problem& problem, uint64_t probes, uint64_t seed) {
+    IntegrandTail tail;
+    tail.probes = probes;
+    const Domain& d = problem.domain;
+    Pcg32 rng(mix64(seed ^ 0x7461696cULL), hash_string("integrand_tail")); // "tail"
+    const SamplerPlan plan =
+        make_sampler_plan(SamplerKind::Independent, d.sample_dim(), probes, rng);
+    std::vector<double> values;
+    values.reserve(static_cast<size_t>(probes));
+    Workspace ws;
+    for_each_block(problem, uniform_proposal(d), plan, ws, [&](const SampleBlock& b) {
+        for (size_t i = 0; i < b.count; ++i) {
+            const double a = std::fabs(b.f[i]);
+            if (std::isfinite(a)) values.push_back(a);
+        }
+    });
+    const int k = tail_order(probes);
+    if (k <= 0 || values.size() < static_cast<size_t>(k) + 1) return tail;
+    std::nth_element(values.begin(), values.begin() + k, values.end(), std::greater<double>());
+    values.resize(static_cast<size_t>(k) + 1);
+    std::sort(values.begin(), values.end(), std::greater<double>());
+    tail.k = k;
+    tail.alpha = hill_tail_index(values, k);
+    return tail;
+}
+
 SupportCheck check_support(const Problem& problem, const EstimatorSpec& spec, uint64_t probes,
                            uint64_t seed) {
     SupportCheck check;
@@ -441,7 +467,7 @@ LevelStats summarise_level(const std::vector<RunResult>& runs, const Problem& pr
     double run_dof_sum = 0.0;
     s.has_exact = problem.exact.has_value();
     const double exact = s.has_exact ? *problem.exact : 0.0;
-    // Every run keeps its kTopWeights largest |w|, so the largest of the pooled tops are the
+    // Every run keeps its kTailWeights largest |w|, so the largest of the pooled tops are the
     // largest weights of all R N samples: the tail index uses them all.
     std::vector<double> pooled;
     double nonzero = 0.0, ess = 0.0;
@@ -492,8 +518,8 @@ LevelStats summarise_level(const std::vector<RunResult>& runs, const Problem& pr
     s.nonzero_per_run = nonzero / R;
     s.ess_mean = ess / R;
     std::sort(pooled.begin(), pooled.end(), std::greater<double>());
-    s.tail_k = hill_order(s.n * static_cast<uint64_t>(s.reps));
-    s.tail_index = hill_tail_index(pooled, s.tail_k);
+    s.tail_index =
+        stable_tail_index(pooled, tail_order(s.n * static_cast<uint64_t>(s.reps)), &s.tail_k);
     s.mean = est.mean();
     s.variance = est.variance();
     // s^2 / sigma^2 ~ chi^2_{R-1} for normal estimates.
@@ -790,6 +816,8 @@ EstimatorStudy begin_estimator_study(const Problem& problem, const EstimatorSpec
     es.error_method = error_method_for(spec);
     es.support = check_support(problem, spec, kSupportProbes, settings.seed);
     es.weights_bounded = weights_bounded(problem, spec);
+    if (variance_follows_integrand(spec) && !es.weights_bounded)
+        es.integrand = integrand_tail(problem, kTailProbes, settings.seed);
     return es;
 }
 

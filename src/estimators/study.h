@@ -252,6 +252,23 @@ struct LevelConsistency {
 };
 LevelConsistency level_consistency(const std::vector<LevelStats>& levels);
 
+/// Hill's tail index of |f| at uniform points of the domain (integrand_tail). For an estimator
+/// whose sampling density is bounded above and below (variance_follows_integrand) the variance
+/// of f/p is finite exactly when int f^2 is, that is when this index exceeds 2 (for a power
+/// law), whatever the estimator does with its points: its own weights' tail, reshaped by
+/// MISER's boxes or a VEGAS map, can look light at any N (x^-0.55 y^-0.1 z^-0.1 under MISER,
+/// 1/sqrt|x - 0.3| under VEGAS+) or heavy. Uniform points give the exact Pareto tail of a power
+/// singularity, so Hill's order can be large (kTailOrder) and its standard error small.
+struct IntegrandTail {
+    uint64_t probes = 0; ///< uniform points (0: not measured)
+    double alpha = std::numeric_limits<double>::quiet_NaN();
+    int k = 0; ///< Hill's order
+};
+/// Uniform points probed for the integrand's tail: Hill's order k = min(kTailOrder, probes / 16)
+/// reaches kTailOrder.
+constexpr uint64_t kTailProbes = uint64_t(1) << 15;
+IntegrandTail integrand_tail(const Problem& problem, uint64_t probes, uint64_t seed);
+
 struct EstimatorStudy {
     EstimatorSpec spec;
     LevelConsistency consistency;
@@ -260,6 +277,8 @@ struct EstimatorStudy {
     /// The weights are bounded by what the problem and estimator say (weights_bounded): every
     /// moment is finite, and a heavy-looking tail is pre-asymptotic.
     bool weights_bounded = false;
+    /// The integrand's tail at uniform points, measured when variance_follows_integrand.
+    IntegrandTail integrand;
     std::vector<LevelStats> levels;
     ConvergenceFit fit;     ///< of the variance
     ConvergenceFit mse_fit; ///< of the MSE, with an exact value (else not valid)

@@ -203,7 +203,7 @@ class VegasEstimator final : public EstimatorAlgorithm, private TrainingPoints {
         r.std_error = weighted ? 1.0 / std::sqrt(sum_w.value()) : std::sqrt(sum_se2.value()) / m;
         r.dof = static_cast<int>(std::min<long>(dof, 1000000));
         std::sort(r.top.begin(), r.top.end(), std::greater<double>());
-        if (r.top.size() > kTopWeights) r.top.resize(kTopWeights);
+        if (r.top.size() > kTailWeights) r.top.resize(kTailWeights);
         if (weighted && rounds.size() > 1) {
             NeumaierSum chi2;
             for (const RunResult& x : rounds) {

@@ -254,6 +254,7 @@ test('raceClaim: runs that did not reach the target say why in words, never as a
   assert.doesNotMatch(u.reachedText, /_/);
   assert.equal(reasonWords('untrusted_error_bar'), 'its error bar could not be trusted');
   assert.equal(reasonWords('no_error_bar'), 'no error bar');
+  assert.equal(reasonWords('all_zero'), 'every point gave 0');
   assert.doesNotMatch(reasonWords('some_new_code'), /_/);
   // most runs out: "did not reach" is said of it, as the data show
   const out = withRuns(only(EXP, ['uniform', 'importance']), 'uniform', (run, i) => (i < 4 ? { ...run, met: false, reason: 'max_seconds' } : run));

@@ -46,6 +46,7 @@ const REASON_WORDS = Object.freeze({
   max_seconds: 'ran out of time',
   no_error_bar: 'no error bar',
   untrusted_error_bar: 'its error bar could not be trusted',
+  all_zero: 'every point gave 0',
   tolerance_met: 'reached the target',
 });
 
