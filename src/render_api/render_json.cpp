@@ -115,7 +115,17 @@ Json render_warnings(const RenderEstimatorStudy& s, double floor) {
             break;
         case FlagCode::HeavyTail:
         case FlagCode::HeavyTail4:
-            w.push_back(tail_warning(f, s.levels.back().diagnostics.nonzero, tail_words));
+            if (f.code == FlagCode::HeavyTail && s.bound.infinite_variance &&
+                !(f.value < kHeavyTailAlpha))
+                w.push_back(flag_warning(
+                    f, "the pixel variance is infinite by the scene's construction (" +
+                           s.bound.reason + "), though the samples' tail index reads " +
+                           fmt("%.2f", f.value) + " at spp = " + std::to_string(f.n) +
+                           ": the rare samples near the contact that make it infinite are "
+                           "beyond the tail estimate's view. The error bars are not "
+                           "trustworthy"));
+            else
+                w.push_back(tail_warning(f, s.levels.back().diagnostics.nonzero, tail_words));
             break;
         case FlagCode::SlowConvergence:
             w.push_back(
@@ -135,7 +145,12 @@ Json render_warnings(const RenderEstimatorStudy& s, double floor) {
                        "understate it, so the relative MSE need not fall with spp and the "
                        "fitted order is unreliable; more images per spp or more pixels average "
                        "more of them, and each level's relative_mse_median shows the typical "
-                       "image"));
+                       "image" +
+                       (f.severity == Severity::Info
+                            ? ". The samples are bounded (" + s.bound.reason +
+                                  "), so these terms have a finite variance and their weight "
+                                  "fades as spp, images or pixels grow"
+                            : std::string())));
             break;
         case FlagCode::PixelErrorBars:
             w.push_back(
@@ -282,7 +297,9 @@ Json estimator_study_to_json(const RenderEstimatorStudy& s, bool previews, doubl
                              const RenderImage* reference, double floor, bool all_levels,
                              size_t level) {
     Json j = estimator_to_json(s.estimator);
-    j["contribution_bound"] = Json{{"bounded", s.bound.bounded}, {"reason", s.bound.reason}};
+    j["contribution_bound"] = Json{{"bounded", s.bound.bounded},
+                                   {"infinite_variance", s.bound.infinite_variance},
+                                   {"reason", s.bound.reason}};
     j["warnings"] = render_warnings(s, floor);
     if (all_levels) {
         Json levels = Json::array();
