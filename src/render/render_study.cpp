@@ -222,6 +222,10 @@ std::vector<Flag> render_flags(const RenderEstimatorStudy& s, double floor) {
     for (const Flag& f : tail) flags.push_back(f);
     if (s.fit.valid && s.fit.order > -1.0 + 3.0 * s.fit.order_se && s.fit.order > -0.8) {
         Flag f(FlagCode::SlowConvergence);
+        // Bounded samples have a finite variance: unbiased, their expected relative MSE falls
+        // as 1/spp, and a slower fit is the levels' own noise (rare large errors), the
+        // reference's, or a bias, which pixel_error_bars judges against the reference.
+        if (s.bound.bounded) f.severity = Severity::Info;
         f.value = s.fit.order;
         f.se = s.fit.order_se;
         f.threshold = -1.0;

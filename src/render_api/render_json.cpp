@@ -128,11 +128,18 @@ Json render_warnings(const RenderEstimatorStudy& s, double floor) {
                 w.push_back(tail_warning(f, s.levels.back().diagnostics.nonzero, tail_words));
             break;
         case FlagCode::SlowConvergence:
-            w.push_back(
-                flag_warning(f, "relative MSE falls as spp^" + fmt("%.2f", f.value) + " +/- " +
-                                    fmt("%.2f", f.se) +
-                                    ", slower than 1/spp: infinite variance, bias against the "
-                                    "reference, or a reference too noisy for this spp"));
+            w.push_back(flag_warning(
+                f, "relative MSE falls as spp^" + fmt("%.2f", f.value) + " +/- " +
+                       fmt("%.2f", f.se) + ", slower than 1/spp: " +
+                       (s.bound.bounded
+                            ? "the samples are bounded (" + s.bound.reason +
+                                  "), so the variance is finite and unbiased samples' expected "
+                                  "relative MSE falls as 1/spp; the slower fit comes from rare "
+                                  "large errors some levels missed, a reference too noisy for "
+                                  "this spp, or a bias (pixel_error_bars judges the pixels "
+                                  "against the reference)"
+                            : std::string("infinite variance, bias against the reference, or "
+                                          "a reference too noisy for this spp"))));
             break;
         case FlagCode::RareLargeErrors:
             w.push_back(flag_warning(
@@ -158,7 +165,13 @@ Json render_warnings(const RenderEstimatorStudy& s, double floor) {
                                     "% of the pixels' own 95% error bars cover the reference at "
                                     "spp = " +
                                     std::to_string(f.n) +
-                                    ": per-pixel error bars are too small (heavy tails or bias)"));
+                                    ": per-pixel error bars are too small (" +
+                                    (s.bound.bounded
+                                         ? "the samples are bounded, so not a heavy tail: "
+                                           "rare large values that most pixels have not yet "
+                                           "drawn, or a bias"
+                                         : "heavy tails or bias") +
+                                    ")"));
             break;
         // A level's flags (render_level_to_json words them), and the integration studies' flags,
         // which render_flags never raises.
