@@ -270,6 +270,7 @@ LightContacts light_contacts(const RenderScene& rs, double aspect) {
     out.checked = true;
     out.pairs = candidates.size();
     const View view(rs.scene->camera, aspect);
+    size_t seen_checks = 0;
     for (const auto& [l, t] : candidates) {
         const Triangle tl = triangle_of(mesh, l), tr = triangle_of(mesh, t);
         if (degenerate(tl) || degenerate(tr)) continue;
@@ -287,8 +288,10 @@ LightContacts light_contacts(const RenderScene& rs, double aspect) {
         }
         out.contact = true;
         out.interior_contact = out.interior_contact || c.interior;
-        if (c.touching && !out.seen_contact)
+        if (c.touching && !out.seen_contact && seen_checks < kMaxSeenChecks) {
+            ++seen_checks;
             out.seen_contact = seen_touching(rs, view, tl, tr, l, t, c.point, extent);
+        }
     }
     return out;
 }

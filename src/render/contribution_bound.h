@@ -43,6 +43,9 @@ constexpr double kPlaneDistance = 1e-9;
 /// contacts are not checked (area and solid-angle sampling are left to the tail estimate).
 constexpr size_t kMaxContactBoxTests = size_t(1) << 26;
 constexpr size_t kMaxContactPairs = size_t(1) << 24;
+/// Touching pairs tested for being seen (two camera rays each); beyond, a contact is not
+/// called seen (the tail estimate decides).
+constexpr size_t kMaxSeenChecks = 4096;
 LightContacts light_contacts(const RenderScene& rs, double aspect = 1.0);
 
 /// Whether the estimator's per-sample reflected radiance is bounded, whether its variance is
