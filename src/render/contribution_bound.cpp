@@ -335,8 +335,8 @@ ContributionBound contribution_bound(const RenderEstimator& e, const LightContac
         if (contacts.contact)
             return {false, false,
                     "a light comes within 1e-4 of the scene's extent of a surface it lights, in "
-                    "the camera's view: cos cos' / r^2 is bounded by 1 / d^2 at best, for d that "
-                    "small distance"};
+                    "the camera's view, though not seen touching it face to face: "
+                    "cos cos' / r^2 is not known to be bounded there"};
         return {true, false,
                 contacts.ignored > 0
                     ? "the lights touch only surfaces that reflect nothing or that the camera "
