@@ -119,8 +119,11 @@ Json render_warnings(const RenderEstimatorStudy& s, double floor) {
                 !(f.value < kHeavyTailAlpha))
                 w.push_back(flag_warning(
                     f, "the pixel variance is infinite by the scene's construction (" +
-                           s.bound.reason + "), though the samples' tail index reads " +
-                           fmt("%.2f", f.value) + " at spp = " + std::to_string(f.n) +
+                           s.bound.reason + "), though " +
+                           (std::isfinite(f.value)
+                                ? "the samples' tail index reads " + fmt("%.2f", f.value)
+                                : std::string("there are too few samples to estimate a tail")) +
+                           " at spp = " + std::to_string(f.n) +
                            ": the rare samples near the contact that make it infinite are "
                            "beyond the tail estimate's view. The error bars are not "
                            "trustworthy"));
