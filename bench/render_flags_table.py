@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 """The render diagnostics judged both ways (issue 48): every bundled render scene at its default
 study, for each seed given, through the native CLI; prints a markdown table of each estimator's
-contribution bound (docs/render-scenes.md, "Bounded contributions"), its heavy_tail severity
-and the tail index of its deepest level.
+contribution bound (docs/render-scenes.md, "Bounded contributions": yes, no, or infinite
+variance by construction), the severities of its heavy_tail and rare_large_errors flags, any
+other warning or error it gets, and the tail index of its deepest level.
 
     python3 bench/render_flags_table.py [--mcplay build/mcplay] [--seeds 1,2]
 """
@@ -23,22 +24,31 @@ def main():
     scenes = sorted(p for p in (ROOT / "scenes").glob("*.json")
                     if "render" in json.loads(p.read_text()))
     print("| scene | estimator | bounded | heavy_tail (seed " + ", ".join(map(str, seeds)) +
-          ") | tail index |")
-    print("|---|---|---|---|---|")
+          ") | rare_large_errors | other warnings | tail index |")
+    print("|---|---|---|---|---|---|---|")
     for scene in scenes:
         rows = {}
         for seed in seeds:
             out = subprocess.run([args.mcplay, "run", str(scene), "--format", "json", "--seed",
                                   str(seed), "--quiet"], check=True, capture_output=True, text=True)
             for e in json.loads(out.stdout)["estimators"]:
-                sev = next((w["severity"] for w in e["warnings"] if w["code"] == "heavy_tail"), "-")
+                def severity(code):
+                    return next((w["severity"] for w in e["warnings"] if w["code"] == code), "-")
+                others = {w["code"] for w in e["warnings"]
+                          if w["severity"] in ("warning", "error")
+                          and w["code"] not in ("heavy_tail", "rare_large_errors")}
                 tail = e["levels"][-1].get("tail_index") if e["levels"] else None
-                row = rows.setdefault(e["name"], [e["contribution_bound"]["bounded"], [], []])
-                row[1].append(sev)
-                row[2].append("-" if tail is None else f"{tail:.2f}")
-        for name, (bounded, sevs, tails) in rows.items():
-            print(f"| {scene.stem} | {name} | {'yes' if bounded else 'no'} | {', '.join(sevs)} | "
-                  f"{', '.join(tails)} |")
+                b = e["contribution_bound"]
+                bound = ("infinite" if b.get("infinite_variance") else
+                         "yes" if b["bounded"] else "no")
+                row = rows.setdefault(e["name"], [bound, [], [], set(), []])
+                row[1].append(severity("heavy_tail"))
+                row[2].append(severity("rare_large_errors"))
+                row[3] |= others
+                row[4].append("-" if tail is None else f"{tail:.2f}")
+        for name, (bound, heavy, rare, others, tails) in rows.items():
+            print(f"| {scene.stem} | {name} | {bound} | {', '.join(heavy)} | {', '.join(rare)} | "
+                  f"{', '.join(sorted(others)) or '-'} | {', '.join(tails)} |")
 
 
 if __name__ == "__main__":

@@ -70,9 +70,11 @@ export interface RenderStudyResult extends JsonObject {
   estimators: Array<JsonObject & {
     name: string;
     strategy: string;
-    /** Whether each sample's reflected radiance is bounded by construction (then heavy_tail is
-     * info): docs/render-scenes.md, "Bounded contributions". */
-    contribution_bound: { bounded: boolean; reason: string };
+    /** Whether each sample's reflected radiance is bounded by construction (then heavy_tail and
+     * rare_large_errors are info), or its variance infinite by construction (then heavy_tail is
+     * a warning whatever the tail reads); neither: the tail estimate decides.
+     * docs/render-scenes.md, "Bounded contributions". */
+    contribution_bound: { bounded: boolean; infinite_variance: boolean; reason: string };
     rays_per_second: number;
     warnings: Warning[];
     /** One per spp: `variance` is the relative MSE against the reference. */

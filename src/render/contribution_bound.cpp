@@ -72,12 +72,16 @@ constexpr double kInteriorMargin = 1e-6;
 
 struct PairContact {
     bool contact = false, interior = false;
+    bool touching = false;     ///< within `tight`: the two meet
+    Vec3 point{0.0};           ///< a point where they meet (the mean of those found)
 };
 
 /// Contact of a receiver triangle r with a light triangle l (neither degenerate): within `tol`
 /// of each other, and whether within `tight` (the rounding of vertices) of the light's inside.
 /// Their distance is 0 where an edge of one crosses the other, else that of a vertex of one
-/// from the other or of two edges (the closest points of two convex polygons).
+/// from the other or of two edges (the closest points of two convex polygons). Where they
+/// meet, `point` is the mean of the meeting points found (vertices on the other triangle,
+/// edges through it): inside the convex set where they meet.
 PairContact triangle_contact(const Triangle& l, const Triangle& r, double tol, double tight) {
     PairContact c;
     const Vec3 nl = glm::normalize(glm::cross(l[1] - l[0], l[2] - l[0]));
@@ -87,10 +91,17 @@ PairContact triangle_contact(const Triangle& l, const Triangle& r, double tol, d
         return std::fabs(glm::dot(v - l[0], nl)) <= tight;
     });
     if (in_plane && glm::length(glm::cross(nl, nr)) <= kCoplanarSine) return c;
+    Vec3 met(0.0);
+    int meetings = 0;
+    auto meet = [&](const Vec3& x) {
+        met += x;
+        ++meetings;
+    };
     double d = std::numeric_limits<double>::infinity();
     for (const Vec3& v : r) {
         const double dv = point_triangle_distance(v, l);
         d = std::min(d, dv);
+        if (dv <= tight) meet(v);
         if (dv <= tight && projects_inside(v, l, kInteriorMargin)) c.interior = true;
     }
     int light_vertices_on = 0;
@@ -98,6 +109,7 @@ PairContact triangle_contact(const Triangle& l, const Triangle& r, double tol, d
         const double dv = point_triangle_distance(v, r);
         d = std::min(d, dv);
         light_vertices_on += dv <= tight;
+        if (dv <= tight) meet(v);
     }
     int light_edges_through = 0;
     for (int i = 0; i < 3; ++i) {
@@ -107,10 +119,12 @@ PairContact triangle_contact(const Triangle& l, const Triangle& r, double tol, d
         Vec3 x;
         if (crosses_plane(a, b, l, tight, &x) && projects_inside(x, l, 0.0)) {
             d = 0.0;
+            meet(x);
             if (projects_inside(x, l, kInteriorMargin)) c.interior = true;
         }
         if (crosses_plane(p, q, r, tight, &x) && projects_inside(x, r, 0.0)) {
             d = 0.0;
+            meet(x);
             ++light_edges_through;
         }
     }
@@ -118,7 +132,48 @@ PairContact triangle_contact(const Triangle& l, const Triangle& r, double tol, d
     // the light's face lying on the receiver's.
     if (light_edges_through >= 2 || light_vertices_on == 3) c.interior = true;
     c.contact = d <= tol;
+    c.touching = d <= tight && meetings > 0;
+    if (c.touching) c.point = met / double(meetings);
     return c;
+}
+
+/// The camera's view: the pyramid of the image's rays (jittered rays stay inside it).
+struct View {
+    Vec3 eye, right, up, forward;
+    double tx = 0.0, ty = 0.0; ///< tan of the half-angles across and up
+
+    View(const Camera& c, double aspect)
+        : eye(c.position), right(c.right), up(c.up), forward(c.forward),
+          tx(std::tan(0.5 * c.yfov) * aspect), ty(std::tan(0.5 * c.yfov)) {}
+
+    /// The bounding planes' outward functions at x (inside: every one <= 0).
+    std::array<double, 5> sides(const Vec3& x) const {
+        const Vec3 v = x - eye;
+        const double z = glm::dot(v, forward), h = glm::dot(v, right), u = glm::dot(v, up);
+        return {h - tx * z, -h - tx * z, u - ty * z, -u - ty * z, -z};
+    }
+    bool sees_point(const Vec3& x) const {
+        const auto s = sides(x);
+        return std::all_of(s.begin(), s.end(), [](double g) { return g < 0.0; });
+    }
+    /// false only when the box lies outside one bounding plane (then no ray meets it).
+    bool may_see_box(const Vec3& lo, const Vec3& hi) const {
+        std::array<bool, 5> outside;
+        outside.fill(true);
+        for (int k = 0; k < 8; ++k) {
+            const Vec3 x(k & 1 ? hi.x : lo.x, k & 2 ? hi.y : lo.y, k & 4 ? hi.z : lo.z);
+            const auto s = sides(x);
+            for (size_t i = 0; i < 5; ++i) outside[i] = outside[i] && s[i] > 0.0;
+        }
+        return std::none_of(outside.begin(), outside.end(), [](bool o) { return o; });
+    }
+};
+
+/// Whether a surface reflects anything: glTF's BRDF is zero only for a black base colour with
+/// metallic 0 and specular factor 0 (f0 = 0.04 s, f90 = s, c_diff = base).
+bool reflects(const Material& m) {
+    const bool black = m.base_color.x <= 0.0 && m.base_color.y <= 0.0 && m.base_color.z <= 0.0;
+    return !(black && m.metallic <= 0.0 && m.specular <= 0.0);
 }
 
 Triangle triangle_of(const Mesh& mesh, size_t t) {
@@ -130,9 +185,38 @@ bool degenerate(const Triangle& t) {
     return !(a > 0.0) || !std::isfinite(a);
 }
 
+/// Whether the light l and the receiver t, touching at x, face each other there (the light
+/// emits towards the receiver's side near x, and the receiver faces the light from the
+/// camera's side) and camera rays reach the receiver 1e-3 and 1e-6 of the extent from x,
+/// towards its inside: the pixels there see points arbitrarily close to the contact.
+bool seen_touching(const RenderScene& rs, const View& view, const Triangle& tl,
+                   const Triangle& tr, size_t l, size_t t, const Vec3& x, double extent) {
+    const Vec3 cl = (tl[0] + tl[1] + tl[2]) / 3.0, cr = (tr[0] + tr[1] + tr[2]) / 3.0;
+    if (!(glm::length(cl - x) > 0.0) || !(glm::length(cr - x) > 0.0)) return false;
+    const Vec3 to_r = glm::normalize(cr - x), to_l = glm::normalize(cl - x);
+    const Vec3 nl = glm::normalize(glm::cross(tl[1] - tl[0], tl[2] - tl[0]));
+    const Vec3 nr = glm::normalize(glm::cross(tr[1] - tr[0], tr[2] - tr[0]));
+    const Mesh& mesh = rs.scene->mesh;
+    const bool two_sided = rs.scene->materials[mesh.material[l]].double_sided;
+    const double emits = glm::dot(to_r, nl), eye_side = glm::dot(view.eye - x, nr);
+    const double light_side = glm::dot(to_l, nr);
+    if (!(std::fabs(emits) > kCoplanarSine) || (!two_sided && emits < 0.0)) return false;
+    if (!(std::fabs(light_side) > kCoplanarSine) || eye_side * light_side <= 0.0) return false;
+    for (double step : {1e-3, 1e-6}) {
+        const Vec3 q = x + to_r * (step * extent);
+        if (!view.sees_point(q)) return false;
+        Ray ray;
+        ray.origin = view.eye;
+        ray.direction = glm::normalize(q - view.eye);
+        Hit hit;
+        if (!rs.accel.intersect(ray, &hit) || hit.triangle != t) return false;
+    }
+    return true;
+}
+
 } // namespace
 
-LightContacts light_contacts(const RenderScene& rs) {
+LightContacts light_contacts(const RenderScene& rs, double aspect) {
     LightContacts out;
     const Mesh& mesh = rs.scene->mesh;
     const LightSet& lights = rs.lights_uniform;
@@ -185,12 +269,29 @@ LightContacts light_contacts(const RenderScene& rs) {
     }
     out.checked = true;
     out.pairs = candidates.size();
+    const View view(rs.scene->camera, aspect);
+    size_t seen_checks = 0;
     for (const auto& [l, t] : candidates) {
         const Triangle tl = triangle_of(mesh, l), tr = triangle_of(mesh, t);
         if (degenerate(tl) || degenerate(tr)) continue;
         const PairContact c = triangle_contact(tl, tr, tol, tight);
-        out.contact = out.contact || c.contact;
+        if (!c.contact) continue;
+        // The receiver's points within tol of the light lie in this box: out of view, the
+        // surfaces the camera sees keep a distance from this light.
+        const Box near_light = box_of(l, tol), receiver = box_of(t, 0.0);
+        const Vec3 box_lo = glm::max(near_light.lo, receiver.lo);
+        const Vec3 box_hi = glm::min(near_light.hi, receiver.hi);
+        if (!reflects(rs.scene->materials[mesh.material[t]]) ||
+            !view.may_see_box(box_lo, box_hi)) {
+            ++out.ignored;
+            continue;
+        }
+        out.contact = true;
         out.interior_contact = out.interior_contact || c.interior;
+        if (c.touching && !out.seen_contact && seen_checks < kMaxSeenChecks) {
+            ++seen_checks;
+            out.seen_contact = seen_touching(rs, view, tl, tr, l, t, c.point, extent);
+        }
     }
     return out;
 }
@@ -198,37 +299,53 @@ LightContacts light_contacts(const RenderScene& rs) {
 ContributionBound contribution_bound(const RenderEstimator& e, const LightContacts& contacts) {
     // The bounds of docs/render-scenes.md, "Bounded contributions", with Le the largest
     // emission (finite: the loader refuses more than 3.4e38).
+    const ContributionBound unchecked{false, false,
+                                      "too many light-surface pairs to check contacts"};
     switch (e.strategy) {
     case RadianceStrategy::UniformHemisphere:
     case RadianceStrategy::CosineHemisphere:
-        return {true, "f cos / p <= 2 pi max f cos, and f is bounded (alpha >= 1e-3)"};
+        return {true, false, "f cos / p <= 2 pi max f cos, and f is bounded (alpha >= 1e-3)"};
     case RadianceStrategy::Bsdf:
-        return {true, "f cos / p <= 1/q_spec + 1/q_diff <= 21.05 (lobe choice clamped to "
-                      "[0.05, 0.95])"};
+        return {true, false,
+                "f cos / p <= 1/q_spec + 1/q_diff <= 21.05 (lobe choice clamped to [0.05, 0.95])"};
     case RadianceStrategy::MisBalance:
     case RadianceStrategy::MisPower:
-        return {true, "multiple importance sampling with BSDF sampling, whose f cos / p is "
-                      "bounded: each weighted term is at most f cos / p_bsdf"};
+        return {true, false,
+                "multiple importance sampling with BSDF sampling, whose f cos / p is bounded: "
+                "each weighted term is at most f cos / p_bsdf"};
     case RadianceStrategy::Path:
-        return {true, "at most max_depth bounces, each a bounded BSDF weight (Russian roulette "
-                      "divides by at least min(0.95, the throughput)) and a bounded "
-                      "multiple-importance term"};
+        return {true, false,
+                "at most max_depth bounces, each a bounded BSDF weight (Russian roulette divides "
+                "by at least min(0.95, the throughput)) and a bounded multiple-importance term"};
     case RadianceStrategy::LightSolidAngle:
-        if (!contacts.checked) return {false, "too many light-surface pairs to check contacts"};
+        if (!contacts.checked) return unchecked;
         if (contacts.interior_contact)
-            return {false, "a surface touches a light inside its edges, where solid-angle "
-                           "sampling falls back to area sampling"};
-        return {true, "f cos Le / p <= f cos Le (solid angle) / P(light), the solid angle at "
-                      "most 2 pi"};
+            return {false, false,
+                    "a surface touches a light inside its edges, where solid-angle sampling "
+                    "falls back to area sampling"};
+        return {true, false,
+                "f cos Le / p <= f cos Le (solid angle) / P(light), the solid angle at most 2 pi"};
     case RadianceStrategy::LightArea:
-        if (!contacts.checked) return {false, "too many light-surface pairs to check contacts"};
+        if (!contacts.checked) return unchecked;
+        if (contacts.seen_contact)
+            return {false, true,
+                    "a light touches a surface it lights where the camera sees: at distance a "
+                    "from the contact the second moment of cos cos' / r^2 grows as 1 / a^2, "
+                    "whose integral over the pixel diverges"};
         if (contacts.contact)
-            return {false, "a light touches a surface it lights: cos cos' / r^2 is unbounded "
-                           "at the contact"};
-        return {true, "every light is away from the surfaces: cos cos' / r^2 <= 1 / d^2 for "
+            return {false, false,
+                    "a light comes within 1e-4 of the scene's extent of a surface it lights, in "
+                    "the camera's view, though not seen touching it face to face: "
+                    "cos cos' / r^2 is not known to be bounded there"};
+        return {true, false,
+                contacts.ignored > 0
+                    ? "the lights touch only surfaces that reflect nothing or that the camera "
+                      "does not see there: cos cos' / r^2 <= 1 / d^2 on the surfaces seen, for "
+                      "d their smallest distance from a light"
+                    : "every light is away from the surfaces: cos cos' / r^2 <= 1 / d^2 for "
                       "d the smallest distance"};
     }
-    return {false, "unknown strategy"};
+    return {false, false, "unknown strategy"};
 }
 
 } // namespace mcp

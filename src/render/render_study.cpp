@@ -196,6 +196,9 @@ std::vector<Flag> render_flags(const RenderEstimatorStudy& s, double floor) {
         }
     if (concentrated > 0) {
         Flag f(FlagCode::RareLargeErrors);
+        // Bounded samples: each term has finite variance, and the concentration fades as the
+        // images and pixels grow (heavy_tail's rule for bounded contributions).
+        if (s.bound.bounded) f.severity = Severity::Info;
         f.count = concentrated;
         f.of = s.levels.size();
         f.n = s.levels[worst].n;
@@ -204,9 +207,25 @@ std::vector<Flag> render_flags(const RenderEstimatorStudy& s, double floor) {
         flags.push_back(f);
     }
     const LevelStats& deepest = s.levels.back();
-    for (const Flag& f : tail_flags(deepest, s.bound.bounded)) flags.push_back(f);
+    std::vector<Flag> tail = tail_flags(deepest, s.bound.bounded);
+    // Infinite by construction (contribution_bound): heavy_tail at warning, whatever the tail
+    // estimate reads (a contact is carried by rare pixels, beyond a few thousand samples' view).
+    if (s.bound.infinite_variance && (tail.empty() || tail[0].code != FlagCode::HeavyTail)) {
+        Flag f(FlagCode::HeavyTail);
+        f.n = deepest.n;
+        f.value = deepest.tail_index;
+        f.count = deepest.tail_k > 0 ? uint64_t(deepest.tail_k) : 0;
+        if (f.count > 0) f.se = f.value / std::sqrt(double(f.count));
+        f.threshold = kHeavyTailAlpha;
+        tail = {f};
+    }
+    for (const Flag& f : tail) flags.push_back(f);
     if (s.fit.valid && s.fit.order > -1.0 + 3.0 * s.fit.order_se && s.fit.order > -0.8) {
         Flag f(FlagCode::SlowConvergence);
+        // Bounded samples have a finite variance: unbiased, their expected relative MSE falls
+        // as 1/spp, and a slower fit is the levels' own noise (rare large errors), the
+        // reference's, or a bias, which pixel_error_bars judges against the reference.
+        if (s.bound.bounded) f.severity = Severity::Info;
         f.value = s.fit.order;
         f.se = s.fit.order_se;
         f.threshold = -1.0;
@@ -378,7 +397,8 @@ RenderStudyResult run_render_study(const RenderScene& rs,
     result.threads_used = resolve_threads(settings.threads);
     result.reference_mean_luminance = mean_luminance(reference, nullptr);
     result.relative_mse_floor = relative_mse_floor(reference);
-    const LightContacts contacts = light_contacts(rs);
+    const LightContacts contacts =
+        light_contacts(rs, double(settings.width) / double(settings.height));
     for (const RenderEstimator& e : estimators) {
         RenderEstimatorStudy s;
         s.estimator = e;

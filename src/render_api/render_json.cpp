@@ -115,14 +115,34 @@ Json render_warnings(const RenderEstimatorStudy& s, double floor) {
             break;
         case FlagCode::HeavyTail:
         case FlagCode::HeavyTail4:
-            w.push_back(tail_warning(f, s.levels.back().diagnostics.nonzero, tail_words));
+            if (f.code == FlagCode::HeavyTail && s.bound.infinite_variance &&
+                !(f.value < kHeavyTailAlpha))
+                w.push_back(flag_warning(
+                    f, "the pixel variance is infinite by the scene's construction (" +
+                           s.bound.reason + "), though " +
+                           (std::isfinite(f.value)
+                                ? "the samples' tail index reads " + fmt("%.2f", f.value)
+                                : std::string("there are too few samples to estimate a tail")) +
+                           " at spp = " + std::to_string(f.n) +
+                           ": the rare samples near the contact that make it infinite are "
+                           "beyond the tail estimate's view. The error bars are not "
+                           "trustworthy"));
+            else
+                w.push_back(tail_warning(f, s.levels.back().diagnostics.nonzero, tail_words));
             break;
         case FlagCode::SlowConvergence:
-            w.push_back(
-                flag_warning(f, "relative MSE falls as spp^" + fmt("%.2f", f.value) + " +/- " +
-                                    fmt("%.2f", f.se) +
-                                    ", slower than 1/spp: infinite variance, bias against the "
-                                    "reference, or a reference too noisy for this spp"));
+            w.push_back(flag_warning(
+                f, "relative MSE falls as spp^" + fmt("%.2f", f.value) + " +/- " +
+                       fmt("%.2f", f.se) + ", slower than 1/spp: " +
+                       (s.bound.bounded
+                            ? "the samples are bounded (" + s.bound.reason +
+                                  "), so the variance is finite and unbiased samples' expected "
+                                  "relative MSE falls as 1/spp; the slower fit comes from rare "
+                                  "large errors some levels missed, a reference too noisy for "
+                                  "this spp, or a bias (pixel_error_bars judges the pixels "
+                                  "against the reference)"
+                            : std::string("infinite variance, bias against the reference, or "
+                                          "a reference too noisy for this spp"))));
             break;
         case FlagCode::RareLargeErrors:
             w.push_back(flag_warning(
@@ -135,7 +155,12 @@ Json render_warnings(const RenderEstimatorStudy& s, double floor) {
                        "understate it, so the relative MSE need not fall with spp and the "
                        "fitted order is unreliable; more images per spp or more pixels average "
                        "more of them, and each level's relative_mse_median shows the typical "
-                       "image"));
+                       "image" +
+                       (f.severity == Severity::Info
+                            ? ". The samples are bounded (" + s.bound.reason +
+                                  "), so these terms have a finite variance and their weight "
+                                  "fades as spp, images or pixels grow"
+                            : std::string())));
             break;
         case FlagCode::PixelErrorBars:
             w.push_back(
@@ -143,7 +168,13 @@ Json render_warnings(const RenderEstimatorStudy& s, double floor) {
                                     "% of the pixels' own 95% error bars cover the reference at "
                                     "spp = " +
                                     std::to_string(f.n) +
-                                    ": per-pixel error bars are too small (heavy tails or bias)"));
+                                    ": per-pixel error bars are too small (" +
+                                    (s.bound.bounded
+                                         ? "the samples are bounded, so not a heavy tail: "
+                                           "rare large values that most pixels have not yet "
+                                           "drawn, or a bias"
+                                         : "heavy tails or bias") +
+                                    ")"));
             break;
         // A level's flags (render_level_to_json words them), and the integration studies' flags,
         // which render_flags never raises.
@@ -282,7 +313,9 @@ Json estimator_study_to_json(const RenderEstimatorStudy& s, bool previews, doubl
                              const RenderImage* reference, double floor, bool all_levels,
                              size_t level) {
     Json j = estimator_to_json(s.estimator);
-    j["contribution_bound"] = Json{{"bounded", s.bound.bounded}, {"reason", s.bound.reason}};
+    j["contribution_bound"] = Json{{"bounded", s.bound.bounded},
+                                   {"infinite_variance", s.bound.infinite_variance},
+                                   {"reason", s.bound.reason}};
     j["warnings"] = render_warnings(s, floor);
     if (all_levels) {
         Json levels = Json::array();

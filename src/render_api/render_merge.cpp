@@ -184,11 +184,19 @@ bool merge_estimator(Ctx& c, const std::vector<const Json*>& parts, size_t e,
     if (const Json* b = find((*parts[0])["estimators"][e], "contribution_bound")) {
         const Json* bounded = b->is_object() ? find(*b, "bounded") : nullptr;
         const Json* reason = b->is_object() ? find(*b, "reason") : nullptr;
+        // infinite_variance: absent in parts from before the field (false then).
+        const Json* infinite = b->is_object() ? find(*b, "infinite_variance") : nullptr;
+        const bool infinite_ok =
+            !infinite || (infinite->is_boolean() &&
+                          !(infinite->get<bool>() && bounded && bounded->is_boolean() &&
+                            bounded->get<bool>()));
         if (!bounded || !bounded->is_boolean() || !reason || !reason->is_string() ||
-            reason->get<std::string>().size() > 1000)
+            reason->get<std::string>().size() > 1000 || !infinite_ok)
             return c.fail("part 0.estimators[" + std::to_string(e) + "].contribution_bound",
-                          "expected {\"bounded\": true or false, \"reason\": a string}");
-        study.bound = {bounded->get<bool>(), reason->get<std::string>()};
+                          "expected {\"bounded\": true or false, \"infinite_variance\": true "
+                          "or false (not both true), \"reason\": a string}");
+        study.bound = {bounded->get<bool>(), infinite && infinite->get<bool>(),
+                       reason->get<std::string>()};
     }
     for (size_t i = 0; i < levels; ++i) {
         const std::string lp = path + ".levels[" + std::to_string(i) + "]";
