@@ -16,7 +16,7 @@ case "$js" in /*) ;; *) js="$PWD/$js" ;; esac
 mkdir "$tmp/elsewhere"
 cp scenes/exp_1d.json "$tmp/elsewhere/only_here.json"
 env_run=(run only_here --n-min 16 --n-max 256 --reps 4 --quiet --format json)
-if (cd "$tmp" && MCPLAY_SCENES="$tmp/elsewhere" node "$js" list) | grep -q only_here &&
+if (cd "$tmp" && MCPLAY_SCENES="$tmp/elsewhere" node "$js" list) | grep only_here >/dev/null &&
     (cd "$tmp" && MCPLAY_SCENES="$tmp/elsewhere" node "$js" "${env_run[@]}" --out "$tmp/env.wasm.json"); then
     MCPLAY_SCENES="$tmp/elsewhere" $native "${env_run[@]}" --threads 2 --out "$tmp/env.native.json"
     node tests/compare_results.mjs "$tmp/env.native.json" "$tmp/env.wasm.json" || status=1
