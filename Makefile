@@ -34,7 +34,9 @@ ARGS ?=
 PORT ?= 8000
 SITE := $(BUILD)/site
 
-# Node 20's fetch() cannot load the .wasm beside a non-ES6 Emscripten program from a file path.
+# Node 20's fetch() cannot load the .wasm beside a non-ES6 Emscripten program from a file path;
+# the CLI and the bench read theirs from disk (src/wasm/node_pre.js) and need no flag, the
+# flag stays for any program linked without it.
 NODE_RUN := node --no-experimental-fetch
 
 # emcc's JavaScript optimiser needs Debian's acorn when node is not Debian's own.

@@ -178,6 +178,7 @@ for (const name of names) {
   if (mine.map((l) => l.spp).join() !== "1,2,4") bad(`${name}: spp ${mine.map((l) => l.spp)}`);
   for (const l of mine) {
     if (!(Number.isFinite(l.relative_mse) && l.relative_mse >= 0)) bad(`${name}: relative_mse ${l.relative_mse}`);
+    if (l.relative_mse_reason !== null) bad(`${name}: a reason beside a number: ${l.relative_mse_reason}`);
     if (!Number.isFinite(l.relative_mse_raw) || !Number.isFinite(l.seconds)) bad(`${name}: ${JSON.stringify(l)}`);
     if (l.width !== 16 || l.height !== 16) bad(`${name}: ${l.width}x${l.height}, expected 16x16`);
     const png = `${dir}/${name}_${l.spp}spp.png`, hdr = `${dir}/${name}_${l.spp}spp.hdr`;
@@ -198,6 +199,18 @@ check progressive-one-shot 0 '' -- render quad_light_floor --estimator mis_power
 if ! cmp -s "$tmp/prog1/mis_power_4spp.hdr" "$tmp/oneshot.hdr"; then
     echo "FAIL progressive-equals-one-shot: the 4 spp pass image differs from a 4 spp render"; failed=$((failed + 1))
 fi
+# A null relative MSE says why (issue 48): a camera far away and turned from the scene sees a
+# black reference, which gives a relative error no scale.
+node -e '
+const fs = require("fs"), [src, out] = process.argv.slice(1);
+const g = JSON.parse(fs.readFileSync(src + "/scenes/quad_light_floor.gltf", "utf8"));
+const camera = g.nodes.find((n) => n.camera !== undefined);
+camera.translation = [0, 0.95, 1e5];
+camera.rotation = [0, 1, 0, 0]; // looking along +z, away from the floor and the light
+const render = { gltf: g, width: 8, height: 8, spp_min: 1, spp_max: 2, reps: 2, estimators: ["light_area"] };
+fs.writeFileSync(out, JSON.stringify({ name: "black", render }));
+' "$src" "$tmp/black.json"
+check progressive-null-reason 0 '"relative_mse":null,"relative_mse_raw":null,"relative_mse_reason":"the reference is black' -- render "$tmp/black.json" --progressive --spp 2 --long-side 16 --out-dir "$tmp/black" --no-cache --quiet
 touch "$tmp/afile"
 prog=(quad_light_floor --progressive --spp 4 --no-cache)
 check progressive-no-out-dir 2 '--progressive needs --out-dir DIR' -- render "${prog[@]}"
@@ -244,7 +257,7 @@ check merge-nothing 2 'merge needs the JSON results of run --part' -- merge
 check merge-no-file 2 "cannot open '$tmp/none.json'" -- merge "$tmp/none.json"
 check part-bad 2 '--part: expected I/K' -- run quad_light_floor --part 3 --format json
 check part-table 2 '--part needs --format json' -- run quad_light_floor --part 0/2
-check part-too-many 2 'options.parts: must be in 1..reps = 3' -- run "${split[@]}" --part 0/4 --format json
+check part-too-many 2 '--part 0/4 \(K\): must be in 1..reps = 3, got 4' -- run "${split[@]}" --part 0/4 --format json
 # Parts of one render study only: another seed is refused (named), the same seed accepted.
 check split-seed-1 0 '' -- run "${split[@]}" --seed 1 --part 0/2 --format json --out "$tmp/seed1.json"
 check split-seed-9 0 '' -- run "${split[@]}" --seed 9 --part 1/2 --format json --out "$tmp/seed9.json"
@@ -285,7 +298,7 @@ check int-merge-twice 2 'part 1 of 3 is given twice' -- merge "$tmp/int0.json" "
 check int-part-seed-9 0 '' -- run exp_1d --rel-tol 1e-2 --reps 5 --estimators uniform,stratified --seed 9 --part 2/3 --format json --out "$tmp/int_seed9.json"
 check int-merge-seeds 2 'options.seed: differs from parts\[0\]' -- merge "$tmp/int0.json" "$tmp/int1.json" "$tmp/int_seed9.json"
 check int-merge-render 2 'kind' -- merge "$tmp/int0.json" "$tmp/seed1b.json"
-check int-part-bad 2 'options.part: must be in 0..parts - 1 = 2' -- run exp_1d --part 3/3 --format json
+check int-part-bad 2 '--part 3/3 \(I\): must be in 0..K - 1 = 2, got 3' -- run exp_1d --part 3/3 --format json
 
 # A result that cannot be written is a failure: a full disk (--out, standard output) and a
 # closed standard output exit 1 with a message, never 0 with the result lost.
@@ -309,10 +322,8 @@ esac
 : >"$tmp/cachefile"
 check cache-file 2 "--cache: '$tmp/cachefile' is not a directory" -- run quad_light_floor --cache "$tmp/cachefile" --n-max 2 --reps 2 --width 8 --height 6 --quiet
 # The wasm CLI sees Emscripten's own environment, not the shell's: the native run checks it.
-case "$exe" in
-    *.js) echo "skip cache-env-file: the wasm CLI does not read the shell's environment" ;;
-    *) MCPLAY_CACHE="$tmp/cachefile" check cache-env-file 2 "MCPLAY_CACHE: '$tmp/cachefile' is not a directory" -- reference quad_light_floor --width 8 --height 6 --out "$tmp/ref.pfm" ;;
-esac
+# The wasm CLI reads the shell's environment too (src/wasm/node_pre.js).
+MCPLAY_CACHE="$tmp/cachefile" check cache-env-file 2 "MCPLAY_CACHE: '$tmp/cachefile' is not a directory" -- reference quad_light_floor --width 8 --height 6 --out "$tmp/ref.pfm"
 check cache-dir 0 '' -- run quad_light_floor --cache "$tmp/cachedir" --n-max 2 --reps 2 --width 8 --height 6 --estimators light_area --quiet
 
 # Issue 48: quad_light_floor split in two at its default settings has images whose relative MSE
@@ -335,6 +346,16 @@ check points-no-n 2 'points needs --n N' -- points sobol
 check points-too-many 2 'n: expected 1 to 1048576 points' -- points sobol --n 2000000
 check analyze-table 0 'L2-star discrepancy \(Warnock\) +[0-9.e-]+ +\(independent points' -- analyze "$tmp/h.csv"
 check analyze-json 0 '"l2_star_discrepancy": [0-9.e-]+' -- analyze "$tmp/h.csv" --format json --spectrum-out "$tmp/h.png"
+# --axes counts the columns from 1 as they are named (x1, x2: the header above), in the table
+# too (issue 48: it printed "axes 0, 1" for --axes 1,2); the JSON's spectrum.axes count from 0.
+check analyze-axes-table 0 'power spectrum of x2, x1 on a' -- analyze "$tmp/h.csv" --axes 2,1
+$mcplay analyze "$tmp/h.csv" --axes 2,1 --format json >"$tmp/axes.json" 2>/dev/null
+if node -e 'const r = JSON.parse(require("fs").readFileSync(process.argv[1], "utf8"));
+process.exit(r.spectrum.axes.join() === "1,0" ? 0 : 1)' "$tmp/axes.json"; then
+    passed=$((passed + 1))
+else
+    echo "FAIL analyze-axes-json: spectrum.axes is not [1, 0] for --axes 2,1"; failed=$((failed + 1))
+fi
 if [ "$(head -c 4 "$tmp/h.png" | tail -c 3)" != "PNG" ]; then
     echo "FAIL analyze-png: $tmp/h.png is not a PNG"; failed=$((failed + 1))
 fi

@@ -8,6 +8,22 @@ wasm=${2:?wasm mcplay command}
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 status=0
+# The wasm CLI as a user runs it (issue 48): plain `node mcplay.js`, no flags (Node 20's fetch()
+# once made it fail without --no-experimental-fetch), from another folder, finding its scene
+# through $MCPLAY_SCENES (which it ignored) and giving the native CLI's numbers.
+js=${wasm##* }
+case "$js" in /*) ;; *) js="$PWD/$js" ;; esac
+mkdir "$tmp/elsewhere"
+cp scenes/exp_1d.json "$tmp/elsewhere/only_here.json"
+env_run=(run only_here --n-min 16 --n-max 256 --reps 4 --quiet --format json)
+if (cd "$tmp" && MCPLAY_SCENES="$tmp/elsewhere" node "$js" list) | grep only_here >/dev/null &&
+    (cd "$tmp" && MCPLAY_SCENES="$tmp/elsewhere" node "$js" "${env_run[@]}" --out "$tmp/env.wasm.json"); then
+    MCPLAY_SCENES="$tmp/elsewhere" $native "${env_run[@]}" --threads 2 --out "$tmp/env.native.json"
+    node tests/compare_results.mjs "$tmp/env.native.json" "$tmp/env.wasm.json" || status=1
+else
+    echo "FAIL plain node $js: no scene from \$MCPLAY_SCENES listed or run"
+    status=1
+fi
 for scene in scenes/*.json; do
     name=$(basename "$scene" .json)
     if grep -q '"render"' "$scene"; then

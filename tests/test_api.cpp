@@ -715,3 +715,120 @@ TEST(Api, AStudyWhoseWarpLeavesItsDomainFailsNamingThePoint) {
               MCP_ERROR_SCENE);
     EXPECT_EQ(out, nullptr);
 }
+
+namespace {
+
+std::string warp_scene(const json& warp) {
+    return json{{"f", "1"}, {"warp", warp}, {"estimators", {"warp"}}, {"n_max", 64}, {"reps", 4}}
+        .dump();
+}
+
+} // namespace
+
+// Issue 48: a named warp reads its own parameters only. Each warp's own parameters are taken;
+// a parameter it does not read (another warp's) is refused, naming it and the warp's own.
+TEST(Api, NamedWarpsTakeTheirOwnParametersOnly) {
+    const json own = {
+        {"uniform", {{"lower", {0, 0}}, {"upper", {2, 1}}}},
+        {"polar_disk", {{"center", {1, 0}}, {"radius", 2}}},
+        {"concentric_disk", {{"center", {1, 0}}, {"radius", 2}}},
+        {"uniform_sphere", json::object()},
+        {"uniform_hemisphere", json::object()},
+        {"cosine_hemisphere", json::object()},
+        {"triangle", {{"vertices", {{0, 0}, {2, 0}, {0, 1}}}}},
+        {"tabulated_1d", {{"lower", 0}, {"upper", 2}, {"f", "1 + x"}, {"bins", 8}}},
+        {"tabulated_2d", {{"f", "1 + x*y"}, {"nx", 4}, {"ny", 3}}},
+        {"ggx_visible_normals", {{"alpha", 0.3}, {"wo", {0, 0, 1}}}},
+        {"spherical_triangle",
+         {{"a", {1, 0, 1}}, {"b", {0, 1, 1}}, {"c", {0, 0, 1}}, {"viewpoint", {0, 0, -1}}}},
+    };
+    for (auto it = own.begin(); it != own.end(); ++it) {
+        json warp = it.value();
+        warp["name"] = it.key();
+        const Outcome right = plan(warp_scene(warp));
+        EXPECT_EQ(right.status, MCP_OK) << it.key() << ": " << right.error;
+        const char* foreign = it.key() == "ggx_visible_normals" ? "radius" : "alpha";
+        warp[foreign] = 0.5;
+        const Outcome wrong = plan(warp_scene(warp));
+        EXPECT_EQ(wrong.status, MCP_ERROR_SCENE) << it.key();
+        const std::string says = std::string("unknown parameter '") + foreign +
+                                 "' of the warp '" + it.key() + "' (";
+        EXPECT_NE(wrong.error.find(says), std::string::npos) << wrong.error;
+        EXPECT_NE(wrong.error.find(it.value().empty() ? "it takes none" : "its parameters: "),
+                  std::string::npos)
+            << wrong.error;
+    }
+    // Every warp of the catalog is in the table above (a new warp must say what it reads).
+    char* out = nullptr;
+    ASSERT_EQ(mcp_catalog(&out), MCP_OK);
+    const json catalog = json::parse(out);
+    mcp_free(out);
+    ASSERT_TRUE(catalog.contains("warps"));
+    for (const json& w : catalog["warps"]) EXPECT_TRUE(own.contains(w["name"])) << w.dump();
+}
+
+// Issue 48: a table's count given as 0 is refused, not read as the default (bins 0 gave 64);
+// 1 is the smallest taken, and leaving it out takes the default.
+TEST(Api, NamedWarpCountsOfZeroAreRefused) {
+    const json cases[] = {{{"name", "tabulated_1d"}, {"f", "1 + x"}, {"bins", 0}},
+                          {{"name", "tabulated_2d"}, {"f", "1 + x"}, {"nx", 0}, {"ny", 4}},
+                          {{"name", "tabulated_2d"}, {"f", "1 + x"}, {"nx", 4}, {"ny", 0}}};
+    const char* fields[] = {"warp.bins", "warp.nx", "warp.ny"};
+    for (size_t k = 0; k < 3; ++k) {
+        const Outcome zero = plan(warp_scene(cases[k]));
+        EXPECT_EQ(zero.status, MCP_ERROR_SCENE) << cases[k].dump();
+        EXPECT_NE(zero.error.find(std::string(fields[k]) + ": must be in 1..4096, got 0"),
+                  std::string::npos)
+            << zero.error;
+        json one = cases[k];
+        for (const char* key : {"bins", "nx", "ny"})
+            if (one.contains(key) && one[key] == 0) one[key] = 1;
+        EXPECT_EQ(plan(warp_scene(one)).status, MCP_OK) << one.dump();
+    }
+    EXPECT_EQ(plan(warp_scene({{"name", "tabulated_1d"}, {"f", "1 + x"}})).status, MCP_OK);
+}
+
+// Issue 48: max_seconds given is a budget, so 0 is refused (it read as "no budget"), in the
+// scene or the options, with or without a tolerance; a positive budget with a tolerance runs.
+TEST(Api, AZeroTimeBudgetIsRefused) {
+    const std::string scene = R"({"f": "x", "estimators": ["uniform"], "reps": 4)";
+    for (const char* extra : {R"(, "rel_tol": 0.1, "max_seconds": 0})", R"(, "max_seconds": 0})"}) {
+        const Outcome o = plan(scene + extra);
+        EXPECT_EQ(o.status, MCP_ERROR_SCENE) << extra;
+        EXPECT_NE(o.error.find("scene: max_seconds: must be a finite number > 0, got 0"),
+                  std::string::npos)
+            << o.error;
+    }
+    const Outcome in_options = plan(scene + "}", R"({"rel_tol": 0.1, "max_seconds": 0})");
+    EXPECT_EQ(in_options.status, MCP_ERROR_ARGUMENT);
+    EXPECT_NE(in_options.error.find("options: max_seconds: must be a finite number > 0"),
+              std::string::npos)
+        << in_options.error;
+    EXPECT_EQ(plan(scene + R"(, "rel_tol": 0.1, "max_seconds": 5})").status, MCP_OK);
+    EXPECT_EQ(plan(scene + "}", R"({"rel_tol": 0.1, "max_seconds": 0.5})").status, MCP_OK);
+}
+
+// Issue 48: a heuristic weighs two or more techniques. Given to an estimator of one technique
+// (a pdf, or one proposal) it was ignored; it is refused naming the estimator, and taken with
+// two proposals or a defensive mixture.
+TEST(Api, AHeuristicOverOneTechniqueIsRefused) {
+    const std::string pdf = R"({"type": "power", "k": 1})";
+    auto scene = [](const std::string& estimator) {
+        return R"({"f": "x", "reps": 4, "n_max": 64, "estimators": [)" + estimator + "]}";
+    };
+    for (const std::string& one :
+         {R"({"name": "is_power", "pdf": )" + pdf + R"(, "heuristic": "power"})",
+          R"({"name": "is_power", "proposals": [)" + pdf + R"(], "heuristic": "power"})"}) {
+        const Outcome o = plan(scene(one));
+        EXPECT_EQ(o.status, MCP_ERROR_SCENE) << one;
+        EXPECT_NE(o.error.find("scene.estimators[0].heuristic: estimator 'is_power' samples one "
+                               "technique"),
+                  std::string::npos)
+            << o.error;
+    }
+    const std::string power = R"(, "heuristic": "power"})";
+    for (const std::string& two :
+         {R"({"name": "mis_power", "proposals": [)" + pdf + R"(, "uniform"])" + power,
+          R"({"name": "mis_power", "pdf": )" + pdf + R"(, "defensive": 0.2)" + power})
+        EXPECT_EQ(plan(scene(two)).status, MCP_OK) << two << ": " << plan(scene(two)).error;
+}

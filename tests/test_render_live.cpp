@@ -258,5 +258,49 @@ TEST(LiveApi, RefusesBadRequestsWithAReason) {
     EXPECT_EQ(mcp_render_live_close(id), MCP_OK);
 }
 
+// Issue 48: the live view validates its estimators as a study does (the CLI's --estimators
+// refuses a name given twice, and so does the API under the page): each name once is taken.
+TEST(LiveApi, AnEstimatorNamedTwiceIsRefused) {
+    const json scene = test::scene_json("quad_light_floor");
+    const json base{{"long_side", 16}, {"live_reference", "available"}};
+    json twice = base;
+    twice["estimators"] = {"bsdf", "light_area", "bsdf"};
+    Call c = open_live(scene, twice);
+    EXPECT_EQ(c.status, MCP_ERROR_ARGUMENT);
+    EXPECT_NE(c.error.find("options.estimators[2]: 'bsdf' is named twice"), std::string::npos)
+        << c.error;
+    json once = base;
+    once["estimators"] = {"bsdf", "light_area"};
+    c = open_live(scene, once);
+    ASSERT_EQ(c.error, "");
+    EXPECT_EQ(c.result["estimators"].size(), 2u);
+    mcp_render_live_close(c.result["session"]);
+    // A study's options likewise.
+    char* out = nullptr;
+    json study{{"base_dir", test::kScenes}, {"estimators", {"mis_power", "mis_power"}}};
+    EXPECT_EQ(mcp_render_study_plan(scene.dump().c_str(), study.dump().c_str(), &out),
+              MCP_ERROR_ARGUMENT);
+    EXPECT_NE(std::string(mcp_last_error()).find("'mis_power' is named twice"), std::string::npos)
+        << mcp_last_error();
+    mcp_free(out);
+}
+
+// Issue 48: the memory a session needs counts its rows. The whole 4096 x 4096 image with one
+// estimator is beyond the limit (its message names the rows); 64 of its rows are not (the
+// estimate counted every row of the pass image and refused them too).
+TEST(LiveApi, MemoryEstimateCountsTheRows) {
+    const json scene = test::scene_json("quad_light_floor");
+    json options{{"long_side", 4096}, {"estimators", {"bsdf"}}, {"live_reference", "available"}};
+    Call whole = open_live(scene, options);
+    EXPECT_EQ(whole.status, MCP_ERROR_ARGUMENT);
+    EXPECT_NE(whole.error.find("rows [0, 4096) of a 4096x4096 image"), std::string::npos)
+        << whole.error;
+    options["rows"] = {0, 64};
+    Call band = open_live(scene, options);
+    ASSERT_EQ(band.error, "");
+    EXPECT_EQ(band.result["width"], 4096);
+    mcp_render_live_close(band.result["session"]);
+}
+
 } // namespace
 } // namespace mcp

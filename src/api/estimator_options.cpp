@@ -221,6 +221,18 @@ bool parse_mis_options(Ctx& c, const Json& j, const std::string& path, const Pro
             return c.fail(sub(path, "one_sample"), "expected true or false, got " + type_of(*one));
         out->one_sample = one->get<bool>();
     }
+    // A heuristic weighs two or more techniques: over one it would be ignored without a word.
+    if (out->proposals.size() < 2)
+        for (const char* key : {"heuristic", "beta", "cutoff"})
+            if (find(j, key)) {
+                const Json* name = find(j, "name");
+                return c.fail(sub(path, key),
+                              "estimator '" +
+                                  name_text(name && name->is_string() ? name->get<std::string>()
+                                                                      : std::string()) +
+                                  "' samples one technique, and a heuristic weighs two or more: "
+                                  "give two or more \"proposals\" (or \"defensive\")");
+            }
     return true;
 }
 

@@ -1,5 +1,6 @@
 // A scene's "warp" (docs/scene-format.md, "Warps"): a named warp ("concentric_disk", or
 // {"name": ..., its parameters}) or one typed as expressions ({"domain", "g", "p"}).
+#include <algorithm>
 #include <cmath>
 
 #include "api/scene_parsers.h"
@@ -26,12 +27,40 @@ bool get_point2(Ctx& c, const Json& v, const std::string& path, Vec2* out) {
     return true;
 }
 
-/// The parameters of a named warp from its object (each warp reads its own).
-bool parse_named_params(Ctx& c, const Json& j, const std::string& path, NamedWarpParams* p) {
-    if (!check_keys(c, j, path,
-                    {"name", "lower", "upper", "center", "radius", "vertices", "values", "f",
-                     "bins", "nx", "ny", "alpha", "wo", "a", "b", "c", "viewpoint"}))
-        return false;
+/// The parameters each named warp reads (docs/scene-format.md, "Warps"); null for a name that
+/// is none of them.
+const std::vector<std::string>* named_warp_fields(const std::string& name) {
+    static const std::vector<std::pair<std::string, std::vector<std::string>>> fields = {
+        {"uniform", {"lower", "upper"}},
+        {"polar_disk", {"center", "radius"}},
+        {"concentric_disk", {"center", "radius"}},
+        {"uniform_sphere", {}},
+        {"uniform_hemisphere", {}},
+        {"cosine_hemisphere", {}},
+        {"triangle", {"vertices"}},
+        {"tabulated_1d", {"lower", "upper", "values", "f", "bins"}},
+        {"tabulated_2d", {"lower", "upper", "values", "f", "nx", "ny"}},
+        {"ggx_visible_normals", {"alpha", "wo"}},
+        {"spherical_triangle", {"a", "b", "c", "viewpoint"}},
+    };
+    for (const auto& [n, f] : fields)
+        if (n == name) return &f;
+    return nullptr;
+}
+
+/// The parameters of a named warp from its object: only those the warp reads, so that a
+/// parameter of another warp is refused rather than ignored.
+bool parse_named_params(Ctx& c, const Json& j, const std::string& path, const std::string& name,
+                        const std::vector<std::string>& known, NamedWarpParams* p) {
+    for (auto it = j.begin(); it != j.end(); ++it) {
+        if (it.key() == "name" ||
+            std::find(known.begin(), known.end(), it.key()) != known.end())
+            continue;
+        return c.fail(path, "unknown parameter '" + it.key() + "' of the warp '" + name + "' (" +
+                                (known.empty() ? std::string("it takes none")
+                                               : "its parameters: " + join(known)) +
+                                ")");
+    }
     if (!get_numbers(c, j, "lower", path, &p->lo) || !get_numbers(c, j, "upper", path, &p->hi) ||
         !get_number(c, j, "radius", path, &p->radius) ||
         !get_number(c, j, "alpha", path, &p->alpha) || !get_vec3(c, j, "wo", path, &p->wo) ||
@@ -53,14 +82,18 @@ bool parse_named_params(Ctx& c, const Json& j, const std::string& path, NamedWar
     if (const Json* v = find(j, "values"); v && v->is_array() && v->size() > (size_t(1) << 20))
         return c.fail(sub(path, "values"), "at most 2^20 values");
     if (!get_numbers(c, j, "values", path, &p->values)) return false;
-    uint64_t bins = 0, nx = 0, ny = 0;
-    if (!get_count(c, j, "bins", path, &bins) || !get_count(c, j, "nx", path, &nx) ||
-        !get_count(c, j, "ny", path, &ny))
-        return false;
-    for (uint64_t v : {bins, nx, ny})
-        if (v > 4096) return c.fail(path, "bins, nx and ny must be at most 4096");
-    p->nx = static_cast<int>(bins ? bins : nx);
-    p->ny = static_cast<int>(ny);
+    // Left out, a count takes the warp's default; given, it is 1..4096 (a 0 is not the default).
+    uint64_t counts[3] = {0, 0, 0};
+    const char* count_keys[3] = {"bins", "nx", "ny"};
+    for (int k = 0; k < 3; ++k) {
+        if (!get_count(c, j, count_keys[k], path, &counts[k])) return false;
+        if (find(j, count_keys[k]) && (counts[k] < 1 || counts[k] > 4096))
+            return c.fail(sub(path, count_keys[k]),
+                          "must be in 1..4096, got " + std::to_string(counts[k]) +
+                              " (leave it out for the default)");
+    }
+    p->nx = static_cast<int>(counts[0] ? counts[0] : counts[1]);
+    p->ny = static_cast<int>(counts[2]);
     return true;
 }
 
@@ -77,8 +110,9 @@ bool parse_warp(Ctx& c, const Json& j, const std::string& path, NamedWarp* out) 
     if (find(j, "name")) {
         std::string name;
         if (!get_string(c, j, "name", path, &name)) return false;
+        const std::vector<std::string>* known = named_warp_fields(name);
         NamedWarpParams params;
-        if (!parse_named_params(c, j, path, &params)) return false;
+        if (known && !parse_named_params(c, j, path, name, *known, &params)) return false;
         Made<NamedWarp> w = make_named_warp(name, params);
         if (!w.ok()) return c.fail(path, w.error);
         *out = std::move(w.value);

@@ -8,6 +8,7 @@
 #include <set>
 
 #include "api/json_read.h"
+#include "api/report.h" // fmt
 #include "api/scene_parsers.h"
 #include "core/rng.h"
 #include "core/walsh_bound.h"
@@ -251,14 +252,18 @@ Made<SceneRequest> build_request(const Json& scene, const Json& options,
     if (s.stopping() && !(options.is_object() && find(options, "n_max")) &&
         !(scene_stops && find(scene, "n_max")))
         s.n_max = kStoppingDefaultNMax;
-    if (s.stopping() || s.abs_tol != 0.0 || s.rel_tol != 0.0 || s.max_seconds != 0.0) {
+    const bool max_seconds_given = find(scene, "max_seconds") || find(options, "max_seconds");
+    if (s.stopping() || s.abs_tol != 0.0 || s.rel_tol != 0.0 || max_seconds_given) {
         const bool from_options =
             options.is_object() &&
             (find(options, "rel_tol") || find(options, "abs_tol") || find(options, "max_seconds"));
         const char* who = from_options ? "options: " : "scene: ";
-        if (!(s.max_seconds >= 0.0) || !std::isfinite(s.max_seconds))
-            return made_error<SceneRequest>(std::string(who) +
-                                            "max_seconds: must be a finite number >= 0");
+        // Given, a budget is a budget: 0 is refused rather than read as "none".
+        if (!(s.max_seconds > 0.0 || !max_seconds_given) || !std::isfinite(s.max_seconds))
+            return made_error<SceneRequest>(
+                std::string(find(options, "max_seconds") ? "options: " : "scene: ") +
+                "max_seconds: must be a finite number > 0, got " +
+                fmt("%.3g", s.max_seconds) + " (leave it out for no time budget)");
         if (!s.stopping() && s.max_seconds > 0.0)
             return made_error<SceneRequest>(std::string(who) +
                                             "max_seconds: applies with rel_tol or abs_tol only");

@@ -34,6 +34,14 @@ inline Json api_json(const char* text) {
     return j.ok() ? std::move(j.value) : Json(Json::value_t::discarded);
 }
 
+/// A C API error about `field` ("options.parts: must be ...") named as the command-line flag
+/// that set it ("--part 0/9: must be ..."); other errors unchanged.
+inline std::string flag_named(const std::string& error, const std::string& field,
+                              const std::string& flag) {
+    if (error.compare(0, field.size() + 1, field + ":") != 0) return error;
+    return flag + error.substr(field.size());
+}
+
 inline int usage_error(const std::string& msg) {
     std::fprintf(stderr, "mcplay: %s (see mcplay --help)\n", boundary::one_line(msg).c_str());
     return kExitUsage;

@@ -146,7 +146,8 @@ std::string analysis_table(const nlohmann::json& a) {
     if (a.contains("spectrum")) {
         const auto& s = a["spectrum"];
         const auto& radial = s["radial"];
-        out += "power spectrum of axes " + s["axes"][0].dump() + ", " + s["axes"][1].dump() +
+        out += "power spectrum of x" + std::to_string(s["axes"][0].get<int>() + 1) + ", x" +
+               std::to_string(s["axes"][1].get<int>() + 1) +
                " on a " + s["size"].dump() + " x " + s["size"].dump() +
                " frequency grid; radial average (1 = independent points):\n";
         const size_t rings = radial["frequency"].size();
@@ -269,21 +270,33 @@ int cmd_analyze(const std::vector<std::string>& args) {
     }
     nlohmann::json spectrum = nlohmann::json::object();
     if (!count_option(o, "--spectrum-size", "size", &spectrum, &error)) return usage_error(error);
-    if (const std::string* axes = o.get("--axes")) {
+    // --axes counts from 1, as the columns x1, x2, ... are named (mcplay points, the table's
+    // "power spectrum of x1, x2"); the request's spectrum.axes counts from 0.
+    const std::string* axes = o.get("--axes");
+    if (axes) {
         unsigned long long a = 0, b = 0;
         const size_t comma = axes->find(',');
         if (comma == std::string::npos || !parse_count(axes->substr(0, comma), &a) ||
-            !parse_count(axes->substr(comma + 1), &b) || a < 1 || b < 1)
-            return usage_error("--axes: expected two 1-based axes such as 1,2, got '" + *axes +
-                               "'");
+            !parse_count(axes->substr(comma + 1), &b) || a < 1 || b < 1 || a > 64 || b > 64 ||
+            a == b)
+            return usage_error("--axes: expected two different columns counted from 1, such as "
+                               "1,2 (x1 and x2), got '" +
+                               *axes + "'");
         spectrum["axes"] = {a - 1, b - 1};
     }
     request["spectrum"] = spectrum;
     char* text = nullptr;
     const int status = mcp_points_analyze(boundary::dump(request).c_str(), &text);
     if (status != MCP_OK) {
+        // The request's fields named as the flags that set them, the columns counted from 1.
+        std::string why = flag_named(mcp_last_error(), "request.spectrum.size", "--spectrum-size");
+        int dim = 0;
+        if (axes &&
+            std::sscanf(why.c_str(), "request.spectrum.axes: the points have %d", &dim) == 1)
+            why = "--axes " + *axes + ": the points have " + std::to_string(dim) +
+                  " coordinates (x1 to x" + std::to_string(dim) + ")";
         std::fprintf(stderr, "mcplay: analyze: %s: %s\n", boundary::one_line(path).c_str(),
-                     mcp_last_error());
+                     boundary::one_line(why).c_str());
         return exit_code(status);
     }
     const nlohmann::json result = api_json(text);

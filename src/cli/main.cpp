@@ -98,7 +98,8 @@ const char* kUsage =
     "  2, 4, ... N spp (--spp, a power of two), never restarting; at each power of two its\n"
     "  image goes to DIR/<estimator>_<spp>spp.png and .hdr (--out-dir DIR, created if missing)\n"
     "  and one JSON line to standard output: estimator, spp, seconds, relative_mse,\n"
-    "  relative_mse_raw (null without a reference), width, height, png, hdr. The size:\n"
+    "  relative_mse_raw, relative_mse_reason (why they are null, else null), width, height,\n"
+    "  png, hdr. The size:\n"
     "  --long-side L (16..4096, default 256; the other side from the camera's aspect) or\n"
     "  --width and --height; --pixel-sampler padded_sobol (default) or independent (the\n"
     "  samplers that extend; stratified and sobol depend on the final spp). The reference is\n"
@@ -118,7 +119,8 @@ const char* kUsage =
     "  analyze reads points in [0,1)^d (CSV with an optional header, a column named set\n"
     "  splitting the rows into randomizations; or a JSON array of rows) and prints their\n"
     "  L2-star, centred and wrap-around L2 discrepancies, minimum distances and the radial\n"
-    "  power spectrum; --spectrum-out writes the spectrum of axes --axes (default 1,2) as a PNG\n"
+    "  power spectrum; --spectrum-out writes the spectrum of columns --axes A,B (counted from 1\n"
+    "  as x1, x2, ... are named; default 1,2) as a PNG; the JSON's spectrum.axes count from 0\n"
     "  warp-test tests a scene's \"warp\" (g and p, or a named warp): the density's integral\n"
     "  and a chi-square test of --samples (default 10^6) samples in equal-measure bins; exits 0\n"
     "  whether the warp passes or fails (a failed test is a result)\n"
@@ -474,7 +476,7 @@ void announce_long_study(const std::string& scene, const std::string& options, b
 }
 
 int cmd_run(const std::vector<std::string>& args) {
-    std::string scene_arg, format = "table", out_path, dir_arg, cache_arg;
+    std::string scene_arg, format = "table", out_path, dir_arg, cache_arg, part_arg;
     bool quiet = false, no_cache = false;
     nlohmann::json options = nlohmann::json::object();
     for (size_t i = 0; i < args.size(); ++i) {
@@ -531,6 +533,7 @@ int cmd_run(const std::vector<std::string>& args) {
                 return usage_error("--part: expected I/K with whole numbers, e.g. 0/4");
             options["part"] = part;
             options["parts"] = parts;
+            part_arg = v;
         } else if (a == "--format") {
             if (!value(&v)) return usage_error("--format needs table, json or csv");
             if (v != "table" && v != "json" && v != "csv")
@@ -595,8 +598,14 @@ int cmd_run(const std::vector<std::string>& args) {
                                nullptr, &result);
     }
     if (status != MCP_OK && status != MCP_ERROR_CANCELLED) {
+        // The limits of --part I/K named as the flag typed, not as the options it sets.
+        std::string why =
+            flag_named(mcp_last_error(), "options.parts", "--part " + part_arg + " (K)");
+        why = flag_named(why, "options.part", "--part " + part_arg + " (I)");
+        if (why.compare(0, 7, "--part ") == 0 && why.find("0..parts - 1") != std::string::npos)
+            why.replace(why.find("0..parts - 1"), 12, "0..K - 1");
         std::fprintf(stderr, "mcplay: %s: %s\n", mcp::boundary::one_line(path).c_str(),
-                     mcp_last_error());
+                     mcp::boundary::one_line(why).c_str());
         out_file.discard();
         return exit_code(status);
     }
@@ -722,6 +731,17 @@ int check_long_side(const nlohmann::json& options) {
 
 /// The largest spp a progressive pass takes (mcp_render_live_pass's limit).
 constexpr unsigned long long kMaxLiveSpp = 1ull << 20;
+
+/// Why a live pass's relative MSE is null, from its error sums and the session's reference.
+std::string null_error_reason(const nlohmann::json& error, const nlohmann::json& reference) {
+    if (!error.is_object() || !reference.is_object()) return "no reference image to compare with";
+    if (!(error["terms"].is_number() && error["terms"].get<double>() > 0))
+        return "no pixel of the reference to compare with";
+    if (!(reference["mean_luminance"].is_number() &&
+          reference["mean_luminance"].get<double>() > 0))
+        return "the reference is black: a relative error has no scale";
+    return "the error is not finite: the image holds non-finite or overflowing pixels";
+}
 
 /// `mcplay render SCENE --progressive --spp N --out-dir DIR`: the live view's progression.
 /// Each estimator's image is taken pass by pass to 1, 2, 4, ..., N spp (the estimators in turn,
@@ -857,6 +877,7 @@ int cmd_render_progressive(ImageCommand& c) {
                                            {"seconds", r["seconds"]},
                                            {"relative_mse", nullptr},
                                            {"relative_mse_raw", nullptr},
+                                           {"relative_mse_reason", nullptr},
                                            {"width", width},
                                            {"height", height},
                                            {"png", base + ".png"},
@@ -871,6 +892,9 @@ int cmd_render_progressive(ImageCommand& c) {
                     if (error[key].is_number() && std::isfinite(error[key].get<double>()))
                         line[field] = error[key].get<double>() / terms;
             }
+            // A null relative MSE says why (render_study.cpp, band_error_sums).
+            if (line["relative_mse"].is_null())
+                line["relative_mse_reason"] = null_error_reason(error, open["reference"]);
             std::printf("%s\n", line.dump().c_str());
             std::fflush(stdout);
         }

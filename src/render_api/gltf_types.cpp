@@ -67,6 +67,15 @@ struct GltfTypeChecker {
         }
         return true;
     }
+    /// A perspective camera's aspectRatio, when given, is > 0 [glTF2, camera.perspective]:
+    /// tinygltf reads 0 as "not given", which would silently use the scene's own ratio.
+    bool positive_aspect(const Json& perspective, const std::string& path) {
+        auto it = perspective.find("aspectRatio");
+        if (it == perspective.end() || it->get<double>() > 0.0) return true;
+        return fail(path + ".aspectRatio",
+                    "a number > 0, got " + it->dump() +
+                        " (leave it out to use the scene's width / height)");
+    }
     /// Each element of the array `key` of the root, checked by `each`.
     template <class F> bool each(const Json& root, const char* key, F check) {
         auto it = root.find(key);
@@ -104,8 +113,9 @@ struct GltfTypeChecker {
                     [&](const Json& c, const std::string& p) {
                         return fields(c, p, {"type:s", "perspective:o", "orthographic:o"}) &&
                                (!c.contains("perspective") ||
-                                fields(c["perspective"], p + ".perspective",
-                                       {"yfov:n", "znear:n", "zfar:n", "aspectRatio:n"}));
+                                (fields(c["perspective"], p + ".perspective",
+                                        {"yfov:n", "znear:n", "zfar:n", "aspectRatio:n"}) &&
+                                 positive_aspect(c["perspective"], p + ".perspective")));
                     }) &&
                each(g, "meshes",
                     [&](const Json& m, const std::string& p) {

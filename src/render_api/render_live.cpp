@@ -33,9 +33,9 @@ constexpr size_t kMaxLiveEstimators = 4;
 constexpr size_t kMaxLiveSessions = 16;
 constexpr uint64_t kMaxLiveSpp = uint64_t(1) << 20;
 /// Bytes a band pixel holds per estimator (ImageBand: mean, m2, kept, luminance sum and
-/// maximum, the generator) and per pixel of the image the session holds whole (the reference,
-/// and the band's image made for a pass's result).
-constexpr double kBandPixelBytes = 88.0, kImagePixelBytes = 48.0 * 2.0;
+/// maximum, the generator), and per pixel of an image (RenderImage): the reference, held whole,
+/// and the band's image made for a pass's result, of the band's rows.
+constexpr double kBandPixelBytes = 88.0, kImagePixelBytes = 48.0;
 
 struct LiveSession {
     LoadedRender loaded;
@@ -172,16 +172,19 @@ int open_session(const char* scene_json, const char* options_json, mcp_progress_
     if (!parse_rows(live_options, height, &row_begin, &row_end, &error))
         return fail(MCP_ERROR_ARGUMENT, error);
     const double band_pixels = double(width) * double(row_end - row_begin);
-    const double bytes = band_pixels * kBandPixelBytes * double(r.estimators.size()) +
-                         double(width) * double(height) * kImagePixelBytes;
+    const double bytes =
+        band_pixels * (kBandPixelBytes * double(r.estimators.size()) + kImagePixelBytes) +
+        double(width) * double(height) * kImagePixelBytes;
     if (!(bytes <= kMaxImageBytes))
         return fail(MCP_ERROR_ARGUMENT,
-                    "options: a live view of " + std::to_string(width) + "x" +
-                        std::to_string(height) + " pixels and " +
+                    "options: a live view of rows [" + std::to_string(row_begin) + ", " +
+                        std::to_string(row_end) + ") of a " + std::to_string(width) + "x" +
+                        std::to_string(height) + " image and " +
                         std::to_string(r.estimators.size()) + " estimator(s) needs " +
-                        fmt("%.0f", bytes / 1048576.0) + " MiB, more than the limit of " +
+                        fmt("%.0f", bytes / 1048576.0) + " MiB (its rows, and the reference " +
+                        "whole), more than the limit of " +
                         fmt("%.0f", kMaxImageBytes / 1048576.0) +
-                        " MiB: lower the image size or the estimators");
+                        " MiB: lower the image size, the rows or the estimators");
     {
         std::lock_guard<std::mutex> lock(g_sessions_lock);
         if (g_sessions.size() >= kMaxLiveSessions)

@@ -360,11 +360,13 @@ Made<std::shared_ptr<RenderRequest>> build_render_request(const Json& scene, con
         !get_count(c, opts, "parts", "options", &parts))
         return error();
     if (parts < 1 || parts > uint64_t(r->settings.reps)) {
-        c.fail("options.parts", "must be in 1..reps = " + std::to_string(r->settings.reps));
+        c.fail("options.parts", "must be in 1..reps = " + std::to_string(r->settings.reps) +
+                                    ", got " + std::to_string(parts));
         return error();
     }
     if (part >= parts) {
-        c.fail("options.part", "must be in 0..parts - 1 = " + std::to_string(parts - 1));
+        c.fail("options.part", "must be in 0..parts - 1 = " + std::to_string(parts - 1) +
+                                   ", got " + std::to_string(part));
         return error();
     }
     r->settings.part = int(part);
@@ -391,22 +393,28 @@ Made<std::shared_ptr<RenderRequest>> build_render_request(const Json& scene, con
         if (!list->is_array() || list->empty())
             return made_error<std::shared_ptr<RenderRequest>>(
                 "options.estimators: expected a non-empty array");
+        // A name given twice is refused (as the CLI's --estimators refuses it): the same
+        // estimator twice is one study, not a comparison.
         std::vector<RenderEstimator> chosen;
         for (size_t i = 0; i < list->size(); ++i) {
             const Json& item = (*list)[i];
+            const std::string at = "options.estimators[" + std::to_string(i) + "]";
+            RenderEstimator e;
             bool found = false;
             if (item.is_string())
-                for (const RenderEstimator& e : r->estimators)
-                    if (e.name == item.get<std::string>()) {
-                        chosen.push_back(e);
+                for (const RenderEstimator& s : r->estimators)
+                    if (s.name == item.get<std::string>()) {
+                        e = s;
                         found = true;
+                        break;
                     }
-            if (!found) {
-                RenderEstimator e;
-                if (!parse_estimator(c, item, "options.estimators[" + std::to_string(i) + "]", &e))
+            if (!found && !parse_estimator(c, item, at, &e)) return error();
+            for (const RenderEstimator& o : chosen)
+                if (o.name == e.name) {
+                    c.fail(at, "'" + e.name + "' is named twice");
                     return error();
-                chosen.push_back(e);
-            }
+                }
+            chosen.push_back(e);
         }
         r->estimators = chosen;
     }

@@ -99,6 +99,20 @@ scene('deep_8000_object', '{"a":'.repeat(8000) + '1' + '}'.repeat(8000), 'nested
 scene('deep_65', '{"f": "x", "notes": ' + '['.repeat(65) + ']'.repeat(65) + '}', 'nested more than 64 levels');
 // A typed warp that leaves its domain fails the study, naming the point (issue 48).
 scene('warp_outside_study', { warp: { domain: { type: 'interval', lower: 0, upper: 1 }, g: ['2*u'], p: '1' }, f: 'x', estimators: ['warp'], n_max: 64, reps: 4 }, 'its warp put a point outside its domain');
+// Issue 48's silent limits, each refused with the field and the reason: a named warp's
+// parameter it does not read (or that another warp reads), a count of 0 that meant the default,
+// a time budget of 0 that meant none, --part and --axes named as typed.
+scene('warp_param_unknown', withf({ warp: { name: 'concentric_disk', alpha: 0.3 } }), "unknown parameter 'alpha' of the warp 'concentric_disk' (its parameters: center, radius)");
+scene('warp_param_none', withf({ warp: { name: 'uniform_sphere', radius: 2 } }), "the warp 'uniform_sphere' (it takes none)");
+scene('warp_bins_zero', withf({ warp: { name: 'tabulated_1d', f: 'x', bins: 0 } }), 'warp.bins: must be in 1..4096, got 0');
+scene('warp_ny_zero', withf({ warp: { name: 'tabulated_2d', f: 'x*y', nx: 8, ny: 0 } }), 'warp.ny: must be in 1..4096, got 0');
+scene('max_seconds_zero', withf({ rel_tol: 0.01, max_seconds: 0 }), 'scene: max_seconds: must be a finite number > 0, got 0');
+scene('max_seconds_zero_alone', withf({ max_seconds: 0 }), 'max_seconds: must be a finite number > 0');
+scene('heuristic_one_technique', withf({ estimators: [{ name: 'is_power', pdf: { type: 'power', k: 1 }, heuristic: 'power' }] }), "heuristic: estimator 'is_power' samples one technique");
+add('part_beyond_reps', 2, ['run', ok, '--part', '0/9', '--format', 'json'], '--part 0/9 (K): must be in 1..reps = 4, got 9');
+write('lab/points_2d.csv', '0.1,0.2\n0.3,0.4\n0.5,0.6\n0.7,0.8\n');
+add('analyze_axes_beyond', 2, ['analyze', 'lab/points_2d.csv', '--axes', '1,3'], '--axes 1,3: the points have 2 coordinates (x1 to x2)');
+add('analyze_axes_zero', 2, ['analyze', 'lab/points_2d.csv', '--axes', '0,1'], '--axes: expected two different columns counted from 1');
 // Every reader of JSON is bounded as run's is (issue 48): a point file for analyze, a part for
 // merge (analyze on this file crashed with exit 139).
 add('analyze_deep_150000', 2, ['analyze', 'scene/deep_150000.json'], 'nested more than 64 levels');
@@ -322,6 +336,9 @@ render('reference_wrong_size', { gltf: 'ok.gltf', width: 4, reference: { file: '
 { const g = clone(gltf); g.materials[0].pbrMetallicRoughness.roughnessFactor = 'rough'; render('material_type', { gltf: g }, 'materials[0]'); }
 { const g = clone(gltf); g.buffers[0].byteLength = 1e15; render('buffer_length_huge', { gltf: g }, 'buffers[0]'); }
 { const g = clone(gltf); g.asset.version = '1.0'; render('asset_version', { gltf: g }, 'version'); }
+// glTF 2.0 asks aspectRatio > 0; tinygltf reads 0 as "none", which silently used the scene's
+// ratio (issue 48).
+{ const g = clone(gltf); g.cameras[0].perspective.aspectRatio = 0; render('camera_aspect_zero', { gltf: g }, 'cameras[0].perspective.aspectRatio: expected a number > 0, got 0'); }
 write('render/bad_json.gltf', '{"asset": {"version": "2.0"}, "nodes": [}\n');
 render('gltf_invalid_json', { gltf: 'bad_json.gltf' }, 'invalid JSON');
 write('render/dup.gltf', '{"asset": {"version": "2.0"}, "scene": 0, "scene": 1}\n');
