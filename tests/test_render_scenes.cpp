@@ -544,6 +544,18 @@ TEST(RenderSplit, PartsMergeToTheWholeStudy) {
     ASSERT_EQ(whole.status, MCP_OK) << whole.error;
     EXPECT_FALSE(whole.result.contains("part"));
     EXPECT_FALSE(whole.result["estimators"][0]["levels"][0].contains("images"));
+    // Each level times its images as an integration level times its replicates: a spread and a
+    // median interval that brackets the median (the equal-time comparison tests against them).
+    for (const json& est : whole.result["estimators"])
+        for (const json& l : est["levels"]) {
+            ASSERT_TRUE(l["time_std_s"].is_number()) << l.dump();
+            EXPECT_GT(l["time_std_s"].get<double>(), 0.0) << l.dump();
+            const json& ci = l["time_median_ci95_s"];
+            ASSERT_TRUE(ci.is_array() && ci.size() == 2 && l["time_median_s"].is_number());
+            EXPECT_LE(ci[0].get<double>(), l["time_median_s"].get<double>());
+            EXPECT_GE(ci[1].get<double>(), l["time_median_s"].get<double>());
+            EXPECT_LT(ci[0].get<double>(), ci[1].get<double>());
+        }
     const char* const kTimed[] = {"time_mean_s",        "time_std_s",   "time_median_s",
                                   "time_median_ci95_s", "time_total_s", "efficiency"};
     for (int k : {3, 4}) {
@@ -702,11 +714,11 @@ TEST(RenderSplit, PartsMergeToTheWholeStudy) {
     o["parts"] = 7;
     Call c = run(o);
     EXPECT_EQ(c.status, MCP_ERROR_ARGUMENT);
-    EXPECT_EQ(c.error, "options.parts: must be in 1..reps = 6");
+    EXPECT_EQ(c.error, "options.parts: must be in 1..reps = 6, got 7");
     o["parts"] = 2;
     o["part"] = 2;
     c = run(o);
-    EXPECT_EQ(c.error, "options.part: must be in 0..parts - 1 = 1");
+    EXPECT_EQ(c.error, "options.part: must be in 0..parts - 1 = 1, got 2");
 }
 
 /// quad_light_floor with its glTF inline, edited by `edit`.

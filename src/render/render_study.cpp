@@ -311,7 +311,8 @@ LevelStats render_level_stats(const std::vector<ImageSummary>& images,
     if (images.empty()) return l;
     l.n = images[0].spp;
     const double ref_se = reference.mean_luminance_se, ref_mean = reference.mean_luminance;
-    RunningMoments rel, lum;
+    RunningMoments rel, lum, times;
+    std::vector<double> seconds;
     double coverage = 0.0, run_se = 0.0;
     RenderDiagnostics pooled;
     for (const ImageSummary& im : images) {
@@ -323,6 +324,8 @@ LevelStats render_level_stats(const std::vector<ImageSummary>& images,
         l.estimates.push_back(e.mean_luminance);
         l.run_std_errors.push_back(e.mean_luminance_se);
         l.time_total += im.seconds;
+        times.add(im.seconds);
+        seconds.push_back(im.seconds);
         pooled.merge(im.diagnostics);
     }
     double R = double(images.size());
@@ -345,6 +348,13 @@ LevelStats render_level_stats(const std::vector<ImageSummary>& images,
     l.coverage = coverage / R;
     l.mean_run_se = run_se / R;
     l.time_mean = l.time_total / R;
+    // The images' own timing noise, as for an integration level's replicates: the equal-time
+    // comparison tests a difference against it (without it no winner can be named).
+    l.time_std = std::sqrt(times.variance());
+    const MedianInterval mi = median_interval(seconds);
+    l.time_median = mi.median;
+    l.time_median_lo = mi.lo;
+    l.time_median_hi = mi.hi;
     // Below the reference's noise the relative MSE measures the reference, not the estimator:
     // no efficiency (it would be arbitrarily large).
     l.efficiency =
