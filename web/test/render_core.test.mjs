@@ -112,7 +112,8 @@ function pngSize(base64) {
 }
 
 const withoutTimes = (levels) => levels.map((l) => {
-  const { time_mean_s: _a, time_total_s: _b, efficiency: _c, ...rest } = l;
+  const { time_mean_s: _a, time_total_s: _b, efficiency: _c, time_std_s: _d, time_median_s: _e,
+    time_median_ci95_s: _f, ...rest } = l;
   return rest;
 });
 
