@@ -60,9 +60,9 @@ test('veach_mis on the CLI: bounded estimators keep their order, tail words and 
   assert.doesNotMatch(verdict.text, /Fewer than two/);
   for (const name of MIS) assert.ok(verdict.ranked.some((x) => x.name === name), `${name} is compared at equal time`);
   assert.ok(!verdict.left.some((x) => /infinite/.test(x.why)), verdict.text);
-  // The images' timing noise is reported, so the leaders' difference can be tested: MIS leads.
+  // The images' timing noise is reported, so the leaders' difference can be tested (which one
+  // leads depends on the machine's timing: not asserted).
   for (const x of verdict.ranked.slice(0, 2)) assert.ok(x.se > 0, `${x.name}: an uncertainty at equal time`);
-  assert.ok(MIS.includes(verdict.ranked[0].name), verdict.text);
   assert.doesNotMatch(verdict.text, /cannot be tested/, verdict.text);
   // A level at the reference's noise is words in the tables, never its number.
   for (const name of v.order) {
