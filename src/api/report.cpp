@@ -246,6 +246,12 @@ Json tail_warning(const Flag& f, uint64_t pooled, const TailWording& words) {
                                   std::to_string(f.of) +
                                   " uniform points; the sampling density is bounded above and "
                                   "below, so the weights' variance is finite where int f^2 is)";
+        if (f.code == FlagCode::HeavyTail && f.severity == Severity::Info)
+            return flag_warning(f, "f looks heavy-tailed: tail index " + fmt("%.2f", f.value) +
+                                       " +/- " + fmt("%.2f", f.se) + where +
+                                       ", but f's form makes int f^2 finite (bounded, or every "
+                                       "power above -1/2), so the variance is finite: a slowly "
+                                       "varying tail that Hill's index reads too heavy");
         if (f.code == FlagCode::HeavyTail)
             return flag_warning(f, "f is heavy-tailed: tail index " + fmt("%.2f", f.value) +
                                        " +/- " + fmt("%.2f", f.se) + where +

@@ -151,7 +151,8 @@ std::vector<Flag> level_flags(const LevelStats& level);
 /// With `integrand` measured (an estimator whose variance follows the integrand's,
 /// variance_follows_integrand), the tail index is the integrand's at its uniform probes
 /// instead (the flag's `of` says how many probes): an adaptive estimator's own weights can look
-/// light-tailed under an infinite variance, or heavy under a finite one.
+/// light-tailed under an infinite variance, or heavy under a finite one. Where f's form makes
+/// int f^2 finite (IntegrandTail::square_integrable), heavy_tail from that index is info.
 std::vector<Flag> tail_flags(const LevelStats& deepest, bool bounded = false,
                              const IntegrandTail* integrand = nullptr);
 
