@@ -504,6 +504,62 @@ TEST(Diagnostics, AReplicateFarOutsideItsIntervalIsAnAlarm) {
     EXPECT_NEAR(f->threshold, 5.0 * student_t_quantile(0.975, 3.0) / 1.959963984540054, 1e-9);
 }
 
+// The skew's signature, blind: skewed weights give the runs that miss the rare large ones a low
+// estimate and a small error bar [Hall92]. 26 runs honour error bars of 1, 4 have error bars of
+// 8, and two low runs have error bars of 0.2: the leave-one-out check, whose spread the wide
+// runs inflate, finds nothing beyond 5, yet the low runs lie about 5 of their own error bars
+// below the others' mean, on the side the studentized deviations skew toward. That raises
+// replicate_far_off and keeps skewed_weights a warning. The other way: the same runs with one
+// low and one high (no skew), with both low runs 3.5 error bars off (skewness -1), and honest
+// runs raise nothing and leave skewed_weights info; the mirror image (high runs) is flagged.
+TEST(Diagnostics, ReplicatesSkewedWithTheirErrorBarsAreAnAlarm) {
+    const std::vector<double> z = honest_errors(32);
+    auto level = [&](double low_a, double low_b, double sign) {
+        LevelStats l = replicates_level(z, false);
+        RunningMoments m, se2;
+        for (size_t i = 0; i < z.size(); ++i) {
+            l.run_std_errors[i] = i % 8 == 3 ? 8.0 : 1.0;
+            l.estimates[i] = sign * l.run_std_errors[i] * z[i];
+        }
+        l.run_std_errors[5] = l.run_std_errors[20] = 0.2;
+        l.estimates[5] = sign * low_a;
+        l.estimates[20] = sign * low_b;
+        for (size_t i = 0; i < z.size(); ++i) {
+            m.add(l.estimates[i]);
+            se2.add(l.run_std_errors[i] * l.run_std_errors[i]);
+        }
+        l.mean = m.mean();
+        l.variance = m.variance();
+        l.mean_run_variance = se2.mean();
+        return l;
+    };
+    for (double sign : {1.0, -1.0}) {
+        const LevelStats skewed = level(-1.0, -0.95, sign);
+        const ReplicateCheck c = check_replicates(skewed);
+        EXPECT_EQ(c.far, 0); // the leave-one-out check alone passes them
+        EXPECT_LT(sign * c.skewness, -kSkewSignature);
+        const std::vector<Flag> flags = level_flags(skewed);
+        const std::optional<Flag> f = find(flags, FlagCode::ReplicateFarOff);
+        ASSERT_TRUE(f.has_value()) << sign;
+        EXPECT_EQ(f->severity, Severity::Warning);
+        EXPECT_TRUE(f->dof == 5 || f->dof == 20) << f->dof;
+        EXPECT_GT(f->value, f->threshold);
+        EXPECT_NEAR(f->threshold, kSkewedFarZ * student_t_quantile(0.975, 1000.0) / 1.96, 1e-3);
+        const std::optional<Flag> w = find(flags, FlagCode::SkewedWeights);
+        ASSERT_TRUE(w.has_value());
+        EXPECT_EQ(w->severity, Severity::Warning); // no demotion by replicates that only seem to
+    }
+    EXPECT_LT(std::fabs(check_replicates(level(-1.0, 1.0, 1.0)).skewness), kSkewSignature);
+    for (const LevelStats& fine : {level(-1.0, 1.0, 1.0), level(-0.7, -0.7, 1.0),
+                                   replicates_level(z, false)}) {
+        const std::vector<Flag> flags = level_flags(fine);
+        EXPECT_FALSE(find(flags, FlagCode::ReplicateFarOff));
+        const std::optional<Flag> w = find(flags, FlagCode::SkewedWeights);
+        ASSERT_TRUE(w.has_value());
+        EXPECT_EQ(w->severity, Severity::Info);
+    }
+}
+
 // Replicates judged one by one against their own error bars (Cochran's Q, replicate_scatter),
 // without the exact value: 28 runs whose error bars are 14 times too small (se 1, estimates
 // spread 14) beside 4 runs with error bars of 60 that cover. The 4 large se^2 carry the mean

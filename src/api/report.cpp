@@ -199,6 +199,18 @@ Json level_warning(const Flag& f, const LevelStats& l) {
                                    "and error bars computed from them are 0 or wrong (scale the "
                                    "integrand up)");
     case FlagCode::ReplicateFarOff:
+        if (std::isfinite(f.skewness))
+            return flag_warning(
+                f, "replicate " + std::to_string(f.dof + 1) + " of " + std::to_string(f.of) +
+                       " lies " + fmt("%.1f", f.value) +
+                       " of its own standard errors from the other replicates' mean" + at_n +
+                       " (beyond " + fmt("%.1f", f.threshold) +
+                       ") on the side toward which the replicates' deviations in their own error "
+                       "bars skew (skewness " +
+                       fmt("%.2f", f.skewness) + ", beyond " + fmt("%.1f", kSkewSignature) +
+                       "): skewed weights give the runs that miss the rare large ones both a "
+                       "low estimate and a small error bar, so the error bars understate the "
+                       "error on that side");
         return flag_warning(f, "replicate " + std::to_string(f.dof + 1) + " of " +
                                    std::to_string(f.of) +
                                    (f.replicates_judged < int(f.of)
