@@ -548,6 +548,12 @@ TEST(Diagnostics, ReplicatesSkewedWithTheirErrorBarsAreAnAlarm) {
         const std::optional<Flag> w = find(flags, FlagCode::SkewedWeights);
         ASSERT_TRUE(w.has_value());
         EXPECT_EQ(w->severity, Severity::Warning); // no demotion by replicates that only seem to
+        const Json level_json = level_to_json(skewed);
+        std::string said;
+        for (const Json& m : level_json["warnings"])
+            if (m["code"] == "replicate_far_off") said = m["message"].get<std::string>();
+        EXPECT_NE(said.find(sign > 0 ? "a low estimate" : "a high estimate"), std::string::npos)
+            << said;
     }
     EXPECT_LT(std::fabs(check_replicates(level(-1.0, 1.0, 1.0)).skewness), kSkewSignature);
     for (const LevelStats& fine : {level(-1.0, 1.0, 1.0), level(-0.7, -0.7, 1.0),
@@ -694,6 +700,9 @@ TEST(Diagnostics, HeavyTailKnowsTheSquareIntegralFromTheIntegrandsForm) {
         ASSERT_TRUE(f.has_value()); // Hill's index reads below 2 + 2 se ...
         EXPECT_LT(f->value, 2.0 + 2.0 * f->se);
         EXPECT_EQ(f->severity, Severity::Info); // ... but int f^2 is finite
+        const std::string said =
+            tail_warning(*f, 0, TailWording{"w", "w", "N", "v"})["message"].get<std::string>();
+        EXPECT_NE(said.find("int f^2 finite"), std::string::npos) << said;
     }
     for (const std::optional<Flag>& f :
          heavy_tail(scene({{"type", "monomial"}, {"powers", infinite}}, 10))) {

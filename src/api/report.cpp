@@ -208,9 +208,10 @@ Json level_warning(const Flag& f, const LevelStats& l) {
                        ") on the side toward which the replicates' deviations in their own error "
                        "bars skew (skewness " +
                        fmt("%.2f", f.skewness) + ", beyond " + fmt("%.1f", kSkewSignature) +
-                       "): skewed weights give the runs that miss the rare large ones both a "
-                       "low estimate and a small error bar, so the error bars understate the "
-                       "error on that side");
+                       "): skewed weights give the runs that miss the rare large ones both " +
+                       (f.skewness < 0.0 ? "a low" : "a high") +
+                       " estimate and a small error bar, so the error bars understate the error "
+                       "on that side");
         return flag_warning(f, "replicate " + std::to_string(f.dof + 1) + " of " +
                                    std::to_string(f.of) +
                                    (f.replicates_judged < int(f.of)
