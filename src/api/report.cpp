@@ -199,6 +199,19 @@ Json level_warning(const Flag& f, const LevelStats& l) {
                                    "and error bars computed from them are 0 or wrong (scale the "
                                    "integrand up)");
     case FlagCode::ReplicateFarOff:
+        if (std::isfinite(f.skewness))
+            return flag_warning(
+                f, "replicate " + std::to_string(f.dof + 1) + " of " + std::to_string(f.of) +
+                       " lies " + fmt("%.1f", f.value) +
+                       " of its own standard errors from the other replicates' mean" + at_n +
+                       " (beyond " + fmt("%.1f", f.threshold) +
+                       ") on the side toward which the replicates' deviations in their own error "
+                       "bars skew (skewness " +
+                       fmt("%.2f", f.skewness) + ", beyond " + fmt("%.1f", kSkewSignature) +
+                       "): skewed weights give the runs that miss the rare large ones both " +
+                       (f.skewness < 0.0 ? "a low" : "a high") +
+                       " estimate and a small error bar, so the error bars understate the error "
+                       "on that side");
         return flag_warning(f, "replicate " + std::to_string(f.dof + 1) + " of " +
                                    std::to_string(f.of) +
                                    (f.replicates_judged < int(f.of)
@@ -246,6 +259,12 @@ Json tail_warning(const Flag& f, uint64_t pooled, const TailWording& words) {
                                   std::to_string(f.of) +
                                   " uniform points; the sampling density is bounded above and "
                                   "below, so the weights' variance is finite where int f^2 is)";
+        if (f.code == FlagCode::HeavyTail && f.severity == Severity::Info)
+            return flag_warning(f, "f looks heavy-tailed: tail index " + fmt("%.2f", f.value) +
+                                       " +/- " + fmt("%.2f", f.se) + where +
+                                       ", but f's form makes int f^2 finite (bounded, or every "
+                                       "power above -1/2), so the variance is finite: a slowly "
+                                       "varying tail that Hill's index reads too heavy");
         if (f.code == FlagCode::HeavyTail)
             return flag_warning(f, "f is heavy-tailed: tail index " + fmt("%.2f", f.value) +
                                        " +/- " + fmt("%.2f", f.se) + where +

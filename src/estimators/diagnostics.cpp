@@ -210,9 +210,17 @@ ReplicateCheck check_replicates(const LevelStats& l) {
     const bool against_exact = l.has_exact && std::isfinite(l.exact);
     if (!against_exact && finite < 3) return c;
     const double r = static_cast<double>(finite);
+    std::vector<double> studentized, limits; // t_i against the others' mean, and its far limit
+    std::vector<int> index;
     for (size_t i = 0; i < reps; ++i) {
         const double x = l.estimates[i], se = l.run_std_errors[i];
         if (!std::isfinite(x) || !(std::isfinite(se) && se > 0.0) || l.run_dofs[i] < 1) continue;
+        if (!against_exact && finite >= 3) {
+            const double t95 = student_t_quantile(0.975, static_cast<double>(l.run_dofs[i]));
+            studentized.push_back((x - (r * mean - x) / (r - 1.0)) / se);
+            limits.push_back(kSkewedFarZ * t95 / 1.959963984540054);
+            index.push_back(static_cast<int>(i));
+        }
         double centre = l.exact, spread = se;
         if (!against_exact) {
             centre = (r * mean - x) / (r - 1.0);
@@ -232,6 +240,32 @@ ReplicateCheck check_replicates(const LevelStats& l) {
         }
     }
     c.allowance = miss_allowance(c.judged);
+    // The skew's signature, without the exact value: the studentized deviations skew, and the
+    // farthest of them on that side lies beyond kSkewedFarZ of its own error bar. Blind, the
+    // others' mean sits on the skewed runs' side of the integral (most runs miss the rare large
+    // weights), so their distance from it understates their error.
+    const size_t m = studentized.size();
+    if (m >= 8) {
+        double mt = 0.0, m2 = 0.0, m3 = 0.0;
+        for (double t : studentized) mt += t / static_cast<double>(m);
+        for (double t : studentized) {
+            m2 += (t - mt) * (t - mt) / static_cast<double>(m);
+            m3 += (t - mt) * (t - mt) * (t - mt) / static_cast<double>(m);
+        }
+        if (m2 > 0.0) c.skewness = m3 / std::pow(m2, 1.5);
+        if (std::fabs(c.skewness) > kSkewSignature) {
+            const double side = c.skewness > 0.0 ? 1.0 : -1.0;
+            size_t far = 0;
+            for (size_t j = 1; j < m; ++j)
+                if (side * studentized[j] / limits[j] > side * studentized[far] / limits[far])
+                    far = j;
+            if (side * studentized[far] > limits[far]) {
+                c.skewed_index = index[far];
+                c.skewed_z = std::fabs(studentized[far]);
+                c.skewed_limit = limits[far];
+            }
+        }
+    }
     return c;
 }
 
@@ -272,7 +306,8 @@ std::vector<Flag> level_flags(const LevelStats& l) {
     const bool scattered = scatter.judged > 0 && scatter.p_value < kLevelDriftP;
     const bool replicates_cover = replicates.judged >= kEvidenceReplicates &&
                                   replicates.misses <= replicates.allowance &&
-                                  replicates.far == 0 && !scattered;
+                                  replicates.far == 0 && replicates.skewed_index < 0 &&
+                                  !scattered;
     // `blind_ok`: whether replicates judged without the exact value may demote the flag. For
     // error_bars_unstable only when Cochran's Q shows no sign of scatter (p >= 0.05, not merely
     // no proof of it): without the exact value each replicate is judged against the others'
@@ -296,6 +331,22 @@ std::vector<Flag> level_flags(const LevelStats& l) {
         f.of = reps; // "replicate 3 of 32": of all of them, not of those judged
         f.dof = replicates.worst_index; // which replicate (0-based)
         f.se = l.has_exact ? 1.0 : 0.0; // 1: judged against the exact value
+        f.replicates_judged = replicates.judged;
+        f.replicate_misses = replicates.misses;
+        f.miss_allowance = replicates.allowance;
+    } else if (replicates.skewed_index >= 0) {
+        // Within kFarOffZ of the others' mean and its spread, but skewed runs pull that mean and
+        // spread with them: the runs 5.9-7.1 standard errors from the exact value in the fresh
+        // battery (corner peaks, border products) were 4.5-7.0 of their own error bars from the
+        // others' mean, on the side the deviations skew toward.
+        Flag& f = raise(FlagCode::ReplicateFarOff);
+        f.value = replicates.skewed_z;
+        f.threshold = replicates.skewed_limit;
+        f.count = 1;
+        f.of = reps;
+        f.dof = replicates.skewed_index;
+        f.se = 0.0; // judged against the others' mean
+        f.skewness = replicates.skewness;
         f.replicates_judged = replicates.judged;
         f.replicate_misses = replicates.misses;
         f.miss_allowance = replicates.allowance;
@@ -485,7 +536,9 @@ std::vector<Flag> tail_flags(const LevelStats& deepest, bool bounded,
         f.count = static_cast<uint64_t>(integrand->k);
         f.of = integrand->probes;
         f.threshold = infinite_variance ? kHeavyTailAlpha : kHeavyTail4Alpha;
-        if (bounded) f.severity = Severity::Info;
+        // int f^2 known finite from f's form: Hill's index, read low by a slowly varying factor
+        // at 2^15 probes, is no evidence against it.
+        if (bounded || integrand->square_integrable == true) f.severity = Severity::Info;
         flags.push_back(f);
         return flags;
     }

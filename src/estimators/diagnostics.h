@@ -78,6 +78,9 @@ struct Flag {
     /// replicates judged (0: not consulted), how many missed their 95% interval, and how many
     /// misses honest intervals give in 9 of 10 studies.
     int replicates_judged = 0, replicate_misses = 0, miss_allowance = 0;
+    /// The replicates' studentized skewness where the flag rests on it (replicate_far_off from
+    /// the skew's signature, ReplicateCheck::skewed_index), NaN otherwise.
+    double skewness = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// Each replicate against its own 95% interval: its estimate's distance from the exact value
@@ -92,6 +95,12 @@ struct ReplicateCheck {
     double worst_z = 0.0;     ///< its distance in its own standard errors
     double worst_limit = 0.0; ///< kFarOffZ widened for its degrees of freedom
     int allowance = 0;        ///< misses that honest 95% intervals exceed in < 1 study in 10
+    /// Without the exact value: the skewness of t_i = (x_i - mean of the others) / se_i, and
+    /// the replicate farthest off on the side it points to when |skewness| > kSkewSignature and
+    /// |t_i| > kSkewedFarZ widened by t_0.975(dof) / 1.96 (-1: none).
+    double skewness = std::numeric_limits<double>::quiet_NaN();
+    int skewed_index = -1;
+    double skewed_z = 0.0, skewed_limit = 0.0;
 };
 ReplicateCheck check_replicates(const LevelStats& level);
 
@@ -125,6 +134,15 @@ constexpr double kHeavyTailAlpha = 2.0; ///< infinite variance below this tail i
 constexpr double kHeavyTail4Alpha = 4.0;
 /// A replicate this many (t-widened) standard errors off has an error bar far too small.
 constexpr double kFarOffZ = 5.0;
+/// Skewed weights make a run's studentized error skewed, -2 g1 / sqrt(N) for weights of
+/// skewness g1 [Hall92]: a low estimate comes with a small error bar. The replicates'
+/// deviations from the others' mean in their own error bars skewing beyond this (3 standard
+/// errors of a sample skewness of 32 normal values) ...
+constexpr double kSkewSignature = 1.2;
+/// ... with one of them this many (t-widened) standard errors off on the side they skew toward
+/// is a replicate whose error bar is far too small (honest: 32 replicates reach it in fewer than
+/// 1 cell in 500).
+constexpr double kSkewedFarZ = 4.0;
 /// From this many judged replicates their misses are evidence enough to overrule a warning
 /// that rests on the weights alone (skewed_weights, error_bars_unstable): with 20, an
 /// estimator whose intervals cover 85% shows more than the allowance in 6 studies of 10.
@@ -151,7 +169,8 @@ std::vector<Flag> level_flags(const LevelStats& level);
 /// With `integrand` measured (an estimator whose variance follows the integrand's,
 /// variance_follows_integrand), the tail index is the integrand's at its uniform probes
 /// instead (the flag's `of` says how many probes): an adaptive estimator's own weights can look
-/// light-tailed under an infinite variance, or heavy under a finite one.
+/// light-tailed under an infinite variance, or heavy under a finite one. Where f's form makes
+/// int f^2 finite (IntegrandTail::square_integrable), heavy_tail from that index is info.
 std::vector<Flag> tail_flags(const LevelStats& deepest, bool bounded = false,
                              const IntegrandTail* integrand = nullptr);
 

@@ -264,6 +264,8 @@ IntegrandTail integrand_tail(const Problem& problem, uint64_t probes, uint64_t s
     IntegrandTail tail;
     tail.probes = probes;
     const Domain& d = problem.domain;
+    if (d.kind == DomainKind::Box)
+        tail.square_integrable = integrand_square_integrable(problem.integrand, d.lo, d.hi);
     Pcg32 rng(mix64(seed ^ 0x7461696cULL), hash_string("integrand_tail")); // "tail"
     const SamplerPlan plan =
         make_sampler_plan(SamplerKind::Independent, d.sample_dim(), probes, rng);

@@ -263,6 +263,11 @@ struct IntegrandTail {
     uint64_t probes = 0; ///< uniform points (0: not measured)
     double alpha = std::numeric_limits<double>::quiet_NaN();
     int k = 0; ///< Hill's order
+    /// Whether int f^2 over the domain is finite, where f's form says so
+    /// (integrand_square_integrable, box domains): then the variance's finiteness is known, and a
+    /// low Hill index is a slowly varying tail read too heavy (x^-0.3 y^-0.3 ... z^-0.3: P(f > t) ~
+    /// t^-3.3 (log t)^(d-1)), not an infinite variance.
+    std::optional<bool> square_integrable;
 };
 /// Uniform points probed for the integrand's tail: Hill's order k = min(kTailOrder, probes / 16)
 /// reaches kTailOrder.

@@ -208,6 +208,20 @@ bool integrand_bounded(const Integrand& f) {
     return false;
 }
 
+std::optional<bool> integrand_square_integrable(const Integrand& f, const std::vector<double>& lo,
+                                                const std::vector<double>& hi) {
+    if (integrand_bounded(f)) return true;
+    if (f.kind != IntegrandKind::Monomial || f.coeffs.size() != lo.size() ||
+        f.coeffs.size() != hi.size())
+        return std::nullopt;
+    if (f.scale == 0.0) return true;
+    for (size_t j = 0; j < f.coeffs.size(); ++j) {
+        const bool reaches_zero = lo[j] <= 0.0 && hi[j] >= 0.0;
+        if (reaches_zero && !(2.0 * f.coeffs[j] > -1.0)) return false;
+    }
+    return true;
+}
+
 double ball_volume(int dim, double r) {
     return std::pow(kPi, 0.5 * dim) * std::pow(r, dim) / std::tgamma(0.5 * dim + 1.0);
 }

@@ -69,6 +69,12 @@ std::optional<double> exact_integral_over_box(const Integrand& f, const std::vec
 /// (a singularity).
 bool integrand_bounded(const Integrand& f);
 
+/// Whether int f^2 over the box [lo, hi] is finite, where f's kind says so: yes for a bounded
+/// kind (integrand_bounded), for a monomial yes exactly when every power p_j whose coordinate
+/// reaches 0 has 2 p_j > -1 (int_0 x^(2 p) dx); unknown (nullopt) otherwise.
+std::optional<bool> integrand_square_integrable(const Integrand& f, const std::vector<double>& lo,
+                                                const std::vector<double>& hi);
+
 /// Volume of the d-dimensional ball of radius r: pi^(d/2) r^d / Gamma(d/2 + 1).
 double ball_volume(int dim, double r);
 
