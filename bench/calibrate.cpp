@@ -221,31 +221,29 @@ struct Case {
     double exact = std::numeric_limits<double>::quiet_NaN(); // the generated cases' value
 };
 
-// --border: products prod x_i^-a_i whose weights' tail index 1 / a_1 lies on either side of 2,
-// the variance's border (x^-0.45 y^-0.2 has a finite variance, x^-0.55 y^-0.1 z^-0.1 an
-// infinite one): one a_1 in (0.40, 0.45) or (0.52, 0.60), the others in (0.05, 0.2) (they
-// leave the tail index 1 / a_1: E x^-a_i/a_1 is finite).
-void add_border_products(const Options& o, std::vector<Case>* cases) {
+// Products prod x_i^-a_i on the unit box (E f^2 is finite iff every a_i < 1/2), one with a
+// finite and one with an infinite variance per dimension and parameter seed: a_i =
+// power(i, infinite_variance, u) for a uniform u, the cases named KIND_finvar/KIND_infvar_dD_sS.
+template <class Power>
+void add_power_products(const Options& o, const std::string& kind, Power power,
+                        std::vector<Case>* cases) {
+    Json presets = Json::array();
+    for (const std::string& p : o.presets) presets.push_back(p);
     for (int d : o.dims)
         for (uint64_t seed : o.param_seeds)
             for (const bool infinite_variance : {false, true}) {
-                Pcg32 rng(seed, hash_string(infinite_variance ? "border_iv" : "border_fv"));
+                Pcg32 rng(seed, hash_string((kind + (infinite_variance ? "_iv" : "_fv")).c_str()));
                 std::vector<double> powers(static_cast<size_t>(d));
                 double exact = 1.0;
                 for (size_t i = 0; i < powers.size(); ++i) {
-                    const double u = rng.next_double();
-                    const double a = i > 0 ? 0.05 + 0.15 * u
-                                     : infinite_variance ? 0.52 + 0.08 * u
-                                                         : 0.40 + 0.05 * u;
+                    const double a = power(i, infinite_variance, rng.next_double());
                     powers[i] = -a;
                     exact /= 1.0 - a;
                 }
                 Case c;
-                c.name = std::string(infinite_variance ? "border_infvar" : "border_finvar") +
-                         "_d" + std::to_string(d) + "_s" + std::to_string(seed);
+                c.name = kind + (infinite_variance ? "_infvar" : "_finvar") + "_d" +
+                         std::to_string(d) + "_s" + std::to_string(seed);
                 c.infinite_variance = infinite_variance;
-                Json presets = Json::array();
-                for (const std::string& p : o.presets) presets.push_back(p);
                 c.scene = {{"name", c.name},
                            {"domain", {{"type", "box"}, {"dim", d}}},
                            {"integrand", {{"type", "monomial"}, {"powers", powers}}},
@@ -254,6 +252,19 @@ void add_border_products(const Options& o, std::vector<Case>* cases) {
                 c.exact = exact;
                 cases->push_back(c);
             }
+}
+
+// --border: products whose weights' tail index 1 / a_1 lies on either side of 2, the
+// variance's border (x^-0.45 y^-0.2 has a finite variance, x^-0.55 y^-0.1 z^-0.1 an infinite
+// one): one a_1 in (0.40, 0.45) or (0.52, 0.60), the others in (0.05, 0.2) (they leave the tail
+// index 1 / a_1: E x^-a_i/a_1 is finite).
+void add_border_products(const Options& o, std::vector<Case>* cases) {
+    add_power_products(
+        o, "border",
+        [](size_t i, bool infinite_variance, double u) {
+            return i > 0 ? 0.05 + 0.15 * u : infinite_variance ? 0.52 + 0.08 * u : 0.40 + 0.05 * u;
+        },
+        cases);
 }
 
 std::vector<Case> genz_cases(const Options& o) {
@@ -278,32 +289,14 @@ std::vector<Case> genz_cases(const Options& o) {
             }
     if (o.border) add_border_products(o, &cases);
     if (!o.singular) return cases;
-    // Singular products prod x_i^-a_i: E f^k is finite iff every k a_i < 1.
-    for (int d : o.dims)
-        for (uint64_t seed : o.param_seeds)
-            for (const bool infinite_variance : {false, true}) {
-                Pcg32 rng(seed, hash_string(infinite_variance ? "singular_iv" : "singular_fv"));
-                std::vector<double> powers(static_cast<size_t>(d));
-                double exact = 1.0;
-                for (size_t i = 0; i < powers.size(); ++i) {
-                    const bool heavy = infinite_variance && i == 0;
-                    const double a =
-                        heavy ? 0.55 + 0.3 * rng.next_double() : 0.25 + 0.1 * rng.next_double();
-                    powers[i] = -a;
-                    exact /= 1.0 - a;
-                }
-                Case c;
-                c.name = std::string(infinite_variance ? "singular_infvar" : "singular_finvar") +
-                         "_d" + std::to_string(d) + "_s" + std::to_string(seed);
-                c.infinite_variance = infinite_variance;
-                c.scene = {{"name", c.name},
-                           {"domain", {{"type", "box"}, {"dim", d}}},
-                           {"integrand", {{"type", "monomial"}, {"powers", powers}}},
-                           {"exact", exact},
-                           {"estimators", presets}};
-                c.exact = exact;
-                cases.push_back(c);
-            }
+    // Singular products: the first power in (0.55, 0.85) for an infinite variance, the others
+    // (and all of a finite-variance case's) in (0.25, 0.35).
+    add_power_products(
+        o, "singular",
+        [](size_t i, bool infinite_variance, double u) {
+            return infinite_variance && i == 0 ? 0.55 + 0.3 * u : 0.25 + 0.1 * u;
+        },
+        &cases);
     return cases;
 }
 
