@@ -79,7 +79,9 @@ def integrate(
             compiled by the core (e.g. ``"exp(-(x-0.5)^2/0.01)"``); or a scene integrand object
             (``{"type": "genz_gaussian", ...}``). A callable may be called from several of the
             core's threads at once; each call holds the GIL, so blocks of a Python callable run one
-            at a time while the core's own work (points, warps, sums) runs in parallel.
+            at a time while the core's own work (points, warps, sums) runs in parallel. Besides
+            the study's points, f is evaluated once a study at 2^15 uniform points, to judge its
+            tail (whether the variance may be infinite) where an estimator's variance follows f's.
         dim
             The dimension, for the unit cube [0, 1]^dim (a callable needs ``dim`` or ``domain``).
         domain

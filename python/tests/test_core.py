@@ -215,7 +215,13 @@ def test_callable_gets_blocks_of_read_only_points_in_the_domain() -> None:
     scene["domain"] = {"type": "box", "lower": [-1, 0, 2], "upper": [0, 1, 5]}
     run_study(scene, FAST, {"f": f})
     points = np.concatenate(seen)
-    assert points.shape == (4096 * 2, 3)
+    # the study's 2 x 4096 points, and once the 2^15 uniform points at which the study judges
+    # the integrand's tail (an estimator whose variance follows f's: docs/result-schema.md)
+    tail_probes = 1 << 15
+    assert points.shape == (4096 * 2 + tail_probes, 3)
+    seen.clear()
+    run_study(scene, {**FAST, "estimators": ["uniform", "latin_hypercube"]}, {"f": f})
+    assert np.concatenate(seen).shape == (2 * 4096 * 2 + tail_probes, 3), "probed once a study"
     assert len(seen) * 256 <= len(points), "called per block, not per point"
     assert (points.min(0) >= [-1, 0, 2]).all() and (points.max(0) <= [0, 1, 5]).all()
 

@@ -526,8 +526,10 @@ bool merge_study_parts(Ctx& c, const Json& in, Json* out) {
     result.threads_used = threads;
     result.wall_seconds = wall;
     const std::vector<uint64_t> ladder = n_ladder(settings.n_min, settings.n_max);
+    IntegrandTail shared_tail; // measured once for the merged study, as run_study does
     for (size_t e = 0; e < estimators; ++e) {
-        EstimatorStudy es = begin_estimator_study(rq.problem, rq.estimators[e], settings);
+        EstimatorStudy es =
+            begin_estimator_study(rq.problem, rq.estimators[e], settings, &shared_tail);
         for (size_t level = 0; level < ladder.size(); ++level) {
             std::vector<RunResult> runs(static_cast<size_t>(settings.reps));
             for (size_t index = 0; index < parts.size(); ++index) {

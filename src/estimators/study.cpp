@@ -812,14 +812,21 @@ StudyPlan plan_study(const Problem& problem, const std::vector<EstimatorSpec>& e
 }
 
 EstimatorStudy begin_estimator_study(const Problem& problem, const EstimatorSpec& spec,
-                                     const StudySettings& settings) {
+                                     const StudySettings& settings, IntegrandTail* shared_tail) {
     EstimatorStudy es;
     es.spec = spec;
     es.error_method = error_method_for(spec);
     es.support = check_support(problem, spec, kSupportProbes, settings.seed);
     es.weights_bounded = weights_bounded(problem, spec);
-    if (variance_follows_integrand(spec) && !es.weights_bounded)
-        es.integrand = integrand_tail(problem, kTailProbes, settings.seed);
+    if (variance_follows_integrand(spec) && !es.weights_bounded) {
+        if (!shared_tail) {
+            es.integrand = integrand_tail(problem, kTailProbes, settings.seed);
+        } else {
+            if (shared_tail->probes == 0)
+                *shared_tail = integrand_tail(problem, kTailProbes, settings.seed);
+            es.integrand = *shared_tail;
+        }
+    }
     return es;
 }
 
@@ -837,8 +844,9 @@ StudyResult run_study(const Problem& problem, const std::vector<EstimatorSpec>& 
     result.problem = problem;
     result.settings = settings;
     result.threads_used = resolve_threads(settings.threads);
+    IntegrandTail shared_tail; // measured once, for every estimator whose variance follows f's
     for (const EstimatorSpec& spec : estimators)
-        result.estimators.push_back(begin_estimator_study(problem, spec, settings));
+        result.estimators.push_back(begin_estimator_study(problem, spec, settings, &shared_tail));
     if (problem_stopped(problem)) {
         result.cancelled = true;
         return result;

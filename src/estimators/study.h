@@ -312,8 +312,11 @@ Pcg32 replicate_rng(uint64_t seed, const std::string& estimator, uint64_t n, int
 
 /// An estimator's study before its first level: its spec, error method, support check and
 /// whether its weights are bounded (what run_study and a merge of study parts start from).
+/// `shared_tail`: the integrand's tail at uniform points, measured once a study (it depends on
+/// the problem and the seed alone) by the first estimator that needs it; null measures anew.
 EstimatorStudy begin_estimator_study(const Problem& problem, const EstimatorSpec& spec,
-                                     const StudySettings& settings);
+                                     const StudySettings& settings,
+                                     IntegrandTail* shared_tail = nullptr);
 /// Appends the level of these runs (replicate r at index r) and recomputes the estimator's
 /// fits and level consistency: what run_study does after each level, and a merge of parts.
 void add_level(EstimatorStudy& es, const std::vector<RunResult>& runs, const Problem& problem);
