@@ -20,7 +20,7 @@ function floorOk(floor) {
 export function atReferenceNoise(value, { floor = null, below = null } = {}) {
   if (below === true || below === false) return below;
   if (typeof value !== 'number' || !Number.isFinite(value)) return false;
-  return value <= 0 || (floorOk(floor) && value <= floor);
+  return value <= 0 || (floorOk(floor) && value < floor); // the core's below_reference_noise
 }
 
 /** The words for a relative MSE at the reference's noise: "at the reference's noise (below X)";

@@ -5,6 +5,7 @@
 // of the bands' own seconds / workers), tone mapping and the relative-error colours (those of
 // the core's error PNGs, src/render_api/image_io.cpp), the wipe's geometry, the prediction of
 // the time to 64 spp, and the view's state (reducer).
+import { atReferenceNoise, relativeMseText } from '../claims/reference_noise.js';
 
 /** The long sides offered (pixels); the core computes the other side from the camera's aspect. */
 export const LONG_SIDES = Object.freeze([128, 256, 512, 1024]);
@@ -276,7 +277,7 @@ export function fitZoom(w, count, box) {
  *  reference can resolve: not positive, or below the floor (the reference's own relative MSE)?
  *  The study's rule (src/render/render_study.cpp, below_reference_noise; docs/render-scenes.md). */
 export function belowReferenceNoise(relmse, floor) {
-  return Number.isFinite(relmse) && (!(relmse > 0) || (Number.isFinite(floor) && relmse < floor));
+  return atReferenceNoise(relmse, { floor });
 }
 
 /** A positive number in `digits` significant digits, in scientific notation below 1e-3 or
@@ -290,8 +291,7 @@ export function shortNumber(v, digits = 3) {
  *  reference's noise (below <floor>)". Empty when there is none. */
 export function relmseText(relmse, floor) {
   if (relmse === null || relmse === undefined || !Number.isFinite(relmse)) return '';
-  if (!belowReferenceNoise(relmse, floor)) return shortNumber(relmse, 3);
-  return Number.isFinite(floor) && floor > 0 ? `at the reference's noise (below ${shortNumber(floor, 2)})` : 'at the reference\'s noise';
+  return relativeMseText(relmse, { floor, digits: 3 });
 }
 
 /**
