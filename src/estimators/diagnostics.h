@@ -121,6 +121,9 @@ ScatterTest replicate_scatter(const LevelStats& level);
 
 // Thresholds (see the functions' comments for why).
 constexpr double kSkewnessRule = 25.0;  ///< skewed_weights below N = 25 g1^2 [Cochran77]
+/// One weight carrying this share of a run's sum: the run rests on a few weights (its Kish ESS
+/// is at most 1 / share^2), too few for replicates judged blind to vouch for its interval.
+constexpr double kRulingShare = 0.1;
 constexpr double kErrorBarSpread = 2.0; ///< runs' max se / min se above this: unsettled
 /// error_bars_unstable: runs' max se / min se above this (some run's error bar is off by a
 /// factor 2 or more from the others' middle: enough to show a 2.5-SE error as 5 SE), and
