@@ -285,6 +285,17 @@ IntegrandTail integrand_tail(const Problem& problem, uint64_t probes, uint64_t s
     std::sort(values.begin(), values.end(), std::greater<double>());
     tail.k = k;
     tail.alpha = hill_tail_index(values, k);
+    // Hill's reading assumes a power tail above x_(k+1): the log-excesses log(x_(i) / x_(k+1))
+    // are then k exponentials of mean 1 / alpha, whose largest m exceeds a given value with
+    // P(max < m) = (1 - e^(-alpha m))^k. A top far more compressed than that (p below
+    // kBoundedTopP) has an upper end, not a tail: a bounded peak (a narrow Gaussian on a plateau
+    // reads alpha 0.6 at k = 2048 though f is bounded). No tail: alpha infinite.
+    const double m = std::log(values.front() / values[static_cast<size_t>(k)]);
+    if (tail.alpha > 0.0 && std::isfinite(tail.alpha) && m > 0.0) {
+        const double log_p = k * std::log1p(-std::exp(-tail.alpha * m));
+        tail.top_log_p = log_p;
+        if (log_p < std::log(kBoundedTopP)) tail.alpha = std::numeric_limits<double>::infinity();
+    }
     return tail;
 }
 
