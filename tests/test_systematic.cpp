@@ -120,8 +120,8 @@ TEST(Systematic, UnbiasedWithHonestErrorBarsAndTheShiftedGridsVariance) {
     const double var_b = a * a * (md / 2.0 * std::expm1(2.0 / md) - md * md * e1 * e1);
     const double var_run = var_b / static_cast<double>(k);
     EXPECT_NEAR(sys.variance, var_run, 0.25 * var_run);
-    // and below as many independent points', Var(e^U) / N: for a smooth f, Var b falls as
-    // m^-2 (about (e - 1)^2 / (12 m^2)), here a sixteenth of uniform's; "below a fifth" holds
+    // and below as many independent points', Var(e^U) / N: in 1D, for a smooth f, Var b falls
+    // as m^-2 (about (e - 1)^2 / (12 m^2)), here a sixteenth of uniform's; "below a fifth" holds
     // with both sample variances 25% off.
     const double var_u = (std::exp(2.0) - 1.0) / 2.0 - kExact * kExact;
     EXPECT_NEAR(uniform.variance, var_u / n, 0.25 * var_u / n);
