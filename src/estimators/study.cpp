@@ -901,17 +901,8 @@ SampleDump dump_samples(const Problem& problem, const EstimatorSpec& spec, uint6
     const Domain& d = problem.domain;
     dump.sample_dim = d.sample_dim();
     dump.point_dim = d.point_dim();
-    // The same stream and seeding as replicate 0 of the study at this N; the plan drawn from a
-    // copy of it is the one a fixed estimator draws (its strata and batches).
+    // The same stream and seeding as replicate 0 of the study at this N.
     Pcg32 rng = replicate_rng(seed, spec.name, n, 0);
-    Pcg32 plan_rng = rng;
-    const SamplerPlan plan =
-        make_sampler_plan(spec.sampler, dump.sample_dim, n, plan_rng, spec.sampler_options());
-    if (!adaptive) {
-        dump.strata = plan.strata;
-        dump.per_stratum = plan.per_stratum;
-        dump.randomizations = plan.batches();
-    }
     std::unique_ptr<EstimatorAlgorithm> estimator =
         make_estimator(problem, spec, Accumulator::Compensated);
     estimator->observe([&](const SampleBlock& blk) {
@@ -926,6 +917,10 @@ SampleDump dump_samples(const Problem& problem, const EstimatorSpec& spec, uint6
     });
     Workspace ws;
     estimator->begin(n, rng);
+    const PointDesign design = estimator->design(); // the estimator's own layout of its points
+    dump.strata = design.strata;
+    dump.per_stratum = design.per_stratum;
+    dump.randomizations = design.randomizations;
     while (estimator->run_block(rng, ws)) {
     }
     dump.adaptive = estimator->adaptive_view();
