@@ -261,10 +261,11 @@ Vec3 direction_sample_term(const RenderScene& rs, const RenderEstimator& est,
 }
 
 /// A light sample's unshadowed contribution f Le cos at a shading point (its RIS target is the
-/// luminance of `value`), and where it lies, for the shadow ray if it is kept.
+/// luminance of `value`), and where it lies, for the shadow ray if it is kept. No member
+/// initializers: ris_light_term's array of kMaxRisCandidates is not cleared per sample.
 struct RisCandidate {
-    Vec3 point{0.0}, normal{0.0}, value{0.0};
-    double target = 0.0;
+    Vec3 point, normal, value;
+    double target;
 };
 
 /// The unshadowed contribution of one light sample (target 0 where it contributes nothing);
@@ -272,7 +273,7 @@ struct RisCandidate {
 template <class S>
 RisCandidate ris_candidate(const LightSet& lights, LightSampling mode, const ShadingPoint& sp,
                            PixelSampler& sampler, SampleCounters& c, double* pdf) {
-    RisCandidate x;
+    RisCandidate x{Vec3(0.0), Vec3(0.0), Vec3(0.0), 0.0};
     *pdf = 0.0;
     ChoiceSample cs = sampler.get_choice_2d();
     LightSample ls = lights.sample(sp.p, cs.choice, cs.u, mode);
@@ -320,7 +321,9 @@ Vec3 ris_light_term(const RenderScene& rs, const RenderEstimator& est, const Lig
         weight_sum += weights[j];
     }
     double u = m > 1 ? sampler.get_1d() : 0.0;
-    if (!(weight_sum > 0.0) || !std::isfinite(weight_sum)) return Vec3(0.0);
+    if (!(weight_sum > 0.0)) return Vec3(0.0);
+    // An overflowing sum gives a non-finite sample, which the renderer drops and counts.
+    if (!std::isfinite(weight_sum)) return Vec3(weight_sum);
     int kept = -1;
     double below = 0.0, threshold = u * weight_sum;
     for (int j = 0; j < m; ++j) {
