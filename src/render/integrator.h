@@ -19,6 +19,10 @@
 //   path                path tracing with next-event estimation, MIS (power heuristic) of
 //                       light and BSDF samples at every vertex, a maximum number of bounces
 //                       and Russian roulette [Veach97; PBR4, 13]
+// Splitting (light_samples, bsdf_samples): n_L light samples and n_B BSDF samples per shading
+// point, each term divided by its count, combined by multi-sample MIS whose heuristics take
+// q_k = n_k p_k [Veach97, 9.2; PBR4, 13.4's several light samples per point]; path tracing
+// continues along the first BSDF sample. Counts of 1 are the estimators above.
 #pragma once
 
 #include <cstdint>
@@ -45,6 +49,19 @@ enum class RadianceStrategy {
 const char* strategy_name(RadianceStrategy s);
 bool parse_strategy(const std::string& name, RadianceStrategy* s);
 
+/// The most light or BSDF samples one shading point takes (splitting).
+constexpr int kMaxSplitSamples = 64;
+
+/// A timed pilot's figures behind an automatic light_samples (splitting.h): per camera sample,
+/// the variance of the rest of the estimator and of one light sample, and their seconds.
+struct SplitPilot {
+    bool ran = false;
+    double variance_rest = 0.0, variance_light = 0.0; ///< relative (as the images' rel. MSE)
+    double seconds_rest = 0.0, seconds_light = 0.0;   ///< per camera sample
+    uint64_t samples = 0;                             ///< camera samples of each pilot image
+    double seconds = 0.0;                             ///< the pilot's own wall time
+};
+
 struct RenderEstimator {
     std::string name; ///< unique within a study: keys its random streams
     RadianceStrategy strategy = RadianceStrategy::MisPower;
@@ -56,6 +73,11 @@ struct RenderEstimator {
     PixelSamplerKind pixel_sampler = PixelSamplerKind::Stratified;
     int max_depth = 5; ///< path: bounces (1 = direct lighting only)
     int rr_depth = 3;  ///< path: Russian roulette from this bounce on
+    /// Light samples per shading point (strategies that sample lights); 0 (JSON "auto") until
+    /// a timed pilot chooses it (splitting.h): the integrator takes 0 as 1.
+    int light_samples = 1;
+    int bsdf_samples = 1; ///< BSDF samples per shading point (strategies that sample the BSDF)
+    SplitPilot split_pilot; ///< what the pilot measured, when it chose light_samples
 };
 
 /// Per-sample counters, summed per image.
