@@ -28,8 +28,8 @@ also compared with each other (the same relative MSE), which says whether they r
 image. With --sobol, mcplay also renders every cell with its Owen-scrambled Sobol' pixel sampler
 (`--pixel-sampler sobol`; the default is stratified), scored against the same mcplay reference:
 one more column, and its own efficiency ratio against Mitsuba. With --best, mcplay also renders
-each class with its best estimator (MCPLAY_BEST: light samples per camera sample chosen by a
-timed pilot, the pilot's time counted), one more column the same way. With --scalar, Mitsuba's
+each class with its best estimator (MCPLAY_BEST: Sobol' pixels, light samples per camera sample
+chosen by a timed pilot, the pilot's time counted), one more column the same way. With --scalar, Mitsuba's
 `scalar_rgb` variant renders every cell too: the same integrators one sample at a time per
 thread, as mcplay runs, against `llvm_ad_rgb`'s kernels that run a SIMD register's width of
 samples at once. It is scored against the `llvm_ad_rgb` reference (the same estimator), and
@@ -70,13 +70,13 @@ SCENES = [
     ('veach_mis', 'veach_mis.gltf', 320, 180, ['light', 'bsdf', 'mis']),
 ]
 MCPLAY_ESTIMATOR = {'light': 'light_solid_angle', 'bsdf': 'bsdf', 'mis': 'mis_power', 'path': 'path'}
-# mcplay's best per class (--best): the same strategy with the light samples per camera sample
-# chosen by a timed pilot (src/render/splitting.h; its time counted in the image's). BSDF
-# sampling alone has no such choice: its row is a pure speed contest.
+# mcplay's best per class (--best): the same strategy with Sobol' pixels and the light samples
+# per camera sample chosen by a timed pilot (src/render/splitting.h; its time counted in the
+# image's). BSDF sampling alone has no such choice: its row is a pure speed contest.
 MCPLAY_BEST = {
-    'light': {'strategy': 'light_solid_angle', 'light_samples': 'auto'},
-    'mis': {'strategy': 'mis_power', 'light_samples': 'auto'},
-    'path': {'strategy': 'path', 'max_depth': 5, 'light_samples': 'auto'},
+    'light': {'strategy': 'light_solid_angle', 'light_samples': 'auto', 'pixel_sampler': 'sobol'},
+    'mis': {'strategy': 'mis_power', 'light_samples': 'auto', 'pixel_sampler': 'sobol'},
+    'path': {'strategy': 'path', 'max_depth': 5, 'light_samples': 'auto', 'pixel_sampler': 'sobol'},
 }
 PATH_BOUNCES, PATH_RR = 5, 3  # mcplay's path defaults (src/render/integrator.h)
 
