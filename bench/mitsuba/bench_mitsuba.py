@@ -3,7 +3,8 @@
 and efficiency at 16, 64 and 256 spp, each renderer scored against its own converged reference.
 
   build/mitsuba-venv/bin/python bench/mitsuba/bench_mitsuba.py [--mcplay build/mcplay]
-      [--spp 16,64,256] [--ref-spp 4096] [--threads 2] [--quick] [--sobol] [--scalar] [--widths]
+      [--spp 16,64,256] [--ref-spp 4096] [--threads 2] [--quick] [--sobol] [--scalar] [--best]
+      [--widths]
 
 `make bench-mitsuba` installs what it needs (Debian's libllvm19 for drjit 1.5, Mitsuba 3.9.1 in a
 virtual environment under build/) and runs this. Not part of `make test`.
@@ -26,7 +27,9 @@ size compiled its kernels; mcplay's from its result JSON). The two renderers' re
 also compared with each other (the same relative MSE), which says whether they render the same
 image. With --sobol, mcplay also renders every cell with its Owen-scrambled Sobol' pixel sampler
 (`--pixel-sampler sobol`; the default is stratified), scored against the same mcplay reference:
-one more column, and its own efficiency ratio against Mitsuba. With --scalar, Mitsuba's
+one more column, and its own efficiency ratio against Mitsuba. With --best, mcplay also renders
+each class with its best estimator (MCPLAY_BEST: Sobol' pixels, light samples per camera sample
+chosen by a timed pilot, the pilot's time counted), one more column the same way. With --scalar, Mitsuba's
 `scalar_rgb` variant renders every cell too: the same integrators one sample at a time per
 thread, as mcplay runs, against `llvm_ad_rgb`'s kernels that run a SIMD register's width of
 samples at once. It is scored against the `llvm_ad_rgb` reference (the same estimator), and
@@ -67,6 +70,14 @@ SCENES = [
     ('veach_mis', 'veach_mis.gltf', 320, 180, ['light', 'bsdf', 'mis']),
 ]
 MCPLAY_ESTIMATOR = {'light': 'light_solid_angle', 'bsdf': 'bsdf', 'mis': 'mis_power', 'path': 'path'}
+# mcplay's best per class (--best): the same strategy with Sobol' pixels and the light samples
+# per camera sample chosen by a timed pilot (src/render/splitting.h; its time counted in the
+# image's). BSDF sampling alone has no such choice: its row is a pure speed contest.
+MCPLAY_BEST = {
+    'light': {'strategy': 'light_solid_angle', 'light_samples': 'auto', 'pixel_sampler': 'sobol'},
+    'mis': {'strategy': 'mis_power', 'light_samples': 'auto', 'pixel_sampler': 'sobol'},
+    'path': {'strategy': 'path', 'max_depth': 5, 'light_samples': 'auto', 'pixel_sampler': 'sobol'},
+}
 PATH_BOUNCES, PATH_RR = 5, 3  # mcplay's path defaults (src/render/integrator.h)
 
 
@@ -231,23 +242,32 @@ def read_pfm(path):
 
 
 class Mcplay:
-    def __init__(self, exe, scene, width, height, threads, folder, pixel_sampler=None):
+    def __init__(self, exe, scene, width, height, threads, folder, pixel_sampler=None, best=False):
         self.exe, self.scene, self.width, self.height = exe, scene, width, height
         self.threads, self.folder, self.pixel_sampler = threads, folder, pixel_sampler
+        self.best, self.light_samples = best, []
 
     def render(self, strategy, spp, seed):
         out = os.path.join(self.folder, 'mcplay.pfm')
+        estimator = MCPLAY_ESTIMATOR[strategy]
+        if self.best and strategy in MCPLAY_BEST:
+            estimator = json.dumps(MCPLAY_BEST[strategy])
         cmd = [self.exe, 'render', self.scene, '--scenes', os.path.join(ROOT, 'scenes'),
-               '--estimator', MCPLAY_ESTIMATOR[strategy], '--spp', str(spp), '--seed', str(seed),
+               '--estimator', estimator, '--spp', str(spp), '--seed', str(seed),
                '--width', str(self.width), '--height', str(self.height), '--threads', str(self.threads),
                '--out', out, '--format', 'json', '--no-cache']
         if self.pixel_sampler:
             cmd += ['--pixel-sampler', self.pixel_sampler]
         if strategy == 'path':  # the path scene: the Cornell box's path estimators
             cmd[2] = 'cornell_box_path'
-            cmd[6] = 'path_mis'
+            if estimator == MCPLAY_ESTIMATOR[strategy]:
+                cmd[6] = 'path_mis'
         r = subprocess.run(cmd, check=True, capture_output=True, text=True)
-        return read_pfm(out), json.loads(r.stdout)['seconds']
+        result = json.loads(r.stdout)
+        pilot = result['estimator'].get('split_pilot')
+        self.light_samples.append(result['estimator'].get('light_samples', 1))
+        # A pilot that chose the split count is part of the image's cost.
+        return read_pfm(out), result['seconds'] + (pilot['seconds'] if pilot else 0.0)
 
 
 # --------------------------------------------------------------------------------------------
@@ -427,6 +447,9 @@ def main():
     ap.add_argument('--scalar', action='store_true',
                     help="also Mitsuba's scalar_rgb variant (one sample at a time per thread, as "
                          "mcplay runs): one more column, scored against the same Mitsuba reference")
+    ap.add_argument('--best', action='store_true',
+                    help="also mcplay's best per class (MCPLAY_BEST: splitting chosen by a timed "
+                         "pilot): one more column, scored against the same mcplay reference")
     ap.add_argument('--sobol', action='store_true',
                     help="also mcplay with Sobol' pixels (--pixel-sampler sobol): one more column")
     ap.add_argument('--widths', action='store_true',
@@ -462,6 +485,7 @@ def main():
                           if args.scalar else None)
             mcp = Mcplay(args.mcplay, name, w, h, args.threads, folder)
             mcp_sobol = Mcplay(args.mcplay, name, w, h, args.threads, folder, 'sobol')
+            mcp_best = Mcplay(args.mcplay, name, w, h, args.threads, folder, best=True)
             cache = {}  # the references of this scene, per reference strategy
             for strategy in strategies:
                 ref_strategy = 'path' if strategy == 'path' else 'mis'
@@ -482,6 +506,9 @@ def main():
                     runs = [('mcplay', mcp, 'mcplay'), ('mitsuba', mit, 'mitsuba')]
                     if args.sobol:
                         runs.append(('mcplay_sobol', mcp_sobol, 'mcplay'))
+                    if args.best:
+                        runs.append(('mcplay_best', mcp_best, 'mcplay'))
+                        mcp_best.light_samples = []
                     if mit_scalar:
                         runs.append(('mitsuba_scalar', mit_scalar, 'mitsuba'))
                     for label, r, ref_label in runs:
@@ -505,6 +532,16 @@ def main():
                         row['rare_large_errors_sobol'] = sob['rare_large_errors'] or row['mitsuba']['rare_large_errors']
                         line += (f"  |  sobol {sob['seconds']:7.3f} s relMSE {rel_text(sob)} "
                                  f"efficiency x{ratio_text(row['efficiency_ratio_sobol'])}")
+                    if args.best:
+                        best = row['mcplay_best']
+                        best['light_samples'] = sorted(set(mcp_best.light_samples))
+                        row['efficiency_ratio_best'] = (best['efficiency'] / eff[1]
+                                                        if best['efficiency'] and eff[1] else None)
+                        row['rare_large_errors_best'] = best['rare_large_errors'] or row['mitsuba']['rare_large_errors']
+                        kind = ('speed contest' if strategy not in MCPLAY_BEST
+                                else f"light samples {best['light_samples']}")
+                        line += (f"  |  best ({kind}) {best['seconds']:7.3f} s relMSE {rel_text(best)} "
+                                 f"efficiency x{ratio_text(row['efficiency_ratio_best'])}")
                     if mit_scalar:
                         sca = row['mitsuba_scalar']
                         row['time_ratio_scalar'] = row['mcplay']['seconds'] / sca['seconds']
@@ -520,7 +557,8 @@ def main():
         json.dump(rows, f, indent=1)
     times = sorted(r['time_ratio'] for r in rows)
     for key, flag, label in (('efficiency_ratio', 'rare_large_errors', 'mcplay'),
-                             ('efficiency_ratio_sobol', 'rare_large_errors_sobol', 'mcplay sobol')):
+                             ('efficiency_ratio_sobol', 'rare_large_errors_sobol', 'mcplay sobol'),
+                             ('efficiency_ratio_best', 'rare_large_errors_best', 'mcplay best')):
         ratios = sorted(r[key] for r in rows if r.get(key))
         if ratios:
             print(f'efficiency {label} / Mitsuba over {len(ratios)} cells: median {ratios[len(ratios) // 2]:.2f}, '

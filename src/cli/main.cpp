@@ -91,7 +91,9 @@ const char* kUsage =
     "  .pfm linear float32),\n"
     "  --error-out FILE (false-colour relative error against the reference, PNG),\n"
     "  --estimator NAME (default the scene's best: MIS with the power heuristic, or path\n"
-    "  tracing with MIS for a path scene), --spp N (default the scene's spp_max),\n"
+    "  tracing with MIS for a path scene; or an estimator object as a scene lists them,\n"
+    "  '{\"strategy\": \"mis_power\", \"light_samples\": 4}'), --spp N (default the scene's\n"
+    "  spp_max),\n"
     "  --seed S, --threads T, --format json (print the result JSON instead of a summary)\n"
     "  render --progressive writes the live view's progression: each estimator (--estimators,\n"
     "  at most 4, or --estimator; default the scene's first four) is rendered in passes to 1,\n"
@@ -654,6 +656,11 @@ int parse_image_command(const char* command, const std::vector<std::string>& arg
         } else if (render_only && a == "--estimator") {
             if (!value(&v)) return usage_error("--estimator needs a name");
             c->options["estimator"] = v;
+            if (!v.empty() && v[0] == '{') { // an estimator object, as a scene lists them
+                c->options["estimator"] = nlohmann::json::parse(v, nullptr, false);
+                if (c->options["estimator"].is_discarded())
+                    return usage_error("--estimator: '" + v + "' is not valid JSON");
+            }
         } else if (render_only && a == "--estimators") {
             if (!value(&v))
                 return usage_error("--estimators needs a comma-separated list of names");

@@ -157,11 +157,11 @@ Ray spawn_ray(const ShadingPoint& sp, const Vec3& direction) {
 }
 
 /// One light sample's contribution f Le cos / p, times its MIS weight against BSDF sampling
-/// when `mis` is set.
+/// when `mis` is set (n_light light and n_bsdf BSDF samples per point: q_k = n_k p_k).
 template <class S>
 Vec3 light_sample_term(const RenderScene& rs, const LightSet& lights, LightSampling mode,
                        const ShadingPoint& sp, PixelSampler& sampler, SampleCounters& c, bool mis,
-                       bool power) {
+                       bool power, double n_light = 1.0, double n_bsdf = 1.0) {
     ChoiceSample cs = sampler.get_choice_2d();
     LightSample ls = lights.sample(sp.p, cs.choice, cs.u, mode);
     if (!ls.valid || !(ls.pdf > 0.0)) {
@@ -180,7 +180,7 @@ Vec3 light_sample_term(const RenderScene& rs, const LightSet& lights, LightSampl
     Vec3 f = S::eval_pdf(sp.bsdf, sp.wo_local, wi_local, &bsdf_density);
     if (is_black(f)) return Vec3(0.0);
     if (!visible(rs, sp, ls.point, ls.normal, c)) return Vec3(0.0);
-    double w = mis ? mis_weight(ls.pdf, bsdf_density, power) : 1.0;
+    double w = mis ? mis_weight(n_light * ls.pdf, n_bsdf * bsdf_density, power) : 1.0;
     return f * ls.radiance * (wi_local.z * w / ls.pdf);
 }
 
@@ -204,11 +204,12 @@ DirectionResult trace_direction(const RenderScene& rs, const ShadingPoint& sp, c
 
 /// Direct lighting by sampling directions: wi from the uniform hemisphere, the cosine
 /// hemisphere or the BRDF, weighted f Le cos / p (times the MIS weight against light
-/// sampling when `mis` is set).
+/// sampling when `mis` is set, with the counts as in light_sample_term).
 template <class S>
 Vec3 direction_sample_term(const RenderScene& rs, const RenderEstimator& est,
                            const LightSet& lights, const ShadingPoint& sp, PixelSampler& sampler,
-                           SampleCounters& c, bool mis, bool power) {
+                           SampleCounters& c, bool mis, bool power, double n_light = 1.0,
+                           double n_bsdf = 1.0) {
     Vec3 wi_local(0.0), f(0.0); // f stays black for a strategy out of range: no term
     double pdf = 0.0;
     bool delta = false;
@@ -255,7 +256,7 @@ Vec3 direction_sample_term(const RenderScene& rs, const RenderEstimator& est,
     if (mis && !delta) {
         Vec3 p_light = sp.p + wi * d.h.t;
         double light_pdf = lights.pdf(sp.p, d.h.triangle, p_light, est.light_sampling);
-        w = mis_weight(pdf, light_pdf, power);
+        w = mis_weight(n_bsdf * pdf, n_light * light_pdf, power);
     }
     return f * d.emitted * (wi_local.z * w / pdf);
 }
@@ -337,6 +338,41 @@ Vec3 ris_light_term(const RenderScene& rs, const RenderEstimator& est, const Lig
     return y.value * (weight_sum / (double(m) * y.target));
 }
 
+/// Does the estimator take more than one light or BSDF sample per shading point?
+bool is_split(const RenderEstimator& est) {
+    return est.light_samples > 1 || est.bsdf_samples > 1;
+}
+
+/// The mean of each strategy's samples at a shading point: light_samples light samples for the
+/// strategies that sample lights, bsdf_samples direction samples for those that sample
+/// directions, weighted by MIS with the counts for mis_* [Veach97, 9.2.1].
+template <class S>
+Vec3 split_direct_term(const RenderScene& rs, const RenderEstimator& est, const LightSet& lights,
+                       const ShadingPoint& sp, PixelSampler& sampler, SampleCounters& c) {
+    const bool mis = est.strategy == RadianceStrategy::MisBalance ||
+                     est.strategy == RadianceStrategy::MisPower;
+    const bool power = est.strategy == RadianceStrategy::MisPower;
+    const bool lights_sampled = mis || est.strategy == RadianceStrategy::LightArea ||
+                                est.strategy == RadianceStrategy::LightSolidAngle;
+    const int n_light = lights_sampled ? std::max(1, est.light_samples) : 0;
+    const int n_bsdf = lights_sampled && !mis ? 0 : std::max(1, est.bsdf_samples);
+    LightSampling mode = est.strategy == RadianceStrategy::LightArea ? LightSampling::Area
+                         : est.strategy == RadianceStrategy::LightSolidAngle
+                             ? LightSampling::SolidAngle
+                             : est.light_sampling;
+    Vec3 from_light(0.0), from_bsdf(0.0);
+    for (int i = 0; i < n_light; ++i)
+        from_light += light_sample_term<S>(rs, lights, mode, sp, sampler, c, mis, power, n_light,
+                                           n_bsdf);
+    for (int i = 0; i < n_bsdf; ++i)
+        from_bsdf += direction_sample_term<S>(rs, est, lights, sp, sampler, c, mis, power,
+                                              n_light, n_bsdf);
+    Vec3 sum(0.0);
+    if (n_light > 0) sum += from_light / double(n_light);
+    if (n_bsdf > 0) sum += from_bsdf / double(n_bsdf);
+    return sum;
+}
+
 /// The direct-lighting estimators: emission seen by the camera plus one estimate of the
 /// reflected direct light at the first hit.
 template <class S>
@@ -353,6 +389,10 @@ RadianceSample direct_radiance(const RenderScene& rs, const RenderEstimator& est
     if (sp.wo_local.z <= 0.0) return out;
     const LightSet& lights = rs.lights(est.light_selection);
     if (lights.empty()) return out;
+    if (is_split(est)) {
+        out.reflected = split_direct_term<S>(rs, est, lights, sp, sampler, c);
+        return out;
+    }
     switch (est.strategy) {
     case RadianceStrategy::UniformHemisphere:
     case RadianceStrategy::CosineHemisphere:
@@ -445,6 +485,77 @@ RadianceSample path_radiance(const RenderScene& rs, const RenderEstimator& est,
     return RadianceSample{emitted, L};
 }
 
+/// path_radiance with splitting: at every vertex light_samples light samples and bsdf_samples
+/// BSDF samples, each weighted by the power heuristic with the counts and divided by its count
+/// [Veach97, 9.2.1]. The BSDF samples count the emission they reach (the next vertex's
+/// emission is theirs, not the path's), and the first of them continues the path.
+template <class S>
+RadianceSample split_path_radiance(const RenderScene& rs, const RenderEstimator& est,
+                                   const Ray& camera_ray, PixelSampler& sampler,
+                                   SampleCounters& c) {
+    const Scene& scene = *rs.scene;
+    const LightSet& lights = rs.lights(est.light_selection);
+    const int n_light = std::max(1, est.light_samples), n_bsdf = std::max(1, est.bsdf_samples);
+    Vec3 L(0.0), beta(1.0), emitted(0.0);
+    Ray ray = camera_ray;
+    Hit hit;
+    ++c.rays;
+    if (!rs.accel.intersect(ray, &hit)) return RadianceSample{};
+    emitted = lights.emitted(hit.triangle, -glm::normalize(ray.direction));
+    for (int depth = 0; depth < est.max_depth; ++depth) {
+        ShadingPoint sp = shade<S>(scene, ray, hit);
+        if (sp.wo_local.z <= 0.0) break;
+        Vec3 direct(0.0), from_bsdf(0.0);
+        if (!lights.empty())
+            for (int i = 0; i < n_light; ++i)
+                direct += light_sample_term<S>(rs, lights, est.light_sampling, sp, sampler, c,
+                                               true, true, n_light, n_bsdf);
+        bool next = false;
+        Vec3 next_beta(0.0);
+        Ray next_ray;
+        Hit next_hit;
+        for (int j = 0; j < n_bsdf; ++j) {
+            ChoiceSample cs = sampler.get_choice_2d();
+            BsdfSample bs = S::sample(sp.bsdf, sp.wo_local, cs.choice, cs.u);
+            if (!bs.valid || !(bs.pdf > 0.0) || is_black(bs.f)) continue;
+            Vec3 wi = sp.frame.to_world(bs.wi);
+            if (glm::dot(wi, sp.ng) <= 0.0) continue;
+            Ray r = spawn_ray(sp, wi);
+            Hit h;
+            ++c.rays;
+            if (!rs.accel.intersect(r, &h)) continue;
+            Vec3 Le = lights.emitted(h.triangle, -wi);
+            if (!is_black(Le)) {
+                double w = 1.0;
+                if (!bs.delta) {
+                    Vec3 p = r.origin + r.direction * h.t;
+                    w = mis_weight(n_bsdf * bs.pdf,
+                                   n_light * lights.pdf(sp.p, h.triangle, p, est.light_sampling),
+                                   true);
+                }
+                from_bsdf += bs.f * Le * (bs.wi.z * w / bs.pdf);
+            }
+            if (j == 0) {
+                next = true;
+                next_beta = beta * bs.f * (bs.wi.z / bs.pdf);
+                next_ray = r;
+                next_hit = h;
+            }
+        }
+        L += beta * (direct / double(n_light) + from_bsdf / double(n_bsdf));
+        if (!next || depth + 1 >= est.max_depth) break;
+        beta = next_beta;
+        ray = next_ray;
+        hit = next_hit;
+        if (depth + 1 >= est.rr_depth) {
+            double q = std::min(0.95, std::max(beta.x, std::max(beta.y, beta.z)));
+            if (!(q > 0.0) || sampler.get_1d() >= q) break;
+            beta /= q;
+        }
+    }
+    return RadianceSample{emitted, L};
+}
+
 } // namespace
 
 const char* strategy_name(RadianceStrategy s) {
@@ -491,7 +602,8 @@ RadianceSample sample_radiance_with(const RenderScene& rs, const RenderEstimator
         Surfaces<K == SurfaceKernel::Lambertian || K == SurfaceKernel::LambertianTextured,
                  K == SurfaceKernel::GeneralTextured || K == SurfaceKernel::LambertianTextured>;
     if (est.strategy == RadianceStrategy::Path)
-        return path_radiance<S>(rs, est, camera_ray, sampler, counters);
+        return is_split(est) ? split_path_radiance<S>(rs, est, camera_ray, sampler, counters)
+                             : path_radiance<S>(rs, est, camera_ray, sampler, counters);
     return direct_radiance<S>(rs, est, camera_ray, sampler, counters);
 }
 

@@ -27,6 +27,10 @@
 //                       shadow ray, weighted f Le cos V / target(y) * (1/M) sum_j w_j
 //                       [Talbot05, 4; BitterliEtAl20, eq. 6]: unbiased, since the target is
 //                       positive wherever f Le cos is
+// Splitting (light_samples, bsdf_samples): n_L light samples and n_B BSDF samples per shading
+// point, each term divided by its count, combined by multi-sample MIS whose heuristics take
+// q_k = n_k p_k [Veach97, 9.2; PBR4, 13.4's several light samples per point]; path tracing
+// continues along the first BSDF sample. Counts of 1 are the estimators above.
 #pragma once
 
 #include <cstdint>
@@ -54,6 +58,19 @@ enum class RadianceStrategy {
 const char* strategy_name(RadianceStrategy s);
 bool parse_strategy(const std::string& name, RadianceStrategy* s);
 
+/// The most light or BSDF samples one shading point takes (splitting).
+constexpr int kMaxSplitSamples = 64;
+
+/// A timed pilot's figures behind an automatic light_samples (splitting.h): per camera sample,
+/// the variance of the rest of the estimator and of one light sample, and their seconds.
+struct SplitPilot {
+    bool ran = false;
+    double variance_rest = 0.0, variance_light = 0.0; ///< relative (as the images' rel. MSE)
+    double seconds_rest = 0.0, seconds_light = 0.0;   ///< per camera sample
+    uint64_t samples = 0;                             ///< camera samples of each pilot image
+    double seconds = 0.0;                             ///< the pilot's own wall time
+};
+
 struct RenderEstimator {
     std::string name; ///< unique within a study: keys its random streams
     RadianceStrategy strategy = RadianceStrategy::MisPower;
@@ -66,6 +83,11 @@ struct RenderEstimator {
     int max_depth = 5;  ///< path: bounces (1 = direct lighting only)
     int rr_depth = 3;   ///< path: Russian roulette from this bounce on
     int candidates = 8; ///< ris: light samples resampled per shading point (M)
+    /// Light samples per shading point (strategies that sample lights); 0 (JSON "auto") until
+    /// a timed pilot chooses it (splitting.h): the integrator takes 0 as 1.
+    int light_samples = 1;
+    int bsdf_samples = 1; ///< BSDF samples per shading point (strategies that sample the BSDF)
+    SplitPilot split_pilot; ///< what the pilot measured, when it chose light_samples
 };
 /// The bounds of ris's candidate count M, checked where estimators are parsed.
 constexpr int kMinRisCandidates = 1, kMaxRisCandidates = 64;

@@ -2,6 +2,7 @@
 // level's statistics, flags and error concentration, the fitted order, and the study's loop
 // over the spp ladder and the replicates.
 #include "render/render_study.h"
+#include "render/splitting.h"
 
 #include <algorithm>
 #include <chrono>
@@ -397,7 +398,7 @@ ConvergenceFit fit_render_convergence(const std::vector<LevelStats>& levels, dou
 }
 
 RenderStudyResult run_render_study(const RenderScene& rs,
-                                   const std::vector<RenderEstimator>& estimators,
+                                   const std::vector<RenderEstimator>& given,
                                    const RenderStudySettings& settings,
                                    const RenderImage& reference,
                                    const RenderStudyProgress& progress) {
@@ -405,6 +406,16 @@ RenderStudyResult run_render_study(const RenderScene& rs,
     RenderStudyResult result;
     result.settings = settings;
     result.threads_used = resolve_threads(settings.threads);
+    // light_samples "auto": chosen once per study by a timed pilot (splitting.h).
+    std::vector<RenderEstimator> estimators;
+    for (const RenderEstimator& e : given) {
+        RenderSettings image;
+        image.width = settings.width;
+        image.height = settings.height;
+        image.stream = replicate_stream(settings.seed, e.name, 0, 0);
+        image.threads = result.threads_used;
+        estimators.push_back(resolve_split(rs, e, image));
+    }
     result.reference_mean_luminance = mean_luminance(reference, nullptr);
     result.relative_mse_floor = relative_mse_floor(reference);
     const LightContacts contacts =

@@ -12,6 +12,7 @@
 #include "api/report.h"
 #include "api/scene.h"
 #include "estimators/study.h"
+#include "render/splitting.h"
 #include "render_api/image_io.h"
 #include "render_api/render_call.h"
 #include "render_api/render_json.h"
@@ -183,6 +184,7 @@ int mcp_render_image(const char* scene_json, const char* options_json, char** re
                                  sampler_extends(est.pixel_sampler) ? 0 : spp, 0);
     rs.threads = resolve_threads(r.settings.threads);
     rs.jitter_pixels = r.settings.jitter_pixels;
+    est = resolve_split(l.scene, est, rs); // light_samples "auto" (splitting.h)
     RenderImage image = render_image(l.scene, est, rs);
     const RenderDiagnostics& d = image.diagnostics;
     Json diag{{"samples", d.samples},

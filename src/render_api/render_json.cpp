@@ -96,6 +96,17 @@ Json estimator_to_json(const RenderEstimator& e) {
         j["rr_depth"] = e.rr_depth;
     }
     if (e.strategy == RadianceStrategy::Ris) j["candidates"] = e.candidates;
+    if (e.light_samples != 1 || e.bsdf_samples != 1 || e.split_pilot.ran) {
+        j["light_samples"] = e.light_samples;
+        j["bsdf_samples"] = e.bsdf_samples;
+    }
+    if (e.split_pilot.ran) // light_samples "auto": what the pilot measured (splitting.h)
+        j["split_pilot"] = Json{{"variance_rest", e.split_pilot.variance_rest},
+                                {"variance_light", e.split_pilot.variance_light},
+                                {"seconds_rest", e.split_pilot.seconds_rest},
+                                {"seconds_light", e.split_pilot.seconds_light},
+                                {"samples", e.split_pilot.samples},
+                                {"seconds", e.split_pilot.seconds}};
     return j;
 }
 

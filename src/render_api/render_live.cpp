@@ -166,6 +166,12 @@ int open_session(const char* scene_json, const char* options_json, mcp_progress_
                     std::string(pixel_sampler_name(e.pixel_sampler)) +
                     "' sampler cannot (its samples depend on the final spp): use "
                     "'padded_sobol' or 'independent'");
+    for (const RenderEstimator& e : r.estimators)
+        if (e.light_samples == 0) // each band would run its own pilot and choose its own count
+            return fail(MCP_ERROR_ARGUMENT, "estimator '" + e.name +
+                                                "': light_samples \"auto\" is chosen by a timed "
+                                                "pilot, which the live view's bands would each "
+                                                "run: give a count");
     const int width = r.settings.width, height = r.settings.height;
     int row_begin = 0, row_end = height;
     std::string error;

@@ -53,6 +53,50 @@ void use_ris_defaults(RenderEstimator* e) {
     e->light_sampling = LightSampling::Area;
 }
 
+/// light_samples and bsdf_samples (splitting, integrator.h): whole numbers in
+/// 1..kMaxSplitSamples, on the strategies that draw such samples; light_samples may be "auto"
+/// (0: a timed pilot chooses it, splitting.h).
+bool parse_split_counts(Ctx& c, const Json& j, const std::string& path, RenderEstimator* e) {
+    const RadianceStrategy s = e->strategy;
+    const bool mis = s == RadianceStrategy::MisBalance || s == RadianceStrategy::MisPower ||
+                     s == RadianceStrategy::Path;
+    const bool samples_lights =
+        mis || s == RadianceStrategy::LightArea || s == RadianceStrategy::LightSolidAngle;
+    const bool samples_bsdf = mis || s == RadianceStrategy::Bsdf;
+    const std::string range = "must be a whole number in 1.." + std::to_string(kMaxSplitSamples);
+    struct Count {
+        const char* key;
+        bool allowed;
+        const char* who;
+        int* out;
+    };
+    const Count counts[] = {
+        {"light_samples", samples_lights, "strategies that sample lights (light_area, "
+                                          "light_solid_angle, mis_balance, mis_power, path)",
+         &e->light_samples},
+        {"bsdf_samples", samples_bsdf, "strategies that sample the BSDF (bsdf, mis_balance, "
+                                       "mis_power, path)",
+         &e->bsdf_samples}};
+    for (const Count& k : counts) {
+        const Json* v = find(j, k.key);
+        if (!v) continue;
+        if (!k.allowed)
+            return c.fail(sub(path, k.key), std::string("only the ") + k.who + " take it, not '" +
+                                                strategy_name(s) + "'");
+        if (v->is_string() && v->get<std::string>() == "auto" && k.out == &e->light_samples) {
+            *k.out = 0;
+            continue;
+        }
+        const bool whole = v->is_number_integer() || v->is_number_unsigned();
+        if (!whole || v->get<int64_t>() < 1 || v->get<int64_t>() > kMaxSplitSamples)
+            return c.fail(sub(path, k.key),
+                          range + (k.out == &e->light_samples ? " or \"auto\"" : "") +
+                              ", got " + v->dump());
+        *k.out = int(v->get<int64_t>());
+    }
+    return true;
+}
+
 bool parse_estimator(Ctx& c, const Json& j, const std::string& path, RenderEstimator* out) {
     RenderEstimator e;
     if (j.is_string()) {
@@ -67,7 +111,8 @@ bool parse_estimator(Ctx& c, const Json& j, const std::string& path, RenderEstim
     }
     if (!check_keys(c, j, path,
                     {"name", "strategy", "light_selection", "light_sampling", "pixel_sampler",
-                     "max_depth", "rr_depth", "candidates"}))
+                     "max_depth", "rr_depth", "candidates", "light_samples",
+                     "bsdf_samples"}))
         return false;
     std::string strategy;
     if (!get_string(c, j, "strategy", path, &strategy)) return false;
@@ -107,6 +152,7 @@ bool parse_estimator(Ctx& c, const Json& j, const std::string& path, RenderEstim
                       "must be in " + std::to_string(kMinRisCandidates) + ".." +
                           std::to_string(kMaxRisCandidates) + ", got " + std::to_string(m));
     e.candidates = int(m);
+    if (!parse_split_counts(c, j, path, &e)) return false;
     *out = e;
     return true;
 }
@@ -140,6 +186,9 @@ bool parse_reference(Ctx& c, const Json& j, const std::string& path, const std::
     if (!check_keys(c, j, path, {"estimator", "spp", "seed", "file"})) return false;
     if (const Json* e = find(j, "estimator"))
         if (!parse_estimator(c, *e, sub(path, "estimator"), &out->estimator)) return false;
+    if (out->estimator.light_samples == 0) // a pilot's timing would make it differ run to run
+        return c.fail(sub(sub(path, "estimator"), "light_samples"),
+                      "\"auto\" depends on timing; a reference takes a fixed count");
     if (!get_count(c, j, "spp", path, &out->spp) || !get_count(c, j, "seed", path, &out->seed))
         return false;
     if (out->spp < 1 || out->spp > kMaxSpp)
@@ -436,6 +485,13 @@ Made<std::shared_ptr<RenderRequest>> build_render_request(const Json& scene, con
         }
         r->estimators = chosen;
     }
+    for (const RenderEstimator& e : r->estimators)
+        if (e.light_samples == 0 && parts > 1) {
+            c.fail("options.parts", "estimator '" + e.name +
+                                        "' has light_samples \"auto\", which each part's timed "
+                                        "pilot would choose on its own: give a count");
+            return error();
+        }
     // options.pixel_sampler (mcplay's --pixel-sampler): every estimator's pixel sampler, not
     // the reference's (the reference is the study's fixed target).
     if (find(opts, "pixel_sampler")) {

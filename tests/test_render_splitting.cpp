@@ -1,0 +1,226 @@
+// Splitting (integrator.h: light_samples, bsdf_samples; splitting.h: the count chosen by a
+// timed pilot): unbiased against closed forms, lower variance per camera sample, counts of 1
+// the estimators without splitting, and the options' errors.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "core/special.h"
+#include "render/render_study.h"
+#include "render/splitting.h"
+#include "render_api/render_request.h"
+#include "render_scenes.h"
+#include "test_support.h"
+
+namespace mcp {
+namespace {
+
+RenderEstimator split(RadianceStrategy s, int light_samples, int bsdf_samples) {
+    RenderEstimator e;
+    e.strategy = s;
+    e.name = strategy_name(s);
+    e.light_samples = light_samples;
+    e.bsdf_samples = bsdf_samples;
+    return e;
+}
+
+RenderSettings settings(int w, int h, uint64_t spp, uint64_t stream) {
+    RenderSettings s;
+    s.width = w;
+    s.height = h;
+    s.spp = spp;
+    s.stream = stream;
+    s.threads = 1;
+    s.jitter_pixels = false; // each pixel's expectation is the closed form at its centre
+    return s;
+}
+
+/// Pixels of `im` (quad light floor, pixel-centre rays) farther than z_max of their own
+/// standard errors from Lambert's formula, times `scale` (1: the true value).
+int pixels_off(const Scene& scene, const RenderImage& im, double z_max, double scale) {
+    const double Le = 5.0, albedo = 0.5;
+    const Vec3 light[4] = {{-0.5, 1, -0.5}, {0.5, 1, -0.5}, {0.5, 1, 0.5}, {-0.5, 1, 0.5}};
+    int off = 0;
+    for (int y = 0; y < im.height; ++y)
+        for (int x = 0; x < im.width; ++x) {
+            Ray r = camera_ray(scene.camera, im.width, im.height, x + 0.5, y + 0.5);
+            Vec3 p = r.origin + r.direction * (-r.origin.y / r.direction.y);
+            double expected = scale * albedo * Le *
+                              lambert_polygon_form_factor(p, Vec3(0, 1, 0), light, 4);
+            size_t k = (size_t(y) * size_t(im.width) + size_t(x)) * 3;
+            if (std::fabs(im.rgb[k] - expected) > z_max * std::sqrt(im.variance[k]) + 1e-12)
+                ++off;
+        }
+    return off;
+}
+
+struct Case {
+    RadianceStrategy strategy;
+    int light_samples, bsdf_samples;
+};
+const Case kSplitCases[] = {
+    {RadianceStrategy::LightArea, 3, 1},  {RadianceStrategy::LightSolidAngle, 4, 1},
+    {RadianceStrategy::Bsdf, 1, 3},       {RadianceStrategy::MisBalance, 3, 2},
+    {RadianceStrategy::MisPower, 2, 5},   {RadianceStrategy::MisPower, 7, 1},
+    {RadianceStrategy::Path, 3, 2},
+};
+
+// Every split estimator, every pixel, within its error bar of Lambert's formula (Sidak
+// level 1e-3 over all pixels); the same images against the formula 20% too bright fail in
+// many pixels (the check can see a bias of that size).
+TEST(RenderSplitting, UnbiasedUnderTheQuadLight) {
+    Scene scene = test::quad_light_scene(5.0);
+    RenderScene rs;
+    rs.build(scene);
+    const int W = 8, H = 8;
+    const int tests = W * H * int(std::size(kSplitCases));
+    const double z_max = -normal_quantile(0.5 * test::sidak_level(1e-3, tests));
+    for (const Case& c : kSplitCases) {
+        RenderEstimator e = split(c.strategy, c.light_samples, c.bsdf_samples);
+        e.max_depth = 1; // path: direct light only, the closed form's quantity
+        RenderImage im = render_image(rs, e, settings(W, H, 1024, 31));
+        EXPECT_EQ(pixels_off(scene, im, z_max, 1.0), 0)
+            << strategy_name(c.strategy) << " " << c.light_samples << "/" << c.bsdf_samples;
+        EXPECT_GT(pixels_off(scene, im, z_max, 1.2), W * H / 4)
+            << strategy_name(c.strategy) << " " << c.light_samples << "/" << c.bsdf_samples;
+    }
+}
+
+// Path tracing with splitting in a furnace (every face emits Le, albedo rho): every bounce
+// gives Le / (1 - rho), direct light only Le (1 + rho), each within 5 standard errors; the
+// other answer is far outside.
+TEST(RenderSplitting, PathSplitInTheFurnace) {
+    const double rho = 0.5, Le = 1.0;
+    Scene scene = test::furnace_box(rho, Le, 4);
+    RenderScene rs;
+    rs.build(scene);
+    for (int depth : {1, 1000}) {
+        RenderEstimator e = split(RadianceStrategy::Path, 3, 2);
+        e.max_depth = depth;
+        RenderImage im = render_image(rs, e, settings(16, 16, 32, 9));
+        RenderImage exact = im;
+        const double right = depth == 1 ? Le * (1 + rho) : Le / (1 - rho);
+        const double wrong = depth == 1 ? Le / (1 - rho) : Le * (1 + rho);
+        ImageError err = image_error(im, exact);
+        EXPECT_NEAR(err.mean_luminance, right, 5.0 * err.mean_luminance_se) << depth;
+        EXPECT_GT(std::fabs(err.mean_luminance - wrong), 5.0 * err.mean_luminance_se) << depth;
+    }
+}
+
+/// Mean over pixels of the variance of one camera sample (variance of the mean times spp).
+double sample_variance(const RenderImage& im) {
+    double sum = 0.0;
+    for (double v : im.variance) sum += v * double(im.spp);
+    return sum / double(im.variance.size());
+}
+
+// n light samples per camera sample leave the camera sample's own variance: the variance per
+// camera sample falls, by at most 1 / n (V_rest + V_light / n >= V(1) / n). With independent
+// pixel samples and jittered pixels, so that V_rest is not 0.
+TEST(RenderSplitting, LowerVariancePerCameraSample) {
+    Scene scene = test::quad_light_scene(5.0);
+    RenderScene rs;
+    rs.build(scene);
+    for (RadianceStrategy s : {RadianceStrategy::LightSolidAngle, RadianceStrategy::MisPower,
+                               RadianceStrategy::Path}) {
+        RenderSettings st = settings(12, 12, 64, 5);
+        st.jitter_pixels = true;
+        RenderEstimator one = split(s, 1, 1), four = split(s, 4, 1);
+        one.pixel_sampler = four.pixel_sampler = PixelSamplerKind::Independent;
+        const double v1 = sample_variance(render_image(rs, one, st));
+        const double v4 = sample_variance(render_image(rs, four, st));
+        EXPECT_LT(v4, 0.7 * v1) << strategy_name(s);
+        EXPECT_GT(v4, 0.8 * v1 / 4.0) << strategy_name(s);
+    }
+}
+
+// Counts of 1, given in the JSON, are the estimator without splitting: the same image, bit for
+// bit; a count of 2 is not.
+TEST(RenderSplitting, CountsOfOneAreTheEstimatorsWithoutSplitting) {
+    Scene scene = test::quad_light_scene(5.0);
+    RenderScene rs;
+    rs.build(scene);
+    for (const char* strategy : {"light_solid_angle", "bsdf", "mis_balance", "mis_power", "path"}) {
+        const bool lights = std::string(strategy) != "bsdf";
+        const bool bsdf = std::string(strategy) != "light_solid_angle";
+        Json j{{"strategy", strategy}};
+        if (lights) j["light_samples"] = 1;
+        if (bsdf) j["bsdf_samples"] = 1;
+        Made<RenderEstimator> given = parse_render_estimator(j, "e");
+        Made<RenderEstimator> plain = parse_render_estimator(Json(strategy), "e");
+        ASSERT_TRUE(given.ok() && plain.ok()) << given.error << plain.error;
+        RenderSettings st = settings(10, 8, 16, 3);
+        RenderImage a = render_image(rs, given.value, st);
+        RenderImage b = render_image(rs, plain.value, st);
+        EXPECT_EQ(a.rgb, b.rgb) << strategy;
+        EXPECT_EQ(a.diagnostics.rays, b.diagnostics.rays) << strategy;
+        j[lights ? "light_samples" : "bsdf_samples"] = 2;
+        Made<RenderEstimator> two = parse_render_estimator(j, "e");
+        ASSERT_TRUE(two.ok()) << two.error;
+        EXPECT_NE(render_image(rs, two.value, st).rgb, b.rgb) << strategy;
+    }
+}
+
+TEST(RenderSplitting, CountErrorsNameTheField) {
+    struct Bad {
+        Json j;
+        const char* says;
+    };
+    const Bad bad[] = {
+        {{{"strategy", "bsdf"}, {"light_samples", 2}}, "e.light_samples: only the strategies"},
+        {{{"strategy", "light_area"}, {"bsdf_samples", 2}}, "e.bsdf_samples: only the strategies"},
+        {{{"strategy", "mis_power"}, {"light_samples", 0}}, "e.light_samples: must be a whole"},
+        {{{"strategy", "mis_power"}, {"light_samples", 65}}, "got 65"},
+        {{{"strategy", "mis_power"}, {"light_samples", 2.5}}, "got 2.5"},
+        {{{"strategy", "mis_power"}, {"light_samples", "many"}}, "or \"auto\", got \"many\""},
+        {{{"strategy", "path"}, {"bsdf_samples", "auto"}}, "e.bsdf_samples: must be a whole"},
+    };
+    for (const Bad& b : bad) {
+        Made<RenderEstimator> m = parse_render_estimator(b.j, "e");
+        EXPECT_FALSE(m.ok()) << b.j.dump();
+        EXPECT_NE(m.error.find(b.says), std::string::npos) << m.error;
+        EXPECT_EQ(m.error.find('\n'), std::string::npos) << m.error;
+    }
+    Made<RenderEstimator> automatic =
+        parse_render_estimator(Json{{"strategy", "mis_power"}, {"light_samples", "auto"}}, "e");
+    ASSERT_TRUE(automatic.ok()) << automatic.error;
+    EXPECT_EQ(automatic.value.light_samples, 0);
+}
+
+// n* = sqrt((V_light / V_rest) (c_rest / c_light)), the better integer neighbour, in
+// 1..kMaxSplitSamples.
+TEST(RenderSplitting, OptimalSplitCount) {
+    EXPECT_EQ(optimal_split(1.0, 16.0, 4.0, 1.0), 8);
+    EXPECT_EQ(optimal_split(1.0, 1.0, 1.0, 1.0), 1);
+    EXPECT_EQ(optimal_split(1.0, 0.0, 4.0, 1.0), 1);                // nothing to split
+    EXPECT_EQ(optimal_split(0.0, 1.0, 4.0, 1.0), kMaxSplitSamples); // all variance split off
+    EXPECT_EQ(optimal_split(1e-6, 1.0, 1.0, 1.0), kMaxSplitSamples);
+    // n* = sqrt(10) = 3.16: 3 and 4 compared by (V_rest + V_light / n) (c_rest + n c_light).
+    EXPECT_EQ(optimal_split(1.0, 10.0, 1.0, 1.0), 3);
+}
+
+// "auto": the pilot runs, measures both variances and costs as positive, and chooses a count
+// the formula gives for its own figures; a fixed count runs no pilot.
+TEST(RenderSplitting, AutoCountComesFromThePilot) {
+    Scene scene = test::quad_light_scene(5.0);
+    RenderScene rs;
+    rs.build(scene);
+    RenderSettings image = settings(64, 48, 16, 7);
+    image.jitter_pixels = true;
+    RenderEstimator e = split(RadianceStrategy::MisPower, 0, 1);
+    RenderEstimator chosen = resolve_split(rs, e, image);
+    ASSERT_TRUE(chosen.split_pilot.ran);
+    const SplitPilot& p = chosen.split_pilot;
+    EXPECT_GT(p.variance_light, 0.0);
+    EXPECT_GT(p.seconds_rest + p.seconds_light, 0.0);
+    EXPECT_EQ(chosen.light_samples,
+              optimal_split(p.variance_rest, p.variance_light, p.seconds_rest, p.seconds_light));
+    EXPECT_GE(chosen.light_samples, 1);
+    e.light_samples = 3;
+    RenderEstimator fixed = resolve_split(rs, e, image);
+    EXPECT_FALSE(fixed.split_pilot.ran);
+    EXPECT_EQ(fixed.light_samples, 3);
+}
+
+} // namespace
+} // namespace mcp
