@@ -714,18 +714,21 @@ double best_eff_sig(const std::vector<Cell>& cells, bool mcplay) {
 
 /// A method is a preset name, optionally with a randomization and a count of randomizations:
 /// "sobol", "sobol:lms_shift", "sobol:owen:32"; or a VEGAS preset with options of its "vegas"
-/// object, numbers or words: "vegas/alpha=1.5/train_fraction=0.4", "vegas/report=iterations".
+/// object, numbers or words: "vegas/alpha=1.5/train_fraction=0.4", "vegas/report=iterations";
+/// "sampler=" is the estimator's own field (a new name: "vegas_strat/sampler=stratified").
 Json estimator_for(const std::string& method) {
     if (method.find('/') != std::string::npos) {
         std::vector<std::string> parts = split(method, '/');
-        Json options = Json::object();
+        Json options = Json::object(), top = Json::object();
         for (size_t i = 1; i < parts.size(); ++i) {
             const size_t eq = parts[i].find('=');
             const std::string key = parts[i].substr(0, eq);
             const std::string value = eq == std::string::npos ? "" : parts[i].substr(eq + 1);
             char* end = nullptr;
             const double x = std::strtod(value.c_str(), &end);
-            if (!value.empty() && end && *end == 0 &&
+            if (key == "sampler") // the estimator's own field: "vegas_strat/sampler=stratified"
+                top[key] = value;
+            else if (!value.empty() && end && *end == 0 &&
                 value.find_first_of(".eE") == std::string::npos)
                 options[key] = static_cast<long long>(x);
             else if (!value.empty() && end && *end == 0)
@@ -733,7 +736,9 @@ Json estimator_for(const std::string& method) {
             else
                 options[key] = value;
         }
-        return {{"name", parts[0]}, {"vegas", options}};
+        top["name"] = parts[0];
+        top["vegas"] = options;
+        return top;
     }
     std::vector<std::string> parts = split(method, ':');
     if (parts.size() == 1) return method;
