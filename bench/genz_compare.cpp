@@ -5,12 +5,19 @@
 //   genz_compare [--quick] [--n N] [--reps R] [--dims 2,4,8,16] [--families 1,...,6]
 //                [--methods uniform,stratified,...] [--gsl plain,miser,vegas|none]
 //                [--param-seed S] [--seed S] [--params-dir DIR] [--json FILE]
-//                [--write-params DIR] [--external FILE.jsonl] [--peaks]
+//                [--write-params DIR] [--external FILE.jsonl] [--peaks] [--singular]
 //
 // --peaks: instead of genz_random's cases, Genz's product peak with every a_j = a for a in
 // {100, 200, 500, 1000} and d in --dims (default 4, 6, 8), u_j the peak positions of
 // genz_random(product_peak, d, param seed): sharp separable peaks, where a VEGAS map should be
 // at its best (docs/benchmarks.md).
+//
+// --singular: instead, products of power singularities with finite variance, f = prod_j g_j(x_j)
+// on [0,1]^d, d in --dims (default 1..6), each a_j drawn in [0.1, 0.49] from the param seed:
+// a corner, g_j = x_j^-a_j; an edge, g_j = x_j^-a_j on the first ceil(d/2) axes and the smooth
+// e^(x_j) on the others; an interior point, g_j = |x_j - c_j|^-a_j with c_j in [0.2, 0.8]; and
+// x^-0.45 y^-0.2 (issue 49). Both sides call the same point function (singular_point): GSL once
+// per point, mcplay per block as a caller's function.
 //
 // Both sides evaluate mcplay's Genz code: GSL calls genz_evaluate_point (one point per call,
 // the only interface GSL has), mcplay runs its own block path (run_estimate ->
@@ -90,6 +97,7 @@ struct Options {
     std::string params_dir, json_path, write_params_dir, external_path;
     bool quick = false;
     bool peaks = false; // --peaks: the sharp product peaks instead of genz_random's cases
+    bool singular = false; // --singular: products of power singularities
 };
 
 std::vector<std::string> split(const std::string& s, char separator = ',') {
@@ -108,7 +116,7 @@ std::vector<std::string> split(const std::string& s, char separator = ',') {
                  "         [--families 1,2,3,4,5,6 | oscillatory,...] [--methods PRESET,...]\n"
                  "         [--gsl plain,miser,vegas|none] [--param-seed S] [--seed S]\n"
                  "         [--params-dir DIR] [--json FILE] [--write-params DIR]\n"
-                 "         [--external FILE.jsonl] [--peaks]\n");
+                 "         [--external FILE.jsonl] [--peaks] [--singular]\n");
     std::exit(2);
 }
 
@@ -186,6 +194,8 @@ Options parse_options(int argc, char** argv) {
             o.external_path = value();
         else if (a == "--peaks")
             o.peaks = true;
+        else if (a == "--singular")
+            o.singular = true;
         else if (a == "-h" || a == "--help")
             usage(nullptr);
         else
@@ -199,6 +209,9 @@ Options parse_options(int argc, char** argv) {
     if (o.peaks && !o.dims_given) o.dims = {4, 6, 8};
     if (o.peaks && (o.families_given || !o.params_dir.empty()))
         usage("--peaks makes its own cases: no --families or --params-dir with it");
+    if (o.singular && !o.dims_given) o.dims = {1, 2, 3, 4, 5, 6};
+    if (o.singular && (o.peaks || o.families_given || !o.params_dir.empty()))
+        usage("--singular makes its own cases: no --peaks, --families or --params-dir with it");
     return o;
 }
 
@@ -213,7 +226,79 @@ struct Case {
     double exact = kNaN;        // the value errors are measured against
     double mcplay_exact = kNaN; // genz_exact(params)
     std::string source;
+    // --singular: f = prod_j g_j(x_j), g_j = |x_j - c_j|^-power_j, or e^(x_j) where smooth_j.
+    bool singular = false;
+    std::vector<double> power, centre;
+    std::vector<char> smooth;
 };
+
+double singular_point(const Case& c, const double* x) {
+    double f = 1.0;
+    for (size_t j = 0; j < c.power.size(); ++j)
+        f *= c.smooth[j] ? std::exp(x[j]) : std::pow(std::fabs(x[j] - c.centre[j]), -c.power[j]);
+    return f;
+}
+
+/// int_0^1 g_j: (c^(1-a) + (1-c)^(1-a)) / (1 - a) for |x - c|^-a, e - 1 for e^x.
+double singular_exact(const Case& c) {
+    double v = 1.0;
+    for (size_t j = 0; j < c.power.size(); ++j) {
+        const double a = c.power[j], m = c.centre[j];
+        v *= c.smooth[j] ? std::exp(1.0) - 1.0
+                         : (std::pow(m, 1.0 - a) + std::pow(1.0 - m, 1.0 - a)) / (1.0 - a);
+    }
+    return v;
+}
+
+std::vector<Case> singular_cases(const Options& o) {
+    std::vector<Case> cases;
+    auto add = [&](const std::string& kind, std::vector<double> a, std::vector<double> c,
+                   std::vector<char> smooth) {
+        Case k;
+        const int d = int(a.size());
+        k.family = 5; // a placeholder for the scene's domain; the integrand is singular_point
+        k.params = genz_random(GenzFamily::Continuous, d, 1);
+        k.singular = true;
+        k.power = a, k.centre = c, k.smooth = smooth;
+        k.mcplay_exact = k.exact = singular_exact(k);
+        std::string powers;
+        for (int j = 0; j < d; ++j) {
+            char b[48];
+            std::snprintf(b, sizeof b, "%s%.2f", j ? "," : "", smooth[size_t(j)] ? 0.0 : a[j]);
+            powers += b;
+        }
+        k.label = kind + " d=" + std::to_string(d) + " a=" + powers;
+        k.name = kind + "_d" + std::to_string(d);
+        k.source = kind + " singular product, a of param seed " + std::to_string(o.param_seed);
+        cases.push_back(k);
+    };
+    add("issue49", {0.45, 0.2}, {0.0, 0.0}, {0, 0});
+    for (int d : o.dims) {
+        Pcg32 rng(hash_combine(o.param_seed, uint64_t(d)), 49);
+        std::vector<double> a(static_cast<size_t>(d)), c(static_cast<size_t>(d));
+        for (int j = 0; j < d; ++j) a[j] = 0.1 + 0.39 * rng.next_double();
+        for (int j = 0; j < d; ++j) c[j] = 0.2 + 0.6 * rng.next_double();
+        add("corner", a, std::vector<double>(size_t(d), 0.0), std::vector<char>(size_t(d), 0));
+        if (d > 1) {
+            std::vector<char> smooth(size_t(d), 0);
+            for (int j = (d + 1) / 2; j < d; ++j) smooth[j] = 1;
+            add("edge", a, std::vector<double>(size_t(d), 0.0), smooth);
+        }
+        add("interior", a, c, std::vector<char>(size_t(d), 0));
+    }
+    return cases;
+}
+
+/// The caller's-function form of singular_point, for mcplay: a block of n points, column-major.
+int singular_block(void* user, const double* x, uint64_t n, int dim, double* out, int) {
+    const Case& c = *static_cast<const Case*>(user);
+    std::vector<double> point(static_cast<size_t>(dim));
+    for (uint64_t i = 0; i < n; ++i) {
+        for (int j = 0; j < dim; ++j) point[size_t(j)] = x[uint64_t(j) * n + i];
+        out[i] = singular_point(c, point.data());
+    }
+    return 0;
+}
 
 std::vector<Case> random_cases(const Options& o) {
     std::vector<Case> cases;
@@ -335,12 +420,13 @@ struct Estimate {
 struct GslContext {
     const GenzParams* params;
     uint64_t calls;
+    const Case* singular = nullptr; // --singular: singular_point instead of Genz
 };
 
 double gsl_integrand(double* x, size_t, void* context) {
     GslContext* c = static_cast<GslContext*>(context);
     ++c->calls;
-    return genz_evaluate_point(*c->params, x);
+    return c->singular ? singular_point(*c->singular, x) : genz_evaluate_point(*c->params, x);
 }
 
 // VEGAS as GSL's manual recommends: a warm-up of 10^4 calls (stage 0: fresh grid) to train
@@ -396,8 +482,9 @@ Estimate gsl_vegas(gsl_monte_function* F, GslContext* ctx, int d, uint64_t n, gs
     return e;
 }
 
-Estimate run_gsl(const std::string& method, const GenzParams& p, uint64_t n, gsl_rng* r) {
-    GslContext ctx{&p, 0};
+Estimate run_gsl(const std::string& method, const Case& cs, uint64_t n, gsl_rng* r) {
+    const GenzParams& p = cs.params;
+    GslContext ctx{&p, 0, cs.singular ? &cs : nullptr};
     gsl_monte_function F{&gsl_integrand, size_t(p.dim()), &ctx};
     const int d = p.dim();
     std::vector<double> lo(size_t(d), 0.0), hi(size_t(d), 1.0);
@@ -627,18 +714,21 @@ double best_eff_sig(const std::vector<Cell>& cells, bool mcplay) {
 
 /// A method is a preset name, optionally with a randomization and a count of randomizations:
 /// "sobol", "sobol:lms_shift", "sobol:owen:32"; or a VEGAS preset with options of its "vegas"
-/// object, numbers or words: "vegas/alpha=1.5/train_fraction=0.4", "vegas/report=iterations".
+/// object, numbers or words: "vegas/alpha=1.5/train_fraction=0.4", "vegas/report=iterations";
+/// "sampler=" is the estimator's own field (a new name: "vegas_strat/sampler=stratified").
 Json estimator_for(const std::string& method) {
     if (method.find('/') != std::string::npos) {
         std::vector<std::string> parts = split(method, '/');
-        Json options = Json::object();
+        Json options = Json::object(), top = Json::object();
         for (size_t i = 1; i < parts.size(); ++i) {
             const size_t eq = parts[i].find('=');
             const std::string key = parts[i].substr(0, eq);
             const std::string value = eq == std::string::npos ? "" : parts[i].substr(eq + 1);
             char* end = nullptr;
             const double x = std::strtod(value.c_str(), &end);
-            if (!value.empty() && end && *end == 0 &&
+            if (key == "sampler") // the estimator's own field: "vegas_strat/sampler=stratified"
+                top[key] = value;
+            else if (!value.empty() && end && *end == 0 &&
                 value.find_first_of(".eE") == std::string::npos)
                 options[key] = static_cast<long long>(x);
             else if (!value.empty() && end && *end == 0)
@@ -646,7 +736,9 @@ Json estimator_for(const std::string& method) {
             else
                 options[key] = value;
         }
-        return {{"name", parts[0]}, {"vegas", options}};
+        top["name"] = parts[0];
+        top["vegas"] = options;
+        return top;
     }
     std::vector<std::string> parts = split(method, ':');
     if (parts.size() == 1) return method;
@@ -694,6 +786,10 @@ int main(int argc, char** argv) {
                 (unsigned long long)o.n, o.reps,
                 from_files
                     ? ("parameters from " + o.params_dir + " (exact values from the files)").c_str()
+                : o.singular
+                    ? ("--singular: power-singular products, a of param seed " +
+                       std::to_string(o.param_seed) + ", exact values in closed form")
+                          .c_str()
                     : ((o.peaks ? "--peaks: product peaks a = 100, 200, 500, 1000 at u of "
                                   "genz_random(product_peak, d, seed "
                                 : "parameters genz_random(family, d, seed ") +
@@ -705,7 +801,8 @@ int main(int argc, char** argv) {
                 "grid; total calls = N (see docs/benchmarks.md)\n");
     std::fflush(stdout);
     std::vector<Case> cases =
-        from_files ? file_cases(o) : (o.peaks ? peak_cases(o) : random_cases(o));
+        from_files ? file_cases(o)
+                   : (o.peaks ? peak_cases(o) : (o.singular ? singular_cases(o) : random_cases(o)));
     if (cases.empty()) usage("no cases to run");
     if (!o.write_params_dir.empty()) {
         write_params(cases, o.write_params_dir);
@@ -753,7 +850,7 @@ int main(int argc, char** argv) {
             cell.tool = "gsl";
             for (int rep = 0; rep < o.reps; ++rep) {
                 gsl_rng_set(rng, o.seed + uint64_t(rep));
-                cell.reps.push_back(run_gsl(g, cs.params, o.n, rng));
+                cell.reps.push_back(run_gsl(g, cs, o.n, rng));
             }
             cr.cells.push_back(cell);
         }
@@ -763,10 +860,16 @@ int main(int argc, char** argv) {
                 std::printf("skipped %s on %s: %s\n", m.c_str(), cs.label.c_str(), r.error.c_str());
                 continue;
             }
-            const SceneRequest& req = r.value;
+            SceneRequest& req = r.value;
+            if (cs.singular) // the same point function as GSL's, a block at a time
+                req.problem.integrand = make_function_integrand(
+                    make_caller_function("singular", &singular_block,
+                                         const_cast<Case*>(&cs), std::make_shared<CallControl>()),
+                    cs.params.dim());
             // The scene carries the same parameters GSL integrates (same a, u, same family).
-            const GenzParams& q = req.problem.integrand.genz;
-            if (req.problem.integrand.kind != IntegrandKind::Genz || q.family != cs.params.family ||
+            const GenzParams& q = cs.singular ? cs.params : req.problem.integrand.genz;
+            const bool genz = cs.singular || req.problem.integrand.kind == IntegrandKind::Genz;
+            if (!genz || q.family != cs.params.family ||
                 q.a != cs.params.a || q.u != cs.params.u || req.estimators.size() != 1) {
                 std::fprintf(stderr, "genz_compare: the scene for %s did not reproduce the case\n",
                              cs.label.c_str());

@@ -34,6 +34,20 @@ VegasOptions vegas_resolved(const VegasOptions& options, SamplerKind sampler, bo
     return o;
 }
 
+uint64_t vegas_plus_per_axis(int dim, uint64_t points) {
+    auto fits = [&](uint64_t m) {
+        uint64_t cubes = 1;
+        for (int j = 0; j < dim; ++j) {
+            cubes *= m;
+            if (cubes * 4 > points || cubes > kVegasMaxHypercubes) return false;
+        }
+        return true;
+    };
+    uint64_t m = 1;
+    while (fits(m + 1)) ++m;
+    return m;
+}
+
 int vegas_increments(int dim, uint64_t points_per_iteration) {
     const uint64_t most = dim <= 4 ? 1000 : (dim <= 8 ? 500 : 200);
     return static_cast<int>(std::max<uint64_t>(2, std::min(most, points_per_iteration / 100)));
@@ -131,6 +145,15 @@ void VegasMap::add_training(const uint32_t* bins, const double* weights, const d
             sums[bin[i]] += c * w * w;
             counts[bin[i]] += c;
         }
+    }
+}
+
+void VegasMap::add_square(const uint32_t* bins, size_t stride, double square, double importance) {
+    if (!std::isfinite(square)) return;
+    for (int j = 0; j < dim_; ++j) {
+        const size_t at = static_cast<size_t>(j) * k_ + bins[static_cast<size_t>(j) * stride];
+        sum_w2_[at] += importance * square;
+        counts_[at] += importance;
     }
 }
 

@@ -59,6 +59,12 @@ constexpr double kVegasEvenShare = 0.05;
 /// its unit cube (docs/scene-format.md, VEGAS).
 VegasOptions vegas_resolved(const VegasOptions& options, SamplerKind sampler, bool plus, int dim);
 
+/// VEGAS+'s hypercubes per axis for an iteration of `points` points in `dim` dimensions: the
+/// largest m with m^dim hypercubes of about 4 points each (m^dim * 4 <= points) and at most
+/// kVegasMaxHypercubes of them; at least 1.
+uint64_t vegas_plus_per_axis(int dim, uint64_t points);
+constexpr uint64_t kVegasMaxHypercubes = uint64_t(1) << 20;
+
 /// Least points per training iteration where the training share allows: fewer, and the map
 /// learns from noise (vegas's own examples train on 1000 points per iteration).
 constexpr uint64_t kVegasIterationPoints = 1000;
@@ -128,6 +134,10 @@ class VegasMap {
     /// increment's mean w^2 stays the mean over y uniform in it.
     void add_training(const uint32_t* bins, const double* weights, const double* importance,
                       size_t count);
+    /// Adds one point's `square` in place of its w^2 (VEGAS+'s squared deviation from its
+    /// hypercube's mean) to its increments bins[j * stride], counted with `importance`. A
+    /// non-finite square is skipped.
+    void add_square(const uint32_t* bins, size_t stride, double square, double importance);
 
     /// Refines the map from the training data and clears it [Lepage21, sec. 2.2]: per axis the
     /// mean w^2 of each increment d_i is smoothed with its neighbours (weights 1, 6, 1 over 8;

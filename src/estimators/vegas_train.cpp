@@ -87,7 +87,7 @@ TrainingSpent train_map(MapStage& stage, const VegasOptions& options, const Prob
             evaluate_block(problem.integrand, ws.x, ws.f.data());
             double* weights = stage.scratch(); // the Jacobians are used up
             const double* importance = points.weigh(ws, count, weights);
-            stage.map().add_training(stage.bins(), weights, importance, count);
+            points.train(stage.map(), stage.bins(), weights, importance, count);
             double block_cw = 0.0, block_cw2 = 0.0; // one block: plain sums, then compensated
             for (size_t i = 0; i < count; ++i) {
                 const double c = importance ? importance[i] : 1.0, w = weights[i];
@@ -99,7 +99,7 @@ TrainingSpent train_map(MapStage& stage, const VegasOptions& options, const Prob
             seen += count;
             log.trained(count);
         }
-        points.finish();
+        points.finish(stage.map());
         const bool judge = options.train_stop == VegasTrainStop::Settled && seen > 0;
         if (judge) before = stage.map(); // edges and (cleared) sums: per iteration, not per point
         stage.map().adapt(options.alpha, options.uniform_share);

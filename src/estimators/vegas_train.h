@@ -49,8 +49,14 @@ class TrainingPoints {
     /// the points' importance 1 / q(y) relative to uniform y (VegasMap::add_training), or null
     /// for uniform y.
     virtual const double* weigh(const Workspace& ws, size_t count, double* weights) = 0;
-    /// The iteration is over (before the map adapts to it).
-    virtual void finish() {}
+    /// Gives the block's points (their increments `bins`, weights and importance) to the map:
+    /// their w^2 (VegasMap::add_training) unless the points hold them back.
+    virtual void train(VegasMap& map, const uint32_t* bins, const double* weights,
+                       const double* importance, size_t count) {
+        map.add_training(bins, weights, importance, count);
+    }
+    /// The iteration is over (before the map adapts to it): what `train` held back goes to map.
+    virtual void finish(VegasMap& /*map*/) {}
 };
 
 /// Least relative fall of the map's movement, or of the per-point variance, that counts as
