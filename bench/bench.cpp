@@ -364,6 +364,21 @@ void point_analysis_cases() {
     std::printf("INFO warp/expression_disk_1e6: %.3f s a test of 10^6 samples\n", 1.0 / expression);
 }
 
+// An expression against the same integrand compiled in C++: exp(-(x-0.5)^2/0.01) is the
+// built-in Gaussian with 2 sigma^2 = 0.01.
+bool expression_cases(uint64_t n) {
+    Made<Integrand> expr = make_expression_integrand("exp(-(x-0.5)^2/0.01)", 1);
+    Made<Integrand> gauss =
+        make_integrand(IntegrandKind::Gaussian, 1, 1.0, {}, {0.5}, std::sqrt(0.005));
+    if (!expr.ok() || !gauss.ok()) return false;
+    const double e = evaluations_per_second(expr.value, n),
+                 g = evaluations_per_second(gauss.value, n);
+    std::printf("BENCH eval/expression_gaussian %.6e\n", e);
+    std::printf("BENCH eval/compiled_gaussian %.6e\n", g);
+    std::printf("RATIO compiled/expression %.2f\n", g / e);
+    return true;
+}
+
 void render_cases(const std::string& dir) {
     brute_force_crossover();
     traversal_rays_per_second(dir, "cornell_box");
@@ -396,14 +411,21 @@ int main(int argc, char** argv) {
         {"disk_quarter", "stratified_concentric"},
         {"hemisphere_cos2", "cosine"},
     };
-    // --only NAME: one estimator case, "render" for the render cases alone, or "analysis" for
-    // the sampler lab's cases alone (point-set analysis, warp tests).
+    // --only NAME: one estimator case, "render" for the render cases alone, "rays" for the
+    // accelerator rows alone, "eval" for the expression rows alone, or "analysis" for the
+    // sampler lab's cases alone (point-set analysis, warp tests).
     const char* only = argc > 4 && std::string(argv[3]) == "--only" ? argv[4] : nullptr;
     const bool render_only = only && std::string(only) == "render";
     if (only && std::string(only) == "analysis") {
         point_analysis_cases();
         return 0;
     }
+    if (only && std::string(only) == "rays") { // the accelerator rows alone
+        for (const char* scene : {"cornell_box", "veach_mis", "quad_light_floor"})
+            traversal_rays_per_second(dir, scene);
+        return 0;
+    }
+    if (only && std::string(only) == "eval") return expression_cases(n) ? 0 : 1;
     for (auto& c : cases) {
         if (only && std::string(c[1]) != only) continue;
         SceneRequest req;
@@ -427,17 +449,7 @@ int main(int argc, char** argv) {
         if (load(dir, "exp_1d", &req)) estimator_overhead(req, n);
     }
 
-    // An expression against the same integrand compiled in C++: exp(-(x-0.5)^2/0.01) is the
-    // built-in Gaussian with 2 sigma^2 = 0.01.
-    Made<Integrand> expr = make_expression_integrand("exp(-(x-0.5)^2/0.01)", 1);
-    Made<Integrand> gauss =
-        make_integrand(IntegrandKind::Gaussian, 1, 1.0, {}, {0.5}, std::sqrt(0.005));
-    if (!expr.ok() || !gauss.ok()) return 1;
-    const double e = evaluations_per_second(expr.value, n),
-                 g = evaluations_per_second(gauss.value, n);
-    std::printf("BENCH eval/expression_gaussian %.6e\n", e);
-    std::printf("BENCH eval/compiled_gaussian %.6e\n", g);
-    std::printf("RATIO compiled/expression %.2f\n", g / e);
+    if (!expression_cases(n)) return 1;
     render_cases(dir);
     point_analysis_cases();
     if (argc > 3 && std::string(argv[3]) == "--accumulation") accumulation_accuracy();
