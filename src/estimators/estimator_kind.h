@@ -4,8 +4,8 @@
 // the page and the reports read instead of knowing estimators (whether the running mean of its
 // first points is its estimate, whether it adapts). Each kind defines its entry in its own file
 // (estimators/fixed.cpp, vegas_estimator.cpp, vegas_plus.cpp, miser.cpp, mis.cpp,
-// control_variates.cpp, antithetic.cpp); estimators/registry.cpp lists them with the presets
-// (docs/adding-an-estimator.md).
+// control_variates.cpp, antithetic.cpp, ris.cpp); estimators/registry.cpp lists them with the
+// presets (docs/adding-an-estimator.md).
 #pragma once
 
 #include <memory>

@@ -31,6 +31,7 @@ struct EstimatorPreset {
     const char* summary;
     /// Sobol' with one linear scramble (lms_shift) and the Walsh error bound (walsh_bound).
     bool walsh_bound = false;
+    int ris_candidates = 0; ///< resampled importance sampling: M candidates per point
 };
 /// Every preset, in the order messages and the catalog list them.
 const std::vector<EstimatorPreset>& estimator_presets();
@@ -40,7 +41,7 @@ const EstimatorPreset* find_preset(const std::string& name);
 /// The method a spec is an instance of, for explaining it (its kind's method): "uniform",
 /// "importance", "stratified", "stratified_importance", "latin_hypercube", "rqmc" (randomized
 /// quasi-Monte Carlo), "qmc" (no randomization), "vegas", "vegas_plus", "miser", "mis",
-/// "control_variates", "antithetic".
+/// "control_variates", "antithetic", "ris".
 const char* estimator_method(const EstimatorSpec& spec);
 
 /// How a spec's per-run standard error is estimated (its kind's error method).

@@ -6,7 +6,7 @@ import { explainEstimator, EXPLAINED } from '../src/explain.js';
 
 // The methods the core's estimator kinds name (src/estimators/registry.h estimator_method).
 const CORE_METHODS = ['uniform', 'importance', 'stratified', 'stratified_importance', 'latin_hypercube', 'rqmc',
-  'rqmc_walsh', 'qmc', 'vegas', 'vegas_plus', 'miser', 'mis', 'control_variates', 'antithetic'];
+  'rqmc_walsh', 'qmc', 'vegas', 'vegas_plus', 'miser', 'mis', 'control_variates', 'antithetic', 'ris'];
 
 test('every method the core names is explained, with a formula, an order and what to look for', () => {
   assert.deepEqual([...EXPLAINED].sort(), [...CORE_METHODS].sort());
