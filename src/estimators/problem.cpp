@@ -600,11 +600,11 @@ std::string describe_sampling_text(const EstimatorSpec& spec, const Domain& doma
     else if (kind == "miser")
         s += ", within the boxes MISER's recursive bisection makes";
     else if (kind == "ris")
-        s += ", " + std::to_string(spec.ris_options.candidates) +
-             " candidates per point, one kept in proportion to " +
-             (spec.ris_options.target_pdf ? spec.ris_options.target.describe_text(domain)
-                                          : std::string("|f|")) +
-             " over the candidates' density";
+        s += ": " + std::to_string(spec.ris_options.candidates) +
+             " candidates per point, one kept with probability proportional to g / p, where g "
+             "is " +
+             (spec.ris_options.target_pdf ? "the " + spec.ris_options.target.describe_text(domain)
+                                          : std::string("|f|"));
     return s;
 }
 
