@@ -43,8 +43,10 @@ enum { kUniform, kRisM1, kRisM8, kImportance, kRisFromNormal, kRis1, kRis4, kRis
 // one positive everywhere.
 const char* kGap = R"J({"f": "exp(x)",
     "estimators": [
-        {"name": "ris_gap", "ris": {"candidates": 4}, "pdf": {"type": "tabulated", "values": [0, 1, 1.5, 2]}},
-        {"name": "ris_cover", "ris": {"candidates": 4}, "pdf": {"type": "tabulated", "values": [0.5, 1, 1.5, 2]}}]})J";
+        {"name": "ris_gap", "ris": {"candidates": 4},
+         "pdf": {"type": "tabulated", "values": [0, 1, 1.5, 2]}},
+        {"name": "ris_cover", "ris": {"candidates": 4},
+         "pdf": {"type": "tabulated", "values": [0.5, 1, 1.5, 2]}}]})J";
 
 std::string error_of(const std::string& estimator) {
     const std::string scene = R"J({"f": "x", "estimators": [)J" + estimator + "]}";
@@ -133,7 +135,8 @@ TEST(Ris, UnbiasedWithHonestErrorBarsWhereTheTargetCoversF) {
     const double se = std::sqrt(0.95 * 0.05 / runs);
     for (int e : {kRisM8, kRis4, kRis16}) {
         const EstimatorSpec& spec = r.value.estimators[e];
-        const test::IndependentRuns x = test::independent_runs(problem, spec, 128, runs, 5, 3, exact);
+        const test::IndependentRuns x =
+            test::independent_runs(problem, spec, 128, runs, 5, 3, exact);
         EXPECT_TRUE(x.every_n_reported) << spec.name;
         EXPECT_LT(std::fabs(x.mean - exact), 5.0 * std::sqrt(x.variance / runs)) << spec.name;
         // 400 runs' 95% intervals cover 0.95 +- 4 binomial standard errors.

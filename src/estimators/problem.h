@@ -167,7 +167,8 @@ struct ControlVariateOptions {
 /// Resampled importance sampling [Talbot05] (estimators/ris.cpp; scene field "ris"): M candidates
 /// from the proposal, one kept with probability proportional to g/p for a target g: the scene's
 /// pdf (`target`, a cheap proxy of |f|; the proposal is then uniform) or |f| at the candidates.
-constexpr int kMaxRisCandidates = static_cast<int>(kBlockSize); ///< a point's candidates fit a block
+/// RIS: a point's candidates fit in one block.
+constexpr int kMaxRisCandidates = static_cast<int>(kBlockSize);
 struct RisOptions {
     int candidates = 1;      ///< M
     bool target_pdf = false; ///< g = target's density; false: g = |f|
@@ -222,8 +223,9 @@ bool variance_follows_integrand(const EstimatorSpec& spec);
 std::vector<const Proposal*> proposals_of(const EstimatorSpec& spec);
 
 /// pdf[i] = the density of the estimator's points at x, on average over its techniques: its
-/// proposal's (RIS with a pdf target: the target's, which its points approach as M grows), or for MIS the mixture sum_k c_k p_k(x) with the techniques' shares c_k (zero
-/// exactly where every technique's density is).
+/// proposal's (RIS with a pdf target: the target's, which its points approach as M grows), or
+/// for MIS the mixture sum_k c_k p_k(x) with the techniques' shares c_k (zero exactly where
+/// every technique's density is).
 void sampling_density_block(const EstimatorSpec& spec, const Domain& domain, const PointBlock& x,
                             double* pdf);
 
