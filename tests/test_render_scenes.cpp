@@ -72,6 +72,7 @@ const char* const kRenderScenes[] = {
     "quad_light_floor",     "cornell_box", "cornell_box_path", "veach_mis",
     "tiny_bright_light",    "near_mirror", "grazing_light",    "touching_light",
     "perpendicular_plates", "furnace_box", "sphere_interior",
+    "many_lights",          "occluded_light",
 };
 
 TEST(RenderScenes, AllLoad) {

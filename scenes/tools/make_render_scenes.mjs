@@ -532,3 +532,46 @@ const DOWN = [0, -1, 0];
   b.camera([0, 0, 0.6], [0, 0, 0], 0.5);
   write('sphere_interior.gltf', b);
 }
+
+// 11. Many lights of different power and distance (resampled importance sampling's case): a
+// 1 x 1 m light of radiance 100 high in a corner (98% of the power) and eight dim 0.15 m lights
+// of radiance 40 (warm and cool) 0.3 m above a 6 x 6 m floor, where each outshines the far one.
+{
+  const b = new Builder(
+    'a bright light 5 m up (1 m, radiance 100), eight dim ones 0.3 m up (0.15 m, radiance 40)');
+  const floor = b.material('floor', { base: 0.6 });
+  const wall = b.material('wall', { base: 0.4 });
+  b.object('floor', rect([0, 0, 0], UP, X, 6, 6), floor);
+  b.object('back wall', rect([0, 1.5, -3], [0, 0, 1], X, 6, 3), wall);
+  const far = b.material('far light', { base: 0, radiance: 100 });
+  b.object('far light', rect([2, 5, -2], DOWN, X, 1, 1), far);
+  const warm = b.material('warm light', { base: 0, radiance: [40, 30, 18] });
+  const cool = b.material('cool light', { base: 0, radiance: [18, 30, 40] });
+  for (let i = 0; i < 8; ++i) {
+    const x = -2.1 + 0.6 * i;
+    const z = i % 2 ? -1.2 : 0.4;
+    b.object(`near light ${i}`, rect([x, 0.3, z], DOWN, X, 0.15, 0.15), i % 2 ? cool : warm);
+  }
+  b.camera([0, 2.8, 4.2], [0, 0, -0.6], 0.8);
+  write('many_lights.gltf', b);
+}
+
+// 12. Where the unshadowed target misleads: a bright 1 m light (radiance 50) above a 3 x 3 m
+// slab that hides it from the floor the camera sees, and a dim 0.5 m light (radiance 5) beside
+// the slab that lights that floor. Resampling by f Le cos (visibility left out) keeps the
+// hidden light's candidates, as light selection by power does.
+{
+  const b = new Builder(
+    'a bright light hidden above a slab (radiance 50), a dim one beside it (radiance 5)');
+  const floor = b.material('floor', { base: 0.6 });
+  const slab = b.material('slab', { base: 0.3 });
+  b.object('floor', rect([0, 0, 0], UP, X, 4, 4), floor);
+  b.object('slab', box([0, 1.05, 0], [1.5, 0.05, 1.5], 1), slab);
+  const bright = b.material('hidden light', { base: 0, radiance: 50 });
+  b.object('hidden light', rect([0, 1.4, 0], DOWN, X, 1, 1), bright);
+  const dim = b.material('visible light', { base: 0, radiance: 5 });
+  const tilted = normalize([1, -1, 0]);
+  b.object('visible light', rect([-1.9, 0.7, 0], tilted, [0, 0, 1], 0.5, 0.5), dim);
+  b.camera([0.3, 0.75, 2.6], [0, 0, 0], 0.8);
+  write('occluded_light.gltf', b);
+}

@@ -320,20 +320,20 @@ int mcp_study_samples(const char* scene_json, const char* options_json, char** s
             return out;
         };
         const mcp::EstimatorKind& kind = mcp::kind_of(spec);
+        const mcp::PointWords words = mcp::point_words(spec);
         estimators.push_back(
             {{"name", spec.name},
              {"kind", kind.name},
              {"method", mcp::estimator_method(spec)},
              // whether the mean of the first k points' weights is the estimate at N = k
              {"replay_is_estimate", kind.replay_is_estimate(spec)},
-             {"sampler", mcp::sampler_name(spec.sampler)},
+             {"sampler", words.sampler},
              {"pdf", mcp::describe_sampling(spec)},
              {"pdf_text", mcp::describe_sampling_text(spec, domain)},
              {"strata", d.strata},
              {"samples_per_stratum", d.per_stratum},
-             {"randomization", mcp::is_qmc(spec.sampler)
-                                   ? mcp::Json(mcp::randomization_name(spec.randomization))
-                                   : mcp::Json(nullptr)},
+             {"randomization",
+              words.randomization ? mcp::Json(words.randomization) : mcp::Json(nullptr)},
              {"randomizations", d.randomizations},
              {"u", axes(d.u, d.sample_dim)},
              {"x", axes(d.x, d.point_dim)},
@@ -453,7 +453,7 @@ int mcp_scene_info(const char* scene_json, char** info_json) {
                          {"kind", mcp::kind_of(e).name},
                          {"summary", mcp::kind_of(e).summary},
                          {"method", mcp::estimator_method(e)},
-                         {"sampler", mcp::sampler_name(e.sampler)},
+                         {"sampler", mcp::point_words(e).sampler},
                          {"pdf", mcp::describe_sampling(e)},
                          {"pdf_text", mcp::describe_sampling_text(e, p.domain)}};
     };
@@ -493,12 +493,16 @@ int mcp_scene_info(const char* scene_json, char** info_json) {
 int mcp_catalog(char** catalog_json) {
     if (!catalog_json) return fail(MCP_ERROR_ARGUMENT, "mcp_catalog: catalog_json is NULL");
     mcp::Json presets = mcp::Json::array();
-    for (const mcp::EstimatorPreset& p : mcp::estimator_presets())
+    for (const mcp::EstimatorPreset& p : mcp::estimator_presets()) {
+        mcp::EstimatorSpec spec; // the preset's words for its points are its kind's
+        spec.kind = mcp::find_estimator_kind(p.kind);
+        spec.sampler = p.sampler;
         presets.push_back({{"name", p.name},
                            {"kind", p.kind},
-                           {"sampler", mcp::sampler_name(p.sampler)},
+                           {"sampler", mcp::point_words(spec).sampler},
                            {"needs_pdf", p.needs_pdf},
                            {"summary", p.summary}});
+    }
     mcp::Json kinds = mcp::Json::array();
     for (const mcp::EstimatorKind* k : mcp::estimator_kinds())
         kinds.push_back({{"name", k->name}, {"summary", k->summary}});

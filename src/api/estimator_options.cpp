@@ -350,9 +350,9 @@ bool parse_ris_fields(Ctx& c, const Json& j, const std::string& path, const Prob
     if (!check_keys(c, r, at, {"candidates", "target"}) ||
         !get_count(c, r, "candidates", at, &m) || !get_string(c, r, "target", at, &target))
         return false;
-    if (m < 1 || m > static_cast<uint64_t>(kMaxRisCandidates))
+    if (m < 1 || m > static_cast<uint64_t>(RisOptions::kMaxCandidates))
         return c.fail(sub(at, "candidates"), "must be in [1, " +
-                                                 std::to_string(kMaxRisCandidates) +
+                                                 std::to_string(RisOptions::kMaxCandidates) +
                                                  "] (candidates per point), got " +
                                                  std::to_string(m));
     if (!target.empty() && target != "pdf" && target != "f")

@@ -65,7 +65,8 @@ int mcp_study_plan(const char* scene_json, const char* options_json, char** plan
  * (default 256), "adaptive_n": calls of the adaptive estimators' run (1..2^20)}. Result:
  * {"version", "n", "estimators": [{"name", "kind", "method", "replay_is_estimate", "sampler",
  * "pdf", "pdf_text" (the density in words), "strata", "samples_per_stratum", "randomization",
- * "randomizations", "u": [per axis], "x": [per axis], "f", "density", "weight"}],
+ * "randomizations" (the estimator's own grid and randomizations), "u": [per axis], "x": [per
+ * axis], "f", "density", "weight"}],
  * and for 1D box domains "curve": {"x", "f", "pdf": {name: density values}, "mis_weights":
  * {name: [per technique: weights]}}}. The points are those of replicate 0 of a study at N = n,
  * so the mean of "weight" is that replicate's estimate. "replay_is_estimate" (from the

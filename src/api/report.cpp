@@ -463,18 +463,18 @@ Json fit_to_json(const ConvergenceFit& f) {
 namespace {
 
 Json estimator_header(const EstimatorStudy& e, const StudySettings& s, const Domain& domain) {
+    const PointWords words = point_words(e.spec); // the estimator's words for its points
     return Json{
         {"name", e.spec.name},
         {"kind", kind_of(e.spec).name},
         {"method", estimator_method(e.spec)},
-        {"sampler", sampler_name(e.spec.sampler)},
+        {"sampler", words.sampler},
         {"samples_per_stratum", e.spec.per_stratum},
         {"pdf", describe_sampling(e.spec)},
         {"pdf_text", describe_sampling_text(e.spec, domain)},
         {"importance", e.spec.proposal.importance || e.spec.has_techniques()},
-        {"randomization",
-         is_qmc(e.spec.sampler) ? Json(randomization_name(e.spec.randomization)) : Json(nullptr)},
-        {"randomizations", is_qmc(e.spec.sampler) ? Json(e.spec.randomizations) : Json(nullptr)},
+        {"randomization", words.randomization ? Json(words.randomization) : Json(nullptr)},
+        {"randomizations", words.randomizations ? Json(words.randomizations) : Json(nullptr)},
         {"error_method", error_method_name(e.error_method)},
         // Error bars wider than the estimator's spread by design: coverage above 95% is no fault.
         {"error_bars_conservative", error_method_conservative(e.error_method)},

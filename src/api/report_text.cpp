@@ -133,7 +133,10 @@ std::string format_render_table(const Json& r) {
     for (const Json& e : list(r, "estimators")) {
         out << "\n"
             << jstr(e, "name") << "  [" << jstr(e, "strategy") << ", lights by "
-            << jstr(e, "light_selection") << ", " << jstr(e, "pixel_sampler") << " pixels]\n";
+            << jstr(e, "light_selection") << ", " << jstr(e, "pixel_sampler") << " pixels";
+        if (get(e, "candidates").is_number())
+            out << ", " << fmt("%.0f", jnum(e, "candidates")) << " candidates";
+        out << "]\n";
         out << padl("spp", 7) << padl("rel.MSE", 12) << padl("mean lum.", 13) << padl("bias/se", 9)
             << padl("px cover", 9) << padl("s/image", 10) << padl("efficiency", 12)
             << padl("discarded", 10) << "\n";

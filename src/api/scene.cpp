@@ -289,6 +289,18 @@ Made<SceneRequest> build_request(const Json& scene, const Json& options,
         if (!untrainable.empty())
             return made_error<SceneRequest>("estimator '" + name_text(e.name) +
                                             "': " + untrainable);
+        // The estimator's own checks (its file's): N doubles from the ladder's first power of
+        // two, or from n_min when stopping at a tolerance.
+        const std::vector<uint64_t> runs_n = n_ladder(s.n_min, s.n_max);
+        const uint64_t n_first = s.stopping() || runs_n.empty() ? s.n_min : runs_n.front();
+        const std::string refused = check_estimator(
+            e, StudyShape{req.problem.domain.sample_dim(), n_first, s.n_max});
+        if (!refused.empty())
+            return made_error<SceneRequest>(
+                (options.is_object() && (find(options, "n_min") || find(options, "n_max"))
+                     ? "options: estimator '"
+                     : "scene: estimator '") +
+                name_text(e.name) + "': " + refused);
         if (e.per_stratum > 1 && s.n_min < e.per_stratum)
             return made_error<SceneRequest>("estimator '" + e.name + "': samples_per_stratum = " +
                                             std::to_string(e.per_stratum) +

@@ -17,9 +17,10 @@ int interval_dof(uint64_t dof) {
 }
 } // namespace
 
-void WeightAccumulator::reset(ErrorMethod method, const SamplerPlan& plan, bool float32_sum) {
+void WeightAccumulator::reset(ErrorMethod method, uint64_t total, size_t batches,
+                              bool float32_sum) {
     method_ = method;
-    plan_ = &plan;
+    total_ = total;
     float32_ = float32_sum;
     moments_ = RunningMoments();
     abs_sum_ = diff_sq_sum_ = NeumaierSum();
@@ -31,9 +32,9 @@ void WeightAccumulator::reset(ErrorMethod method, const SamplerPlan& plan, bool 
     top_.clear();
     top_.reserve(kTailWeights + kBlockSize);
     top_threshold_ = -1.0;
-    batch_sums_.assign(plan.batches(), NeumaierSum());
+    batch_sums_.assign(batches, NeumaierSum());
     walsh_values_.clear();
-    if (method == ErrorMethod::WalshBound) walsh_values_.reserve(plan.total);
+    if (method == ErrorMethod::WalshBound) walsh_values_.reserve(total);
 }
 
 void WeightAccumulator::keep_top() {
@@ -121,14 +122,13 @@ void WeightAccumulator::add_block(uint64_t first, const double* f, const double*
     switch (method_) {
     case ErrorMethod::Randomizations: {
         // Sum each randomization's weights apart (a block may span several batches).
-        const SamplerPlan& plan = *plan_;
-        const size_t batches = plan.batches();
-        size_t batch = static_cast<size_t>(first * batches / plan.total);
+        const size_t batches = batch_sums_.size();
+        size_t batch = static_cast<size_t>(first * batches / total_);
         size_t i = 0;
         while (i < count) {
-            while (plan.batch_begin(batch + 1) <= first + i) ++batch;
+            while (batch_begin(batch + 1) <= first + i) ++batch;
             const size_t end =
-                static_cast<size_t>(std::min<uint64_t>(count, plan.batch_begin(batch + 1) - first));
+                static_cast<size_t>(std::min<uint64_t>(count, batch_begin(batch + 1) - first));
             double part = 0.0;
             for (; i < end; ++i) part += w[i];
             batch_sums_[batch].add(part);
@@ -229,8 +229,7 @@ RunResult WeightAccumulator::finish(double scale) const {
         RunningMoments batch_means;
         const size_t batches = batch_sums_.size();
         for (size_t k = 0; k < batches; ++k) {
-            const double size =
-                static_cast<double>(plan_->batch_begin(k + 1) - plan_->batch_begin(k));
+            const double size = static_cast<double>(batch_begin(k + 1) - batch_begin(k));
             batch_means.add(batch_sums_[k].value() / size);
         }
         if (!float32_) mean = batch_means.mean();

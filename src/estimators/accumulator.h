@@ -17,9 +17,15 @@ namespace mcp {
 
 class WeightAccumulator {
   public:
-    /// Starts a run of `n` samples whose error bar is computed by `method`; `plan` gives the
-    /// quasi-Monte Carlo batches (its randomizers) and must outlive the accumulator's use.
-    void reset(ErrorMethod method, const SamplerPlan& plan, bool float32_sum);
+    /// Starts a run of `total` samples whose error bar is computed by `method`. For
+    /// ErrorMethod::Randomizations they are `batches` independent randomizations, batch k the
+    /// samples [total k / batches, total (k + 1) / batches): a sampler plan's batches
+    /// (SamplerPlan::batch_begin), or an estimator's that draws its own points.
+    void reset(ErrorMethod method, uint64_t total, size_t batches, bool float32_sum);
+    /// reset for a run of a sampler plan's points and batches (its randomizers).
+    void reset(ErrorMethod method, const SamplerPlan& plan, bool float32_sum) {
+        reset(method, plan.total, plan.batches(), float32_sum);
+    }
 
     /// Turns the values f and densities p of samples first .. first + count - 1 into weights
     /// w = f/p (w may alias p), drops (as 0) and counts the non-finite and zero-pdf ones, and
@@ -38,9 +44,10 @@ class WeightAccumulator {
 
   private:
     void keep_top();
+    uint64_t batch_begin(size_t k) const { return total_ * k / batch_sums_.size(); }
 
     ErrorMethod method_ = ErrorMethod::Iid;
-    const SamplerPlan* plan_ = nullptr;
+    uint64_t total_ = 0;
     bool float32_ = false;
     RunningMoments moments_;
     NeumaierSum abs_sum_, diff_sq_sum_;

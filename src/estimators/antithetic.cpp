@@ -83,7 +83,7 @@ class AntitheticEstimator final : public EstimatorAlgorithm {
     bool float32_;
     uint64_t pairs_ = 0, next_ = 0;
     bool prepared_ = false;
-    SamplerPlan plan_; // outlives the accumulator's use of it
+    SamplerPlan plan_; // the run's points
     WeightAccumulator accumulator_;
     std::vector<double> ones_, means_, units_; // per block: p = 1, the pair means, their weights
 };

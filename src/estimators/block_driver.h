@@ -189,6 +189,14 @@ class TrainingLog {
     std::vector<std::vector<std::vector<double>>> history_;
 };
 
+/// How a run laid out its points, for the sample view: the grid's cells per axis (empty: no
+/// grid), the points per cell, and the independent randomizations it is made of (0: none).
+struct PointDesign {
+    std::vector<uint64_t> strata;
+    uint64_t per_stratum = 1;
+    size_t randomizations = 0;
+};
+
 /// An estimator as an algorithm: it plans a run, consumes it block by block, and gives the
 /// run's result. Fixed estimators (a sampler and one proposal; estimators/fixed.cpp) are one
 /// implementation; VEGAS (vegas_estimator.cpp), VEGAS+ and MISER (which adapt their sampling
@@ -204,6 +212,8 @@ class EstimatorAlgorithm {
     void observe(BlockObserver observer) { observer_ = std::move(observer); }
     /// The state an adaptive estimator ended its last run with (empty for fixed ones).
     virtual AdaptiveView adaptive_view() const { return {}; }
+    /// How the run begun last laid out its points (none: independent points, or adaptive ones).
+    virtual PointDesign design() const { return {}; }
     /// Starts a run of n samples; the run's randomization is drawn from rng.
     virtual void begin(uint64_t n, Pcg32& rng) = 0;
     /// Samples and weighs the next block; false when the run is complete (nothing was done).

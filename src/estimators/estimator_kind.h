@@ -1,20 +1,36 @@
 // An estimator kind: the one place that says what an estimator is, as pbrt-v4 makes its
 // integrators by name in one place (Integrator::Create, src/pbrt/cpu/integrators.cpp). A kind
-// owns its method name (what the page explains), its error method, its factory, and the facts
-// the page and the reports read instead of knowing estimators (whether the running mean of its
-// first points is its estimate, whether it adapts). Each kind defines its entry in its own file
-// (estimators/fixed.cpp, vegas_estimator.cpp, vegas_plus.cpp, miser.cpp, mis.cpp,
-// control_variates.cpp, antithetic.cpp, ris.cpp); estimators/registry.cpp lists them with the
+// owns its method name (what the page explains), its error method, its factory (whose algorithm
+// draws and randomizes its own points), its checks on a study of it, the words reports show of
+// its points, and the facts the page and the reports read instead of knowing estimators (whether
+// the running mean of its first points is its estimate, whether it adapts). Each kind defines
+// its entry in its own file under estimators/; estimators/registry.cpp lists them with the
 // presets (docs/adding-an-estimator.md).
 #pragma once
 
+#include <cstdint>
 #include <memory>
+#include <string>
 
 #include "estimators/block_driver.h"
 #include "estimators/estimator.h"
 #include "estimators/problem.h"
 
 namespace mcp {
+
+/// What reports and the sample view say of an estimator's points.
+struct PointWords {
+    const char* sampler;       ///< how they are placed: "independent", "sobol", "systematic", ...
+    const char* randomization; ///< how a randomization is drawn ("owen", ...); null: none
+    int randomizations;        ///< K independent randomizations per run; 0: none
+};
+
+/// What a kind's own check sees of a study: the sample dimension and the N of its runs, which
+/// double from n_first up to n_max (the study's powers of two, or a stopping rule's n_min).
+struct StudyShape {
+    int dim;
+    uint64_t n_first, n_max;
+};
 
 struct EstimatorKind {
     const char* name;    ///< "fixed", "vegas", "vegas_plus", "miser", "mis", ... (spec.kind)
@@ -35,6 +51,12 @@ struct EstimatorKind {
     /// at a larger N (options.adaptive_n) and shows its first points; its points follow no
     /// sampler plan of their own.
     bool adaptive;
+    /// The words reports and the sample view show of its points; null: its spec's sampler's
+    /// (sampler_point_words, estimators/registry.h).
+    PointWords (*points)(const EstimatorSpec& spec) = nullptr;
+    /// Its own checks on a study of it (N, dimension, options), run before any work: "" or one
+    /// line naming what is wrong, the value given and the way out; null: none.
+    std::string (*check)(const EstimatorSpec& spec, const StudyShape& study) = nullptr;
 };
 
 } // namespace mcp

@@ -40,6 +40,10 @@ class FixedEstimator final : public EstimatorAlgorithm {
         return true;
     }
 
+    PointDesign design() const override {
+        return {plan_.strata, plan_.per_stratum, plan_.batches()};
+    }
+
     RunResult result() const override {
         const double scale = quantity_scale(problem_);
         RunResult r = accumulator_.finish(scale);

@@ -208,7 +208,7 @@ class MiserEstimator final : public EstimatorAlgorithm {
     StratifiedSum strata_;
     uint64_t accumulated_ = 0, probed_n_ = 0;
     double probe_seconds_ = 0.0;
-    SamplerPlan plan_; // outlives the accumulator's use of it
+    SamplerPlan plan_; // the run's points
     WeightAccumulator accumulator_;
     RunResult result_;
 };

@@ -167,9 +167,8 @@ struct ControlVariateOptions {
 /// Resampled importance sampling [Talbot05] (estimators/ris.cpp; scene field "ris"): M candidates
 /// from the proposal, one kept with probability proportional to g/p for a target g: the scene's
 /// pdf (`target`, a cheap proxy of |f|; the proposal is then uniform) or |f| at the candidates.
-/// RIS: a point's candidates fit in one block.
-constexpr int kMaxRisCandidates = static_cast<int>(kBlockSize);
 struct RisOptions {
+    static constexpr int kMaxCandidates = static_cast<int>(kBlockSize); ///< fit in one block
     int candidates = 1;      ///< M
     bool target_pdf = false; ///< g = target's density; false: g = |f|
     Proposal target;

@@ -14,13 +14,15 @@ const EstimatorKind& miser_estimator_kind();           // estimators/miser.cpp
 const EstimatorKind& mis_estimator_kind();             // estimators/mis.cpp
 const EstimatorKind& control_variate_estimator_kind(); // estimators/control_variates.cpp
 const EstimatorKind& antithetic_estimator_kind();      // estimators/antithetic.cpp
+const EstimatorKind& systematic_estimator_kind();      // estimators/systematic.cpp
 const EstimatorKind& ris_estimator_kind();             // estimators/ris.cpp
 
 const std::vector<const EstimatorKind*>& estimator_kinds() {
     static const std::vector<const EstimatorKind*> kinds = {
         &fixed_estimator_kind(),      &vegas_estimator_kind(), &vegas_plus_estimator_kind(),
         &miser_estimator_kind(),      &mis_estimator_kind(),   &control_variate_estimator_kind(),
-        &antithetic_estimator_kind(), &ris_estimator_kind(),
+        &antithetic_estimator_kind(),
+        &systematic_estimator_kind(), &ris_estimator_kind(),
     };
     return kinds;
 }
@@ -58,6 +60,8 @@ const std::vector<EstimatorPreset>& estimator_presets() {
          "frozen"},
         {"antithetic", "antithetic", SamplerKind::Independent, false,
          "antithetic pairs u and 1 - u: N/2 independent pairs, the error bar from their means"},
+        {"systematic", "systematic", SamplerKind::Independent, false,
+         "systematic sampling: 16 randomly shifted grids of N/16 points"},
         {"ris_m1", "ris", SamplerKind::Independent, false,
          "resampled importance sampling with M = 1 candidate: uniform sampling", false, 1},
         {"ris_m2", "ris", SamplerKind::Independent, false,
@@ -94,6 +98,22 @@ const EstimatorPreset* find_preset(const std::string& name) {
 
 const char* estimator_method(const EstimatorSpec& spec) {
     return kind_of(spec).method(spec);
+}
+
+PointWords sampler_point_words(const EstimatorSpec& spec) {
+    if (!is_qmc(spec.sampler)) return {sampler_name(spec.sampler), nullptr, 0};
+    return {sampler_name(spec.sampler), randomization_name(spec.randomization),
+            spec.randomizations};
+}
+
+PointWords point_words(const EstimatorSpec& spec) {
+    const EstimatorKind& kind = kind_of(spec);
+    return kind.points ? kind.points(spec) : sampler_point_words(spec);
+}
+
+std::string check_estimator(const EstimatorSpec& spec, const StudyShape& study) {
+    const EstimatorKind& kind = kind_of(spec);
+    return kind.check ? kind.check(spec, study) : std::string();
 }
 
 ErrorMethod error_method_for(const EstimatorSpec& spec) {

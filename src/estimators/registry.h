@@ -38,11 +38,16 @@ const std::vector<EstimatorPreset>& estimator_presets();
 /// The preset of that name, or null.
 const EstimatorPreset* find_preset(const std::string& name);
 
-/// The method a spec is an instance of, for explaining it (its kind's method): "uniform",
-/// "importance", "stratified", "stratified_importance", "latin_hypercube", "rqmc" (randomized
-/// quasi-Monte Carlo), "qmc" (no randomization), "vegas", "vegas_plus", "miser", "mis",
-/// "control_variates", "antithetic", "ris".
+/// The method a spec is an instance of, for explaining it (its kind's method; the catalog lists
+/// every kind's).
 const char* estimator_method(const EstimatorSpec& spec);
+
+/// The words of a spec's points (its kind's, or sampler_point_words).
+PointWords point_words(const EstimatorSpec& spec);
+/// The words of the spec's sampler: its name, and for quasi-Monte Carlo its randomization and K.
+PointWords sampler_point_words(const EstimatorSpec& spec);
+/// The spec's kind's own checks on a study of it: "" or a one-line error.
+std::string check_estimator(const EstimatorSpec& spec, const StudyShape& study);
 
 /// How a spec's per-run standard error is estimated (its kind's error method).
 ErrorMethod error_method_for(const EstimatorSpec& spec);

@@ -25,7 +25,8 @@ class RisEstimator final : public EstimatorAlgorithm {
   public:
     RisEstimator(const Problem& problem, const EstimatorSpec& spec, Accumulator accumulator)
         : problem_(problem), options_(spec.ris_options), source_(spec.proposal),
-          m_(static_cast<size_t>(std::clamp(spec.ris_options.candidates, 1, kMaxRisCandidates))),
+          m_(static_cast<size_t>(
+              std::clamp(spec.ris_options.candidates, 1, RisOptions::kMaxCandidates))),
           float32_(accumulator == Accumulator::Float32) {}
 
     void begin(uint64_t n, Pcg32& rng) override {
@@ -90,7 +91,7 @@ class RisEstimator final : public EstimatorAlgorithm {
     /// NaN when W is not finite).
     void resample(size_t k, const Workspace& ws) {
         const size_t base = k * m_;
-        double cumulative[kMaxRisCandidates];
+        double cumulative[RisOptions::kMaxCandidates];
         double sum = 0.0;
         for (size_t j = 0; j < m_; ++j) {
             const double p = ws.pdf[base + j];

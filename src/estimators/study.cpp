@@ -285,6 +285,17 @@ IntegrandTail integrand_tail(const Problem& problem, uint64_t probes, uint64_t s
     std::sort(values.begin(), values.end(), std::greater<double>());
     tail.k = k;
     tail.alpha = hill_tail_index(values, k);
+    // Hill's reading assumes a power tail above x_(k+1): the log-excesses log(x_(i) / x_(k+1))
+    // are then k exponentials of mean 1 / alpha, whose largest m exceeds a given value with
+    // P(max < m) = (1 - e^(-alpha m))^k. A top far more compressed than that (p below
+    // kBoundedTopP) has an upper end, not a tail: a bounded peak (a narrow Gaussian on a plateau
+    // reads alpha 0.6 at k = 2048 though f is bounded). No tail: alpha infinite.
+    const double m = std::log(values.front() / values[static_cast<size_t>(k)]);
+    if (tail.alpha > 0.0 && std::isfinite(tail.alpha) && m > 0.0) {
+        const double log_p = k * std::log1p(-std::exp(-tail.alpha * m));
+        tail.top_log_p = log_p;
+        if (log_p < std::log(kBoundedTopP)) tail.alpha = std::numeric_limits<double>::infinity();
+    }
     return tail;
 }
 
@@ -890,17 +901,8 @@ SampleDump dump_samples(const Problem& problem, const EstimatorSpec& spec, uint6
     const Domain& d = problem.domain;
     dump.sample_dim = d.sample_dim();
     dump.point_dim = d.point_dim();
-    // The same stream and seeding as replicate 0 of the study at this N; the plan drawn from a
-    // copy of it is the one a fixed estimator draws (its strata and batches).
+    // The same stream and seeding as replicate 0 of the study at this N.
     Pcg32 rng = replicate_rng(seed, spec.name, n, 0);
-    Pcg32 plan_rng = rng;
-    const SamplerPlan plan =
-        make_sampler_plan(spec.sampler, dump.sample_dim, n, plan_rng, spec.sampler_options());
-    if (!adaptive) {
-        dump.strata = plan.strata;
-        dump.per_stratum = plan.per_stratum;
-        dump.randomizations = plan.batches();
-    }
     std::unique_ptr<EstimatorAlgorithm> estimator =
         make_estimator(problem, spec, Accumulator::Compensated);
     estimator->observe([&](const SampleBlock& blk) {
@@ -915,6 +917,10 @@ SampleDump dump_samples(const Problem& problem, const EstimatorSpec& spec, uint6
     });
     Workspace ws;
     estimator->begin(n, rng);
+    const PointDesign design = estimator->design(); // the estimator's own layout of its points
+    dump.strata = design.strata;
+    dump.per_stratum = design.per_stratum;
+    dump.randomizations = design.randomizations;
     while (estimator->run_block(rng, ws)) {
     }
     dump.adaptive = estimator->adaptive_view();

@@ -268,7 +268,12 @@ struct IntegrandTail {
     /// low Hill index is a slowly varying tail read too heavy (x^-0.3 y^-0.3 ... z^-0.3: P(f > t) ~
     /// t^-3.3 (log t)^(d-1)), not an infinite variance.
     std::optional<bool> square_integrable;
+    /// log P(the largest log-excess is this small) under Hill's power tail (NaN: not tested);
+    /// below log(kBoundedTopP) the top has an upper end and alpha is set infinite.
+    double top_log_p = std::numeric_limits<double>::quiet_NaN();
 };
+/// A top of the probes more compressed than a power tail gives with this probability: bounded.
+constexpr double kBoundedTopP = 1e-3;
 /// Uniform points probed for the integrand's tail: Hill's order k = min(kTailOrder, probes / 16)
 /// reaches kTailOrder.
 constexpr uint64_t kTailProbes = uint64_t(1) << 15;

@@ -245,7 +245,7 @@ class VegasPlusEstimator final : public EstimatorAlgorithm, private TrainingPoin
     std::vector<double> sigma_, importance_, weight_;
     std::vector<uint32_t> cube_of_;
     std::vector<RunningMoments> cube_moments_;
-    SamplerPlan plan_; // outlives the accumulator's use of it
+    SamplerPlan plan_; // the run's points
     WeightAccumulator accumulator_;
     RunResult final_result_;
 };

@@ -344,6 +344,19 @@ ContributionBound contribution_bound(const RenderEstimator& e, const LightContac
                       "d their smallest distance from a light"
                     : "every light is away from the surfaces: cos cos' / r^2 <= 1 / d^2 for "
                       "d the smallest distance"};
+    case RadianceStrategy::Ris: {
+        // f Le cos V / target(y) * (1/M) sum_j w_j: the first factor is at most
+        // max_c(rgb_c) / lum(rgb) <= 1 / 0.0722 per channel, the mean at most the largest
+        // w_j = lum(f Le cos) / p, light sampling's weight. Bounded exactly where that is.
+        RenderEstimator light = e;
+        const bool area = e.light_sampling == LightSampling::Area;
+        light.strategy = area ? RadianceStrategy::LightArea : RadianceStrategy::LightSolidAngle;
+        ContributionBound b = contribution_bound(light, contacts);
+        b.reason = "resampled light samples: f Le cos / target <= 1 / 0.0722 times the mean "
+                   "of light sampling's weights, so bounded where light sampling is: " +
+                   b.reason;
+        return b;
+    }
     }
     return {false, false, "unknown strategy"};
 }

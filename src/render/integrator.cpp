@@ -28,6 +28,7 @@ constexpr StrategyName kStrategyNames[] = {
     {RadianceStrategy::MisBalance, "mis_balance"},
     {RadianceStrategy::MisPower, "mis_power"},
     {RadianceStrategy::Path, "path"},
+    {RadianceStrategy::Ris, "ris"},
 };
 
 bool is_black(const Vec3& c) {
@@ -242,6 +243,7 @@ Vec3 direction_sample_term(const RenderScene& rs, const RenderEstimator& est,
     case RadianceStrategy::LightArea:
     case RadianceStrategy::LightSolidAngle:
     case RadianceStrategy::Path:
+    case RadianceStrategy::Ris:
         return Vec3(0.0); // never called with these (direct_radiance, path_radiance)
     }
     if (is_black(f)) return Vec3(0.0);
@@ -256,6 +258,83 @@ Vec3 direction_sample_term(const RenderScene& rs, const RenderEstimator& est,
         w = mis_weight(pdf, light_pdf, power);
     }
     return f * d.emitted * (wi_local.z * w / pdf);
+}
+
+/// A light sample's unshadowed contribution f Le cos at a shading point (its RIS target is the
+/// luminance of `value`), and where it lies, for the shadow ray if it is kept. No member
+/// initializers: ris_light_term's array of kMaxRisCandidates is not cleared per sample.
+struct RisCandidate {
+    Vec3 point, normal, value;
+    double target;
+};
+
+/// The unshadowed contribution of one light sample (target 0 where it contributes nothing);
+/// its solid-angle density in *pdf (0 for an invalid sample, counted as a light miss).
+template <class S>
+RisCandidate ris_candidate(const LightSet& lights, LightSampling mode, const ShadingPoint& sp,
+                           PixelSampler& sampler, SampleCounters& c, double* pdf) {
+    RisCandidate x{Vec3(0.0), Vec3(0.0), Vec3(0.0), 0.0};
+    *pdf = 0.0;
+    ChoiceSample cs = sampler.get_choice_2d();
+    LightSample ls = lights.sample(sp.p, cs.choice, cs.u, mode);
+    if (!ls.valid || !(ls.pdf > 0.0)) {
+        ++c.light_misses;
+        return x;
+    }
+    *pdf = ls.pdf;
+    Vec3 to_light = ls.point - sp.p;
+    double dist = glm::length(to_light);
+    if (is_black(ls.radiance) || !(dist > 0.0)) return x;
+    Vec3 wi = to_light / dist;
+    if (glm::dot(wi, sp.ng) <= 0.0) return x; // below the surface: no light leaks
+    Vec3 wi_local = sp.frame.to_local(wi);
+    if (wi_local.z <= 0.0) return x;
+    double unused_pdf;
+    Vec3 f = S::eval_pdf(sp.bsdf, sp.wo_local, wi_local, &unused_pdf);
+    x.point = ls.point;
+    x.normal = ls.normal;
+    x.value = f * ls.radiance * wi_local.z;
+    x.target = luminance(x.value);
+    if (!(x.target > 0.0) || !std::isfinite(x.target)) x.target = 0.0;
+    return x;
+}
+
+/// Direct lighting by resampled importance sampling [Talbot05, 4]: est.candidates light samples
+/// x_j of density p, weights w_j = target(x_j) / p(x_j) with the unshadowed lum(f Le cos) as the
+/// target, one y kept with probability w_j / sum_k w_k, and the one shadow ray towards y:
+/// f Le cos V(y) / target(y) * (1/M) sum_j w_j [BitterliEtAl20, eq. 6]. Unbiased because the
+/// target is positive wherever f Le cos V is (luminance weights every channel positively);
+/// visibility is left out of the target, so occluded candidates still draw weight. M = 1 is
+/// light sampling. The kept candidate's number is drawn after the M light samples (not for
+/// M = 1, whose numbers are light sampling's).
+template <class S>
+Vec3 ris_light_term(const RenderScene& rs, const RenderEstimator& est, const LightSet& lights,
+                    const ShadingPoint& sp, PixelSampler& sampler, SampleCounters& c) {
+    const int m = std::clamp(est.candidates, kMinRisCandidates, kMaxRisCandidates);
+    RisCandidate candidates[kMaxRisCandidates];
+    double weights[kMaxRisCandidates];
+    double weight_sum = 0.0;
+    for (int j = 0; j < m; ++j) {
+        double pdf = 0.0;
+        candidates[j] = ris_candidate<S>(lights, est.light_sampling, sp, sampler, c, &pdf);
+        weights[j] = candidates[j].target > 0.0 ? candidates[j].target / pdf : 0.0;
+        weight_sum += weights[j];
+    }
+    double u = m > 1 ? sampler.get_1d() : 0.0;
+    if (!(weight_sum > 0.0)) return Vec3(0.0);
+    // An overflowing sum gives a non-finite sample, which the renderer drops and counts.
+    if (!std::isfinite(weight_sum)) return Vec3(weight_sum);
+    int kept = -1;
+    double below = 0.0, threshold = u * weight_sum;
+    for (int j = 0; j < m; ++j) {
+        if (!(weights[j] > 0.0)) continue;
+        kept = j; // the last positive weight takes what rounding leaves past the sum
+        below += weights[j];
+        if (threshold < below) break;
+    }
+    const RisCandidate& y = candidates[kept];
+    if (!visible(rs, sp, y.point, y.normal, c)) return Vec3(0.0);
+    return y.value * (weight_sum / (double(m) * y.target));
 }
 
 /// The direct-lighting estimators: emission seen by the camera plus one estimate of the
@@ -299,6 +378,9 @@ RadianceSample direct_radiance(const RenderScene& rs, const RenderEstimator& est
         out.reflected = from_light + from_bsdf;
         break;
     }
+    case RadianceStrategy::Ris:
+        out.reflected = ris_light_term<S>(rs, est, lights, sp, sampler, c);
+        break;
     case RadianceStrategy::Path: break; // path_radiance's (sample_radiance_with)
     }
     return out;

@@ -19,6 +19,14 @@
 //   path                path tracing with next-event estimation, MIS (power heuristic) of
 //                       light and BSDF samples at every vertex, a maximum number of bounces
 //                       and Russian roulette [Veach97; PBR4, 13]
+//   ris                 resampled importance sampling [Talbot05]: M candidates from light
+//                       sampling (light_selection, light_sampling; the render API's default
+//                       for ris: uniform choice, by area), one of them chosen in
+//                       proportion to w_j = target(x_j) / p(x_j), the target the unshadowed
+//                       contribution's luminance lum(f Le cos); the chosen y gets the one
+//                       shadow ray, weighted f Le cos V / target(y) * (1/M) sum_j w_j
+//                       [Talbot05, 4; BitterliEtAl20, eq. 6]: unbiased, since the target is
+//                       positive wherever f Le cos is
 #pragma once
 
 #include <cstdint>
@@ -41,6 +49,7 @@ enum class RadianceStrategy {
     MisBalance,
     MisPower,
     Path,
+    Ris,
 };
 const char* strategy_name(RadianceStrategy s);
 bool parse_strategy(const std::string& name, RadianceStrategy* s);
@@ -54,9 +63,12 @@ struct RenderEstimator {
     /// Where every number of a sample comes from (camera jitter, light selection and
     /// sampling, BSDF sampling, Russian roulette): pixel_sampler.h.
     PixelSamplerKind pixel_sampler = PixelSamplerKind::Stratified;
-    int max_depth = 5; ///< path: bounces (1 = direct lighting only)
-    int rr_depth = 3;  ///< path: Russian roulette from this bounce on
+    int max_depth = 5;  ///< path: bounces (1 = direct lighting only)
+    int rr_depth = 3;   ///< path: Russian roulette from this bounce on
+    int candidates = 8; ///< ris: light samples resampled per shading point (M)
 };
+/// The bounds of ris's candidate count M, checked where estimators are parsed.
+constexpr int kMinRisCandidates = 1, kMaxRisCandidates = 64;
 
 /// Per-sample counters, summed per image.
 struct SampleCounters {

@@ -95,6 +95,7 @@ Json estimator_to_json(const RenderEstimator& e) {
         j["max_depth"] = e.max_depth;
         j["rr_depth"] = e.rr_depth;
     }
+    if (e.strategy == RadianceStrategy::Ris) j["candidates"] = e.candidates;
     return j;
 }
 

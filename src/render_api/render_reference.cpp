@@ -61,6 +61,7 @@ uint64_t reference_key(const RenderRequest& r) {
           uint64_t(e.light_selection), uint64_t(e.light_sampling), uint64_t(e.pixel_sampler),
           uint64_t(e.max_depth), uint64_t(e.rr_depth), r.reference.spp, r.reference.seed})
         key = hash_combine(key, v);
+    if (e.strategy == RadianceStrategy::Ris) key = hash_combine(key, uint64_t(e.candidates));
     return key;
 }
 

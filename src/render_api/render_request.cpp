@@ -41,9 +41,16 @@ bool parse_enum(Ctx& c, const Json& obj, const char* key, const std::string& pat
 
 std::vector<std::string> strategy_names() {
     std::vector<std::string> names;
-    for (int s = 0; s <= int(RadianceStrategy::Path); ++s)
+    for (int s = 0; s <= int(RadianceStrategy::Ris); ++s)
         names.push_back(strategy_name(RadianceStrategy(s)));
     return names;
+}
+
+/// ris draws its candidates cheaply by default (a light chosen uniformly, a point uniform in
+/// its area) and leaves the importance to its target [Talbot05]; both can be set.
+void use_ris_defaults(RenderEstimator* e) {
+    e->light_selection = LightSelection::Uniform;
+    e->light_sampling = LightSampling::Area;
 }
 
 bool parse_estimator(Ctx& c, const Json& j, const std::string& path, RenderEstimator* out) {
@@ -54,12 +61,13 @@ bool parse_estimator(Ctx& c, const Json& j, const std::string& path, RenderEstim
             return c.fail(path, "unknown estimator '" + name +
                                     "' (known: " + join(strategy_names()) + ")");
         e.name = name;
+        if (e.strategy == RadianceStrategy::Ris) use_ris_defaults(&e);
         *out = e;
         return true;
     }
     if (!check_keys(c, j, path,
                     {"name", "strategy", "light_selection", "light_sampling", "pixel_sampler",
-                     "max_depth", "rr_depth"}))
+                     "max_depth", "rr_depth", "candidates"}))
         return false;
     std::string strategy;
     if (!get_string(c, j, "strategy", path, &strategy)) return false;
@@ -69,6 +77,7 @@ bool parse_estimator(Ctx& c, const Json& j, const std::string& path, RenderEstim
         return c.fail(sub(path, "strategy"), "unknown strategy '" + strategy +
                                                  "' (known: " + join(strategy_names()) + ")");
     e.name = strategy;
+    if (e.strategy == RadianceStrategy::Ris) use_ris_defaults(&e);
     if (!get_string(c, j, "name", path, &e.name)) return false;
     if (e.name.empty()) return c.fail(sub(path, "name"), "must not be empty");
     int v = int(e.light_selection);
@@ -89,6 +98,15 @@ bool parse_estimator(Ctx& c, const Json& j, const std::string& path, RenderEstim
         return c.fail(sub(path, "max_depth"), "only the 'path' strategy has bounces");
     e.max_depth = int(depth);
     e.rr_depth = int(rr);
+    uint64_t m = uint64_t(e.candidates);
+    if (!get_count(c, j, "candidates", path, &m)) return false;
+    if (find(j, "candidates") && e.strategy != RadianceStrategy::Ris)
+        return c.fail(sub(path, "candidates"), "only the 'ris' strategy resamples candidates");
+    if (m < uint64_t(kMinRisCandidates) || m > uint64_t(kMaxRisCandidates))
+        return c.fail(sub(path, "candidates"),
+                      "must be in " + std::to_string(kMinRisCandidates) + ".." +
+                          std::to_string(kMaxRisCandidates) + ", got " + std::to_string(m));
+    e.candidates = int(m);
     *out = e;
     return true;
 }

@@ -355,6 +355,8 @@ render('spp_max_huge', { gltf: 'ok.gltf', spp_max: 4194304 }, 'spp_max');
 render('reps_one_render', { gltf: 'ok.gltf', reps: 1 }, 'scene.render.reps');
 render('estimator_unknown_render', { gltf: 'ok.gltf', estimators: ['mis_cubic'] }, "unknown estimator 'mis_cubic'");
 render('estimator_depth_zero', { gltf: 'ok.gltf', estimators: [{ strategy: 'path', max_depth: 0 }] }, 'max_depth');
+render('estimator_ris_candidates_huge', { gltf: 'ok.gltf', estimators: [{ strategy: 'ris', candidates: 1000 }] }, 'candidates: must be in 1..64, got 1000');
+render('estimator_candidates_not_ris', { gltf: 'ok.gltf', estimators: [{ strategy: 'light_area', candidates: 4 }] }, "only the 'ris' strategy resamples candidates");
 render('render_unknown_field', { gltf: 'ok.gltf', colour: 'red' }, "unknown field 'colour'");
 render('render_exposure_string', { gltf: 'ok.gltf', exposure: 'bright' }, 'exposure');
 render('render_accel_bad', { gltf: 'ok.gltf', accel: 'kd_tree' }, 'accel');

@@ -129,6 +129,7 @@ export function renderFacts(r) {
   if (r.light_sampling) parts.push(`sampled by ${r.light_sampling.replace('_', ' ')}`);
   if (r.pixel_sampler) parts.push(`${r.pixel_sampler} pixel samples`);
   if (r.max_depth) parts.push(`up to ${r.max_depth} bounces`);
+  if (r.candidates) parts.push(`${r.candidates} candidates resampled`);
   return parts.join(', ');
 }
 

@@ -1,19 +1,53 @@
-// Tests of web/src/explain.js: every method the core names has an explanation, and the orders
-// follow the dimension where they depend on it.
+// Tests of web/src/explain.js: every method the core names gets a panel (its teaching text, or
+// the generic one with its kind's summary), and the orders follow the dimension where they
+// depend on it. The core's methods come from the wasm module's catalog and scene info, not from
+// a list here: MCPLAY_WASM_DIR holds mcplay_web.mjs + mcplay_web.wasm (default build-wasm).
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
+import fs from 'node:fs';
+import path from 'node:path';
+import { fileURLToPath, pathToFileURL } from 'node:url';
+
 import { explainEstimator, EXPLAINED } from '../src/explain.js';
+import { loadCore } from '../core.js';
 
-// The methods the core's estimator kinds name (src/estimators/registry.h estimator_method).
-const CORE_METHODS = ['uniform', 'importance', 'stratified', 'stratified_importance', 'latin_hypercube', 'rqmc',
-  'rqmc_walsh', 'qmc', 'vegas', 'vegas_plus', 'miser', 'mis', 'control_variates', 'antithetic', 'ris'];
+const ROOT = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '..', '..');
+const WASM_DIR = path.resolve(ROOT, process.env.MCPLAY_WASM_DIR || 'build-wasm');
 
-test('every method the core names is explained, with a formula, an order and what to look for', () => {
-  assert.deepEqual([...EXPLAINED].sort(), [...CORE_METHODS].sort());
-  for (const method of CORE_METHODS) {
+async function getCore() {
+  const mjs = path.join(WASM_DIR, 'mcplay_web.mjs');
+  const wasm = path.join(WASM_DIR, 'mcplay_web.wasm');
+  for (const f of [mjs, wasm]) {
+    if (!fs.existsSync(f)) {
+      throw new Error(`wasm module not found: ${f}. Build it with \`make build-wasm\` or point ` +
+        'MCPLAY_WASM_DIR at the directory holding mcplay_web.mjs/.wasm');
+    }
+  }
+  const { default: createMcplay } = await import(pathToFileURL(mjs).href);
+  return loadCore(createMcplay, { wasmBinary: fs.readFileSync(wasm) });
+}
+
+test('every teaching text has a formula, an order and what to look for', () => {
+  for (const method of EXPLAINED) {
     const x = explainEstimator({ name: 'e', method, pdf: 'uniform' }, 2);
     assert.ok(x.title && x.formula && x.order && x.look, method);
     assert.match(x.formula, /I_N|map|bisect|VEGAS/, `${method}: ${x.formula}`);
+  }
+});
+
+test('every preset of the core\'s catalog gets a panel: its teaching text or its kind\'s summary', async () => {
+  const core = await getCore();
+  const presets = core.catalog().estimators.filter((e) => !e.needs_pdf).map((e) => e.name);
+  assert.ok(presets.length >= 10, `catalog presets: ${presets}`);
+  const info = core.sceneInfo({ f: 'x', n_min: 1024, n_max: 65536, estimators: presets });
+  assert.equal(info.estimator_details.length, presets.length);
+  for (const detail of info.estimator_details) {
+    const x = explainEstimator(detail, 1);
+    assert.ok(x.title && x.formula && x.order && x.look, `${detail.name}: ${JSON.stringify(x)}`);
+    if (!EXPLAINED.includes(detail.method)) {
+      assert.equal(x.title, detail.method);
+      assert.equal(x.look, detail.summary, detail.name);
+    }
   }
 });
 
