@@ -67,7 +67,8 @@ INSTANTIATE_TEST_SUITE_P(AllScenes, SceneUnbiased,
                          ::testing::Values("disk_quarter", "disk_third", "expectation_4xy",
                                            "sin_product_2d", "exp_1d", "gaussian_peak_1d",
                                            "gaussian_2d", "hemisphere_cos2", "triangle_moment",
-                                           "vegas_corner_peak", "control_variates_2d"));
+                                           "vegas_corner_peak", "control_variates_2d",
+                                           "ris_peak_1d"));
 
 TEST(Convergence, UniformVarianceFallsAsOneOverN) {
     // Fitted order within 0.1 of -1 (the fit's own standard error is ~0.02 here).

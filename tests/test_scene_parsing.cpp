@@ -36,7 +36,7 @@ std::string repeated(size_t n, const std::string& item) {
 }
 
 constexpr const char* kNewName = "; a new name needs \"sampler\", \"pdf\", \"vegas\", "
-                                 "\"miser\", \"proposals\" or \"control_variates\")";
+                                 "\"miser\", \"proposals\", \"control_variates\" or \"ris\")";
 
 // The unknown-name message lists every preset of the registry, in its order (a new preset joins
 // the message without a change here).

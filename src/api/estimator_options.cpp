@@ -1,7 +1,8 @@
 // The estimator kinds' own JSON fields (api/estimator_options.h): VEGAS and VEGAS+ ("vegas"),
-// MISER ("miser"), multiple importance sampling ("proposals", "heuristic", ...) and control
-// variates ("control_variates", "coefficients"). Each parse validates its fields up front,
-// bounded before any work, and checks the sampler its kind accepts.
+// MISER ("miser"), multiple importance sampling ("proposals", "heuristic", ...), control
+// variates ("control_variates", "coefficients") and resampled importance sampling ("ris"). Each
+// parse validates its fields up front, bounded before any work, and checks the sampler its kind
+// accepts.
 #include "api/estimator_options.h"
 
 #include <cmath>
@@ -334,6 +335,43 @@ bool parse_control_variate_fields(Ctx& c, const Json& j, const std::string& path
     return parse_control_variates(c, j, path, problem, &out->control_variate_options);
 }
 
+/// Resampled importance sampling: "ris": {"candidates": M, "target": "pdf" or "f"}. The target
+/// is the estimator's "pdf" when it has one (the candidates are then uniform), else |f| at the
+/// candidates (drawn from the "pdf" under "target": "f", else uniform).
+bool parse_ris_fields(Ctx& c, const Json& j, const std::string& path, const Problem& problem,
+                      const Json* pdf, EstimatorSpec* out) {
+    out->kind = find_estimator_kind("ris");
+    const std::string at = sub(path, "ris");
+    const Json& r = *find(j, "ris");
+    if (!r.is_object())
+        return c.fail(at, "expected an object {\"candidates\", \"target\"}, got " + type_of(r));
+    uint64_t m = static_cast<uint64_t>(out->ris_options.candidates);
+    std::string target;
+    if (!check_keys(c, r, at, {"candidates", "target"}) ||
+        !get_count(c, r, "candidates", at, &m) || !get_string(c, r, "target", at, &target))
+        return false;
+    if (m < 1 || m > static_cast<uint64_t>(RisOptions::kMaxCandidates))
+        return c.fail(sub(at, "candidates"), "must be in [1, " +
+                                                 std::to_string(RisOptions::kMaxCandidates) +
+                                                 "] (candidates per point), got " +
+                                                 std::to_string(m));
+    if (!target.empty() && target != "pdf" && target != "f")
+        return c.fail(sub(at, "target"), "expected \"pdf\" (the estimator's pdf) or \"f\" (|f| "
+                                         "at the candidates), got \"" + target + "\"");
+    if (target == "pdf" && !pdf)
+        return c.fail(sub(at, "target"), "\"pdf\" needs the estimator's \"pdf\" as the target");
+    if (out->sampler != SamplerKind::Independent)
+        return c.fail(sub(path, "sampler"), "resampled importance sampling needs the independent "
+                                            "sampler (its error bar is that of independent "
+                                            "points)");
+    out->ris_options.candidates = static_cast<int>(m);
+    out->ris_options.target_pdf = pdf && target != "f";
+    out->proposal = uniform_proposal(problem.domain);
+    if (!pdf) return true;
+    Proposal* into = out->ris_options.target_pdf ? &out->ris_options.target : &out->proposal;
+    return parse_pdf(c, *pdf, sub(path, "pdf"), problem, into);
+}
+
 } // namespace
 
 const std::vector<KindFields>& kind_fields() {
@@ -350,6 +388,7 @@ const std::vector<KindFields>& kind_fields() {
          {"coefficients"},
          false,
          parse_control_variate_fields},
+        {{"ris"}, {"ris"}, {}, true, parse_ris_fields},
     };
     return fields;
 }

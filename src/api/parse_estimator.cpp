@@ -212,6 +212,7 @@ bool parse_estimator(Ctx& c, const Json& j, const std::string& path, const Probl
     out->name = name;
     out->kind = preset ? find_estimator_kind(preset->kind) : nullptr;
     out->sampler = preset ? preset->sampler : SamplerKind::Independent;
+    if (preset && preset->ris_candidates > 0) out->ris_options.candidates = preset->ris_candidates;
     if (!sampler_name_str.empty() && !parse_sampler(sampler_name_str, &out->sampler))
         return c.fail(sub(path, "sampler"), "unknown sampler '" + sampler_name_str +
                                                 "' (known: " + sampler_names() + ")");

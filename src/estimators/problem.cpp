@@ -553,7 +553,8 @@ bool variance_follows_integrand(const EstimatorSpec& spec) {
 std::vector<const Proposal*> proposals_of(const EstimatorSpec& spec) {
     std::vector<const Proposal*> out;
     if (!spec.has_techniques()) {
-        out.push_back(&spec.proposal);
+        // RIS with a pdf as its target keeps points only where the target is positive.
+        out.push_back(spec.ris_options.target_pdf ? &spec.ris_options.target : &spec.proposal);
         return out;
     }
     for (const Proposal& p : spec.mis_options.proposals) out.push_back(&p);
@@ -563,7 +564,7 @@ std::vector<const Proposal*> proposals_of(const EstimatorSpec& spec) {
 void sampling_density_block(const EstimatorSpec& spec, const Domain& domain, const PointBlock& x,
                             double* pdf) {
     if (!spec.has_techniques()) {
-        proposal_pdf_block(spec.proposal, domain, x, pdf);
+        proposal_pdf_block(*proposals_of(spec)[0], domain, x, pdf);
         return;
     }
     std::vector<double> one(x.n);
@@ -598,6 +599,12 @@ std::string describe_sampling_text(const EstimatorSpec& spec, const Domain& doma
         s += ", reshaped by the VEGAS map the run learns";
     else if (kind == "miser")
         s += ", within the boxes MISER's recursive bisection makes";
+    else if (kind == "ris")
+        s += ": " + std::to_string(spec.ris_options.candidates) +
+             " candidates per point, one kept with probability proportional to g / p, where g "
+             "is " +
+             (spec.ris_options.target_pdf ? "the " + spec.ris_options.target.describe_text(domain)
+                                          : std::string("|f|"));
     return s;
 }
 

@@ -164,6 +164,16 @@ struct ControlVariateOptions {
     std::vector<double> coefficients; ///< given c (one per variate); empty: fitted
 };
 
+/// Resampled importance sampling [Talbot05] (estimators/ris.cpp; scene field "ris"): M candidates
+/// from the proposal, one kept with probability proportional to g/p for a target g: the scene's
+/// pdf (`target`, a cheap proxy of |f|; the proposal is then uniform) or |f| at the candidates.
+struct RisOptions {
+    static constexpr int kMaxCandidates = static_cast<int>(kBlockSize); ///< fit in one block
+    int candidates = 1;      ///< M
+    bool target_pdf = false; ///< g = target's density; false: g = |f|
+    Proposal target;
+};
+
 struct EstimatorSpec {
     std::string name;
     /// What the estimator is (its algorithm, method and error method; estimators/registry.h):
@@ -186,6 +196,7 @@ struct EstimatorSpec {
     MisOptions mis_options;
     /// Control variates (estimators/control_variates.cpp); empty for every other kind.
     ControlVariateOptions control_variate_options;
+    RisOptions ris_options; ///< RIS (estimators/ris.cpp); M = 1 and g = |f| for other kinds
 
     SamplerOptions sampler_options() const { return {per_stratum, randomization, randomizations}; }
     /// Whether it samples a mixture of techniques (MIS) rather than one proposal.
@@ -206,12 +217,14 @@ bool weights_bounded(const Problem& problem, const EstimatorSpec& spec);
 /// control variates (whose weights mix other functions in).
 bool variance_follows_integrand(const EstimatorSpec& spec);
 
-/// The proposals an estimator draws from: its one proposal, or its MIS techniques.
+/// The proposals an estimator draws from: its one proposal, or its MIS techniques; for RIS with
+/// a pdf as its target, that target (its points keep to where the target is positive).
 std::vector<const Proposal*> proposals_of(const EstimatorSpec& spec);
 
 /// pdf[i] = the density of the estimator's points at x, on average over its techniques: its
-/// proposal's, or for MIS the mixture sum_k c_k p_k(x) with the techniques' shares c_k (zero
-/// exactly where every technique's density is).
+/// proposal's (RIS with a pdf target: the target's, which its points approach as M grows), or
+/// for MIS the mixture sum_k c_k p_k(x) with the techniques' shares c_k (zero exactly where
+/// every technique's density is).
 void sampling_density_block(const EstimatorSpec& spec, const Domain& domain, const PointBlock& x,
                             double* pdf);
 

@@ -15,13 +15,14 @@ const EstimatorKind& mis_estimator_kind();             // estimators/mis.cpp
 const EstimatorKind& control_variate_estimator_kind(); // estimators/control_variates.cpp
 const EstimatorKind& antithetic_estimator_kind();      // estimators/antithetic.cpp
 const EstimatorKind& systematic_estimator_kind();      // estimators/systematic.cpp
+const EstimatorKind& ris_estimator_kind();             // estimators/ris.cpp
 
 const std::vector<const EstimatorKind*>& estimator_kinds() {
     static const std::vector<const EstimatorKind*> kinds = {
         &fixed_estimator_kind(),      &vegas_estimator_kind(), &vegas_plus_estimator_kind(),
         &miser_estimator_kind(),      &mis_estimator_kind(),   &control_variate_estimator_kind(),
         &antithetic_estimator_kind(),
-        &systematic_estimator_kind(),
+        &systematic_estimator_kind(), &ris_estimator_kind(),
     };
     return kinds;
 }
@@ -61,6 +62,20 @@ const std::vector<EstimatorPreset>& estimator_presets() {
          "antithetic pairs u and 1 - u: N/2 independent pairs, the error bar from their means"},
         {"systematic", "systematic", SamplerKind::Independent, false,
          "systematic sampling: 16 randomly shifted grids of N/16 points"},
+        {"ris_m1", "ris", SamplerKind::Independent, false,
+         "resampled importance sampling with M = 1 candidate: uniform sampling", false, 1},
+        {"ris_m2", "ris", SamplerKind::Independent, false,
+         "resampled importance sampling: 2 uniform candidates per point, one kept by |f|", false,
+         2},
+        {"ris_m4", "ris", SamplerKind::Independent, false,
+         "resampled importance sampling: 4 uniform candidates per point, one kept by |f|", false,
+         4},
+        {"ris_m8", "ris", SamplerKind::Independent, false,
+         "resampled importance sampling: 8 uniform candidates per point, one kept by |f|", false,
+         8},
+        {"ris_m16", "ris", SamplerKind::Independent, false,
+         "resampled importance sampling: 16 uniform candidates per point, one kept by |f|", false,
+         16},
     };
     return presets;
 }

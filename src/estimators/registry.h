@@ -31,6 +31,7 @@ struct EstimatorPreset {
     const char* summary;
     /// Sobol' with one linear scramble (lms_shift) and the Walsh error bound (walsh_bound).
     bool walsh_bound = false;
+    int ris_candidates = 0; ///< resampled importance sampling: M candidates per point
 };
 /// Every preset, in the order messages and the catalog list them.
 const std::vector<EstimatorPreset>& estimator_presets();

@@ -104,6 +104,12 @@ const METHODS = {
     order: () => 'N⁻¹, the variance times 1 + ρ (ρ the correlation of f at u and at 1 − u)',
     look: 'The same slope as uniform sampling, a lower line when f is monotone in each coordinate (then ρ < 0); a higher one when f is symmetric about the centre (ρ > 0). The error bar comes from the N/2 pair means.',
   },
+  ris: {
+    title: 'Resampled importance sampling',
+    formula: 'I_N = (1/N) Σᵢ f(yᵢ)/g(yᵢ) · (1/M) Σⱼ g(xᵢⱼ)/p(xᵢⱼ): M candidates xᵢⱼ from p, yᵢ one of them kept with probability ∝ g/p',
+    order: () => 'N⁻¹, the constant falling with M towards importance sampling with g',
+    look: 'The variance falls as M grows while each point costs M candidates: compare the efficiency of ris_m1 to ris_m16 for the M that pays. With g = |f| a point is just the mean of M weights (no gain per call of f); a cheap g that follows f gains. Unbiased only where g > 0 wherever f ≠ 0: a target that misses f is flagged.',
+  },
 };
 
 /** The methods this module explains. */

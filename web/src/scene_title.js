@@ -14,6 +14,7 @@ const WORDS = Object.freeze({
   halton: 'Halton',
   latin: 'Latin',
   mis: 'MIS',
+  ris: 'RIS',
   is: 'IS',
   vegas: 'VEGAS',
   miser: 'MISER',
