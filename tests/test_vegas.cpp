@@ -586,7 +586,9 @@ TEST(VegasPlus, HypercubesPerAxisHoldAboutFourPointsEach) {
             ASSERT_GE(m, 1u);
             const double cubes = std::pow(static_cast<double>(m), dim);
             const double more = std::pow(static_cast<double>(m + 1), dim);
-            if (m > 1) EXPECT_LE(4.0 * cubes, static_cast<double>(points)) << dim << " " << points;
+            if (m > 1) {
+                EXPECT_LE(4.0 * cubes, static_cast<double>(points)) << dim << " " << points;
+            }
             EXPECT_TRUE(4.0 * more > static_cast<double>(points) ||
                         more > static_cast<double>(kVegasMaxHypercubes))
                 << "m + 1 would still fit: dim " << dim << ", points " << points;
