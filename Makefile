@@ -50,7 +50,7 @@ DEP_PROBES := /usr/bin/cmake /usr/bin/ninja /usr/bin/g++ /usr/src/googletest/CMa
 	/usr/include/tiny_gltf.h /usr/include/nlohmann/json.hpp /usr/bin/chromium /usr/bin/clang-format
 
 .PHONY: all deps deps-web deps-npm build build-wasm site test test-native test-wasm test-wasm-check test-compare test-web-core \
-	test-npm test-e2e test-sanitize test-suites check run cli bench bench-mitsuba bench-embree format clean help \
+	test-npm test-e2e test-sanitize test-suites check run cli bench bench-mitsuba bench-embree format format-files clean help \
 	fuzz fuzz-build fuzz-smoke deps-fuzz
 
 all: build
@@ -72,7 +72,7 @@ help:
 	@echo "make bench-qmc  mcplay's randomized QMC beside QMCPy's and scipy's on Genz 1, 4, 5 (pip venv in build/)"
 	@echo "make bench-mitsuba  the renderer beside Mitsuba 3.9.1 on three glTF scenes: time, relMSE, efficiency (ARGS: --quick, --sobol, --scalar, --widths)"
 	@echo "make bench-embree  the accelerator beside Embree 3 (Debian's libembree-dev) on the same rays, one thread"
-	@echo "make format clang-format every C++ source"
+	@echo "make format clang-format every C++ source, untracked ones too (make -s format-files lists them)"
 	@echo "make test-python  build the Python wheel, install it in a fresh venv, run python/tests (part of make check)"
 	@echo "make test-notebook  run examples/mcplay_tour.ipynb headless with the installed wheel (part of make check)"
 	@echo "make bench-python  the Python package beside vegas and QMCPy on Genz's families; callable against expression"
@@ -422,10 +422,16 @@ bench-qmc: deps deps-gsl $(BUILD)/CMakeCache.txt $(QMC_VENV)/installed
 	  --methods sobol,sobol:lms_shift,sobol:digital_shift,lattice,halton \
 	  --json $(QMC_DIR)/compare.jsonl | tee $(QMC_DIR)/compare.txt
 
-# Tracked and untracked (not ignored) sources: a new file is formatted before its first commit.
+# The C++ sources, tracked and untracked (not ignored): a new file is formatted before its first
+# commit. `make -s format-files` lists them (tests/make_format_test.sh).
+FORMAT_FILES = git ls-files --cached --others --exclude-standard '*.cpp' '*.h' | sort -u | \
+	while read -r f; do [ -e "$$f" ] && echo "$$f"; done
+
+format-files:
+	@$(FORMAT_FILES)
+
 format: deps
-	git ls-files --cached --others --exclude-standard '*.cpp' '*.h' | sort -u | \
-	  while read -r f; do [ -e "$$f" ] && echo "$$f"; done | xargs -r clang-format -i
+	$(FORMAT_FILES) | xargs -r clang-format -i
 
 # ---------------------------------------------------------------------------
 # libFuzzer (docs/fuzzing.md): clang 14 + libclang-rt-14-dev, a build of its own ($(BUILD_FUZZ)),
