@@ -42,8 +42,8 @@ NODE_RUN := node --no-experimental-fetch
 # emcc's JavaScript optimiser needs Debian's acorn when node is not Debian's own.
 export NODE_PATH := /usr/share/nodejs
 
-APT_PACKAGES := cmake ninja-build g++ make googletest libgtest-dev emscripten libglm-dev libstb-dev \
-	libtinygltf-dev nlohmann-json3-dev chromium clang-format
+APT_PACKAGES := cmake ninja-build g++ make googletest libgtest-dev emscripten libglm-dev \
+	libstb-dev libtinygltf-dev nlohmann-json3-dev chromium clang-format
 # One file or command per package that tells whether it is installed.
 DEP_PROBES := /usr/bin/cmake /usr/bin/ninja /usr/bin/g++ /usr/src/googletest/CMakeLists.txt \
 	/usr/include/gtest/gtest.h /usr/bin/em++ /usr/include/glm/glm.hpp /usr/include/stb/stb_image_write.h \
