@@ -42,15 +42,15 @@ NODE_RUN := node --no-experimental-fetch
 # emcc's JavaScript optimiser needs Debian's acorn when node is not Debian's own.
 export NODE_PATH := /usr/share/nodejs
 
-APT_PACKAGES := cmake g++ make googletest libgtest-dev emscripten libglm-dev libstb-dev \
-	libtinygltf-dev nlohmann-json3-dev chromium
+APT_PACKAGES := cmake ninja-build g++ make googletest libgtest-dev emscripten libglm-dev \
+	libstb-dev libtinygltf-dev nlohmann-json3-dev chromium clang-format
 # One file or command per package that tells whether it is installed.
-DEP_PROBES := /usr/bin/cmake /usr/bin/g++ /usr/src/googletest/CMakeLists.txt \
+DEP_PROBES := /usr/bin/cmake /usr/bin/ninja /usr/bin/g++ /usr/src/googletest/CMakeLists.txt \
 	/usr/include/gtest/gtest.h /usr/bin/em++ /usr/include/glm/glm.hpp /usr/include/stb/stb_image_write.h \
-	/usr/include/tiny_gltf.h /usr/include/nlohmann/json.hpp /usr/bin/chromium
+	/usr/include/tiny_gltf.h /usr/include/nlohmann/json.hpp /usr/bin/chromium /usr/bin/clang-format
 
-.PHONY: all deps deps-web deps-npm build build-wasm site test test-native test-wasm test-wasm-statistical test-compare test-web-core \
-	test-npm test-e2e test-sanitize test-suites check run cli bench bench-mitsuba bench-embree format clean help \
+.PHONY: all deps deps-web deps-npm build build-wasm site test test-native test-wasm test-wasm-check test-compare test-web-core \
+	test-npm test-e2e test-sanitize test-suites check run cli bench bench-mitsuba bench-embree format format-files clean help \
 	fuzz fuzz-build fuzz-smoke deps-fuzz
 
 all: build
@@ -63,7 +63,7 @@ help:
 	@echo "make test-npm  the wasm core as the npm package mcplay: packed, installed from the tarball into an"
 	@echo "           empty folder, run there against the native CLI and in Chromium; its types checked"
 	@echo "make check  everything CI runs: make test, then the ASan/UBSan suite, make fuzz-smoke and the"
-	@echo "           statistical runs under Node (test-wasm-statistical)"
+	@echo "           wasm suites make test leaves out: statistical runs, CLI scripts (test-wasm-check)"
 	@echo "make bench  samples per second natively and in wasm under Node, and their ratio; then bench-genz"
 	@echo "make bench-genz  mcplay beside GSL plain/MISER/VEGAS on Genz's families (GENZ_ARGS=--quick: 15 s)"
 	@echo "make bench-genz-peaks  vegas, vegas_plus beside GSL VEGAS on sharp product peaks (~4 min)"
@@ -72,7 +72,7 @@ help:
 	@echo "make bench-qmc  mcplay's randomized QMC beside QMCPy's and scipy's on Genz 1, 4, 5 (pip venv in build/)"
 	@echo "make bench-mitsuba  the renderer beside Mitsuba 3.9.1 on three glTF scenes: time, relMSE, efficiency (ARGS: --quick, --sobol, --scalar, --widths)"
 	@echo "make bench-embree  the accelerator beside Embree 3 (Debian's libembree-dev) on the same rays, one thread"
-	@echo "make format clang-format every C++ source"
+	@echo "make format clang-format every C++ source, untracked ones too (make -s format-files lists them)"
 	@echo "make test-python  build the Python wheel, install it in a fresh venv, run python/tests (part of make check)"
 	@echo "make test-notebook  run examples/mcplay_tour.ipynb headless with the installed wheel (part of make check)"
 	@echo "make bench-python  the Python package beside vegas and QMCPy on Genz's families; callable against expression"
@@ -114,12 +114,18 @@ PY_CMAKE_FLAGS = $(if $(wildcard $(PY_VENV)/installed),-DMCPLAY_PYTHON=ON \
 	-DPython_EXECUTABLE=$(CURDIR)/$(PY_VENV)/bin/python \
 	-Dnanobind_DIR=$$($(PY_VENV)/bin/python -m nanobind --cmake_dir))
 
+# Build trees are configured for Ninja: it rebuilds what a changed command line concerns, where
+# CMake's Makefiles make every object of a target depend on one flags file that lists its
+# sources (a new test file recompiled every test file and the precompiled header). A tree
+# configured earlier keeps its generator.
+CMAKE_GEN := -G Ninja
+
 # Order-only on deps: under make -j the configure step must wait for apt-get (and the venv).
 $(BUILD)/CMakeCache.txt: | deps deps-python
-	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release $(PY_CMAKE_FLAGS)
+	cmake $(CMAKE_GEN) -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release $(PY_CMAKE_FLAGS)
 
 $(BUILD_WASM)/CMakeCache.txt: | deps
-	emcmake cmake -S . -B $(BUILD_WASM) -DCMAKE_BUILD_TYPE=Release
+	emcmake cmake $(CMAKE_GEN) -S . -B $(BUILD_WASM) -DCMAKE_BUILD_TYPE=Release
 
 build: deps deps-python $(BUILD)/CMakeCache.txt
 	@if [ -e $(PY_VENV)/installed ] && ! grep -q '^MCPLAY_PYTHON:BOOL=ON' $(BUILD)/CMakeCache.txt; then \
@@ -134,14 +140,16 @@ build-wasm: deps $(BUILD_WASM)/CMakeCache.txt
 test-native: build
 	ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS)
 
-# Under Node the statistical promise runs (label "statistical": test_stopping, hundreds of
-# stopping runs per estimator, the slowest module there) wait for `make check`; the native suite
-# runs them in every loop.
+# Under Node two labels wait for `make check` (the native suite runs both in every loop): the
+# statistical promise runs ("statistical": test_stopping, hundreds of stopping runs per
+# estimator) and the CLI's scripts ("cli": cli and corpus, minutes under Node; test-compare
+# runs every scene through the wasm CLI in every loop).
+WASM_CHECK_LABELS := ^(statistical|cli)$$
 test-wasm: build-wasm
-	ctest --test-dir $(BUILD_WASM) --output-on-failure -j $(JOBS) -LE statistical
+	ctest --test-dir $(BUILD_WASM) --output-on-failure -j $(JOBS) -LE '$(WASM_CHECK_LABELS)'
 
-test-wasm-statistical: build-wasm
-	ctest --test-dir $(BUILD_WASM) --output-on-failure -j $(JOBS) -L statistical
+test-wasm-check: build-wasm
+	ctest --test-dir $(BUILD_WASM) --output-on-failure -j $(JOBS) -L '$(WASM_CHECK_LABELS)'
 
 # The same study through the native CLI and the wasm CLI under Node must agree.
 test-compare: build build-wasm
@@ -187,7 +195,7 @@ test-e2e: build site
 # a leak, an out-of-bounds access or undefined behaviour fails the test that triggers it.
 # -O1 with assertions on: about 3x slower than Release, and every assert() is checked.
 $(BUILD_ASAN)/CMakeCache.txt: | deps
-	cmake -S . -B $(BUILD_ASAN) -DMCPLAY_SANITIZE=ON -DMCPLAY_UNITY=OFF -DCMAKE_BUILD_TYPE=Debug \
+	cmake $(CMAKE_GEN) -S . -B $(BUILD_ASAN) -DMCPLAY_SANITIZE=ON -DMCPLAY_UNITY=OFF -DCMAKE_BUILD_TYPE=Debug \
 	  -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g"
 
 test-sanitize: deps $(BUILD_ASAN)/CMakeCache.txt
@@ -211,7 +219,7 @@ test-suites: test-native test-wasm test-compare test-web-core test-npm test-e2e
 check:
 	@start=$$(date +%s); \
 	$(MAKE) --no-print-directory test && \
-	$(MAKE) --no-print-directory -j 2 test-sanitize fuzz-smoke test-wasm-statistical test-python && \
+	$(MAKE) --no-print-directory -j 2 test-sanitize fuzz-smoke test-wasm-check test-python && \
 	$(MAKE) --no-print-directory test-notebook && \
 	echo "make check: all suites passed in $$(( $$(date +%s) - start )) s"
 
@@ -414,8 +422,16 @@ bench-qmc: deps deps-gsl $(BUILD)/CMakeCache.txt $(QMC_VENV)/installed
 	  --methods sobol,sobol:lms_shift,sobol:digital_shift,lattice,halton \
 	  --json $(QMC_DIR)/compare.jsonl | tee $(QMC_DIR)/compare.txt
 
-format:
-	clang-format -i $$(git ls-files '*.cpp' '*.h')
+# The C++ sources, tracked and untracked (not ignored): a new file is formatted before its first
+# commit. `make -s format-files` lists them (tests/make_format_test.sh).
+FORMAT_FILES = git ls-files --cached --others --exclude-standard '*.cpp' '*.h' | sort -u | \
+	while read -r f; do [ -e "$$f" ] && echo "$$f"; done
+
+format-files:
+	@$(FORMAT_FILES)
+
+format: deps
+	$(FORMAT_FILES) | xargs -r clang-format -i
 
 # ---------------------------------------------------------------------------
 # libFuzzer (docs/fuzzing.md): clang 14 + libclang-rt-14-dev, a build of its own ($(BUILD_FUZZ)),
@@ -434,7 +450,7 @@ deps-fuzz: deps
 	fi
 
 $(BUILD_FUZZ)/CMakeCache.txt: | deps-fuzz
-	CC=clang CXX=clang++ cmake -S . -B $(BUILD_FUZZ) -DMCPLAY_FUZZ=ON -DMCPLAY_UNITY=OFF -DCMAKE_BUILD_TYPE=Debug \
+	CC=clang CXX=clang++ cmake $(CMAKE_GEN) -S . -B $(BUILD_FUZZ) -DMCPLAY_FUZZ=ON -DMCPLAY_UNITY=OFF -DCMAKE_BUILD_TYPE=Debug \
 	  -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g"
 
 fuzz-build: deps-fuzz $(BUILD_FUZZ)/CMakeCache.txt
