@@ -2,9 +2,23 @@
 // answers (no glTF involved).
 #pragma once
 
+#include "render/renderer.h"
 #include "render/scene.h"
 
 namespace mcp::test {
+
+/// A w x h render of spp samples per pixel on `threads` threads, its random streams keyed by
+/// `stream`.
+inline RenderSettings render_settings(int w, int h, uint64_t spp, uint64_t stream,
+                                      int threads = 1) {
+    RenderSettings s;
+    s.width = w;
+    s.height = h;
+    s.spp = spp;
+    s.stream = stream;
+    s.threads = threads;
+    return s;
+}
 
 /// Appends the quad p0 p1 p2 p3 (counter-clockwise seen from its front) as two triangles.
 inline void add_quad(Scene& s, Vec3 p0, Vec3 p1, Vec3 p2, Vec3 p3, uint32_t material) {

@@ -35,13 +35,7 @@ RenderEstimator estimator(RadianceStrategy s, PixelSamplerKind px = PixelSampler
 }
 
 RenderSettings settings(int w, int h, uint64_t spp, uint64_t stream) {
-    RenderSettings s;
-    s.width = w;
-    s.height = h;
-    s.spp = spp;
-    s.stream = stream;
-    s.threads = 1;
-    return s;
+    return mcp::test::render_settings(w, h, spp, stream);
 }
 
 // A stratum's position (k + u) / n and quotient k / n: a power of two n multiplies by its

@@ -134,13 +134,7 @@ std::shared_ptr<RenderRequest> request(const std::string& name) {
 }
 
 RenderSettings settings(int w, int h, uint64_t spp, int threads) {
-    RenderSettings s;
-    s.width = w;
-    s.height = h;
-    s.spp = spp;
-    s.stream = 20261204;
-    s.threads = threads;
-    return s;
+    return mcp::test::render_settings(w, h, spp, 20261204, threads);
 }
 
 RenderEstimator estimator(RadianceStrategy strategy, PixelSamplerKind kind) {

@@ -42,13 +42,7 @@ RenderEstimator light(LightSampling sampling) {
 }
 
 RenderSettings settings(int w, int h, uint64_t spp, uint64_t stream) {
-    RenderSettings s;
-    s.width = w;
-    s.height = h;
-    s.spp = spp;
-    s.stream = stream;
-    s.threads = 1;
-    return s;
+    return mcp::test::render_settings(w, h, spp, stream);
 }
 
 /// A light quad facing down at height h (corners counter-clockwise seen from below).

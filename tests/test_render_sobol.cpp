@@ -310,13 +310,7 @@ std::shared_ptr<RenderRequest> request(const std::string& name, json options) {
 }
 
 RenderSettings settings(int w, int h, uint64_t spp, uint64_t stream, int threads = 1) {
-    RenderSettings s;
-    s.width = w;
-    s.height = h;
-    s.spp = spp;
-    s.stream = stream;
-    s.threads = threads;
-    return s;
+    return mcp::test::render_settings(w, h, spp, stream, threads);
 }
 
 TEST(RenderSobol, ImagesDoNotDependOnThreads) {

@@ -25,12 +25,7 @@ RenderEstimator split(RadianceStrategy s, int light_samples, int bsdf_samples) {
 }
 
 RenderSettings settings(int w, int h, uint64_t spp, uint64_t stream) {
-    RenderSettings s;
-    s.width = w;
-    s.height = h;
-    s.spp = spp;
-    s.stream = stream;
-    s.threads = 1;
+    RenderSettings s = mcp::test::render_settings(w, h, spp, stream);
     s.jitter_pixels = false; // each pixel's expectation is the closed form at its centre
     return s;
 }
