@@ -51,7 +51,7 @@ class Accelerator {
 #endif
     /// A node visit's cost in triangle tests, measured with `make bench` (rays/closed_N:
     /// both structures on closed meshes of 4 to 80 triangles; figures in
-    /// docs/benchmarks.md#brute-force-against-the-bvh-on-closed-meshes; about 4.5 natively for
+    /// docs/performance-notes.md#traversal-and-the-bvh; about 4.5 natively for
     /// both widths). V8 runs the float SIMD box test at about native speed and the
     /// double-precision triangle test at about 0.65 of it, so a node costs fewer triangle tests
     /// in wasm.
