@@ -835,7 +835,9 @@ test('veach_mis: bounded MIS keeps its order, tail words and equal-time comparis
     const fit = await page.textContent(`[data-fit="${name}"]`);
     assert.doesNotMatch(fit, /infinite/, `${name}: "${fit}"`);
     const time = await page.textContent(`#legend-time li[data-series="${name}"]`);
-    assert.doesNotMatch(time, /infinite|fixed cost dominates/, `${name}: "${time}"`);
+    // Only the tail words are asserted: whether a fixed cost shows at 1-16 spp depends on the
+    // machine's load (a true reading then), not on the estimator.
+    assert.doesNotMatch(time, /infinite/, `${name}: "${time}"`);
     console.log(`# ${name}: time legend "${time}"; seconds per image ${est.levels.map((l) => l.time_mean_s.toExponential(2)).join(', ')}`);
     const summary = await page.textContent(`#levels details[data-for="${name}"] summary`);
     assert.match(summary, /tail of the weights at spp = 16: /);
