@@ -246,6 +246,7 @@ bench: build build-wasm site
 	cmake --build $(BUILD) -j $(JOBS) --target mcplay_bench
 	cmake --build $(BUILD_WASM) -j $(JOBS) --target mcplay_bench
 	bash bench/run_bench.sh $(BUILD)/mcplay_bench "$(NODE_RUN) --no-liftoff $(BUILD_WASM)/mcplay_bench.js"
+	bash bench/kernels.sh $(BUILD) $(BUILD_WASM)
 	node web/e2e/first_plot.bench.mjs $(SITE) all 3
 	node web/e2e/live_view.bench.mjs $(SITE) all 3 2
 	$(MAKE) --no-print-directory bench-genz

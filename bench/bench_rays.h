@@ -72,10 +72,11 @@ inline DirectRays direct_lighting_rays(const RenderScene& rs, const Camera& came
 }
 
 /// Rays per second of trace() (which traces `rays` rays and returns its hit count, so that the
-/// calls are not dropped): best of three after a warm-up.
+/// calls are not dropped): best of 24 after a warm-up. A call takes a few milliseconds, so on a
+/// shared machine some of them run unpreempted and the best is the machine's rate, not its load.
 template <typename Trace> double best_rays_per_second(Trace&& trace, size_t rays, size_t* hits) {
     double best = 0.0;
-    for (int rep = 0; rep < 4; ++rep) {
+    for (int rep = 0; rep < 25; ++rep) {
         auto t0 = std::chrono::steady_clock::now();
         *hits = trace();
         const double s = seconds_since(t0);

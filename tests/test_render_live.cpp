@@ -10,7 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "render_api/image_io.h" // base64_decode
+#include "render_api/image_io.h" // base64_decode, base64_encode
 #include "render_api/mcplay_render.h"
 #include "scene_files.h"
 
@@ -70,6 +70,38 @@ std::string live_reference(const json& scene, int width, int height) {
 // Two sessions over two bands of rows, and one over every row: after each pass the bands'
 // pixels side by side are the whole image's, bit for bit, and their error sums add up to the
 // whole image's relative MSE; the relative MSE falls as passes add samples.
+// The base64 codec the live view's pixels and references travel in: RFC 4648's test vectors
+// (section 10), every byte value at every length modulo 3, and what is not padded base64 refused.
+TEST(LiveApi, Base64RoundTripsAndRefusesWhatIsNotBase64) {
+    const char* vectors[][2] = {{"", ""},
+                                {"f", "Zg=="},
+                                {"fo", "Zm8="},
+                                {"foo", "Zm9v"},
+                                {"foob", "Zm9vYg=="},
+                                {"fooba", "Zm9vYmE="},
+                                {"foobar", "Zm9vYmFy"}};
+    for (const auto& v : vectors) {
+        EXPECT_EQ(base64_encode(v[0]), v[1]);
+        std::string back = "untouched";
+        EXPECT_TRUE(base64_decode(v[1], &back)) << v[1];
+        EXPECT_EQ(back, v[0]);
+    }
+    std::string all;
+    for (int c = 0; c < 256; ++c) all += char(c);
+    for (size_t n = 250; n <= 256; ++n) {
+        const std::string bytes = all.substr(256 - n) + all.substr(0, n / 2);
+        std::string back;
+        ASSERT_TRUE(base64_decode(base64_encode(bytes), &back)) << n;
+        EXPECT_EQ(back, bytes) << n;
+    }
+    for (const char* bad : {"Zg=", "Zg", "Z===", "====", "Zm9v=Zg=", "Zm9vYg=a", "Zm 9", "Zm9\x80",
+                            "Zm-v", "Zm_v", "=Zm9"}) {
+        std::string out = "untouched";
+        EXPECT_FALSE(base64_decode(bad, &out)) << bad;
+        EXPECT_EQ(out, "untouched") << bad;
+    }
+}
+
 TEST(LiveApi, BandsMergeIntoTheWholeImage) {
     const json scene = test::scene_json("quad_light_floor");
     const json base{{"estimators", {"light_area", "bsdf"}},

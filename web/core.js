@@ -120,8 +120,21 @@ export function wasmBridge(M) {
     return p;
   }
 
+  // ASCII text (the JSON of images and references as base64: megabytes) is copied by the
+  // engine's TextEncoder, the bytes stringToUTF8 writes, without its loop over the characters
+  // in JavaScript; other text goes through stringToUTF8.
+  const ASCII = /^[\x00-\x7f]*$/;
+  const encoder = typeof TextEncoder === 'function' ? new TextEncoder() : null;
+  const utf8Length = (text) => (ASCII.test(text) ? text.length : M.lengthBytesUTF8(text));
+
   // A JS string as a NUL-terminated UTF-8 copy on the C heap; the caller frees it.
   function cString(text) {
+    if (encoder && ASCII.test(text)) {
+      const p = malloc(text.length + 1);
+      encoder.encodeInto(text, M.HEAPU8.subarray(p, p + text.length));
+      M.HEAPU8[p + text.length] = 0;
+      return p;
+    }
     const bytes = M.lengthBytesUTF8(text) + 1;
     const p = malloc(bytes);
     M.stringToUTF8(text, p, bytes);
@@ -164,7 +177,7 @@ export function wasmBridge(M) {
     }
     // Before any allocation: a text beyond the C side's limit would only be refused there,
     // after growing the wasm memory for it (or failing to).
-    if (text.length > MAX_JSON_BYTES || M.lengthBytesUTF8(text) > MAX_JSON_BYTES) {
+    if (text.length > MAX_JSON_BYTES || utf8Length(text) > MAX_JSON_BYTES) {
       throw new McplayError(Status.ARGUMENT, `${what}: the JSON text has more than the limit of ` +
         `${MAX_JSON_BYTES} bytes`);
     }

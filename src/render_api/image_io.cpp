@@ -383,56 +383,87 @@ bool read_reference_cache(const std::string& path, uint64_t key, RenderImage* im
     return decode_reference(bytes, key, image, why);
 }
 
+// The base64 codec writes into a string sized once and decodes through a table: the live
+// view hands each session a reference of about 4 MB of base64, and a character at a time through
+// push_back and a chain of range tests took about a fifth of that call in wasm.
+
 std::string base64_encode(const std::string& bytes) {
     static const char kAlphabet[] =
         "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    std::string out;
-    out.reserve((bytes.size() + 2) / 3 * 4);
+    std::string out((bytes.size() + 2) / 3 * 4, '=');
+    const unsigned char* in = reinterpret_cast<const unsigned char*>(bytes.data());
+    char* o = &out[0];
     size_t i = 0;
-    for (; i + 2 < bytes.size(); i += 3) {
-        uint32_t v = (uint32_t(uint8_t(bytes[i])) << 16) | (uint32_t(uint8_t(bytes[i + 1])) << 8) |
-                     uint32_t(uint8_t(bytes[i + 2]));
-        for (int k = 3; k >= 0; --k) out += kAlphabet[(v >> (6 * k)) & 63];
+    for (; i + 2 < bytes.size(); i += 3, o += 4) {
+        const uint32_t v = (uint32_t(in[i]) << 16) | (uint32_t(in[i + 1]) << 8) | in[i + 2];
+        o[0] = kAlphabet[v >> 18];
+        o[1] = kAlphabet[(v >> 12) & 63];
+        o[2] = kAlphabet[(v >> 6) & 63];
+        o[3] = kAlphabet[v & 63];
     }
-    if (i < bytes.size()) {
-        uint32_t v = uint32_t(uint8_t(bytes[i])) << 16;
-        if (i + 1 < bytes.size()) v |= uint32_t(uint8_t(bytes[i + 1])) << 8;
-        out += kAlphabet[(v >> 18) & 63];
-        out += kAlphabet[(v >> 12) & 63];
-        out += i + 1 < bytes.size() ? kAlphabet[(v >> 6) & 63] : '=';
-        out += '=';
+    if (i < bytes.size()) { // one or two bytes left: '=' pads the group (already in place)
+        uint32_t v = uint32_t(in[i]) << 16;
+        if (i + 1 < bytes.size()) v |= uint32_t(in[i + 1]) << 8;
+        o[0] = kAlphabet[v >> 18];
+        o[1] = kAlphabet[(v >> 12) & 63];
+        if (i + 1 < bytes.size()) o[2] = kAlphabet[(v >> 6) & 63];
     }
     return out;
 }
 
+namespace {
+
+/// The value of each base64 character, 64 for any other byte.
+struct Base64Values {
+    uint8_t v[256];
+    constexpr Base64Values() : v() {
+        for (int c = 0; c < 256; ++c) v[c] = 64;
+        for (int k = 0; k < 26; ++k) {
+            v['A' + k] = uint8_t(k);
+            v['a' + k] = uint8_t(26 + k);
+        }
+        for (int k = 0; k < 10; ++k) v['0' + k] = uint8_t(52 + k);
+        v[int('+')] = 62;
+        v[int('/')] = 63;
+    }
+};
+constexpr Base64Values kBase64Values;
+
+} // namespace
+
 bool base64_decode(const std::string& text, std::string* bytes) {
     // RFC 4648 section 4, padded: a length that is a multiple of 4, '=' only at the end.
     if (text.size() % 4 != 0) return false;
-    auto value = [](char c) -> int {
-        if (c >= 'A' && c <= 'Z') return c - 'A';
-        if (c >= 'a' && c <= 'z') return c - 'a' + 26;
-        if (c >= '0' && c <= '9') return c - '0' + 52;
-        if (c == '+') return 62;
-        if (c == '/') return 63;
-        return -1;
-    };
     // Padding: '=' in the last one or two places of the last group only.
     size_t pad = 0;
     if (!text.empty() && text.back() == '=') pad = text[text.size() - 2] == '=' ? 2 : 1;
-    std::string out;
-    out.reserve(text.size() / 4 * 3);
-    for (size_t i = 0; i < text.size(); i += 4) {
-        const size_t used = i + 4 == text.size() ? 4 - pad : 4; // characters carrying data
+    std::string out(text.size() / 4 * 3 - pad, '\0');
+    const unsigned char* in = reinterpret_cast<const unsigned char*>(text.data());
+    char* o = &out[0];
+    const size_t full = text.empty() ? 0 : text.size() - 4; // the groups before the last
+    uint32_t bad = 0; // the OR of the values read: bit 6 set after any other character
+    for (size_t i = 0; i < full; i += 4, o += 3) {
+        const uint32_t a = kBase64Values.v[in[i]], b = kBase64Values.v[in[i + 1]],
+                       c = kBase64Values.v[in[i + 2]], d = kBase64Values.v[in[i + 3]];
+        bad |= a | b | c | d;
+        const uint32_t v = (a << 18) | (b << 12) | (c << 6) | d;
+        o[0] = char(v >> 16);
+        o[1] = char((v >> 8) & 255);
+        o[2] = char(v & 255);
+    }
+    if (!text.empty()) { // the last group: 4 - pad characters carry data
+        const size_t used = 4 - pad;
         uint32_t v = 0;
         for (size_t k = 0; k < 4; ++k) {
-            const int d = k < used ? value(text[i + k]) : 0;
-            if (d < 0) return false;
-            v = (v << 6) | uint32_t(d);
+            const uint32_t d = k < used ? kBase64Values.v[in[full + k]] : 0;
+            bad |= d;
+            v = (v << 6) | (d & 63);
         }
-        out += char((v >> 16) & 255);
-        if (used > 2) out += char((v >> 8) & 255);
-        if (used > 3) out += char(v & 255);
+        o[0] = char(v >> 16);
+        if (used > 2) o[1] = char((v >> 8) & 255);
+        if (used > 3) o[2] = char(v & 255);
     }
+    if (bad & 64) return false;
     *bytes = std::move(out);
     return true;
 }

@@ -4,7 +4,9 @@
 // the live view shows), the time from pressing Start to the first full image drawn (every band of one
 // estimator at 1 spp, on its canvas) and to 64 spp of every estimator (drawn); prints the
 // medians as one line per scene:
-//   SCENE: first image WxH at T ms; 64 spp at T ms
+//   SCENE: first image WxH at T ms; 64 spp at T ms (rendering T ms of it: ...)
+// where rendering is the passes' own seconds summed over the images and divided by the workers:
+// the wall the view would take if the workers did nothing but render, all of them busy.
 // A scene predicted to take long is paused by the page after its first passes: the bench
 // presses Resume at once (the line then says "(paused: predicted N s)").
 // Usage: node web/e2e/live_view.bench.mjs SITE_DIR SCENE|all [loads=3] [workers=2]
@@ -31,6 +33,7 @@ try {
   for (const scene of scenes) {
     const first = [];
     const full = [];
+    const work = [];
     let size = null;
     let paused = null;
     for (let r = 0; r < loads; ++r) {
@@ -58,7 +61,10 @@ try {
           if (firstMs === null && drawn.length) firstMs = performance.now() - t0;
           if (v.order.length && v.order.every((n) => v.estimators[n].spp >= 64)
               && drawn.length === v.order.length && drawn.every((c) => Number(c.dataset.spp) >= 64)) {
-            done({ first: firstMs, full: performance.now() - t0, size: v.size, paused: pausedFor });
+            // the passes' own seconds over the workers: the wall a view would take with
+            // nothing but rendering, every worker busy
+            const work = v.order.reduce((a, n) => a + v.estimators[n].seconds, 0) * 1000;
+            done({ first: firstMs, full: performance.now() - t0, work, size: v.size, paused: pausedFor });
             return;
           }
           requestAnimationFrame(poll);
@@ -67,12 +73,14 @@ try {
       }));
       first.push(t.first);
       full.push(t.full);
+      work.push(t.work);
       size = t.size;
       paused = paused || t.paused;
       await page.click('#live-cancel').catch(() => {});
     }
     const predicted = paused ? /64 spp will take about (.+?)\. /.exec(paused) : null;
     console.log(`${scene}: first image ${size.width}x${size.height} at ${median(first).toFixed(0)} ms; 64 spp at ${median(full).toFixed(0)} ms` +
+      ` (rendering ${median(work).toFixed(0)} ms of it: the passes' seconds over the workers)` +
       (paused ? ` (paused: predicted ${predicted ? predicted[1] : 'long'})` : ''));
   }
 } finally {

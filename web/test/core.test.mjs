@@ -354,6 +354,9 @@ test('strings cross as UTF-8, and large ones grow the wasm memory', async () => 
   const label = 'π ≈ 3.14159 — ∫ eˣ dx, ünïcödé 🎲 "quoted" \\ back\nslash';
   assert.equal(core.sceneInfo({ f: 'x', description: label }).description, label);
   assert.equal(core.runStudy({ ...TINY_SCENE, name: 'ñame 🎲' }, null).scene.name, 'ñame 🎲');
+  // every ASCII character but NUL (copied by TextEncoder, the rest by stringToUTF8)
+  const ascii = Array.from({ length: 127 }, (_, i) => String.fromCharCode(i + 1)).join('');
+  assert.equal(core.sceneInfo({ f: 'x', description: ascii }).description, ascii);
 
   const before = core.heapStats();
   const big = 'x'.repeat(24 << 20); // 24 MB in and out: more than the initial 16 MB memory
