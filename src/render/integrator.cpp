@@ -274,10 +274,9 @@ struct RisCandidate {
 /// its solid-angle density in *pdf (0 for an invalid sample, counted as a light miss).
 template <class S>
 RisCandidate ris_candidate(const LightSet& lights, LightSampling mode, const ShadingPoint& sp,
-                           PixelSampler& sampler, SampleCounters& c, double* pdf) {
+                           const ChoiceSample& cs, SampleCounters& c, double* pdf) {
     RisCandidate x{Vec3(0.0), Vec3(0.0), Vec3(0.0), 0.0, 0.0};
     *pdf = 0.0;
-    ChoiceSample cs = sampler.get_choice_2d();
     LightSample ls = lights.sample(sp.p, cs.choice, cs.u, mode);
     if (!ls.valid || !(ls.pdf > 0.0)) {
         ++c.light_misses;
@@ -300,14 +299,29 @@ RisCandidate ris_candidate(const LightSet& lights, LightSampling mode, const Sha
     return x;
 }
 
+/// Candidate j of M drawn from the first one's numbers x_0 = (choice, u): x_j = frac(x_0 + j g),
+/// g = (1/M, a_1, a_2) with a_1, a_2 the fractions of Roberts' R_3 sequence [Roberts18]. Each
+/// x_j is uniform because x_0 is (a shift modulo 1 keeps the uniform measure), which is all
+/// RIS's unbiasedness asks of its candidates (by linearity: E[w_j f/target ...] needs only each
+/// x_j's own density p [Talbot05, 4]); the choices are stratified by j/M, the points a shifted
+/// Kronecker set, and one sampler request serves all M (the Sobol' sampler's dimensions cost).
+ChoiceSample shifted_candidate(const ChoiceSample& first, int j, int m) {
+    constexpr double kA1 = 0.7548776662466927, kA2 = 0.5698402909980532;
+    const auto frac = [](double v) { return v - std::floor(v); };
+    ChoiceSample cs;
+    cs.choice = frac(first.choice + double(j) / double(m));
+    cs.u = Vec2(frac(first.u.x + double(j) * kA1), frac(first.u.y + double(j) * kA2));
+    return cs;
+}
+
 /// Direct lighting by resampled importance sampling [Talbot05, 4]: est.candidates light samples
 /// x_j of density p, weights w_j = target(x_j) / p(x_j) with the unshadowed lum(f Le cos) as the
 /// target, one y kept with probability w_j / sum_k w_k, and the one shadow ray towards y:
 /// f Le cos V(y) / target(y) * (1/M) sum_j w_j [BitterliEtAl20, eq. 6]. Unbiased because the
 /// target is positive wherever f Le cos V is (luminance weights every channel positively);
 /// visibility is left out of the target, so occluded candidates still draw weight. M = 1 is
-/// light sampling. The kept candidate's number is drawn after the M light samples (not for
-/// M = 1, whose numbers are light sampling's).
+/// light sampling. The M candidates share one sampler request (shifted_candidate), and the kept
+/// candidate's number is drawn after it (not for M = 1, whose numbers are light sampling's).
 /// With `mis` (next-event estimation beside BSDF sampling: mis_* and path with candidates) the
 /// integrand is w_L f Le cos V, w_L the heuristic of the counts times the source density p(y)
 /// against the BSDF's density: RIS estimates any integrand the target covers without bias
@@ -322,8 +336,10 @@ Vec3 ris_light_term(const RenderScene& rs, const RenderEstimator& est, const Lig
     RisCandidate candidates[kMaxRisCandidates];
     double weights[kMaxRisCandidates], pdfs[kMaxRisCandidates];
     double weight_sum = 0.0;
+    const ChoiceSample first = sampler.get_choice_2d();
     for (int j = 0; j < m; ++j) {
-        candidates[j] = ris_candidate<S>(lights, est.light_sampling, sp, sampler, c, &pdfs[j]);
+        const ChoiceSample cs = j == 0 ? first : shifted_candidate(first, j, m);
+        candidates[j] = ris_candidate<S>(lights, est.light_sampling, sp, cs, c, &pdfs[j]);
         weights[j] = candidates[j].target > 0.0 ? candidates[j].target / pdfs[j] : 0.0;
         weight_sum += weights[j];
     }
