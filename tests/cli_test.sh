@@ -95,7 +95,7 @@ check render-list 0 'cornell_box +render, [0-9]+ triangles' -- list
 check render-ris 0 'ris_32 +\[ris, lights by uniform' -- run many_lights --n-min 1 --n-max 2 --reps 2 --estimators light_solid_angle,ris_32 "${tiny[@]}"
 mkdir -p "$tmp/ris" && cp scenes/quad_light_floor.gltf "$tmp/ris/"
 printf '{"render": {"gltf": "quad_light_floor.gltf", "estimators": [{"strategy": "ris", "candidates": 0}]}}' >"$tmp/ris/r.json"
-check render-ris-bad-m 3 'estimators\[0\]\.candidates: must be in 1\.\.64, got 0' -- run "$tmp/ris/r.json"
+check render-ris-bad-m 3 'estimators\[0\]\.candidates: must be a whole number in 1\.\.64 or "auto", got 0' -- run "$tmp/ris/r.json"
 check render-png 0 'quad_light_floor: light_area at 4 spp, 8x6' -- render quad_light_floor --estimator light_area --spp 4 --out "$tmp/img.png" "${tiny[@]}"
 if [ "$(head -c 8 "$tmp/img.png" | od -An -tx1 | tr -d ' \n')" = 89504e470d0a1a0a ]; then
     passed=$((passed + 1))
