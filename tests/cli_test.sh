@@ -119,6 +119,7 @@ check render-bad-estimator 2 "unknown estimator 'lite'" -- render quad_light_flo
 check render-estimator-object 0 '"light_samples": 3' -- render quad_light_floor --estimator '{"strategy": "mis_power", "light_samples": 3}' --spp 4 --out "$tmp/split.png" --format json "${tiny[@]}"
 check render-estimator-auto 0 '"split_pilot"' -- render quad_light_floor --estimator '{"strategy": "light_area", "light_samples": "auto"}' --spp 4 --out "$tmp/split.png" --format json "${tiny[@]}"
 check render-estimator-bad-json 2 'is not valid JSON' -- render quad_light_floor --estimator '{"strategy"' --out "$tmp/x.png" "${tiny[@]}"
+check render-estimator-auto-candidates 0 '"candidate_pilot"' -- render quad_light_floor --estimator '{"strategy": "path", "candidates": "auto"}' --spp 4 --out "$tmp/ris.png" --format json "${tiny[@]}"
 check render-estimator-bad-count 2 'options.estimator.light_samples: must be a whole number in 1..64 or "auto", got 0' -- render quad_light_floor --estimator '{"strategy": "mis_power", "light_samples": 0}' --out "$tmp/x.png" "${tiny[@]}"
 check render-bad-spp 2 "--spp: expected a whole number" -- render quad_light_floor --spp many --out "$tmp/x.png"
 check render-width-on-integral 2 'for render scenes' -- run exp_1d --width 8
