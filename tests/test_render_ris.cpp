@@ -392,7 +392,8 @@ TEST(RenderRis, AutoCandidatesComeFromThePilot) {
         const SplitPilot& p = chosen.candidate_pilot;
         EXPECT_GT(p.variance_light, 0.0) << strategy;
         EXPECT_EQ(chosen.candidates,
-                  optimal_split(p.variance_rest, p.variance_light, p.seconds_rest, p.seconds_light))
+                  std::min(32, optimal_split(p.variance_rest, p.variance_light, p.seconds_rest,
+                                             p.seconds_light))) // at most 4 x the pilot's 8
             << strategy;
         EXPECT_GE(chosen.candidates, kMinRisCandidates);
         EXPECT_LE(chosen.candidates, kMaxRisCandidates);
@@ -406,6 +407,22 @@ TEST(RenderRis, AutoCandidatesComeFromThePilot) {
         EXPECT_FALSE(fixed.candidate_pilot.ran) << strategy;
         EXPECT_EQ(fixed.candidates, 3) << strategy;
     }
+}
+
+// The pilot does not extrapolate its model past 4 times its second count: under one quad light
+// with nothing in the way, RIS's stratified candidates leave almost no variance to the rest of
+// the estimator (V_rest near 0, where n* runs to the largest count, 64); the pilot stops at 32.
+TEST(RenderRis, AutoCandidatesStayWithinThePilotsReach) {
+    const Scene scene = test::quad_light_scene(5.0);
+    RenderScene rs;
+    rs.build(scene);
+    RenderEstimator e = parsed({{"strategy", "ris"}, {"candidates", "auto"}});
+    const RenderEstimator chosen = resolve_split(rs, e, settings(64, 48, 16, 7));
+    const SplitPilot& p = chosen.candidate_pilot;
+    ASSERT_TRUE(p.ran);
+    EXPECT_GT(optimal_split(p.variance_rest, p.variance_light, p.seconds_rest, p.seconds_light),
+              32); // the formula alone would go past the reach
+    EXPECT_EQ(chosen.candidates, 32);
 }
 
 // "auto" candidates are refused where a pilot cannot choose them once: a reference, a render

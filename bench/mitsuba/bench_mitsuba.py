@@ -72,17 +72,15 @@ SCENES = [
 MCPLAY_ESTIMATOR = {'light': 'light_solid_angle', 'bsdf': 'bsdf', 'mis': 'mis_power', 'path': 'path'}
 # mcplay's best per class (--best), Sobol' pixels throughout. Light sampling: resampled light
 # samples (ris: candidates drawn as light_solid_angle draws them, the target lum(f Le cos) with
-# the BSDF in it). MIS and path tracing: their light sample resampled the same way. In each the
-# candidate count and then the light samples per camera sample are chosen by timed pilots
-# (src/render/splitting.h; their time counted in the image's). BSDF sampling alone has no such
-# choice: its row is a pure speed contest.
+# the BSDF in it). Path tracing: each vertex's light sample resampled the same way. MIS: light
+# samples per camera sample (splitting). Each count chosen by a timed pilot (src/render/
+# splitting.h; its time counted in the image's). BSDF sampling alone has no such choice: its
+# row is a pure speed contest.
 MCPLAY_BEST = {
     'light': {'strategy': 'ris', 'light_selection': 'power', 'light_sampling': 'solid_angle',
-              'candidates': 'auto', 'light_samples': 'auto', 'pixel_sampler': 'sobol'},
-    'mis': {'strategy': 'mis_power', 'candidates': 'auto', 'light_samples': 'auto',
-            'pixel_sampler': 'sobol'},
-    'path': {'strategy': 'path', 'max_depth': 5, 'candidates': 'auto', 'light_samples': 'auto',
-             'pixel_sampler': 'sobol'},
+              'candidates': 'auto', 'pixel_sampler': 'sobol'},
+    'mis': {'strategy': 'mis_power', 'light_samples': 'auto', 'pixel_sampler': 'sobol'},
+    'path': {'strategy': 'path', 'max_depth': 5, 'candidates': 'auto', 'pixel_sampler': 'sobol'},
 }
 PATH_BOUNCES, PATH_RR = 5, 3  # mcplay's path defaults (src/render/integrator.h)
 

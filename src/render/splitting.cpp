@@ -16,6 +16,7 @@ namespace {
 /// noise, small enough that the pilot stays short.
 constexpr int kPilotSplit = 5;
 constexpr int kPilotCandidates = 8; ///< the pilot's second count of RIS candidates
+constexpr int kPilotReach = 4;      ///< the chosen count is at most this times the second
 constexpr uint64_t kPilotSpp = 2;
 constexpr int kPilotRuns = 1; ///< per count, the shortest time kept (interleaved runs)
 /// The pilot's rows: kPilotBands bands spread over the image, an eighth of its rows in all, at
@@ -136,7 +137,11 @@ RenderEstimator run_pilot(const RenderScene& rs, const RenderEstimator& est,
     p.seconds_light = std::max(0.0, (t2 - t1) / ((k - 1.0) * samples));
     p.seconds_rest = std::max(0.0, t1 / samples - p.seconds_light);
     RenderEstimator out = est;
-    const int n = optimal_split(p.variance_rest, p.variance_light, p.seconds_rest, p.seconds_light);
+    // The model is measured at 1 and k only: n* is not taken past kPilotReach k, where a
+    // V_rest lost in the pilot's noise would send it to the largest count.
+    const int n = std::min(
+        optimal_split(p.variance_rest, p.variance_light, p.seconds_rest, p.seconds_light),
+        kPilotReach * k_count);
     p.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (what == PilotCount::Candidates) {
         out.candidates = std::min(n, kMaxRisCandidates);
