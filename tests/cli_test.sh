@@ -95,7 +95,7 @@ check render-list 0 'cornell_box +render, [0-9]+ triangles' -- list
 check render-ris 0 'ris_32 +\[ris, lights by uniform' -- run many_lights --n-min 1 --n-max 2 --reps 2 --estimators light_solid_angle,ris_32 "${tiny[@]}"
 mkdir -p "$tmp/ris" && cp scenes/quad_light_floor.gltf "$tmp/ris/"
 printf '{"render": {"gltf": "quad_light_floor.gltf", "estimators": [{"strategy": "ris", "candidates": 0}]}}' >"$tmp/ris/r.json"
-check render-ris-bad-m 3 'estimators\[0\]\.candidates: must be in 1\.\.64, got 0' -- run "$tmp/ris/r.json"
+check render-ris-bad-m 3 'estimators\[0\]\.candidates: must be a whole number in 1\.\.64 or "auto", got 0' -- run "$tmp/ris/r.json"
 check render-png 0 'quad_light_floor: light_area at 4 spp, 8x6' -- render quad_light_floor --estimator light_area --spp 4 --out "$tmp/img.png" "${tiny[@]}"
 if [ "$(head -c 8 "$tmp/img.png" | od -An -tx1 | tr -d ' \n')" = 89504e470d0a1a0a ]; then
     passed=$((passed + 1))
@@ -119,6 +119,7 @@ check render-bad-estimator 2 "unknown estimator 'lite'" -- render quad_light_flo
 check render-estimator-object 0 '"light_samples": 3' -- render quad_light_floor --estimator '{"strategy": "mis_power", "light_samples": 3}' --spp 4 --out "$tmp/split.png" --format json "${tiny[@]}"
 check render-estimator-auto 0 '"split_pilot"' -- render quad_light_floor --estimator '{"strategy": "light_area", "light_samples": "auto"}' --spp 4 --out "$tmp/split.png" --format json "${tiny[@]}"
 check render-estimator-bad-json 2 'is not valid JSON' -- render quad_light_floor --estimator '{"strategy"' --out "$tmp/x.png" "${tiny[@]}"
+check render-estimator-auto-candidates 0 '"candidate_pilot"' -- render quad_light_floor --estimator '{"strategy": "path", "candidates": "auto"}' --spp 4 --out "$tmp/ris.png" --format json "${tiny[@]}"
 check render-estimator-bad-count 2 'options.estimator.light_samples: must be a whole number in 1..64 or "auto", got 0' -- render quad_light_floor --estimator '{"strategy": "mis_power", "light_samples": 0}' --out "$tmp/x.png" "${tiny[@]}"
 check render-bad-spp 2 "--spp: expected a whole number" -- render quad_light_floor --spp many --out "$tmp/x.png"
 check render-width-on-integral 2 'for render scenes' -- run exp_1d --width 8

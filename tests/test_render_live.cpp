@@ -252,6 +252,14 @@ TEST(LiveApi, RefusesBadRequestsWithAReason) {
     EXPECT_NE(open_error({{"rows", {0, 17}}}).find("options.rows"), std::string::npos);
     EXPECT_NE(open_error({{"live_reference", "maybe"}}).find("live_reference"), std::string::npos);
     EXPECT_NE(open_error({{"live", false}}).find("options.live"), std::string::npos);
+    const json resampled{{"strategy", "path"}, {"candidates", "auto"}};
+    EXPECT_NE(open_error({{"estimators", {resampled}}}).find("candidates \"auto\""),
+              std::string::npos);
+    json fixed = resampled;
+    fixed["candidates"] = 4;
+    json with_fixed = base;
+    with_fixed["estimators"] = {fixed};
+    EXPECT_EQ(open_live(scene, with_fixed).error, ""); // a fixed count: no pilot per band
     EXPECT_NE(
         open_error({{"estimators", {"bsdf", "bsdf", "bsdf", "bsdf", "bsdf"}}}).find("at most 4"),
         std::string::npos);

@@ -209,7 +209,8 @@ TEST(RenderSplitting, AutoCountComesFromThePilot) {
     EXPECT_GT(p.variance_light, 0.0);
     EXPECT_GT(p.seconds_rest + p.seconds_light, 0.0);
     EXPECT_EQ(chosen.light_samples,
-              optimal_split(p.variance_rest, p.variance_light, p.seconds_rest, p.seconds_light));
+              std::min(20, optimal_split(p.variance_rest, p.variance_light, p.seconds_rest,
+                                         p.seconds_light))); // at most 4 x the pilot's 5
     EXPECT_GE(chosen.light_samples, 1);
     e.light_samples = 3;
     RenderEstimator fixed = resolve_split(rs, e, image);

@@ -28,8 +28,8 @@ also compared with each other (the same relative MSE), which says whether they r
 image. With --sobol, mcplay also renders every cell with its Owen-scrambled Sobol' pixel sampler
 (`--pixel-sampler sobol`; the default is stratified), scored against the same mcplay reference:
 one more column, and its own efficiency ratio against Mitsuba. With --best, mcplay also renders
-each class with its best estimator (MCPLAY_BEST: Sobol' pixels, light samples per camera sample
-chosen by a timed pilot, the pilot's time counted), one more column the same way. With --scalar, Mitsuba's
+each class with its best estimator (MCPLAY_BEST: Sobol' pixels, resampled light samples, the
+candidates and light samples per camera sample chosen by timed pilots, their time counted), one more column the same way. With --scalar, Mitsuba's
 `scalar_rgb` variant renders every cell too: the same integrators one sample at a time per
 thread, as mcplay runs, against `llvm_ad_rgb`'s kernels that run a SIMD register's width of
 samples at once. It is scored against the `llvm_ad_rgb` reference (the same estimator), and
@@ -70,13 +70,17 @@ SCENES = [
     ('veach_mis', 'veach_mis.gltf', 320, 180, ['light', 'bsdf', 'mis']),
 ]
 MCPLAY_ESTIMATOR = {'light': 'light_solid_angle', 'bsdf': 'bsdf', 'mis': 'mis_power', 'path': 'path'}
-# mcplay's best per class (--best): the same strategy with Sobol' pixels and the light samples
-# per camera sample chosen by a timed pilot (src/render/splitting.h; its time counted in the
-# image's). BSDF sampling alone has no such choice: its row is a pure speed contest.
+# mcplay's best per class (--best), Sobol' pixels throughout. Light sampling: resampled light
+# samples (ris: candidates drawn as light_solid_angle draws them, the target lum(f Le cos) with
+# the BSDF in it). Path tracing: each vertex's light sample resampled the same way. MIS: light
+# samples per camera sample (splitting). Each count chosen by a timed pilot (src/render/
+# splitting.h; its time counted in the image's). BSDF sampling alone has no such choice: its
+# row is a pure speed contest.
 MCPLAY_BEST = {
-    'light': {'strategy': 'light_solid_angle', 'light_samples': 'auto', 'pixel_sampler': 'sobol'},
+    'light': {'strategy': 'ris', 'light_selection': 'power', 'light_sampling': 'solid_angle',
+              'candidates': 'auto', 'pixel_sampler': 'sobol'},
     'mis': {'strategy': 'mis_power', 'light_samples': 'auto', 'pixel_sampler': 'sobol'},
-    'path': {'strategy': 'path', 'max_depth': 5, 'light_samples': 'auto', 'pixel_sampler': 'sobol'},
+    'path': {'strategy': 'path', 'max_depth': 5, 'candidates': 'auto', 'pixel_sampler': 'sobol'},
 }
 PATH_BOUNCES, PATH_RR = 5, 3  # mcplay's path defaults (src/render/integrator.h)
 
@@ -245,7 +249,7 @@ class Mcplay:
     def __init__(self, exe, scene, width, height, threads, folder, pixel_sampler=None, best=False):
         self.exe, self.scene, self.width, self.height = exe, scene, width, height
         self.threads, self.folder, self.pixel_sampler = threads, folder, pixel_sampler
-        self.best, self.light_samples = best, []
+        self.best, self.light_samples, self.candidates = best, [], []
 
     def render(self, strategy, spp, seed):
         out = os.path.join(self.folder, 'mcplay.pfm')
@@ -264,10 +268,12 @@ class Mcplay:
                 cmd[6] = 'path_mis'
         r = subprocess.run(cmd, check=True, capture_output=True, text=True)
         result = json.loads(r.stdout)
-        pilot = result['estimator'].get('split_pilot')
-        self.light_samples.append(result['estimator'].get('light_samples', 1))
-        # A pilot that chose the split count is part of the image's cost.
-        return read_pfm(out), result['seconds'] + (pilot['seconds'] if pilot else 0.0)
+        est = result['estimator']
+        self.light_samples.append(est.get('light_samples', 1))
+        self.candidates.append(est.get('candidates', 1))
+        # The pilots that chose the counts are part of the image's cost.
+        pilots = sum(est[k]['seconds'] for k in ('split_pilot', 'candidate_pilot') if k in est)
+        return read_pfm(out), result['seconds'] + pilots
 
 
 # --------------------------------------------------------------------------------------------
@@ -508,7 +514,7 @@ def main():
                         runs.append(('mcplay_sobol', mcp_sobol, 'mcplay'))
                     if args.best:
                         runs.append(('mcplay_best', mcp_best, 'mcplay'))
-                        mcp_best.light_samples = []
+                        mcp_best.light_samples, mcp_best.candidates = [], []
                     if mit_scalar:
                         runs.append(('mitsuba_scalar', mit_scalar, 'mitsuba'))
                     for label, r, ref_label in runs:
@@ -535,11 +541,12 @@ def main():
                     if args.best:
                         best = row['mcplay_best']
                         best['light_samples'] = sorted(set(mcp_best.light_samples))
+                        best['candidates'] = sorted(set(mcp_best.candidates))
                         row['efficiency_ratio_best'] = (best['efficiency'] / eff[1]
                                                         if best['efficiency'] and eff[1] else None)
                         row['rare_large_errors_best'] = best['rare_large_errors'] or row['mitsuba']['rare_large_errors']
                         kind = ('speed contest' if strategy not in MCPLAY_BEST
-                                else f"light samples {best['light_samples']}")
+                                else f"candidates {best['candidates']} light samples {best['light_samples']}")
                         line += (f"  |  best ({kind}) {best['seconds']:7.3f} s relMSE {rel_text(best)} "
                                  f"efficiency x{ratio_text(row['efficiency_ratio_best'])}")
                     if mit_scalar:

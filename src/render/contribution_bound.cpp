@@ -301,6 +301,20 @@ ContributionBound contribution_bound(const RenderEstimator& e, const LightContac
     // emission (finite: the loader refuses more than 3.4e38).
     const ContributionBound unchecked{false, false,
                                       "too many light-surface pairs to check contacts"};
+    const bool nee_strategy = e.strategy == RadianceStrategy::MisBalance ||
+                              e.strategy == RadianceStrategy::MisPower ||
+                              e.strategy == RadianceStrategy::Path;
+    if (nee_strategy && e.candidates != 1) {
+        // The MIS weight is taken at the kept candidate, while the mean of the weights may be
+        // ruled by another: bounded where resampled light sampling (ris) is.
+        RenderEstimator ris = e;
+        ris.strategy = RadianceStrategy::Ris;
+        ContributionBound b = contribution_bound(ris, contacts);
+        b.reason = "the light sample resampled from candidates (MIS weight at the kept one, "
+                   "not at the candidate that rules the weights' mean): " +
+                   b.reason;
+        return b;
+    }
     switch (e.strategy) {
     case RadianceStrategy::UniformHemisphere:
     case RadianceStrategy::CosineHemisphere:

@@ -267,16 +267,16 @@ Vec3 direction_sample_term(const RenderScene& rs, const RenderEstimator& est,
 struct RisCandidate {
     Vec3 point, normal, value;
     double target;
+    double bsdf_pdf; ///< the BSDF's sampling density towards the candidate (for MIS)
 };
 
 /// The unshadowed contribution of one light sample (target 0 where it contributes nothing);
 /// its solid-angle density in *pdf (0 for an invalid sample, counted as a light miss).
 template <class S>
 RisCandidate ris_candidate(const LightSet& lights, LightSampling mode, const ShadingPoint& sp,
-                           PixelSampler& sampler, SampleCounters& c, double* pdf) {
-    RisCandidate x{Vec3(0.0), Vec3(0.0), Vec3(0.0), 0.0};
+                           const ChoiceSample& cs, SampleCounters& c, double* pdf) {
+    RisCandidate x{Vec3(0.0), Vec3(0.0), Vec3(0.0), 0.0, 0.0};
     *pdf = 0.0;
-    ChoiceSample cs = sampler.get_choice_2d();
     LightSample ls = lights.sample(sp.p, cs.choice, cs.u, mode);
     if (!ls.valid || !(ls.pdf > 0.0)) {
         ++c.light_misses;
@@ -290,8 +290,7 @@ RisCandidate ris_candidate(const LightSet& lights, LightSampling mode, const Sha
     if (glm::dot(wi, sp.ng) <= 0.0) return x; // below the surface: no light leaks
     Vec3 wi_local = sp.frame.to_local(wi);
     if (wi_local.z <= 0.0) return x;
-    double unused_pdf;
-    Vec3 f = S::eval_pdf(sp.bsdf, sp.wo_local, wi_local, &unused_pdf);
+    Vec3 f = S::eval_pdf(sp.bsdf, sp.wo_local, wi_local, &x.bsdf_pdf);
     x.point = ls.point;
     x.normal = ls.normal;
     x.value = f * ls.radiance * wi_local.z;
@@ -300,25 +299,48 @@ RisCandidate ris_candidate(const LightSet& lights, LightSampling mode, const Sha
     return x;
 }
 
+/// Candidate j of M drawn from the first one's numbers x_0 = (choice, u): x_j = frac(x_0 + j g),
+/// g = (1/M, a_1, a_2) with a_1, a_2 the fractions of Roberts' R_3 sequence [Roberts18]. Each
+/// x_j is uniform because x_0 is (a shift modulo 1 keeps the uniform measure), which is all
+/// RIS's unbiasedness asks of its candidates (by linearity: E[w_j f/target ...] needs only each
+/// x_j's own density p [Talbot05, 4]); the choices are stratified by j/M, the points a shifted
+/// Kronecker set, and one sampler request serves all M (the Sobol' sampler's dimensions cost).
+ChoiceSample shifted_candidate(const ChoiceSample& first, int j, int m) {
+    constexpr double kA1 = 0.7548776662466927, kA2 = 0.5698402909980532;
+    const auto frac = [](double v) { return v - std::floor(v); };
+    ChoiceSample cs;
+    cs.choice = frac(first.choice + double(j) / double(m));
+    cs.u = Vec2(frac(first.u.x + double(j) * kA1), frac(first.u.y + double(j) * kA2));
+    return cs;
+}
+
 /// Direct lighting by resampled importance sampling [Talbot05, 4]: est.candidates light samples
 /// x_j of density p, weights w_j = target(x_j) / p(x_j) with the unshadowed lum(f Le cos) as the
 /// target, one y kept with probability w_j / sum_k w_k, and the one shadow ray towards y:
 /// f Le cos V(y) / target(y) * (1/M) sum_j w_j [BitterliEtAl20, eq. 6]. Unbiased because the
 /// target is positive wherever f Le cos V is (luminance weights every channel positively);
 /// visibility is left out of the target, so occluded candidates still draw weight. M = 1 is
-/// light sampling. The kept candidate's number is drawn after the M light samples (not for
-/// M = 1, whose numbers are light sampling's).
+/// light sampling. The M candidates share one sampler request (shifted_candidate), and the kept
+/// candidate's number is drawn after it (not for M = 1, whose numbers are light sampling's).
+/// With `mis` (next-event estimation beside BSDF sampling: mis_* and path with candidates) the
+/// integrand is w_L f Le cos V, w_L the heuristic of the counts times the source density p(y)
+/// against the BSDF's density: RIS estimates any integrand the target covers without bias
+/// [Talbot05, 4], and the BSDF sample's weight 1 - w_L (the same p) completes the partition of
+/// unity [Veach97, 9.2], so the pair stays unbiased without RIS's own (intractable) density.
 template <class S>
 Vec3 ris_light_term(const RenderScene& rs, const RenderEstimator& est, const LightSet& lights,
-                    const ShadingPoint& sp, PixelSampler& sampler, SampleCounters& c) {
+                    const ShadingPoint& sp, PixelSampler& sampler, SampleCounters& c,
+                    bool mis = false, bool power = false, double n_light = 1.0,
+                    double n_bsdf = 1.0) {
     const int m = std::clamp(est.candidates, kMinRisCandidates, kMaxRisCandidates);
     RisCandidate candidates[kMaxRisCandidates];
-    double weights[kMaxRisCandidates];
+    double weights[kMaxRisCandidates], pdfs[kMaxRisCandidates];
     double weight_sum = 0.0;
+    const ChoiceSample first = sampler.get_choice_2d();
     for (int j = 0; j < m; ++j) {
-        double pdf = 0.0;
-        candidates[j] = ris_candidate<S>(lights, est.light_sampling, sp, sampler, c, &pdf);
-        weights[j] = candidates[j].target > 0.0 ? candidates[j].target / pdf : 0.0;
+        const ChoiceSample cs = j == 0 ? first : shifted_candidate(first, j, m);
+        candidates[j] = ris_candidate<S>(lights, est.light_sampling, sp, cs, c, &pdfs[j]);
+        weights[j] = candidates[j].target > 0.0 ? candidates[j].target / pdfs[j] : 0.0;
         weight_sum += weights[j];
     }
     double u = m > 1 ? sampler.get_1d() : 0.0;
@@ -335,7 +357,20 @@ Vec3 ris_light_term(const RenderScene& rs, const RenderEstimator& est, const Lig
     }
     const RisCandidate& y = candidates[kept];
     if (!visible(rs, sp, y.point, y.normal, c)) return Vec3(0.0);
-    return y.value * (weight_sum / (double(m) * y.target));
+    const double w = mis ? mis_weight(n_light * pdfs[kept], n_bsdf * y.bsdf_pdf, power) : 1.0;
+    return y.value * (w * weight_sum / (double(m) * y.target));
+}
+
+/// Next-event estimation at a shading point beside BSDF sampling (MIS with the counts): one
+/// light sample, or RIS over est.candidates light samples (ris_light_term) when there are more.
+template <class S>
+Vec3 nee_term(const RenderScene& rs, const RenderEstimator& est, const LightSet& lights,
+              const ShadingPoint& sp, PixelSampler& sampler, SampleCounters& c, bool power,
+              double n_light = 1.0, double n_bsdf = 1.0) {
+    if (est.candidates > 1)
+        return ris_light_term<S>(rs, est, lights, sp, sampler, c, true, power, n_light, n_bsdf);
+    return light_sample_term<S>(rs, lights, est.light_sampling, sp, sampler, c, true, power,
+                                n_light, n_bsdf);
 }
 
 /// Does the estimator take more than one light or BSDF sample per shading point?
@@ -352,7 +387,8 @@ Vec3 split_direct_term(const RenderScene& rs, const RenderEstimator& est, const 
     const bool mis = est.strategy == RadianceStrategy::MisBalance ||
                      est.strategy == RadianceStrategy::MisPower;
     const bool power = est.strategy == RadianceStrategy::MisPower;
-    const bool lights_sampled = mis || est.strategy == RadianceStrategy::LightArea ||
+    const bool ris = est.strategy == RadianceStrategy::Ris;
+    const bool lights_sampled = mis || ris || est.strategy == RadianceStrategy::LightArea ||
                                 est.strategy == RadianceStrategy::LightSolidAngle;
     const int n_light = lights_sampled ? std::max(1, est.light_samples) : 0;
     const int n_bsdf = lights_sampled && !mis ? 0 : std::max(1, est.bsdf_samples);
@@ -362,8 +398,9 @@ Vec3 split_direct_term(const RenderScene& rs, const RenderEstimator& est, const 
                              : est.light_sampling;
     Vec3 from_light(0.0), from_bsdf(0.0);
     for (int i = 0; i < n_light; ++i)
-        from_light += light_sample_term<S>(rs, lights, mode, sp, sampler, c, mis, power, n_light,
-                                           n_bsdf);
+        from_light += ris   ? ris_light_term<S>(rs, est, lights, sp, sampler, c)
+                      : mis ? nee_term<S>(rs, est, lights, sp, sampler, c, power, n_light, n_bsdf)
+                            : light_sample_term<S>(rs, lights, mode, sp, sampler, c, false, false);
     for (int i = 0; i < n_bsdf; ++i)
         from_bsdf += direction_sample_term<S>(rs, est, lights, sp, sampler, c, mis, power,
                                               n_light, n_bsdf);
@@ -412,8 +449,7 @@ RadianceSample direct_radiance(const RenderScene& rs, const RenderEstimator& est
         bool power = est.strategy == RadianceStrategy::MisPower;
         // Two statements: both terms draw from the sampler, and the order in which the
         // operands of + are evaluated is unspecified (g++ and clang differ).
-        Vec3 from_light =
-            light_sample_term<S>(rs, lights, est.light_sampling, sp, sampler, c, true, power);
+        Vec3 from_light = nee_term<S>(rs, est, lights, sp, sampler, c, power);
         Vec3 from_bsdf = direction_sample_term<S>(rs, est, lights, sp, sampler, c, true, power);
         out.reflected = from_light + from_bsdf;
         break;
@@ -462,9 +498,7 @@ RadianceSample path_radiance(const RenderScene& rs, const RenderEstimator& est,
         if (depth >= est.max_depth) break;
         ShadingPoint sp = shade<S>(scene, ray, hit);
         if (sp.wo_local.z <= 0.0) break;
-        if (!lights.empty())
-            L += beta *
-                 light_sample_term<S>(rs, lights, est.light_sampling, sp, sampler, c, true, true);
+        if (!lights.empty()) L += beta * nee_term<S>(rs, est, lights, sp, sampler, c, true);
         ChoiceSample cs = sampler.get_choice_2d();
         BsdfSample bs = S::sample(sp.bsdf, sp.wo_local, cs.choice, cs.u);
         if (!bs.valid || !(bs.pdf > 0.0) || is_black(bs.f)) break;
@@ -508,8 +542,7 @@ RadianceSample split_path_radiance(const RenderScene& rs, const RenderEstimator&
         Vec3 direct(0.0), from_bsdf(0.0);
         if (!lights.empty())
             for (int i = 0; i < n_light; ++i)
-                direct += light_sample_term<S>(rs, lights, est.light_sampling, sp, sampler, c,
-                                               true, true, n_light, n_bsdf);
+                direct += nee_term<S>(rs, est, lights, sp, sampler, c, true, n_light, n_bsdf);
         bool next = false;
         Vec3 next_beta(0.0);
         Ray next_ray;

@@ -27,6 +27,9 @@
 //                       shadow ray, weighted f Le cos V / target(y) * (1/M) sum_j w_j
 //                       [Talbot05, 4; BitterliEtAl20, eq. 6]: unbiased, since the target is
 //                       positive wherever f Le cos is
+// mis_* and path take candidates too: their light sample (next-event estimation at every
+// vertex) is then resampled from M light samples the same way, weighted by MIS against the
+// BSDF sample with the source density p (integrator.cpp's ris_light_term).
 // Splitting (light_samples, bsdf_samples): n_L light samples and n_B BSDF samples per shading
 // point, each term divided by its count, combined by multi-sample MIS whose heuristics take
 // q_k = n_k p_k [Veach97, 9.2; PBR4, 13.4's several light samples per point]; path tracing
@@ -80,14 +83,18 @@ struct RenderEstimator {
     /// Where every number of a sample comes from (camera jitter, light selection and
     /// sampling, BSDF sampling, Russian roulette): pixel_sampler.h.
     PixelSamplerKind pixel_sampler = PixelSamplerKind::Stratified;
-    int max_depth = 5;  ///< path: bounces (1 = direct lighting only)
-    int rr_depth = 3;   ///< path: Russian roulette from this bounce on
-    int candidates = 8; ///< ris: light samples resampled per shading point (M)
+    int max_depth = 5; ///< path: bounces (1 = direct lighting only)
+    int rr_depth = 3;  ///< path: Russian roulette from this bounce on
+    /// Light samples resampled per shading point (M): ris (the render API's default 8), and
+    /// the light sample of mis_* and path (1: plain light sampling). 0 (JSON "auto") until a
+    /// timed pilot chooses it (splitting.h): the integrator takes 0 as 1.
+    int candidates = 1;
     /// Light samples per shading point (strategies that sample lights); 0 (JSON "auto") until
     /// a timed pilot chooses it (splitting.h): the integrator takes 0 as 1.
     int light_samples = 1;
-    int bsdf_samples = 1; ///< BSDF samples per shading point (strategies that sample the BSDF)
+    int bsdf_samples = 1;   ///< BSDF samples per shading point (strategies that sample the BSDF)
     SplitPilot split_pilot; ///< what the pilot measured, when it chose light_samples
+    SplitPilot candidate_pilot; ///< the same for candidates (variance_light: the resampled part)
 };
 /// The bounds of ris's candidate count M, checked where estimators are parsed.
 constexpr int kMinRisCandidates = 1, kMaxRisCandidates = 64;

@@ -15,6 +15,8 @@ namespace {
 /// The pilot's second count: large enough that its extra shadow rays stand out of the timing
 /// noise, small enough that the pilot stays short.
 constexpr int kPilotSplit = 5;
+constexpr int kPilotCandidates = 8; ///< the pilot's second count of RIS candidates
+constexpr int kPilotReach = 4;      ///< the chosen count is at most this times the second
 constexpr uint64_t kPilotSpp = 2;
 constexpr int kPilotRuns = 1; ///< per count, the shortest time kept (interleaved runs)
 /// The pilot's rows: kPilotBands bands spread over the image, an eighth of its rows in all, at
@@ -70,9 +72,17 @@ int optimal_split(double variance_rest, double variance_light, double seconds_re
     return cost(hi) < cost(lo) ? hi : lo;
 }
 
-RenderEstimator resolve_split(const RenderScene& rs, const RenderEstimator& est,
-                              const RenderSettings& image) {
-    if (est.light_samples != 0) return est;
+namespace {
+
+/// Which count a pilot chooses: light_samples (splitting) or candidates (RIS).
+enum class PilotCount { LightSamples, Candidates };
+
+/// The pilot of one count: estimates with the count at 1 and at k, the variance model
+/// V(n) = V_rest + V_light / n and cost c_rest + n c_light read from the two, and n* chosen.
+/// RIS's variance with M candidates falls as V_target + (V(1) - V_target) / M to first order
+/// [Talbot05, 4], so the same model serves its candidates (c_light: one candidate's cost).
+RenderEstimator run_pilot(const RenderScene& rs, const RenderEstimator& est,
+                          const RenderSettings& image, PilotCount what) {
     const auto start = std::chrono::steady_clock::now();
     RenderSettings pilot = image;
     pilot.spp = kPilotSpp;
@@ -82,9 +92,17 @@ RenderEstimator resolve_split(const RenderScene& rs, const RenderEstimator& est,
     // One thread, timed by the processor time it uses: other processes on the machine do not
     // enter the costs (wall time under load once made a shadow ray look free).
     pilot.threads = 1;
+    // A candidate costs far less than a shadow ray: a larger second count stands out of the
+    // timing noise.
+    const int k_count = what == PilotCount::Candidates ? kPilotCandidates : kPilotSplit;
     RenderEstimator one = est, many = est;
-    one.light_samples = 1;
-    many.light_samples = kPilotSplit;
+    int& one_count = what == PilotCount::Candidates ? one.candidates : one.light_samples;
+    int& many_count = what == PilotCount::Candidates ? many.candidates : many.light_samples;
+    one_count = 1;
+    many_count = k_count;
+    // The other count, if it is still "auto", at 1 during this pilot.
+    if (one.light_samples == 0) one.light_samples = many.light_samples = 1;
+    if (one.candidates == 0) one.candidates = many.candidates = 1;
     one.pixel_sampler = many.pixel_sampler = PixelSamplerKind::Independent;
     std::vector<RenderImage> a, b;
     double t1 = 1e300, t2 = 1e300;
@@ -110,7 +128,7 @@ RenderEstimator resolve_split(const RenderScene& rs, const RenderEstimator& est,
     v1 /= std::max(1.0, terms);
     vk /= std::max(1.0, terms);
     // V(1) = V_rest + V_light and V(k) = V_rest + V_light / k.
-    const double k = kPilotSplit;
+    const double k = k_count;
     SplitPilot p;
     p.ran = true;
     p.samples = uint64_t(samples);
@@ -119,11 +137,30 @@ RenderEstimator resolve_split(const RenderScene& rs, const RenderEstimator& est,
     p.seconds_light = std::max(0.0, (t2 - t1) / ((k - 1.0) * samples));
     p.seconds_rest = std::max(0.0, t1 / samples - p.seconds_light);
     RenderEstimator out = est;
-    out.light_samples =
-        optimal_split(p.variance_rest, p.variance_light, p.seconds_rest, p.seconds_light);
-    out.split_pilot = p;
-    out.split_pilot.seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    // The model is measured at 1 and k only: n* is not taken past kPilotReach k, where a
+    // V_rest lost in the pilot's noise would send it to the largest count.
+    const int n = std::min(
+        optimal_split(p.variance_rest, p.variance_light, p.seconds_rest, p.seconds_light),
+        kPilotReach * k_count);
+    p.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (what == PilotCount::Candidates) {
+        out.candidates = std::min(n, kMaxRisCandidates);
+        out.candidate_pilot = p;
+    } else {
+        out.light_samples = n;
+        out.split_pilot = p;
+    }
+    return out;
+}
+
+} // namespace
+
+RenderEstimator resolve_split(const RenderScene& rs, const RenderEstimator& est,
+                              const RenderSettings& image) {
+    RenderEstimator out = est;
+    // The candidates first (with one light sample), then the light samples of that estimator.
+    if (out.candidates == 0) out = run_pilot(rs, out, image, PilotCount::Candidates);
+    if (out.light_samples == 0) out = run_pilot(rs, out, image, PilotCount::LightSamples);
     return out;
 }
 

@@ -95,18 +95,23 @@ Json estimator_to_json(const RenderEstimator& e) {
         j["max_depth"] = e.max_depth;
         j["rr_depth"] = e.rr_depth;
     }
-    if (e.strategy == RadianceStrategy::Ris) j["candidates"] = e.candidates;
+    if (e.strategy == RadianceStrategy::Ris || e.candidates != 1 || e.candidate_pilot.ran)
+        j["candidates"] = e.candidates;
     if (e.light_samples != 1 || e.bsdf_samples != 1 || e.split_pilot.ran) {
         j["light_samples"] = e.light_samples;
         j["bsdf_samples"] = e.bsdf_samples;
     }
-    if (e.split_pilot.ran) // light_samples "auto": what the pilot measured (splitting.h)
-        j["split_pilot"] = Json{{"variance_rest", e.split_pilot.variance_rest},
-                                {"variance_light", e.split_pilot.variance_light},
-                                {"seconds_rest", e.split_pilot.seconds_rest},
-                                {"seconds_light", e.split_pilot.seconds_light},
-                                {"samples", e.split_pilot.samples},
-                                {"seconds", e.split_pilot.seconds}};
+    const auto pilot_json = [](const SplitPilot& p) {
+        return Json{{"variance_rest", p.variance_rest},
+                    {"variance_light", p.variance_light},
+                    {"seconds_rest", p.seconds_rest},
+                    {"seconds_light", p.seconds_light},
+                    {"samples", p.samples},
+                    {"seconds", p.seconds}};
+    };
+    // light_samples or candidates "auto": what the pilot measured (splitting.h)
+    if (e.split_pilot.ran) j["split_pilot"] = pilot_json(e.split_pilot);
+    if (e.candidate_pilot.ran) j["candidate_pilot"] = pilot_json(e.candidate_pilot);
     return j;
 }
 

@@ -167,11 +167,12 @@ int open_session(const char* scene_json, const char* options_json, mcp_progress_
                     "' sampler cannot (its samples depend on the final spp): use "
                     "'padded_sobol' or 'independent'");
     for (const RenderEstimator& e : r.estimators)
-        if (e.light_samples == 0) // each band would run its own pilot and choose its own count
-            return fail(MCP_ERROR_ARGUMENT, "estimator '" + e.name +
-                                                "': light_samples \"auto\" is chosen by a timed "
-                                                "pilot, which the live view's bands would each "
-                                                "run: give a count");
+        if (e.light_samples == 0 || e.candidates == 0) // each band would run its own pilot
+            return fail(MCP_ERROR_ARGUMENT,
+                        "estimator '" + e.name +
+                            "': " + (e.light_samples == 0 ? "light_samples" : "candidates") +
+                            " \"auto\" is chosen by a timed pilot, which the live view's bands "
+                            "would each run: give a count");
     const int width = r.settings.width, height = r.settings.height;
     int row_begin = 0, row_end = height;
     std::string error;

@@ -61,7 +61,8 @@ uint64_t reference_key(const RenderRequest& r) {
           uint64_t(e.light_selection), uint64_t(e.light_sampling), uint64_t(e.pixel_sampler),
           uint64_t(e.max_depth), uint64_t(e.rr_depth), r.reference.spp, r.reference.seed})
         key = hash_combine(key, v);
-    if (e.strategy == RadianceStrategy::Ris) key = hash_combine(key, uint64_t(e.candidates));
+    if (e.strategy == RadianceStrategy::Ris || e.candidates != 1)
+        key = hash_combine(key, uint64_t(e.candidates));
     if (e.light_samples != 1 || e.bsdf_samples != 1) // splitting (keys of 1, 1 unchanged)
         key = hash_combine(hash_combine(key, uint64_t(e.light_samples)), uint64_t(e.bsdf_samples));
     return key;

@@ -51,6 +51,7 @@ std::vector<std::string> strategy_names() {
 void use_ris_defaults(RenderEstimator* e) {
     e->light_selection = LightSelection::Uniform;
     e->light_sampling = LightSampling::Area;
+    e->candidates = 8;
 }
 
 /// light_samples and bsdf_samples (splitting, integrator.h): whole numbers in
@@ -60,8 +61,9 @@ bool parse_split_counts(Ctx& c, const Json& j, const std::string& path, RenderEs
     const RadianceStrategy s = e->strategy;
     const bool mis = s == RadianceStrategy::MisBalance || s == RadianceStrategy::MisPower ||
                      s == RadianceStrategy::Path;
-    const bool samples_lights =
-        mis || s == RadianceStrategy::LightArea || s == RadianceStrategy::LightSolidAngle;
+    const bool samples_lights = mis || s == RadianceStrategy::LightArea ||
+                                s == RadianceStrategy::LightSolidAngle ||
+                                s == RadianceStrategy::Ris;
     const bool samples_bsdf = mis || s == RadianceStrategy::Bsdf;
     const std::string range = "must be a whole number in 1.." + std::to_string(kMaxSplitSamples);
     struct Count {
@@ -70,13 +72,14 @@ bool parse_split_counts(Ctx& c, const Json& j, const std::string& path, RenderEs
         const char* who;
         int* out;
     };
-    const Count counts[] = {
-        {"light_samples", samples_lights, "strategies that sample lights (light_area, "
-                                          "light_solid_angle, mis_balance, mis_power, path)",
-         &e->light_samples},
-        {"bsdf_samples", samples_bsdf, "strategies that sample the BSDF (bsdf, mis_balance, "
-                                       "mis_power, path)",
-         &e->bsdf_samples}};
+    const Count counts[] = {{"light_samples", samples_lights,
+                             "strategies that sample lights (light_area, "
+                             "light_solid_angle, mis_balance, mis_power, path, ris)",
+                             &e->light_samples},
+                            {"bsdf_samples", samples_bsdf,
+                             "strategies that sample the BSDF (bsdf, mis_balance, "
+                             "mis_power, path)",
+                             &e->bsdf_samples}};
     for (const Count& k : counts) {
         const Json* v = find(j, k.key);
         if (!v) continue;
@@ -94,6 +97,31 @@ bool parse_split_counts(Ctx& c, const Json& j, const std::string& path, RenderEs
                               ", got " + v->dump());
         *k.out = int(v->get<int64_t>());
     }
+    return true;
+}
+
+/// candidates (RIS, integrator.h): a whole number in kMinRisCandidates..kMaxRisCandidates or
+/// "auto" (0: a timed pilot chooses it, splitting.h), on the strategies that sample lights
+/// beside or instead of the BSDF by one light sample (ris, mis_*, path).
+bool parse_candidates(Ctx& c, const Json& j, const std::string& path, RenderEstimator* e) {
+    const Json* v = find(j, "candidates");
+    if (!v) return true;
+    const RadianceStrategy s = e->strategy;
+    if (s != RadianceStrategy::Ris && s != RadianceStrategy::MisBalance &&
+        s != RadianceStrategy::MisPower && s != RadianceStrategy::Path)
+        return c.fail(sub(path, "candidates"), std::string("only ris, mis_balance, mis_power and "
+                                                           "path resample candidates, not '") +
+                                                   strategy_name(s) + "'");
+    if (v->is_string() && v->get<std::string>() == "auto") {
+        e->candidates = 0;
+        return true;
+    }
+    const bool whole = v->is_number_integer() || v->is_number_unsigned();
+    if (!whole || v->get<int64_t>() < kMinRisCandidates || v->get<int64_t>() > kMaxRisCandidates)
+        return c.fail(sub(path, "candidates"),
+                      "must be a whole number in " + std::to_string(kMinRisCandidates) + ".." +
+                          std::to_string(kMaxRisCandidates) + " or \"auto\", got " + v->dump());
+    e->candidates = int(v->get<int64_t>());
     return true;
 }
 
@@ -143,15 +171,7 @@ bool parse_estimator(Ctx& c, const Json& j, const std::string& path, RenderEstim
         return c.fail(sub(path, "max_depth"), "only the 'path' strategy has bounces");
     e.max_depth = int(depth);
     e.rr_depth = int(rr);
-    uint64_t m = uint64_t(e.candidates);
-    if (!get_count(c, j, "candidates", path, &m)) return false;
-    if (find(j, "candidates") && e.strategy != RadianceStrategy::Ris)
-        return c.fail(sub(path, "candidates"), "only the 'ris' strategy resamples candidates");
-    if (m < uint64_t(kMinRisCandidates) || m > uint64_t(kMaxRisCandidates))
-        return c.fail(sub(path, "candidates"),
-                      "must be in " + std::to_string(kMinRisCandidates) + ".." +
-                          std::to_string(kMaxRisCandidates) + ", got " + std::to_string(m));
-    e.candidates = int(m);
+    if (!parse_candidates(c, j, path, &e)) return false;
     if (!parse_split_counts(c, j, path, &e)) return false;
     *out = e;
     return true;
@@ -188,6 +208,9 @@ bool parse_reference(Ctx& c, const Json& j, const std::string& path, const std::
         if (!parse_estimator(c, *e, sub(path, "estimator"), &out->estimator)) return false;
     if (out->estimator.light_samples == 0) // a pilot's timing would make it differ run to run
         return c.fail(sub(sub(path, "estimator"), "light_samples"),
+                      "\"auto\" depends on timing; a reference takes a fixed count");
+    if (out->estimator.candidates == 0)
+        return c.fail(sub(sub(path, "estimator"), "candidates"),
                       "\"auto\" depends on timing; a reference takes a fixed count");
     if (!get_count(c, j, "spp", path, &out->spp) || !get_count(c, j, "seed", path, &out->seed))
         return false;
@@ -486,10 +509,11 @@ Made<std::shared_ptr<RenderRequest>> build_render_request(const Json& scene, con
         r->estimators = chosen;
     }
     for (const RenderEstimator& e : r->estimators)
-        if (e.light_samples == 0 && parts > 1) {
-            c.fail("options.parts", "estimator '" + e.name +
-                                        "' has light_samples \"auto\", which each part's timed "
-                                        "pilot would choose on its own: give a count");
+        if ((e.light_samples == 0 || e.candidates == 0) && parts > 1) {
+            c.fail("options.parts", "estimator '" + e.name + "' has " +
+                                        (e.light_samples == 0 ? "light_samples" : "candidates") +
+                                        " \"auto\", which each part's timed pilot would choose "
+                                        "on its own: give a count");
             return error();
         }
     // options.pixel_sampler (mcplay's --pixel-sampler): every estimator's pixel sampler, not
