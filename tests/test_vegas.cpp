@@ -308,13 +308,14 @@ TEST(VegasEstimator, SampleDumpKeepsTheMapOfEveryTrainingIteration) {
         const size_t step = (frozen.size() - 1) / m;
         for (size_t i = 0; i <= m; ++i) EXPECT_EQ(h.back()[0][i], frozen[i * step]);
         // Share of the thinned edges within 0.1 of the peak (0.3 on axis 0): 0.2 for the
-        // identity, far more once trained.
+        // identity, at least twice that once trained (vegas_plus's nested map has K = 10 here:
+        // 11 edges, 5 of them near the peak).
         auto near_peak = [](const std::vector<double>& e) {
             int c = 0;
             for (double v : e) c += std::fabs(v - 0.3) < 0.1;
             return static_cast<double>(c) / e.size();
         };
-        EXPECT_GT(near_peak(h.back()[0]), 0.5) << spec.name;
+        EXPECT_GT(near_peak(h.back()[0]), 0.4) << spec.name;
     }
 }
 
@@ -623,19 +624,20 @@ TEST(VegasPlus, HonestOnACornerSingularity) {
 }
 
 // VEGAS+ trains its map on the errors where its hypercubes are at least as fine as the map's
-// increments (1-D here: 2^18 calls, a training iteration's 1638 hypercubes against K = 65): a
-// point counts with its squared deviation from its hypercube's mean, as GSL's stratified mode
+// increments (1-D here: 2^18 calls, a training iteration's 1638 hypercubes, 26 in each of K = 63):
+// a point counts with its squared deviation from its hypercube's mean, as GSL's stratified mode
 // does. At x^-0.45 the increments then pile into the singular corner far below the width of
 // the first increment of the map with equal mass per increment, K^(-1/(1-a)) (the optimum of
 // the map alone, whose increments hold equal shares of f): the variance there comes from
-// within the first hypercubes, which shrink until it is spent. Judged both ways: at x^0.45,
-// which vanishes at 0 and is smooth, the first increment stays wider than the even 1/K.
+// within the first hypercubes, which shrink until it is spent. Judged both ways: at x^2, which
+// vanishes at 0 with its slope, the first increment stays wider than the even 1/K (not x^0.45:
+// its slope is singular at 0, and with alpha 1.5 the error-trained map narrows there too).
 TEST(VegasPlus, MapTrainedOnTheErrorsPilesIntoASingularCorner) {
-    for (const double a : {0.45, -0.45}) {
+    for (const double a : {0.45, -2.0}) {
         const std::string power = std::to_string(-a);
         Made<SceneRequest> r = request(R"({"name": "c", "domain": {"type": "box", "dim": 1},
-            "integrand": {"type": "monomial", "powers": [)" + power +
-                                       R"(]}, "estimators": ["vegas_plus"]})");
+            "integrand": {"type": "monomial", "powers": [)" +
+                                       power + R"(]}, "estimators": ["vegas_plus"]})");
         ASSERT_TRUE(r.ok()) << r.error;
         const SampleDump d = dump_samples(r.value.problem, r.value.estimators[0], 256, 1, 1 << 18);
         ASSERT_EQ(d.adaptive.edges.size(), 1u);
@@ -648,4 +650,71 @@ TEST(VegasPlus, MapTrainedOnTheErrorsPilesIntoASingularCorner) {
             EXPECT_GT(e[1], 1.0 / k) << "K " << k;
         }
     }
+}
+
+// VEGAS+'s nested mode (GSL's stratified mode): where a training iteration has at least
+// kVegasPlusNestedAxis hypercubes per axis and the training runs kVegasSizingIterations
+// iterations, the default increments are cut to a whole number of hypercubes each, and the map
+// trains on the hypercubes' errors with damping kVegasNestedAlpha. Judged both ways on the
+// map's size: 2-D at 2^18 calls (40 hypercubes per axis in each of 10 training iterations of
+// 6553 points, where the default K would be 65) gets K = 40; 4-D (8 per axis) and 2-D at 2^15
+// (8 training iterations) keep the default K, trained on w^2.
+TEST(VegasPlus, NestedModeWhereHypercubesAreFineEnough) {
+    struct Case {
+        int dim;
+        uint64_t n;
+        bool nested;
+    };
+    for (const Case c : {Case{2, uint64_t(1) << 18, true}, Case{4, uint64_t(1) << 18, false},
+                         Case{2, uint64_t(1) << 15, false}}) {
+        Made<SceneRequest> r = request(R"({"name": "c", "domain": {"type": "box", "dim": )" +
+                                       std::to_string(c.dim) + R"(},
+            "integrand": {"type": "gaussian", "center": )" +
+                                       (c.dim == 2 ? "[0.3, 0.6]" : "[0.3, 0.6, 0.4, 0.5]") +
+                                       R"(, "sigma": 0.2},
+            "estimators": ["vegas_plus"]})");
+        ASSERT_TRUE(r.ok()) << r.error;
+        const SampleDump d = dump_samples(r.value.problem, r.value.estimators[0], 16, 1, c.n);
+        ASSERT_EQ(d.adaptive.edges.size(), static_cast<size_t>(c.dim));
+        const size_t k = d.adaptive.edges[0].size() - 1;
+        const VegasOptions defaults;
+        const uint64_t train = c.n / 4;
+        const int iterations = vegas_training_iterations(
+            vegas_resolved(defaults, SamplerKind::Independent, true, c.dim), train);
+        const uint64_t per_iteration = train / static_cast<uint64_t>(iterations);
+        const size_t k_default = vegas_trainable_increments(defaults, c.dim, per_iteration, train);
+        const uint64_t m = vegas_plus_per_axis(c.dim, per_iteration);
+        if (c.nested) {
+            ASSERT_GE(m, kVegasPlusNestedAxis);
+            ASSERT_EQ(iterations, kVegasSizingIterations);
+            EXPECT_EQ(m % k, 0u) << "K " << k << " M " << m;
+            EXPECT_LT(k, k_default);
+        } else {
+            EXPECT_TRUE(m < kVegasPlusNestedAxis || iterations < kVegasSizingIterations);
+            EXPECT_EQ(k, k_default) << "d " << c.dim << " n " << c.n;
+        }
+    }
+}
+
+// The nested mode against the map trained on w^2 with the default increments (what VEGAS+ did
+// before; an explicit K keeps it): on x^-0.45 y^-0.2 at 2^18 calls the estimates' variance over
+// 30 seeded runs each falls more than 4-fold (measured 35-fold at R = 40; under equal variances
+// the ratio of two 30-run variances exceeds 3.1 with probability 0.001), both unbiased (4
+// standard errors).
+TEST(VegasPlus, NestedModeLowersTheVarianceOnACornerSingularity) {
+    Made<SceneRequest> r = request(R"({"name": "corner", "domain": {"type": "box", "dim": 2},
+        "integrand": {"type": "monomial", "powers": [-0.45, -0.2]},
+        "estimators": ["vegas_plus",
+                       {"name": "w2", "vegas": {"stratify": true, "increments": 65}}]})");
+    ASSERT_TRUE(r.ok()) << r.error;
+    const double exact = *r.value.problem.exact;
+    const int runs = 30;
+    std::vector<test::IndependentRuns> of;
+    for (const EstimatorSpec& spec : r.value.estimators) {
+        of.push_back(test::independent_runs(r.value.problem, spec, 1 << 18, runs, 5151, 51, exact));
+        EXPECT_LE(std::fabs(of.back().mean - exact), 4.0 * std::sqrt(of.back().variance / runs))
+            << spec.name;
+    }
+    EXPECT_LT(4.0 * of[0].variance, of[1].variance)
+        << "nested " << of[0].variance << ", w^2-trained " << of[1].variance;
 }

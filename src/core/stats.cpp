@@ -168,9 +168,17 @@ void allocate_largest_remainders(uint64_t points, const std::vector<double>& sha
         given += whole;
         remainders[h] = {exact - static_cast<double>(whole), h};
     }
-    std::sort(remainders.begin(), remainders.end(), [](const auto& a, const auto& b) {
+    // Only the `left` largest remainders get a point: a selection, not a sort (VEGAS+'s 10^5
+    // hypercubes per iteration spent 12% of its run sorting).
+    const auto larger = [](const auto& a, const auto& b) {
         return a.first != b.first ? a.first > b.first : a.second < b.second;
-    });
+    };
+    const uint64_t left = points - given;
+    if (left < n)
+        std::nth_element(remainders.begin(), remainders.begin() + static_cast<long>(left),
+                         remainders.end(), larger);
+    else
+        std::sort(remainders.begin(), remainders.end(), larger);
     for (size_t k = 0; given < points; k = (k + 1) % n, ++given) ++(*counts)[remainders[k].second];
 }
 

@@ -65,6 +65,18 @@ VegasOptions vegas_resolved(const VegasOptions& options, SamplerKind sampler, bo
 uint64_t vegas_plus_per_axis(int dim, uint64_t points);
 constexpr uint64_t kVegasMaxHypercubes = uint64_t(1) << 20;
 
+/// Least hypercubes per axis of a training iteration for VEGAS+'s nested mode (GSL's stratified
+/// mode): with the default increments, each increment then holds a whole number of hypercubes
+/// per axis (K at most M) and the map trains on the hypercubes' errors. Fewer, and K = M
+/// increments are too coarse a map. The mode also needs kVegasSizingIterations training
+/// iterations (N >= 40,000 at the defaults): the estimate keeps the map the last one measured,
+/// and with one or two that is the identity or close to it, whose sigma_h from 4-point
+/// hypercubes understated the error bars on a corner peak at N = 4096-32768.
+constexpr uint64_t kVegasPlusNestedAxis = 16;
+/// The map's damping in VEGAS+'s nested mode unless `alpha` is given: GSL's [Lepage78 gives
+/// 1 to 2]; trained on the errors, the map must shrink a singularity's increments far.
+constexpr double kVegasNestedAlpha = 1.5;
+
 /// Least points per training iteration where the training share allows: fewer, and the map
 /// learns from noise (vegas's own examples train on 1000 points per iteration).
 constexpr uint64_t kVegasIterationPoints = 1000;

@@ -41,10 +41,25 @@ class VegasPlusEstimator final : public EstimatorAlgorithm, private TrainingPoin
         if (train == 0) iterations_ = 0;
         final_ = n - train;
         train_ = train;
-        stage_.reset(dim_,
-                     iterations_ > 0
-                         ? vegas_trainable_increments(o, dim_, train_ / iterations_, train_)
-                         : (o.increments > 0 ? o.increments : vegas_increments(dim_, final_)));
+        int increments = iterations_ > 0
+                             ? vegas_trainable_increments(o, dim_, train_ / iterations_, train_)
+                             : (o.increments > 0 ? o.increments : vegas_increments(dim_, final_));
+        nested_ = iterations_ >= kVegasSizingIterations && o.increments <= 0 &&
+                  per_axis_ >= kVegasPlusNestedAxis;
+        if (nested_) {
+            // GSL's stratified mode [Lepage78, sec. 3]: every increment holds a whole number b
+            // of hypercubes per axis (b = ceil(M / K), K = M / b, M = b K), so that a
+            // hypercube's spread is variance the estimate has, all of it from within one
+            // increment of each axis: the map then trains on those errors (train).
+            const uint64_t b = (per_axis_ + static_cast<uint64_t>(increments) - 1) /
+                               static_cast<uint64_t>(increments);
+            increments = static_cast<int>(per_axis_ / b);
+            per_axis_ = b * static_cast<uint64_t>(increments);
+            cubes_ = 1;
+            for (int j = 0; j < dim_; ++j) cubes_ *= per_axis_;
+        }
+        alpha_ = nested_ && spec_.vegas_options.alpha < 0.0 ? kVegasNestedAlpha : o.alpha;
+        stage_.reset(dim_, increments);
         sigma_.assign(cubes_, 1.0); // uniform allocation first
         trained_ = false;
         planned_ = false;
@@ -62,11 +77,17 @@ class VegasPlusEstimator final : public EstimatorAlgorithm, private TrainingPoin
             prepared_ = true;
         }
         if (!trained_) {
-            const TrainingSpent spent = train_map(stage_, options_, problem_, spec_.proposal,
+            VegasOptions training = options_;
+            training.alpha = alpha_;
+            const TrainingSpent spent = train_map(stage_, training, problem_, spec_.proposal,
                                                   iterations_, train_, *this, rng, ws, log_);
             if (spent.iterations < iterations_ && spent.calls < train_) {
                 final_ += train_ - spent.calls; // settled early: the calls left go to the estimate
                 train_ = spent.calls;
+            }
+            if (nested_ && spent.iterations > 0) { // the last measured map (finish)
+                stage_.map() = measured_map_;
+                log_.adapted(stage_.map(), iterations_); // the history ends with the frozen map
             }
             trained_ = true;
         }
@@ -141,6 +162,13 @@ class VegasPlusEstimator final : public EstimatorAlgorithm, private TrainingPoin
     void finish(VegasMap& map) override {
         flush_cube(map);
         finish_iteration(true);
+        // Nested, the estimate keeps the map this iteration used, on which its sigma_h were
+        // measured: with alpha 1.5 an error-trained map can overshoot in one step (Genz's
+        // discontinuous family in 2-D: variance per point 1.4e6, then 1.4e9), and sigma_h from
+        // the map before it then starve the hypercubes that now hold the variance (error bars
+        // of half the RMSE). Not the iteration of least variance: that favours one whose
+        // points missed a peak, and its sigma_h starve the peak.
+        if (nested_) measured_map_ = map;
     }
 
     // Where the hypercubes are at least as fine as the map's increments (per_axis_ >= K, the
@@ -150,9 +178,10 @@ class VegasPlusEstimator final : public EstimatorAlgorithm, private TrainingPoin
     // stratified estimate's variance comes from (a singularity's hypercubes), not where w^2 is
     // large. Coarser hypercubes hold the variance between increments too, which the map alone
     // (w^2) balances. A hypercube's points wait in train until its last one is seen.
-    void train(VegasMap& map, const uint32_t* bins, const double* weights,
-               const double* importance, size_t count) override {
-        if (per_axis_ < static_cast<uint64_t>(map.increments())) {
+    void train(VegasMap& map, const uint32_t* bins, const double* weights, const double* importance,
+               size_t count) override {
+        if (per_axis_ < static_cast<uint64_t>(map.increments()) ||
+            per_axis_ % static_cast<uint64_t>(map.increments()) != 0) {
             map.add_training(bins, weights, importance, count);
             return;
         }
@@ -295,6 +324,9 @@ class VegasPlusEstimator final : public EstimatorAlgorithm, private TrainingPoin
     uint64_t total_ = 0, train_ = 0, final_ = 0, points_ = 0, accumulated_ = 0;
     uint64_t per_axis_ = 1, cubes_ = 1, cube_ = 0, left_in_cube_ = 0;
     int iterations_ = 0;
+    bool nested_ = false;   // hypercubes nested in the map's increments (begin)
+    double alpha_ = 0.5;    // the map's damping: options_'s, or kVegasNestedAlpha when nested_
+    VegasMap measured_map_; // nested: the map the last training iteration used (finish)
     bool trained_ = false, planned_ = false, prepared_ = false, finished_final_ = false;
     TrainingLog log_;
     MapStage stage_; // the map and its buffers
