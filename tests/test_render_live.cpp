@@ -258,7 +258,7 @@ TEST(LiveApi, RefusesBadRequestsWithAReason) {
     json fixed = resampled;
     fixed["candidates"] = 4;
     json with_fixed = base;
-    with_fixed["estimators"] = {fixed};
+    with_fixed["estimators"] = json::array({fixed});
     EXPECT_EQ(open_live(scene, with_fixed).error, ""); // a fixed count: no pilot per band
     EXPECT_NE(
         open_error({{"estimators", {"bsdf", "bsdf", "bsdf", "bsdf", "bsdf"}}}).find("at most 4"),
