@@ -49,7 +49,7 @@ DEP_PROBES := /usr/bin/cmake /usr/bin/ninja /usr/bin/g++ /usr/src/googletest/CMa
 	/usr/include/gtest/gtest.h /usr/bin/em++ /usr/include/glm/glm.hpp /usr/include/stb/stb_image_write.h \
 	/usr/include/tiny_gltf.h /usr/include/nlohmann/json.hpp /usr/bin/chromium /usr/bin/clang-format
 
-.PHONY: all deps deps-web deps-npm build build-wasm site test test-native test-wasm test-wasm-check test-compare test-web-core \
+.PHONY: all deps deps-web deps-npm build build-wasm site test test-native test-wasm test-native-check test-wasm-check test-compare test-web-core \
 	test-npm test-e2e test-sanitize test-suites check run cli bench bench-mitsuba bench-embree format format-files clean help \
 	fuzz fuzz-build fuzz-smoke deps-fuzz
 
@@ -62,8 +62,9 @@ help:
 	@echo "           native, wasm, Node and Chromium suites (independent ones at the same time)"
 	@echo "make test-npm  the wasm core as the npm package mcplay: packed, installed from the tarball into an"
 	@echo "           empty folder, run there against the native CLI and in Chromium; its types checked"
-	@echo "make check  everything CI runs: make test, then the ASan/UBSan suite, make fuzz-smoke and the"
-	@echo "           wasm suites make test leaves out: statistical runs, CLI scripts (test-wasm-check)"
+	@echo "make check  everything CI runs: make test, then the ASan/UBSan suite, make fuzz-smoke, the"
+	@echo "           stopping promise runs (test-native-check) and the wasm modules make test leaves out:"
+	@echo "           statistical and long modules, CLI scripts (test-wasm-check); the Python suites"
 	@echo "make bench  samples per second natively and in wasm under Node, and their ratio; then bench-genz"
 	@echo "make bench-genz  mcplay beside GSL plain/MISER/VEGAS on Genz's families (GENZ_ARGS=--quick: 15 s)"
 	@echo "make bench-genz-peaks  vegas, vegas_plus beside GSL VEGAS on sharp product peaks (~4 min)"
@@ -137,14 +138,19 @@ build: deps deps-python $(BUILD)/CMakeCache.txt
 build-wasm: deps $(BUILD_WASM)/CMakeCache.txt
 	cmake --build $(BUILD_WASM) -j $(JOBS)
 
+# The statistical promise runs (label statistical: test_stopping_promise, hundreds of stopping
+# runs per estimator) wait for `make check`, natively and under Node. Under Node two more labels
+# wait: the CLI's scripts ("cli": cli and corpus, minutes under Node; test-compare runs every
+# scene through the wasm CLI in every loop) and the modules of long statistical loops ("long":
+# 10-100 s each under Node, seconds natively, where every loop runs them).
+NATIVE_CHECK_LABELS := ^statistical$$
+WASM_CHECK_LABELS := ^(statistical|cli|long)$$
 test-native: build
-	ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS)
+	ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS) -LE '$(NATIVE_CHECK_LABELS)'
 
-# Under Node two labels wait for `make check` (the native suite runs both in every loop): the
-# statistical promise runs ("statistical": test_stopping, hundreds of stopping runs per
-# estimator) and the CLI's scripts ("cli": cli and corpus, minutes under Node; test-compare
-# runs every scene through the wasm CLI in every loop).
-WASM_CHECK_LABELS := ^(statistical|cli)$$
+test-native-check: build
+	ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS) -L '$(NATIVE_CHECK_LABELS)'
+
 test-wasm: build-wasm
 	ctest --test-dir $(BUILD_WASM) --output-on-failure -j $(JOBS) -LE '$(WASM_CHECK_LABELS)'
 
@@ -211,7 +217,9 @@ test:
 	$(MAKE) --no-print-directory -j $(TEST_JOBS) test-suites && \
 	echo "make test: all suites passed in $$(( $$(date +%s) - start )) s"
 
-test-suites: test-native test-wasm test-compare test-web-core test-npm test-e2e
+# `site` first: its references (the native CLI rendering every render scene's) are the longest
+# chain before test-e2e, so that make -j starts them as soon as the builds are done.
+test-suites: site test-native test-wasm test-compare test-web-core test-npm test-e2e
 
 # Everything: the loop, then the suites too slow for it (sanitizers; the fuzz targets, built with
 # clang, over their seed corpus and past findings; the Python wheel's tests and the notebook).
@@ -219,7 +227,7 @@ test-suites: test-native test-wasm test-compare test-web-core test-npm test-e2e
 check:
 	@start=$$(date +%s); \
 	$(MAKE) --no-print-directory test && \
-	$(MAKE) --no-print-directory -j 2 test-sanitize fuzz-smoke test-wasm-check test-python && \
+	$(MAKE) --no-print-directory -j 2 test-sanitize fuzz-smoke test-native-check test-wasm-check test-python && \
 	$(MAKE) --no-print-directory test-notebook && \
 	echo "make check: all suites passed in $$(( $$(date +%s) - start )) s"
 
