@@ -43,11 +43,12 @@ NODE_RUN := node --no-experimental-fetch
 export NODE_PATH := /usr/share/nodejs
 
 APT_PACKAGES := cmake ninja-build g++ make googletest libgtest-dev emscripten libglm-dev \
-	libstb-dev libtinygltf-dev nlohmann-json3-dev chromium clang-format
+	libstb-dev libtinygltf-dev nlohmann-json3-dev chromium clang-format ccache
 # One file or command per package that tells whether it is installed.
 DEP_PROBES := /usr/bin/cmake /usr/bin/ninja /usr/bin/g++ /usr/src/googletest/CMakeLists.txt \
 	/usr/include/gtest/gtest.h /usr/bin/em++ /usr/include/glm/glm.hpp /usr/include/stb/stb_image_write.h \
-	/usr/include/tiny_gltf.h /usr/include/nlohmann/json.hpp /usr/bin/chromium /usr/bin/clang-format
+	/usr/include/tiny_gltf.h /usr/include/nlohmann/json.hpp /usr/bin/chromium /usr/bin/clang-format \
+	/usr/bin/ccache
 
 .PHONY: all deps deps-web deps-npm build build-wasm site test test-native test-wasm test-native-check test-wasm-check test-compare test-web-core \
 	test-npm test-e2e test-sanitize test-suites check run cli bench bench-mitsuba bench-embree format format-files clean help \
