@@ -42,7 +42,7 @@ struct MetCount {
     int met = 0, met_outside = 0, runs = 0, heavy_tail = 0;
 };
 inline MetCount count_met(const Json& scene, const char* estimator, Tolerance tol, uint64_t n_max,
-                   int reps) {
+                          int reps) {
     Json one = scene;
     one["estimators"] = Json::array({estimator});
     SceneRequest r = request(one);
