@@ -375,12 +375,23 @@ bench-flags-fresh: deps $(BUILD)/CMakeCache.txt
 # cases' parameters, bench/qmc_tools.py runs the other tools on them (installed with pip into a
 # virtual environment under $(BUILD); nothing else uses it), genz_compare runs mcplay's RQMC
 # estimators and GSL's plain and MISER and prints all of them in one table.
-# QMC_REPS replicates per (case, method); `make bench-qmc QMC_REPS=5` for a fast look.
+# QMC_REPS replicates per (case, method); `make bench-qmc QMC_REPS=5` for a fast look. Every
+# knob is a variable; both sides get the same N (QMC_N) and K randomizations of N/K points
+# (QMC_K; 1 = one net: QMC_METHODS=sobol_walsh on mcplay's side). Issue 49's oscillatory study
+# (docs/performance-notes.md):
+#   make bench-qmc QMC_CASES="--families 1 --dims 3,5,10,20" QMC_PARAM_SEED=52 QMC_REPS=100 \
+#     QMC_GSL=none QMC_METHODS=sobol,sobol:lms_shift QMC_TOOLS=qmcpy_lms,scipy_sobol QMC_K=4
 .PHONY: bench-qmc deps-venv
 QMC_REPS ?= 40
-QMC_DIR := $(BUILD)/bench-qmc
+QMC_N ?= 1048576
+QMC_K ?= 16
+QMC_PARAM_SEED ?= 1
+QMC_DIR ?= $(BUILD)/bench-qmc
 QMC_VENV := $(BUILD)/bench-venv
-QMC_CASES := --families 1,4,5 --dims 2,4,8,16
+QMC_CASES ?= --families 1,4,5 --dims 2,4,8,16
+QMC_GSL ?= plain,miser
+QMC_METHODS ?= sobol,sobol:lms_shift,sobol:digital_shift,lattice,halton
+QMC_TOOLS ?= qmcpy_lms,qmcpy_lattice,scipy_sobol
 
 # After deps: two apt-get runs at once fail (their package cache is shared).
 deps-venv: deps
@@ -424,12 +435,13 @@ $(QMC_VENV)/installed: | deps-venv
 bench-qmc: deps deps-gsl $(BUILD)/CMakeCache.txt $(QMC_VENV)/installed
 	cmake --build $(BUILD) -j $(JOBS) --target mcplay_api
 	$(MAKE) --no-print-directory $(BUILD)/genz_compare
-	rm -rf $(QMC_DIR)/params && $(BUILD)/genz_compare $(QMC_CASES) --write-params $(QMC_DIR)/params
-	$(QMC_VENV)/bin/python bench/qmc_tools.py $(QMC_DIR)/params --n 1048576 --reps $(QMC_REPS) \
-	  > $(QMC_DIR)/tools.jsonl
+	rm -rf $(QMC_DIR)/params && $(BUILD)/genz_compare $(QMC_CASES) --param-seed $(QMC_PARAM_SEED) \
+	  --write-params $(QMC_DIR)/params
+	$(QMC_VENV)/bin/python bench/qmc_tools.py $(QMC_DIR)/params --n $(QMC_N) --reps $(QMC_REPS) \
+	  --randomizations $(QMC_K) --methods $(QMC_TOOLS) > $(QMC_DIR)/tools.jsonl
 	set -o pipefail; $(BUILD)/genz_compare $(QMC_CASES) --params-dir $(QMC_DIR)/params \
-	  --external $(QMC_DIR)/tools.jsonl --n 1048576 --reps $(QMC_REPS) --gsl plain,miser \
-	  --methods sobol,sobol:lms_shift,sobol:digital_shift,lattice,halton \
+	  --external $(QMC_DIR)/tools.jsonl --n $(QMC_N) --reps $(QMC_REPS) --gsl $(QMC_GSL) \
+	  --randomizations $(QMC_K) --methods $(QMC_METHODS) \
 	  --json $(QMC_DIR)/compare.jsonl | tee $(QMC_DIR)/compare.txt
 
 # The C++ sources, tracked and untracked (not ignored): a new file is formatted before its first

@@ -10,7 +10,9 @@
 //
 // --no-genz leaves Genz's families out (the scenes, and with --singular the products, alone).
 // --ns runs each listed N as a study of its own (instead of the ladder n_min..n_max).
-// --presets runs these presets only (default: every preset of kPresets).
+// --presets runs these presets only (default: every preset of kPresets); "sobol:4" (also
+// halton:K, lattice:K) is the preset with K randomizations of N/K points instead of 16, run as
+// the estimator "sobol_k4", to judge the error bars of few randomizations.
 // --border adds, per dimension and parameter seed, two products on either side of an infinite
 // variance (tail index 1 / a_1 in (2.22, 2.5) and (1.67, 1.92); add_border_products).
 // --blind runs the generated cases (Genz, --singular, --border) without telling the studies
@@ -96,6 +98,19 @@ struct Options {
     uint64_t stop_n_max = uint64_t(1) << 22;
 };
 
+/// A --presets item as a scene's estimator: the preset's name, or for "sobol:K" (halton:K,
+/// lattice:K) the estimator "sobol_kK" with that sampler and K randomizations; null if the item
+/// is neither.
+Json randomized_nets(const std::string& item) {
+    const size_t colon = item.find(':');
+    if (colon == std::string::npos) return item;
+    const std::string base = item.substr(0, colon), k = item.substr(colon + 1);
+    if ((base != "sobol" && base != "halton" && base != "lattice") || k.empty() || k.size() > 6 ||
+        k.find_first_not_of("0123456789") != std::string::npos)
+        return nullptr;
+    return {{"name", base + "_k" + k}, {"sampler", base}, {"randomizations", std::stoi(k)}};
+}
+
 [[noreturn]] void usage(const std::string& msg) {
     if (!msg.empty()) std::fprintf(stderr, "calibrate: %s\n", msg.c_str());
     std::fprintf(stderr, "usage: calibrate [--quick] [--reps R] [--n-min N] [--n-max N]\n"
@@ -158,9 +173,13 @@ Options parse_options(int argc, char** argv) {
             o.presets.clear();
             std::stringstream ss(value());
             for (std::string item; std::getline(ss, item, ',');) {
+                const std::string base = item.substr(0, item.find(':'));
                 if (std::find_if(std::begin(kPresets), std::end(kPresets),
-                                 [&](const char* p) { return item == p; }) == std::end(kPresets))
+                                 [&](const char* p) { return base == p; }) == std::end(kPresets))
                     usage("--presets: unknown preset '" + item + "'");
+                if (base != item && !randomized_nets(item).is_object())
+                    usage("--presets: '" + item +
+                          "': K randomizations are written sobol:K, halton:K or lattice:K");
                 o.presets.push_back(item);
             }
         } else if (a == "--singular")
@@ -228,7 +247,7 @@ template <class Power>
 void add_power_products(const Options& o, const std::string& kind, Power power,
                         std::vector<Case>* cases) {
     Json presets = Json::array();
-    for (const std::string& p : o.presets) presets.push_back(p);
+    for (const std::string& p : o.presets) presets.push_back(randomized_nets(p));
     for (int d : o.dims)
         for (uint64_t seed : o.param_seeds)
             for (const bool infinite_variance : {false, true}) {
@@ -270,7 +289,7 @@ void add_border_products(const Options& o, std::vector<Case>* cases) {
 std::vector<Case> genz_cases(const Options& o) {
     std::vector<Case> cases;
     Json presets = Json::array();
-    for (const std::string& p : o.presets) presets.push_back(p);
+    for (const std::string& p : o.presets) presets.push_back(randomized_nets(p));
     for (int fam1 : o.genz ? o.families : std::vector<int>())
         for (int d : o.dims)
             for (uint64_t seed : o.param_seeds) {
@@ -320,8 +339,9 @@ std::vector<Case> scene_cases(const Options& o) {
         if (!j.ok() || !j.value.is_object() || j.value.contains("render")) continue;
         cases.push_back(Case{p.stem().string(), j.value, Json::object()});
         for (const std::string& preset : o.presets)
-            cases.push_back(
-                Case{p.stem().string() + "+" + preset, j.value, {{"estimators", {preset}}}});
+            cases.push_back(Case{p.stem().string() + "+" + preset,
+                                 j.value,
+                                 {{"estimators", Json::array({randomized_nets(preset)})}}});
     }
     return cases;
 }

@@ -4,8 +4,14 @@
 //
 //   genz_compare [--quick] [--n N] [--reps R] [--dims 2,4,8,16] [--families 1,...,6]
 //                [--methods uniform,stratified,...] [--gsl plain,miser,vegas|none]
-//                [--param-seed S] [--seed S] [--params-dir DIR] [--json FILE]
-//                [--write-params DIR] [--external FILE.jsonl] [--peaks] [--singular]
+//                [--param-seed S] [--seed S] [--randomizations K] [--params-dir DIR]
+//                [--json FILE] [--write-params DIR] [--external FILE.jsonl] [--peaks]
+//                [--singular]
+//
+// --randomizations K: the presets sobol, halton and lattice as K randomizations of N/K points
+// instead of their 16 (a method may also name its own: "sobol:4", "sobol:lms_shift:4"), to
+// compare with bench/qmc_tools.py --randomizations K at equal N and K; as there, a K other than
+// 16 shows in the method's name ("sobol:4").
 //
 // --peaks: instead of genz_random's cases, Genz's product peak with every a_j = a for a in
 // {100, 200, 500, 1000} and d in --dims (default 4, 6, 8), u_j the peak positions of
@@ -94,6 +100,7 @@ struct Options {
     std::vector<std::string> gsl{"plain", "miser", "vegas"};
     uint64_t param_seed = 1; // genz_random(family, d, param_seed)
     uint64_t seed = 1;       // replicate seeds
+    int randomizations = 0;  // --randomizations K for the QMC presets; 0: each preset's own (16)
     std::string params_dir, json_path, write_params_dir, external_path;
     bool quick = false;
     bool peaks = false; // --peaks: the sharp product peaks instead of genz_random's cases
@@ -109,12 +116,18 @@ std::vector<std::string> split(const std::string& s, char separator = ',') {
     return out;
 }
 
+/// Digits only: a count of randomizations in a method's name ("sobol:4").
+bool is_count(const std::string& s) {
+    return !s.empty() && s.find_first_not_of("0123456789") == std::string::npos;
+}
+
 [[noreturn]] void usage(const char* msg) {
     if (msg) std::fprintf(stderr, "genz_compare: %s\n", msg);
     std::fprintf(stderr,
                  "usage: genz_compare [--quick] [--n N] [--reps R] [--dims 2,4,8,16]\n"
                  "         [--families 1,2,3,4,5,6 | oscillatory,...] [--methods PRESET,...]\n"
                  "         [--gsl plain,miser,vegas|none] [--param-seed S] [--seed S]\n"
+                 "         [--randomizations K]\n"
                  "         [--params-dir DIR] [--json FILE] [--write-params DIR]\n"
                  "         [--external FILE.jsonl] [--peaks] [--singular]\n");
     std::exit(2);
@@ -184,6 +197,9 @@ Options parse_options(int argc, char** argv) {
             o.param_seed = parse_u64(value(), "--param-seed");
         else if (a == "--seed")
             o.seed = parse_u64(value(), "--seed");
+        else if (a == "--randomizations")
+            o.randomizations =
+                int(std::min<uint64_t>(parse_u64(value(), "--randomizations"), 1u << 30));
         else if (a == "--params-dir")
             o.params_dir = value();
         else if (a == "--json")
@@ -206,6 +222,16 @@ Options parse_options(int argc, char** argv) {
         if (!reps_given) o.reps = 3;
     }
     if (o.reps < 2) usage("--reps must be at least 2");
+    // --randomizations K: the QMC presets that name no K take it in their name ("sobol:4"), so
+    // the tables say what ran; 16 is their own and leaves the name as it is.
+    if (o.randomizations > 0 && o.randomizations != 16)
+        for (std::string& m : o.methods) {
+            const std::vector<std::string> parts = split(m, ':');
+            bool has_k = false;
+            for (size_t i = 1; i < parts.size(); ++i) has_k = has_k || is_count(parts[i]);
+            if (!has_k && (parts[0] == "sobol" || parts[0] == "halton" || parts[0] == "lattice"))
+                m += ":" + std::to_string(o.randomizations);
+        }
     if (o.peaks && !o.dims_given) o.dims = {4, 6, 8};
     if (o.peaks && (o.families_given || !o.params_dir.empty()))
         usage("--peaks makes its own cases: no --families or --params-dir with it");
@@ -713,9 +739,10 @@ double best_eff_sig(const std::vector<Cell>& cells, bool mcplay) {
 }
 
 /// A method is a preset name, optionally with a randomization and a count of randomizations:
-/// "sobol", "sobol:lms_shift", "sobol:owen:32"; or a VEGAS preset with options of its "vegas"
-/// object, numbers or words: "vegas/alpha=1.5/train_fraction=0.4", "vegas/report=iterations";
-/// "sampler=" is the estimator's own field (a new name: "vegas_strat/sampler=stratified").
+/// "sobol", "sobol:lms_shift", "sobol:owen:32", "sobol:4"; or a VEGAS preset with options of its
+/// "vegas" object, numbers or words: "vegas/alpha=1.5/train_fraction=0.4",
+/// "vegas/report=iterations"; "sampler=" is the estimator's own field (a new name:
+/// "vegas_strat/sampler=stratified").
 Json estimator_for(const std::string& method) {
     if (method.find('/') != std::string::npos) {
         std::vector<std::string> parts = split(method, '/');
@@ -740,10 +767,17 @@ Json estimator_for(const std::string& method) {
         top["vegas"] = options;
         return top;
     }
+    // "sobol:owen", "sobol:owen:4" or "sobol:4": the randomization and/or the number K of
+    // randomizations.
     std::vector<std::string> parts = split(method, ':');
-    if (parts.size() == 1) return method;
-    Json e = {{"name", parts[0]}, {"randomization", parts[1]}};
-    if (parts.size() > 2) e["randomizations"] = std::atoll(parts[2].c_str());
+    Json e = {{"name", parts[0]}};
+    for (size_t i = 1; i < parts.size(); ++i) {
+        if (is_count(parts[i]))
+            e["randomizations"] = std::atoll(parts[i].c_str());
+        else
+            e["randomization"] = parts[i];
+    }
+    if (e.size() == 1) return method;
     return e;
 }
 
@@ -795,6 +829,10 @@ int main(int argc, char** argv) {
                                 : "parameters genz_random(family, d, seed ") +
                        std::to_string(o.param_seed) + "), exact values genz_exact")
                           .c_str());
+    if (o.randomizations > 0)
+        std::printf(
+            "  sobol, halton, lattice: %d randomizations of N/%d points (--randomizations)\n",
+            o.randomizations, o.randomizations);
     std::printf("  %s, %s %s; %s\n", date, un.machine, un.release,
                 o.quick ? "--quick" : "full run");
     std::printf("  VEGAS: warm-up 10^4 calls (stage 0), then the main run (stage 1) on the trained "
@@ -827,6 +865,7 @@ int main(int argc, char** argv) {
           {"N", o.n},
           {"R", o.reps},
           {"seed", o.seed},
+          {"randomizations", o.randomizations > 0 ? Json(o.randomizations) : Json(nullptr)},
           {"param_seed", from_files ? Json(nullptr) : Json(o.param_seed)},
           {"params_dir", from_files ? Json(o.params_dir) : Json(nullptr)},
           {"quick", o.quick},

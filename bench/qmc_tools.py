@@ -9,7 +9,9 @@ prints one JSON line per estimate in the format `genz_compare --external` reads:
 
 Methods, each estimate from K independent randomizations of N/K points (N/K rounded to a power
 of two), the mean as estimate and the standard deviation of the K means / sqrt(K) as its error
-bar, as mcplay's RQMC estimators report theirs:
+bar, as mcplay's RQMC estimators report theirs (K = 1: one randomized net of N points and no
+error bar, "reported_sigma": null); a K other than 16 is part of the method's name
+("qmcpy_lms:4"), so runs at several K can share one file:
   qmcpy_lms     QMCPy DigitalNetB2: Joe-Kuo Sobol', linear matrix scramble + digital shift
   qmcpy_lattice QMCPy Lattice: rank-1 lattice, random shifts
   scipy_sobol   scipy.stats.qmc.Sobol(scramble=True): LMS + digital shift, K generators
@@ -73,8 +75,8 @@ def main():
     ap.add_argument("--methods", default="qmcpy_lms,qmcpy_lattice,scipy_sobol")
     ap.add_argument("--seed", type=int, default=1)
     o = ap.parse_args()
-    if o.randomizations < 2 or o.n < 4 * o.randomizations or o.reps < 1:
-        sys.exit("qmc_tools: need --randomizations >= 2, --n >= 4 K and --reps >= 1")
+    if o.randomizations < 1 or o.n < 4 * o.randomizations or o.reps < 1:
+        sys.exit("qmc_tools: need --randomizations >= 1, --n >= 4 K and --reps >= 1")
     m = int(round(math.log2(o.n / o.randomizations)))
     files = sorted(glob.glob(os.path.join(o.params_dir, "*.json")))
     if not files:
@@ -90,13 +92,16 @@ def main():
                 seed = o.seed * 1000003 + rep
                 t0 = time.perf_counter()
                 x = point_sets(method, d, o.randomizations, m, seed)
+                x = x.reshape(o.randomizations, 2 ** m, d)  # K = 1: QMCPy drops the axis
                 means = np.array([genz(p["family"], p["a"], p["u"], x[j]).mean()
                                   for j in range(o.randomizations)])
                 seconds = time.perf_counter() - t0
+                sigma = (float(means.std(ddof=1) / math.sqrt(len(means)))
+                         if len(means) > 1 else None)
+                label = method if o.randomizations == 16 else "%s:%d" % (method, o.randomizations)
                 print(json.dumps({
-                    "tool": tools[method], "method": method, "case": name,
-                    "estimate": float(means.mean()),
-                    "reported_sigma": float(means.std(ddof=1) / math.sqrt(len(means))),
+                    "tool": tools[method], "method": label, "case": name,
+                    "estimate": float(means.mean()), "reported_sigma": sigma,
                     "calls": o.randomizations * 2 ** m, "seconds": seconds}), flush=True)
 
 

@@ -106,6 +106,68 @@ TEST(RqmcErrorBars, ReportedVarianceMatchesReplicateSpread) {
     }
 }
 
+// Few randomizations (K = 4 and 2: 3 and 1 degrees of freedom) still make honest intervals:
+// the t quantile widens them as the K batch means, near normal for smooth f [Loh03], ask.
+// Coverage over 400 runs within 3.5 binomial standard errors of 95% (sqrt(0.95 x 0.05 / 400)
+// = 1.1%: [0.912, 0.988]), on smooth families at parameters the rules were not tuned on.
+TEST(RqmcErrorBars, FewRandomizationsStillCoverNinetyFivePercent) {
+    const double se = std::sqrt(0.95 * 0.05 / 400.0);
+    for (int k : {4, 2}) {
+        for (const char* family : {"oscillatory", "gaussian", "continuous"}) {
+            for (int dim : {3, 5}) {
+                Json sobol_k = {{"name", "sobol"}, {"randomizations", k}};
+                SceneRequest req =
+                    must(genz_scene(family, dim, 52, Json::array({sobol_k})), Json{{"n_min", 1024},
+                                                                                   {"n_max", 1024},
+                                                                                   {"reps", 400},
+                                                                                   {"seed", 49},
+                                                                                   {"threads", 2}});
+                ASSERT_EQ(req.estimators[0].randomizations, k);
+                StudyResult s = run_study(req.problem, req.estimators, req.settings);
+                const LevelStats& l = s.estimators[0].levels[0];
+                EXPECT_EQ(l.run_dofs[0], k - 1);
+                EXPECT_NEAR(l.coverage, 0.95, 3.5 * se)
+                    << "K=" << k << " " << family << " d=" << dim;
+            }
+        }
+    }
+}
+
+// At a fixed N, fewer randomizations mean larger nets: Owen-scrambled nets of n points have
+// variance O(n^-3 (log n)^(d-1)) on smooth f [Owen97b], so K nets of N/K points have
+// O(K^2 N^-3) up to logarithms, and the variance falls with K. Over R = 300 runs the log of a
+// ratio of two replicate variances has standard error about sqrt(2/(R-1) + 2/(R-1)) = 0.116;
+// each step 16 -> 4 -> 2 must lower it by more than 4 of those (a factor above 1.6), the
+// direction theory gives and plain Monte Carlo (whose variance ignores K) would not.
+TEST(RqmcVariance, FewerRandomizationsAtFixedNLowerTheVariance) {
+    const int reps = 300;
+    const double log_ratio_se = std::sqrt(4.0 / (reps - 1.0));
+    Json estimators = Json::array();
+    for (int k : {16, 4, 2})
+        estimators.push_back(Json{
+            {"name", "sobol_k" + std::to_string(k)}, {"sampler", "sobol"}, {"randomizations", k}});
+    Json scene{{"name", "smooth_3d"},
+               {"domain", {{"type", "box"}, {"lower", {0, 0, 0}}, {"upper", {1, 1, 1}}}},
+               {"integrand", {{"type", "exponential"}, {"rates", {1.0, -0.7, 0.4}}}},
+               {"estimators", estimators}};
+    SceneRequest req =
+        must(scene,
+             Json{{"n_min", 4096}, {"n_max", 4096}, {"reps", reps}, {"seed", 49}, {"threads", 2}});
+    StudyResult s = run_study(req.problem, req.estimators, req.settings);
+    ASSERT_EQ(s.estimators.size(), 3u);
+    for (size_t i = 0; i + 1 < s.estimators.size(); ++i) {
+        const double more = s.estimators[i].levels[0].variance;
+        const double fewer = s.estimators[i + 1].levels[0].variance;
+        ASSERT_GT(fewer, 0.0);
+        EXPECT_GT(std::log(more / fewer), 4.0 * log_ratio_se)
+            << s.estimators[i].spec.name << " variance " << more << ", "
+            << s.estimators[i + 1].spec.name << " " << fewer;
+        // The error bars follow: the runs' mean reported variance falls by a like factor.
+        EXPECT_LT(s.estimators[i + 1].levels[0].mean_run_variance,
+                  s.estimators[i].levels[0].mean_run_variance);
+    }
+}
+
 // Owen-scrambled Sobol' points on a smooth 2-D integrand: the variance falls at least as N^-2
 // (theory: N^-3 for smooth f [Owen97b]); plain Monte Carlo falls as N^-1.
 TEST(RqmcRates, SobolOnASmoothIntegrandFallsFasterThanNToMinus2) {
