@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "core/qmc.h"
+#include "core/rng.h"
 #include "test_support.h"
 
 using namespace mcp;
@@ -195,6 +196,24 @@ TEST(Qmc, SobolMatchesBratleyFoxRecurrence) {
     auto r = make_qmc_randomizer(QmcKind::Sobol, QmcRandomization::None, 3, 1);
     EXPECT_EQ(qmc_coordinate(r, 0, 2), 0.0);
     EXPECT_EQ(qmc_coordinate(r, 12345, 2), sobol_u32(12345, 2) * 0x1p-32);
+}
+
+TEST(Qmc, SobolByteTablesMatchTheGrayCodeLoop) {
+    // The pixel samplers' table lookups against sobol_u32 on indices spread over 32 bits:
+    // the first 4096, every single bit and pseudo-random ones.
+    const SobolByteTables& t = sobol_byte_tables();
+    std::vector<uint32_t> indices;
+    for (uint32_t i = 0; i < 4096; ++i) indices.push_back(i);
+    for (int b = 0; b < 32; ++b) indices.push_back(uint32_t(1) << b);
+    Pcg32 rng(7, 3);
+    for (int i = 0; i < 20000; ++i) indices.push_back(rng.next_u32());
+    indices.push_back(0xffffffffu);
+    for (uint32_t i : indices) {
+        const uint64_t xy = t.point_2d(i);
+        ASSERT_EQ(uint32_t(xy), sobol_u32(i, 0)) << i;
+        ASSERT_EQ(uint32_t(xy >> 32), sobol_u32(i, 1)) << i;
+        ASSERT_EQ(t.coordinate_2(i), sobol_u32(i, 2)) << i;
+    }
 }
 
 TEST(Qmc, HaltonAndLatticeKnownValues) {

@@ -254,6 +254,48 @@ TEST(Render, ImagesDoNotDependOnThreads) {
     }
 }
 
+// Directions sampled at shading points meet the lights first when the lights are at most half
+// the scene (RenderScene::emitters_first), then ask the scene whether anything lies in front:
+// the images are those of tracing every direction to its closest hit, bit for bit, with a
+// blocker half shadowing the floor, a second light above the first (hidden behind it) and a
+// light seen from its back. A closed box of emitters keeps the closest-hit path.
+TEST(Render, LightsFirstGivesTheClosestHitImages) {
+    Scene scene = test::quad_light_scene(5.0);
+    Material light = diffuse(0.0);
+    light.emission = Vec3(2.0);
+    scene.materials.push_back(light);
+    test::add_quad(scene, {-0.3, 1.5, -0.3}, {0.3, 1.5, -0.3}, {0.3, 1.5, 0.3}, {-0.3, 1.5, 0.3},
+                   2); // faces -y
+    test::add_quad(scene, {1.2, 0.8, -1}, {1.2, 0.8, 1}, {1.6, 0.8, 1}, {1.6, 0.8, -1},
+                   2);                                                              // faces +y
+    test::add_quad(scene, {-1, 0.4, 0}, {-1, 0.4, 1}, {0, 0.4, 1}, {0, 0.4, 0}, 0); // blocker
+    test::add_quad(scene, {-1, 0.4, 0}, {0, 0.4, 0}, {0, 0.4, 1}, {-1, 0.4, 1}, 0);
+    test::add_quad(scene, {-2, 0, 2}, {-2, 2, 2}, {2, 2, 2}, {2, 0, 2}, 0); // a wall
+    test::add_quad(scene, {-2, 0, -2}, {2, 0, -2}, {2, 2, -2}, {-2, 2, -2}, 0);
+    scene.camera = test::look_at({0, 1.2, 1.9}, {0, 0, 0}, {0, 1, 0}, 1.3);
+    RenderScene lights_first;
+    lights_first.build(scene);
+    ASSERT_TRUE(lights_first.emitters_first);
+    RenderScene closest_hit = lights_first;
+    closest_hit.emitters_first = false;
+    for (RadianceStrategy s : {RadianceStrategy::UniformHemisphere, RadianceStrategy::Bsdf,
+                               RadianceStrategy::MisPower}) {
+        for (PixelSamplerKind px : {PixelSamplerKind::Stratified, PixelSamplerKind::PaddedSobol}) {
+            RenderImage a = render_image(lights_first, estimator(s, px), settings(16, 12, 16, 9));
+            RenderImage b = render_image(closest_hit, estimator(s, px), settings(16, 12, 16, 9));
+            EXPECT_EQ(a.rgb, b.rgb) << strategy_name(s);
+            EXPECT_EQ(a.diagnostics.rays, b.diagnostics.rays);
+            double sum = 0.0;
+            for (double v : a.rgb) sum += v;
+            EXPECT_GT(sum, 0.0);
+        }
+    }
+    Scene box = test::furnace_box(0.5, 1.0, 2);
+    RenderScene all_lights;
+    all_lights.build(box);
+    EXPECT_FALSE(all_lights.emitters_first);
+}
+
 // Relative MSE against a reference falls as 1/spp for every unbiased estimator with
 // independent pixel samples (fitted order within 4 standard errors of -1, plus 0.1 for the
 // reference's own noise at the largest spp); stratified samples do at least as well.

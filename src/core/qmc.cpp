@@ -10,6 +10,9 @@ namespace mcp {
 
 namespace {
 
+using qmc_detail::owen_hash_reversed;
+using qmc_detail::reverse_bits32;
+
 constexpr int kDigitBits = 32;             // Sobol' digits per coordinate
 constexpr int kFillBits = 53 - kDigitBits; // random bits below the digits
 constexpr uint64_t kMask53 = (uint64_t(1) << 53) - 1;
@@ -20,15 +23,6 @@ constexpr size_t kChunk = 256; // points per pass of the block loops
 
 inline int trailing_zeros(uint64_t x) {
     return __builtin_ctzll(x);
-}
-
-inline uint32_t reverse_bits32(uint32_t x) {
-    x = (x >> 16) | (x << 16);
-    x = ((x & 0xff00ff00u) >> 8) | ((x & 0x00ff00ffu) << 8);
-    x = ((x & 0xf0f0f0f0u) >> 4) | ((x & 0x0f0f0f0fu) << 4);
-    x = ((x & 0xccccccccu) >> 2) | ((x & 0x33333333u) << 2);
-    x = ((x & 0xaaaaaaaau) >> 1) | ((x & 0x55555555u) << 1);
-    return x;
 }
 
 inline uint32_t parity32(uint32_t x) {
@@ -129,21 +123,6 @@ uint32_t sobol_from_directions(const uint32_t* v, uint64_t index) {
 
 // ---------------------------------------------------------------------------------------------
 // Owen scrambling of base-2 digits by hashing.
-
-// Laine-Karras hash of bit-reversed digits [LaineKarras11, Burley20] with the constants of
-// [Vegdahl21], who searched them for avalanche between the bits it is allowed to mix (the
-// original ones leave visible structure). Every step (x ^= x * even, x += seed, x *= odd) is
-// a bijection that changes bit i by a function of bits 0 .. i-1 (and the seed) only: products
-// and carries move upwards. After reversal bit i is digit i + 1, so each digit is flipped by a
-// function of the digits before it, which is a nested (Owen) scramble of the 32 digits.
-inline uint32_t owen_hash_reversed(uint32_t x, uint32_t seed) {
-    x ^= x * 0x3d20adeau;
-    x += seed;
-    x *= (seed >> 16) | 1u;
-    x ^= x * 0x05526c56u;
-    x ^= x * 0x53a22864u;
-    return x;
-}
 
 // A per-dimension key for the fill bits and the Halton digit permutations.
 inline uint64_t dimension_key(uint32_t seed, int dim) {
@@ -453,8 +432,23 @@ uint32_t sobol_u32(uint64_t index, int dim) {
     return sobol_from_directions(tables().sobol[dim], index);
 }
 
-uint32_t owen_scramble_u32(uint32_t v, uint32_t seed) {
-    return reverse_bits32(owen_hash_reversed(reverse_bits32(v), seed));
+const SobolByteTables& sobol_byte_tables() {
+    static const SobolByteTables t = [] {
+        SobolByteTables b{};
+        const QmcTables& q = tables();
+        for (int byte = 0; byte < 4; ++byte)
+            for (uint32_t g = 0; g < 256; ++g) {
+                // The XOR of the directions of gray-code bits 8 byte .. 8 byte + 7 set in g.
+                uint32_t c[3] = {0, 0, 0};
+                for (int bit = 0; bit < 8; ++bit)
+                    if ((g >> bit) & 1u)
+                        for (int dim = 0; dim < 3; ++dim) c[dim] ^= q.sobol[dim][8 * byte + bit];
+                b.xy[byte][g] = uint64_t(c[0]) | (uint64_t(c[1]) << 32);
+                b.z[byte][g] = c[2];
+            }
+        return b;
+    }();
+    return t;
 }
 
 QmcRandomizer make_qmc_randomizer(QmcKind kind, QmcRandomization r, int dim, uint64_t key,

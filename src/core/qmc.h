@@ -77,10 +77,63 @@ uint64_t qmc_max_points(QmcKind kind);
 /// (index < 2^32), as 32 binary digits (the most significant bit is the first digit).
 uint32_t sobol_u32(uint64_t index, int dim);
 
+/// Sobol' coordinates 0, 1 and 2 of 32-bit indices by tables instead of a loop over the set
+/// bits of the Gray code: since the point is the XOR of the directions of gray(index)'s bits
+/// (linear over GF(2)), it is the XOR of four entries, one per byte of gray(index), each the
+/// XOR of the directions of that byte's bits. Coordinates 0 and 1 share an entry (low and
+/// high halves), so a 2D point takes four lookups. 12 KiB, built once (sobol_byte_tables()).
+struct SobolByteTables {
+    uint64_t xy[4][256]; ///< coordinate 0 | coordinate 1 << 32
+    uint32_t z[4][256];  ///< coordinate 2
+    /// sobol_u32(index, 0) | sobol_u32(index, 1) << 32.
+    uint64_t point_2d(uint32_t index) const {
+        const uint32_t g = index ^ (index >> 1);
+        return xy[0][g & 255u] ^ xy[1][(g >> 8) & 255u] ^ xy[2][(g >> 16) & 255u] ^ xy[3][g >> 24];
+    }
+    /// sobol_u32(index, 2).
+    uint32_t coordinate_2(uint32_t index) const {
+        const uint32_t g = index ^ (index >> 1);
+        return z[0][g & 255u] ^ z[1][(g >> 8) & 255u] ^ z[2][(g >> 16) & 255u] ^ z[3][g >> 24];
+    }
+};
+const SobolByteTables& sobol_byte_tables();
+
+namespace qmc_detail {
+
+inline uint32_t reverse_bits32(uint32_t x) {
+    x = (x >> 16) | (x << 16);
+    x = ((x & 0xff00ff00u) >> 8) | ((x & 0x00ff00ffu) << 8);
+    x = ((x & 0xf0f0f0f0u) >> 4) | ((x & 0x0f0f0f0fu) << 4);
+    x = ((x & 0xccccccccu) >> 2) | ((x & 0x33333333u) << 2);
+    x = ((x & 0xaaaaaaaau) >> 1) | ((x & 0x55555555u) << 1);
+    return x;
+}
+
+// Laine-Karras hash of bit-reversed digits [LaineKarras11, Burley20] with the constants of
+// [Vegdahl21], who searched them for avalanche between the bits it is allowed to mix (the
+// original ones leave visible structure). Every step (x ^= x * even, x += seed, x *= odd) is
+// a bijection that changes bit i by a function of bits 0 .. i-1 (and the seed) only: products
+// and carries move upwards. After reversal bit i is digit i + 1, so each digit is flipped by a
+// function of the digits before it, which is a nested (Owen) scramble of the 32 digits.
+inline uint32_t owen_hash_reversed(uint32_t x, uint32_t seed) {
+    x ^= x * 0x3d20adeau;
+    x += seed;
+    x *= (seed >> 16) | 1u;
+    x ^= x * 0x05526c56u;
+    x ^= x * 0x53a22864u;
+    return x;
+}
+
+} // namespace qmc_detail
+
 /// Nested uniform scrambling of 32 binary digits by a keyed hash: every digit is flipped by a
 /// hash of the digits before it and the seed [LaineKarras11, Burley20], with the hash
-/// constants of [Vegdahl21]. The seed should be random (a full 32-bit draw).
-uint32_t owen_scramble_u32(uint32_t v, uint32_t seed);
+/// constants of [Vegdahl21]. The seed should be random (a full 32-bit draw). Inline: the
+/// pixel samplers call it several times per sample.
+inline uint32_t owen_scramble_u32(uint32_t v, uint32_t seed) {
+    using namespace qmc_detail;
+    return reverse_bits32(owen_hash_reversed(reverse_bits32(v), seed));
+}
 
 /// 32 digits followed by 21 fill bits as a double in (0, 1): ((v << 21 | fill) + 1/2) 2^-53.
 /// Above 1/2 the half step is not representable and k + 1/2 rounds to an even neighbour; the

@@ -191,13 +191,25 @@ struct DirectionResult {
     Hit h;
     Vec3 emitted{0.0};
 };
-/// Traces the ray from the shading point along the world-space direction wi.
+/// Traces the ray from the shading point along the world-space direction wi. With
+/// rs.emitters_first the closest light hit comes from the lights' own accelerator and the
+/// scene's only says whether anything is hit before it (0 < t < the light's t): the same
+/// answer wherever the emission is nonzero (the triangle tests give the same t bit for bit in
+/// both structures), r.hit false where the closest hit is not a light. The ray counts once.
 DirectionResult trace_direction(const RenderScene& rs, const ShadingPoint& sp, const Vec3& wi,
                                 SampleCounters& c) {
     DirectionResult r;
     Ray ray = spawn_ray(sp, wi);
     ++c.rays;
-    r.hit = rs.accel.intersect(ray, &r.h);
+    if (rs.emitters_first) {
+        if (!rs.emitters.intersect(ray, &r.h)) return r;
+        r.h.triangle = rs.emitter_triangle[r.h.triangle];
+        ray.t_max = r.h.t;
+        if (rs.accel.occluded(ray)) return r;
+        r.hit = true;
+    } else {
+        r.hit = rs.accel.intersect(ray, &r.h);
+    }
     if (r.hit) r.emitted = rs.lights_uniform.emitted(r.h.triangle, -wi);
     return r;
 }
@@ -612,6 +624,20 @@ void RenderScene::build(const Scene& s, AccelKind accel_kind) {
     lights_uniform.build(s, LightSelection::Uniform);
     lights_area.build(s, LightSelection::Area);
     lights_power.build(s, LightSelection::Power);
+    // The lights as a mesh of their own, triangles in the scene's order (so ties between
+    // lights at the same t go to the lower mesh id in both structures).
+    Mesh lights;
+    lights.position = s.mesh.position;
+    emitter_triangle.clear();
+    for (uint32_t t = 0; t < uint32_t(s.mesh.triangle_count()); ++t)
+        if (lights_uniform.light_index(t) >= 0) {
+            lights.index.push_back(s.mesh.index[t]);
+            emitter_triangle.push_back(t);
+        }
+    emitters_first =
+        !emitter_triangle.empty() && 2 * emitter_triangle.size() <= s.mesh.triangle_count();
+    emitters = Accelerator();
+    if (emitters_first) emitters.build(lights, accel_kind);
 }
 
 const LightSet& RenderScene::lights(LightSelection selection) const {

@@ -111,6 +111,14 @@ struct RenderScene {
     const Scene* scene = nullptr;
     Accelerator accel;
     LightSet lights_uniform, lights_area, lights_power;
+    /// The lights' triangles alone (emitter_triangle: its triangle -> the mesh's), built when
+    /// they are at most half the scene's: a direction sampled at a shading point contributes
+    /// only when its closest hit is a light, so it is tested against the lights first and the
+    /// whole scene is asked only whether something lies in front of the light it meets (an
+    /// any-hit query) instead of tracing every direction to its closest hit.
+    Accelerator emitters;
+    std::vector<uint32_t> emitter_triangle;
+    bool emitters_first = false;
 
     /// Builds the accelerator and the light sets (selection tables only where there is more
     /// than one light). The scene must outlive this object.

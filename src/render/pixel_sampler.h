@@ -188,6 +188,7 @@ class PixelSampler {
         spp_ = spp;
         width_ = width > 0 ? uint64_t(width) : 1;
         image_key_ = image_key;
+        sobol_ = &sobol_byte_tables();
         auto grid = stratification_grid(spp, 2);
         grid_x_ = grid[0];
         grid_y_ = grid[1];
@@ -238,7 +239,7 @@ class PixelSampler {
         int d = dimension_++;
         if (kind_ == PixelSamplerKind::PaddedSobol) {
             const PaddedRequest r = padded_request(d);
-            return sobol_value(sobol_u32(r.index, 0), 0, r.seeds);
+            return sobol_value(uint32_t(sobol_->point_2d(r.index)), 0, r.seeds);
         }
         if (kind_ == PixelSamplerKind::Sobol) {
             uint32_t v[1];
@@ -258,8 +259,9 @@ class PixelSampler {
         dimension_ += 2;
         if (kind_ == PixelSamplerKind::PaddedSobol) {
             const PaddedRequest r = padded_request(d);
-            double u0 = sobol_value(sobol_u32(r.index, 0), 0, r.seeds);
-            double u1 = sobol_value(sobol_u32(r.index, 1), 1, r.seeds);
+            const uint64_t xy = sobol_->point_2d(r.index);
+            double u0 = sobol_value(uint32_t(xy), 0, r.seeds);
+            double u1 = sobol_value(uint32_t(xy >> 32), 1, r.seeds);
             return Vec2(u0, u1);
         }
         if (kind_ == PixelSamplerKind::Sobol) {
@@ -298,7 +300,10 @@ class PixelSampler {
         uint64_t seeds;
         if (kind_ == PixelSamplerKind::PaddedSobol) {
             const PaddedRequest r = padded_request(d);
-            for (int k = 0; k < 3; ++k) v[k] = sobol_u32(r.index, k);
+            const uint64_t xy = sobol_->point_2d(r.index);
+            v[0] = uint32_t(xy);
+            v[1] = uint32_t(xy >> 32);
+            v[2] = sobol_->coordinate_2(r.index);
             seeds = r.seeds;
         } else {
             seeds = sobol_point(d, 3, v);
@@ -408,7 +413,10 @@ class PixelSampler {
         // The sample part lies below bit 32 (sample_bits <= 32): the bits of I above 32 are
         // the pixel's, so the seeds are too.
         r->seeds = hash_combine(dim_key ^ 0x6f77656e5365656eULL, r->high >> 32); // "owenSeen"
-        for (int c = 0; c < 3; ++c) r->high_digits[c] = sobol_u32(uint32_t(r->high), c);
+        const uint64_t xy = sobol_->point_2d(uint32_t(r->high));
+        r->high_digits[0] = uint32_t(xy);
+        r->high_digits[1] = uint32_t(xy >> 32);
+        r->high_digits[2] = sobol_->coordinate_2(uint32_t(r->high));
         const uint64_t key = hash_combine(dim_key, morton_);
         if (row != nullptr)
             shuffle_row(row, key);
@@ -441,7 +449,11 @@ class PixelSampler {
             sample = row[index_];
         else
             sample = permute_index(index_, r->permutation);
-        for (int c = 0; c < count; ++c) digits[c] = r->high_digits[c] ^ sobol_u32(sample, c);
+        // sample < 2^32 (sample_bits <= 32).
+        const uint64_t xy = sobol_->point_2d(uint32_t(sample));
+        digits[0] = r->high_digits[0] ^ uint32_t(xy);
+        if (count > 1) digits[1] = r->high_digits[1] ^ uint32_t(xy >> 32);
+        if (count > 2) digits[2] = r->high_digits[2] ^ sobol_->coordinate_2(uint32_t(sample));
         return r->seeds;
     }
 
@@ -464,6 +476,7 @@ class PixelSampler {
     int sample_bits_ = 0, morton_bits_ = 0;
     int dimension_ = 0;
     Pcg32 rng_;
+    const SobolByteTables* sobol_ = nullptr; ///< set by configure
     uint64_t prepared_ = 0; ///< bit d: dimension (request) d is prepared for this pixel
     static_assert(kStratifiedDimensions <= 64 && kSobolPreparedRequests <= 64,
                   "one bit of prepared_ per dimension");
