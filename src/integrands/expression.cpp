@@ -18,6 +18,7 @@
 #include <cstring>
 #include <limits>
 
+#include "core/exp_block.h"
 #include "core/points.h"
 
 namespace mcp {
@@ -158,7 +159,7 @@ double apply_unary(uint8_t op, int k, double a) {
     case OpSinh: return std::sinh(a);
     case OpCosh: return std::cosh(a);
     case OpTanh: return std::tanh(a);
-    case OpExp: return std::exp(a);
+    case OpExp: return exp_tang(a);
     case OpLog: return std::log(a);
     case OpLog10: return std::log10(a);
     case OpSqrt: return std::sqrt(a);
@@ -227,7 +228,7 @@ void run_unary(uint8_t op, int k, const double* a, double* r, size_t n) {
     case OpSinh: loop1(a, r, n, [](double v) { return std::sinh(v); }); return;
     case OpCosh: loop1(a, r, n, [](double v) { return std::cosh(v); }); return;
     case OpTanh: loop1(a, r, n, [](double v) { return std::tanh(v); }); return;
-    case OpExp: loop1(a, r, n, [](double v) { return std::exp(v); }); return;
+    case OpExp: exp_block(a, r, n); return; // two lanes a step, as fast in wasm as natively
     case OpLog: loop1(a, r, n, [](double v) { return std::log(v); }); return;
     case OpLog10: loop1(a, r, n, [](double v) { return std::log10(v); }); return;
     case OpSqrt: loop1(a, r, n, [](double v) { return std::sqrt(v); }); return;
