@@ -2,7 +2,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
+#include <vector>
 
+#include "core/exp_block.h"
+#include "core/rng.h"
 #include "core/special.h"
 
 using namespace mcp;
@@ -97,4 +101,105 @@ TEST(Special, IncompleteBetaAndFTailIdentities) {
     EXPECT_NEAR(f_sf(1.7, 15.0, 1e8), chi_square_sf(15.0 * 1.7, 15.0), 1e-6);
     EXPECT_EQ(f_sf(0.0, 3.0, 4.0), 1.0);
     EXPECT_EQ(f_sf(std::numeric_limits<double>::infinity(), 3.0, 4.0), 0.0);
+}
+
+namespace {
+
+/// Arguments over exp's whole domain and near 0, with the ranges' ends and special values.
+std::vector<double> exp_arguments(size_t n) {
+    Pcg32 rng(21u, 5u);
+    std::vector<double> x(n);
+    for (size_t i = 0; i < n; ++i) {
+        const double u = rng.next_double();
+        switch (i % 4) {
+        case 0: x[i] = -750.0 + 1465.0 * u; break; // underflow to overflow
+        case 1: x[i] = -1.0 + 2.0 * u; break;
+        case 2: x[i] = std::ldexp(u - 0.5, -int(i % 60)); break; // tiny arguments
+        default: x[i] = -704.0 + 1408.0 * u; break;              // the table's range
+        }
+    }
+    const double inf = std::numeric_limits<double>::infinity();
+    for (double v : {0.0, -0.0, 1.0, -1.0, 703.99, -703.99, 704.0, -704.0, 709.78, 709.79, -708.4,
+                     -745.1, -746.0, inf, -inf, std::numeric_limits<double>::quiet_NaN(),
+                     std::numeric_limits<double>::denorm_min(), 1e-300})
+        x.push_back(v);
+    return x;
+}
+
+bool same_double(double a, double b) {
+    return a == b || (std::isnan(a) && std::isnan(b));
+}
+
+} // namespace
+
+TEST(ExpBlock, WithinOneUlpOfTheLibraryAndBlockEqualsScalar) {
+    const std::vector<double> x = exp_arguments(400001); // odd: the block's scalar tail runs
+    std::vector<double> y(x.size()), in_place = x;
+    exp_block(x.data(), y.data(), x.size());
+    exp_block(in_place.data(), in_place.data(), in_place.size());
+    size_t equal = 0;
+    for (size_t i = 0; i < x.size(); ++i) {
+        const double want = std::exp(x[i]), got = y[i];
+        const double t = exp_tang(x[i]);
+        ASSERT_TRUE(same_double(got, t)) << x[i];
+        ASSERT_TRUE(same_double(in_place[i], t)) << x[i];
+        if (std::isnan(want) || std::isinf(want)) { // NaN, overflow: the library's own
+            ASSERT_TRUE(same_double(got, want)) << x[i];
+            continue;
+        }
+        // Both within about half an ulp of e^x: equal or neighbours.
+        const double ulp = std::nextafter(want, std::numeric_limits<double>::infinity()) - want;
+        ASSERT_LE(std::fabs(got - want), ulp) << x[i];
+        equal += got == want;
+    }
+    // A correctly rounded result most of the time (both are).
+    EXPECT_GT(double(equal), 0.99 * double(x.size()));
+}
+
+namespace {
+
+/// e^x in long double when it is IEEE quadruple (wasm: musl's expl there is exp itself):
+/// x = k ln2 + r with ln2 in two parts (the first 33 bits, exact times k), then the Taylor
+/// series of e^r to 30 terms, within a few units of 2^-113.
+long double exp_quad_reference(double x) {
+    const long double ln2_hi = 0x1.62e42fefp-1L;
+    const long double ln2_lo = 7.4406171100123967161301568075500134360255e-11L;
+    const long double k = std::nearbyint(x / 0.6931471805599453);
+    const long double r = (static_cast<long double>(x) - k * ln2_hi) - k * ln2_lo;
+    long double term = 1.0L, sum = 1.0L;
+    for (int i = 1; i < 30; ++i) {
+        term *= r / i;
+        sum += term;
+    }
+    return std::ldexp(sum, static_cast<int>(k));
+}
+
+} // namespace
+
+TEST(ExpBlock, AsAccurateAsTheLibrary) {
+    // The reference: x87's 64-bit long double expl natively, the quadruple series in wasm.
+    const int digits = std::numeric_limits<long double>::digits;
+    if (digits != 64 && digits != 113)
+        GTEST_SKIP() << "long double has " << digits << " bits: no reference to measure ulps";
+    auto reference = [&](double x) {
+        return digits == 64 ? expl(static_cast<long double>(x)) : exp_quad_reference(x);
+    };
+    const std::vector<double> x = exp_arguments(digits == 64 ? 400000 : 100000);
+    std::vector<double> y(x.size());
+    exp_block(x.data(), y.data(), x.size());
+    double worst = 0.0, worst_library = 0.0;
+    for (size_t i = 0; i < x.size(); ++i) {
+        const long double ref = reference(x[i]);
+        if (!std::isfinite(x[i]) || !std::isfinite(static_cast<double>(ref)) ||
+            static_cast<double>(ref) < std::numeric_limits<double>::min())
+            continue; // overflow, subnormal results: std::exp's own (asserted above)
+        int e = 0;
+        std::frexp(static_cast<double>(ref), &e);
+        const long double ulp = std::ldexp(1.0L, e - 53);
+        worst = std::max(worst, double(std::fabs(y[i] - ref) / ulp));
+        worst_library = std::max(worst_library, double(std::fabs(std::exp(x[i]) - ref) / ulp));
+    }
+    // [Tang89]'s bound for 128 entries and a degree-5 polynomial: 0.5 + about 0.01 ulp.
+    EXPECT_LT(worst, 0.51) << "library " << worst_library;
+    EXPECT_LT(worst, worst_library + 0.005) << "library " << worst_library;
 }

@@ -447,8 +447,8 @@ double min_distance(const PointSet& set, bool toroidal, int threads) {
 // ---------------------------------------------------------------------------------------
 // Periodogram. F(kx, ky) = sum_j A_j(kx) B_j(ky) with A_j(kx) = exp(-2 pi i kx x_j) and
 // B_j(ky) = exp(-2 pi i ky y_j): a complex matrix product over the points. Only the rows
-// ky = -size/2 .. 0 are computed, over the columns kx = -size/2 .. size/2: the other rows
-// follow from F(-k) = conj F(k) (real points).
+// ky = -size/2 .. 0 are computed: the other rows follow from F(-k) = conj F(k) (real points).
+// A row is kept as four real sums over kx = 0 .. size/2, which give F at kx and at -kx.
 
 namespace {
 
@@ -486,9 +486,13 @@ void phases(double x, int k0, int count, double* re, double* im) {
     }
 }
 
-/// F row += sum over points of B_j A_j (four points a step: A rows a0..a3 re/im, 16-bit
-/// aligned stride), over the columns [0, columns).
-MCP_VECTOR_CLONES void accumulate_row(double* __restrict fr, double* __restrict fi,
+/// The four real sums of a row of F over the columns kx = 0 .. columns - 1, four points a step
+/// (A rows a0..a3, 64-byte aligned stride): P += sum A_re B_re, Q += sum A_im B_im,
+/// R += sum A_re B_im, S += sum A_im B_re. Then F(kx) = (P - Q) + i (R + S) and, as
+/// A_j(-kx) = conj A_j(kx), F(-kx) = (P + Q) + i (R - S): both halves of the row for half the
+/// products of the complex ones.
+MCP_VECTOR_CLONES void accumulate_row(double* __restrict sum_p, double* __restrict sum_q,
+                                      double* __restrict sum_r, double* __restrict sum_s,
                                       const double* are, const double* aim, size_t stride,
                                       const double* br, const double* bi, int points, int columns) {
     for (int j = 0; j < points; j += 4) {
@@ -499,10 +503,10 @@ MCP_VECTOR_CLONES void accumulate_row(double* __restrict fr, double* __restrict 
         const double *a0i = aim + size_t(j) * stride, *a1i = a0i + stride, *a2i = a1i + stride,
                      *a3i = a2i + stride;
         for (int c = 0; c < columns; ++c) {
-            fr[c] += ((r0 * a0r[c] - i0 * a0i[c]) + (r1 * a1r[c] - i1 * a1i[c])) +
-                     ((r2 * a2r[c] - i2 * a2i[c]) + (r3 * a3r[c] - i3 * a3i[c]));
-            fi[c] += ((r0 * a0i[c] + i0 * a0r[c]) + (r1 * a1i[c] + i1 * a1r[c])) +
-                     ((r2 * a2i[c] + i2 * a2r[c]) + (r3 * a3i[c] + i3 * a3r[c]));
+            sum_p[c] += (r0 * a0r[c] + r1 * a1r[c]) + (r2 * a2r[c] + r3 * a3r[c]);
+            sum_q[c] += (i0 * a0i[c] + i1 * a1i[c]) + (i2 * a2i[c] + i3 * a3i[c]);
+            sum_r[c] += (i0 * a0r[c] + i1 * a1r[c]) + (i2 * a2r[c] + i3 * a3r[c]);
+            sum_s[c] += (r0 * a0i[c] + r1 * a1i[c]) + (r2 * a2i[c] + r3 * a3i[c]);
         }
     }
 }
@@ -518,14 +522,15 @@ PowerSpectrum power_spectrum(const PointSet& set, int axis_a, int axis_b, int si
         return out;
     if (!one_d && (axis_b < 0 || axis_b >= set.dim || axis_b == axis_a)) return out;
     const int half = size / 2;
-    const int columns = size + 1;                        // kx = -half .. half
+    const int columns = half + 1;                        // kx = 0 .. half (and their negatives)
     const size_t stride = size_t((columns + 7) / 8 * 8); // 64-byte rows
     const int rows = one_d ? 1 : half + 1;               // ky = -half .. 0, or 0 alone
     const int ky0 = one_d ? 0 : -half;
     const double* xa = set.coords.data() + uint64_t(axis_a) * n;
     const double* xb = one_d ? nullptr : set.coords.data() + uint64_t(axis_b) * n;
 
-    std::vector<double> fr(size_t(rows) * stride, 0.0), fi(size_t(rows) * stride, 0.0);
+    // The four sums of accumulate_row, row after row.
+    std::vector<double> sums(size_t(rows) * 4 * stride, 0.0);
     // Workers own fixed ranges of rows and go through all the points, each computing the
     // column phases itself (N size work against the N size^2 / 2 of the product).
     const double work = double(n) * rows * columns;
@@ -545,7 +550,7 @@ PowerSpectrum power_spectrum(const PointSet& set, int axis_a, int axis_b, int si
             const int padded = (m + 3) / 4 * 4; // padding points: B = 0 adds exact zeros
             for (int j = 0; j < padded; ++j) {
                 if (j < m) {
-                    phases(xa[j0 + j], -half, columns, are.data() + size_t(j) * stride,
+                    phases(xa[j0 + j], 0, columns, are.data() + size_t(j) * stride,
                            aim.data() + size_t(j) * stride);
                     phases(one_d ? 0.0 : xb[j0 + j], ky0 + r0, my_rows, tre.data(), tim.data());
                 } else {
@@ -557,11 +562,12 @@ PowerSpectrum power_spectrum(const PointSet& set, int axis_a, int axis_b, int si
                     bim[size_t(r) * kSpectrumPoints + j] = tim[r];
                 }
             }
-            for (int r = 0; r < my_rows; ++r)
-                accumulate_row(fr.data() + size_t(r0 + r) * stride,
-                               fi.data() + size_t(r0 + r) * stride, are.data(), aim.data(), stride,
-                               bre.data() + size_t(r) * kSpectrumPoints,
+            for (int r = 0; r < my_rows; ++r) {
+                double* row = sums.data() + size_t(r0 + r) * 4 * stride;
+                accumulate_row(row, row + stride, row + 2 * stride, row + 3 * stride, are.data(),
+                               aim.data(), stride, bre.data() + size_t(r) * kSpectrumPoints,
                                bim.data() + size_t(r) * kSpectrumPoints, padded, columns);
+            }
         }
     });
 
@@ -572,7 +578,10 @@ PowerSpectrum power_spectrum(const PointSet& set, int axis_a, int axis_b, int si
     out.power.assign(size_t(size) * size, 0.0);
     const double nn = static_cast<double>(n);
     auto computed = [&](int r, int c) { // P at row r of F (ky = ky0 + r), column c (kx = c - half)
-        const double re = fr[size_t(r) * stride + c], im = fi[size_t(r) * stride + c];
+        const int kx = c - half;
+        const double* row = sums.data() + size_t(r) * 4 * stride + size_t(kx < 0 ? -kx : kx);
+        const double p = row[0], q = row[stride], rr = row[2 * stride], s = row[3 * stride];
+        const double re = kx < 0 ? p + q : p - q, im = kx < 0 ? rr - s : rr + s;
         return (re * re + im * im) / nn; // divided, not times 1/N: P(0) = N^2 / N exactly
     };
     for (int row = 0; row < size; ++row) {

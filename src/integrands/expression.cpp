@@ -18,6 +18,7 @@
 #include <cstring>
 #include <limits>
 
+#include "core/exp_block.h"
 #include "core/points.h"
 
 namespace mcp {
@@ -158,7 +159,7 @@ double apply_unary(uint8_t op, int k, double a) {
     case OpSinh: return std::sinh(a);
     case OpCosh: return std::cosh(a);
     case OpTanh: return std::tanh(a);
-    case OpExp: return std::exp(a);
+    case OpExp: return exp_tang(a);
     case OpLog: return std::log(a);
     case OpLog10: return std::log10(a);
     case OpSqrt: return std::sqrt(a);
@@ -189,8 +190,16 @@ double apply_binary(uint8_t op, double a, double b) {
 // ---------------------------------------------------------------------------
 // Block loops: one tight loop per (operation, operand kinds); no dispatch per point.
 
+// Four vectors an iteration under clang (the wasm build): V8 pays a stack check and the address
+// arithmetic of every iteration; `(x-0.5)^2/0.01` took 0.94 ns a point instead of 1.00.
+#if defined(__clang__)
+#define MCP_INTERLEAVE _Pragma("clang loop interleave_count(4)")
+#else
+#define MCP_INTERLEAVE
+#endif
+
 template <class F> inline void loop1(const double* a, double* r, size_t n, F f) {
-    for (size_t i = 0; i < n; ++i) r[i] = f(a[i]);
+    MCP_INTERLEAVE for (size_t i = 0; i < n; ++i) r[i] = f(a[i]);
 }
 
 /// A resolved operand: an array (p != nullptr) or a constant c.
@@ -203,15 +212,15 @@ template <class F> inline void loop2(Arg a, Arg b, double* r, size_t n, F f) {
     if (a.p && b.p) {
         const double* pa = a.p;
         const double* pb = b.p;
-        for (size_t i = 0; i < n; ++i) r[i] = f(pa[i], pb[i]);
+        MCP_INTERLEAVE for (size_t i = 0; i < n; ++i) r[i] = f(pa[i], pb[i]);
     } else if (a.p) {
         const double* pa = a.p;
         const double cb = b.c;
-        for (size_t i = 0; i < n; ++i) r[i] = f(pa[i], cb);
+        MCP_INTERLEAVE for (size_t i = 0; i < n; ++i) r[i] = f(pa[i], cb);
     } else {
         const double ca = a.c;
         const double* pb = b.p;
-        for (size_t i = 0; i < n; ++i) r[i] = f(ca, pb[i]);
+        MCP_INTERLEAVE for (size_t i = 0; i < n; ++i) r[i] = f(ca, pb[i]);
     }
 }
 
@@ -227,7 +236,7 @@ void run_unary(uint8_t op, int k, const double* a, double* r, size_t n) {
     case OpSinh: loop1(a, r, n, [](double v) { return std::sinh(v); }); return;
     case OpCosh: loop1(a, r, n, [](double v) { return std::cosh(v); }); return;
     case OpTanh: loop1(a, r, n, [](double v) { return std::tanh(v); }); return;
-    case OpExp: loop1(a, r, n, [](double v) { return std::exp(v); }); return;
+    case OpExp: exp_block(a, r, n); return; // two lanes a step, as fast in wasm as natively
     case OpLog: loop1(a, r, n, [](double v) { return std::log(v); }); return;
     case OpLog10: loop1(a, r, n, [](double v) { return std::log10(v); }); return;
     case OpSqrt: loop1(a, r, n, [](double v) { return std::sqrt(v); }); return;
@@ -275,7 +284,7 @@ template <class Body> inline void with_arithmetic(uint8_t op, Body body) {
 template <bool InnerLeft, class F1, class F2>
 inline void loop_fused(const double* a, const double* b, const double* c, double* r, size_t n,
                        F1 inner, F2 outer) {
-    for (size_t i = 0; i < n; ++i) {
+    MCP_INTERLEAVE for (size_t i = 0; i < n; ++i) {
         const double t = inner(a[i], b[i]); // rounded to double, as in two separate loops
         r[i] = InnerLeft ? outer(t, c[i]) : outer(c[i], t);
     }

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "core/exp_block.h"
 #include "core/special.h"
 
 namespace mcp {
@@ -159,7 +160,8 @@ void evaluate_block(const Integrand& f, const PointBlock& x, double* out) {
             const double* xj = x.coord(j);
             for (size_t i = 0; i < n; ++i) out[i] += a * xj[i];
         }
-        for (size_t i = 0; i < n; ++i) out[i] = f.scale * std::exp(out[i]);
+        exp_block(out, out, n);
+        for (size_t i = 0; i < n; ++i) out[i] = f.scale * out[i];
         break;
     case IntegrandKind::Gaussian:
     case IntegrandKind::IndicatorBall: {
@@ -171,7 +173,9 @@ void evaluate_block(const Integrand& f, const PointBlock& x, double* out) {
         }
         if (f.kind == IntegrandKind::Gaussian) {
             const double k = -0.5 / (f.width * f.width);
-            for (size_t i = 0; i < n; ++i) out[i] = f.scale * std::exp(k * out[i]);
+            for (size_t i = 0; i < n; ++i) out[i] = k * out[i];
+            exp_block(out, out, n);
+            for (size_t i = 0; i < n; ++i) out[i] = f.scale * out[i];
         } else {
             const double r2 = f.width * f.width;
             for (size_t i = 0; i < n; ++i) out[i] = out[i] < r2 ? f.scale : 0.0;
