@@ -17,8 +17,8 @@
 namespace {
 
 [[noreturn]] void violation(const char* what, const std::string& text, int dim, size_t i = 0) {
-    std::fprintf(stderr, "fuzz_expression: %s (dim %d, point %zu, expression of %zu bytes)\n",
-                 what, dim, i, text.size());
+    std::fprintf(stderr, "fuzz_expression: %s (dim %d, point %zu, expression of %zu bytes)\n", what,
+                 dim, i, text.size());
     std::abort();
 }
 
@@ -29,9 +29,9 @@ bool same(double a, double b) {
 
 // Point i's coordinate j: ordinary values, edges of [0, 1], and awkward doubles.
 double coordinate(size_t i, int j) {
-    static const double kValues[] = {0.5,  0.0,     1.0,    0.25,  -0.0, 1e-300, 0.999999,
-                                     -1.0, 3.14159, 1e-8,   2.0,   0.75, 1e300,  -2.5,
-                                     0.1,  0.9,     4.9e-324};
+    static const double kValues[] = {0.5,      0.0,  1.0,     0.25, -0.0,    1e-300,
+                                     0.999999, -1.0, 3.14159, 1e-8, 2.0,     0.75,
+                                     1e300,    -2.5, 0.1,     0.9,  4.9e-324};
     const size_t n = sizeof kValues / sizeof kValues[0];
     return kValues[(i * 7 + size_t(j) * 3 + i / n) % n];
 }
@@ -42,7 +42,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     const std::string text(reinterpret_cast<const char*>(data), size);
     constexpr size_t kN = 300; // longer than one block (kBlockSize = 256)
     for (int dim = 1; dim <= 3; ++dim) {
-        mcp::Made<std::shared_ptr<const mcp::ExprProgram>> made = mcp::compile_expression(text, dim);
+        mcp::Made<std::shared_ptr<const mcp::ExprProgram>> made =
+            mcp::compile_expression(text, dim);
         if (!made.ok()) {
             if (made.error.compare(0, 12, "at position ") != 0)
                 violation("error does not start with 'at position '", text, dim);

@@ -70,7 +70,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     for (uint32_t mat : m.material)
         if (mat >= s.materials.size()) violation("a material index is out of range");
     for (const mcp::Material& mat : s.materials) {
-        if (mat.base_color_texture >= int(s.textures.size())) violation("texture index out of range");
+        if (mat.base_color_texture >= int(s.textures.size()))
+            violation("texture index out of range");
         if (!std::isfinite(mat.roughness) || !std::isfinite(mat.metallic))
             violation("a material parameter is not finite");
     }

@@ -690,8 +690,10 @@ TEST(Api, ErrorMessagesStayOnOneLine) {
 TEST(Api, AStudyWhoseWarpLeavesItsDomainFailsNamingThePoint) {
     auto scene = [](const char* g, const char* p, const char* extra) {
         return std::string(R"({"warp": {"domain": {"type": "interval", "lower": 0, "upper": 1},
-            "g": [")") + g + R"("], "p": ")" + p + R"("}, "f": "x", "estimators": ["warp"],
-            "n_min": 64, "n_max": 1024, "reps": 4, "seed": 3)" + extra + "}";
+            "g": [")") +
+               g + R"("], "p": ")" + p + R"("}, "f": "x", "estimators": ["warp"],
+            "n_min": 64, "n_max": 1024, "reps": 4, "seed": 3)" +
+               extra + "}";
     };
     const Outcome inside = run(scene("u^2", "0.5 / sqrt(x)", ""));
     ASSERT_EQ(inside.status, MCP_OK) << inside.error;
@@ -710,8 +712,8 @@ TEST(Api, AStudyWhoseWarpLeavesItsDomainFailsNamingThePoint) {
     }
     // Split into parts, each part is refused too.
     char* out = nullptr;
-    EXPECT_EQ(mcp_study_run(scene("2*u", "0.5", "").c_str(), R"({"part": 0, "parts": 2})",
-                            nullptr, nullptr, &out),
+    EXPECT_EQ(mcp_study_run(scene("2*u", "0.5", "").c_str(), R"({"part": 0, "parts": 2})", nullptr,
+                            nullptr, &out),
               MCP_ERROR_SCENE);
     EXPECT_EQ(out, nullptr);
 }
@@ -751,8 +753,8 @@ TEST(Api, NamedWarpsTakeTheirOwnParametersOnly) {
         warp[foreign] = 0.5;
         const Outcome wrong = plan(warp_scene(warp));
         EXPECT_EQ(wrong.status, MCP_ERROR_SCENE) << it.key();
-        const std::string says = std::string("unknown parameter '") + foreign +
-                                 "' of the warp '" + it.key() + "' (";
+        const std::string says =
+            std::string("unknown parameter '") + foreign + "' of the warp '" + it.key() + "' (";
         EXPECT_NE(wrong.error.find(says), std::string::npos) << wrong.error;
         EXPECT_NE(wrong.error.find(it.value().empty() ? "it takes none" : "its parameters: "),
                   std::string::npos)

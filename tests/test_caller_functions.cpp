@@ -82,9 +82,10 @@ int second_coordinate(void* user, const double* x, uint64_t n, int in_dim, doubl
 json box_scene(const json& integrand, int dim) {
     return json{{"name", "caller"},
                 {"integrand", integrand},
-                {"domain", {{"type", "box"},
-                            {"lower", std::vector<double>(size_t(dim), 0.0)},
-                            {"upper", std::vector<double>(size_t(dim), 1.0)}}}};
+                {"domain",
+                 {{"type", "box"},
+                  {"lower", std::vector<double>(size_t(dim), 0.0)},
+                  {"upper", std::vector<double>(size_t(dim), 1.0)}}}};
 }
 
 mcp_context context_of(const mcp_function* fns, int count, mcp_cancel_fn cancel = nullptr,
@@ -105,9 +106,11 @@ void expect_same_numbers(const json& a, const json& b) {
         const json& lb = b["estimators"][e]["levels"];
         ASSERT_EQ(la.size(), lb.size());
         for (size_t l = 0; l < la.size(); ++l)
-            for (const char* key : {"n", "mean", "variance", "std_error", "mean_run_std_error", "coverage95"}) {
+            for (const char* key :
+                 {"n", "mean", "variance", "std_error", "mean_run_std_error", "coverage95"}) {
                 if (!la[l].contains(key)) continue;
-                EXPECT_EQ(la[l][key], lb[l][key]) << "estimator " << e << " level " << l << " " << key;
+                EXPECT_EQ(la[l][key], lb[l][key])
+                    << "estimator " << e << " level " << l << " " << key;
             }
     }
 }
@@ -161,10 +164,9 @@ TEST(CallerFunctions, VegasEstimatesFromItsFrozenMapInBatches) {
     calls.expect_dim = 2;
     const mcp_function fns[] = {{"f", product_plus_first, &calls}};
     const mcp_context ctx = context_of(fns, 1);
-    const Outcome o = run_with(box_scene({{"type", "function"}, {"name", "f"}}, 2),
-                               {{"estimators", {"vegas"}}, {"n_min", 65536}, {"n_max", 65536},
-                                {"reps", 2}},
-                               &ctx);
+    const Outcome o = run_with(
+        box_scene({{"type", "function"}, {"name", "f"}}, 2),
+        {{"estimators", {"vegas"}}, {"n_min", 65536}, {"n_max", 65536}, {"reps", 2}}, &ctx);
     ASSERT_EQ(o.status, MCP_OK) << o.error;
     EXPECT_EQ(calls.largest.load(), 4096u);
     EXPECT_LT(calls.calls.load(), calls.points.load() / 512); // half the calls of 256 each
@@ -194,12 +196,10 @@ TEST(CallerFunctions, AFailingFunctionStopsTheStudyWithinABlock) {
     calls.fail_at = 5;
     const mcp_function fns[] = {{"my_f", product_plus_first, &calls}};
     const mcp_context ctx = context_of(fns, 1);
-    const Outcome o = run_with(box_scene({{"type", "function"}, {"name", "my_f"}}, 2),
-                               {{"estimators", {"uniform", "vegas"}},
-                                {"n_max", 1 << 20},
-                                {"reps", 16},
-                                {"threads", 2}},
-                               &ctx);
+    const Outcome o = run_with(
+        box_scene({{"type", "function"}, {"name", "my_f"}}, 2),
+        {{"estimators", {"uniform", "vegas"}}, {"n_max", 1 << 20}, {"reps", 16}, {"threads", 2}},
+        &ctx);
     EXPECT_EQ(o.status, MCP_ERROR_FUNCTION);
     EXPECT_NE(o.error.find("'my_f'"), std::string::npos) << o.error;
     EXPECT_TRUE(o.result.is_null()); // a failed function's numbers are not given
@@ -214,8 +214,7 @@ TEST(CallerFunctions, AFailingFunctionStopsAStoppingStudyAndAPlan) {
     const mcp_function fns[] = {{"f", product_plus_first, &calls}};
     const mcp_context ctx = context_of(fns, 1);
     const Outcome o = run_with(box_scene({{"type", "function"}, {"name", "f"}}, 2),
-                               {{"estimators", {"uniform", "sobol"}}, {"rel_tol", 1e-9}},
-                               &ctx);
+                               {{"estimators", {"uniform", "sobol"}}, {"rel_tol", 1e-9}}, &ctx);
     EXPECT_EQ(o.status, MCP_ERROR_FUNCTION) << o.error;
     EXPECT_LE(calls.calls.load(), 3u);
 
@@ -262,10 +261,11 @@ TEST(CallerFunctions, ScenesNamingFunctionsTheCallWasNotGiven) {
     EXPECT_NE(std::string(mcp_last_error()).find("given no functions"), std::string::npos)
         << mcp_last_error();
     Calls calls;
-    const mcp_function fns[] = {{"g", product_plus_first, &calls}, {"h", product_plus_first, &calls}};
+    const mcp_function fns[] = {{"g", product_plus_first, &calls},
+                                {"h", product_plus_first, &calls}};
     const mcp_context ctx = context_of(fns, 2);
-    const Outcome o = run_with(box_scene({{"type", "function"}, {"name", "f"}}, 2), json::object(),
-                               &ctx);
+    const Outcome o =
+        run_with(box_scene({{"type", "function"}, {"name", "f"}}, 2), json::object(), &ctx);
     EXPECT_EQ(o.status, MCP_ERROR_SCENE);
     EXPECT_NE(o.error.find("no function named 'f' was given (given: g, h)"), std::string::npos)
         << o.error;
@@ -279,7 +279,8 @@ TEST(CallerFunctions, ScenesNamingFunctionsTheCallWasNotGiven) {
 TEST(CallerFunctions, BadContextsAreArgumentErrors) {
     Calls calls;
     const json scene = box_scene({{"type", "function"}, {"name", "f"}}, 2);
-    const mcp_function twice[] = {{"f", product_plus_first, &calls}, {"f", product_plus_first, &calls}};
+    const mcp_function twice[] = {{"f", product_plus_first, &calls},
+                                  {"f", product_plus_first, &calls}};
     mcp_context ctx = context_of(twice, 2);
     Outcome o = run_with(scene, json::object(), &ctx);
     EXPECT_EQ(o.status, MCP_ERROR_ARGUMENT);

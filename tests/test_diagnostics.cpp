@@ -515,14 +515,13 @@ TEST(Diagnostics, BlindReplicatesDoNotVouchForAMeanRuledByAFewWeights) {
 // warning whatever the 32 replicates look like: seeds 13 and 20 are two of the 6 in 1..40
 // whose replicates look covering blind, where replicates alone would demote it.
 TEST(Diagnostics, AStratifiedCornerPeakRuledByOneCellStaysAWarningBlind) {
-    const Json peak = {
-        {"name", "corner3"},
-        {"integrand",
-         {{"type", "genz_corner_peak"},
-          {"a", {4.90452, 36.5253, 25.2368}},
-          {"u", {0.5, 0.5, 0.5}}}},
-        {"exact", nullptr}, // as a user's own integrand runs
-        {"estimators", {"stratified"}}};
+    const Json peak = {{"name", "corner3"},
+                       {"integrand",
+                        {{"type", "genz_corner_peak"},
+                         {"a", {4.90452, 36.5253, 25.2368}},
+                         {"u", {0.5, 0.5, 0.5}}}},
+                       {"exact", nullptr}, // as a user's own integrand runs
+                       {"estimators", {"stratified"}}};
     for (uint64_t seed : {13, 20}) {
         Made<SceneRequest> r = build_request(
             peak, Json{{"n_min", 8192}, {"n_max", 8192}, {"reps", 32}, {"seed", seed}});
@@ -622,8 +621,8 @@ TEST(Diagnostics, ReplicatesSkewedWithTheirErrorBarsAreAnAlarm) {
             << said;
     }
     EXPECT_LT(std::fabs(check_replicates(level(-1.0, 1.0, 1.0)).skewness), kSkewSignature);
-    for (const LevelStats& fine : {level(-1.0, 1.0, 1.0), level(-0.7, -0.7, 1.0),
-                                   replicates_level(z, false)}) {
+    for (const LevelStats& fine :
+         {level(-1.0, 1.0, 1.0), level(-0.7, -0.7, 1.0), replicates_level(z, false)}) {
         const std::vector<Flag> flags = level_flags(fine);
         EXPECT_FALSE(find(flags, FlagCode::ReplicateFarOff));
         const std::optional<Flag> w = find(flags, FlagCode::SkewedWeights);
@@ -718,8 +717,8 @@ TEST(Diagnostics, HeavyTailFollowsTheIntegrandWhereTheDensityIsBounded) {
         for (const EstimatorStudy& e : finite.estimators) {
             const std::optional<Flag> f =
                 find(estimator_flags(e, finite.settings), FlagCode::HeavyTail);
-            EXPECT_FALSE(f.has_value()) << e.spec.name << " N = " << n << ": tail index "
-                                        << (f ? f->value : 0.0);
+            EXPECT_FALSE(f.has_value())
+                << e.spec.name << " N = " << n << ": tail index " << (f ? f->value : 0.0);
             const double se = 2.22 / std::sqrt(2048.0);
             EXPECT_NEAR(e.integrand.alpha, 1.0 / 0.45, 4.0 * se) << e.spec.name;
         }
@@ -747,8 +746,8 @@ TEST(Diagnostics, ABoundedPeakHasNoTail) {
                             {"integrand", integrand},
                             {"exact", nullptr},
                             {"estimators", {"uniform"}}};
-        Made<SceneRequest> r = build_request(
-            scene, Json{{"n_min", 4096}, {"n_max", 4096}, {"reps", 8}, {"seed", 3}});
+        Made<SceneRequest> r =
+            build_request(scene, Json{{"n_min", 4096}, {"n_max", 4096}, {"reps", 8}, {"seed", 3}});
         EXPECT_TRUE(r.ok()) << r.error;
         return run_study(r.value.problem, r.value.estimators, r.value.settings);
     };
@@ -818,8 +817,8 @@ TEST(Diagnostics, HeavyTailKnowsTheSquareIntegralFromTheIntegrandsForm) {
     // The rule itself: int_0 x^(2p) dx is finite iff 2p > -1; a box away from 0 bounds x^p.
     auto monomial = [](std::vector<double> p) {
         const size_t d = p.size();
-        return make_integrand(IntegrandKind::Monomial, static_cast<int>(d), 1.0, std::move(p),
-                              {}, 1.0)
+        return make_integrand(IntegrandKind::Monomial, static_cast<int>(d), 1.0, std::move(p), {},
+                              1.0)
             .value;
     };
     const std::vector<double> lo2{0.0, 0.0}, hi2{1.0, 1.0}, away{0.5, 0.0};
@@ -827,9 +826,9 @@ TEST(Diagnostics, HeavyTailKnowsTheSquareIntegralFromTheIntegrandsForm) {
     EXPECT_EQ(integrand_square_integrable(monomial({-0.5, 0.0}), lo2, hi2), false);
     EXPECT_EQ(integrand_square_integrable(monomial({-0.2, -0.55}), lo2, hi2), false);
     EXPECT_EQ(integrand_square_integrable(monomial({-0.9, -0.2}), away, hi2), true);
-    EXPECT_EQ(integrand_square_integrable(make_expression_integrand("x1^-0.3", 1).value,
-                                          {0.0}, {1.0}),
-              std::nullopt);
+    EXPECT_EQ(
+        integrand_square_integrable(make_expression_integrand("x1^-0.3", 1).value, {0.0}, {1.0}),
+        std::nullopt);
 }
 
 // Agreement is not exactness. A deterministic point set (Sobol' without randomization) gives
@@ -1297,8 +1296,8 @@ TEST(Diagnostics, StiffPeakSentencesDoNotContradictThemselves) {
     EXPECT_NE(message(replicates_level(z, true), "replicate_far_off")
                   .find("replicate 8 of 32 lies 5.6 of its own standard errors"),
               std::string::npos);
-    EXPECT_FALSE(find(level_flags(stiff_level(65536, {}, false, 0.0, 0.0, 0.0)),
-                      FlagCode::ZeroErrorBar));
+    EXPECT_FALSE(
+        find(level_flags(stiff_level(65536, {}, false, 0.0, 0.0, 0.0)), FlagCode::ZeroErrorBar));
 }
 
 // Every sentence writes a number beyond 1e6 or below 1e-4 (not 0) in scientific notation.

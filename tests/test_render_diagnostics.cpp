@@ -80,14 +80,13 @@ TEST(RenderBounds, ContactsAreFoundWhereLightsTouchWhatTheyLight) {
     EXPECT_FALSE(lifted.contact);
     EXPECT_TRUE(bounded(RadianceStrategy::LightArea, lifted));
     // ... and 1e-6 above it (touching_light's gap is 5e-5 of its extent): a contact.
-    EXPECT_TRUE(contacts_of(floor_and_light({0, 1e-6, 0}, {1, 1e-6, 0}, {1, 1, 0}, {0, 1, 0}))
-                    .contact);
+    EXPECT_TRUE(
+        contacts_of(floor_and_light({0, 1e-6, 0}, {1, 1e-6, 0}, {1, 1, 0}, {0, 1, 0})).contact);
     // A light facing the floor 1e-4 above it (touching_light): a contact for area sampling,
     // but not within the vertices' rounding of the light's inside: solid angles stay below
     // 2 pi by far more than 1e-12, and solid-angle sampling stays bounded.
-    const LightContacts hovering =
-        contacts_of(floor_and_light({0.25, 1e-4, 0.25}, {0.75, 1e-4, 0.25}, {0.75, 1e-4, 0.75},
-                                    {0.25, 1e-4, 0.75}));
+    const LightContacts hovering = contacts_of(floor_and_light(
+        {0.25, 1e-4, 0.25}, {0.75, 1e-4, 0.25}, {0.75, 1e-4, 0.75}, {0.25, 1e-4, 0.75}));
     EXPECT_TRUE(hovering.contact);
     EXPECT_FALSE(hovering.interior_contact);
     EXPECT_TRUE(bounded(RadianceStrategy::LightSolidAngle, hovering));
@@ -98,9 +97,8 @@ TEST(RenderBounds, ContactsAreFoundWhereLightsTouchWhatTheyLight) {
     EXPECT_TRUE(bounded(RadianceStrategy::LightArea, coplanar));
     // A light through the floor: the floor crosses the light's interior, where solid-angle
     // sampling falls back to area sampling.
-    const LightContacts through =
-        contacts_of(floor_and_light({0.2, -0.5, 0.5}, {0.8, -0.5, 0.5}, {0.8, 0.5, 0.5},
-                                    {0.2, 0.5, 0.5}));
+    const LightContacts through = contacts_of(
+        floor_and_light({0.2, -0.5, 0.5}, {0.8, -0.5, 0.5}, {0.8, 0.5, 0.5}, {0.2, 0.5, 0.5}));
     EXPECT_TRUE(through.contact);
     EXPECT_TRUE(through.interior_contact);
     EXPECT_FALSE(bounded(RadianceStrategy::LightSolidAngle, through));
@@ -172,8 +170,7 @@ TEST(RenderBounds, ContactsCountWhereTheCameraSeesThemAndTheyReflect) {
 
 /// Area sampling's flags over a study of `s` (size x size pixels, 1 to spp, 2 images) against a
 /// reference rendered by MIS at 256 spp; its tail index at the deepest level in *tail_index.
-std::vector<Flag> area_flags(const Scene& s, double* tail_index, int size = 16,
-                             uint64_t spp = 16) {
+std::vector<Flag> area_flags(const Scene& s, double* tail_index, int size = 16, uint64_t spp = 16) {
     RenderScene rs;
     rs.build(s);
     RenderEstimator mis;
@@ -280,8 +277,8 @@ const json& estimator(const json& result, const std::string& name) {
 TEST(RenderBounds, BoundedEstimatorsGetNoHeavyTailWarning) {
     const json veach = study("veach_mis", json{{"seed", 1}});
     int read_heavy = 0;
-    for (const char* name : {"light_area", "light_solid_angle", "bsdf", "mis_balance",
-                             "mis_power"}) {
+    for (const char* name :
+         {"light_area", "light_solid_angle", "bsdf", "mis_balance", "mis_power"}) {
         const json& e = estimator(veach, name);
         EXPECT_TRUE(e["contribution_bound"]["bounded"].get<bool>()) << name;
         EXPECT_NE(heavy_tail_severity(e), "warning") << name << e["warnings"].dump();
@@ -379,9 +376,14 @@ TEST(RenderBounds, MergedPartsKeepTheBound) {
     const std::string scene = test::read(test::kScenes + "/perpendicular_plates.json");
     json parts = json::array();
     for (int part = 0; part < 2; ++part) {
-        const json options{{"base_dir", test::kScenes}, {"width", 8},     {"height", 8},
-                           {"spp_max", 4},              {"reps", 2},      {"part", part},
-                           {"parts", 2},                {"reference", {{"spp", 64}}},
+        const json options{{"base_dir", test::kScenes},
+                           {"width", 8},
+                           {"height", 8},
+                           {"spp_max", 4},
+                           {"reps", 2},
+                           {"part", part},
+                           {"parts", 2},
+                           {"reference", {{"spp", 64}}},
                            {"estimators", {"light_area", "light_solid_angle"}}};
         parts.push_back(call([&](char** out) {
             return mcp_render_study_run(scene.c_str(), options.dump().c_str(), nullptr, nullptr,

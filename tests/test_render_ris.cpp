@@ -57,10 +57,8 @@ constexpr double kLightHeight = 1.0;
 
 std::vector<Vec3> corners(const QuadLight& q) {
     const double a = 0.5 * q.side, h = kLightHeight;
-    return {{q.x - a, h, q.z - a},
-            {q.x + a, h, q.z - a},
-            {q.x + a, h, q.z + a},
-            {q.x - a, h, q.z + a}};
+    return {
+        {q.x - a, h, q.z - a}, {q.x + a, h, q.z - a}, {q.x + a, h, q.z + a}, {q.x - a, h, q.z + a}};
 }
 
 /// A diffuse floor (albedo 0.5) under lights of different size and radiance, all in the plane
@@ -136,10 +134,9 @@ TEST(RenderRis, UnbiasedAgainstTheClosedFormWithSeveralLights) {
     rs.build(scene);
     const int W = 8, H = 8;
     const std::vector<double> exact = several_lights_exact(scene, W, H);
-    const std::vector<RenderEstimator> ests = {
-        ris(1), ris(4), ris(16), ris(1, LightSampling::Area), ris(16, LightSampling::Area)};
-    const double z_max =
-        -normal_quantile(0.5 * test::sidak_level(1e-3, W * H * int(ests.size())));
+    const std::vector<RenderEstimator> ests = {ris(1), ris(4), ris(16), ris(1, LightSampling::Area),
+                                               ris(16, LightSampling::Area)};
+    const double z_max = -normal_quantile(0.5 * test::sidak_level(1e-3, W * H * int(ests.size())));
     const double z_pooled = -normal_quantile(0.5 * test::sidak_level(1e-3, int(ests.size())));
     uint64_t stream = 301;
     for (const RenderEstimator& e : ests) {
@@ -187,10 +184,10 @@ TEST(RenderRis, OneCandidateIsLightSampling) {
 double pixels_noisier_z(const RenderImage& a, const RenderImage& b) {
     double larger = 0.0, differ = 0.0;
     for (size_t i = 0; i < a.pixel_count(); ++i) {
-        const double va = luminance(Vec3(a.variance[3 * i], a.variance[3 * i + 1],
-                                         a.variance[3 * i + 2]));
-        const double vb = luminance(Vec3(b.variance[3 * i], b.variance[3 * i + 1],
-                                         b.variance[3 * i + 2]));
+        const double va =
+            luminance(Vec3(a.variance[3 * i], a.variance[3 * i + 1], a.variance[3 * i + 2]));
+        const double vb =
+            luminance(Vec3(b.variance[3 * i], b.variance[3 * i + 1], b.variance[3 * i + 2]));
         if (va == vb) continue;
         differ += 1.0;
         larger += va > vb;
@@ -200,8 +197,7 @@ double pixels_noisier_z(const RenderImage& a, const RenderImage& b) {
 
 std::shared_ptr<RenderRequest> bundled(const std::string& name) {
     json options{{"base_dir", test::kScenes}};
-    Made<std::shared_ptr<RenderRequest>> r =
-        build_render_request(test::scene_json(name), options);
+    Made<std::shared_ptr<RenderRequest>> r = build_render_request(test::scene_json(name), options);
     EXPECT_TRUE(r.ok()) << name << ": " << r.error;
     return r.value;
 }
@@ -215,11 +211,11 @@ TEST(RenderRis, FewerErrorsThanLightSamplingAmongManyLights) {
     ASSERT_TRUE(r);
     RenderScene rs;
     rs.build(*r->scene, r->accel);
-    const RenderImage by_light = render_image(rs, light(LightSampling::SolidAngle),
-                                              settings(48, 36, 64, 5));
+    const RenderImage by_light =
+        render_image(rs, light(LightSampling::SolidAngle), settings(48, 36, 64, 5));
     const RenderImage by_ris = render_image(rs, ris(8), settings(48, 36, 64, 6));
-    const RenderImage again = render_image(rs, light(LightSampling::SolidAngle),
-                                           settings(48, 36, 64, 7));
+    const RenderImage again =
+        render_image(rs, light(LightSampling::SolidAngle), settings(48, 36, 64, 7));
     EXPECT_GT(pixels_noisier_z(by_light, by_ris), 5.0);
     EXPECT_LT(std::fabs(pixels_noisier_z(by_light, again)), 5.0);
 }

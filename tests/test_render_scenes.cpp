@@ -71,8 +71,8 @@ const json& find_estimator(const json& result, const std::string& name) {
 const char* const kRenderScenes[] = {
     "quad_light_floor",     "cornell_box", "cornell_box_path", "veach_mis",
     "tiny_bright_light",    "near_mirror", "grazing_light",    "touching_light",
-    "perpendicular_plates", "furnace_box", "sphere_interior",
-    "many_lights",          "occluded_light",
+    "perpendicular_plates", "furnace_box", "sphere_interior",  "many_lights",
+    "occluded_light",
 };
 
 TEST(RenderScenes, AllLoad) {
@@ -491,9 +491,14 @@ Call merge_text(const json& parts) {
 // range and still refuses what lies outside it.
 TEST(RenderSplit, MergeAcceptsANegativeRelativeMseDownToTheFloor) {
     const json scene = json::parse(read(kScenes + "/quad_light_floor.json"));
-    json o{{"base_dir", kScenes}, {"width", 8},  {"height", 6},
-           {"spp_min", 1},        {"spp_max", 2}, {"reps", 2},
-           {"seed", 3},           {"estimators", {"light_solid_angle"}},
+    json o{{"base_dir", kScenes},
+           {"width", 8},
+           {"height", 6},
+           {"spp_min", 1},
+           {"spp_max", 2},
+           {"reps", 2},
+           {"seed", 3},
+           {"estimators", {"light_solid_angle"}},
            {"reference", {{"spp", 16}}}};
     json parts = json::array();
     for (int i = 0; i < 2; ++i) {

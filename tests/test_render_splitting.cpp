@@ -40,11 +40,10 @@ int pixels_off(const Scene& scene, const RenderImage& im, double z_max, double s
         for (int x = 0; x < im.width; ++x) {
             Ray r = camera_ray(scene.camera, im.width, im.height, x + 0.5, y + 0.5);
             Vec3 p = r.origin + r.direction * (-r.origin.y / r.direction.y);
-            double expected = scale * albedo * Le *
-                              lambert_polygon_form_factor(p, Vec3(0, 1, 0), light, 4);
+            double expected =
+                scale * albedo * Le * lambert_polygon_form_factor(p, Vec3(0, 1, 0), light, 4);
             size_t k = (size_t(y) * size_t(im.width) + size_t(x)) * 3;
-            if (std::fabs(im.rgb[k] - expected) > z_max * std::sqrt(im.variance[k]) + 1e-12)
-                ++off;
+            if (std::fabs(im.rgb[k] - expected) > z_max * std::sqrt(im.variance[k]) + 1e-12) ++off;
         }
     return off;
 }
@@ -54,9 +53,9 @@ struct Case {
     int light_samples, bsdf_samples;
 };
 const Case kSplitCases[] = {
-    {RadianceStrategy::LightArea, 3, 1},  {RadianceStrategy::LightSolidAngle, 4, 1},
-    {RadianceStrategy::Bsdf, 1, 3},       {RadianceStrategy::MisBalance, 3, 2},
-    {RadianceStrategy::MisPower, 2, 5},   {RadianceStrategy::MisPower, 7, 1},
+    {RadianceStrategy::LightArea, 3, 1}, {RadianceStrategy::LightSolidAngle, 4, 1},
+    {RadianceStrategy::Bsdf, 1, 3},      {RadianceStrategy::MisBalance, 3, 2},
+    {RadianceStrategy::MisPower, 2, 5},  {RadianceStrategy::MisPower, 7, 1},
     {RadianceStrategy::Path, 3, 2},
 };
 
@@ -116,8 +115,8 @@ TEST(RenderSplitting, LowerVariancePerCameraSample) {
     Scene scene = test::quad_light_scene(5.0);
     RenderScene rs;
     rs.build(scene);
-    for (RadianceStrategy s : {RadianceStrategy::LightSolidAngle, RadianceStrategy::MisPower,
-                               RadianceStrategy::Path}) {
+    for (RadianceStrategy s :
+         {RadianceStrategy::LightSolidAngle, RadianceStrategy::MisPower, RadianceStrategy::Path}) {
         RenderSettings st = settings(12, 12, 64, 5);
         st.jitter_pixels = true;
         RenderEstimator one = split(s, 1, 1), four = split(s, 4, 1);

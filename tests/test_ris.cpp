@@ -224,9 +224,9 @@ void expect_no_confident_wrong_answer(const char* scene, const Json& options);
 // stiff one-dimensional scenes: peaks missed, singularities of finite and infinite variance, a
 // step, a large offset.
 TEST(Ris, NoConfidentWrongAnswerOnTheStiffScenes) {
-    for (const char* scene : {"stiff_peak_1e-8", "singular_power_0.3", "singular_power_0.5",
-                              "singular_power_0.9", "step_1d", "heavy_tail_abs",
-                              "oscillatory_cos1000", "offset_1e8_sin"})
+    for (const char* scene :
+         {"stiff_peak_1e-8", "singular_power_0.3", "singular_power_0.5", "singular_power_0.9",
+          "step_1d", "heavy_tail_abs", "oscillatory_cos1000", "offset_1e8_sin"})
         expect_no_confident_wrong_answer(scene, Json{{"n_min", 16},
                                                      {"n_max", 16384},
                                                      {"reps", 16},

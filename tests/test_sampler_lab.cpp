@@ -167,15 +167,21 @@ TEST(SamplerLabCsv, AHeaderHasNoNumberAndAByteOrderMarkIsSkipped) {
     };
     EXPECT_EQ(points("x,y\n0.5,0.5\n0.25,0.75\n"), 2);
     EXPECT_EQ(points("x,,y\n0.5,0.5,0.5\n"), 1); // a header with an unnamed column: no number
-    EXPECT_EQ(points("\xEF\xBB\xBF" "0.5,0.5\n0.25,0.75\n"), 2);
-    EXPECT_EQ(points("\xEF\xBB\xBF" "x,y\n0.5,0.5\n0.25,0.75\n"), 2);
+    EXPECT_EQ(points("\xEF\xBB\xBF"
+                     "0.5,0.5\n0.25,0.75\n"),
+              2);
+    EXPECT_EQ(points("\xEF\xBB\xBF"
+                     "x,y\n0.5,0.5\n0.25,0.75\n"),
+              2);
     struct Case {
         const char* csv;
         const char* message;
     } cases[] = {
         {"0.5e,0.5\n0.25,0.75\n", "row 1, column 1: '0.5e' is not a number (the row's other"},
         {"0.5,,0.5\n0.25,0.5,0.75\n", "row 1, column 2: the field is empty"},
-        {"\xEF\xBB\xBF" "0.5,x\n", "row 1, column 2: 'x' is not a number"},
+        {"\xEF\xBB\xBF"
+         "0.5,x\n",
+         "row 1, column 2: 'x' is not a number"},
         {"0.5,0.5\n0.25,\n", "row 2, column 2: the field is empty"},
     };
     for (const Case& k : cases) {
@@ -289,8 +295,7 @@ TEST(SamplerLabIntegrate, NoZeroWidthErrorBar) {
     ASSERT_EQ(tiny.status, MCP_OK) << tiny.error;
     ASSERT_TRUE(tiny.result["error_bar"].is_object()) << tiny.result;
     const double se = plain.result["error_bar"]["standard_error"].get<double>();
-    EXPECT_NEAR(tiny.result["error_bar"]["standard_error"].get<double>() / 1e-170, se,
-                1e-12 * se);
+    EXPECT_NEAR(tiny.result["error_bar"]["standard_error"].get<double>() / 1e-170, se, 1e-12 * se);
     Call flat = integrate({{"name", "one"}, {"f", "1"}}, {{"points", {a, b}}});
     ASSERT_EQ(flat.status, MCP_OK) << flat.error;
     EXPECT_TRUE(flat.result["error_bar"].is_null());

@@ -769,9 +769,8 @@ bool says_where(const WarpTestResult& r) {
 // the azimuth: the verdict says so rather than naming one bin. r = sqrt(u1) says nothing.
 TEST(WarpTestWhere, TooManyNearTheCentreInEveryDirection) {
     const Domain disk = make_disk({0.0, 0.0}, 1.0).value;
-    const WarpTestResult wrong =
-        run_seeded(disk, expression(disk, {"u1*cos(2*pi*u2)", "u1*sin(2*pi*u2)"}, "1/pi"),
-                   100000, 1);
+    const WarpTestResult wrong = run_seeded(
+        disk, expression(disk, {"u1*cos(2*pi*u2)", "u1*sin(2*pi*u2)"}, "1/pi"), 100000, 1);
     expect_wrong(wrong, "r = u1");
     EXPECT_EQ(wrong.where.rfind("too many samples near the centre (", 0), 0u) << wrong.where;
     EXPECT_TRUE(contains(wrong.where, "too few")) << wrong.where;
@@ -782,8 +781,8 @@ TEST(WarpTestWhere, TooManyNearTheCentreInEveryDirection) {
     EXPECT_FALSE(contains(wrong.reason, "most deviant")) << wrong.reason;
     // seed 2: seed 1 is one of the 1% of seeds where the right warp is rejected at 12 x 12 bins
     const WarpTestResult right = run_seeded(
-        disk, expression(disk, {"sqrt(u1)*cos(2*pi*u2)", "sqrt(u1)*sin(2*pi*u2)"}, "1/pi"),
-        100000, 2);
+        disk, expression(disk, {"sqrt(u1)*cos(2*pi*u2)", "sqrt(u1)*sin(2*pi*u2)"}, "1/pi"), 100000,
+        2);
     EXPECT_EQ(right.outcome, WarpTestOutcome::Passed) << right.reason;
     EXPECT_FALSE(says_where(right)) << right.reason;
 }

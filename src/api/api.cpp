@@ -48,9 +48,9 @@ int load_functions(const mcp_context* ctx, mcp::CallerFunctions* out) {
 }
 
 int run_study_call(const char* scene_json, const char* options_json, const mcp_context* ctx,
-              mcp_progress_fn progress, void* user, char** result_json);
+                   mcp_progress_fn progress, void* user, char** result_json);
 int plan_study_call(const char* scene_json, const char* options_json, const mcp_context* ctx,
-               char** plan_json);
+                    char** plan_json);
 
 } // namespace
 
@@ -92,7 +92,7 @@ int mcp_study_plan_with(const char* scene_json, const char* options_json, const 
 namespace {
 
 int run_study_call(const char* scene_json, const char* options_json, const mcp_context* ctx,
-              mcp_progress_fn progress, void* user, char** result_json) {
+                   mcp_progress_fn progress, void* user, char** result_json) {
     if (!result_json) return fail(MCP_ERROR_ARGUMENT, "mcp_study_run: result_json is NULL");
     *result_json = nullptr;
     mcp::CallerFunctions functions;
@@ -177,9 +177,8 @@ int run_study_call(const char* scene_json, const char* options_json, const mcp_c
     return MCP_OK;
 }
 
-
 int plan_study_call(const char* scene_json, const char* options_json, const mcp_context* ctx,
-               char** plan_json) {
+                    char** plan_json) {
     if (!plan_json) return fail(MCP_ERROR_ARGUMENT, "mcp_study_plan: plan_json is NULL");
     *plan_json = nullptr;
     mcp::CallerFunctions functions;

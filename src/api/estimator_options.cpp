@@ -347,17 +347,17 @@ bool parse_ris_fields(Ctx& c, const Json& j, const std::string& path, const Prob
         return c.fail(at, "expected an object {\"candidates\", \"target\"}, got " + type_of(r));
     uint64_t m = static_cast<uint64_t>(out->ris_options.candidates);
     std::string target;
-    if (!check_keys(c, r, at, {"candidates", "target"}) ||
-        !get_count(c, r, "candidates", at, &m) || !get_string(c, r, "target", at, &target))
+    if (!check_keys(c, r, at, {"candidates", "target"}) || !get_count(c, r, "candidates", at, &m) ||
+        !get_string(c, r, "target", at, &target))
         return false;
     if (m < 1 || m > static_cast<uint64_t>(RisOptions::kMaxCandidates))
-        return c.fail(sub(at, "candidates"), "must be in [1, " +
-                                                 std::to_string(RisOptions::kMaxCandidates) +
-                                                 "] (candidates per point), got " +
-                                                 std::to_string(m));
+        return c.fail(sub(at, "candidates"),
+                      "must be in [1, " + std::to_string(RisOptions::kMaxCandidates) +
+                          "] (candidates per point), got " + std::to_string(m));
     if (!target.empty() && target != "pdf" && target != "f")
         return c.fail(sub(at, "target"), "expected \"pdf\" (the estimator's pdf) or \"f\" (|f| "
-                                         "at the candidates), got \"" + target + "\"");
+                                         "at the candidates), got \"" +
+                                             target + "\"");
     if (target == "pdf" && !pdf)
         return c.fail(sub(at, "target"), "\"pdf\" needs the estimator's \"pdf\" as the target");
     if (out->sampler != SamplerKind::Independent)

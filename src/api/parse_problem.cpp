@@ -217,7 +217,8 @@ bool parse_function_integrand(Ctx& c, const Json& j, const std::string& path, in
     uint64_t given = 0;
     if (!get_count(c, j, "dim", path, &given)) return false;
     if (find(j, "dim") && given != static_cast<uint64_t>(dim))
-        return c.fail(sub(path, "dim"), "is " + std::to_string(given) + ", but the domain's points have " +
+        return c.fail(sub(path, "dim"), "is " + std::to_string(given) +
+                                            ", but the domain's points have " +
                                             std::to_string(dim) + " coordinates");
     *out = make_function_integrand(std::move(fn), dim);
     return true;
@@ -320,7 +321,8 @@ bool find_caller_function(Ctx& c, const Json& j, const char* key, const std::str
                           std::shared_ptr<const CallerFunction>* out) {
     std::string name;
     if (!get_string(c, j, key, path, &name)) return false;
-    if (name.empty()) return c.fail(sub(path, key), "expected the name of a function the caller gave");
+    if (name.empty())
+        return c.fail(sub(path, key), "expected the name of a function the caller gave");
     if (!c.functions || c.functions->list.empty())
         return c.fail(sub(path, key),
                       "names the caller's function '" + name_text(name) +

@@ -53,8 +53,7 @@ const std::vector<std::string>* named_warp_fields(const std::string& name) {
 bool parse_named_params(Ctx& c, const Json& j, const std::string& path, const std::string& name,
                         const std::vector<std::string>& known, NamedWarpParams* p) {
     for (auto it = j.begin(); it != j.end(); ++it) {
-        if (it.key() == "name" ||
-            std::find(known.begin(), known.end(), it.key()) != known.end())
+        if (it.key() == "name" || std::find(known.begin(), known.end(), it.key()) != known.end())
             continue;
         return c.fail(path, "unknown parameter '" + it.key() + "' of the warp '" + name + "' (" +
                                 (known.empty() ? std::string("it takes none")
@@ -88,9 +87,9 @@ bool parse_named_params(Ctx& c, const Json& j, const std::string& path, const st
     for (int k = 0; k < 3; ++k) {
         if (!get_count(c, j, count_keys[k], path, &counts[k])) return false;
         if (find(j, count_keys[k]) && (counts[k] < 1 || counts[k] > 4096))
-            return c.fail(sub(path, count_keys[k]),
-                          "must be in 1..4096, got " + std::to_string(counts[k]) +
-                              " (leave it out for the default)");
+            return c.fail(sub(path, count_keys[k]), "must be in 1..4096, got " +
+                                                        std::to_string(counts[k]) +
+                                                        " (leave it out for the default)");
     }
     p->nx = static_cast<int>(counts[0] ? counts[0] : counts[1]);
     p->ny = static_cast<int>(counts[2]);
@@ -180,9 +179,8 @@ bool parse_warp(Ctx& c, const Json& j, const std::string& path, NamedWarp* out) 
                                           " expressions, but points of the " + domain.describe() +
                                           " have " + std::to_string(domain.point_dim()) +
                                           " coordinates");
-    Made<Warp> w = make_typed_warp(domain, g_texts, g_function, p_function ? std::string()
-                                                                         : p->get<std::string>(),
-                                   p_function);
+    Made<Warp> w = make_typed_warp(domain, g_texts, g_function,
+                                   p_function ? std::string() : p->get<std::string>(), p_function);
     if (!w.ok()) return c.fail(path, w.error);
     out->warp = std::move(w.value);
     out->domain = domain;

@@ -96,25 +96,23 @@ Json level_warning(const Flag& f, const LevelStats& l) {
         return flag_warning(f, "the variance across replicates is not a finite number >= 0" + at_n +
                                    ": no error bar");
     case FlagCode::ZeroErrorBar:
-        return flag_warning(f, std::to_string(f.count) + " of " + std::to_string(f.of) +
-                                   " replicates reported a standard error of 0" + at_n +
-                                   " although the replicates differ (standard deviation " +
-                                   fmt("%.3g", f.value) +
-                                   (std::isfinite(f.threshold)
-                                        ? ", from " + fmt("%.3g", f.threshold) + " to " +
-                                              fmt("%.3g", f.se)
-                                        : std::string()) +
-                                   (l.values_underflow
-                                        ? "): their error bars are wrong (the squares of values "
-                                          "this small underflow: values_underflow)"
-                                        : "): their error bars are wrong (too few samples to see "
-                                          "f vary)"));
+        return flag_warning(
+            f, std::to_string(f.count) + " of " + std::to_string(f.of) +
+                   " replicates reported a standard error of 0" + at_n +
+                   " although the replicates differ (standard deviation " + fmt("%.3g", f.value) +
+                   (std::isfinite(f.threshold)
+                        ? ", from " + fmt("%.3g", f.threshold) + " to " + fmt("%.3g", f.se)
+                        : std::string()) +
+                   (l.values_underflow ? "): their error bars are wrong (the squares of values "
+                                         "this small underflow: values_underflow)"
+                                       : "): their error bars are wrong (too few samples to see "
+                                         "f vary)"));
     case FlagCode::ErrorBarsUnderstate:
         if (f.count > 0) // Cochran's Q: each replicate in its own standard errors
             return flag_warning(
                 f, "the " + std::to_string(f.count) + " replicates" + at_n + " lie " +
-                       fmt("%.3g", std::sqrt(f.value)) +
-                       " times farther from " + (l.has_exact ? "the exact value" : "their mean") +
+                       fmt("%.3g", std::sqrt(f.value)) + " times farther from " +
+                       (l.has_exact ? "the exact value" : "their mean") +
                        " than their own standard errors say (chi-square " +
                        fmt("%.4g", f.value * f.dof) + " on " + std::to_string(f.dof) + " dof, " +
                        p_value_text(f.p_value) +
@@ -212,19 +210,18 @@ Json level_warning(const Flag& f, const LevelStats& l) {
                        (f.skewness < 0.0 ? "a low" : "a high") +
                        " estimate and a small error bar, so the error bars understate the error "
                        "on that side");
-        return flag_warning(f, "replicate " + std::to_string(f.dof + 1) + " of " +
-                                   std::to_string(f.of) +
-                                   (f.replicates_judged < int(f.of)
-                                        ? " (" + std::to_string(f.replicates_judged) + " of the " +
-                                              std::to_string(f.of) + " had an error bar to judge)"
-                                        : std::string()) +
-                                   " lies " + fmt("%.1f", f.value) +
-                                   " of its own standard errors from " +
-                                   (f.se > 0.0 ? "the exact value" : "the other replicates' mean") +
-                                   at_n + " (beyond " + fmt("%.1f", f.threshold) +
-                                   ", 5 standard errors widened for its degrees of freedom" +
-                                   (f.count > 1 ? "; " + std::to_string(f.count) + " such" : "") +
-                                   "): its error bar is far too small, and any one run's may be");
+        return flag_warning(
+            f, "replicate " + std::to_string(f.dof + 1) + " of " + std::to_string(f.of) +
+                   (f.replicates_judged < int(f.of)
+                        ? " (" + std::to_string(f.replicates_judged) + " of the " +
+                              std::to_string(f.of) + " had an error bar to judge)"
+                        : std::string()) +
+                   " lies " + fmt("%.1f", f.value) + " of its own standard errors from " +
+                   (f.se > 0.0 ? "the exact value" : "the other replicates' mean") + at_n +
+                   " (beyond " + fmt("%.1f", f.threshold) +
+                   ", 5 standard errors widened for its degrees of freedom" +
+                   (f.count > 1 ? "; " + std::to_string(f.count) + " such" : "") +
+                   "): its error bar is far too small, and any one run's may be");
     case FlagCode::ExactOutsideCi:
         return flag_warning(
             f, "the mean of " + std::to_string(f.of) + " replicates misses the exact value by " +

@@ -262,8 +262,8 @@ Made<SceneRequest> build_request(const Json& scene, const Json& options,
         if (!(s.max_seconds > 0.0 || !max_seconds_given) || !std::isfinite(s.max_seconds))
             return made_error<SceneRequest>(
                 std::string(find(options, "max_seconds") ? "options: " : "scene: ") +
-                "max_seconds: must be a finite number > 0, got " +
-                fmt("%.3g", s.max_seconds) + " (leave it out for no time budget)");
+                "max_seconds: must be a finite number > 0, got " + fmt("%.3g", s.max_seconds) +
+                " (leave it out for no time budget)");
         if (!s.stopping() && s.max_seconds > 0.0)
             return made_error<SceneRequest>(std::string(who) +
                                             "max_seconds: applies with rel_tol or abs_tol only");
@@ -293,8 +293,8 @@ Made<SceneRequest> build_request(const Json& scene, const Json& options,
         // two, or from n_min when stopping at a tolerance.
         const std::vector<uint64_t> runs_n = n_ladder(s.n_min, s.n_max);
         const uint64_t n_first = s.stopping() || runs_n.empty() ? s.n_min : runs_n.front();
-        const std::string refused = check_estimator(
-            e, StudyShape{req.problem.domain.sample_dim(), n_first, s.n_max});
+        const std::string refused =
+            check_estimator(e, StudyShape{req.problem.domain.sample_dim(), n_first, s.n_max});
         if (!refused.empty())
             return made_error<SceneRequest>(
                 (options.is_object() && (find(options, "n_min") || find(options, "n_max"))

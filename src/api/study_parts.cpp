@@ -192,8 +192,8 @@ bool run_from_json(Ctx& c, const Json& j, const std::string& path, uint64_t n, R
            moments_from_json(c, *uj, sub(dp, "error_units"), n, &d.error_units);
 }
 
-const StopReason kStopReasons[] = {StopReason::ToleranceMet, StopReason::NMax,
-                                   StopReason::TimeBudget, StopReason::NoErrorBar,
+const StopReason kStopReasons[] = {StopReason::ToleranceMet,      StopReason::NMax,
+                                   StopReason::TimeBudget,        StopReason::NoErrorBar,
                                    StopReason::UntrustedErrorBar, StopReason::AllZero};
 
 Json stopping_run_to_json(const StoppingResult& s) {

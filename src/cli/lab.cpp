@@ -147,9 +147,8 @@ std::string analysis_table(const nlohmann::json& a) {
         const auto& s = a["spectrum"];
         const auto& radial = s["radial"];
         out += "power spectrum of x" + std::to_string(s["axes"][0].get<int>() + 1) + ", x" +
-               std::to_string(s["axes"][1].get<int>() + 1) +
-               " on a " + s["size"].dump() + " x " + s["size"].dump() +
-               " frequency grid; radial average (1 = independent points):\n";
+               std::to_string(s["axes"][1].get<int>() + 1) + " on a " + s["size"].dump() + " x " +
+               s["size"].dump() + " frequency grid; radial average (1 = independent points):\n";
         const size_t rings = radial["frequency"].size();
         for (size_t r = 0; r < rings; r += std::max<size_t>(1, rings / 16))
             out += "  |k| " + num(radial["frequency"][r].get<double>(), "%6.1f") + "  " +

@@ -744,8 +744,7 @@ std::string null_error_reason(const nlohmann::json& error, const nlohmann::json&
     if (!error.is_object() || !reference.is_object()) return "no reference image to compare with";
     if (!(error["terms"].is_number() && error["terms"].get<double>() > 0))
         return "no pixel of the reference to compare with";
-    if (!(reference["mean_luminance"].is_number() &&
-          reference["mean_luminance"].get<double>() > 0))
+    if (!(reference["mean_luminance"].is_number() && reference["mean_luminance"].get<double>() > 0))
         return "the reference is black: a relative error has no scale";
     return "the error is not finite: the image holds non-finite or overflowing pixels";
 }

@@ -30,7 +30,8 @@ bool CallerFunction::evaluate(const PointBlock& x, int out_dim, double* out,
                               size_t out_stride) const {
     const size_t n = x.n;
     auto zeros = [&] {
-        for (int k = 0; k < out_dim; ++k) std::fill(out + k * out_stride, out + k * out_stride + n, 0.0);
+        for (int k = 0; k < out_dim; ++k)
+            std::fill(out + k * out_stride, out + k * out_stride + n, 0.0);
     };
     if (n == 0) return !control->stopped();
     if (control->stopped()) {

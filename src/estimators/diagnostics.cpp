@@ -306,8 +306,7 @@ std::vector<Flag> level_flags(const LevelStats& l) {
     const bool scattered = scatter.judged > 0 && scatter.p_value < kLevelDriftP;
     const bool replicates_cover = replicates.judged >= kEvidenceReplicates &&
                                   replicates.misses <= replicates.allowance &&
-                                  replicates.far == 0 && replicates.skewed_index < 0 &&
-                                  !scattered;
+                                  replicates.far == 0 && replicates.skewed_index < 0 && !scattered;
     // `blind_ok`: whether replicates judged without the exact value may demote the flag. For
     // error_bars_unstable only when Cochran's Q shows no sign of scatter (p >= 0.05, not merely
     // no proof of it): without the exact value each replicate is judged against the others'
@@ -328,7 +327,7 @@ std::vector<Flag> level_flags(const LevelStats& l) {
         f.value = replicates.worst_z;
         f.threshold = replicates.worst_limit;
         f.count = static_cast<uint64_t>(replicates.far);
-        f.of = reps; // "replicate 3 of 32": of all of them, not of those judged
+        f.of = reps;                    // "replicate 3 of 32": of all of them, not of those judged
         f.dof = replicates.worst_index; // which replicate (0-based)
         f.se = l.has_exact ? 1.0 : 0.0; // 1: judged against the exact value
         f.replicates_judged = replicates.judged;

@@ -120,7 +120,7 @@ struct ScatterTest {
 ScatterTest replicate_scatter(const LevelStats& level);
 
 // Thresholds (see the functions' comments for why).
-constexpr double kSkewnessRule = 25.0;  ///< skewed_weights below N = 25 g1^2 [Cochran77]
+constexpr double kSkewnessRule = 25.0; ///< skewed_weights below N = 25 g1^2 [Cochran77]
 /// One weight carrying this share of a run's sum: the run rests on a few weights (its Kish ESS
 /// is at most 1 / share^2), too few for replicates judged blind to vouch for its interval.
 constexpr double kRulingShare = 0.1;

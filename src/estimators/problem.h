@@ -169,7 +169,7 @@ struct ControlVariateOptions {
 /// pdf (`target`, a cheap proxy of |f|; the proposal is then uniform) or |f| at the candidates.
 struct RisOptions {
     static constexpr int kMaxCandidates = static_cast<int>(kBlockSize); ///< fit in one block
-    int candidates = 1;      ///< M
+    int candidates = 1;                                                 ///< M
     bool target_pdf = false; ///< g = target's density; false: g = |f|
     Proposal target;
 };

@@ -19,10 +19,11 @@ const EstimatorKind& ris_estimator_kind();             // estimators/ris.cpp
 
 const std::vector<const EstimatorKind*>& estimator_kinds() {
     static const std::vector<const EstimatorKind*> kinds = {
-        &fixed_estimator_kind(),      &vegas_estimator_kind(), &vegas_plus_estimator_kind(),
-        &miser_estimator_kind(),      &mis_estimator_kind(),   &control_variate_estimator_kind(),
-        &antithetic_estimator_kind(),
-        &systematic_estimator_kind(), &ris_estimator_kind(),
+        &fixed_estimator_kind(),      &vegas_estimator_kind(),
+        &vegas_plus_estimator_kind(), &miser_estimator_kind(),
+        &mis_estimator_kind(),        &control_variate_estimator_kind(),
+        &antithetic_estimator_kind(), &systematic_estimator_kind(),
+        &ris_estimator_kind(),
     };
     return kinds;
 }

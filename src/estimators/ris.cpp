@@ -33,8 +33,8 @@ class RisEstimator final : public EstimatorAlgorithm {
         total_ = n;
         // Candidates i M .. i M + M - 1 are point i's; the plan is drawn first, so that M = 1
         // takes the importance sampler's very points from the same rng.
-        plan_ = make_sampler_plan(SamplerKind::Independent, problem_.domain.sample_dim(),
-                                  n * m_, rng, {});
+        plan_ = make_sampler_plan(SamplerKind::Independent, problem_.domain.sample_dim(), n * m_,
+                                  rng, {});
         const uint64_t seed = rng.next_u32() | (uint64_t(rng.next_u32()) << 32);
         pick_ = Pcg32(seed, 0x726973); // "ris": the resampling's draws
         accumulator_.reset(ErrorMethod::Iid, plan_, float32_);

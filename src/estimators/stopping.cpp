@@ -60,8 +60,8 @@ StoppingStep step_of(const RunResult& r, uint64_t n, double t) {
     step.seconds = r.seconds;
     step.half_width = t * r.std_error;
     const RunDiagnostics& d = r.diagnostics;
-    step.all_zero = r.n > 0 && r.estimate == 0.0 && d.nonzero == 0 && d.nonfinite == 0 &&
-                    d.zero_pdf == 0;
+    step.all_zero =
+        r.n > 0 && r.estimate == 0.0 && d.nonzero == 0 && d.nonfinite == 0 && d.zero_pdf == 0;
     return step;
 }
 

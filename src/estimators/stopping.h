@@ -96,10 +96,10 @@ struct StoppingStep {
     uint64_t n = 0;
     double estimate = 0.0, std_error = 0.0, half_width = 0.0, seconds = 0.0;
     int dof = 0;
-    bool trusted = false; ///< condition 4 (Cochran's rule on the run's weights, ESS) and 3
-                          ///< (skewness of the batch means) for extended runs
-    bool agrees = false;  ///< condition 2 (extended) or 3 (fresh runs): agrees with earlier N
-    bool flagged = false; ///< a warning or error flag of the study's judgement (condition 5)
+    bool trusted = false;  ///< condition 4 (Cochran's rule on the run's weights, ESS) and 3
+                           ///< (skewness of the batch means) for extended runs
+    bool agrees = false;   ///< condition 2 (extended) or 3 (fresh runs): agrees with earlier N
+    bool flagged = false;  ///< a warning or error flag of the study's judgement (condition 5)
     bool all_zero = false; ///< every point's f/p was 0 (none dropped): the estimate is 0 +- 0
 };
 

@@ -103,7 +103,7 @@ class SystematicEstimator final : public EstimatorAlgorithm {
     int dim_ = 1;
     uint64_t total_ = 0, next_ = 0, grid_size_ = 0;
     bool prepared_ = false;
-    std::vector<double> shifts_;  ///< K shifts s in [0,1)^d, shift k at [k d, (k + 1) d)
+    std::vector<double> shifts_; ///< K shifts s in [0,1)^d, shift k at [k d, (k + 1) d)
     std::vector<uint64_t> grid_; ///< cells per axis of a batch of grid_size_ points
     WeightAccumulator accumulator_;
 };
@@ -123,9 +123,9 @@ std::string systematic_check(const EstimatorSpec&, const StudyShape& study) {
                               " shifted grids of N/" + std::to_string(k) + " points";
     const uint64_t least = d < 58 ? k << d : 0; // 16 x 2^d, 0 past 2^64
     if (least == 0 || least > study.n_max)
-        return grids + ", each to be cut at least twice along every axis: in " +
-               std::to_string(d) + " dimensions that takes N >= " + std::to_string(k) + " x 2^" +
-               std::to_string(d) + (least ? " = " + std::to_string(least) : "") +
+        return grids + ", each to be cut at least twice along every axis: in " + std::to_string(d) +
+               " dimensions that takes N >= " + std::to_string(k) + " x 2^" + std::to_string(d) +
+               (least ? " = " + std::to_string(least) : "") +
                ", beyond n_max = " + std::to_string(study.n_max) +
                ": raise n_max, or use latin_hypercube or sobol in this many dimensions";
     if (study.n_first < k)

@@ -618,8 +618,7 @@ Quadrature integrate_bins(const Domain& domain, const Warp& warp, const Natural&
                     if (child >> j & 1u) c.lo[j] += std::ldexp(bin_width[j], -c.level[j]);
                 }
                 c.seed_begin = at;
-                while (at < parent.seed_end && child_of(parent, s.axes, seeds[at].t) == child)
-                    ++at;
+                while (at < parent.seed_end && child_of(parent, s.axes, seeds[at].t) == child) ++at;
                 c.seed_end = at;
                 next.push_back(c);
             }
@@ -1110,8 +1109,8 @@ Made<WarpTestResult> run_warp_test(const Domain& domain, const Warp& warp,
             }
             seeds.swap(sorted);
         }
-        Quadrature q = integrate_bins(domain, warp, natural, r.bins, nbins, again, seeds,
-                                      seed_bin, n_samples, options.pdf_tolerance);
+        Quadrature q = integrate_bins(domain, warp, natural, r.bins, nbins, again, seeds, seed_bin,
+                                      n_samples, options.pdf_tolerance);
         if (!q.error_message.empty()) return made_error<WarpTestResult>(q.error_message);
         for (uint32_t b : again) {
             integral.add((q.expected[b] - r.expected[b]) / n_samples);
@@ -1148,10 +1147,9 @@ Made<WarpTestResult> run_warp_test(const Domain& domain, const Warp& warp,
     r.p_value_low = r.p_value_high = r.p_value;
     if (r.dof >= 1 && r.quadrature_chi_square > 0.0) {
         const double root = std::sqrt(r.chi_square), d = std::sqrt(r.quadrature_chi_square);
-        const double high = max_relative < 1.0 ? (root + d) * (root + d) / (1.0 - max_relative)
-                                               : HUGE_VAL;
-        const double low =
-            std::max(root - d, 0.0) * std::max(root - d, 0.0) / (1.0 + max_relative);
+        const double high =
+            max_relative < 1.0 ? (root + d) * (root + d) / (1.0 - max_relative) : HUGE_VAL;
+        const double low = std::max(root - d, 0.0) * std::max(root - d, 0.0) / (1.0 + max_relative);
         r.p_value_low = std::isfinite(high) ? chi_square_sf(high, r.dof) : 0.0;
         r.p_value_high = chi_square_sf(low, r.dof);
     }
@@ -1178,10 +1176,11 @@ Made<WarpTestResult> run_warp_test(const Domain& domain, const Warp& warp,
     const std::string stat = "chi-square " + fmt(r.chi_square, 6) + " on " + std::to_string(r.dof) +
                              " degrees of freedom, " + p_value_text(r.p_value, 3);
     const std::string range = "p between " + fmt(r.p_value_low, 3) + " and " +
-                              fmt(r.p_value_high, 3) + " over the expected counts within the "
+                              fmt(r.p_value_high, 3) +
+                              " over the expected counts within the "
                               "quadrature's error";
-    const std::string integral_text = "the pdf integrates to " + fmt(r.pdf_integral, 7) +
-                                      " (+- " + fmt(r.pdf_integral_error, 2) + ")";
+    const std::string integral_text = "the pdf integrates to " + fmt(r.pdf_integral, 7) + " (+- " +
+                                      fmt(r.pdf_integral_error, 2) + ")";
     // The statistic over the bins whose expected counts the quadrature settled (error under
     // kTrustedError sqrt(expected)), given the samples they hold: multinomial with the bins'
     // shares of their expectation, whatever the other bins' counts or the pdf's integral (so
@@ -1229,8 +1228,7 @@ Made<WarpTestResult> run_warp_test(const Domain& domain, const Warp& warp,
     };
     auto shape_text = [&](const Shape& sh) {
         return "chi-square " + fmt(sh.chi, 6) + " on " + std::to_string(sh.dof) +
-               " degrees of freedom against p's shape, " + p_value_text(sh.p_high, 3) +
-               " at most";
+               " degrees of freedom against p's shape, " + p_value_text(sh.p_high, 3) + " at most";
     };
     // Where the mass is wrong, in words; a local departure names its most deviant bin.
     auto where_text = [&]() {
@@ -1258,8 +1256,8 @@ Made<WarpTestResult> run_warp_test(const Domain& domain, const Warp& warp,
     if (zero_probe) {
         r.reason = "rejected: " + std::to_string(r.zero_pdf_samples) +
                    " sample(s) fell where the pdf is 0, the first sample " +
-                   std::to_string(zero_probe->sample) + " at x = " +
-                   tuple(zero_probe->x, point_dim) +
+                   std::to_string(zero_probe->sample) +
+                   " at x = " + tuple(zero_probe->x, point_dim) +
                    ": the warp lands where its pdf says it cannot";
     } else if (integral_wrong) {
         // A constant factor alone, or a wrong shape besides.
@@ -1273,12 +1271,12 @@ Made<WarpTestResult> run_warp_test(const Domain& domain, const Warp& warp,
                        shape_text(sh) + ")";
         } else {
             r.where = where_text();
-            r.reason = "rejected: " + integral_text + " over the domain, not 1 (tolerance " +
-                       fmt(options.pdf_tolerance, 3) + ")" +
-                       (sh.ok ? ", and the samples do not follow its shape either (" +
-                                    shape_text(sh) + ")"
-                              : "; " + stat) +
-                       (r.where.empty() ? "" : "; " + r.where);
+            r.reason =
+                "rejected: " + integral_text + " over the domain, not 1 (tolerance " +
+                fmt(options.pdf_tolerance, 3) + ")" +
+                (sh.ok ? ", and the samples do not follow its shape either (" + shape_text(sh) + ")"
+                       : "; " + stat) +
+                (r.where.empty() ? "" : "; " + r.where);
         }
     } else if (r.dof >= 1 && !(r.p_value_high >= r.level)) {
         r.where = where_text();
@@ -1306,8 +1304,8 @@ Made<WarpTestResult> run_warp_test(const Domain& domain, const Warp& warp,
                   " cell(s) after pooling bins of expected count under 5; take more samples "
                   "or fewer bins";
     } else if (!(r.p_value_low >= r.level)) {
-        why_not = "the quadrature's error on the expected counts decides the test: " + stat +
-                  ", " + range + ", level " + fmt(r.level, 3);
+        why_not = "the quadrature's error on the expected counts decides the test: " + stat + ", " +
+                  range + ", level " + fmt(r.level, 3);
     } else {
         r.outcome = WarpTestOutcome::Passed;
         r.reason = "passed: " + stat + " >= level " + fmt(r.level, 3) + "; " + integral_text;

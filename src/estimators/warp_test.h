@@ -113,7 +113,7 @@ struct WarpTestResult {
     bool pdf_integral_ok = false;
     WarpTestOutcome outcome = WarpTestOutcome::Failed;
     bool passed = false; ///< outcome == Passed
-    std::string reason; ///< the verdict in plain words
+    std::string reason;  ///< the verdict in plain words
     /// Where the samples' mass departs from p's, in words, when the samples do not follow p
     /// (empty otherwise): per natural axis, the samples against p's expected counts (rescaled
     /// to the samples' total) in the quarters of its range summed over the other axes, the

@@ -30,8 +30,7 @@ using mcp::python::raise_error;
 namespace {
 
 // Parameter types in the signatures Python sees (help(), stubs).
-#define FUNCTIONS_T                                                                                \
-    "dict[str, collections.abc.Callable[[numpy.ndarray], numpy.typing.ArrayLike]]"
+#define FUNCTIONS_T "dict[str, collections.abc.Callable[[numpy.ndarray], numpy.typing.ArrayLike]]"
 #define PROGRESS_T "collections.abc.Callable[[str], object]"
 
 using OptionalText = std::optional<std::string>;
@@ -228,9 +227,8 @@ std::string run_with_functions(FunctionsCall call, const std::string& scene,
     CallState state(functions, nb::none());
     const char* scene_c = c_text(scene, "scene");
     const char* options_c = c_text(options, "options");
-    return run_watched(state, [&](char** out) {
-        return call(scene_c, options_c, state.context(), out);
-    });
+    return run_watched(state,
+                       [&](char** out) { return call(scene_c, options_c, state.context(), out); });
 }
 
 std::string study_plan(const std::string& scene, const OptionalText& options,
@@ -306,11 +304,10 @@ NB_MODULE(_core, m) {
               "warps. Use the package mcplay rather than this module.";
     mcp::python::register_error_type(m);
 
-    m.def("version", [] { return std::string(mcp_version()); },
-          "The core's version, e.g. '0.1.0'.");
+    m.def(
+        "version", [] { return std::string(mcp_version()); }, "The core's version, e.g. '0.1.0'.");
 
-    m.def("call", &call, nb::arg("fn"), nb::arg("request") = "",
-          nb::arg("options") = nb::none(),
+    m.def("call", &call, nb::arg("fn"), nb::arg("request") = "", nb::arg("options") = nb::none(),
           "Runs one JSON-in, JSON-out C call that takes no callback, by name: 'catalog' (no "
           "request), 'scene_info', 'points', 'points_analyze', 'discrepancy_curve', "
           "'points_integrate' (request: the scene, options: the points request), "
@@ -321,12 +318,11 @@ NB_MODULE(_core, m) {
           "while it runs. Raises McplayError with the C API's message.");
 
     m.def("study_run", &study_run,
-          nb::sig(
-                "def study_run(scene: str, options: str | None = None, "
-                "functions: " FUNCTIONS_T " | None = None, "
-                "progress: " PROGRESS_T " | None = None) -> str"),
-          nb::arg("scene"), nb::arg("options") = nb::none(),
-          nb::arg("functions") = nb::none(), nb::arg("progress") = nb::none(),
+          nb::sig("def study_run(scene: str, options: str | None = None, "
+                  "functions: " FUNCTIONS_T " | None = None, "
+                  "progress: " PROGRESS_T " | None = None) -> str"),
+          nb::arg("scene"), nb::arg("options") = nb::none(), nb::arg("functions") = nb::none(),
+          nb::arg("progress") = nb::none(),
           "A convergence study (mcp_study_run_with). functions maps the names the scene gives "
           "({'type': 'function', 'name': ...}) to callables f(x) -> values, x a read-only "
           "(n, in_dim) float64 array of one block of points (the callable may keep it), the "
@@ -336,55 +332,43 @@ NB_MODULE(_core, m) {
           "naming the block and the point, from the callable's exception.");
 
     m.def("study_plan", &study_plan,
-          nb::sig(
-                "def study_plan(scene: str, options: str | None = None, "
-                "functions: " FUNCTIONS_T " | None = None) -> str"),
-          nb::arg("scene"), nb::arg("options") = nb::none(),
-          nb::arg("functions") = nb::none(),
+          nb::sig("def study_plan(scene: str, options: str | None = None, "
+                  "functions: " FUNCTIONS_T " | None = None) -> str"),
+          nb::arg("scene"), nb::arg("options") = nb::none(), nb::arg("functions") = nb::none(),
           "A study's cost predicted from a short pilot (mcp_study_plan_with); functions as "
           "study_run's.");
 
     m.def("warp_test", &warp_test,
-          nb::sig(
-                "def warp_test(scene: str, options: str | None = None, "
-                "functions: " FUNCTIONS_T " | None = None) -> str"),
-          nb::arg("scene"), nb::arg("options") = nb::none(),
-          nb::arg("functions") = nb::none(),
+          nb::sig("def warp_test(scene: str, options: str | None = None, "
+                  "functions: " FUNCTIONS_T " | None = None) -> str"),
+          nb::arg("scene"), nb::arg("options") = nb::none(), nb::arg("functions") = nb::none(),
           "Tests a warp against its density (mcp_warp_test_with); the warp's map g and density "
           "p may name callables in functions (g returns (n, dim) points, p (n,) densities).");
 
     m.def("render_study_run", &render_study_run,
-          nb::sig(
-                "def render_study_run(scene: str, options: str | None = None, "
-                "progress: " PROGRESS_T " | None = None) -> str"),
-          nb::arg("scene"),
-          nb::arg("options") = nb::none(), nb::arg("progress") = nb::none(),
+          nb::sig("def render_study_run(scene: str, options: str | None = None, "
+                  "progress: " PROGRESS_T " | None = None) -> str"),
+          nb::arg("scene"), nb::arg("options") = nb::none(), nb::arg("progress") = nb::none(),
           "A render convergence study (mcp_render_study_run); progress and Ctrl-C as "
           "study_run's.");
 
     m.def("render_reference", &render_reference,
-          nb::sig(
-                "def render_reference(scene: str, options: str | None = None, "
-                "progress: " PROGRESS_T " | None = None) -> str"),
-          nb::arg("scene"),
-          nb::arg("options") = nb::none(), nb::arg("progress") = nb::none(),
+          nb::sig("def render_reference(scene: str, options: str | None = None, "
+                  "progress: " PROGRESS_T " | None = None) -> str"),
+          nb::arg("scene"), nb::arg("options") = nb::none(), nb::arg("progress") = nb::none(),
           "A render study's reference image (mcp_render_reference).");
 
     m.def("render_live_open", &render_live_open,
-          nb::sig(
-                "def render_live_open(scene: str, options: str | None = None, "
-                "progress: " PROGRESS_T " | None = None) -> str"),
-          nb::arg("scene"),
-          nb::arg("options") = nb::none(), nb::arg("progress") = nb::none(),
+          nb::sig("def render_live_open(scene: str, options: str | None = None, "
+                  "progress: " PROGRESS_T " | None = None) -> str"),
+          nb::arg("scene"), nb::arg("options") = nb::none(), nb::arg("progress") = nb::none(),
           "Opens a live-view session (mcp_render_live_open); the result's 'session' is the "
           "id the other render_live_* calls take. Close it with render_live_close.");
 
     m.def("render_live_pass", &render_live_pass,
-          nb::sig(
-                "def render_live_pass(session: int, pass_json: str, "
-                "progress: " PROGRESS_T " | None = None) -> str"),
-          nb::arg("session"), nb::arg("pass_json"),
-          nb::arg("progress") = nb::none(),
+          nb::sig("def render_live_pass(session: int, pass_json: str, "
+                  "progress: " PROGRESS_T " | None = None) -> str"),
+          nb::arg("session"), nb::arg("pass_json"), nb::arg("progress") = nb::none(),
           "Takes one estimator of a live session to more samples per pixel "
           "(mcp_render_live_pass).");
 

@@ -55,7 +55,9 @@ std::string text_of(nb::handle object) {
     return nb::cast<std::string>(text);
 }
 
-std::string python_type_name(nb::handle object) { return Py_TYPE(object.ptr())->tp_name; }
+std::string python_type_name(nb::handle object) {
+    return Py_TYPE(object.ptr())->tp_name;
+}
 
 /// "ZeroDivisionError: division by zero", kept short.
 std::string exception_text(nb::handle exception) {
@@ -181,8 +183,8 @@ void CallState::raise_failure(int status, const std::string& c_error) {
     if (status != MCP_OK) raise_error(status, c_error);
 }
 
-int CallState::function_trampoline(void* user, const double* x, uint64_t n, int in_dim,
-                                   double* out, int out_dim) noexcept {
+int CallState::function_trampoline(void* user, const double* x, uint64_t n, int in_dim, double* out,
+                                   int out_dim) noexcept {
     Slot& slot = *static_cast<Slot*>(user);
     CallState& state = *slot.state;
     if (state.stopping()) return 1;
@@ -216,11 +218,12 @@ int CallState::function_trampoline(void* user, const double* x, uint64_t n, int 
 void CallState::record_failure(const Slot& slot, uint64_t block, uint64_t first, uint64_t n,
                                const std::string& what, nb::handle cause) {
     if (failed_.exchange(true)) return; // the first failure is the one reported
-    std::string points = n == 0 ? "no points" : "points " + std::to_string(first) + ".." +
-                                                    std::to_string(first + n - 1);
-    failure_message_ = mcp::boundary::one_line("function '" + slot.name + "' on block " +
-                                               std::to_string(block) + " (" + points +
-                                               "): " + what);
+    std::string points =
+        n == 0 ? "no points"
+               : "points " + std::to_string(first) + ".." + std::to_string(first + n - 1);
+    failure_message_ =
+        mcp::boundary::one_line("function '" + slot.name + "' on block " + std::to_string(block) +
+                                " (" + points + "): " + what);
     failure_cause_ = nb::borrow(cause);
 }
 
@@ -300,7 +303,7 @@ std::string CallState::store_values(nb::handle returned, const double* x, uint64
             const nb::object dtype_object = array.attr("dtype");
             const std::string dtype = text_of(dtype_object);
             const std::string what =
-                returned.is_none()                                  ? std::string("None")
+                returned.is_none() ? std::string("None")
                 : PyObject_IsInstance(returned.ptr(), numpy_.attr("ndarray").ptr()) == 1
                     ? std::string("an array")
                     : "a " + python_type_name(returned);

@@ -22,7 +22,7 @@
 namespace mcp::python {
 
 class CallState {
-public:
+  public:
     /// functions: None or a dict {name: callable}; progress: None or a callable taking the
     /// level's JSON. Raises McplayError (ARGUMENT) naming a bad entry. The GIL must be held.
     CallState(const nanobind::object& functions, const nanobind::object& progress);
@@ -48,7 +48,7 @@ public:
     /// returns when the call succeeded.
     void raise_failure(int status, const std::string& c_error);
 
-private:
+  private:
     /// A block of input points as a read-only (n, dim) float64 array in column-major order (as
     /// the core gives them), which the callable may keep.
     struct InputArray {
@@ -67,8 +67,8 @@ private:
         std::vector<InputArray> spare_inputs; // arrays no one else holds, reused (GIL held)
     };
 
-    static int function_trampoline(void* user, const double* x, uint64_t n, int in_dim,
-                                   double* out, int out_dim) noexcept;
+    static int function_trampoline(void* user, const double* x, uint64_t n, int in_dim, double* out,
+                                   int out_dim) noexcept;
     static int cancel_trampoline(void* user) noexcept;
 
     bool stopping() const { return cancel_.load() || failed_.load(); }

@@ -39,8 +39,8 @@ void register_error_type(nb::module_& m) {
     if (!g_error_type) nb::raise_python_error();
     m.attr("McplayError") = nb::handle(g_error_type);
     nb::dict names;
-    for (int status : {MCP_ERROR_ARGUMENT, MCP_ERROR_SCENE, MCP_ERROR_CANCELLED,
-                       MCP_ERROR_INTERNAL, MCP_ERROR_FUNCTION}) {
+    for (int status : {MCP_ERROR_ARGUMENT, MCP_ERROR_SCENE, MCP_ERROR_CANCELLED, MCP_ERROR_INTERNAL,
+                       MCP_ERROR_FUNCTION}) {
         names[nb::int_(status)] = status_name(status);
     }
     m.attr("STATUS_NAMES") = names;
@@ -48,8 +48,8 @@ void register_error_type(nb::module_& m) {
 
 void raise_error(int status, const std::string& message, nb::handle cause) {
     // The message may quote user text that is not valid UTF-8: replaced, never an error.
-    nb::object text = nb::steal(
-        PyUnicode_DecodeUTF8(message.data(), Py_ssize_t(message.size()), "replace"));
+    nb::object text =
+        nb::steal(PyUnicode_DecodeUTF8(message.data(), Py_ssize_t(message.size()), "replace"));
     if (!text.is_valid()) nb::raise_python_error();
     nb::object error = nb::handle(g_error_type)(text);
     error.attr("status") = status;

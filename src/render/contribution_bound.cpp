@@ -72,8 +72,8 @@ constexpr double kInteriorMargin = 1e-6;
 
 struct PairContact {
     bool contact = false, interior = false;
-    bool touching = false;     ///< within `tight`: the two meet
-    Vec3 point{0.0};           ///< a point where they meet (the mean of those found)
+    bool touching = false; ///< within `tight`: the two meet
+    Vec3 point{0.0};       ///< a point where they meet (the mean of those found)
 };
 
 /// Contact of a receiver triangle r with a light triangle l (neither degenerate): within `tol`
@@ -189,8 +189,8 @@ bool degenerate(const Triangle& t) {
 /// emits towards the receiver's side near x, and the receiver faces the light from the
 /// camera's side) and camera rays reach the receiver 1e-3 and 1e-6 of the extent from x,
 /// towards its inside: the pixels there see points arbitrarily close to the contact.
-bool seen_touching(const RenderScene& rs, const View& view, const Triangle& tl,
-                   const Triangle& tr, size_t l, size_t t, const Vec3& x, double extent) {
+bool seen_touching(const RenderScene& rs, const View& view, const Triangle& tl, const Triangle& tr,
+                   size_t l, size_t t, const Vec3& x, double extent) {
     const Vec3 cl = (tl[0] + tl[1] + tl[2]) / 3.0, cr = (tr[0] + tr[1] + tr[2]) / 3.0;
     if (!(glm::length(cl - x) > 0.0) || !(glm::length(cr - x) > 0.0)) return false;
     const Vec3 to_r = glm::normalize(cr - x), to_l = glm::normalize(cl - x);
@@ -281,8 +281,7 @@ LightContacts light_contacts(const RenderScene& rs, double aspect) {
         const Box near_light = box_of(l, tol), receiver = box_of(t, 0.0);
         const Vec3 box_lo = glm::max(near_light.lo, receiver.lo);
         const Vec3 box_hi = glm::min(near_light.hi, receiver.hi);
-        if (!reflects(rs.scene->materials[mesh.material[t]]) ||
-            !view.may_see_box(box_lo, box_hi)) {
+        if (!reflects(rs.scene->materials[mesh.material[t]]) || !view.may_see_box(box_lo, box_hi)) {
             ++out.ignored;
             continue;
         }

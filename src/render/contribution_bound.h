@@ -30,7 +30,7 @@ struct LightContacts {
     bool interior_contact = false; ///< ... at a point inside the light, not on its edges
     bool seen_contact = false;     ///< ... touching, facing it, where the camera sees it
     size_t pairs = 0;              ///< (light, triangle) pairs whose boxes overlap
-    size_t ignored = 0; ///< contacts with black surfaces or out of the camera's view
+    size_t ignored = 0;            ///< contacts with black surfaces or out of the camera's view
 };
 /// A light closer than this (relative to the scene's extent) to a surface is taken as touching
 /// it: the area form's bound, of order 1 / d^2, is then 1e8 times its typical value or more,

@@ -396,8 +396,8 @@ bool is_split(const RenderEstimator& est) {
 template <class S>
 Vec3 split_direct_term(const RenderScene& rs, const RenderEstimator& est, const LightSet& lights,
                        const ShadingPoint& sp, PixelSampler& sampler, SampleCounters& c) {
-    const bool mis = est.strategy == RadianceStrategy::MisBalance ||
-                     est.strategy == RadianceStrategy::MisPower;
+    const bool mis =
+        est.strategy == RadianceStrategy::MisBalance || est.strategy == RadianceStrategy::MisPower;
     const bool power = est.strategy == RadianceStrategy::MisPower;
     const bool ris = est.strategy == RadianceStrategy::Ris;
     const bool lights_sampled = mis || ris || est.strategy == RadianceStrategy::LightArea ||
@@ -414,8 +414,8 @@ Vec3 split_direct_term(const RenderScene& rs, const RenderEstimator& est, const 
                       : mis ? nee_term<S>(rs, est, lights, sp, sampler, c, power, n_light, n_bsdf)
                             : light_sample_term<S>(rs, lights, mode, sp, sampler, c, false, false);
     for (int i = 0; i < n_bsdf; ++i)
-        from_bsdf += direction_sample_term<S>(rs, est, lights, sp, sampler, c, mis, power,
-                                              n_light, n_bsdf);
+        from_bsdf +=
+            direction_sample_term<S>(rs, est, lights, sp, sampler, c, mis, power, n_light, n_bsdf);
     Vec3 sum(0.0);
     if (n_light > 0) sum += from_light / double(n_light);
     if (n_bsdf > 0) sum += from_bsdf / double(n_bsdf);

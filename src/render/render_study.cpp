@@ -397,8 +397,7 @@ ConvergenceFit fit_render_convergence(const std::vector<LevelStats>& levels, dou
     return fit;
 }
 
-RenderStudyResult run_render_study(const RenderScene& rs,
-                                   const std::vector<RenderEstimator>& given,
+RenderStudyResult run_render_study(const RenderScene& rs, const std::vector<RenderEstimator>& given,
                                    const RenderStudySettings& settings,
                                    const RenderImage& reference,
                                    const RenderStudyProgress& progress) {

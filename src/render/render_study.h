@@ -130,7 +130,7 @@ struct RenderEstimatorStudy {
     /// Whether its per-sample contributions are bounded by construction (contribution_bound):
     /// then heavy_tail is info, a pre-asymptotic tail.
     ContributionBound bound;
-    RenderImage preview;                           ///< replicate 0 at the largest spp rendered
+    RenderImage preview; ///< replicate 0 at the largest spp rendered
     /// Each level's images, kept by a part of a study split over processes (for the merge).
     std::vector<std::vector<ImageSummary>> images;
 };

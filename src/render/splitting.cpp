@@ -46,9 +46,9 @@ std::vector<RenderImage> pilot_bands(const RenderScene& rs, const RenderEstimato
     const std::clock_t begin = std::clock();
     for (int k = 0; k < kPilotBands; ++k) {
         const int first = std::min(pilot.height - rows, k * pilot.height / kPilotBands);
-        ImageBand band = make_band(pilot.width, pilot.height, std::max(0, first),
-                                   std::min(pilot.height, std::max(0, first) + rows),
-                                   est.pixel_sampler);
+        ImageBand band =
+            make_band(pilot.width, pilot.height, std::max(0, first),
+                      std::min(pilot.height, std::max(0, first) + rows), est.pixel_sampler);
         render_pass(rs, est, pilot, band);
         out.push_back(band_image(band));
     }
@@ -139,9 +139,9 @@ RenderEstimator run_pilot(const RenderScene& rs, const RenderEstimator& est,
     RenderEstimator out = est;
     // The model is measured at 1 and k only: n* is not taken past kPilotReach k, where a
     // V_rest lost in the pilot's noise would send it to the largest count.
-    const int n = std::min(
-        optimal_split(p.variance_rest, p.variance_light, p.seconds_rest, p.seconds_light),
-        kPilotReach * k_count);
+    const int n =
+        std::min(optimal_split(p.variance_rest, p.variance_light, p.seconds_rest, p.seconds_light),
+                 kPilotReach * k_count);
     p.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (what == PilotCount::Candidates) {
         out.candidates = std::min(n, kMaxRisCandidates);

@@ -72,9 +72,8 @@ struct GltfTypeChecker {
     bool positive_aspect(const Json& perspective, const std::string& path) {
         auto it = perspective.find("aspectRatio");
         if (it == perspective.end() || it->get<double>() > 0.0) return true;
-        return fail(path + ".aspectRatio",
-                    "a number > 0, got " + it->dump() +
-                        " (leave it out to use the scene's width / height)");
+        return fail(path + ".aspectRatio", "a number > 0, got " + it->dump() +
+                                               " (leave it out to use the scene's width / height)");
     }
     /// Each element of the array `key` of the root, checked by `each`.
     template <class F> bool each(const Json& root, const char* key, F check) {

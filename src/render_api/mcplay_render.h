@@ -64,11 +64,11 @@ int mcp_render_image(const char* scene_json, const char* options_json, char** re
 
 /* The points one pixel's samples take from a render pixel sampler, for the sampler lab:
  * request {"pixel_sampler": "independent" | "stratified" | "sobol" (default) | "padded_sobol",
- * "spp" (1..65536; a power of two for sobol; default 64), "dim" (2, 4, 6 or 8: the sample's first dim / 2 2D requests,
- * default 2), "seed" (the image's key, default 1), "width", "height" (the image, default 1 x 1),
- * "pixel": [x, y] (default [0, 0])}. Result: {"pixel_sampler", "n", "dim", "seed", "width",
- * "height", "pixel", "points": [[u_1, ..., u_dim] per sample]}, rows as mcp_points_analyze
- * takes them. */
+ * "spp" (1..65536; a power of two for sobol; default 64), "dim" (2, 4, 6 or 8: the sample's first
+ * dim / 2 2D requests, default 2), "seed" (the image's key, default 1), "width", "height" (the
+ * image, default 1 x 1), "pixel": [x, y] (default [0, 0])}. Result: {"pixel_sampler", "n", "dim",
+ * "seed", "width", "height", "pixel", "points": [[u_1, ..., u_dim] per sample]}, rows as
+ * mcp_points_analyze takes them. */
 int mcp_render_pixel_points(const char* request_json, char** points_json);
 
 /* The live view: images that converge pass by pass (render/progressive.h). A session holds one
@@ -94,9 +94,10 @@ int mcp_render_pixel_points(const char* request_json, char** points_json);
  *     never rendered; the session then has none until mcp_render_live_reference gives one);
  *   pixels: true to return float32 pixels (below).
  * Result: {"version", "kind": "render_live", "session" (an integer > 0), "scene", "width",
- * "height", "rows": [begin, end], "pixel_sampler", "stream_seed", "estimators": [objects], "reference":
- * null or {"source", "spp", "mean_luminance", "relative_mse_floor", "rgb_f32" (with pixels: the
- * band's reference, base64 little-endian float32 RGB, rows from row_begin)}, "warnings"}.
+ * "height", "rows": [begin, end], "pixel_sampler", "stream_seed", "estimators": [objects],
+ * "reference": null or {"source", "spp", "mean_luminance", "relative_mse_floor", "rgb_f32" (with
+ * pixels: the band's reference, base64 little-endian float32 RGB, rows from row_begin)},
+ * "warnings"}.
  *
  * mcp_render_live_pass: pass_json {"estimator": index (0-based, in the session's list), "spp":
  * the samples per pixel the band is taken to (more than it has; at most 2^20), "pixels": bool,

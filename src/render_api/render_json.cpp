@@ -180,18 +180,16 @@ Json render_warnings(const RenderEstimatorStudy& s, double floor) {
                             : std::string())));
             break;
         case FlagCode::PixelErrorBars:
-            w.push_back(
-                flag_warning(f, "only " + fmt("%.1f", 100.0 * f.value) +
-                                    "% of the pixels' own 95% error bars cover the reference at "
-                                    "spp = " +
-                                    std::to_string(f.n) +
-                                    ": per-pixel error bars are too small (" +
-                                    (s.bound.bounded
-                                         ? "the samples are bounded, so not a heavy tail: "
-                                           "rare large values that most pixels have not yet "
-                                           "drawn, or a bias"
-                                         : "heavy tails or bias") +
-                                    ")"));
+            w.push_back(flag_warning(
+                f, "only " + fmt("%.1f", 100.0 * f.value) +
+                       "% of the pixels' own 95% error bars cover the reference at "
+                       "spp = " +
+                       std::to_string(f.n) + ": per-pixel error bars are too small (" +
+                       (s.bound.bounded ? "the samples are bounded, so not a heavy tail: "
+                                          "rare large values that most pixels have not yet "
+                                          "drawn, or a bias"
+                                        : "heavy tails or bias") +
+                       ")"));
             break;
         // A level's flags (render_level_to_json words them), and the integration studies' flags,
         // which render_flags never raises.

@@ -187,9 +187,9 @@ bool merge_estimator(Ctx& c, const std::vector<const Json*>& parts, size_t e,
         // infinite_variance: absent in parts from before the field (false then).
         const Json* infinite = b->is_object() ? find(*b, "infinite_variance") : nullptr;
         const bool infinite_ok =
-            !infinite || (infinite->is_boolean() &&
-                          !(infinite->get<bool>() && bounded && bounded->is_boolean() &&
-                            bounded->get<bool>()));
+            !infinite ||
+            (infinite->is_boolean() &&
+             !(infinite->get<bool>() && bounded && bounded->is_boolean() && bounded->get<bool>()));
         if (!bounded || !bounded->is_boolean() || !reason || !reason->is_string() ||
             reason->get<std::string>().size() > 1000 || !infinite_ok)
             return c.fail("part 0.estimators[" + std::to_string(e) + "].contribution_bound",

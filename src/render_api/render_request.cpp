@@ -92,9 +92,9 @@ bool parse_split_counts(Ctx& c, const Json& j, const std::string& path, RenderEs
         }
         const bool whole = v->is_number_integer() || v->is_number_unsigned();
         if (!whole || v->get<int64_t>() < 1 || v->get<int64_t>() > kMaxSplitSamples)
-            return c.fail(sub(path, k.key),
-                          range + (k.out == &e->light_samples ? " or \"auto\"" : "") +
-                              ", got " + v->dump());
+            return c.fail(sub(path, k.key), range +
+                                                (k.out == &e->light_samples ? " or \"auto\"" : "") +
+                                                ", got " + v->dump());
         *k.out = int(v->get<int64_t>());
     }
     return true;
@@ -139,8 +139,7 @@ bool parse_estimator(Ctx& c, const Json& j, const std::string& path, RenderEstim
     }
     if (!check_keys(c, j, path,
                     {"name", "strategy", "light_selection", "light_sampling", "pixel_sampler",
-                     "max_depth", "rr_depth", "candidates", "light_samples",
-                     "bsdf_samples"}))
+                     "max_depth", "rr_depth", "candidates", "light_samples", "bsdf_samples"}))
         return false;
     std::string strategy;
     if (!get_string(c, j, "strategy", path, &strategy)) return false;
@@ -455,8 +454,8 @@ Made<std::shared_ptr<RenderRequest>> build_render_request(const Json& scene, con
         return error();
     }
     if (part >= parts) {
-        c.fail("options.part", "must be in 0..parts - 1 = " + std::to_string(parts - 1) +
-                                   ", got " + std::to_string(part));
+        c.fail("options.part", "must be in 0..parts - 1 = " + std::to_string(parts - 1) + ", got " +
+                                   std::to_string(part));
         return error();
     }
     r->settings.part = int(part);
