@@ -151,12 +151,12 @@ class VegasPlusEstimator final : public EstimatorAlgorithm, private TrainingPoin
     // evaluations]. Stratification's gain grows with the number of strata: the training grid
     // alone left about 30 points per hypercube in the estimate at the default 10 iterations.
     // But VEGAS+'s allocation n_h ~ sigma_h^beta needs sigma_h measured on the hypercubes it
-    // allocates [Lepage21, eq. 20]: inherited from its parent, a cut or a singularity got the
+    // allocates [Lepage21, sec. 3]: inherited from its parent, a cut or a singularity got the
     // parent's share split evenly among r^d children, its child often only 2 points that miss
     // the cut or the tail's largest weights, and the error bar, dominated by that one child,
     // fell far short (1-D Genz discontinuous: 15-20 of 32 runs covered, the worst 170-230
     // standard errors off). So the finer grid is measured before it is used, as MISER explores
-    // a region before it allocates to it [Press90]: a pilot of 2 points per hypercube (its
+    // a region before it allocates to it [PressFarrar90]: a pilot of 2 points per hypercube (its
     // size returned; 0 when the points are too few) measures sigma_h (finish_pilot), and the
     // estimate's points, about 4 per hypercube (the grid is sized for 6), follow it. The
     // pilot's points are not in the estimate: an allocation that depended on the points a
