@@ -73,9 +73,9 @@ using namespace mcp;
 
 namespace {
 
-const char* const kPresets[] = {
-    "uniform", "stratified", "latin_hypercube", "sobol",      "sobol_walsh", "halton",
-    "lattice", "vegas",      "vegas_sobol",     "vegas_plus", "miser",       "ris_m4"};
+const char* const kPresets[] = {"uniform",     "stratified", "latin_hypercube", "sobol",
+                                "sobol_walsh", "halton",     "lattice",         "vegas",
+                                "vegas_sobol", "vegas_plus", "miser",           "ris_m4"};
 
 struct Options {
     int reps = 10;

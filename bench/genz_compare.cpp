@@ -103,7 +103,7 @@ struct Options {
     int randomizations = 0;  // --randomizations K for the QMC presets; 0: each preset's own (16)
     std::string params_dir, json_path, write_params_dir, external_path;
     bool quick = false;
-    bool peaks = false; // --peaks: the sharp product peaks instead of genz_random's cases
+    bool peaks = false;    // --peaks: the sharp product peaks instead of genz_random's cases
     bool singular = false; // --singular: products of power singularities
 };
 
@@ -756,7 +756,7 @@ Json estimator_for(const std::string& method) {
             if (key == "sampler") // the estimator's own field: "vegas_strat/sampler=stratified"
                 top[key] = value;
             else if (!value.empty() && end && *end == 0 &&
-                value.find_first_of(".eE") == std::string::npos)
+                     value.find_first_of(".eE") == std::string::npos)
                 options[key] = static_cast<long long>(x);
             else if (!value.empty() && end && *end == 0)
                 options[key] = x;
@@ -820,15 +820,14 @@ int main(int argc, char** argv) {
                 (unsigned long long)o.n, o.reps,
                 from_files
                     ? ("parameters from " + o.params_dir + " (exact values from the files)").c_str()
-                : o.singular
-                    ? ("--singular: power-singular products, a of param seed " +
-                       std::to_string(o.param_seed) + ", exact values in closed form")
-                          .c_str()
-                    : ((o.peaks ? "--peaks: product peaks a = 100, 200, 500, 1000 at u of "
-                                  "genz_random(product_peak, d, seed "
-                                : "parameters genz_random(family, d, seed ") +
-                       std::to_string(o.param_seed) + "), exact values genz_exact")
-                          .c_str());
+                : o.singular ? ("--singular: power-singular products, a of param seed " +
+                                std::to_string(o.param_seed) + ", exact values in closed form")
+                                   .c_str()
+                             : ((o.peaks ? "--peaks: product peaks a = 100, 200, 500, 1000 at u of "
+                                           "genz_random(product_peak, d, seed "
+                                         : "parameters genz_random(family, d, seed ") +
+                                std::to_string(o.param_seed) + "), exact values genz_exact")
+                                   .c_str());
     if (o.randomizations > 0)
         std::printf(
             "  sobol, halton, lattice: %d randomizations of N/%d points (--randomizations)\n",
@@ -902,14 +901,14 @@ int main(int argc, char** argv) {
             SceneRequest& req = r.value;
             if (cs.singular) // the same point function as GSL's, a block at a time
                 req.problem.integrand = make_function_integrand(
-                    make_caller_function("singular", &singular_block,
-                                         const_cast<Case*>(&cs), std::make_shared<CallControl>()),
+                    make_caller_function("singular", &singular_block, const_cast<Case*>(&cs),
+                                         std::make_shared<CallControl>()),
                     cs.params.dim());
             // The scene carries the same parameters GSL integrates (same a, u, same family).
             const GenzParams& q = cs.singular ? cs.params : req.problem.integrand.genz;
             const bool genz = cs.singular || req.problem.integrand.kind == IntegrandKind::Genz;
-            if (!genz || q.family != cs.params.family ||
-                q.a != cs.params.a || q.u != cs.params.u || req.estimators.size() != 1) {
+            if (!genz || q.family != cs.params.family || q.a != cs.params.a || q.u != cs.params.u ||
+                req.estimators.size() != 1) {
                 std::fprintf(stderr, "genz_compare: the scene for %s did not reproduce the case\n",
                              cs.label.c_str());
                 return 1;
