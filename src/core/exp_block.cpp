@@ -157,8 +157,9 @@ constexpr double kRoundShift = 0x1.8p52;          ///< a + this rounds a to an i
 constexpr double kFastLimit = 704.0;              ///< |x| below: 2^m T_j is a normal double
 constexpr double kC2 = 1.0 / 2, kC3 = 1.0 / 6, kC4 = 1.0 / 24, kC5 = 1.0 / 120;
 
-/// The algorithm on T = double or a vector of doubles, I the matching 64-bit integers; gather
-/// reads the table entries of the indices.
+/// The algorithm on T = double or a vector of doubles, I the matching unsigned 64-bit integers
+/// (the exponent's shift wraps, as only unsigned arithmetic may); gather reads the table entries
+/// of the indices.
 template <class T, class I, class Gather> T exp_core(T x, Gather gather) {
     // k = round(128 x / ln 2), in the low bits of kd's representation too.
     T kd = x * kInvLn2N + kRoundShift;
@@ -183,6 +184,7 @@ template <class T, class I, class Gather> T exp_core(T x, Gather gather) {
 
 typedef double Vec2 __attribute__((vector_size(16)));
 typedef int64_t Int2 __attribute__((vector_size(16)));
+typedef uint64_t Bits2 __attribute__((vector_size(16)));
 constexpr int64_t kFastLimitBits = 0x4086000000000000; ///< the bits of kFastLimit
 static_assert(kFastLimit == 704.0, "kFastLimitBits");
 
@@ -190,14 +192,14 @@ static_assert(kFastLimit == 704.0, "kFastLimitBits");
 
 double exp_tang(double x) {
     if (!(std::fabs(x) < kFastLimit)) return std::exp(x);
-    return exp_core<double, int64_t>(x, [](int64_t j, double& value, double& tail) {
+    return exp_core<double, uint64_t>(x, [](uint64_t j, double& value, double& tail) {
         value = kExp2Table[j].value;
         tail = kExp2Table[j].tail;
     });
 }
 
 /// The table entries of two indices.
-void gather2(Int2 j, Vec2& value, Vec2& tail) {
+void gather2(Bits2 j, Vec2& value, Vec2& tail) {
     const Exp2Entry& a = kExp2Table[j[0]];
     const Exp2Entry& b = kExp2Table[j[1]];
     value = Vec2{a.value, b.value};
@@ -228,7 +230,7 @@ void exp_block(const double* x, double* out, size_t n) {
             }
             continue;
         }
-        const Vec2 eu = exp_core<Vec2, Int2>(u, gather2), ev = exp_core<Vec2, Int2>(v, gather2);
+        const Vec2 eu = exp_core<Vec2, Bits2>(u, gather2), ev = exp_core<Vec2, Bits2>(v, gather2);
         std::memcpy(out + i, &eu, sizeof eu);
         std::memcpy(out + i + 2, &ev, sizeof ev);
     }
