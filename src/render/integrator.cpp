@@ -624,20 +624,20 @@ void RenderScene::build(const Scene& s, AccelKind accel_kind) {
     lights_uniform.build(s, LightSelection::Uniform);
     lights_area.build(s, LightSelection::Area);
     lights_power.build(s, LightSelection::Power);
+    emitter_triangle.clear();
+    for (uint32_t t = 0; t < uint32_t(s.mesh.triangle_count()); ++t)
+        if (lights_uniform.light_index(t) >= 0) emitter_triangle.push_back(t);
+    emitters_first =
+        !emitter_triangle.empty() && 2 * emitter_triangle.size() <= s.mesh.triangle_count();
+    emitters = Accelerator();
+    if (!emitters_first) return;
     // The lights as a mesh of their own, triangles in the scene's order (so ties between
     // lights at the same t go to the lower mesh id in both structures).
     Mesh lights;
     lights.position = s.mesh.position;
-    emitter_triangle.clear();
-    for (uint32_t t = 0; t < uint32_t(s.mesh.triangle_count()); ++t)
-        if (lights_uniform.light_index(t) >= 0) {
-            lights.index.push_back(s.mesh.index[t]);
-            emitter_triangle.push_back(t);
-        }
-    emitters_first =
-        !emitter_triangle.empty() && 2 * emitter_triangle.size() <= s.mesh.triangle_count();
-    emitters = Accelerator();
-    if (emitters_first) emitters.build(lights, accel_kind);
+    lights.index.reserve(emitter_triangle.size());
+    for (uint32_t t : emitter_triangle) lights.index.push_back(s.mesh.index[t]);
+    emitters.build(lights, accel_kind);
 }
 
 const LightSet& RenderScene::lights(LightSelection selection) const {
