@@ -33,8 +33,10 @@
 // study through the C API, as the CLI and the page run it (N = n_min, 2 n_min, ..., n_max;
 // R replicates), so the flags are the ones users see.
 //
-// Per cell (case, estimator, N) of R replicates, with t = t_0.975(run dof) / 1.96 widening the
-// normal multiples for a run's few degrees of freedom:
+// Per cell (case, estimator, N) of R replicates, "k t" standard errors being widened_limit(k,
+// run dof): k t_0.975(dof) / 1.96 for a run's few degrees of freedom, and below 15 of them never
+// a limit an honest replicate crosses more often than it crosses k t at 15 (at 1-3 degrees of
+// freedom t's tails reach far beyond k t_0.975 / 1.96):
 //   fine     every replicate within 3 t of its own standard error of the exact value
 //            (an exact estimator, se = 0 and the error at round-off, is fine)
 //   flagged  the level, or the estimator as a whole, carries a flag of severity error or
@@ -392,8 +394,11 @@ void judge(const Options& o, const Case& c, size_t case_index, const Json& resul
             std::vector<std::string> codes = estimator_codes;
             alarms(l["warnings"], &codes);
             const double dof = number_or_nan(l["run_dof"]);
+            const double run_dof = dof >= 1.0 ? std::min(dof, 1e6) : INFINITY;
             const double widen =
-                dof >= 1.0 ? student_t_quantile(0.975, std::min(dof, 1e6)) / 1.959963985 : 1.0;
+                dof >= 1.0 ? student_t_quantile(0.975, run_dof) / 1.959963985 : 1.0;
+            auto limit = [&](double k) { return dof >= 1.0 ? widened_limit(k, run_dof) : k; };
+            const double limit3 = limit(3.0), limit35 = limit(3.5), limit5 = limit(5.0);
             const Json& est = l["replicates"]["estimate"];
             const Json& se = l["replicates"]["std_error"];
             bool fine = true;
@@ -405,11 +410,10 @@ void judge(const Options& o, const Case& c, size_t case_index, const Json& resul
                 const double roundoff = 1e-12 * std::max(std::fabs(exact), std::fabs(x));
                 ++t->runs;
                 ++judged;
-                if (!(err <= 3.0 * widen * s + roundoff)) fine = false;
+                if (!(err <= limit3 * s + roundoff)) fine = false;
                 if (err <= 1.959963985 * widen * s + roundoff) ++covered;
-                if (!(err <= 3.5 * widen * s + roundoff)) ++beyond35;
-                if (!(err <= 5.0 * widen * s + roundoff))
-                    misses.push_back(s > 0.0 ? err / s : INFINITY);
+                if (!(err <= limit35 * s + roundoff)) ++beyond35;
+                if (!(err <= limit5 * s + roundoff)) misses.push_back(s > 0.0 ? err / s : INFINITY);
             }
             if (o.fine_by_coverage) fine = covered >= judged - (3 * judged) / 32 && beyond35 == 0;
             ++t->cells;
@@ -484,7 +488,7 @@ bool recheck_cell(const Options& o, const Case& c, const FineCell& cell, uint64_
     const Json& l = r.value["estimators"][0]["levels"][0];
     const double dof = number_or_nan(l["run_dof"]);
     const double t975 = dof >= 1.0 ? student_t_quantile(0.975, std::min(dof, 1e6)) : 1.959963985;
-    const double widen = t975 / 1.959963985;
+    const double limit3 = dof >= 1.0 ? widened_limit(3.0, std::min(dof, 1e6)) : 3.0;
     const Json& est = l["replicates"]["estimate"];
     const Json& se = l["replicates"]["std_error"];
     long b = 0, cov = 0, n = 0;
@@ -493,7 +497,7 @@ bool recheck_cell(const Options& o, const Case& c, const FineCell& cell, uint64_
         const double err = std::fabs(x - exact);
         const double roundoff = 1e-12 * std::max(std::fabs(exact), std::fabs(x));
         ++n;
-        if (!(err <= 3.0 * widen * s + roundoff)) ++b;
+        if (!(err <= limit3 * s + roundoff)) ++b;
         if (err <= t975 * s + roundoff) ++cov;
     }
     *beyond3 += b;

@@ -538,8 +538,10 @@ TEST(Diagnostics, AStratifiedCornerPeakRuledByOneCellStaysAWarningBlind) {
 
 // A replicate beyond 5 of its own standard errors (widened by t_0.975(dof) / 1.96 for few
 // degrees of freedom) is an alarm by itself, against the exact value or, without one, against
-// the other replicates' mean: 5.6 with 1000 dof is raised, 4.5 is not; with 3 dof (4
-// randomizations) the limit is 5 x 3.18 / 1.96 = 8.1, so 7 is not raised and 16.5 is.
+// the other replicates' mean: 5.6 with 1000 dof is raised, 4.5 is not; with 15 dof (16
+// randomizations) the limit is 5 x 2.13 / 1.96 = 5.44; with 3 dof (4 randomizations) it is t_3's
+// quantile crossed as rarely as 5.44 is at 15 (about 32, not 5 x 3.18 / 1.96 = 8.1), so 16.5 is
+// not raised and 60 is.
 TEST(Diagnostics, AReplicateFarOutsideItsIntervalIsAnAlarm) {
     std::vector<double> z = honest_errors(32);
     z[7] = 5.6;
@@ -559,14 +561,50 @@ TEST(Diagnostics, AReplicateFarOutsideItsIntervalIsAnAlarm) {
     EXPECT_GT(f->value, 5.5);
     EXPECT_LT(f->value, 6.5);
 
+    LevelStats default_dof = replicates_level(honest_errors(32), true);
+    default_dof.run_dofs.assign(32, 15);
+    default_dof.estimates[7] = 5.6;
+    f = find(level_flags(default_dof), FlagCode::ReplicateFarOff);
+    ASSERT_TRUE(f.has_value());
+    EXPECT_NEAR(f->threshold, 5.0 * student_t_quantile(0.975, 15.0) / 1.959963984540054, 1e-9);
+
     LevelStats few_dof = replicates_level(honest_errors(32), true);
     few_dof.run_dofs.assign(32, 3);
-    few_dof.estimates[7] = 7.0;
-    EXPECT_FALSE(find(level_flags(few_dof), FlagCode::ReplicateFarOff));
     few_dof.estimates[7] = 16.5;
+    EXPECT_FALSE(find(level_flags(few_dof), FlagCode::ReplicateFarOff));
+    few_dof.estimates[7] = 60.0;
     f = find(level_flags(few_dof), FlagCode::ReplicateFarOff);
     ASSERT_TRUE(f.has_value());
-    EXPECT_NEAR(f->threshold, 5.0 * student_t_quantile(0.975, 3.0) / 1.959963984540054, 1e-9);
+    EXPECT_NEAR(student_t_sf(f->threshold, 3.0),
+                student_t_sf(5.0 * 2.131449546 / 1.959963985, 15.0), 1e-9);
+}
+
+// The other way, at few degrees of freedom: replicates whose errors are Student t with 1 degree
+// of freedom in their own error bars (2 randomizations, honest) cross 5 x 12.7 / 1.96 = 32.4 in
+// 2% of draws, so the old limit raised replicate_far_off on about half of all cells of 32. Now a
+// replicate crosses the limit with probability 6.9e-5 (0.2% of cells); 200 cells, against the
+// exact value and blind, stay under Poisson bounds at p < 1e-3 (4 and 8 cells).
+TEST(Diagnostics, HonestReplicatesWithOneDegreeOfFreedomAreNoAlarm) {
+    Pcg32 rng(20261207, 3);
+    int flagged_exact = 0, flagged_blind = 0;
+    for (int cell = 0; cell < 200; ++cell) {
+        std::vector<double> z(32);
+        for (double& x : z) x = std::tan(kPi * (rng.next_double() - 0.5)); // t_1: Cauchy
+        for (bool with_exact : {true, false}) {
+            LevelStats l = replicates_level(z, with_exact);
+            l.run_dofs.assign(32, 1);
+            if (find(level_flags(l), FlagCode::ReplicateFarOff))
+                ++(with_exact ? flagged_exact : flagged_blind);
+        }
+    }
+    EXPECT_LE(flagged_exact, 4);
+    EXPECT_LE(flagged_blind, 8);
+    // ... and a replicate 10^5 of its error bars off is still raised at 1 degree of freedom.
+    std::vector<double> z = honest_errors(32);
+    z[3] = 1e5;
+    LevelStats l = replicates_level(z, true);
+    l.run_dofs.assign(32, 1);
+    EXPECT_TRUE(find(level_flags(l), FlagCode::ReplicateFarOff));
 }
 
 // The skew's signature, blind: skewed weights give the runs that miss the rare large ones a low

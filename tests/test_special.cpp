@@ -57,6 +57,35 @@ TEST(Special, StudentTTailClosedForms) {
     EXPECT_EQ(student_t_sf(-INFINITY, 9), 1.0);
 }
 
+// The tail quantile inverts the tail: closed forms at nu = 1, 2, and the bisection where the
+// Cornish-Fisher expansion fails (t_3 at a one-sided 5e-5: 28.0; the expansion gives ~12).
+TEST(Special, StudentTTailQuantile) {
+    for (double tail : {0.25, 0.025, 1e-4, 3e-7}) {
+        EXPECT_NEAR(student_t_isf(tail, 1), std::tan(kPi * (0.5 - tail)), 1e-9 / tail) << tail;
+        for (double nu : {1.0, 1.5, 2.0, 3.0, 7.0, 15.0, 150.0}) {
+            const double t = student_t_isf(tail, nu);
+            EXPECT_NEAR(student_t_sf(t, nu) / tail, 1.0, 1e-6) << "nu=" << nu << " tail=" << tail;
+        }
+    }
+    EXPECT_NEAR(student_t_isf(5e-5, 3), 28.0, 0.05);
+    EXPECT_EQ(student_t_isf(0.5, 4), 0.0);
+    EXPECT_TRUE(std::isnan(student_t_isf(0.0, 4)));
+}
+
+// widened_limit: k t_0.975 / 1.96 from 15 degrees of freedom up; below, the point crossed as
+// rarely as that limit is at 15 (never nearer than the widened one).
+TEST(Special, WidenedLimitKeepsItsTailBelowFifteenDegreesOfFreedom) {
+    for (double nu : {15.0, 31.0, 1000.0})
+        EXPECT_DOUBLE_EQ(widened_limit(5.0, nu), 5.0 * student_t_quantile(0.975, nu) / kNormal975);
+    const double reference_tail = student_t_sf(widened_limit(5.0, 15.0), 15.0);
+    for (double nu : {1.0, 2.0, 3.0, 7.0, 14.0}) {
+        const double limit = widened_limit(5.0, nu);
+        EXPECT_GE(limit, 5.0 * student_t_quantile(0.975, nu) / kNormal975 - 1e-12) << nu;
+        EXPECT_LE(student_t_sf(limit, nu), reference_tail * (1.0 + 1e-6)) << nu;
+    }
+    EXPECT_NEAR(widened_limit(5.0, 1.0), 1.0 / std::tan(kPi * reference_tail), 1e-6 * 9000.0);
+}
+
 TEST(Special, IncompleteGammaIdentities) {
     // P(1, x) = 1 - e^-x; chi-square with 2 dof has survival e^(-x/2).
     for (double x : {0.01, 0.5, 1.0, 3.0, 10.0, 50.0}) {

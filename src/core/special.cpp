@@ -197,6 +197,30 @@ double student_t_sf(double t, double nu) {
     return t >= 0.0 ? half_tail : 1.0 - half_tail;
 }
 
+double student_t_isf(double tail, double nu) {
+    if (!(tail > 0.0) || !(nu > 0.0)) return std::numeric_limits<double>::quiet_NaN();
+    if (tail >= 0.5) return 0.0;
+    if (nu == 1.0) return 1.0 / std::tan(kPi * tail);
+    if (nu == 2.0) return (1.0 - 2.0 * tail) / std::sqrt(2.0 * tail * (1.0 - tail));
+    if (nu >= 100.0) return student_t_quantile(1.0 - tail, nu); // the expansion converges there
+    // t's tails are heavier than the normal's: its quantile bounds t from below.
+    double lo = std::max(0.0, -normal_quantile(tail)), hi = std::max(2.0 * lo, 1.0);
+    for (int i = 0; i < 1100 && student_t_sf(hi, nu) > tail; ++i) hi *= 2.0;
+    for (int i = 0; i < 200 && hi - lo > 1e-13 * hi; ++i) {
+        const double mid = 0.5 * (lo + hi);
+        (student_t_sf(mid, nu) > tail ? lo : hi) = mid;
+    }
+    return 0.5 * (lo + hi);
+}
+
+double widened_limit(double z, double nu) {
+    const double widened = z * student_t_quantile(0.975, nu) / kNormal975;
+    if (!(nu < kWidenedReferenceDof)) return widened;
+    const double at_reference = z * student_t_quantile(0.975, kWidenedReferenceDof) / kNormal975;
+    const double tail = student_t_sf(at_reference, kWidenedReferenceDof);
+    return std::max(widened, student_t_isf(tail, nu));
+}
+
 double f_sf(double f, double d1, double d2) {
     if (!(f > 0.0)) return 1.0;
     if (std::isinf(f)) return 0.0;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <vector>
 
 #include "core/special.h"
@@ -211,14 +212,20 @@ ReplicateCheck check_replicates(const LevelStats& l) {
     if (!against_exact && finite < 3) return c;
     const double r = static_cast<double>(finite);
     std::vector<double> studentized, limits; // t_i against the others' mean, and its far limit
+    // The limits per degrees of freedom, computed once: replicates mostly share theirs.
+    std::map<int, double> far_limits, skewed_limits;
+    auto limit_at = [](double z, std::map<int, double>& memo, int dof) {
+        auto [it, fresh] = memo.try_emplace(dof, 0.0);
+        if (fresh) it->second = widened_limit(z, static_cast<double>(dof));
+        return it->second;
+    };
     std::vector<int> index;
     for (size_t i = 0; i < reps; ++i) {
         const double x = l.estimates[i], se = l.run_std_errors[i];
         if (!std::isfinite(x) || !(std::isfinite(se) && se > 0.0) || l.run_dofs[i] < 1) continue;
         if (!against_exact && finite >= 3) {
-            const double t95 = student_t_quantile(0.975, static_cast<double>(l.run_dofs[i]));
             studentized.push_back((x - (r * mean - x) / (r - 1.0)) / se);
-            limits.push_back(kSkewedFarZ * t95 / 1.959963984540054);
+            limits.push_back(limit_at(kSkewedFarZ, skewed_limits, l.run_dofs[i]));
             index.push_back(static_cast<int>(i));
         }
         double centre = l.exact, spread = se;
@@ -229,7 +236,7 @@ ReplicateCheck check_replicates(const LevelStats& l) {
         }
         const double t = student_t_quantile(0.975, static_cast<double>(l.run_dofs[i]));
         const double z = std::fabs(x - centre) / spread;
-        const double far_limit = kFarOffZ * t / 1.959963984540054;
+        const double far_limit = limit_at(kFarOffZ, far_limits, l.run_dofs[i]);
         ++c.judged;
         if (z > t) ++c.misses;
         if (z > far_limit) ++c.far;

@@ -86,18 +86,18 @@ struct Flag {
 /// Each replicate against its own 95% interval: its estimate's distance from the exact value
 /// (when known) or from the mean of the other replicates (leave-one-out, with that mean's own
 /// uncertainty added), in its own standard errors, widened to normal-equivalent units by
-/// t_0.975(dof) / 1.96. Replicates without a finite, positive error bar are not judged.
+/// widened_limit. Replicates without a finite, positive error bar are not judged.
 struct ReplicateCheck {
     int judged = 0;
     int misses = 0;           ///< outside their t_0.975(dof) interval
-    int far = 0;              ///< beyond kFarOffZ normal-equivalent standard errors
+    int far = 0;              ///< beyond widened_limit(kFarOffZ, dof)
     int worst_index = -1;     ///< the replicate farthest off (-1: none judged)
     double worst_z = 0.0;     ///< its distance in its own standard errors
-    double worst_limit = 0.0; ///< kFarOffZ widened for its degrees of freedom
+    double worst_limit = 0.0; ///< widened_limit(kFarOffZ, its degrees of freedom)
     int allowance = 0;        ///< misses that honest 95% intervals exceed in < 1 study in 10
     /// Without the exact value: the skewness of t_i = (x_i - mean of the others) / se_i, and
     /// the replicate farthest off on the side it points to when |skewness| > kSkewSignature and
-    /// |t_i| > kSkewedFarZ widened by t_0.975(dof) / 1.96 (-1: none).
+    /// |t_i| > widened_limit(kSkewedFarZ, dof) (-1: none).
     double skewness = std::numeric_limits<double>::quiet_NaN();
     int skewed_index = -1;
     double skewed_z = 0.0, skewed_limit = 0.0;
@@ -135,7 +135,8 @@ constexpr double kExactOutsideZ = 5.0;  ///< |mean - exact| beyond this many sta
 constexpr double kLevelDriftP = 1e-3;   ///< chi-square p-value below this flags
 constexpr double kHeavyTailAlpha = 2.0; ///< infinite variance below this tail index
 constexpr double kHeavyTail4Alpha = 4.0;
-/// A replicate this many (t-widened) standard errors off has an error bar far too small.
+/// A replicate this many (t-widened: widened_limit) standard errors off has an error bar far too
+/// small.
 constexpr double kFarOffZ = 5.0;
 /// Skewed weights make a run's studentized error skewed, -2 g1 / sqrt(N) for weights of
 /// skewness g1 [Hall92]: a low estimate comes with a small error bar. The replicates'
