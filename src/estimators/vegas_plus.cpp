@@ -126,7 +126,9 @@ class VegasPlusEstimator final : public EstimatorAlgorithm, private TrainingPoin
         stage_.warp(problem_, spec_.proposal, ws, false);
         evaluate_block(problem_.integrand, ws.x, ws.f.data());
         weigh(ws, count, weight_.data());
-        if (piloting_ && lambda_.empty()) return true; // they only size the allocation
+        // The pilot's points only size the allocation and join the estimate's hypercube means
+        // (finish_iteration); the accumulator's diagnostics see the estimate's points.
+        if (piloting_) return true;
         // The accumulator sees the weights scaled by V N / n_h (its plain mean is then the
         // stratified estimate), for its diagnostics: non-finite and zero-pdf counts, the
         // largest weights, the effective sample size.
@@ -354,17 +356,13 @@ class VegasPlusEstimator final : public EstimatorAlgorithm, private TrainingPoin
     // accumulator drops and counts them) and into their hypercubes' moments; the points'
     // importance 1 / q(y) relative to uniform, V N / n_h, into importance_.
     const double* weigh(const Workspace& ws, size_t count, double* weights) override {
-        const double n_iteration = importance_points_;
+        const double n_iteration = static_cast<double>(points_);
         for (size_t i = 0; i < count; ++i) {
             const double w = ws.f[i] / ws.pdf[i];
             weights[i] = std::isfinite(w) && !(ws.pdf[i] == 0.0 && ws.f[i] != 0.0) ? w : 0.0;
             cube_moments_[cube_of_[i]].add(weights[i]);
-            const double scale = importance_mode_ == 0   ? 1.0
-                                 : importance_mode_ == 1 ? lambda_[cube_of_[i]]
-                                                         : 1.0 - lambda_[cube_of_[i]];
-            importance_[i] =
-                scale * n_iteration /
-                (static_cast<double>(cubes_) * static_cast<double>(allocation_[cube_of_[i]]));
+            importance_[i] = n_iteration / (static_cast<double>(cubes_) *
+                                            static_cast<double>(allocation_[cube_of_[i]]));
         }
         return importance_.data();
     }
@@ -381,19 +379,10 @@ class VegasPlusEstimator final : public EstimatorAlgorithm, private TrainingPoin
         digits_.assign(static_cast<size_t>(dim_), 0);
         left_in_cube_ = allocation_[0];
         piloting_ = training && refined_;
-        // The accumulator sees the points of the estimate, the pilot's too when they count
-        // (lambda_): each weight scaled so that the plain mean of all of them is the estimate.
-        const bool combined = !lambda_.empty() && pilot_ > 0;
-        importance_mode_ = 0;
-        importance_points_ = static_cast<double>(points_);
-        if (combined && refined_) {
-            importance_mode_ = piloting_ ? 1 : 2;
-            importance_points_ = static_cast<double>(final_);
-        }
-        if ((!training && !combined) || (piloting_ && combined)) {
+        if (!training) {
             plan_ = SamplerPlan(); // the accumulator's iid error method reads no plan data
             plan_.dim = dim_;
-            plan_.total = combined ? final_ : points_;
+            plan_.total = points_;
             accumulator_.reset(ErrorMethod::Iid, plan_, float32_);
             accumulated_ = 0;
         }
@@ -486,8 +475,6 @@ class VegasPlusEstimator final : public EstimatorAlgorithm, private TrainingPoin
     std::vector<RunningMoments> pilot_moments_; // the pilot's, per hypercube (finish_pilot)
     std::vector<uint32_t> parent_;              // the estimate's hypercubes' training ones
     uint64_t parents_ = 0;                      // the training grid's hypercubes
-    int importance_mode_ = 0;        // weigh's V N / n_h times 1, lambda_h (pilot), 1 - lambda_h
-    double importance_points_ = 0.0; // N there
     TrainingLog log_;
     MapStage stage_; // the map and its buffers
     Pcg32 jitter_;
