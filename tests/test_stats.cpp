@@ -77,6 +77,26 @@ TEST(Stats, MergeEqualsSequential) {
     EXPECT_NEAR(a.variance() / all.variance(), 1.0, 1e-9);
 }
 
+// A part added by value, variance and count is what a stratum adds by its moments: the same
+// estimate, variance and Satterthwaite degrees of freedom; a part of one value leaves no
+// variance estimate.
+TEST(Stats, StratifiedSumPartsAsStrata) {
+    RunningMoments a, b;
+    for (double x : {1.0, 2.0, 4.0}) a.add(x);
+    for (double x : {0.5, 0.25, 3.0, 9.0, 1.0}) b.add(x);
+    StratifiedSum strata, parts;
+    strata.add(0.25, a);
+    strata.add(0.75, b);
+    parts.add_part(0.25 * a.mean(), 0.25 * 0.25 * a.variance() / 3.0, 3);
+    parts.add_part(0.75 * b.mean(), 0.75 * 0.75 * b.variance() / 5.0, 5);
+    EXPECT_DOUBLE_EQ(parts.estimate(), strata.estimate());
+    EXPECT_DOUBLE_EQ(parts.variance(), strata.variance());
+    EXPECT_EQ(parts.dof(), strata.dof());
+    EXPECT_TRUE(parts.has_variance());
+    parts.add_part(1.0, 0.0, 1);
+    EXPECT_FALSE(parts.has_variance());
+}
+
 TEST(Stats, LineFitExactAndUncertainty) {
     std::vector<double> x{0, 1, 2, 3, 4}, y;
     for (double v : x) y.push_back(3.0 - 2.0 * v);

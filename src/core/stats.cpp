@@ -149,6 +149,15 @@ void StratifiedSum::add(double a, const RunningMoments& m) {
     free_ += n - 1;
 }
 
+void StratifiedSum::add_part(double value, double variance, uint64_t values) {
+    estimate_.add(value);
+    complete_ = complete_ && values > 1;
+    if (values < 2) return;
+    variance_.add(variance);
+    satterthwaite_ += variance * variance / static_cast<double>(values - 1);
+    free_ += values - 1;
+}
+
 int StratifiedSum::dof() const {
     const double v = variance();
     if (satterthwaite_ > 0.0)

@@ -105,6 +105,9 @@ class StratifiedSum {
   public:
     /// Adds a_h times the mean of the stratum's values m.
     void add(double a, const RunningMoments& m);
+    /// Adds an estimate `value` whose variance estimate `variance` comes from `values` values
+    /// (values - 1 degrees of freedom; fewer than 2: no variance estimate).
+    void add_part(double value, double variance, uint64_t values);
     double estimate() const { return estimate_.value(); }
     double variance() const { return variance_.value() > 0.0 ? variance_.value() : 0.0; }
     /// Whether every stratum had two values or more (else there is no variance estimate).
