@@ -176,7 +176,7 @@ inline bool watertight(const RayPrep& r, const Vec3* p, TriHit* h) {
 /// brute-force loops are instantiated for each, so that the pair test reads a triangle's rows
 /// at fixed offsets. A RayPrep is the same permutation known at run time (its kx, ky, kz), as
 /// the BVH traversal uses it. In wasm the fixed offsets took quad_light_floor's shadow rays
-/// from 43 to 32 ns (native 27 to 26 ns; docs/performance-notes.md#the-estimator-loop-in-wasm).
+/// from 43 to 33 ns (native 27 to 26.6 ns; docs/performance-notes.md#the-estimator-loop-in-wasm).
 template <int kZ, bool kSwap> struct FixedAxes {
     static constexpr int kz = kZ;
     static constexpr int kx = kSwap ? (kZ + 2) % 3 : (kZ + 1) % 3;
