@@ -310,9 +310,9 @@ void brute_force_crossover() {
                         hits == rays.size() ? best : 0.0);
             if (k == AccelKind::Bvh)
                 std::printf("INFO rays/closed_%zu: BVH expects %.3f node visits and %.3f "
-                            "triangle tests per ray\n",
+                            "triangle tests (%.3f pair tests) per ray\n",
                             mesh.triangle_count(), a.stats().expected_node_visits,
-                            a.stats().expected_triangle_tests);
+                            a.stats().expected_triangle_tests, a.stats().expected_pair_tests);
         }
     }
 }

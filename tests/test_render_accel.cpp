@@ -681,7 +681,7 @@ TEST(Accel, EmptyMeshNeverHits) {
 }
 
 // Auto keeps the BVH of a small scene only when its expected cost per ray (node visits at
-// kNodeCost plus triangle tests, by surface area) is below brute force's triangle count.
+// kNodeCost plus pair tests, by surface area) is below brute force's ceil(n / 2) pair tests.
 TEST(Accel, AutoPicksTheStructureOfLowerExpectedCost) {
     // A closed tetrahedron: every box overlaps every other; the BVH saves no test.
     Mesh tetra;
@@ -693,6 +693,7 @@ TEST(Accel, AutoPicksTheStructureOfLowerExpectedCost) {
     const Accelerator t = build(tetra, AccelKind::Auto);
     EXPECT_EQ(t.stats().kind, AccelKind::BruteForce);
     EXPECT_EQ(t.stats().expected_triangle_tests, 4.0);
+    EXPECT_EQ(t.stats().expected_pair_tests, 2.0);
     // 16 small triangles in two clusters 100 apart: a ray meets one cluster's box at most,
     // and each box is a small part of the scene's.
     Mesh clusters = make_soup(8, 0.3, 3u);
@@ -705,14 +706,14 @@ TEST(Accel, AutoPicksTheStructureOfLowerExpectedCost) {
     const Accelerator c = build(clusters, AccelKind::Auto);
     EXPECT_EQ(c.stats().kind, AccelKind::Bvh);
     EXPECT_LT(Accelerator::kNodeCost * c.stats().expected_node_visits +
-                  c.stats().expected_triangle_tests,
-              16.0);
+                  c.stats().expected_pair_tests,
+              8.0);
     // The BVH built on request reports the tetrahedron's expected costs, above brute force's.
     const Accelerator tb = build(tetra, AccelKind::Bvh);
     EXPECT_EQ(tb.stats().kind, AccelKind::Bvh);
     EXPECT_GE(Accelerator::kNodeCost * tb.stats().expected_node_visits +
-                  tb.stats().expected_triangle_tests,
-              4.0);
+                  tb.stats().expected_pair_tests,
+              2.0);
     // Above kAutoMaxTriangles the BVH is kept without comparing.
     Mesh large = make_soup(int(Accelerator::kAutoMaxTriangles) + 1, 0.3, 3u);
     EXPECT_EQ(build(large, AccelKind::Auto).stats().kind, AccelKind::Bvh);

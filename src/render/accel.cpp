@@ -56,6 +56,13 @@ constexpr double kBoxPad = 0x1p-20;         // of the scene's radius ...
 constexpr double kBoxPadAbsolute = 0x1p-40; // ... plus this of its largest coordinate
 constexpr float kFarScale = 1.0f + 0x1p-18f;
 constexpr int kWidth = Accelerator::kNodeWidth;
+// The BVH traversal's leaf test out of line in wasm: inlined, V8's code for the traversal loop
+// ran shadow rays at 0.6-0.85 of the speed (Cornell, Veach; `mcplay_bench --only rays`).
+#if defined(__EMSCRIPTEN__)
+#define MCP_LEAF_TEST_INLINE __attribute__((noinline))
+#else
+#define MCP_LEAF_TEST_INLINE
+#endif
 constexpr uint32_t kStackSize = kWidth * kMaxDepth; // pushes at most kWidth, pops 1, depth <= 64
 
 /// Everything about a ray that the triangle and box tests reuse [Woop13, sec. 3; Ize13].
@@ -68,6 +75,16 @@ struct RayPrep {
     double zero;         // 0, from memory: a literal 0 turns the first max into a branch
 };
 
+/// False for a ray with an infinite or NaN direction or origin, or t_max <= 0 / NaN.
+__attribute__((always_inline)) inline bool ray_finite(const Ray& ray) {
+    const double* d = &ray.direction.x;
+    const double* o = &ray.origin.x;
+    // x - x is NaN exactly when x is infinite or NaN.
+    const double finite = (d[0] - d[0]) + (d[1] - d[1]) + (d[2] - d[2]) + (o[0] - o[0]) +
+                          (o[1] - o[1]) + (o[2] - o[2]);
+    return finite == 0.0 && ray.t_max > 0.0;
+}
+
 /// False for rays no triangle can be reported for: zero, infinite or NaN direction or
 /// origin, or t_max <= 0 / NaN. The box tests' reciprocals and plane rows (inv, near, far)
 /// are filled only when `boxes` is set (brute force needs only the shear). Forced inline into
@@ -77,10 +94,7 @@ struct RayPrep {
 __attribute__((always_inline)) inline bool prepare(const Ray& ray, bool boxes, RayPrep* r) {
     const double d[3] = {ray.direction.x, ray.direction.y, ray.direction.z};
     const double* o = &ray.origin.x;
-    // x - x is NaN exactly when x is infinite or NaN.
-    const double finite = (d[0] - d[0]) + (d[1] - d[1]) + (d[2] - d[2]) + (o[0] - o[0]) +
-                          (o[1] - o[1]) + (o[2] - o[2]);
-    if (!(finite == 0.0) || !(ray.t_max > 0.0)) return false;
+    if (!ray_finite(ray)) return false;
     const double ax = std::fabs(d[0]), ay = std::fabs(d[1]), az = std::fabs(d[2]);
     const int kz = ax > ay ? (ax > az ? 0 : 2) : (ay > az ? 1 : 2);
     if (!(std::fabs(d[kz]) > 0.0)) return false;
@@ -157,22 +171,57 @@ inline bool watertight(const RayPrep& r, const Vec3* p, TriHit* h) {
     return true;
 }
 
-/// The ray of a RayPrep in both lanes, for watertight2.
+/// One of the six axis permutations prepare() picks, known at compile time: kz, and kx, ky the
+/// next two axes in cyclic order, exchanged when the direction's kz component is negative. The
+/// brute-force loops are instantiated for each, so that the pair test reads a triangle's rows
+/// at fixed offsets. A RayPrep is the same permutation known at run time (its kx, ky, kz), as
+/// the BVH traversal uses it. In wasm the fixed offsets took quad_light_floor's shadow rays
+/// from 43 to 33 ns (native 27 to 26.6 ns; docs/performance-notes.md#the-estimator-loop-in-wasm).
+template <int kZ, bool kSwap> struct FixedAxes {
+    static constexpr int kz = kZ;
+    static constexpr int kx = kSwap ? (kZ + 2) % 3 : (kZ + 1) % 3;
+    static constexpr int ky = kSwap ? (kZ + 1) % 3 : (kZ + 2) % 3;
+};
+
+/// The ray of a RayPrep in both lanes, for watertight2, on the axes `a` (a RayPrep or a
+/// FixedAxes of the same permutation).
 struct RayLanes {
-    int kx, ky, kz;
     D2 ox, oy, oz; // origin on axes kx, ky, kz
     D2 sx, sy, sz;
 };
-__attribute__((always_inline)) inline RayLanes ray_lanes(const RayPrep& r) {
-    return {r.kx,
-            r.ky,
-            r.kz,
-            d2_set1(r.o[r.kx]),
-            d2_set1(r.o[r.ky]),
-            d2_set1(r.o[r.kz]),
-            d2_set1(r.sx),
-            d2_set1(r.sy),
-            d2_set1(r.sz)};
+template <class Axes>
+__attribute__((always_inline)) inline RayLanes ray_lanes(const RayPrep& r, const Axes& a) {
+    return {d2_set1(r.o[a.kx]), d2_set1(r.o[a.ky]), d2_set1(r.o[a.kz]),
+            d2_set1(r.sx),      d2_set1(r.sy),      d2_set1(r.sz)};
+}
+
+/// watertight2 for a pair with an edge function exactly 0 (rare): watertight() on each
+/// triangle, for its exact sign.
+template <bool kInclusive>
+inline int watertight2_scalar(const RayPrep& r, const double (*rows)[2], double t_limit,
+                              TriHit* h) {
+    int hits = 0;
+    for (int l = 0; l < 2; ++l) {
+        const Vec3 p[3] = {Vec3(rows[0][l], rows[1][l], rows[2][l]),
+                           Vec3(rows[3][l], rows[4][l], rows[5][l]),
+                           Vec3(rows[6][l], rows[7][l], rows[8][l])};
+        TriHit th;
+        if (watertight(r, p, &th) && (kInclusive ? th.t <= t_limit : th.t < t_limit)) {
+            hits |= 1 << l;
+            if (h != nullptr) h[l] = th;
+        }
+    }
+    return hits;
+}
+
+/// The same with the RayPrep made again from the ray, out of line: the brute-force loops then
+/// keep none in memory (in wasm they then have no stack frame and keep the ray in registers).
+template <bool kInclusive>
+__attribute__((noinline)) int watertight2_scalar(const Ray& ray, const double (*rows)[2],
+                                                 double t_limit, TriHit* h) {
+    RayPrep r;
+    if (!prepare(ray, false, &r)) return 0; // never: the caller's prepare() was true
+    return watertight2_scalar<kInclusive>(r, rows, t_limit, h);
 }
 
 /// watertight() on the two triangles of a pair at once, one per lane, with the same operations
@@ -180,33 +229,30 @@ __attribute__((always_inline)) inline RayLanes ray_lanes(const RayPrep& r) {
 /// per triangle: all of a triangle's arithmetic is done and the outcomes are masks. A lane with
 /// an edge function exactly 0 (rare) goes through the scalar test for its exact sign. Returns
 /// bit l set where triangle l is hit with 0 < t < t_limit (kInclusive: t <= t_limit), with its
-/// edge functions and distance in h[l].
-template <bool kInclusive>
-inline int watertight2(const RayPrep& r, const RayLanes& q, const double (*rows)[2], double t_limit,
-                       TriHit* h) {
+/// edge functions and distance in h[l] unless h is null. `q` and `a` are the lanes and axes of
+/// prepare(ray); `r` is its RayPrep, or null to make it again in the rare case. (The BVH
+/// traversal keeps its RayPrep in memory anyway, and in wasm its shadow rays ran at 0.8 of
+/// the speed with the RayPrep made again.)
+template <bool kInclusive, class Axes>
+__attribute__((always_inline)) inline int
+watertight2(const Ray& ray, const RayPrep* r, const RayLanes& q, const Axes& a,
+            const double (*rows)[2], double t_limit, TriHit* h) {
     const D2 zero = d2_set1(0.0);
-    const D2 a_z = d2_load(rows[q.kz]) - q.oz;
-    const D2 b_z = d2_load(rows[3 + q.kz]) - q.oz;
-    const D2 c_z = d2_load(rows[6 + q.kz]) - q.oz;
-    const D2 a_x = (d2_load(rows[q.kx]) - q.ox) - q.sx * a_z;
-    const D2 a_y = (d2_load(rows[q.ky]) - q.oy) - q.sy * a_z;
-    const D2 b_x = (d2_load(rows[3 + q.kx]) - q.ox) - q.sx * b_z;
-    const D2 b_y = (d2_load(rows[3 + q.ky]) - q.oy) - q.sy * b_z;
-    const D2 c_x = (d2_load(rows[6 + q.kx]) - q.ox) - q.sx * c_z;
-    const D2 c_y = (d2_load(rows[6 + q.ky]) - q.oy) - q.sy * c_z;
+    const D2 a_z = d2_load(rows[a.kz]) - q.oz;
+    const D2 b_z = d2_load(rows[3 + a.kz]) - q.oz;
+    const D2 c_z = d2_load(rows[6 + a.kz]) - q.oz;
+    const D2 a_x = (d2_load(rows[a.kx]) - q.ox) - q.sx * a_z;
+    const D2 a_y = (d2_load(rows[a.ky]) - q.oy) - q.sy * a_z;
+    const D2 b_x = (d2_load(rows[3 + a.kx]) - q.ox) - q.sx * b_z;
+    const D2 b_y = (d2_load(rows[3 + a.ky]) - q.oy) - q.sy * b_z;
+    const D2 c_x = (d2_load(rows[6 + a.kx]) - q.ox) - q.sx * c_z;
+    const D2 c_y = (d2_load(rows[6 + a.ky]) - q.oy) - q.sy * c_z;
     const D2 u = c_x * b_y - c_y * b_x;
     const D2 v = a_x * c_y - a_y * c_x;
     const D2 w = b_x * a_y - b_y * a_x;
     if (d2_mask_bits(d2_eq(u, zero) | d2_eq(v, zero) | d2_eq(w, zero)) != 0) {
-        int hits = 0;
-        for (int l = 0; l < 2; ++l) {
-            const Vec3 p[3] = {Vec3(rows[0][l], rows[1][l], rows[2][l]),
-                               Vec3(rows[3][l], rows[4][l], rows[5][l]),
-                               Vec3(rows[6][l], rows[7][l], rows[8][l])};
-            if (watertight(r, p, &h[l]) && (kInclusive ? h[l].t <= t_limit : h[l].t < t_limit))
-                hits |= 1 << l;
-        }
-        return hits;
+        return r != nullptr ? watertight2_scalar<kInclusive>(*r, rows, t_limit, h)
+                            : watertight2_scalar<kInclusive>(ray, rows, t_limit, h);
     }
     const D2 mixed = (d2_lt(u, zero) | d2_lt(v, zero) | d2_lt(w, zero)) &
                      (d2_gt(u, zero) | d2_gt(v, zero) | d2_gt(w, zero));
@@ -215,7 +261,7 @@ inline int watertight2(const RayPrep& r, const RayLanes& q, const double (*rows)
     const D2 limit = d2_set1(t_limit);
     const D2 in_range = d2_gt(tt, zero) & (kInclusive ? d2_le(tt, limit) : d2_lt(tt, limit));
     const int hits = d2_mask_bits(d2_andnot(mixed | d2_eq(det, zero), in_range));
-    if (hits != 0) {
+    if (hits != 0 && h != nullptr) {
         alignas(16) double t2[2], v2[2], w2[2], det2[2];
         d2_store(t2, tt);
         d2_store(v2, v);
@@ -531,13 +577,15 @@ void Accelerator::build(const Mesh& mesh, AccelKind kind) {
                 const double p = root_area > 0.0 ? (dx * dy + dy * dz + dz * dx) / root_area : 1.0;
                 if (node.count[l] == 0)
                     stats_.expected_node_visits += std::min(1.0, p);
-                else
+                else {
                     stats_.expected_triangle_tests += std::min(1.0, p) * node.count[l];
+                    stats_.expected_pair_tests += std::min(1.0, p) * ((node.count[l] + 1) / 2);
+                }
             }
         }
         const double bvh_cost =
-            kNodeCost * stats_.expected_node_visits + stats_.expected_triangle_tests;
-        if (choose && !(bvh_cost < double(n))) {
+            kNodeCost * stats_.expected_node_visits + stats_.expected_pair_tests;
+        if (choose && !(bvh_cost < double((n + 1) / 2))) {
             kind = AccelKind::BruteForce;
             nodes_.clear();
             nodes_.shrink_to_fit();
@@ -549,6 +597,7 @@ void Accelerator::build(const Mesh& mesh, AccelKind kind) {
     if (kind == AccelKind::BruteForce) {
         stats_.expected_node_visits = 0.0;
         stats_.expected_triangle_tests = double(n);
+        stats_.expected_pair_tests = double((n + 1) / 2);
     }
 
     // Triangles in leaf order (build order for brute force), two per pair.
@@ -571,22 +620,112 @@ void Accelerator::build(const Mesh& mesh, AccelKind kind) {
                    triangle_id_.size() * sizeof(uint32_t);
 }
 
+namespace {
+
+/// Brute force over the n triangles of `pairs` (slots 0 .. n - 1, the last pair padded when n
+/// is odd) for a usable ray (prepare() true) whose axis permutation is Axes. hit null: an
+/// any-hit query, true at the first hit. Else the closest hit: true when there is one, *hit
+/// filled; among hits at the same t the lowest id (ids[slot]) wins, as in
+/// Accelerator::traverse. One function per permutation, which makes its own RayPrep (in wasm, a
+/// RayPrep handed over in memory cost what the fixed offsets save) and serves both queries:
+/// with two callers, and not inlined, it stays out of the function that holds the BVH
+/// traversal (Binaryen inlines a function with one caller; the traversal's shadow rays in wasm
+/// ran at 0.9 of the speed with the six loops beside it).
+template <class Axes, class Pair>
+__attribute__((noinline)) bool brute_force_pairs(const Ray& ray, const Pair* pairs,
+                                                 const uint32_t* ids, uint32_t n, Hit* hit) {
+    const Axes axes;
+    const double* d = &ray.direction.x;
+    const double* o = &ray.origin.x;
+    RayPrep r;
+    for (int k = 0; k < 3; ++k) r.o[k] = o[k];
+    r.kx = axes.kx;
+    r.ky = axes.ky;
+    r.kz = axes.kz;
+    r.sz = 1.0 / d[axes.kz]; // as in prepare()
+    r.sx = d[axes.kx] * r.sz;
+    r.sy = d[axes.ky] * r.sz;
+    r.zero = 0.0;
+    const RayLanes lanes{d2_set1(o[axes.kx]), d2_set1(o[axes.ky]), d2_set1(o[axes.kz]),
+                         d2_set1(r.sx),       d2_set1(r.sy),       d2_set1(r.sz)};
+    if (hit == nullptr) {
+        for (uint32_t at = 0; at < n; at += 2) {
+            int hits =
+                watertight2<false>(ray, nullptr, lanes, axes, pairs[at / 2].v, ray.t_max, nullptr);
+            if (n - at < 2) hits &= 1;
+            if (hits != 0) return true;
+        }
+        return false;
+    }
+    double best_t = ray.t_max;
+    TriHit best_hit{0.0, 0.0, 0.0, 1.0};
+    uint32_t best = 0;
+    bool found = false;
+    for (uint32_t at = 0; at < n; at += 2) {
+        TriHit h[2];
+        int hits = watertight2<true>(ray, nullptr, lanes, axes, pairs[at / 2].v, best_t, h);
+        if (n - at < 2) hits &= 1;
+        while (hits != 0) {
+            const int l = __builtin_ctz(static_cast<unsigned>(hits));
+            hits &= hits - 1;
+            const uint32_t i = at + uint32_t(l);
+            if (h[l].t < best_t || (found && h[l].t == best_t && ids[i] < ids[best])) {
+                best_t = h[l].t;
+                best_hit = h[l];
+                best = i;
+                found = true;
+            }
+        }
+    }
+    if (!found) return false;
+    hit->t = best_hit.t;
+    hit->triangle = ids[best];
+    hit->b1 = best_hit.v / best_hit.det;
+    hit->b2 = best_hit.w / best_hit.det;
+    return true;
+}
+
+} // namespace
+
+bool Accelerator::brute_force(const Ray& ray, Hit* hit) const {
+    if (triangle_id_.empty() || !ray_finite(ray)) return false;
+    const double* d = &ray.direction.x;
+    const auto* p = pairs_.data();
+    const uint32_t* ids = triangle_id_.data();
+    const uint32_t n = triangles_;
+    // prepare()'s axes and its test of a zero direction (ax > ay >= 0 and ay > az >= 0 are
+    // nonzero), as branches on the comparisons themselves: in wasm, an axis index computed by
+    // selects and then branched on cost ~4 ns more a ray.
+    const double ax = std::fabs(d[0]), ay = std::fabs(d[1]), az = std::fabs(d[2]);
+    if (ax > ay && ax > az) {
+        return d[0] < 0.0 ? brute_force_pairs<FixedAxes<0, true>>(ray, p, ids, n, hit)
+                          : brute_force_pairs<FixedAxes<0, false>>(ray, p, ids, n, hit);
+    }
+    if (!(ax > ay) && ay > az) {
+        return d[1] < 0.0 ? brute_force_pairs<FixedAxes<1, true>>(ray, p, ids, n, hit)
+                          : brute_force_pairs<FixedAxes<1, false>>(ray, p, ids, n, hit);
+    }
+    if (!(az > 0.0)) return false;
+    return d[2] < 0.0 ? brute_force_pairs<FixedAxes<2, true>>(ray, p, ids, n, hit)
+                      : brute_force_pairs<FixedAxes<2, false>>(ray, p, ids, n, hit);
+}
+
 template <bool kAnyHit> bool Accelerator::traverse(const Ray& ray, Hit* hit) const {
     RayPrep r;
-    if (triangle_id_.empty() || !prepare(ray, !nodes_.empty(), &r)) return false;
-    const RayLanes lanes = ray_lanes(r);
+    if (triangle_id_.empty() || !prepare(ray, true, &r)) return false;
+    const RayLanes lanes = ray_lanes(r, r);
     double best_t = ray.t_max;
     TriHit best_hit{0.0, 0.0, 0.0, 1.0};
     uint32_t best = 0;
     bool found = false;
     // Tests the `count` triangles of a leaf from slot `first` (even), two at a time; true when
     // an any-hit query can stop. Among a pair's hits the closest-hit rule runs in slot order.
-    auto test_leaf = [&](uint32_t first, uint32_t count) {
+    auto test_leaf = [&](uint32_t first, uint32_t count) MCP_LEAF_TEST_INLINE {
         const uint32_t end = first + count;
         for (uint32_t at = first; at < end; at += 2) {
             TriHit h[2];
-            int hits =
-                watertight2<!kAnyHit>(r, lanes, pairs_[at / 2].v, kAnyHit ? ray.t_max : best_t, h);
+            int hits = watertight2<!kAnyHit>(ray, &r, lanes, r, pairs_[at / 2].v,
+                                             kAnyHit ? ray.t_max : best_t, h);
             if (end - at < 2) hits &= 1;
             if (kAnyHit) {
                 if (hits != 0) return true;
@@ -608,92 +747,87 @@ template <bool kAnyHit> bool Accelerator::traverse(const Ray& ray, Hit* hit) con
         return false;
     };
 
-    if (nodes_.empty()) {
-        if (test_leaf(0, triangles_)) return true;
-    } else {
-        // The ray in float, relative to the scene's centre (see the file comment).
-        float o_rel[3];
-        for (int k = 0; k < 3; ++k) o_rel[k] = static_cast<float>(r.o[k] - center_[k]);
-        const F4 ox = f4_set1(o_rel[0]);
-        const F4 oy = f4_set1(o_rel[1]);
-        const F4 oz = f4_set1(o_rel[2]);
-        const F4 ix = f4_set1(static_cast<float>(r.inv[0]));
-        const F4 iy = f4_set1(static_cast<float>(r.inv[1]));
-        const F4 iz = f4_set1(static_cast<float>(r.inv[2]));
-        const F4 zero = f4_set1(0.0f), far_scale = f4_set1(kFarScale);
-        const int nx = r.near[0], ny = r.near[1], nz = r.near[2];
-        const int fx = r.far[0], fy = r.far[1], fz = r.far[2];
+    // The ray in float, relative to the scene's centre (see the file comment).
+    float o_rel[3];
+    for (int k = 0; k < 3; ++k) o_rel[k] = static_cast<float>(r.o[k] - center_[k]);
+    const F4 ox = f4_set1(o_rel[0]);
+    const F4 oy = f4_set1(o_rel[1]);
+    const F4 oz = f4_set1(o_rel[2]);
+    const F4 ix = f4_set1(static_cast<float>(r.inv[0]));
+    const F4 iy = f4_set1(static_cast<float>(r.inv[1]));
+    const F4 iz = f4_set1(static_cast<float>(r.inv[2]));
+    const F4 zero = f4_set1(0.0f), far_scale = f4_set1(kFarScale);
+    const int nx = r.near[0], ny = r.near[1], nz = r.near[2];
+    const int fx = r.far[0], fy = r.far[1], fz = r.far[2];
 
-        // Children met by the ray wait on the stack, nearest on top, with their entry
-        // distance; one is skipped when a hit got closer than its box.
-        struct Pending {
-            uint32_t child, count; // count 0: a node; else a leaf's triangles
-            float t_enter;
-        };
-        Pending stack[kStackSize];
-        uint32_t top = 0, current = 0;
-        for (;;) {
-            const WideNode& node = nodes_[current];
-            const float t_max = static_cast<float>(best_t);
-            // Slab test of the boxes, four at a time [KayKajiya86]; max_keep / min_keep
-            // ignore NaN.
-            const F4 t_far = f4_set1(t_max);
-            int mask = 0;
-            alignas(16) float t_enter[kWidth];
-            for (int g = 0; g < kWidth; g += 4) {
-                const F4 tx0 = (f4_load(node.bounds[nx] + g) - ox) * ix;
-                const F4 tx1 = (f4_load(node.bounds[fx] + g) - ox) * ix;
-                const F4 ty0 = (f4_load(node.bounds[ny] + g) - oy) * iy;
-                const F4 ty1 = (f4_load(node.bounds[fy] + g) - oy) * iy;
-                const F4 tz0 = (f4_load(node.bounds[nz] + g) - oz) * iz;
-                const F4 tz1 = (f4_load(node.bounds[fz] + g) - oz) * iz;
-                const F4 t0 = f4_max_keep(tz0, f4_max_keep(ty0, f4_max_keep(tx0, zero)));
-                const F4 t1 = f4_min_keep(tz1, f4_min_keep(ty1, f4_min_keep(tx1, t_far)));
-                mask |= f4_le_mask(t0, t1 * far_scale) << g;
-                f4_store(t_enter + g, t0);
-            }
-            // One interior child met: go straight down.
-            if ((mask & (mask - 1)) == 0 && mask != 0) {
-                const int l = __builtin_ctz(static_cast<unsigned>(mask));
-                if (node.count[l] == 0) {
-                    current = node.child[l];
-                    continue;
-                }
-            }
-            // Push the boxes met, farthest first (closest hit); an any-hit query tests the
-            // leaves met at once and pushes only the nodes.
-            const uint32_t base = top;
-            while (mask != 0) {
-                const int l = __builtin_ctz(static_cast<unsigned>(mask));
-                mask &= mask - 1;
-                const Pending p{node.child[l], node.count[l], t_enter[l]};
-                uint32_t at = top++;
-                if (kAnyHit) {
-                    if (p.count == 0) {
-                        stack[at] = p;
-                        continue;
-                    }
-                    --top;
-                    if (test_leaf(p.child, p.count)) return true;
-                    continue;
-                }
-                for (; at > base && stack[at - 1].t_enter < p.t_enter; --at)
-                    stack[at] = stack[at - 1];
-                stack[at] = p;
-            }
-            bool descend = false;
-            while (top > 0) {
-                const Pending p = stack[--top];
-                if (!kAnyHit && !(p.t_enter <= static_cast<float>(best_t) * kFarScale)) continue;
-                if (p.count == 0) {
-                    current = p.child;
-                    descend = true;
-                    break;
-                }
-                if (test_leaf(p.child, p.count)) return true;
-            }
-            if (!descend) break;
+    // Children met by the ray wait on the stack, nearest on top, with their entry
+    // distance; one is skipped when a hit got closer than its box.
+    struct Pending {
+        uint32_t child, count; // count 0: a node; else a leaf's triangles
+        float t_enter;
+    };
+    Pending stack[kStackSize];
+    uint32_t top = 0, current = 0;
+    for (;;) {
+        const WideNode& node = nodes_[current];
+        const float t_max = static_cast<float>(best_t);
+        // Slab test of the boxes, four at a time [KayKajiya86]; max_keep / min_keep
+        // ignore NaN.
+        const F4 t_far = f4_set1(t_max);
+        int mask = 0;
+        alignas(16) float t_enter[kWidth];
+        for (int g = 0; g < kWidth; g += 4) {
+            const F4 tx0 = (f4_load(node.bounds[nx] + g) - ox) * ix;
+            const F4 tx1 = (f4_load(node.bounds[fx] + g) - ox) * ix;
+            const F4 ty0 = (f4_load(node.bounds[ny] + g) - oy) * iy;
+            const F4 ty1 = (f4_load(node.bounds[fy] + g) - oy) * iy;
+            const F4 tz0 = (f4_load(node.bounds[nz] + g) - oz) * iz;
+            const F4 tz1 = (f4_load(node.bounds[fz] + g) - oz) * iz;
+            const F4 t0 = f4_max_keep(tz0, f4_max_keep(ty0, f4_max_keep(tx0, zero)));
+            const F4 t1 = f4_min_keep(tz1, f4_min_keep(ty1, f4_min_keep(tx1, t_far)));
+            mask |= f4_le_mask(t0, t1 * far_scale) << g;
+            f4_store(t_enter + g, t0);
         }
+        // One interior child met: go straight down.
+        if ((mask & (mask - 1)) == 0 && mask != 0) {
+            const int l = __builtin_ctz(static_cast<unsigned>(mask));
+            if (node.count[l] == 0) {
+                current = node.child[l];
+                continue;
+            }
+        }
+        // Push the boxes met, farthest first (closest hit); an any-hit query tests the
+        // leaves met at once and pushes only the nodes.
+        const uint32_t base = top;
+        while (mask != 0) {
+            const int l = __builtin_ctz(static_cast<unsigned>(mask));
+            mask &= mask - 1;
+            const Pending p{node.child[l], node.count[l], t_enter[l]};
+            uint32_t at = top++;
+            if (kAnyHit) {
+                if (p.count == 0) {
+                    stack[at] = p;
+                    continue;
+                }
+                --top;
+                if (test_leaf(p.child, p.count)) return true;
+                continue;
+            }
+            for (; at > base && stack[at - 1].t_enter < p.t_enter; --at) stack[at] = stack[at - 1];
+            stack[at] = p;
+        }
+        bool descend = false;
+        while (top > 0) {
+            const Pending p = stack[--top];
+            if (!kAnyHit && !(p.t_enter <= static_cast<float>(best_t) * kFarScale)) continue;
+            if (p.count == 0) {
+                current = p.child;
+                descend = true;
+                break;
+            }
+            if (test_leaf(p.child, p.count)) return true;
+        }
+        if (!descend) break;
     }
     if (kAnyHit || !found) return false;
     hit->t = best_hit.t;
@@ -704,11 +838,11 @@ template <bool kAnyHit> bool Accelerator::traverse(const Ray& ray, Hit* hit) con
 }
 
 bool Accelerator::intersect(const Ray& ray, Hit* hit) const {
-    return traverse<false>(ray, hit);
+    return nodes_.empty() ? brute_force(ray, hit) : traverse<false>(ray, hit);
 }
 
 bool Accelerator::occluded(const Ray& ray) const {
-    return traverse<true>(ray, nullptr);
+    return nodes_.empty() ? brute_force(ray, nullptr) : traverse<true>(ray, nullptr);
 }
 
 } // namespace mcp

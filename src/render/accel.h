@@ -32,13 +32,16 @@ struct AccelStats {
     /// scene's box meets its box (area ratio). For brute force, 0 and the triangle count.
     double expected_node_visits = 0.0;
     double expected_triangle_tests = 0.0;
+    /// The same for the pair tests the triangles are tested in: ceil(k / 2) for a leaf of k
+    /// triangles. For brute force, 0 visits and ceil(n / 2). Auto compares these.
+    double expected_pair_tests = 0.0;
 };
 
 class Accelerator {
   public:
     /// Under Auto, scenes of up to this many triangles get the structure of lower expected
-    /// cost per ray: brute force's triangle count against the BVH's expected triangle tests
-    /// plus kNodeCost per expected node visit. Larger scenes always get the BVH.
+    /// cost per ray: brute force's ceil(n / 2) pair tests against the BVH's expected pair
+    /// tests plus kNodeCost per expected node visit. Larger scenes always get the BVH.
     static constexpr size_t kAutoMaxTriangles = 64;
     /// Children per BVH node, tested four at a time. Natively, eight visit fewer nodes than
     /// four for about the same latency per node; in wasm, where V8's SIMD code is slower, the
@@ -49,16 +52,15 @@ class Accelerator {
 #else
     static constexpr int kNodeWidth = 8;
 #endif
-    /// A node visit's cost in triangle tests, measured with `make bench` (rays/closed_N:
-    /// both structures on closed meshes of 4 to 80 triangles; figures in
-    /// docs/performance-notes.md#traversal-and-the-bvh; about 4.5 natively for
-    /// both widths). V8 runs the float SIMD box test at about native speed and the
-    /// double-precision triangle test at about 0.65 of it, so a node costs fewer triangle tests
-    /// in wasm.
+    /// A node visit's cost in pair tests (both structures test triangles two at a time),
+    /// fitted to `make bench`'s rays/closed_N rows (both structures on closed meshes of 4 to 80
+    /// triangles; docs/performance-notes.md#traversal-and-the-bvh): 2.7-3.6 natively, 1.9-2.6
+    /// in wasm, where V8 runs the float SIMD box test at about native speed and the
+    /// double-precision pair test slower.
 #if defined(__EMSCRIPTEN__)
     static constexpr double kNodeCost = 2.0;
 #else
-    static constexpr double kNodeCost = 4.5;
+    static constexpr double kNodeCost = 3.0;
 #endif
 
     /// Builds over the mesh's triangles (which must outlive nothing: the accelerator keeps
@@ -90,7 +92,8 @@ class Accelerator {
     struct alignas(16) TrianglePair {
         double v[9][2];
     };
-    template <bool kAnyHit> bool traverse(const Ray& ray, Hit* hit) const;
+    template <bool kAnyHit> bool traverse(const Ray& ray, Hit* hit) const; // nodes_ not empty
+    bool brute_force(const Ray& ray, Hit* hit) const; // nodes_ empty; hit null: any hit
 
     AccelStats stats_;
     double center_[3] = {0.0, 0.0, 0.0}; // boxes and ray origins are relative to it
