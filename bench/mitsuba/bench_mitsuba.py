@@ -82,6 +82,11 @@ MCPLAY_BEST = {
     'mis': {'strategy': 'mis_power', 'light_samples': 'auto', 'pixel_sampler': 'sobol'},
     'path': {'strategy': 'path', 'max_depth': 5, 'candidates': 'auto', 'pixel_sampler': 'sobol'},
 }
+# Every class: the emission seen directly from BEST_EMISSION_SAMPLES camera rays per sample
+# (emission_samples; the edges of a directly seen light, a pixel's coverage, are camera-sample
+# noise that neither light nor BSDF samples touch). A fixed count: the timed pilot ("auto")
+# sees too few rare edge pixels in its 2-spp bands (docs/performance-notes.md).
+BEST_EMISSION_SAMPLES = 4
 PATH_BOUNCES, PATH_RR = 5, 3  # mcplay's path defaults (src/render/integrator.h)
 
 
@@ -360,6 +365,8 @@ def chosen_scenes(args):
     for name, gltf, w, h, strategies in SCENES:
         if name in args.scenes.split(','):
             scale = 4 if args.quick else 1
+            if args.strategies:
+                strategies = [s for s in strategies if s in args.strategies.split(',')]
             yield name, os.path.join(ROOT, 'scenes', gltf), w // scale, h // scale, strategies
 
 
@@ -450,6 +457,11 @@ def main():
                     help='images per cell whose relative MSE is averaged (heavy-tailed cells need several)')
     ap.add_argument('--quick', action='store_true', help='small images and references: a smoke test')
     ap.add_argument('--scenes', default=','.join(s[0] for s in SCENES))
+    ap.add_argument('--strategies', default='', help='only these classes (light,bsdf,mis,path)')
+    ap.add_argument('--best-emission', default=str(BEST_EMISSION_SAMPLES),
+                    help="camera rays per sample for the emission seen directly in MCPLAY_BEST "
+                         "(emission_samples: a count or auto; 1 leaves the key out, for binaries "
+                         "without it)")
     ap.add_argument('--scalar', action='store_true',
                     help="also Mitsuba's scalar_rgb variant (one sample at a time per thread, as "
                          "mcplay runs): one more column, scored against the same Mitsuba reference")
@@ -465,6 +477,10 @@ def main():
     ap.add_argument('--child-width', type=int, default=0, help=argparse.SUPPRESS)
     args = ap.parse_args()
     spps = [int(s) for s in args.spp.split(',')]
+    for best in MCPLAY_BEST.values():
+        best.pop('emission_samples', None)
+        if args.best_emission != '1':
+            best['emission_samples'] = 'auto' if args.best_emission == 'auto' else int(args.best_emission)
     os.environ.setdefault('DRJIT_NUM_THREADS', str(args.threads))
     if args.child_variant:
         return width_child(args)

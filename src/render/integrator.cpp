@@ -603,6 +603,27 @@ RadianceSample split_path_radiance(const RenderScene& rs, const RenderEstimator&
 
 } // namespace
 
+Vec3 emitted_along(const RenderScene& rs, const Ray& camera_ray, SampleCounters& c) {
+    Ray ray = camera_ray;
+    Hit h;
+    ++c.rays;
+    if (rs.emitters_first) {
+        if (!rs.emitters.intersect(ray, &h)) return Vec3(0.0);
+        h.triangle = rs.emitter_triangle[h.triangle];
+        ray.t_max = h.t;
+        if (rs.accel.occluded(ray)) return Vec3(0.0);
+    } else if (!rs.accel.intersect(ray, &h)) {
+        return Vec3(0.0);
+    }
+    return rs.lights_uniform.emitted(h.triangle, -ray.direction);
+}
+
+Vec2 shifted_jitter(const Vec2& jitter, int j, int n) {
+    constexpr double kGolden = 0.6180339887498949;
+    const auto frac = [](double v) { return v - std::floor(v); };
+    return Vec2(frac(jitter.x + double(j) / double(n)), frac(jitter.y + double(j) * kGolden));
+}
+
 const char* strategy_name(RadianceStrategy s) {
     for (const auto& n : kStrategyNames)
         if (n.strategy == s) return n.name;

@@ -92,8 +92,17 @@ struct RenderEstimator {
     /// Light samples per shading point (strategies that sample lights); 0 (JSON "auto") until
     /// a timed pilot chooses it (splitting.h): the integrator takes 0 as 1.
     int light_samples = 1;
-    int bsdf_samples = 1;   ///< BSDF samples per shading point (strategies that sample the BSDF)
-    SplitPilot split_pilot; ///< what the pilot measured, when it chose light_samples
+    int bsdf_samples = 1; ///< BSDF samples per shading point (strategies that sample the BSDF)
+    /// Camera rays per camera sample for the emission seen directly (every strategy): the
+    /// sample's own ray and emission_samples - 1 more through the same pixel, whose first hits
+    /// count only their emission (emitted_along), the mean of all replacing the sample's
+    /// RadianceSample::emitted. Splitting the pixel integral of Le by term: the emission seen
+    /// directly is cheap to sample again (a ray, most of them tested against the lights alone)
+    /// and rules the pixels an emitter's edge crosses, where the reflected part is the same
+    /// shading point's. 0 (JSON "auto") until a timed pilot chooses it (splitting.h).
+    int emission_samples = 1;
+    SplitPilot split_pilot;     ///< what the pilot measured, when it chose light_samples
+    SplitPilot emission_pilot;  ///< the same for emission_samples
     SplitPilot candidate_pilot; ///< the same for candidates (variance_light: the resampled part)
 };
 /// The bounds of ris's candidate count M, checked where estimators are parsed.
@@ -140,6 +149,18 @@ struct RadianceSample {
 RadianceSample sample_radiance(const RenderScene& rs, const RenderEstimator& est,
                                const Ray& camera_ray, PixelSampler& sampler,
                                SampleCounters& counters);
+
+/// The emission seen along `ray` at its closest hit (0 when it misses or the hit does not
+/// emit): with rs.emitters_first the lights' own accelerator first, then an any-hit query of
+/// the scene short of the light (as a sampled direction is traced), so a ray that meets no
+/// light costs a test of the lights alone. One ray counted.
+Vec3 emitted_along(const RenderScene& rs, const Ray& ray, SampleCounters& counters);
+
+/// Pixel position j of n for the extra camera rays of emission_samples: the sample's own
+/// jitter shifted by (j / n, j a) modulo 1, a the golden ratio's fraction (a rank-1 lattice
+/// around the sample's point; a = R_1 of [Roberts18]). Each is uniform over the pixel when the
+/// sample's jitter is, which is all the mean of the n emissions asks to stay unbiased.
+Vec2 shifted_jitter(const Vec2& jitter, int j, int n);
 
 /// The versions of the integrator compiled for what a scene's surfaces use, so that a scene
 /// does not pay for what it leaves out: GeneralTextured is sample_radiance itself; General

@@ -35,6 +35,10 @@ void render_rows(const RenderScene& rs, const RenderEstimator& est, const Render
     const bool keeps_generator = !band.generators.empty();
     const uint64_t first_sample = band.spp;
     const int rows = band.rows();
+    // Camera rays per sample for the emission seen directly (0, "auto" unresolved, as 1; none
+    // without lights or without jitter, where every ray of the pixel is the same).
+    const int n_emission =
+        st.jitter_pixels && !rs.lights_uniform.empty() ? std::max(1, est.emission_samples) : 1;
     for (int r = first; r < rows; r += step) {
         if (st.cancel && st.cancel->load(std::memory_order_relaxed)) progress.stop = true;
         if (progress.stop.load(std::memory_order_relaxed)) return;
@@ -65,6 +69,15 @@ void render_rows(const RenderScene& rs, const RenderEstimator& est, const Render
                 Vec2 jitter = st.jitter_pixels ? sampler.get_2d() : Vec2(0.5);
                 Ray ray = ray_through(camera, x + jitter.x, y + jitter.y);
                 RadianceSample rad = sample_radiance_with<K>(rs, est, ray, sampler, counters);
+                if (n_emission > 1) { // emission_samples: the emission seen directly, split
+                    Vec3 emitted = rad.emitted;
+                    for (int j = 1; j < n_emission; ++j) {
+                        const Vec2 s = shifted_jitter(jitter, j, n_emission);
+                        emitted +=
+                            emitted_along(rs, ray_through(camera, x + s.x, y + s.y), counters);
+                    }
+                    rad.emitted = emitted / double(n_emission);
+                }
                 Vec3 L = rad.total();
                 if (!std::isfinite(L.x) || !std::isfinite(L.y) || !std::isfinite(L.z)) {
                     ++diag.discarded_nonfinite;

@@ -16,6 +16,7 @@ namespace {
 /// noise, small enough that the pilot stays short.
 constexpr int kPilotSplit = 5;
 constexpr int kPilotCandidates = 8; ///< the pilot's second count of RIS candidates
+constexpr int kPilotEmission = 8;   ///< and of camera rays for the emission seen directly
 constexpr int kPilotReach = 4;      ///< the chosen count is at most this times the second
 constexpr uint64_t kPilotSpp = 2;
 constexpr int kPilotRuns = 1; ///< per count, the shortest time kept (interleaved runs)
@@ -75,7 +76,7 @@ int optimal_split(double variance_rest, double variance_light, double seconds_re
 namespace {
 
 /// Which count a pilot chooses: light_samples (splitting) or candidates (RIS).
-enum class PilotCount { LightSamples, Candidates };
+enum class PilotCount { LightSamples, Candidates, EmissionSamples };
 
 /// The pilot of one count: estimates with the count at 1 and at k, the variance model
 /// V(n) = V_rest + V_light / n and cost c_rest + n c_light read from the two, and n* chosen.
@@ -94,15 +95,21 @@ RenderEstimator run_pilot(const RenderScene& rs, const RenderEstimator& est,
     pilot.threads = 1;
     // A candidate costs far less than a shadow ray: a larger second count stands out of the
     // timing noise.
-    const int k_count = what == PilotCount::Candidates ? kPilotCandidates : kPilotSplit;
+    const int k_count = what == PilotCount::Candidates        ? kPilotCandidates
+                        : what == PilotCount::EmissionSamples ? kPilotEmission
+                                                              : kPilotSplit;
     RenderEstimator one = est, many = est;
-    int& one_count = what == PilotCount::Candidates ? one.candidates : one.light_samples;
-    int& many_count = what == PilotCount::Candidates ? many.candidates : many.light_samples;
-    one_count = 1;
-    many_count = k_count;
-    // The other count, if it is still "auto", at 1 during this pilot.
+    const auto count_of = [what](RenderEstimator& e) -> int& {
+        return what == PilotCount::Candidates        ? e.candidates
+               : what == PilotCount::EmissionSamples ? e.emission_samples
+                                                     : e.light_samples;
+    };
+    count_of(one) = 1;
+    count_of(many) = k_count;
+    // The other counts, if they are still "auto", at 1 during this pilot.
     if (one.light_samples == 0) one.light_samples = many.light_samples = 1;
     if (one.candidates == 0) one.candidates = many.candidates = 1;
+    if (one.emission_samples == 0) one.emission_samples = many.emission_samples = 1;
     one.pixel_sampler = many.pixel_sampler = PixelSamplerKind::Independent;
     std::vector<RenderImage> a, b;
     double t1 = 1e300, t2 = 1e300;
@@ -146,6 +153,9 @@ RenderEstimator run_pilot(const RenderScene& rs, const RenderEstimator& est,
     if (what == PilotCount::Candidates) {
         out.candidates = std::min(n, kMaxRisCandidates);
         out.candidate_pilot = p;
+    } else if (what == PilotCount::EmissionSamples) {
+        out.emission_samples = n;
+        out.emission_pilot = p;
     } else {
         out.light_samples = n;
         out.split_pilot = p;
@@ -161,6 +171,8 @@ RenderEstimator resolve_split(const RenderScene& rs, const RenderEstimator& est,
     // The candidates first (with one light sample), then the light samples of that estimator.
     if (out.candidates == 0) out = run_pilot(rs, out, image, PilotCount::Candidates);
     if (out.light_samples == 0) out = run_pilot(rs, out, image, PilotCount::LightSamples);
+    // Then the camera rays for the emission seen directly, with the shading's counts fixed.
+    if (out.emission_samples == 0) out = run_pilot(rs, out, image, PilotCount::EmissionSamples);
     return out;
 }
 

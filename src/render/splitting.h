@@ -14,7 +14,10 @@ namespace mcp {
 
 /// The estimator with light_samples chosen by the pilot (and its figures in split_pilot)
 /// when light_samples is 0 ("auto"), and likewise candidates (RIS, candidate_pilot; chosen
-/// first, with one light sample, the pilot's second count 8); any other estimator unchanged.
+/// first, with one light sample, the pilot's second count 8), then emission_samples (camera rays
+/// for the emission seen directly, emission_pilot, with the other counts chosen; second count
+/// 8: V_light is then the emission's variance per camera sample, c_light one such ray's cost);
+/// any other estimator unchanged.
 /// The count is at most 4 times the pilot's second count (20 light samples, 32 candidates):
 /// the model is measured at 1 and k only.
 /// `image` gives the image size, stream and threads of the render that follows.

@@ -101,6 +101,7 @@ Json estimator_to_json(const RenderEstimator& e) {
         j["light_samples"] = e.light_samples;
         j["bsdf_samples"] = e.bsdf_samples;
     }
+    if (e.emission_samples != 1 || e.emission_pilot.ran) j["emission_samples"] = e.emission_samples;
     const auto pilot_json = [](const SplitPilot& p) {
         return Json{{"variance_rest", p.variance_rest},
                     {"variance_light", p.variance_light},
@@ -112,6 +113,7 @@ Json estimator_to_json(const RenderEstimator& e) {
     // light_samples or candidates "auto": what the pilot measured (splitting.h)
     if (e.split_pilot.ran) j["split_pilot"] = pilot_json(e.split_pilot);
     if (e.candidate_pilot.ran) j["candidate_pilot"] = pilot_json(e.candidate_pilot);
+    if (e.emission_pilot.ran) j["emission_pilot"] = pilot_json(e.emission_pilot);
     return j;
 }
 

@@ -167,10 +167,13 @@ int open_session(const char* scene_json, const char* options_json, mcp_progress_
                     "' sampler cannot (its samples depend on the final spp): use "
                     "'padded_sobol' or 'independent'");
     for (const RenderEstimator& e : r.estimators)
-        if (e.light_samples == 0 || e.candidates == 0) // each band would run its own pilot
+        if (e.light_samples == 0 || e.candidates == 0 ||
+            e.emission_samples == 0) // each band would run its own pilot
             return fail(MCP_ERROR_ARGUMENT,
-                        "estimator '" + e.name +
-                            "': " + (e.light_samples == 0 ? "light_samples" : "candidates") +
+                        "estimator '" + e.name + "': " +
+                            (e.light_samples == 0 ? "light_samples"
+                             : e.candidates == 0  ? "candidates"
+                                                  : "emission_samples") +
                             " \"auto\" is chosen by a timed pilot, which the live view's bands "
                             "would each run: give a count");
     const int width = r.settings.width, height = r.settings.height;

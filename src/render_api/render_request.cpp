@@ -56,7 +56,8 @@ void use_ris_defaults(RenderEstimator* e) {
 
 /// light_samples and bsdf_samples (splitting, integrator.h): whole numbers in
 /// 1..kMaxSplitSamples, on the strategies that draw such samples; light_samples may be "auto"
-/// (0: a timed pilot chooses it, splitting.h).
+/// (0: a timed pilot chooses it, splitting.h). emission_samples (camera rays per sample for
+/// the emission seen directly) is taken by every strategy, in the same range or "auto".
 bool parse_split_counts(Ctx& c, const Json& j, const std::string& path, RenderEstimator* e) {
     const RadianceStrategy s = e->strategy;
     const bool mis = s == RadianceStrategy::MisBalance || s == RadianceStrategy::MisPower ||
@@ -79,22 +80,23 @@ bool parse_split_counts(Ctx& c, const Json& j, const std::string& path, RenderEs
                             {"bsdf_samples", samples_bsdf,
                              "strategies that sample the BSDF (bsdf, mis_balance, "
                              "mis_power, path)",
-                             &e->bsdf_samples}};
+                             &e->bsdf_samples},
+                            {"emission_samples", true, "", &e->emission_samples}};
     for (const Count& k : counts) {
         const Json* v = find(j, k.key);
         if (!v) continue;
         if (!k.allowed)
             return c.fail(sub(path, k.key), std::string("only the ") + k.who + " take it, not '" +
                                                 strategy_name(s) + "'");
-        if (v->is_string() && v->get<std::string>() == "auto" && k.out == &e->light_samples) {
+        const bool automatic = k.out == &e->light_samples || k.out == &e->emission_samples;
+        if (v->is_string() && v->get<std::string>() == "auto" && automatic) {
             *k.out = 0;
             continue;
         }
         const bool whole = v->is_number_integer() || v->is_number_unsigned();
         if (!whole || v->get<int64_t>() < 1 || v->get<int64_t>() > kMaxSplitSamples)
-            return c.fail(sub(path, k.key), range +
-                                                (k.out == &e->light_samples ? " or \"auto\"" : "") +
-                                                ", got " + v->dump());
+            return c.fail(sub(path, k.key),
+                          range + (automatic ? " or \"auto\"" : "") + ", got " + v->dump());
         *k.out = int(v->get<int64_t>());
     }
     return true;
@@ -139,7 +141,8 @@ bool parse_estimator(Ctx& c, const Json& j, const std::string& path, RenderEstim
     }
     if (!check_keys(c, j, path,
                     {"name", "strategy", "light_selection", "light_sampling", "pixel_sampler",
-                     "max_depth", "rr_depth", "candidates", "light_samples", "bsdf_samples"}))
+                     "max_depth", "rr_depth", "candidates", "light_samples", "bsdf_samples",
+                     "emission_samples"}))
         return false;
     std::string strategy;
     if (!get_string(c, j, "strategy", path, &strategy)) return false;
@@ -210,6 +213,9 @@ bool parse_reference(Ctx& c, const Json& j, const std::string& path, const std::
                       "\"auto\" depends on timing; a reference takes a fixed count");
     if (out->estimator.candidates == 0)
         return c.fail(sub(sub(path, "estimator"), "candidates"),
+                      "\"auto\" depends on timing; a reference takes a fixed count");
+    if (out->estimator.emission_samples == 0)
+        return c.fail(sub(sub(path, "estimator"), "emission_samples"),
                       "\"auto\" depends on timing; a reference takes a fixed count");
     if (!get_count(c, j, "spp", path, &out->spp) || !get_count(c, j, "seed", path, &out->seed))
         return false;
@@ -508,9 +514,11 @@ Made<std::shared_ptr<RenderRequest>> build_render_request(const Json& scene, con
         r->estimators = chosen;
     }
     for (const RenderEstimator& e : r->estimators)
-        if ((e.light_samples == 0 || e.candidates == 0) && parts > 1) {
+        if ((e.light_samples == 0 || e.candidates == 0 || e.emission_samples == 0) && parts > 1) {
             c.fail("options.parts", "estimator '" + e.name + "' has " +
-                                        (e.light_samples == 0 ? "light_samples" : "candidates") +
+                                        (e.light_samples == 0 ? "light_samples"
+                                         : e.candidates == 0  ? "candidates"
+                                                              : "emission_samples") +
                                         " \"auto\", which each part's timed pilot would choose "
                                         "on its own: give a count");
             return error();
