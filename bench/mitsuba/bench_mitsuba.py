@@ -28,8 +28,9 @@ also compared with each other (the same relative MSE), which says whether they r
 image. With --sobol, mcplay also renders every cell with its Owen-scrambled Sobol' pixel sampler
 (`--pixel-sampler sobol`; the default is stratified), scored against the same mcplay reference:
 one more column, and its own efficiency ratio against Mitsuba. With --best, mcplay also renders
-each class with its best estimator (MCPLAY_BEST: Sobol' pixels, resampled light samples, the
-candidates and light samples per camera sample chosen by timed pilots, their time counted), one more column the same way. With --scalar, Mitsuba's
+each class with its best estimator (MCPLAY_BEST: Sobol' pixels, the emission seen directly
+split at emitter edges, the candidates and light samples per camera sample chosen by timed
+pilots, their time counted), one more column the same way. With --scalar, Mitsuba's
 `scalar_rgb` variant renders every cell too: the same integrators one sample at a time per
 thread, as mcplay runs, against `llvm_ad_rgb`'s kernels that run a SIMD register's width of
 samples at once. It is scored against the `llvm_ad_rgb` reference (the same estimator), and
@@ -70,15 +71,15 @@ SCENES = [
     ('veach_mis', 'veach_mis.gltf', 320, 180, ['light', 'bsdf', 'mis']),
 ]
 MCPLAY_ESTIMATOR = {'light': 'light_solid_angle', 'bsdf': 'bsdf', 'mis': 'mis_power', 'path': 'path'}
-# mcplay's best per class (--best), Sobol' pixels throughout. Light sampling: resampled light
-# samples (ris: candidates drawn as light_solid_angle draws them, the target lum(f Le cos) with
-# the BSDF in it). Path tracing: each vertex's light sample resampled the same way. MIS: light
+# mcplay's best per class (--best), Sobol' pixels throughout. Light sampling: plain
+# light_solid_angle (with Sobol' pixels it beat resampled light samples, ris, whose candidate
+# pilot measures with independent pixels: docs/performance-notes.md). Path tracing: each
+# vertex's light sample resampled (ris's target lum(f Le cos) with the BSDF in it). MIS: light
 # samples per camera sample (splitting). Each count chosen by a timed pilot (src/render/
 # splitting.h; its time counted in the image's). BSDF sampling alone has no such choice: its
 # row is a pure speed contest.
 MCPLAY_BEST = {
-    'light': {'strategy': 'ris', 'light_selection': 'power', 'light_sampling': 'solid_angle',
-              'candidates': 'auto', 'pixel_sampler': 'sobol'},
+    'light': {'strategy': 'light_solid_angle', 'pixel_sampler': 'sobol'},
     'mis': {'strategy': 'mis_power', 'light_samples': 'auto', 'pixel_sampler': 'sobol'},
     'path': {'strategy': 'path', 'max_depth': 5, 'candidates': 'auto', 'pixel_sampler': 'sobol'},
 }
@@ -86,7 +87,7 @@ MCPLAY_BEST = {
 # (emission_samples; the edges of a directly seen light, a pixel's coverage, are camera-sample
 # noise that neither light nor BSDF samples touch). A fixed count: the timed pilot ("auto")
 # sees too few rare edge pixels in its 2-spp bands (docs/performance-notes.md).
-BEST_EMISSION_SAMPLES = 4
+BEST_EMISSION_SAMPLES = 16
 PATH_BOUNCES, PATH_RR = 5, 3  # mcplay's path defaults (src/render/integrator.h)
 
 

@@ -93,13 +93,15 @@ struct RenderEstimator {
     /// a timed pilot chooses it (splitting.h): the integrator takes 0 as 1.
     int light_samples = 1;
     int bsdf_samples = 1; ///< BSDF samples per shading point (strategies that sample the BSDF)
-    /// Camera rays per camera sample for the emission seen directly (every strategy): the
+    /// Camera rays per camera sample for the emission seen directly (every strategy), in the
+    /// pixels where the emission seen through the four corners differs (an emitter's or an
+    /// occluder's edge crosses the pixel; a choice fixed by the geometry, so unbiased): the
     /// sample's own ray and emission_samples - 1 more through the same pixel, whose first hits
     /// count only their emission (emitted_along), the mean of all replacing the sample's
-    /// RadianceSample::emitted. Splitting the pixel integral of Le by term: the emission seen
-    /// directly is cheap to sample again (a ray, most of them tested against the lights alone)
-    /// and rules the pixels an emitter's edge crosses, where the reflected part is the same
-    /// shading point's. 0 (JSON "auto") until a timed pilot chooses it (splitting.h).
+    /// RadianceSample::emitted. Splitting the pixel integral by term: the pixel's coverage by
+    /// an emitter is camera-sample noise no light or BSDF sample touches, and a ray that
+    /// meets no light costs a test of the lights alone. 0 (JSON "auto") until a timed pilot
+    /// chooses it (splitting.h).
     int emission_samples = 1;
     SplitPilot split_pilot;     ///< what the pilot measured, when it chose light_samples
     SplitPilot emission_pilot;  ///< the same for emission_samples

@@ -64,19 +64,30 @@ void render_rows(const RenderScene& rs, const RenderEstimator& est, const Render
             double lum_sum = band.lum_sum[p], lum_max = band.lum_max[p];
             uint64_t kept = band.kept[p];
             SampleCounters counters;
+            // emission_samples where the emission seen at the pixel's four corners differs (an
+            // emitter's edge or an occluder's crosses it): a choice fixed by the geometry,
+            // independent of the samples, so each pixel's mean stays unbiased whatever it is.
+            int n_pixel = 1;
+            if (n_emission > 1) {
+                const Vec3 e0 = emitted_along(rs, ray_through(camera, x, y), counters);
+                for (const Vec2 corner : {Vec2(1, 0), Vec2(0, 1), Vec2(1, 1)}) {
+                    const Ray probe = ray_through(camera, x + corner.x, y + corner.y);
+                    if (emitted_along(rs, probe, counters) != e0) n_pixel = n_emission;
+                }
+            }
             for (uint64_t i = first_sample; i < st.spp; ++i) {
                 sampler.start_sample(i);
                 Vec2 jitter = st.jitter_pixels ? sampler.get_2d() : Vec2(0.5);
                 Ray ray = ray_through(camera, x + jitter.x, y + jitter.y);
                 RadianceSample rad = sample_radiance_with<K>(rs, est, ray, sampler, counters);
-                if (n_emission > 1) { // emission_samples: the emission seen directly, split
+                if (n_pixel > 1) { // emission_samples: the emission seen directly, split
                     Vec3 emitted = rad.emitted;
-                    for (int j = 1; j < n_emission; ++j) {
-                        const Vec2 s = shifted_jitter(jitter, j, n_emission);
+                    for (int j = 1; j < n_pixel; ++j) {
+                        const Vec2 s = shifted_jitter(jitter, j, n_pixel);
                         emitted +=
                             emitted_along(rs, ray_through(camera, x + s.x, y + s.y), counters);
                     }
-                    rad.emitted = emitted / double(n_emission);
+                    rad.emitted = emitted / double(n_pixel);
                 }
                 Vec3 L = rad.total();
                 if (!std::isfinite(L.x) || !std::isfinite(L.y) || !std::isfinite(L.z)) {
