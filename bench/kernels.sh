@@ -2,8 +2,9 @@
 # bench/kernels.cpp three ways, in turn, ROUNDS times (default 3), then each kernel's best:
 #   native    g++ -O3 against build/libmcplay_core.a, as the build runs (GCC's AVX2 clones of the
 #             pair loops and the periodogram, glibc's libm with its FMA variants);
-#   native128 the same with the clones' baseline x86-64 code (two doubles a register) and
-#             glibc's non-AVX libm (GLIBC_TUNABLES): the width and instructions wasm has;
+#   native128 the same with the clones' baseline x86-64 code (two doubles a register; the pair
+#             loops' file by clang++ when installed) and glibc's non-AVX libm (GLIBC_TUNABLES):
+#             the width and instructions wasm has;
 #   wasm      em++ against build-wasm/libmcplay_core.a under node --no-liftoff.
 # Usage: bash bench/kernels.sh [BUILD=build] [BUILD_WASM=build-wasm]
 set -eu
@@ -15,9 +16,13 @@ trap 'rm -rf "$tmp"' EXIT
 flags=(-O3 -DNDEBUG -std=c++17 -ffp-contract=off -fno-exceptions -Wno-psabi -I"$root/src")
 g++ "${flags[@]}" -I"$build/deps_include" "$root/bench/kernels.cpp" "$build/libmcplay_core.a" \
     -lpthread -o "$tmp/native"
-# The pair loops' file without its target_clones attribute: GCC's default (baseline) code alone.
+# The pair loops' file without its target_clones attribute: the default (baseline) code alone.
 sed 's/^MCP_VECTOR_CLONES //' "$root/src/core/point_analysis.cpp" >"$tmp/point_analysis.cpp"
-g++ "${flags[@]}" -I"$build/deps_include" -iquote "$root/src/core" -c "$tmp/point_analysis.cpp" \
+# Compiled by clang++ when there is one (the compiler em++ wraps): GCC lowers the pair loops'
+# 256-bit generic vectors without AVX to scalar code through the stack, clang to two SSE2
+# registers, as it lowers them to two SIMD128 values for wasm.
+cxx128=$(command -v clang++ || echo g++)
+"$cxx128" "${flags[@]}" -I"$build/deps_include" -iquote "$root/src/core" -c "$tmp/point_analysis.cpp" \
     -o "$tmp/point_analysis.o"
 g++ "${flags[@]}" -I"$build/deps_include" "$root/bench/kernels.cpp" "$tmp/point_analysis.o" \
     "$build/libmcplay_core.a" -lpthread -o "$tmp/native128"
