@@ -389,20 +389,22 @@ class VegasPlusEstimator final : public EstimatorAlgorithm, private TrainingPoin
     // importance 1 / q(y) relative to uniform, V N / n_h, into importance_.
     const double* weigh(const Workspace& ws, size_t count, double* weights) override {
         const double n_iteration = static_cast<double>(points_);
-        uint32_t last_cube = cube_of_[0];
-        double last_importance = n_iteration / (static_cast<double>(cubes_) *
-                                                static_cast<double>(allocation_[last_cube]));
         for (size_t i = 0; i < count; ++i) {
             const double w = ws.f[i] / ws.pdf[i];
             weights[i] = std::isfinite(w) && !(ws.pdf[i] == 0.0 && ws.f[i] != 0.0) ? w : 0.0;
+        }
+        // A hypercube's points come in a row: its moments and importance once per run.
+        for (size_t i = 0; i < count;) {
             const uint32_t h = cube_of_[i];
-            cube_moments_[h].add(weights[i]);
-            if (h != last_cube) { // a hypercube's points come in a row
-                last_cube = h;
-                last_importance = n_iteration / (static_cast<double>(cubes_) *
-                                                 static_cast<double>(allocation_[h]));
-            }
-            importance_[i] = last_importance;
+            size_t end = i + 1;
+            while (end < count && cube_of_[end] == h) ++end;
+            CubeMoments m = cube_moments_[h];
+            for (size_t k = i; k < end; ++k) m.add(weights[k]);
+            cube_moments_[h] = m;
+            const double importance =
+                n_iteration / (static_cast<double>(cubes_) * static_cast<double>(allocation_[h]));
+            for (size_t k = i; k < end; ++k) importance_[k] = importance;
+            i = end;
         }
         return importance_.data();
     }
