@@ -187,15 +187,15 @@ void allocate_largest_remainders(uint64_t points, const std::vector<double>& sha
         // then every remainder above v gets a point, and the first ones equal to it. (VEGAS+'s
         // 10^5 hypercubes per iteration spent 12% of its run in a sort, then 4% in a selection
         // of (remainder, index) pairs.)
-        constexpr size_t kBuckets = 4096;
-        const auto bucket = [](double r) {
-            return r >= 1.0 ? kBuckets
-                            : (r > 0.0 ? static_cast<size_t>(r * static_cast<double>(kBuckets))
+        const size_t buckets = std::min<size_t>(n, 4096); // about one remainder each, or more
+        const auto bucket = [buckets](double r) {
+            return r >= 1.0 ? buckets
+                            : (r > 0.0 ? static_cast<size_t>(r * static_cast<double>(buckets))
                                        : size_t(0));
         };
-        std::vector<uint64_t> in_bucket(kBuckets + 1, 0);
+        std::vector<uint64_t> in_bucket(buckets + 1, 0);
         for (size_t h = 0; h < n; ++h) ++in_bucket[bucket(remainders[h])];
-        size_t b = kBuckets;
+        size_t b = buckets;
         uint64_t above_bucket = 0; // remainders in buckets above b
         while (above_bucket + in_bucket[b] < left) above_bucket += in_bucket[b--];
         std::vector<double> candidates;
