@@ -20,7 +20,7 @@ namespace {
 constexpr double kMostPilotShare = 0.1;
 
 // A hypercube's count, mean and variance: RunningMoments::add's arithmetic without the third
-// moment, which the hypercubes never read (the same values bit for bit, a point 5% cheaper).
+// moment, which the hypercubes never read (the same values bit for bit, fewer operations).
 class CubeMoments {
   public:
     void add(double x) {
