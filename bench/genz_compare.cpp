@@ -6,7 +6,9 @@
 //                [--methods uniform,stratified,...] [--gsl plain,miser,vegas|none]
 //                [--param-seed S] [--seed S] [--randomizations K] [--params-dir DIR]
 //                [--json FILE] [--write-params DIR] [--external FILE.jsonl] [--peaks]
-//                [--singular]
+//                [--singular] [--cpu-time]
+//
+// --cpu-time: time each estimate by its thread's CPU time instead of wall time (t_med, eff).
 //
 // --randomizations K: the presets sobol, halton and lattice as K randomizations of N/K points
 // instead of their 16 (a method may also name its own: "sobol:4", "sobol:lms_shift:4"), to
@@ -32,10 +34,10 @@
 //   rel_rmse  sqrt(mean((est - I)^2)) / |I|       rel_bias  (mean(est) - I) / |I|
 //   sig/rmse  mean(reported sigma) / RMSE: ~1 honest, << 1 over-confident, >> 1 pessimistic
 //   cov2      replicates with |est - I| <= 2 sigma (about 95% if the error bars are honest)
-//   t_med     median wall seconds per estimate (setup included)
-//   eff       1 / (rel_rmse^2 t_med): higher is better
-//   calls/N   integrand calls actually made / N (mean)
-//   eff_sig   1 / (mean(sigma^2) / I^2 t_med): efficiency from the mean reported variance,
+//   t_med     median wall seconds per estimate (setup included); --cpu-time: the thread's CPU
+//   seconds eff       1 / (rel_rmse^2 t_med): higher is better calls/N   integrand calls actually
+//   made / N (mean) eff_sig   1 / (mean(sigma^2) / I^2 t_med): efficiency from the mean reported
+//   variance,
 //             which for randomized QMC (K randomizations per estimate) pools R (K - 1) degrees
 //             of freedom where the RMSE has R; shown beside eff when the error bars are honest
 // A reported sigma of 0, NaN or infinity, and a non-finite estimate, are counted and shown in
@@ -85,6 +87,17 @@ double now_seconds() {
         .count();
 }
 
+// --cpu-time: an estimate's time is this thread's CPU time, which the other processes on a
+// loaded machine disturb far less than wall time (only through shared caches and frequency).
+bool g_cpu_time = false;
+
+double estimate_clock() {
+    if (!g_cpu_time) return now_seconds();
+    timespec t{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
 // ---------------------------------------------------------------------------------------
 // Options
 
@@ -129,7 +142,7 @@ bool is_count(const std::string& s) {
                  "         [--gsl plain,miser,vegas|none] [--param-seed S] [--seed S]\n"
                  "         [--randomizations K]\n"
                  "         [--params-dir DIR] [--json FILE] [--write-params DIR]\n"
-                 "         [--external FILE.jsonl] [--peaks] [--singular]\n");
+                 "         [--external FILE.jsonl] [--peaks] [--singular] [--cpu-time]\n");
     std::exit(2);
 }
 
@@ -212,6 +225,8 @@ Options parse_options(int argc, char** argv) {
             o.peaks = true;
         else if (a == "--singular")
             o.singular = true;
+        else if (a == "--cpu-time")
+            g_cpu_time = true;
         else if (a == "-h" || a == "--help")
             usage(nullptr);
         else
@@ -514,7 +529,7 @@ Estimate run_gsl(const std::string& method, const Case& cs, uint64_t n, gsl_rng*
     gsl_monte_function F{&gsl_integrand, size_t(p.dim()), &ctx};
     const int d = p.dim();
     std::vector<double> lo(size_t(d), 0.0), hi(size_t(d), 1.0);
-    const double t0 = now_seconds();
+    const double t0 = estimate_clock();
     Estimate e;
     if (method == "plain") {
         gsl_monte_plain_state* s = gsl_monte_plain_alloc(size_t(d));
@@ -529,7 +544,7 @@ Estimate run_gsl(const std::string& method, const Case& cs, uint64_t n, gsl_rng*
     } else {
         e = gsl_vegas(&F, &ctx, d, n, r);
     }
-    e.seconds = now_seconds() - t0;
+    e.seconds = estimate_clock() - t0;
     e.calls = ctx.calls;
     return e;
 }
@@ -813,9 +828,10 @@ int main(int argc, char** argv) {
     std::time_t tt = std::time(nullptr);
     std::strftime(date, sizeof date, "%Y-%m-%d %H:%M UTC", std::gmtime(&tt));
     std::printf("genz_compare: GSL %s (plain, MISER, VEGAS; mt19937, seeds %llu..%llu) vs mcplay "
-                "run_estimate, one thread\n",
+                "run_estimate, one thread%s\n",
                 GSL_VERSION, (unsigned long long)o.seed,
-                (unsigned long long)(o.seed + uint64_t(o.reps) - 1));
+                (unsigned long long)(o.seed + uint64_t(o.reps) - 1),
+                g_cpu_time ? ", times in thread CPU seconds" : "");
     std::printf("  N = %llu integrand calls per estimate, R = %d replicates, %s\n",
                 (unsigned long long)o.n, o.reps,
                 from_files
@@ -920,10 +936,10 @@ int main(int argc, char** argv) {
             for (int rep = 0; rep < o.reps; ++rep) {
                 Pcg32 prng(hash_combine(hash_combine(o.seed, ci), uint64_t(rep)),
                            hash_string(m.c_str()));
-                const double t0 = now_seconds();
+                const double t0 = estimate_clock();
                 RunResult rr = run_estimate(req.problem, req.estimators[0], o.n, prng, ws);
                 Estimate e;
-                e.seconds = now_seconds() - t0;
+                e.seconds = estimate_clock() - t0;
                 e.value = rr.estimate;
                 e.sigma = rr.std_error;
                 e.calls = rr.n;

@@ -14,6 +14,7 @@
 #include "core/rng.h"
 #include "core/special.h"
 #include "core/stats.h"
+#include "estimators/accumulator.h"
 #include "estimators/diagnostics.h"
 
 using namespace mcp;
@@ -43,6 +44,37 @@ bool has(const std::vector<Flag>& flags, FlagCode code) {
 }
 
 } // namespace
+
+// The accumulator's top weights (for the tail index) are the kTailWeights largest |w|,
+// decreasing, however the blocks bring them: rising weights (each block beats the threshold),
+// falling ones, and random ones, in blocks of every size; a merge keeps the largest of both.
+TEST(Diagnostics, TopWeightsAreTheLargest) {
+    Pcg32 rng(5, 9);
+    for (int order = 0; order < 3; ++order) {
+        const size_t total = 5 * kTailWeights + 777;
+        std::vector<double> f(total), p(total, 1.0), w(total);
+        for (size_t i = 0; i < total; ++i)
+            f[i] = order == 0 ? static_cast<double>(i)
+                              : (order == 1 ? -static_cast<double>(total - i) : rng.next_double());
+        WeightAccumulator a, later;
+        a.reset(ErrorMethod::Iid, total, 1, false);
+        later.reset(ErrorMethod::Iid, total, 1, false);
+        const size_t half = total / 2 & ~size_t(1);
+        for (size_t first = 0; first < total;) {
+            const size_t count =
+                std::min<size_t>(2 * (1 + rng.next_below(kBlockSize / 2)), total - first);
+            (first < half ? a : later)
+                .add_block(first, f.data() + first, p.data() + first, w.data() + first, count);
+            first += count;
+        }
+        a.merge(later);
+        std::vector<double> expected(total);
+        for (size_t i = 0; i < total; ++i) expected[i] = std::fabs(f[i]);
+        std::sort(expected.begin(), expected.end(), std::greater<double>());
+        expected.resize(kTailWeights);
+        EXPECT_EQ(a.finish(1.0).top, expected) << "order " << order;
+    }
+}
 
 // x^-0.9 under uniform sampling has weights with tail index 1/0.9 = 1.11: heavy_tail, with the
 // estimate and its standard error as evidence; the exact importance pdf raises nothing.

@@ -1,7 +1,9 @@
 // Compensated sums, Welford moments, line fits.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <utility>
 #include <vector>
 
 #include "core/rng.h"
@@ -95,6 +97,42 @@ TEST(Stats, StratifiedSumPartsAsStrata) {
     EXPECT_TRUE(parts.has_variance());
     parts.add_part(1.0, 0.0, 1);
     EXPECT_FALSE(parts.has_variance());
+}
+
+// The allocation by largest remainders against its definition: the whole parts, then one point
+// more to each of the `left` largest remainders, ties to the lower index (a sort of pairs).
+TEST(Stats, LargestRemaindersAsDefined) {
+    Pcg32 rng(17, 3);
+    for (int trial = 0; trial < 40; ++trial) {
+        const size_t n = 1 + rng.next_below(20000);
+        std::vector<double> share(n);
+        // Some trials draw shares from a few values only, so that many remainders tie.
+        const uint32_t levels = trial % 2 ? 3 : 0;
+        double total = 0.0;
+        for (double& s : share) {
+            s = levels ? static_cast<double>(1 + rng.next_below(levels)) : rng.next_double();
+            total += s;
+        }
+        for (double& s : share) s /= total;
+        const uint64_t points = rng.next_below(static_cast<uint32_t>(8 * n)) + (trial % 5);
+        std::vector<uint64_t> counts(n, 2), expected(n, 2);
+        allocate_largest_remainders(points, share, &counts);
+        uint64_t given = 0;
+        std::vector<std::pair<double, size_t>> remainders(n);
+        for (size_t h = 0; h < n; ++h) {
+            const double exact = static_cast<double>(points) * share[h];
+            const uint64_t whole = std::min(points - given, static_cast<uint64_t>(exact));
+            expected[h] += whole;
+            given += whole;
+            remainders[h] = {exact - static_cast<double>(whole), h};
+        }
+        std::sort(remainders.begin(), remainders.end(), [](const auto& a, const auto& b) {
+            return a.first != b.first ? a.first > b.first : a.second < b.second;
+        });
+        for (size_t k = 0; given < points; k = (k + 1) % n, ++given)
+            ++expected[remainders[k].second];
+        ASSERT_EQ(counts, expected) << "trial " << trial << ", n " << n << ", points " << points;
+    }
 }
 
 TEST(Stats, LineFitExactAndUncertainty) {

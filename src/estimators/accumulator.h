@@ -43,6 +43,8 @@ class WeightAccumulator {
     uint64_t count() const { return moments_.count(); }
 
   private:
+    /// Candidates top_ gathers before keep_top selects the kTailWeights largest.
+    static constexpr size_t kTopCandidates = 4 * kTailWeights;
     void keep_top();
     uint64_t batch_begin(size_t k) const { return total_ * k / batch_sums_.size(); }
 

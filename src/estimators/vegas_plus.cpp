@@ -19,6 +19,28 @@ namespace {
 // The largest share of the estimate the pilot's points get in a hypercube (pilot_weight).
 constexpr double kMostPilotShare = 0.1;
 
+// A hypercube's count, mean and variance: RunningMoments::add's arithmetic without the third
+// moment, which the hypercubes never read (the same values bit for bit, fewer operations).
+class CubeMoments {
+  public:
+    void add(double x) {
+        ++n_;
+        sum_.add(x);
+        const double n = static_cast<double>(n_);
+        const double delta = x - mean_, delta_n = delta / n;
+        mean_ += delta_n;
+        m2_ += delta * delta_n * (n - 1.0);
+    }
+    uint64_t count() const { return n_; }
+    double mean() const { return n_ ? sum_.value() / static_cast<double>(n_) : 0.0; }
+    double variance() const { return n_ > 1 ? m2_ / static_cast<double>(n_ - 1) : 0.0; }
+
+  private:
+    uint64_t n_ = 0;
+    NeumaierSum sum_;
+    double mean_ = 0.0, m2_ = 0.0;
+};
+
 class VegasPlusEstimator final : public EstimatorAlgorithm, private TrainingPoints {
   public:
     VegasPlusEstimator(const Problem& problem, const EstimatorSpec& spec, Accumulator accumulator)
@@ -77,6 +99,7 @@ class VegasPlusEstimator final : public EstimatorAlgorithm, private TrainingPoin
         importance_.assign(kBlockSize, 1.0);
         weight_.assign(kBlockSize, 0.0);
         cube_of_.assign(kBlockSize, 0);
+        offsets_.assign(static_cast<size_t>(dim_) * kBlockSize, 0.0);
     }
 
     bool run_block(Pcg32& rng, Workspace& ws) override {
@@ -341,12 +364,21 @@ class VegasPlusEstimator final : public EstimatorAlgorithm, private TrainingPoin
                 left_in_cube_ = allocation_[cube_];
                 continue;
             }
-            for (int j = 0; j < dim_; ++j)
-                u.coord(j)[count] = below_one(
-                    (static_cast<double>(digits_[j]) + jitter_.next_double()) / per_axis_);
+            for (int j = 0; j < dim_; ++j) { // the draws; their positions in a second pass
+                u.coord(j)[count] = jitter_.next_double();
+                offsets_[static_cast<size_t>(j) * kBlockSize + count] =
+                    static_cast<double>(digits_[j]);
+            }
             cube_of_[count] = static_cast<uint32_t>(cube_);
             --left_in_cube_;
             ++count;
+        }
+        // y = (digit + draw) / M per axis, in loops the compiler vectorises.
+        const double per_axis = static_cast<double>(per_axis_);
+        for (int j = 0; j < dim_; ++j) {
+            double* y = u.coord(j);
+            const double* offset = offsets_.data() + static_cast<size_t>(j) * kBlockSize;
+            for (size_t i = 0; i < count; ++i) y[i] = below_one((offset[i] + y[i]) / per_axis);
         }
         if (count > 0) u.n = count;
         return count;
@@ -360,9 +392,19 @@ class VegasPlusEstimator final : public EstimatorAlgorithm, private TrainingPoin
         for (size_t i = 0; i < count; ++i) {
             const double w = ws.f[i] / ws.pdf[i];
             weights[i] = std::isfinite(w) && !(ws.pdf[i] == 0.0 && ws.f[i] != 0.0) ? w : 0.0;
-            cube_moments_[cube_of_[i]].add(weights[i]);
-            importance_[i] = n_iteration / (static_cast<double>(cubes_) *
-                                            static_cast<double>(allocation_[cube_of_[i]]));
+        }
+        // A hypercube's points come in a row: its moments and importance once per run.
+        for (size_t i = 0; i < count;) {
+            const uint32_t h = cube_of_[i];
+            size_t end = i + 1;
+            while (end < count && cube_of_[end] == h) ++end;
+            CubeMoments m = cube_moments_[h];
+            for (size_t k = i; k < end; ++k) m.add(weights[k]);
+            cube_moments_[h] = m;
+            const double importance =
+                n_iteration / (static_cast<double>(cubes_) * static_cast<double>(allocation_[h]));
+            for (size_t k = i; k < end; ++k) importance_[k] = importance;
+            i = end;
         }
         return importance_.data();
     }
@@ -371,7 +413,7 @@ class VegasPlusEstimator final : public EstimatorAlgorithm, private TrainingPoin
     // (largest remainders), so that they sum to the iteration's size exactly.
     void start_iteration(uint64_t points, Pcg32& rng, bool training) {
         points_ = allocate(points, &allocation_);
-        cube_moments_.assign(cubes_, RunningMoments());
+        cube_moments_.assign(cubes_, CubeMoments());
         const uint64_t seed = (uint64_t(rng.next_u32()) << 32) | rng.next_u32();
         const uint64_t stream = (uint64_t(rng.next_u32()) << 32) | rng.next_u32();
         jitter_ = Pcg32(seed, stream);
@@ -391,17 +433,26 @@ class VegasPlusEstimator final : public EstimatorAlgorithm, private TrainingPoin
 
     // The allocation of `points` over the hypercubes from sigma_: n_h = 2 + the rest in
     // proportion to sigma_h^beta; the points allocated returned.
-    uint64_t allocate(uint64_t points, std::vector<uint64_t>* allocation) const {
+    uint64_t allocate(uint64_t points, std::vector<uint64_t>* allocation) {
         // Two points per hypercube; one only in a run of one point (then no error bar).
         const uint64_t least = points >= 2 * cubes_ ? 2 : 1;
         points = std::max<uint64_t>(points, least * cubes_);
         allocation->assign(cubes_, least);
         const uint64_t rest = points - least * cubes_;
-        std::vector<double> share(cubes_);
+        if (rest == 0) return points; // the pilot: 2 points each
+        std::vector<double>& share = share_;
+        share.resize(cubes_);
         double total = 0.0;
+        // sigma_h^beta, once per run of equal sigma_h: the children of a training hypercube
+        // inherit its sigma_h (refine_grid), r of them in a row on the last axis.
+        double last_sigma = std::numeric_limits<double>::quiet_NaN(), last_share = 0.0;
         for (uint64_t h = 0; h < cubes_; ++h) {
-            share[h] = std::pow(sigma_[h], options_.beta);
-            if (!std::isfinite(share[h])) share[h] = 0.0;
+            if (!(sigma_[h] == last_sigma)) {
+                last_sigma = sigma_[h];
+                last_share = std::pow(last_sigma, options_.beta);
+                if (!std::isfinite(last_share)) last_share = 0.0;
+            }
+            share[h] = last_share;
             total += share[h];
         }
         if (!(total > 0.0)) {
@@ -431,13 +482,16 @@ class VegasPlusEstimator final : public EstimatorAlgorithm, private TrainingPoin
         StratifiedSum strata;
         const bool combined = !training && !lambda_.empty() && pilot_ > 0;
         for (uint64_t h = 0; h < cubes_; ++h) {
-            const RunningMoments& m = cube_moments_[h];
+            const CubeMoments& m = cube_moments_[h];
             sigma_[h] = std::sqrt(m.variance());
-            if (!combined) {
-                strata.add(volume, m);
+            if (!combined) { // StratifiedSum::add(volume, m)'s terms
+                const uint64_t n = m.count();
+                if (n > 0)
+                    strata.add_part(volume * m.mean(),
+                                    volume * volume * m.variance() / static_cast<double>(n), n);
                 continue;
             }
-            const RunningMoments& p = pilot_moments_[h];
+            const CubeMoments& p = pilot_moments_[h];
             const double lambda = lambda_[h];
             const double n = static_cast<double>(m.count());
             const double factor = lambda * lambda / static_cast<double>(p.count()) +
@@ -468,20 +522,22 @@ class VegasPlusEstimator final : public EstimatorAlgorithm, private TrainingPoin
     double alpha_ = 0.5;    // the map's damping: options_'s, or kVegasNestedAlpha when nested_
     VegasMap measured_map_; // nested: the map the last training iteration used (finish)
     bool trained_ = false, planned_ = false, prepared_ = false, finished_final_ = false;
-    bool refined_ = false;                      // the estimate's grid is set (refine_grid)
-    bool piloting_ = false;                     // the current points are the pilot's (finish_pilot)
-    uint64_t pilot_ = 0;                        // the pilot's points, 0 without one
-    std::vector<double> lambda_;                // the pilot's share per hypercube (pilot_weight)
-    std::vector<RunningMoments> pilot_moments_; // the pilot's, per hypercube (finish_pilot)
-    std::vector<uint32_t> parent_;              // the estimate's hypercubes' training ones
-    uint64_t parents_ = 0;                      // the training grid's hypercubes
+    bool refined_ = false;                   // the estimate's grid is set (refine_grid)
+    bool piloting_ = false;                  // the current points are the pilot's (finish_pilot)
+    uint64_t pilot_ = 0;                     // the pilot's points, 0 without one
+    std::vector<double> lambda_;             // the pilot's share per hypercube (pilot_weight)
+    std::vector<CubeMoments> pilot_moments_; // the pilot's, per hypercube (finish_pilot)
+    std::vector<uint32_t> parent_;           // the estimate's hypercubes' training ones
+    uint64_t parents_ = 0;                   // the training grid's hypercubes
     TrainingLog log_;
     MapStage stage_; // the map and its buffers
     Pcg32 jitter_;
     std::vector<uint64_t> digits_, allocation_;
     std::vector<double> sigma_, importance_, weight_;
+    std::vector<double> share_; // allocate's, kept between iterations
     std::vector<uint32_t> cube_of_;
-    std::vector<RunningMoments> cube_moments_;
+    std::vector<double> offsets_; // next's hypercube digits per axis and point
+    std::vector<CubeMoments> cube_moments_;
     uint32_t pending_cube_ = 0;          // the hypercube whose training points wait (train)
     std::vector<uint32_t> pending_bins_; // per waiting point, its dim increments
     std::vector<double> pending_w_, pending_c_;
