@@ -39,6 +39,18 @@ class NeumaierSum {
     double comp_ = 0.0;
 };
 
+/// One value's step of Welford's update [Welford62]: with `count` values counted (the new one
+/// included) and the old mean, delta = x - mean, the mean's increment delta / n and the sum of
+/// squared deviations' increment delta^2 (n - 1) / n.
+struct WelfordStep {
+    double delta_n, m2_increment;
+    WelfordStep(double x, double mean, uint64_t count) {
+        const double n = static_cast<double>(count), delta = x - mean;
+        delta_n = delta / n;
+        m2_increment = delta * delta_n * (n - 1.0);
+    }
+};
+
 /// Running mean, variance and third central moment by Welford's update [Welford62] and its
 /// extension to higher moments [Pebay08]; the mean is also kept as a compensated sum so that 1e9
 /// and more terms lose no digits. Never E[x^2] - E[x]^2.
@@ -47,13 +59,11 @@ class RunningMoments {
     void add(double x) {
         ++n_;
         sum_.add(x);
-        const double n = static_cast<double>(n_);
-        const double delta = x - mean_, delta_n = delta / n;
-        const double term = delta * delta_n * (n - 1.0);
+        const WelfordStep s(x, mean_, n_);
         // Third moment first: it uses the old m2 [Pebay08, eq. 2.1 with one value].
-        m3_ += term * delta_n * (n - 2.0) - 3.0 * delta_n * m2_;
-        mean_ += delta_n;
-        m2_ += term;
+        m3_ += s.m2_increment * s.delta_n * (static_cast<double>(n_) - 2.0) - 3.0 * s.delta_n * m2_;
+        mean_ += s.delta_n;
+        m2_ += s.m2_increment;
     }
     /// Adds a block of values: a compensated sum for the mean, a two-pass sum of squared
     /// deviations about the block mean, merged by Chan's formula (one division per block

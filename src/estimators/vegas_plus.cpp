@@ -26,10 +26,9 @@ class CubeMoments {
     void add(double x) {
         ++n_;
         sum_.add(x);
-        const double n = static_cast<double>(n_);
-        const double delta = x - mean_, delta_n = delta / n;
-        mean_ += delta_n;
-        m2_ += delta * delta_n * (n - 1.0);
+        const WelfordStep s(x, mean_, n_);
+        mean_ += s.delta_n;
+        m2_ += s.m2_increment;
     }
     uint64_t count() const { return n_; }
     double mean() const { return n_ ? sum_.value() / static_cast<double>(n_) : 0.0; }
