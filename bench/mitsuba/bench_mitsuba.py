@@ -71,15 +71,17 @@ SCENES = [
     ('veach_mis', 'veach_mis.gltf', 320, 180, ['light', 'bsdf', 'mis']),
 ]
 MCPLAY_ESTIMATOR = {'light': 'light_solid_angle', 'bsdf': 'bsdf', 'mis': 'mis_power', 'path': 'path'}
-# mcplay's best per class (--best), Sobol' pixels throughout. Light sampling: plain
-# light_solid_angle (with Sobol' pixels it beat resampled light samples, ris, whose candidate
-# pilot measures with independent pixels: docs/performance-notes.md). Path tracing: each
-# vertex's light sample resampled (ris's target lum(f Le cos) with the BSDF in it). MIS: light
+# mcplay's best per class (--best), Sobol' pixels throughout. Light sampling: resampled light
+# samples (ris: candidates drawn as light_solid_angle draws them, the target lum(f Le cos) with
+# the BSDF in it; its pilot may choose M = 1. Plain light_solid_angle won on the Cornell box and
+# lost on Veach's plates at 64 and 256 spp: docs/performance-notes.md). Path tracing: each
+# vertex's light sample resampled the same way. MIS: light
 # samples per camera sample (splitting). Each count chosen by a timed pilot (src/render/
 # splitting.h; its time counted in the image's). BSDF sampling alone has no such choice: its
 # row is a pure speed contest.
 MCPLAY_BEST = {
-    'light': {'strategy': 'light_solid_angle', 'pixel_sampler': 'sobol'},
+    'light': {'strategy': 'ris', 'light_selection': 'power', 'light_sampling': 'solid_angle',
+              'candidates': 'auto', 'pixel_sampler': 'sobol'},
     'mis': {'strategy': 'mis_power', 'light_samples': 'auto', 'pixel_sampler': 'sobol'},
     'path': {'strategy': 'path', 'max_depth': 5, 'candidates': 'auto', 'pixel_sampler': 'sobol'},
 }
