@@ -3,9 +3,11 @@
 // on a peak; the training counts in N; bad options are named).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <initializer_list>
 #include <string>
+#include <vector>
 
 #include "api/scene.h"
 #include "estimators/block_driver.h"
@@ -601,6 +603,39 @@ TEST(VegasPlus, HypercubesPerAxisHoldAboutFourPointsEach) {
     EXPECT_EQ(vegas_plus_per_axis(1, uint64_t(1) << 30), kVegasMaxHypercubes);
 }
 
+// The siblings' median without one of them (VEGAS+'s pilot share must not depend on a
+// hypercube's own pilot points): against sorting the others, for every value of groups of 2 to
+// 9 values with and without ties, and the median of all n left at first + n / 2. A median
+// that kept the value itself fails on either side of it: the largest value's others have a
+// median below the group's, the smallest's above it (n = 4: 1 2 | 3 4).
+TEST(VegasPlus, MedianWithoutOneLeavesTheValueOut) {
+    Pcg32 rng(4901, 58);
+    for (int n = 2; n <= 9; ++n) {
+        for (int trial = 0; trial < 50; ++trial) {
+            std::vector<double> group(static_cast<size_t>(n));
+            for (double& v : group) // few distinct values in half the trials: ties
+                v = trial % 2 ? std::floor(4.0 * rng.next_double()) : rng.next_double();
+            std::vector<double> work = group;
+            const MedianWithoutOne m = median_without_one(work.data(), work.data() + n);
+            std::vector<double> sorted = group;
+            std::sort(sorted.begin(), sorted.end());
+            EXPECT_EQ(work[static_cast<size_t>(n / 2)], sorted[static_cast<size_t>(n / 2)]);
+            for (int i = 0; i < n; ++i) {
+                std::vector<double> others = group;
+                others.erase(others.begin() + i);
+                std::sort(others.begin(), others.end());
+                EXPECT_EQ(m.of(group[static_cast<size_t>(i)]), others[others.size() / 2])
+                    << "n " << n << ", trial " << trial << ", value " << i;
+            }
+        }
+    }
+    double four[] = {3.0, 1.0, 4.0, 2.0};
+    const MedianWithoutOne m = median_without_one(four, four + 4);
+    EXPECT_EQ(m.of(4.0), 2.0); // others 1 2 3
+    EXPECT_EQ(m.of(1.0), 3.0); // others 2 3 4
+    EXPECT_EQ(four[2], 3.0);   // the median of all four: the sorted value 2
+}
+
 // A power singularity at a corner, x^-0.45 y^-0.2 (finite variance: 2 * 0.45 < 1): VEGAS and
 // VEGAS+ stay unbiased (the mean of 100 seeded runs within 4 standard errors) and their error
 // bars cover. The weights' tail is heavy (w^2 has a tail index near 1.1), so a run's error bar
@@ -755,9 +790,10 @@ TEST(VegasPlus, HonestIn1DOnACutAndASingularity) {
                              777, 5);
 }
 
-// In d >= 2 the pilot's points count in VEGAS+'s estimate, with a share per hypercube fixed
-// before the pilot (min(0.1, 2 / (2 + n_h)), n_h from the training), and the hypercubes' sigma_h
-// are at least their siblings' median (issue 49). Both must leave the estimate unbiased and its
+// In d >= 2 the pilot's points count in VEGAS+'s estimate, with a share per hypercube that its
+// own pilot points do not set (min(0.25, 2 / (2 + n_h)), n_h from its neighbours' means and its
+// siblings' variances), and the hypercubes' sigma_h are at least their siblings' median (issue
+// 49). Both must leave the estimate unbiased and its
 // error bar honest where the variance sits in few hypercubes: a cut and a corner singularity
 // x^-0.45 y^-0.2, as above.
 TEST(VegasPlus, PilotInTheEstimateHonestIn2D) {

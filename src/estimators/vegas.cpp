@@ -48,6 +48,24 @@ uint64_t vegas_plus_per_axis(int dim, uint64_t points) {
     return m;
 }
 
+MedianWithoutOne median_without_one(double* first, double* last) {
+    // Without v, the others' median is the sorted value (n - 1) / 2 of the group when v lies
+    // above it (v's rank is larger), else the next one: values n/2 - 1 and n/2 for even n,
+    // (n-1)/2 and (n+1)/2 for odd n. Ties give equal values either way.
+    const std::ptrdiff_t n = last - first;
+    double* middle = first + n / 2;
+    std::nth_element(first, middle, last);
+    MedianWithoutOne m;
+    if (n % 2 == 0) {
+        m.below = *std::max_element(first, middle);
+        m.above = *middle;
+    } else {
+        m.below = *middle;
+        m.above = *std::min_element(middle + 1, last);
+    }
+    return m;
+}
+
 int vegas_increments(int dim, uint64_t points_per_iteration) {
     const uint64_t most = dim <= 4 ? 1000 : (dim <= 8 ? 500 : 200);
     return static_cast<int>(std::max<uint64_t>(2, std::min(most, points_per_iteration / 100)));

@@ -65,6 +65,16 @@ VegasOptions vegas_resolved(const VegasOptions& options, SamplerKind sampler, bo
 uint64_t vegas_plus_per_axis(int dim, uint64_t points);
 constexpr uint64_t kVegasMaxHypercubes = uint64_t(1) << 20;
 
+/// The medians of a group of n values with one of them left out, for VEGAS+'s pilot (a
+/// hypercube's siblings without it): the median of the n - 1 others of a value v of the group
+/// is of(v) (the median of m values: the sorted value m / 2, rounded down). Leaves the median
+/// of all n, the sorted value n / 2, at first + n / 2 (std::nth_element's order); n >= 2.
+struct MedianWithoutOne {
+    double below = 0.0, above = 0.0; ///< the sorted values (n - 1) / 2 and (n + 1) / 2
+    double of(double v) const { return v > below ? below : above; }
+};
+MedianWithoutOne median_without_one(double* first, double* last);
+
 /// Least hypercubes per axis of a training iteration for VEGAS+'s nested mode (GSL's stratified
 /// mode): with the default increments, each increment then holds a whole number of hypercubes
 /// per axis (K at most M) and the map trains on the hypercubes' errors. Fewer, and K = M

@@ -17,7 +17,7 @@ namespace mcp {
 namespace {
 
 // The largest share of the estimate the pilot's points get in a hypercube (pilot_weight).
-constexpr double kMostPilotShare = 0.1;
+constexpr double kMostPilotShare = 0.25;
 
 // A hypercube's count, mean and variance: RunningMoments::add's arithmetic without the third
 // moment, which the hypercubes never read (the same values bit for bit, fewer operations).
@@ -188,9 +188,9 @@ class VegasPlusEstimator final : public EstimatorAlgorithm, private TrainingPoin
     // a region before it allocates to it [PressFarrar90]: a pilot of 2 points per hypercube (its
     // size returned; 0 when the points are too few) measures sigma_h (finish_pilot), and the
     // estimate's points, about 4 per hypercube (the grid is sized for 6), follow it. The
-    // pilot's points count in the estimate only with a weight fixed before the pilot
-    // (pilot_weight): an allocation that depended on the points a hypercube's mean is made of
-    // would bias it by O(1/n_h) in every hypercube, O(sqrt(N)/n_h) standard errors in all.
+    // pilot's points count in a hypercube's estimate only with a weight its own points do not
+    // set (pilot_weight): an allocation that depended on the points a hypercube's mean is made
+    // of would bias it by O(1/n_h) in every hypercube, O(sqrt(N)/n_h) standard errors in all.
     uint64_t refine_grid(uint64_t points) {
         const uint64_t r = vegas_plus_per_axis(dim_, points * 2 / 3) / per_axis_; // 4 of 6
         if (r <= 1) return 0;
@@ -216,36 +216,55 @@ class VegasPlusEstimator final : public EstimatorAlgorithm, private TrainingPoin
         cubes_ = cubes;
         const uint64_t pilot = 2 * cubes_;
         if (points < pilot + 4 * cubes_) return 0;
-        pilot_weight(points - pilot);
+        lambda_.clear(); // set from the pilot (finish_pilot)
         return pilot;
     }
 
     // The pilot's share of the estimate in each hypercube, lambda_h (lambda_; empty: none):
     //   I = sum_h V (lambda_h mean_pilot,h + (1 - lambda_h) mean_h).
-    // lambda_h is fixed before the pilot, from the training alone, so the combination is
-    // unbiased (given the pilot, the estimate's points are unbiased in every hypercube, so the
-    // two parts are uncorrelated), and its variance, sum_h V^2 sigma_h^2 (lambda_h^2 / 2 +
-    // (1 - lambda_h)^2 / n_h), is estimated unbiasedly with the estimate's s_h^2 in both terms
-    // (finish_iteration). Not the weight from the allocation the pilot sets, 2 / (2 + n_h) with
-    // the actual n_h: a pilot that drew a large weight raises its n_h and lowers its own share,
-    // a bias toward small estimates. lambda_h = min(0.1, 2 / (2 + n_h)), n_h the estimate's
-    // allocation from the inherited sigma_h: the inverse-variance weight of the pilot's 2 points
-    // (1/3 at the 4 points a hypercube gets on average) leaves the estimate at the mercy of the
-    // hypercubes the training did not foresee, whose 2 pilot points then dominate it (Genz
-    // discontinuous d = 2, N = 10^6, R = 30: relative RMSE 2.9e-4 without the pilot, 8.1e-4
-    // with 2 / (2 + n_h), 5.0e-4 with 1/3, 2.2e-4 with the cap 0.1). Not in 1-D: a cut or a
-    // point singularity sits in one fine hypercube that carries much of the variance, and its
-    // pilot's two-valued error went unseen (blind calibrate at N = 65536 and 262144: runs 5.5-10
-    // standard errors off on Genz discontinuous and x^-a, 2026-12-07); in d >= 2 the variance
-    // spreads over the hypercubes along a cut or an axis.
-    void pilot_weight(uint64_t estimate_points) {
+    // lambda_h depends on the pilot's points outside h only (`others`: the spread h's
+    // neighbours' means imply and its siblings' median variance, each without h's own points),
+    // so the combination is unbiased (given the pilot, the estimate's points are unbiased in
+    // every hypercube; lambda_h is independent of h's pilot mean), and its variance, sum_h V^2
+    // sigma_h^2 (lambda_h^2 / 2 + (1 - lambda_h)^2 / n_h), is estimated with the estimate's
+    // s_h^2 in both terms (finish_iteration). lambda_h = min(kMostPilotShare, 2 / (2 + n_h)),
+    // n_h the allocation `others` predict (allocate's shares, without the rounding): the
+    // inverse-variance weight of the pilot's 2 points. Not the weight from the actual n_h: a
+    // pilot that drew a large weight raises its n_h and lowers its own share, a bias toward
+    // small estimates. Not n_h from the training's sigma_h alone (the parent's): the
+    // hypercubes it did not foresee, along a cut, got large shares whose 2 pilot points then
+    // dominated them, which needed the cap at 0.1, below the 2 / 7.5 of the pilot's points at
+    // the 7.5 points a hypercube gets on average in 2-D at N = 10^6 (Genz discontinuous d = 2,
+    // N = 10^6, R = 30: relative RMSE 2.9e-4 without the pilot, 8.1e-4 with 2 / (2 + n_h)
+    // uncapped, 3.4e-4 with the cap 0.2, 2.2e-4 with 0.1; with `others`, 2.3e-4 at 0.25). The
+    // cap 0.25 stays: what h's own points show is not in `others` (a point singularity's
+    // hypercube). Not in 1-D: a cut or a point singularity sits in one fine hypercube that
+    // carries much of the variance, and its pilot's two-valued error went unseen (blind
+    // calibrate at N = 65536 and 262144: runs 5.5-10 standard errors off on Genz
+    // discontinuous and x^-a, 2026-12-07); in d >= 2 the variance spreads over the hypercubes
+    // along a cut or an axis.
+    void pilot_weight(uint64_t estimate_points, const std::vector<double>& others) {
         lambda_.clear();
         if (dim_ < 2) return;
-        std::vector<uint64_t> predicted;
-        allocate(estimate_points, &predicted);
+        const uint64_t least = estimate_points >= 2 * cubes_ ? 2 : 1;
+        const double rest =
+            static_cast<double>(estimate_points - std::min(estimate_points, least * cubes_));
+        std::vector<double>& share = share_;
+        share.resize(cubes_);
+        double total = 0.0;
+        for (uint64_t h = 0; h < cubes_; ++h) { // sigma_h^beta, as allocate
+            share[h] = std::pow(others[h], 0.5 * options_.beta);
+            if (!std::isfinite(share[h])) share[h] = 0.0;
+            total += share[h];
+        }
+        const double even = options_.uniform_share, cubes = static_cast<double>(cubes_);
         lambda_.resize(cubes_);
-        for (uint64_t h = 0; h < cubes_; ++h)
-            lambda_[h] = std::min(kMostPilotShare, 2.0 / (2.0 + static_cast<double>(predicted[h])));
+        for (uint64_t h = 0; h < cubes_; ++h) {
+            const double part = total > 0.0 ? share[h] / total : 1.0 / cubes;
+            const double n =
+                static_cast<double>(least) + rest * ((1.0 - even) * part + even / cubes);
+            lambda_[h] = std::min(kMostPilotShare, 2.0 / (2.0 + n));
+        }
     }
 
     // sigma_h from the pilot's 2 points per hypercube, and at least the spread its
@@ -261,7 +280,7 @@ class VegasPlusEstimator final : public EstimatorAlgorithm, private TrainingPoin
     void finish_pilot() {
         std::vector<double> mean(cubes_);
         for (uint64_t h = 0; h < cubes_; ++h) mean[h] = cube_moments_[h].mean();
-        std::vector<double> slopes(cubes_, 0.0);
+        std::vector<double> slopes(cubes_, 0.0), others(cubes_, 0.0);
         uint64_t stride = 1; // of axis j, the last axis fastest
         for (int j = dim_ - 1; j >= 0; --j) {
             for (uint64_t h = 0; h < cubes_; ++h) {
@@ -271,6 +290,7 @@ class VegasPlusEstimator final : public EstimatorAlgorithm, private TrainingPoin
                 if (lo == hi) continue;
                 const double g = (mean[hi] - mean[lo]) / static_cast<double>((hi - lo) / stride);
                 slopes[h] += g * g / 12.0;
+                if (lo != h && hi != h) others[h] += g * g / 12.0; // without h's own mean
             }
             stride *= per_axis_;
         }
@@ -280,6 +300,7 @@ class VegasPlusEstimator final : public EstimatorAlgorithm, private TrainingPoin
         for (uint64_t q = 0; q < parents_; ++q) start[q + 1] += start[q];
         std::vector<uint64_t> at(start.begin(), start.end() - 1);
         std::vector<double> own(cubes_), grouped(cubes_), floor(parents_, 0.0);
+        std::vector<MedianWithoutOne> without(parents_); // the siblings' medians without one
         for (uint64_t h = 0; h < cubes_; ++h) {
             own[h] = cube_moments_[h].variance();
             if (!std::isfinite(own[h])) own[h] = 0.0;
@@ -287,12 +308,19 @@ class VegasPlusEstimator final : public EstimatorAlgorithm, private TrainingPoin
         }
         for (uint64_t q = 0; q < parents_; ++q) {
             if (start[q + 1] == start[q]) continue;
-            const auto first = grouped.begin() + static_cast<std::ptrdiff_t>(start[q]);
-            const auto middle = first + static_cast<std::ptrdiff_t>((start[q + 1] - start[q]) / 2);
-            std::nth_element(first, middle,
-                             grouped.begin() + static_cast<std::ptrdiff_t>(start[q + 1]));
-            floor[q] = *middle;
+            double* first = grouped.data() + start[q];
+            if (start[q + 1] - start[q] < 2) {
+                floor[q] = *first;
+                continue;
+            }
+            without[q] = median_without_one(first, grouped.data() + start[q + 1]);
+            floor[q] = first[(start[q + 1] - start[q]) / 2];
         }
+        for (uint64_t h = 0; h < cubes_; ++h) {
+            const uint32_t q = parent_[h];
+            others[h] = std::max(others[h], without[q].of(own[h]));
+        }
+        pilot_weight(final_ - pilot_, others);
         for (uint64_t h = 0; h < cubes_; ++h)
             sigma_[h] = std::sqrt(std::max({own[h], slopes[h], floor[parent_[h]]}));
         pilot_moments_.swap(cube_moments_);
