@@ -19,6 +19,17 @@ namespace {
 // The largest share of the estimate the pilot's points get in a hypercube (pilot_weight).
 constexpr double kMostPilotShare = 0.25;
 
+// sigma^beta, the allocation's share of a hypercube: for the default beta 0.75 as sqrt(sigma)
+// sqrt(sqrt(sigma)), two square roots (vectorised) for one pow, which at 10^5 hypercubes per
+// allocation took 2-3% of a 2-D estimate's time; the same value to a few ulps.
+inline double power_beta(double sigma, double beta) {
+    if (beta == 0.75) {
+        const double root = std::sqrt(sigma);
+        return root * std::sqrt(root);
+    }
+    return std::pow(sigma, beta);
+}
+
 // A hypercube's count, mean and variance: RunningMoments::add's arithmetic without the third
 // moment, which the hypercubes never read (the same values bit for bit, fewer operations).
 class CubeMoments {
@@ -253,7 +264,7 @@ class VegasPlusEstimator final : public EstimatorAlgorithm, private TrainingPoin
         share.resize(cubes_);
         double total = 0.0;
         for (uint64_t h = 0; h < cubes_; ++h) { // sigma_h^beta, as allocate
-            share[h] = std::pow(others[h], 0.5 * options_.beta);
+            share[h] = power_beta(std::sqrt(others[h]), options_.beta);
             if (!std::isfinite(share[h])) share[h] = 0.0;
             total += share[h];
         }
@@ -476,7 +487,7 @@ class VegasPlusEstimator final : public EstimatorAlgorithm, private TrainingPoin
         for (uint64_t h = 0; h < cubes_; ++h) {
             if (!(sigma_[h] == last_sigma)) {
                 last_sigma = sigma_[h];
-                last_share = std::pow(last_sigma, options_.beta);
+                last_share = power_beta(last_sigma, options_.beta);
                 if (!std::isfinite(last_share)) last_share = 0.0;
             }
             share[h] = last_share;
