@@ -246,9 +246,9 @@ class VegasPlusEstimator final : public EstimatorAlgorithm, private TrainingPoin
     // hypercubes it did not foresee, along a cut, got large shares whose 2 pilot points then
     // dominated them, which needed the cap at 0.1, below the 2 / 7.5 of the pilot's points at
     // the 7.5 points a hypercube gets on average in 2-D at N = 10^6 (Genz discontinuous d = 2,
-    // N = 10^6, R = 30: relative RMSE 2.9e-4 without the pilot, 8.1e-4 with 2 / (2 + n_h)
-    // uncapped, 3.4e-4 with the cap 0.2, 2.2e-4 with 0.1; with `others`, 2.3e-4 at 0.25). The
-    // cap 0.25 stays: what h's own points show is not in `others` (a point singularity's
+    // R = 30, relative RMSE: at N = 10^6 2.9e-4 without the pilot, 8.1e-4 with 2 / (2 + n_h)
+    // uncapped; at 2^20 3.4e-4 with the cap 0.2, 2.2e-4 with 0.1, with `others` 2.3e-4 at 0.25).
+    // The cap 0.25 stays: what h's own points show is not in `others` (a point singularity's
     // hypercube). Not in 1-D: a cut or a point singularity sits in one fine hypercube that
     // carries much of the variance, and its pilot's two-valued error went unseen (blind
     // calibrate at N = 65536 and 262144: runs 5.5-10 standard errors off on Genz
