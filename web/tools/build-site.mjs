@@ -18,6 +18,10 @@
 // default size into refs/<name>.live.mcref (manifest live_reference; shipLiveReference).
 // OUT and WASM_DIR default to build/site and build-wasm in the repository. Fails with a message
 // naming what is missing.
+//   node web/tools/build-site.mjs --references [NATIVE=build/mcplay]
+// renders only the references, into the cache build/ref-cache that the site's build reads: the
+// native build runs it (CMake target site_references) as soon as the CLI is linked, while the
+// rest of the two builds goes on, so that the site waits for no reference.
 import fs from 'node:fs';
 import path from 'node:path';
 import { spawnSync } from 'node:child_process';
@@ -26,10 +30,12 @@ import { fileURLToPath } from 'node:url';
 const ROOT = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '..', '..');
 const WEB = path.join(ROOT, 'web');
 // Arguments are taken from the current directory, the defaults from the repository root.
-const OUT = process.argv[2] ? path.resolve(process.argv[2]) : path.join(ROOT, 'build', 'site');
-const WASM_DIR = process.argv[3] ? path.resolve(process.argv[3]) : path.join(ROOT, 'build-wasm');
+const REFERENCES_ONLY = process.argv[2] === '--references';
+const ARGS = REFERENCES_ONLY ? [undefined, undefined, process.argv[3]] : process.argv.slice(2);
+const OUT = ARGS[0] ? path.resolve(ARGS[0]) : path.join(ROOT, 'build', 'site');
+const WASM_DIR = ARGS[1] ? path.resolve(ARGS[1]) : path.join(ROOT, 'build-wasm');
 const UPLOT = path.join(WEB, 'node_modules', 'uplot');
-const NATIVE = process.argv[4] ? path.resolve(process.argv[4]) : path.join(ROOT, 'build', 'mcplay');
+const NATIVE = ARGS[2] ? path.resolve(ARGS[2]) : path.join(ROOT, 'build', 'mcplay');
 const REF_CACHE = path.join(ROOT, 'build', 'ref-cache');
 
 function fail(message) {
@@ -272,9 +278,9 @@ function copyTree(from, to) {
  * written to OUT/refs/<name>.mcref. References already rendered are kept in build/ref-cache.
  * Returns the path the manifest gives the page.
  */
-function shipReference(sceneFile, name) {
+function shipReference(sceneFile, name, outRoot = OUT) {
   const rel = `refs/${name.replace(/[^A-Za-z0-9_.-]/g, '_')}.mcref`;
-  const out = path.join(OUT, rel);
+  const out = path.join(outRoot, rel);
   fs.mkdirSync(path.dirname(out), { recursive: true });
   const run = spawnSync(NATIVE, ['reference', sceneFile, '--out', out, '--cache', REF_CACHE, '--quiet'],
     { encoding: 'utf8' });
@@ -289,9 +295,9 @@ function shipReference(sceneFile, name) {
  * session of a bundled scene at the default size (options.reference_data), so that its curves
  * start with the first pass. Returns the path the manifest gives the page (entry.live_reference).
  */
-function shipLiveReference(sceneFile, name) {
+function shipLiveReference(sceneFile, name, outRoot = OUT) {
   const rel = `refs/${name.replace(/[^A-Za-z0-9_.-]/g, '_')}.live.mcref`;
-  const out = path.join(OUT, rel);
+  const out = path.join(outRoot, rel);
   fs.mkdirSync(path.dirname(out), { recursive: true });
   const run = spawnSync(NATIVE, ['reference', sceneFile, '--live', '--out', out, '--cache', REF_CACHE, '--quiet'],
     { encoding: 'utf8' });
@@ -300,7 +306,47 @@ function shipLiveReference(sceneFile, name) {
   return rel;
 }
 
+/**
+ * Every render scene's two references rendered into REF_CACHE, from the very scene text the
+ * site ships (siteScene, written to a scratch folder), so that main() later finds them all
+ * there. The scene's name is the one main() gives it (manifestEntry).
+ */
+function renderReferencesOnly() {
+  need(NATIVE, 'build the native CLI first: it renders the render scenes\' references');
+  fs.mkdirSync(REF_CACHE, { recursive: true });
+  const scratch = fs.mkdtempSync(path.join(REF_CACHE, 'scenes-'));
+  try {
+    const scenesDir = path.join(ROOT, 'scenes');
+    for (const file of fs.readdirSync(scenesDir).filter((f) => f.endsWith('.json') && f !== 'manifest.json').sort()) {
+      let scene;
+      try {
+        scene = JSON.parse(fs.readFileSync(path.join(scenesDir, file), 'utf8'));
+      } catch (e) {
+        fail(`scenes/${file}: invalid JSON (${e.message})`);
+      }
+      if (!isRenderScene(scene)) continue;
+      let site;
+      try {
+        site = siteScene(scene, scenesDir);
+      } catch (e) {
+        fail(`scenes/${file}: render.gltf: ${e.message}`);
+      }
+      const sceneFile = path.join(scratch, file);
+      fs.writeFileSync(sceneFile, `${JSON.stringify(site.scene)}\n`);
+      const { name } = manifestEntry(file, scene);
+      shipReference(sceneFile, name, scratch);
+      shipLiveReference(sceneFile, name, scratch);
+    }
+  } finally {
+    fs.rmSync(scratch, { recursive: true, force: true });
+  }
+}
+
 function main() {
+  if (REFERENCES_ONLY) {
+    renderReferencesOnly();
+    return;
+  }
   need(NATIVE, 'build the native CLI with `make build` (or pass its path as the third argument): it renders the render scenes\' references');
   fs.mkdirSync(REF_CACHE, { recursive: true });
   const wasmFiles = ['mcplay_web.mjs', 'mcplay_web.wasm', 'mcplay_render_web.mjs', 'mcplay_render_web.wasm'].map((f) =>
