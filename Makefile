@@ -230,8 +230,8 @@ test:
 	$(MAKE) --no-print-directory -j $(TEST_JOBS) test-suites && \
 	echo "make test: all suites passed in $$(( $$(date +%s) - start )) s"
 
-# `site` first: its references (the native CLI rendering every render scene's) are the longest
-# chain before test-e2e, so that make -j starts them as soon as the builds are done.
+# `site` first: it is the chain before test-e2e (its references are rendered during the native
+# build, BUILD_EXTRA above), so that make -j assembles it as soon as the builds are done.
 test-suites: site test-native test-wasm test-compare test-web-core test-npm test-e2e
 
 # Everything: the loop, then the suites too slow for it (sanitizers; the fuzz targets, built with
