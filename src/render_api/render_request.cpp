@@ -72,23 +72,24 @@ bool parse_split_counts(Ctx& c, const Json& j, const std::string& path, RenderEs
         bool allowed;
         const char* who;
         int* out;
+        bool automatic; ///< takes "auto" (0: a timed pilot chooses it, splitting.h)
     };
     const Count counts[] = {{"light_samples", samples_lights,
                              "strategies that sample lights (light_area, "
                              "light_solid_angle, mis_balance, mis_power, path, ris)",
-                             &e->light_samples},
+                             &e->light_samples, true},
                             {"bsdf_samples", samples_bsdf,
                              "strategies that sample the BSDF (bsdf, mis_balance, "
                              "mis_power, path)",
-                             &e->bsdf_samples},
-                            {"emission_samples", true, "", &e->emission_samples}};
+                             &e->bsdf_samples, false},
+                            {"emission_samples", true, "", &e->emission_samples, true}};
     for (const Count& k : counts) {
         const Json* v = find(j, k.key);
         if (!v) continue;
         if (!k.allowed)
             return c.fail(sub(path, k.key), std::string("only the ") + k.who + " take it, not '" +
                                                 strategy_name(s) + "'");
-        const bool automatic = k.out == &e->light_samples || k.out == &e->emission_samples;
+        const bool automatic = k.automatic;
         if (v->is_string() && v->get<std::string>() == "auto" && automatic) {
             *k.out = 0;
             continue;
