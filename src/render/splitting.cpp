@@ -30,7 +30,7 @@ constexpr double kPilotGain = 1.1;
 /// The pilot renders count 1 and 2, then larger counts only while its processor time, with the
 /// next count's (estimated at twice the last's), stays within this share of the image's at
 /// count 1 (projected from the pilot's seconds per camera sample).
-constexpr double kPilotBudget = 0.15;
+constexpr double kPilotBudget = 0.3;
 
 /// The pilot's pixels: a lattice of spacing s in rows and columns (s = sqrt(image / pilot
 /// pixels)), each row's columns shifted by 3 more than the row above's (modulo s), so that the
