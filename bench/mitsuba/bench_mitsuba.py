@@ -73,8 +73,9 @@ SCENES = [
 MCPLAY_ESTIMATOR = {'light': 'light_solid_angle', 'bsdf': 'bsdf', 'mis': 'mis_power', 'path': 'path'}
 # mcplay's best per class (--best), Sobol' pixels throughout. Light sampling: resampled light
 # samples (ris: candidates drawn as light_solid_angle draws them, the target lum(f Le cos) with
-# the BSDF in it; its pilot may choose M = 1. Plain light_solid_angle won on the Cornell box and
-# lost on Veach's plates at 64 and 256 spp: docs/performance-notes.md). Path tracing: each
+# the BSDF in it; its pilot, measuring with the render's Sobol' pixels, may choose M = 1. Plain
+# light_solid_angle won on the Cornell box and lost on Veach's plates at 64 and 256 spp:
+# docs/performance-notes.md). Path tracing: each
 # vertex's light sample resampled the same way. MIS: light
 # samples per camera sample (splitting). Each count chosen by a timed pilot (src/render/
 # splitting.h; its time counted in the image's). BSDF sampling alone has no such choice: its
@@ -280,7 +281,7 @@ class Mcplay:
         self.light_samples.append(est.get('light_samples', 1))
         self.candidates.append(est.get('candidates', 1))
         # The pilots that chose the counts are part of the image's cost.
-        pilots = sum(est[k]['seconds'] for k in ('split_pilot', 'candidate_pilot') if k in est)
+        pilots = sum(est[k]['seconds'] for k in ('split_pilot', 'candidate_pilot', 'emission_pilot') if k in est)
         return read_pfm(out), result['seconds'] + pilots
 
 

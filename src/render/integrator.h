@@ -64,14 +64,26 @@ bool parse_strategy(const std::string& name, RadianceStrategy* s);
 /// The most light or BSDF samples one shading point takes (splitting).
 constexpr int kMaxSplitSamples = 64;
 
-/// A timed pilot's figures behind an automatic light_samples (splitting.h): per camera sample,
-/// the variance of the rest of the estimator and of one light sample, and their seconds.
+/// A timed pilot's figures behind an automatic count (splitting.h): the counts it rendered
+/// (1, 2, 4, ...) with, for each, the relative variance of one camera sample (the pixel
+/// estimate's variance times spp, at the image's spp and pixel sampler) and one camera sample's
+/// processor seconds; the count chosen is the one of the least product. variance_rest,
+/// variance_light, seconds_rest, seconds_light: the model V(n) = V_rest + V_light / n,
+/// C(n) = c_rest + n c_light through count 1 and the largest count tried, for the record.
 struct SplitPilot {
+    static constexpr int kMaxTried = 7; ///< 1, 2, 4, ..., 64
     bool ran = false;
     double variance_rest = 0.0, variance_light = 0.0; ///< relative (as the images' rel. MSE)
     double seconds_rest = 0.0, seconds_light = 0.0;   ///< per camera sample
-    uint64_t samples = 0;                             ///< camera samples of each pilot image
+    uint64_t samples = 0;                             ///< camera samples of each pilot render
     double seconds = 0.0;                             ///< the pilot's own wall time
+    int tried = 0;                                    ///< counts rendered
+    int counts[kMaxTried] = {};
+    double relative_variance[kMaxTried] = {}; ///< per camera sample, relative
+    double sample_seconds[kMaxTried] = {};    ///< processor seconds per camera sample
+    /// The heavy tail's share of relative_variance at count 1 (pooled over the counts tried;
+    /// count n's share is tail / n).
+    double tail = 0.0;
 };
 
 struct RenderEstimator {

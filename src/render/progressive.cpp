@@ -51,7 +51,7 @@ void render_rows(const RenderScene& rs, const RenderEstimator& est, const Render
             }
         }
         const int y = band.row_begin + r;
-        for (int x = 0; x < st.width; ++x) {
+        for (int x = band.column_first; x < st.width; x += std::max(1, band.column_step)) {
             const size_t p = size_t(r) * size_t(st.width) + size_t(x);
             if (keeps_generator && first_sample > 0)
                 sampler.resume_pixel(x, y, band.generators[p]);

@@ -22,8 +22,11 @@ namespace mcp {
 struct ImageBand {
     int width = 0, height = 0;      ///< the whole image's
     int row_begin = 0, row_end = 0; ///< the band's rows, [row_begin, row_end)
-    uint64_t spp = 0;               ///< samples per pixel so far
-    double seconds = 0.0;           ///< rendering time of all passes so far
+    /// The columns rendered: column_first, column_first + column_step, ... (a timed pilot's
+    /// sparse pixels, splitting.h); the others keep 0 samples (NaN in band_image).
+    int column_first = 0, column_step = 1;
+    uint64_t spp = 0;     ///< samples per pixel so far
+    double seconds = 0.0; ///< rendering time of all passes so far
     /// A pass was cancelled part-way: some rows have more samples than others, and the band
     /// takes no more passes.
     bool torn = false;

@@ -405,7 +405,7 @@ RenderStudyResult run_render_study(const RenderScene& rs, const std::vector<Rend
     RenderStudyResult result;
     result.settings = settings;
     result.threads_used = resolve_threads(settings.threads);
-    // light_samples "auto": chosen once per study by a timed pilot (splitting.h).
+    // The "auto" counts: chosen once per study by a timed pilot (splitting.h).
     std::vector<RenderEstimator> estimators;
     for (const RenderEstimator& e : given) {
         RenderSettings image;
@@ -413,6 +413,8 @@ RenderStudyResult run_render_study(const RenderScene& rs, const std::vector<Rend
         image.height = settings.height;
         image.stream = replicate_stream(settings.seed, e.name, 0, 0);
         image.threads = result.threads_used;
+        // The pilot measures at the study's largest level, where most of its time goes.
+        image.spp = std::max<uint64_t>(1, settings.spp_max);
         estimators.push_back(resolve_split(rs, e, image));
     }
     result.reference_mean_luminance = mean_luminance(reference, nullptr);

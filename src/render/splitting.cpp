@@ -1,59 +1,139 @@
-// The timed pilot behind light_samples "auto" (splitting.h).
+// The timed pilot behind the "auto" counts (splitting.h).
 #include "render/splitting.h"
 
+#include "core/parallel.h"
 #include "render/progressive.h"
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <ctime>
 
 namespace mcp {
 
 namespace {
 
-/// The pilot's second count: large enough that its extra shadow rays stand out of the timing
-/// noise, small enough that the pilot stays short.
-constexpr int kPilotSplit = 5;
-constexpr int kPilotCandidates = 8; ///< the pilot's second count of RIS candidates
-constexpr int kPilotEmission = 8;   ///< and of camera rays for the emission seen directly
-constexpr int kPilotReach = 4;      ///< the chosen count is at most this times the second
-constexpr uint64_t kPilotSpp = 2;
-constexpr int kPilotRuns = 1; ///< per count, the shortest time kept (interleaved runs)
-/// The pilot's rows: kPilotBands bands spread over the image, an eighth of its rows in all, at
-/// the image's own pixel size (a coarser pixel would count the image's detail within it as
-/// camera-sample variance).
-constexpr int kPilotBands = 8;
+/// The pilot's pixels: 1/kPilotShare of the image's samples (at least kPilotMinPixels pixels'),
+/// at the image's spp up to kPilotMaxSpp; past it at kPilotMaxSpp on proportionally more pixels.
+/// The rare large samples of a heavy-tailed estimator, which the pixel sampler does not
+/// stratify away, rule its error at every spp; they are measured by the number of pixels and
+/// samples, so more pixels at fewer spp see more of them for the same time.
+constexpr size_t kPilotMinPixels = 256;
+constexpr size_t kPilotShare = 96;
+constexpr uint64_t kPilotMaxSpp = 16;
+/// A larger count must be this much more efficient than the best smaller one to replace it:
+/// where efficiency is flat in the count (splitting's often is near its optimum) the pilot keeps
+/// the smaller, cheaper one and stops early, and its noise does not send the count up.
+constexpr double kPilotGain = 1.1;
+/// The pilot renders count 1 and 2, then larger counts only while its processor time, with the
+/// next count's (estimated at twice the last's), stays within this share of the image's at
+/// count 1 (projected from the pilot's seconds per camera sample).
+constexpr double kPilotBudget = 0.3;
 
-/// The variance of one camera sample, relative to each pixel's squared mean as the studies'
-/// relative MSE is (eps = 1e-2 of the squared mean luminance), summed over the pixels and
-/// channels of `a` (means from a and b, same pixels), and the number of terms.
-void add_relative_variance(const RenderImage& a, const RenderImage& b, double eps, double* sum,
-                           double* terms) {
-    for (size_t i = 0; i < a.rgb.size(); ++i) {
-        double m = 0.5 * (a.rgb[i] + b.rgb[i]);
-        if (std::isfinite(a.variance[i]) && std::isfinite(m)) {
-            *sum += a.variance[i] * double(a.spp) / (m * m + eps);
-            *terms += 1.0;
-        }
+/// The pilot's pixels: a lattice of spacing s in rows and columns (s = sqrt(image / pilot
+/// pixels)), each row's columns shifted by 3 more than the row above's (modulo s), so that the
+/// pixels spread over the whole image.
+struct PilotPixels {
+    int spacing = 1;
+    std::vector<int> rows, first_columns;
+    size_t pixels = 0;
+};
+
+PilotPixels pilot_pixels(int width, int height, uint64_t spp_ratio) {
+    PilotPixels out;
+    const size_t w = size_t(std::max(1, width)), h = size_t(std::max(1, height));
+    const size_t pixels =
+        std::min(w * h, std::max(kPilotMinPixels, w * h / kPilotShare) * size_t(spp_ratio));
+    out.spacing = std::max(1, int(std::floor(std::sqrt(double(w * h) / double(pixels)))));
+    const int s = out.spacing;
+    for (int k = 0, y = s / 2; y < int(h); ++k, y += s) {
+        const int first = (s / 2 + 3 * k) % s;
+        out.rows.push_back(y);
+        out.first_columns.push_back(first);
+        out.pixels += (w - size_t(first) + size_t(s) - 1) / size_t(s);
     }
+    return out;
 }
 
-/// The pilot's bands of one estimator and the processor seconds they took (one thread).
-std::vector<RenderImage> pilot_bands(const RenderScene& rs, const RenderEstimator& est,
-                                     const RenderSettings& pilot, double* seconds) {
-    std::vector<RenderImage> out;
-    const int rows = std::max(1, pilot.height / (8 * kPilotBands));
+/// One estimator on the pilot's pixels: two renders at the image's own spp and pixel sampler,
+/// independently randomized (streams `streams[0]`, `streams[1]`), on two threads when the
+/// image has them; the processor seconds of both.
+struct PilotRenders {
+    std::vector<RenderImage> a, b; ///< per pilot row (NaN off the lattice)
+    double seconds = 0.0;
+};
+
+PilotRenders pilot_renders(const RenderScene& rs, const RenderEstimator& est,
+                           const RenderSettings& pilot, const PilotPixels& px,
+                           const uint64_t streams[2], int threads) {
+    PilotRenders out;
+    out.a.resize(px.rows.size());
+    out.b.resize(px.rows.size());
     const std::clock_t begin = std::clock();
-    for (int k = 0; k < kPilotBands; ++k) {
-        const int first = std::min(pilot.height - rows, k * pilot.height / kPilotBands);
-        ImageBand band =
-            make_band(pilot.width, pilot.height, std::max(0, first),
-                      std::min(pilot.height, std::max(0, first) + rows), est.pixel_sampler);
-        render_pass(rs, est, pilot, band);
-        out.push_back(band_image(band));
+    auto replica = [&](int r) {
+        RenderSettings s = pilot;
+        s.stream = streams[r];
+        std::vector<RenderImage>& images = r == 0 ? out.a : out.b;
+        for (size_t k = 0; k < px.rows.size(); ++k) {
+            ImageBand band =
+                make_band(pilot.width, pilot.height, px.rows[k], px.rows[k] + 1, est.pixel_sampler);
+            band.column_first = px.first_columns[k];
+            band.column_step = px.spacing;
+            render_pass(rs, est, s, band);
+            images[k] = band_image(band);
+        }
+    };
+    // run_workers returns the workers it ran (1 in a build without threads).
+    const int ran = threads >= 2 ? run_workers(2, replica) : 0;
+    for (int r = ran; r < 2; ++r) replica(r);
+    out.seconds = double(std::clock() - begin) / CLOCKS_PER_SEC;
+    return out;
+}
+
+/// Terms of the relative variance past this many times their median are a heavy tail's rare
+/// large samples (a firefly: 1e4-1e5 times the median on the Veach scene, where a pixel's
+/// ordinary terms spread over 1-2 orders of magnitude).
+constexpr double kTailFactor = 1000.0;
+
+/// The relative variance of one pixel estimate, averaged over the pilot's pixels and channels as
+/// the images' relative MSE is (each term over the squared pixel mean `mean` + eps), split into
+/// the body (each term up to kTailFactor times the terms' median) and the tail (what lies
+/// beyond). With independent pixels the variance comes from each pixel's own samples (both
+/// renders'); with any other sampler, whose samples are not independent within a pixel, from the
+/// two independently randomized renders: E[(a - b)^2 / 2] = Var(a).
+struct RelativeVariance {
+    double body = 0.0, tail = 0.0;
+};
+
+RelativeVariance relative_variance(const PilotRenders& r,
+                                   const std::vector<std::vector<double>>& mean, double eps,
+                                   bool within_pixel) {
+    std::vector<double> terms;
+    for (size_t k = 0; k < r.a.size(); ++k)
+        for (size_t i = 0; i < r.a[k].rgb.size(); ++i) {
+            const double d = r.a[k].rgb[i] - r.b[k].rgb[i];
+            const double v =
+                within_pixel ? 0.5 * (r.a[k].variance[i] + r.b[k].variance[i]) : 0.5 * d * d;
+            const double m = mean[k][i];
+            if (std::isfinite(v) && std::isfinite(m)) terms.push_back(v / (m * m + eps));
+        }
+    RelativeVariance out;
+    if (terms.empty()) return out;
+    // The cut: kTailFactor times the mean of the terms below their 99th percentile.
+    std::vector<double> sorted = terms;
+    std::sort(sorted.begin(), sorted.end());
+    const size_t below = std::max<size_t>(1, sorted.size() * 99 / 100);
+    double lower = 0.0;
+    for (size_t i = 0; i < below; ++i) lower += sorted[i];
+    const double cut = kTailFactor * lower / double(below);
+    for (double t : terms) {
+        out.body += std::min(t, cut);
+        out.tail += std::max(0.0, t - cut);
     }
-    *seconds = double(std::clock() - begin) / CLOCKS_PER_SEC;
+    out.body /= double(terms.size());
+    out.tail /= double(terms.size());
     return out;
 }
 
@@ -73,85 +153,125 @@ int optimal_split(double variance_rest, double variance_light, double seconds_re
     return cost(hi) < cost(lo) ? hi : lo;
 }
 
+int pilot_choice(const SplitPilot& p) {
+    int best = -1;
+    double best_cost = 0.0;
+    for (int i = 0; i < p.tried; ++i) {
+        const double cost = p.relative_variance[i] * p.sample_seconds[i];
+        if (!std::isfinite(cost)) continue;
+        if (best < 0 || cost * kPilotGain < best_cost) {
+            best = i;
+            best_cost = cost;
+        }
+    }
+    return best < 0 ? 1 : p.counts[best];
+}
+
 namespace {
 
-/// Which count a pilot chooses: light_samples (splitting) or candidates (RIS).
+/// Which count a pilot chooses: light_samples (splitting), candidates (RIS) or emission_samples.
 enum class PilotCount { LightSamples, Candidates, EmissionSamples };
 
-/// The pilot of one count: estimates with the count at 1 and at k, the variance model
-/// V(n) = V_rest + V_light / n and cost c_rest + n c_light read from the two, and n* chosen.
-/// RIS's variance with M candidates falls as V_target + (V(1) - V_target) / M to first order
-/// [Talbot05, 4], so the same model serves its candidates (c_light: one candidate's cost).
+/// The pilot of one count: the estimator rendered on the pilot's rows at counts 1, 2, 4, ...,
+/// each twice, at the image's own spp and pixel sampler, and the count of the largest measured
+/// efficiency 1 / (V C) kept (pilot_choice). The ladder stops two counts past the best so far
+/// or at the largest count.
 RenderEstimator run_pilot(const RenderScene& rs, const RenderEstimator& est,
                           const RenderSettings& image, PilotCount what) {
     const auto start = std::chrono::steady_clock::now();
     RenderSettings pilot = image;
-    pilot.spp = kPilotSpp;
-    pilot.stream = image.stream ^ 0x9e3779b97f4a7c15ull; // numbers of its own
+    const uint64_t spp = std::max<uint64_t>(1, image.spp);
+    pilot.spp = std::min(spp, kPilotMaxSpp); // a power of two where spp is (Sobol' pixels)
     pilot.progress = nullptr;
     pilot.cancel = nullptr;
-    // One thread, timed by the processor time it uses: other processes on the machine do not
-    // enter the costs (wall time under load once made a shadow ray look free).
+    // Each render on one thread, timed by the processor time the pilot uses: other processes on
+    // the machine do not enter the costs (wall time under load once made a shadow ray look free).
     pilot.threads = 1;
-    // A candidate costs far less than a shadow ray: a larger second count stands out of the
-    // timing noise.
-    const int k_count = what == PilotCount::Candidates        ? kPilotCandidates
-                        : what == PilotCount::EmissionSamples ? kPilotEmission
-                                                              : kPilotSplit;
-    RenderEstimator one = est, many = est;
-    const auto count_of = [what](RenderEstimator& e) -> int& {
-        return what == PilotCount::Candidates        ? e.candidates
-               : what == PilotCount::EmissionSamples ? e.emission_samples
-                                                     : e.light_samples;
-    };
-    count_of(one) = 1;
-    count_of(many) = k_count;
+    const uint64_t streams[2] = {image.stream ^ 0x9e3779b97f4a7c15ull, // numbers of its own
+                                 image.stream ^ 0xc2b2ae3d27d4eb4full};
+    const PilotPixels px = pilot_pixels(image.width, image.height, spp / pilot.spp);
+    const int largest = what == PilotCount::Candidates ? kMaxRisCandidates : kMaxSplitSamples;
+    const bool within_pixel = est.pixel_sampler == PixelSamplerKind::Independent;
+    RenderEstimator e = est;
     // The other counts, if they are still "auto", at 1 during this pilot.
-    if (one.light_samples == 0) one.light_samples = many.light_samples = 1;
-    if (one.candidates == 0) one.candidates = many.candidates = 1;
-    if (one.emission_samples == 0) one.emission_samples = many.emission_samples = 1;
-    one.pixel_sampler = many.pixel_sampler = PixelSamplerKind::Independent;
-    std::vector<RenderImage> a, b;
-    double t1 = 1e300, t2 = 1e300;
-    for (int run = 0; run < kPilotRuns; ++run) {
-        double t = 0.0;
-        a = pilot_bands(rs, one, pilot, &t);
-        t1 = std::min(t1, t);
-        b = pilot_bands(rs, many, pilot, &t);
-        t2 = std::min(t2, t);
-    }
-    double lum = 0.0, count = 0.0, samples = 0.0;
-    for (size_t k = 0; k < a.size(); ++k) {
-        for (size_t i = 0; i < a[k].rgb.size(); ++i) lum += a[k].rgb[i] + b[k].rgb[i];
-        count += 2.0 * double(a[k].rgb.size());
-        samples += double(a[k].pixel_count()) * double(pilot.spp);
-    }
-    const double eps = 1e-2 * (lum / count) * (lum / count);
-    double v1 = 0.0, vk = 0.0, terms = 0.0, unused = 0.0;
-    for (size_t k = 0; k < a.size(); ++k) {
-        add_relative_variance(a[k], b[k], eps, &v1, &terms);
-        add_relative_variance(b[k], a[k], eps, &vk, &unused);
-    }
-    v1 /= std::max(1.0, terms);
-    vk /= std::max(1.0, terms);
-    // V(1) = V_rest + V_light and V(k) = V_rest + V_light / k.
-    const double k = k_count;
+    if (e.light_samples == 0) e.light_samples = 1;
+    if (e.candidates == 0) e.candidates = 1;
+    if (e.emission_samples == 0) e.emission_samples = 1;
+    int& count = what == PilotCount::Candidates        ? e.candidates
+                 : what == PilotCount::EmissionSamples ? e.emission_samples
+                                                       : e.light_samples;
     SplitPilot p;
     p.ran = true;
+    std::vector<std::vector<double>> mean; // count 1's pixel means: the same weights for all
+    double eps = 0.0, samples = 0.0;
+    int best = 0;
+    double body[SplitPilot::kMaxTried] = {}, tail[SplitPilot::kMaxTried] = {};
+    const double image_samples =
+        double(std::max(1, image.width)) * double(std::max(1, image.height)) * double(spp);
+    double spent = 0.0, last_seconds = 0.0; // the pilot's processor seconds, its last count's
+    for (int n = 1; n <= largest && p.tried < SplitPilot::kMaxTried; n *= 2) {
+        if (n > 2) {
+            const double image_seconds = p.sample_seconds[0] * image_samples; // at count 1
+            if (spent + 2.0 * last_seconds > kPilotBudget * image_seconds) break;
+        }
+        count = n;
+        const PilotRenders r = pilot_renders(rs, e, pilot, px, streams, image.threads);
+        spent += r.seconds;
+        last_seconds = r.seconds;
+        if (n == 1) {
+            double lum = 0.0, terms = 0.0;
+            for (size_t k = 0; k < r.a.size(); ++k) {
+                mean.emplace_back(r.a[k].rgb.size());
+                for (size_t i = 0; i < r.a[k].rgb.size(); ++i) {
+                    mean[k][i] = 0.5 * (r.a[k].rgb[i] + r.b[k].rgb[i]);
+                    if (!std::isfinite(mean[k][i])) continue; // off the lattice
+                    lum += mean[k][i];
+                    terms += 1.0;
+                }
+            }
+            samples = double(px.pixels) * double(pilot.spp);
+            lum /= std::max(1.0, terms);
+            eps = 1e-2 * lum * lum;
+            if (!(eps > 0.0)) eps = 1e-300;
+        }
+        const int i = p.tried++;
+        p.counts[i] = n;
+        const RelativeVariance v = relative_variance(r, mean, eps, within_pixel);
+        body[i] = v.body;
+        tail[i] = v.tail;
+        p.sample_seconds[i] = 0.5 * r.seconds / std::max(1.0, samples);
+        // The tail: rare samples no pixel sampler stratifies, seen by a pilot this small in a
+        // few of its renders only (a lottery per count). Pooled over the counts tried, each
+        // scaled to count 1 by the 1 / n of averaging n samples: T_1 = mean_j (T_j n_j).
+        p.tail = 0.0;
+        for (int j = 0; j <= i; ++j) p.tail += tail[j] * p.counts[j] / double(i + 1);
+        // Per camera sample: the pixel estimate's variance times spp.
+        for (int j = 0; j <= i; ++j)
+            p.relative_variance[j] = (body[j] + p.tail / p.counts[j]) * double(pilot.spp);
+        p.tail *= double(pilot.spp);
+        for (int j = 0; j <= i; ++j) // the best so far, as pilot_choice takes it
+            if (j == 0 || p.relative_variance[j] * p.sample_seconds[j] * kPilotGain <
+                              p.relative_variance[best] * p.sample_seconds[best])
+                best = j;
+        if (i - best >= 2) break; // two counts past the best
+    }
+    // The two-point model V(n) = V_rest + V_light / n, C(n) = c_rest + n c_light read from
+    // count 1 and the largest count tried, for the record (the choice is the measured best).
+    const int last = p.tried - 1;
+    const double k = p.counts[last];
+    if (k > 1.0) {
+        const double v1 = p.relative_variance[0], vk = p.relative_variance[last];
+        p.variance_light = std::max(0.0, (v1 - vk) * k / (k - 1.0));
+        p.variance_rest = std::max(0.0, v1 - p.variance_light);
+        p.seconds_light = std::max(0.0, (p.sample_seconds[last] - p.sample_seconds[0]) / (k - 1.0));
+        p.seconds_rest = std::max(0.0, p.sample_seconds[0] - p.seconds_light);
+    }
     p.samples = uint64_t(samples);
-    p.variance_light = std::max(0.0, (v1 - vk) * k / (k - 1.0));
-    p.variance_rest = std::max(0.0, v1 - p.variance_light);
-    p.seconds_light = std::max(0.0, (t2 - t1) / ((k - 1.0) * samples));
-    p.seconds_rest = std::max(0.0, t1 / samples - p.seconds_light);
-    RenderEstimator out = est;
-    // The model is measured at 1 and k only: n* is not taken past kPilotReach k, where a
-    // V_rest lost in the pilot's noise would send it to the largest count.
-    const int n =
-        std::min(optimal_split(p.variance_rest, p.variance_light, p.seconds_rest, p.seconds_light),
-                 kPilotReach * k_count);
     p.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const int n = pilot_choice(p);
+    RenderEstimator out = est;
     if (what == PilotCount::Candidates) {
-        out.candidates = std::min(n, kMaxRisCandidates);
+        out.candidates = n;
         out.candidate_pilot = p;
     } else if (what == PilotCount::EmissionSamples) {
         out.emission_samples = n;

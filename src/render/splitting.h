@@ -1,11 +1,35 @@
-// The number of light samples per camera sample chosen by measured cost (light_samples
-// "auto", integrator.h). With n light samples per shading point, the variance of one camera
-// sample is V(n) = V_rest + V_light / n and its cost C(n) = c_rest + n c_light, so the
-// efficiency 1 / (V C) is largest at n* = sqrt((V_light / V_rest) (c_rest / c_light)), the
-// classic optimal splitting factor [ArvoKirk90; Veach97, 9.2]. A pilot renders an eighth of
-// the image's rows (8 bands, the image's own pixels, 2 samples per pixel) with n = 1 and n = 5
-// on one thread, timed by the processor time it uses, and reads V_rest, V_light from the two
-// images' pixel variances and c_rest, c_light from the two times.
+// The counts chosen by measured efficiency ("auto" light_samples, candidates and
+// emission_samples, integrator.h). More light samples per shading point (splitting
+// [ArvoKirk90; Veach97, 9.2]), more RIS candidates [Talbot05, 4] or more camera rays for the
+// emission seen directly lower the variance of a camera sample and raise its cost; the best
+// count is the one of the largest efficiency 1 / (V C). With independent pixels
+// V(n) = V_rest + V_light / n and n* = sqrt((V_light / V_rest) (c_rest / c_light))
+// (optimal_split), but the render's own pixel sampler changes V: Sobol' pixels make the error of
+// a smooth integrand fall faster than 1 / spp, by a different amount for each count (a single
+// light sample per camera sample is stratified over the pixel's net; RIS's pick and shifted
+// candidates keep little of that), so a model read with other pixels chooses wrongly (M = 2-4
+// candidates on the Cornell box, where M = 1 is 2-3x as efficient with Sobol' pixels).
+//
+// The pilot measures instead, with the estimator's own pixel sampler: it renders a lattice of
+// pixels spread over the image (spacing s in rows and columns, each row's columns shifted by 3
+// from the row above's) at the image's spp up to 16, twice with independent randomizations, at
+// counts 1, 2, 4, ... (up to 64). Its pixels are 1/96 of the image's (at least 256), times
+// spp / 16 past 16 spp (the same share of the image's samples). V per count: the relative
+// variance of the pixel estimates from the two renders ((a - b)^2 / 2, unbiased for any
+// randomized sampler; independent pixels take each pixel's within-pixel variance, less noisy),
+// weighted as the images' relative MSE (over the squared pixel mean at count 1 + 1e-2 of the
+// squared mean luminance). A heavy tail's rare large samples (terms past 1000 times the mean of
+// the terms below their 99th percentile) fall into a pilot this small in a few renders only, a
+// lottery per count; their excess is pooled over the counts tried, each scaled to count 1 by the
+// 1 / n of averaging n samples, and count n's V is its body plus the pooled tail / n. C: the
+// processor seconds of the renders (both on two threads when the image has them). The count
+// kept is the one of the least V C, a larger one only where it is at least 10 % more efficient
+// than the one kept so far. The ladder stops two counts past the best, or when the pilot's
+// processor time with the next count's (estimated at twice the last's) would pass 30 % of the
+// image's at count 1 (15 % stopped Veach's candidates at 2, where 4-8 win). Measured
+// (2026-12-07, bench_mitsuba.py's light best, `ris`, loaded machine): the pilot's wall time 20 %
+// of the image's on the 128 x 128 Cornell box at 16 and 64 spp (counts 1, 2, 4; 1 chosen), 8-10 %
+// on the 320 x 180 Veach scene (1-8); the pilot's time is counted in the image's.
 #pragma once
 
 #include "render/renderer.h"
@@ -14,18 +38,19 @@ namespace mcp {
 
 /// The estimator with light_samples chosen by the pilot (and its figures in split_pilot)
 /// when light_samples is 0 ("auto"), and likewise candidates (RIS, candidate_pilot; chosen
-/// first, with one light sample, the pilot's second count 8), then emission_samples (camera rays
-/// for the emission seen directly, emission_pilot, with the other counts chosen; second count
-/// 8: V_light is then the emission's variance per camera sample, c_light one such ray's cost);
-/// any other estimator unchanged.
-/// The count is at most 4 times the pilot's second count (20 light samples, 32 candidates):
-/// the model is measured at 1 and k only.
-/// `image` gives the image size, stream and threads of the render that follows.
+/// first, with one light sample), then emission_samples (camera rays for the emission seen
+/// directly, emission_pilot, with the other counts chosen); any other estimator unchanged.
+/// `image` gives the image size, spp, stream and threads of the render that follows; the
+/// pilot renders with the estimator's own pixel sampler at image.spp.
 RenderEstimator resolve_split(const RenderScene& rs, const RenderEstimator& est,
                               const RenderSettings& image);
 
-/// n* of the formula above, rounded to the better neighbour and kept in 1..kMaxSplitSamples
-/// (the largest where V_rest or c_light is not positive).
+/// The count of a pilot's least measured relative variance times seconds, a larger count only
+/// where that product is at least 10 % below every smaller count's (1 if none is finite).
+int pilot_choice(const SplitPilot& p);
+
+/// n* of the formula above (independent pixels), rounded to the better neighbour and kept
+/// in 1..kMaxSplitSamples (the largest where V_rest or c_light is not positive).
 int optimal_split(double variance_rest, double variance_light, double seconds_rest,
                   double seconds_light);
 

@@ -103,12 +103,18 @@ Json estimator_to_json(const RenderEstimator& e) {
     }
     if (e.emission_samples != 1 || e.emission_pilot.ran) j["emission_samples"] = e.emission_samples;
     const auto pilot_json = [](const SplitPilot& p) {
-        return Json{{"variance_rest", p.variance_rest},
-                    {"variance_light", p.variance_light},
-                    {"seconds_rest", p.seconds_rest},
-                    {"seconds_light", p.seconds_light},
-                    {"samples", p.samples},
-                    {"seconds", p.seconds}};
+        return Json{
+            {"variance_rest", p.variance_rest},
+            {"variance_light", p.variance_light},
+            {"seconds_rest", p.seconds_rest},
+            {"seconds_light", p.seconds_light},
+            {"samples", p.samples},
+            {"seconds", p.seconds},
+            {"counts", std::vector<int>(p.counts, p.counts + p.tried)},
+            {"relative_variance",
+             std::vector<double>(p.relative_variance, p.relative_variance + p.tried)},
+            {"tail", p.tail},
+            {"sample_seconds", std::vector<double>(p.sample_seconds, p.sample_seconds + p.tried)}};
     };
     // light_samples or candidates "auto": what the pilot measured (splitting.h)
     if (e.split_pilot.ran) j["split_pilot"] = pilot_json(e.split_pilot);
