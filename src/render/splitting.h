@@ -26,10 +26,8 @@
 // kept is the one of the least V C, a larger one only where it is at least 10 % more efficient
 // than the one kept so far. The ladder stops two counts past the best, or when the pilot's
 // processor time with the next count's (estimated at twice the last's) would pass 30 % of the
-// image's at count 1 (15 % stopped Veach's candidates at 2, where 4-8 win). Measured
-// (2026-12-07, bench_mitsuba.py's light best, `ris`, loaded machine): the pilot's wall time 20 %
-// of the image's on the 128 x 128 Cornell box at 16 and 64 spp (counts 1, 2, 4; 1 chosen), 8-10 %
-// on the 320 x 180 Veach scene (1-8); the pilot's time is counted in the image's.
+// image's at count 1. The pilot's time is counted in the image's; what it costs and chooses on
+// the bench's scenes: docs/performance-notes.md#sampling-and-shading.
 #pragma once
 
 #include "render/renderer.h"
