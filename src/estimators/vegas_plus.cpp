@@ -88,7 +88,7 @@ class VegasPlusEstimator final : public EstimatorAlgorithm, private TrainingPoin
             // GSL's 46 bins (2 points are all a hypercube's error needs; the training's
             // allocation is then even, as GSL's). `genz_compare --singular --dims 2,3 --reps
             // 40`, 2026-12-07: the error bars 0.71-0.83 of before on the d = 3 products,
-            // 0.88-0.92 at d = 2 (docs/performance-notes.md).
+            // 0.84-0.92 at d = 2 (docs/performance-notes.md).
             per_axis_ = vegas_plus_per_axis(dim_, 2 * smallest);
             cubes_ = 1;
             for (int j = 0; j < dim_; ++j) cubes_ *= per_axis_;
