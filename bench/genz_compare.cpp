@@ -6,9 +6,13 @@
 //                [--methods uniform,stratified,...] [--gsl plain,miser,vegas|none]
 //                [--param-seed S] [--seed S] [--randomizations K] [--params-dir DIR]
 //                [--json FILE] [--write-params DIR] [--external FILE.jsonl] [--peaks]
-//                [--singular] [--cpu-time]
+//                [--singular] [--cpu-time] [--ci B]
 //
 // --cpu-time: time each estimate by its thread's CPU time instead of wall time (t_med, eff).
+//
+// --ci B: a 95% interval for each case's mcplay/other ratio and for their geometric mean, from
+// B bootstrap resamples of each cell's replicates (both cells resampled, rel_rmse and t_med
+// recomputed; the best cell of each side as chosen on all replicates). 0 (the default): none.
 //
 // --randomizations K: the presets sobol, halton and lattice as K randomizations of N/K points
 // instead of their 16 (a method may also name its own: "sobol:4", "sobol:lms_shift:4"), to
@@ -57,6 +61,7 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <random>
 #include <set>
 #include <sstream>
 #include <string>
@@ -114,6 +119,7 @@ struct Options {
     uint64_t param_seed = 1; // genz_random(family, d, param_seed)
     uint64_t seed = 1;       // replicate seeds
     int randomizations = 0;  // --randomizations K for the QMC presets; 0: each preset's own (16)
+    int ci = 0;              // --ci B: bootstrap resamples for the ratios' 95% intervals
     std::string params_dir, json_path, write_params_dir, external_path;
     bool quick = false;
     bool peaks = false;    // --peaks: the sharp product peaks instead of genz_random's cases
@@ -142,7 +148,8 @@ bool is_count(const std::string& s) {
                  "         [--gsl plain,miser,vegas|none] [--param-seed S] [--seed S]\n"
                  "         [--randomizations K]\n"
                  "         [--params-dir DIR] [--json FILE] [--write-params DIR]\n"
-                 "         [--external FILE.jsonl] [--peaks] [--singular] [--cpu-time]\n");
+                 "         [--external FILE.jsonl] [--peaks] [--singular] [--cpu-time]\n"
+                 "         [--ci B]\n");
     std::exit(2);
 }
 
@@ -227,6 +234,8 @@ Options parse_options(int argc, char** argv) {
             o.singular = true;
         else if (a == "--cpu-time")
             g_cpu_time = true;
+        else if (a == "--ci")
+            o.ci = int(std::min<uint64_t>(parse_u64(value(), "--ci"), 100000));
         else if (a == "-h" || a == "--help")
             usage(nullptr);
         else
@@ -733,7 +742,49 @@ struct CaseResult {
     std::vector<Cell> cells;
     int best_other = -1, best_mcplay = -1; // best eff of GSL and --external, best of mcplay
     double ratio = kNaN, ratio_sig = kNaN;
+    std::vector<double> boot; // --ci: the ratio in each bootstrap resample
+    double ci_lo = kNaN, ci_hi = kNaN;
 };
+
+// 1 / (rel_rmse^2 t_med) of a resample of c's replicates (indices idx).
+double resampled_eff(const Cell& c, const std::vector<size_t>& idx, double exact) {
+    double se2 = 0.0;
+    std::vector<double> secs;
+    secs.reserve(idx.size());
+    for (size_t i : idx) {
+        const double err = c.reps[i].value - exact;
+        se2 += err * err;
+        secs.push_back(c.reps[i].seconds);
+    }
+    const double rel_mse = se2 / double(idx.size()) / (exact * exact);
+    return 1.0 / (rel_mse * median(secs));
+}
+
+double quantile(std::vector<double> v, double q) {
+    v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return !std::isfinite(x); }),
+            v.end());
+    if (v.empty()) return kNaN;
+    std::sort(v.begin(), v.end());
+    const double pos = q * double(v.size() - 1);
+    const size_t k = size_t(pos);
+    return k + 1 < v.size() ? v[k] + (pos - double(k)) * (v[k + 1] - v[k]) : v[k];
+}
+
+// The ratio's bootstrap distribution: each side's replicates resampled with replacement.
+void bootstrap_ratio(CaseResult& cr, int resamples, uint64_t seed) {
+    if (resamples <= 0 || cr.best_other < 0 || cr.best_mcplay < 0) return;
+    const Cell& g = cr.cells[size_t(cr.best_other)];
+    const Cell& m = cr.cells[size_t(cr.best_mcplay)];
+    std::mt19937_64 rng(seed);
+    std::vector<size_t> ig(g.reps.size()), im(m.reps.size());
+    for (int b = 0; b < resamples; ++b) {
+        for (size_t& i : ig) i = size_t(rng() % g.reps.size());
+        for (size_t& i : im) i = size_t(rng() % m.reps.size());
+        cr.boot.push_back(resampled_eff(m, im, cr.c->exact) / resampled_eff(g, ig, cr.c->exact));
+    }
+    cr.ci_lo = quantile(cr.boot, 0.025);
+    cr.ci_hi = quantile(cr.boot, 0.975);
+}
 
 int best_of(const std::vector<Cell>& cells, bool mcplay) {
     int best = -1;
@@ -961,6 +1012,7 @@ int main(int argc, char** argv) {
         if (cr.best_other >= 0 && cr.best_mcplay >= 0)
             cr.ratio = cr.cells[size_t(cr.best_mcplay)].eff / cr.cells[size_t(cr.best_other)].eff;
         cr.ratio_sig = best_eff_sig(cr.cells, true) / best_eff_sig(cr.cells, false);
+        bootstrap_ratio(cr, o.ci, hash_combine(o.seed, ci));
 
         // Table for this case.
         std::printf("== %s: exact %.15e  [%s]\n", cs.label.c_str(), cs.exact, cs.source.c_str());
@@ -1016,9 +1068,13 @@ int main(int argc, char** argv) {
         if (cr.best_other >= 0 && cr.best_mcplay >= 0) {
             const Cell& g = cr.cells[size_t(cr.best_other)];
             const Cell& m = cr.cells[size_t(cr.best_mcplay)];
-            std::printf("   best other %s (eff %s), best mcplay %s (eff %s): mcplay/other %s\n\n",
+            std::printf("   best other %s (eff %s), best mcplay %s (eff %s): mcplay/other %s",
                         g.method.c_str(), fmt_e(g.eff, 1).c_str(), m.method.c_str(),
                         fmt_e(m.eff, 1).c_str(), fmt_e(cr.ratio, 1).c_str());
+            if (o.ci > 0)
+                std::printf(" (95%% bootstrap %s to %s)", fmt_e(cr.ci_lo, 1).c_str(),
+                            fmt_e(cr.ci_hi, 1).c_str());
+            std::printf("\n\n");
         } else
             std::printf("   (no finite efficiency on one side: no comparison)\n\n");
         emit({{"kind", "case"},
@@ -1030,6 +1086,8 @@ int main(int argc, char** argv) {
               {"best_mcplay",
                cr.best_mcplay >= 0 ? Json(cr.cells[size_t(cr.best_mcplay)].method) : Json(nullptr)},
               {"eff_ratio_mcplay_over_other", jnum(cr.ratio)},
+              {"eff_ratio_ci95",
+               o.ci > 0 ? Json::array({jnum(cr.ci_lo), jnum(cr.ci_hi)}) : Json(nullptr)},
               {"eff_sig_ratio_mcplay_over_other", jnum(cr.ratio_sig)}});
         std::fflush(stdout);
         results.push_back(cr);
@@ -1060,6 +1118,9 @@ int main(int argc, char** argv) {
                     mark(g), m.method.c_str(), fmt_e(m.eff, 1).c_str(),
                     fmt_f(m.sig_rmse, "%.2f").c_str(), mark(m), fmt_e(cr.ratio, 1).c_str(),
                     fmt_e(cr.ratio_sig, 1).c_str());
+        if (o.ci > 0)
+            std::printf("   %-28s 95%% bootstrap interval of mcplay/other: %s to %s\n", "",
+                        fmt_e(cr.ci_lo, 1).c_str(), fmt_e(cr.ci_hi, 1).c_str());
         if (std::isfinite(cr.ratio) && cr.ratio > 0) {
             log_sum += std::log(cr.ratio);
             ++compared;
@@ -1071,6 +1132,20 @@ int main(int argc, char** argv) {
     std::printf("   geometric mean of mcplay/other: %s over %d cases; mcplay ahead on %d of %zu "
                 "(by_sigma: on %d)\n",
                 fmt_e(geomean, 2).c_str(), compared, ahead, results.size(), ahead_sig);
+    double geo_lo = kNaN, geo_hi = kNaN;
+    if (o.ci > 0 && compared) {
+        std::vector<double> geo(size_t(o.ci), 0.0);
+        for (const CaseResult& cr : results) {
+            if (!(std::isfinite(cr.ratio) && cr.ratio > 0) || cr.boot.size() != geo.size())
+                continue;
+            for (size_t b = 0; b < geo.size(); ++b) geo[b] += std::log(cr.boot[b]) / compared;
+        }
+        for (double& x : geo) x = std::exp(x);
+        geo_lo = quantile(geo, 0.025);
+        geo_hi = quantile(geo, 0.975);
+        std::printf("   95%% bootstrap interval of the geometric mean: %s to %s (%d resamples)\n",
+                    fmt_e(geo_lo, 2).c_str(), fmt_e(geo_hi, 2).c_str(), o.ci);
+    }
 
     // Error bars that cannot be taken at face value, mcplay's and GSL's.
     int flagged = 0;
@@ -1101,6 +1176,7 @@ int main(int argc, char** argv) {
           {"compared", compared},
           {"mcplay_ahead", ahead},
           {"geomean_eff_ratio_mcplay_over_other", jnum(geomean)},
+          {"geomean_ci95", o.ci > 0 ? Json::array({jnum(geo_lo), jnum(geo_hi)}) : Json(nullptr)},
           {"mcplay_ahead_by_sigma", ahead_sig},
           {"overconfident_cells", flagged},
           {"seconds", total}});

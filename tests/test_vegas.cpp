@@ -692,10 +692,11 @@ TEST(VegasPlus, MapTrainedOnTheErrorsPilesIntoASingularCorner) {
 // VEGAS+'s nested mode (GSL's stratified mode): where a training iteration has at least
 // kVegasPlusNestedAxis hypercubes per axis and the training runs kVegasSizingIterations
 // iterations, the default increments are cut to a whole number of hypercubes each, and the map
-// trains on the hypercubes' errors with damping kVegasNestedAlpha. Judged both ways on the
-// map's size: 2-D at 2^18 calls (40 hypercubes per axis in each of 10 training iterations of
-// 6553 points, where the default K would be 65) gets K = 40; 4-D (8 per axis) and 2-D at 2^15
-// (8 training iterations) keep the default K, trained on w^2.
+// trains on the hypercubes' errors with damping kVegasNestedAlpha, the training's hypercubes
+// then of 2 points each. Judged both ways on the map's size: 2-D at 2^18 calls (40 hypercubes
+// per axis of 4 points in each of 10 training iterations of 6553 points, where the default K
+// would be 65) gets K = 57, the hypercubes per axis at 2 points each; 4-D (8 per axis) and 2-D
+// at 2^15 (8 training iterations) keep the default K, trained on w^2.
 TEST(VegasPlus, NestedModeWhereHypercubesAreFineEnough) {
     struct Case {
         int dim;
@@ -724,7 +725,11 @@ TEST(VegasPlus, NestedModeWhereHypercubesAreFineEnough) {
         if (c.nested) {
             ASSERT_GE(m, kVegasPlusNestedAxis);
             ASSERT_EQ(iterations, kVegasSizingIterations);
-            EXPECT_EQ(m % k, 0u) << "K " << k << " M " << m;
+            const uint64_t m2 = vegas_plus_per_axis(c.dim, 2 * per_iteration); // 2 points each
+            ASSERT_NE(m2 % k_default, 0u); // else K could not tell M from the default
+            EXPECT_EQ(m2 % k, 0u) << "K " << k << " M " << m2;
+            EXPECT_EQ(m2 / k, (m2 + k_default - 1) / k_default) << "K " << k << " M " << m2;
+            EXPECT_NE(m % k, 0u) << "K " << k << " M at 4 points " << m;
             EXPECT_LT(k, k_default);
         } else {
             EXPECT_TRUE(m < kVegasPlusNestedAxis || iterations < kVegasSizingIterations);
