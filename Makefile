@@ -137,8 +137,8 @@ build: deps deps-python $(BUILD)/CMakeCache.txt
 	cmake --build $(BUILD) -j $(JOBS) $(if $(BUILD_EXTRA),--target all $(BUILD_EXTRA))
 
 # Targets built with the native build when a target below asks for them: the site's references
-# (CMake target site_references, started as soon as the CLI is linked; `make build` alone
-# renders none).
+# (CMake target site_references, run within the native build once the CLI is linked; `make
+# build` alone renders none).
 BUILD_EXTRA :=
 test-suites run site: BUILD_EXTRA := site_references
 

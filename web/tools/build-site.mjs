@@ -20,8 +20,8 @@
 // naming what is missing.
 //   node web/tools/build-site.mjs --references [NATIVE=build/mcplay]
 // renders only the references, into the cache build/ref-cache that the site's build reads: the
-// native build runs it (CMake target site_references) as soon as the CLI is linked, while the
-// rest of the two builds goes on, so that the site waits for no reference.
+// native build runs it (CMake target site_references) once the CLI is linked, while the rest of
+// the two builds goes on, so that the site waits for no reference.
 import fs from 'node:fs';
 import path from 'node:path';
 import { spawnSync } from 'node:child_process';
