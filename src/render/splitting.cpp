@@ -7,8 +7,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <ctime>
 
 namespace mcp {
@@ -92,17 +90,18 @@ PilotRenders pilot_renders(const RenderScene& rs, const RenderEstimator& est,
     return out;
 }
 
-/// Terms of the relative variance past this many times their median are a heavy tail's rare
-/// large samples (a firefly: 1e4-1e5 times the median on the Veach scene, where a pixel's
-/// ordinary terms spread over 1-2 orders of magnitude).
+/// Terms of the relative variance past this many times the mean of the terms below their 99th
+/// percentile are a heavy tail's rare large samples (a firefly: 1e4-1e5 times a pixel's
+/// ordinary term on the Veach scene, where those spread over 1-2 orders of magnitude).
 constexpr double kTailFactor = 1000.0;
 
 /// The relative variance of one pixel estimate, averaged over the pilot's pixels and channels as
 /// the images' relative MSE is (each term over the squared pixel mean `mean` + eps), split into
-/// the body (each term up to kTailFactor times the terms' median) and the tail (what lies
-/// beyond). With independent pixels the variance comes from each pixel's own samples (both
-/// renders'); with any other sampler, whose samples are not independent within a pixel, from the
-/// two independently randomized renders: E[(a - b)^2 / 2] = Var(a).
+/// the body (each term up to the cut, kTailFactor times the mean of the terms below their 99th
+/// percentile) and the tail (what lies beyond). With independent pixels the variance comes from
+/// each pixel's own samples (both renders'); with any other sampler, whose samples are not
+/// independent within a pixel, from the two independently randomized renders: E[(a - b)^2 / 2] =
+/// Var(a).
 struct RelativeVariance {
     double body = 0.0, tail = 0.0;
 };
@@ -153,7 +152,10 @@ int optimal_split(double variance_rest, double variance_light, double seconds_re
     return cost(hi) < cost(lo) ? hi : lo;
 }
 
-int pilot_choice(const SplitPilot& p) {
+namespace {
+
+/// The index in p.counts of the count pilot_choice takes, -1 if no cost is finite.
+int pilot_best(const SplitPilot& p) {
     int best = -1;
     double best_cost = 0.0;
     for (int i = 0; i < p.tried; ++i) {
@@ -164,6 +166,13 @@ int pilot_choice(const SplitPilot& p) {
             best_cost = cost;
         }
     }
+    return best;
+}
+
+} // namespace
+
+int pilot_choice(const SplitPilot& p) {
+    const int best = pilot_best(p);
     return best < 0 ? 1 : p.counts[best];
 }
 
@@ -204,7 +213,6 @@ RenderEstimator run_pilot(const RenderScene& rs, const RenderEstimator& est,
     p.ran = true;
     std::vector<std::vector<double>> mean; // count 1's pixel means: the same weights for all
     double eps = 0.0, samples = 0.0;
-    int best = 0;
     double body[SplitPilot::kMaxTried] = {}, tail[SplitPilot::kMaxTried] = {};
     const double image_samples =
         double(std::max(1, image.width)) * double(std::max(1, image.height)) * double(spp);
@@ -249,11 +257,7 @@ RenderEstimator run_pilot(const RenderScene& rs, const RenderEstimator& est,
         for (int j = 0; j <= i; ++j)
             p.relative_variance[j] = (body[j] + p.tail / p.counts[j]) * double(pilot.spp);
         p.tail *= double(pilot.spp);
-        for (int j = 0; j <= i; ++j) // the best so far, as pilot_choice takes it
-            if (j == 0 || p.relative_variance[j] * p.sample_seconds[j] * kPilotGain <
-                              p.relative_variance[best] * p.sample_seconds[best])
-                best = j;
-        if (i - best >= 2) break; // two counts past the best
+        if (i - std::max(0, pilot_best(p)) >= 2) break; // two counts past the best so far
     }
     // The two-point model V(n) = V_rest + V_light / n, C(n) = c_rest + n c_light read from
     // count 1 and the largest count tried, for the record (the choice is the measured best).
