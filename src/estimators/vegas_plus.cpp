@@ -86,9 +86,7 @@ class VegasPlusEstimator final : public EstimatorAlgorithm, private TrainingPoin
             // increments (K = M / b) follow the singularity only as finely as the hypercubes,
             // and at 4 points each a 3-D training iteration at N = 10^6 had 18 per axis against
             // GSL's 46 bins (2 points are all a hypercube's error needs; the training's
-            // allocation is then even, as GSL's). `genz_compare --singular --dims 2,3 --reps
-            // 40`, 2026-12-07: the error bars 0.71-0.83 of before on the d = 3 products,
-            // 0.84-0.92 at d = 2 (docs/performance-notes.md).
+            // allocation is then even, as GSL's; what it gained: docs/performance-notes.md).
             per_axis_ = vegas_plus_per_axis(dim_, 2 * smallest);
             cubes_ = 1;
             for (int j = 0; j < dim_; ++j) cubes_ *= per_axis_;
@@ -264,26 +262,18 @@ class VegasPlusEstimator final : public EstimatorAlgorithm, private TrainingPoin
     // calibrate at N = 65536 and 262144: runs 5.5-10 standard errors off on Genz
     // discontinuous and x^-a, 2026-12-07); in d >= 2 the variance spreads over the hypercubes
     // along a cut or an axis.
-    void pilot_weight(uint64_t estimate_points, const std::vector<double>& others) {
+    // `others`: the variance `others` predict per hypercube (overwritten with its sigma).
+    void pilot_weight(uint64_t estimate_points, std::vector<double>& others) {
         lambda_.clear();
         if (dim_ < 2) return;
         const uint64_t least = estimate_points >= 2 * cubes_ ? 2 : 1;
         const double rest =
             static_cast<double>(estimate_points - std::min(estimate_points, least * cubes_));
-        std::vector<double>& share = share_;
-        share.resize(cubes_);
-        double total = 0.0;
-        for (uint64_t h = 0; h < cubes_; ++h) { // sigma_h^beta, as allocate
-            share[h] = power_beta(std::sqrt(others[h]), options_.beta);
-            if (!std::isfinite(share[h])) share[h] = 0.0;
-            total += share[h];
-        }
-        const double even = options_.uniform_share, cubes = static_cast<double>(cubes_);
+        for (double& v : others) v = std::sqrt(v);
+        allocation_shares(others);
         lambda_.resize(cubes_);
         for (uint64_t h = 0; h < cubes_; ++h) {
-            const double part = total > 0.0 ? share[h] / total : 1.0 / cubes;
-            const double n =
-                static_cast<double>(least) + rest * ((1.0 - even) * part + even / cubes);
+            const double n = static_cast<double>(least) + rest * share_[h];
             lambda_[h] = std::min(kMostPilotShare, 2.0 / (2.0 + n));
         }
     }
@@ -488,6 +478,14 @@ class VegasPlusEstimator final : public EstimatorAlgorithm, private TrainingPoin
         allocation->assign(cubes_, least);
         const uint64_t rest = points - least * cubes_;
         if (rest == 0) return points; // the pilot: 2 points each
+        allocation_shares(sigma_);
+        allocate_largest_remainders(rest, share_, allocation);
+        return points;
+    }
+
+    // share_[h]: hypercube h's share of the points past the 2 each, from `sigma` per hypercube:
+    // in proportion to sigma_h^beta, mixed with the even share.
+    void allocation_shares(const std::vector<double>& sigma) {
         std::vector<double>& share = share_;
         share.resize(cubes_);
         double total = 0.0;
@@ -495,8 +493,8 @@ class VegasPlusEstimator final : public EstimatorAlgorithm, private TrainingPoin
         // inherit its sigma_h (refine_grid), r of them in a row on the last axis.
         double last_sigma = std::numeric_limits<double>::quiet_NaN(), last_share = 0.0;
         for (uint64_t h = 0; h < cubes_; ++h) {
-            if (!(sigma_[h] == last_sigma)) {
-                last_sigma = sigma_[h];
+            if (!(sigma[h] == last_sigma)) {
+                last_sigma = sigma[h];
                 last_share = power_beta(last_sigma, options_.beta);
                 if (!std::isfinite(last_share)) last_share = 0.0;
             }
@@ -513,8 +511,6 @@ class VegasPlusEstimator final : public EstimatorAlgorithm, private TrainingPoin
         const double even = options_.uniform_share;
         for (uint64_t h = 0; h < cubes_; ++h)
             share[h] = (1.0 - even) * share[h] / total + even / static_cast<double>(cubes_);
-        allocate_largest_remainders(rest, share, allocation);
-        return points;
     }
 
     void advance_digits() {
