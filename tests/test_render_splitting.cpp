@@ -251,11 +251,12 @@ TEST(RenderSplitting, PilotChoiceTakesTheMeasuredBest) {
 
 /// An estimator with `field` "auto" on the quad light scene (pixel-centre jitter off: the image's
 /// camera samples jitter) with the given pixel sampler, resolved for a 192 x 144 image of `spp`.
-RenderEstimator resolved_on_the_quad_light(RenderEstimator e, PixelSamplerKind kind, uint64_t spp) {
+RenderEstimator resolved_on_the_quad_light(RenderEstimator e, PixelSamplerKind kind, uint64_t spp,
+                                           int width = 192, int height = 144) {
     Scene scene = test::quad_light_scene(5.0);
     RenderScene rs;
     rs.build(scene);
-    RenderSettings image = settings(192, 144, spp, 7);
+    RenderSettings image = settings(width, height, spp, 7);
     image.jitter_pixels = true;
     image.threads = 2;
     e.pixel_sampler = kind;
@@ -269,13 +270,18 @@ RenderEstimator resolved_on_the_quad_light(RenderEstimator e, PixelSamplerKind k
 // independent pixels'); RIS's shifted candidates and its pick keep little of that, so 1
 // candidate is the most efficient, while with independent pixels the candidates' variance
 // reduction pays (the old pilot's model, V_target + V / M, read with independent pixels, chose
-// 32 with Sobol' pixels too). Both ways: the same scene and estimator, two answers.
+// 32 with Sobol' pixels too). Both ways: the same scene and estimator, two answers. The choice
+// rests on timed renders (count 1's efficiency about 1.7 times count 4's with Sobol' pixels): at
+// 384 x 288 each of the pilot's renders takes tens of milliseconds, long enough that a burst of
+// load on the machine during one of them does not turn the answer (at 192 x 144, about 15 ms,
+// it once did under Node during `make test`).
 TEST(RenderSplitting, PilotMeasuresWithTheRendersPixelSampler) {
     RenderEstimator e = split(RadianceStrategy::Ris, 1, 1);
     e.candidates = 0;
-    const RenderEstimator sobol = resolved_on_the_quad_light(e, PixelSamplerKind::Sobol, 64);
+    const RenderEstimator sobol =
+        resolved_on_the_quad_light(e, PixelSamplerKind::Sobol, 64, 384, 288);
     const RenderEstimator independent =
-        resolved_on_the_quad_light(e, PixelSamplerKind::Independent, 64);
+        resolved_on_the_quad_light(e, PixelSamplerKind::Independent, 64, 384, 288);
     ASSERT_TRUE(sobol.candidate_pilot.ran && independent.candidate_pilot.ran);
     EXPECT_LT(sobol.candidate_pilot.relative_variance[0],
               0.1 * independent.candidate_pilot.relative_variance[0]);
