@@ -28,9 +28,10 @@ also compared with each other (the same relative MSE), which says whether they r
 image. With --sobol, mcplay also renders every cell with its Owen-scrambled Sobol' pixel sampler
 (`--pixel-sampler sobol`; the default is stratified), scored against the same mcplay reference:
 one more column, and its own efficiency ratio against Mitsuba. With --best, mcplay also renders
-each class with its best estimator (MCPLAY_BEST: Sobol' pixels, the emission seen directly
-split at emitter edges, the candidates and light samples per camera sample chosen by timed
-pilots, their time counted), one more column the same way. With --scalar, Mitsuba's
+each class with its best estimator (MCPLAY_BEST: padded Sobol' pixels with the samples spread
+over the pixels by their neighbours' error, the emission seen directly split at emitter edges,
+the candidates and light samples per camera sample chosen by timed pilots, their time counted),
+one more column the same way. With --scalar, Mitsuba's
 `scalar_rgb` variant renders every cell too: the same integrators one sample at a time per
 thread, as mcplay runs, against `llvm_ad_rgb`'s kernels that run a SIMD register's width of
 samples at once. It is scored against the `llvm_ad_rgb` reference (the same estimator), and
@@ -71,20 +72,24 @@ SCENES = [
     ('veach_mis', 'veach_mis.gltf', 320, 180, ['light', 'bsdf', 'mis']),
 ]
 MCPLAY_ESTIMATOR = {'light': 'light_solid_angle', 'bsdf': 'bsdf', 'mis': 'mis_power', 'path': 'path'}
-# mcplay's best per class (--best), Sobol' pixels throughout. Light sampling: resampled light
+# mcplay's best per class (--best), padded Sobol' pixels throughout. Light sampling: resampled light
 # samples (ris: candidates drawn as light_solid_angle draws them, the target lum(f Le cos) with
 # the BSDF in it; its pilot, measuring with the render's Sobol' pixels, may choose M = 1. Plain
 # light_solid_angle won on the Cornell box and lost on Veach's plates at 64 and 256 spp:
 # docs/performance-notes.md). Path tracing: each
 # vertex's light sample resampled the same way. MIS: light
 # samples per camera sample (splitting). Each count chosen by a timed pilot (src/render/
-# splitting.h; its time counted in the image's). BSDF sampling alone has no such choice: its
-# row is a pure speed contest.
+# splitting.h; its time counted in the image's). Every class spends its samples over the pixels
+# adaptively (pixel_allocation, src/render/adaptive.h: a first pass of half the spp, the rest by
+# the neighbours' error), which needs the padded Sobol' sampler. BSDF sampling alone has no such
+# choice: its row is a pure speed contest.
 MCPLAY_BEST = {
     'light': {'strategy': 'ris', 'light_selection': 'power', 'light_sampling': 'solid_angle',
-              'candidates': 'auto', 'pixel_sampler': 'sobol'},
-    'mis': {'strategy': 'mis_power', 'light_samples': 'auto', 'pixel_sampler': 'sobol'},
-    'path': {'strategy': 'path', 'max_depth': 5, 'candidates': 'auto', 'pixel_sampler': 'sobol'},
+              'candidates': 'auto', 'pixel_sampler': 'padded_sobol', 'pixel_allocation': 'adaptive'},
+    'mis': {'strategy': 'mis_power', 'light_samples': 'auto', 'pixel_sampler': 'padded_sobol',
+            'pixel_allocation': 'adaptive'},
+    'path': {'strategy': 'path', 'max_depth': 5, 'candidates': 'auto',
+             'pixel_sampler': 'padded_sobol', 'pixel_allocation': 'adaptive'},
 }
 # Every class: the emission seen directly from BEST_EMISSION_SAMPLES camera rays per sample
 # (emission_samples; the edges of a directly seen light, a pixel's coverage, are camera-sample

@@ -86,6 +86,9 @@ struct SplitPilot {
     double tail = 0.0;
 };
 
+/// How an image's samples are spread over its pixels (adaptive.h).
+enum class PixelAllocation { Uniform, Adaptive };
+
 struct RenderEstimator {
     std::string name; ///< unique within a study: keys its random streams
     RadianceStrategy strategy = RadianceStrategy::MisPower;
@@ -115,6 +118,9 @@ struct RenderEstimator {
     /// meets no light costs a test of the lights alone. 0 (JSON "auto") until a timed pilot
     /// chooses it (splitting.h).
     int emission_samples = 1;
+    /// How the image's samples are spread over its pixels: the same spp everywhere, or a first
+    /// pass and the rest where the neighbours' error shows they pay (adaptive.h).
+    PixelAllocation pixel_allocation = PixelAllocation::Uniform;
     SplitPilot split_pilot;     ///< what the pilot measured, when it chose light_samples
     SplitPilot emission_pilot;  ///< the same for emission_samples
     SplitPilot candidate_pilot; ///< the same for candidates (variance_light: the resampled part)

@@ -67,15 +67,26 @@ void render_rows(const RenderScene& rs, const RenderEstimator& est, const Render
             // emission_samples where the emission seen at the pixel's four corners differs (an
             // emitter's edge or an occluder's crosses it): a choice fixed by the geometry,
             // independent of the samples, so each pixel's mean stays unbiased whatever it is.
+            // Probed in the pixel's first pass and kept for the next (the live view's, an
+            // adaptive image's second).
             int n_pixel = 1;
             if (n_emission > 1) {
-                const Vec3 e0 = emitted_along(rs, ray_through(camera, x, y), counters);
-                for (const Vec2 corner : {Vec2(1, 0), Vec2(0, 1), Vec2(1, 1)}) {
-                    const Ray probe = ray_through(camera, x + corner.x, y + corner.y);
-                    if (emitted_along(rs, probe, counters) != e0) n_pixel = n_emission;
+                uint8_t& edge = band.emission_edge[p];
+                if (edge == kEdgeUnknown) {
+                    edge = kEdgeNone;
+                    const Vec3 e0 = emitted_along(rs, ray_through(camera, x, y), counters);
+                    for (const Vec2 corner : {Vec2(1, 0), Vec2(0, 1), Vec2(1, 1)}) {
+                        const Ray probe = ray_through(camera, x + corner.x, y + corner.y);
+                        if (emitted_along(rs, probe, counters) != e0) edge = kEdgeCrosses;
+                    }
                 }
+                if (edge == kEdgeCrosses) n_pixel = n_emission;
             }
-            for (uint64_t i = first_sample; i < st.spp; ++i) {
+            // The pixel's own count (adaptive.h) or the pass's.
+            const uint64_t end = st.pixel_spp != nullptr
+                                     ? std::max<uint64_t>(first_sample, (*st.pixel_spp)[p])
+                                     : st.spp;
+            for (uint64_t i = first_sample; i < end; ++i) {
                 sampler.start_sample(i);
                 Vec2 jitter = st.jitter_pixels ? sampler.get_2d() : Vec2(0.5);
                 Ray ray = ray_through(camera, x + jitter.x, y + jitter.y);
@@ -104,7 +115,7 @@ void render_rows(const RenderScene& rs, const RenderEstimator& est, const Render
                 double reflected = std::fabs(luminance(rad.reflected));
                 if (reflected > 0.0) push_top_weight(diag.top, reflected);
             }
-            diag.samples += st.spp - first_sample;
+            diag.samples += end - first_sample;
             diag.rays += counters.rays;
             diag.light_misses += counters.light_misses;
             for (int c = 0; c < 3; ++c) {
@@ -134,6 +145,7 @@ ImageBand make_band(int width, int height, int row_begin, int row_end, PixelSamp
     b.kept.assign(n, 0);
     b.lum_sum.assign(n, 0.0);
     b.lum_max.assign(n, 0.0);
+    b.emission_edge.assign(n, kEdgeUnknown);
     if (kind == PixelSamplerKind::Independent || kind == PixelSamplerKind::Stratified)
         b.generators.resize(n);
     return b;
@@ -206,8 +218,9 @@ RenderImage band_image(const ImageBand& band) {
                 kept > 1 ? band.m2[3 * p + c] / (u63_to_double(kept) * u63_to_double(kept - 1))
                          : NAN;
         }
-        // A pixel owes more than half its value to one sample [renderer.h].
-        if (band.spp >= 16 && band.lum_sum[p] > 0.0) {
+        // A pixel owes more than half its value to one sample [renderer.h]; its own count, as
+        // an adaptive image's pixels have different counts.
+        if (band.kept[p] >= 16 && band.lum_sum[p] > 0.0) {
             const double share = band.lum_max[p] / band.lum_sum[p];
             image.diagnostics.max_sample_share =
                 std::max(image.diagnostics.max_sample_share, share);

@@ -19,6 +19,9 @@
 
 namespace mcp {
 
+/// ImageBand::emission_edge's values.
+constexpr uint8_t kEdgeUnknown = 0, kEdgeNone = 1, kEdgeCrosses = 2;
+
 struct ImageBand {
     int width = 0, height = 0;      ///< the whole image's
     int row_begin = 0, row_end = 0; ///< the band's rows, [row_begin, row_end)
@@ -36,6 +39,9 @@ struct ImageBand {
     std::vector<double> lum_sum;   ///< sum of |luminance| of the kept samples
     std::vector<double> lum_max;   ///< largest |luminance| of a kept sample
     std::vector<Pcg32> generators; ///< the pixel sampler's generator (independent, stratified)
+    /// Whether an emitter's or occluder's edge crosses the pixel (emission_samples' probe of
+    /// its four corners, made once): kEdgeUnknown, kEdgeNone or kEdgeCrosses.
+    std::vector<uint8_t> emission_edge;
     /// Summed over passes; dominated_pixels and max_sample_share are left at 0 here and
     /// computed from the pixels by band_image.
     RenderDiagnostics diagnostics;

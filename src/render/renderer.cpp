@@ -1,7 +1,8 @@
-// One image (renderer.h): one pass over all its rows (progressive.cpp), the diagnostics'
-// merge, and the camera's rays.
+// One image (renderer.h): one pass over all its rows (progressive.cpp) or an adaptive image's
+// two (adaptive.cpp), the diagnostics' merge, and the camera's rays.
 #include "render/renderer.h"
 
+#include "render/adaptive.h"
 #include "render/progressive.h"
 
 #include <algorithm>
@@ -63,6 +64,11 @@ Ray camera_ray(const Camera& camera, int width, int height, double x, double y) 
 
 RenderImage render_image(const RenderScene& rs, const RenderEstimator& est,
                          const RenderSettings& settings) {
+    // Below kAdaptiveMinSpp, or with a sampler that cannot add samples to a pixel (the render
+    // API refuses that pairing), the same spp everywhere; image.allocation says which.
+    if (est.pixel_allocation == PixelAllocation::Adaptive && settings.spp >= kAdaptiveMinSpp &&
+        settings.pixel_spp == nullptr && sampler_extends(est.pixel_sampler))
+        return render_adaptive(rs, est, settings);
     ImageBand band =
         make_band(settings.width, settings.height, 0, settings.height, est.pixel_sampler);
     render_pass(rs, est, settings, band);

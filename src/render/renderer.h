@@ -26,6 +26,19 @@ struct RenderSettings {
     /// Told the rows done so far (of `height`) after each row the calling thread renders, on
     /// that thread; returning false cancels. For long renders (a reference) that show progress.
     std::function<bool(int rows_done, int rows)> progress;
+    /// Per pixel of the band (rows from the top): the samples it is to have after the pass,
+    /// each at least the band's spp and at most `spp` (adaptive.h); null: `spp` everywhere.
+    const std::vector<uint32_t>* pixel_spp = nullptr;
+};
+
+/// How an adaptive image spread its samples over its pixels (adaptive.h).
+struct PixelAllocationInfo {
+    bool adaptive = false;             ///< false: every pixel has the image's spp
+    uint64_t first_pass_spp = 0;       ///< every pixel's samples before the allocation
+    uint64_t min_spp = 0, max_spp = 0; ///< over the pixels
+    /// Relative MSE of uniform allocation over the allocation's, as the first pass predicts
+    /// it (each pixel's error as its neighbours show it; sample variance over n).
+    double predicted_gain = 1.0;
 };
 
 /// Problems found while rendering, summed over the image.
@@ -34,8 +47,8 @@ struct RenderDiagnostics {
     uint64_t discarded_nonfinite = 0; ///< samples whose radiance was NaN or infinite: dropped
     uint64_t rays = 0;
     uint64_t light_misses = 0;     ///< light samples with no valid point (degenerate, pdf 0)
-    uint64_t dominated_pixels = 0; ///< pixels (spp >= 16) where one sample carries > half the sum
-    double max_sample_share = 0.0; ///< over pixels with spp >= 16: largest sample / pixel sum
+    uint64_t dominated_pixels = 0; ///< pixels of >= 16 samples where one carries > half the sum
+    double max_sample_share = 0.0; ///< over pixels of >= 16 samples: largest sample / pixel sum
     /// The kTopWeights largest luminances of the samples' reflected part (the emission seen
     /// directly is not random given the camera ray), decreasing: for Hill's tail index.
     std::vector<double> top;
@@ -54,6 +67,7 @@ struct RenderImage {
     std::vector<double> rgb;      ///< pixel means, 3 per pixel, rows from the top
     std::vector<double> variance; ///< variance of each pixel mean, 3 per pixel
     RenderDiagnostics diagnostics;
+    PixelAllocationInfo allocation;
     double seconds = 0.0;
     bool cancelled = false;
 
@@ -72,7 +86,8 @@ struct CameraRays {
 CameraRays camera_rays(const Camera& camera, int width, int height);
 Ray ray_through(const CameraRays& c, double x, double y);
 
-/// The image in one pass (progressive.h) from 0 to settings.spp samples per pixel.
+/// The image in one pass (progressive.h) from 0 to settings.spp samples per pixel, or, for an
+/// estimator with pixel_allocation adaptive, in two (adaptive.h).
 RenderImage render_image(const RenderScene& rs, const RenderEstimator& est,
                          const RenderSettings& settings);
 

@@ -106,6 +106,8 @@ int mcp_render_image(const char* scene_json, const char* options_json, char** re
     // as it does every estimator of a study.
     if (auto it = options.find("pixel_sampler"); it != options.end() && it->is_string())
         parse_pixel_sampler(it->get<std::string>(), &est.pixel_sampler);
+    if (std::string why = check_pixel_allocation(est); !why.empty())
+        return fail(MCP_ERROR_ARGUMENT, "options.estimator.pixel_allocation: " + why);
     uint64_t spp = r.settings.spp_max;
     const bool spp_given = options.find("spp") != options.end();
     if (auto it = options.find("spp"); it != options.end()) {
@@ -230,6 +232,8 @@ int mcp_render_image(const char* scene_json, const char* options_json, char** re
            {"rays_per_second", num(image.seconds > 0 ? double(d.rays) / image.seconds : NAN)},
            {"diagnostics", diag},
            {"warnings", warnings}};
+    if (est.pixel_allocation == PixelAllocation::Adaptive)
+        j["pixel_allocation"] = pixel_allocation_to_json(image.allocation);
     if (error_png) {
         RenderImage ref;
         Json info;

@@ -85,6 +85,15 @@ Json part_level_to_json(const RenderEstimatorStudy& s, size_t i, double floor) {
 
 } // namespace
 
+Json pixel_allocation_to_json(const PixelAllocationInfo& a) {
+    if (!a.adaptive) return Json{{"adaptive", false}};
+    return Json{{"adaptive", true},
+                {"first_pass_spp", a.first_pass_spp},
+                {"min_spp", a.min_spp},
+                {"max_spp", a.max_spp},
+                {"predicted_gain", num(a.predicted_gain)}};
+}
+
 Json estimator_to_json(const RenderEstimator& e) {
     Json j{{"name", e.name},
            {"strategy", strategy_name(e.strategy)},
@@ -102,6 +111,7 @@ Json estimator_to_json(const RenderEstimator& e) {
         j["bsdf_samples"] = e.bsdf_samples;
     }
     if (e.emission_samples != 1 || e.emission_pilot.ran) j["emission_samples"] = e.emission_samples;
+    if (e.pixel_allocation == PixelAllocation::Adaptive) j["pixel_allocation"] = "adaptive";
     const auto pilot_json = [](const SplitPilot& p) {
         return Json{
             {"variance_rest", p.variance_rest},

@@ -11,6 +11,11 @@
 
 namespace mcp {
 
+/// How an image spread its samples over its pixels (render_image's "pixel_allocation"):
+/// {"adaptive": false} or {"adaptive": true, "first_pass_spp", "min_spp", "max_spp",
+/// "predicted_gain"}.
+Json pixel_allocation_to_json(const PixelAllocationInfo& a);
+
 /// {"name", "strategy", "light_selection", "light_sampling", "pixel_sampler"}, and the depths
 /// of a path tracer.
 Json estimator_to_json(const RenderEstimator& e);

@@ -33,9 +33,9 @@ constexpr size_t kMaxLiveEstimators = 4;
 constexpr size_t kMaxLiveSessions = 16;
 constexpr uint64_t kMaxLiveSpp = uint64_t(1) << 20;
 /// Bytes a band pixel holds per estimator (ImageBand: mean, m2, kept, luminance sum and
-/// maximum, the generator), and per pixel of an image (RenderImage): the reference, held whole,
-/// and the band's image made for a pass's result, of the band's rows.
-constexpr double kBandPixelBytes = 88.0, kImagePixelBytes = 48.0;
+/// maximum, the generator, the emission edge flag), and per pixel of an image (RenderImage):
+/// the reference, held whole, and the band's image made for a pass's result, of the band's rows.
+constexpr double kBandPixelBytes = 89.0, kImagePixelBytes = 48.0;
 
 struct LiveSession {
     LoadedRender loaded;
@@ -166,6 +166,13 @@ int open_session(const char* scene_json, const char* options_json, mcp_progress_
                     std::string(pixel_sampler_name(e.pixel_sampler)) +
                     "' sampler cannot (its samples depend on the final spp): use "
                     "'padded_sobol' or 'independent'");
+    for (const RenderEstimator& e : r.estimators)
+        if (e.pixel_allocation == PixelAllocation::Adaptive)
+            return fail(MCP_ERROR_ARGUMENT,
+                        "estimator '" + e.name +
+                            "': pixel_allocation 'adaptive' spreads a whole image's samples "
+                            "after a first pass; the live view renders every pixel alike, pass "
+                            "by pass: use 'uniform' here");
     for (const RenderEstimator& e : r.estimators)
         if (e.light_samples == 0 || e.candidates == 0 ||
             e.emission_samples == 0) // each band would run its own pilot

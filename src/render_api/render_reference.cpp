@@ -66,6 +66,7 @@ uint64_t reference_key(const RenderRequest& r) {
     if (e.light_samples != 1 || e.bsdf_samples != 1) // splitting (keys of 1, 1 unchanged)
         key = hash_combine(hash_combine(key, uint64_t(e.light_samples)), uint64_t(e.bsdf_samples));
     if (e.emission_samples != 1) key = hash_combine(key, uint64_t(e.emission_samples) << 32);
+    if (e.pixel_allocation == PixelAllocation::Adaptive) key = hash_combine(key, 0xada9u);
     return key;
 }
 

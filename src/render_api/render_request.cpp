@@ -143,7 +143,7 @@ bool parse_estimator(Ctx& c, const Json& j, const std::string& path, RenderEstim
     if (!check_keys(c, j, path,
                     {"name", "strategy", "light_selection", "light_sampling", "pixel_sampler",
                      "max_depth", "rr_depth", "candidates", "light_samples", "bsdf_samples",
-                     "emission_samples"}))
+                     "emission_samples", "pixel_allocation"}))
         return false;
     std::string strategy;
     if (!get_string(c, j, "strategy", path, &strategy)) return false;
@@ -165,6 +165,11 @@ bool parse_estimator(Ctx& c, const Json& j, const std::string& path, RenderEstim
     v = int(e.pixel_sampler);
     if (!parse_enum(c, j, "pixel_sampler", path, pixel_sampler_names(), &v)) return false;
     e.pixel_sampler = PixelSamplerKind(v);
+    v = int(e.pixel_allocation);
+    if (!parse_enum(c, j, "pixel_allocation", path, {"uniform", "adaptive"}, &v)) return false;
+    e.pixel_allocation = PixelAllocation(v);
+    if (std::string why = check_pixel_allocation(e); !why.empty())
+        return c.fail(sub(path, "pixel_allocation"), why);
     uint64_t depth = uint64_t(e.max_depth), rr = uint64_t(e.rr_depth);
     if (!get_count(c, j, "max_depth", path, &depth) || !get_count(c, j, "rr_depth", path, &rr))
         return false;
@@ -179,6 +184,20 @@ bool parse_estimator(Ctx& c, const Json& j, const std::string& path, RenderEstim
     *out = e;
     return true;
 }
+
+} // namespace
+
+std::string check_pixel_allocation(const RenderEstimator& e) {
+    if (e.pixel_allocation != PixelAllocation::Adaptive || sampler_extends(e.pixel_sampler))
+        return "";
+    return std::string("'adaptive' adds samples to the pixels that need them after a first "
+                       "pass, and the '") +
+           pixel_sampler_name(e.pixel_sampler) +
+           "' pixel sampler cannot add samples to a pixel (its samples depend on the final "
+           "spp): use 'padded_sobol' or 'independent'";
+}
+
+namespace {
 
 /// The quantity an estimator estimates: direct lighting, or paths up to a depth. Estimators
 /// of one study must agree, or their errors against one reference mean nothing.
@@ -530,7 +549,13 @@ Made<std::shared_ptr<RenderRequest>> build_render_request(const Json& scene, con
         int v = 0;
         if (!parse_enum(c, opts, "pixel_sampler", "options", pixel_sampler_names(), &v))
             return error();
-        for (RenderEstimator& e : r->estimators) e.pixel_sampler = PixelSamplerKind(v);
+        for (RenderEstimator& e : r->estimators) {
+            e.pixel_sampler = PixelSamplerKind(v);
+            if (std::string why = check_pixel_allocation(e); !why.empty()) {
+                c.fail("options.pixel_sampler", "estimator '" + e.name + "': " + why);
+                return error();
+            }
+        }
     }
 
     // The reference: by default the power-heuristic MIS estimator of the same quantity.

@@ -62,4 +62,8 @@ Made<std::shared_ptr<RenderRequest>> build_render_request(const Json& scene, con
 /// options.estimator names one that is not in the scene's list; errors start with `path`.
 Made<RenderEstimator> parse_render_estimator(const Json& j, const std::string& path);
 
+/// "" or why the estimator's pixel_allocation cannot be rendered with its pixel sampler
+/// (adaptive adds samples to pixels, which the stratified and sobol samplers cannot).
+std::string check_pixel_allocation(const RenderEstimator& e);
+
 } // namespace mcp
