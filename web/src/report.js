@@ -128,6 +128,7 @@ export function renderFacts(r) {
   if (r.light_selection) parts.push(`lights chosen by ${r.light_selection}`);
   if (r.light_sampling) parts.push(`sampled by ${r.light_sampling.replace('_', ' ')}`);
   if (r.pixel_sampler) parts.push(`${r.pixel_sampler} pixel samples`);
+  if (r.pixel_allocation === 'adaptive') parts.push('spread over the pixels by their neighbours\' error');
   if (r.max_depth) parts.push(`up to ${r.max_depth} bounces`);
   if (r.candidates) parts.push(`${r.candidates} candidates resampled`);
   return parts.join(', ');

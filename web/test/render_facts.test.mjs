@@ -14,3 +14,9 @@ test('a ris estimator says how many candidates it resamples; the others say noth
   assert.doesNotMatch(light, /candidates/);
   assert.match(light, /sampled by solid angle/);
 });
+
+test('an adaptive estimator says its samples are spread over the pixels; a uniform one does not', () => {
+  const adaptive = renderFacts({ strategy: 'mis_power', pixel_sampler: 'padded_sobol', pixel_allocation: 'adaptive' });
+  assert.equal(adaptive, 'strategy mis_power, padded_sobol pixel samples, spread over the pixels by their neighbours\' error');
+  assert.doesNotMatch(renderFacts({ strategy: 'mis_power', pixel_sampler: 'padded_sobol' }), /spread/);
+});
