@@ -234,6 +234,30 @@ TEST(RenderAdaptive, LowersTheErrorWhereItIsUneven) {
     EXPECT_GE(double(samples[1]), 0.9 * double(samples[0]));
 }
 
+// The progress an adaptive image reports runs once over the rows (two passes inside), never
+// back; returning false from it cancels the image.
+TEST(RenderAdaptive, ProgressRunsOnceOverTheRows) {
+    const Scene scene = slanted_quad_light();
+    RenderScene rs;
+    rs.build(scene);
+    RenderSettings st = centre_rays(16, 12, 16, 3);
+    std::vector<int> seen;
+    st.progress = [&](int done, int rows) {
+        EXPECT_EQ(rows, 12);
+        seen.push_back(done);
+        return true;
+    };
+    const RenderEstimator e = adaptive(RadianceStrategy::LightArea, PixelSamplerKind::Independent);
+    RenderImage im = render_image(rs, e, st);
+    EXPECT_FALSE(im.cancelled);
+    ASSERT_FALSE(seen.empty());
+    for (size_t i = 1; i < seen.size(); ++i) EXPECT_GE(seen[i], seen[i - 1]);
+    EXPECT_LE(seen.back(), 12);
+    EXPECT_GT(seen.back(), 6); // the second pass reported too
+    st.progress = [](int done, int) { return done < 3; };
+    EXPECT_TRUE(render_image(rs, e, st).cancelled);
+}
+
 // The render API: 'adaptive' with a sampler that cannot add samples to a pixel is an error
 // naming the samplers that can, as is 'adaptive' in the live view; an image reports its counts.
 TEST(RenderAdaptive, RenderApi) {

@@ -150,6 +150,9 @@ RenderImage render_adaptive(const RenderScene& rs, const RenderEstimator& est,
     RenderSettings first = settings;
     first.spp = adaptive_first_pass_spp(settings.spp);
     first.pixel_spp = nullptr;
+    // Progress runs once over the rows: the first pass is its first half, the second its rest.
+    if (settings.progress)
+        first.progress = [&](int done, int rows) { return settings.progress(done / 2, rows); };
     if (!render_pass(rs, est, first, band)) return band_image(band); // cancelled
     const auto start = std::chrono::steady_clock::now();
     double gain = 1.0;
@@ -160,6 +163,10 @@ RenderImage render_adaptive(const RenderScene& rs, const RenderEstimator& est,
     RenderSettings rest = settings;
     rest.spp = *highest; // the sampler's bound; each pixel stops at its own count
     rest.pixel_spp = &counts;
+    if (settings.progress)
+        rest.progress = [&](int done, int rows) {
+            return settings.progress(rows / 2 + (done + 1) / 2, rows);
+        };
     render_pass(rs, est, rest, band);
     RenderImage image = band_image(band);
     image.spp = settings.spp;
