@@ -37,37 +37,38 @@ std::vector<uint32_t> allocate_nets(const std::vector<double>& s, uint64_t lo, u
                                     double budget, uint64_t even) {
     int k_max = 0;
     while ((lo << (k_max + 1)) <= hi) ++k_max;
-    auto rounded = [&](double lambda_s) -> uint64_t {
-        if (!(lambda_s > double(lo))) return lo;
-        const long k = std::lround(std::log2(lambda_s / double(lo)));
-        return lo << std::clamp<long>(k, 0, k_max);
-    };
-    double s_min = INFINITY, s_max = 0.0;
-    for (double v : s)
-        if (v > 0.0) {
-            s_min = std::min(s_min, v);
-            s_max = std::max(s_max, v);
+    // In base-2 logarithms: k_i = round(L + l_i) clamped to [0, k_max], l_i = log2(s_i / lo),
+    // L = log2(lambda); a pixel that shows no error (s_i = 0) keeps lo.
+    std::vector<double> l(s.size(), -INFINITY);
+    double l_min = INFINITY, l_max = -INFINITY;
+    for (size_t i = 0; i < s.size(); ++i)
+        if (s[i] > 0.0) {
+            l[i] = std::log2(s[i] / double(lo));
+            l_min = std::min(l_min, l[i]);
+            l_max = std::max(l_max, l[i]);
         }
     std::vector<uint32_t> counts(s.size(), uint32_t(even));
-    if (!(s_max > 0.0)) return counts;
-    auto total = [&](double lambda) {
+    if (!(l_max > -INFINITY)) return counts;
+    auto k_of = [&](double L, double li) {
+        return int(std::clamp(std::floor(L + li + 0.5), 0.0, double(k_max)));
+    };
+    auto total = [&](double L) {
         double t = 0.0;
-        for (double v : s) t += double(rounded(lambda * v));
+        for (double li : l) t += double(lo << k_of(L, li));
         return t;
     };
-    // At lambda = lo / s_max every count is lo (within budget); past hi / s_min, every
-    // pixel with error is at hi.
-    double log_lo = std::log(double(lo) / s_max), log_hi = std::log(2.0 * double(hi) / s_min);
-    if (total(std::exp(log_hi)) <= budget) {
-        log_lo = log_hi;
+    // At L = -l_max - 1 every count is lo (within budget); at k_max + 1 - l_min every pixel
+    // with error is at hi.
+    double L_lo = -l_max - 1.0, L_hi = double(k_max) + 1.0 - l_min;
+    if (total(L_hi) <= budget) {
+        L_lo = L_hi;
     } else {
-        for (int it = 0; it < 60; ++it) { // total(exp(log_lo)) <= budget < total(exp(log_hi))
-            const double mid = 0.5 * (log_lo + log_hi);
-            (total(std::exp(mid)) <= budget ? log_lo : log_hi) = mid;
+        for (int it = 0; it < 40; ++it) { // total(L_lo) <= budget < total(L_hi)
+            const double mid = 0.5 * (L_lo + L_hi);
+            (total(mid) <= budget ? L_lo : L_hi) = mid;
         }
     }
-    const double lambda = std::exp(log_lo);
-    for (size_t i = 0; i < s.size(); ++i) counts[i] = uint32_t(rounded(lambda * s[i]));
+    for (size_t i = 0; i < s.size(); ++i) counts[i] = uint32_t(lo << k_of(L_lo, l[i]));
     return counts;
 }
 
