@@ -21,24 +21,19 @@ import os
 import subprocess
 import tempfile
 
+import sys
+
 import numpy as np
 
 ROOT = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), '..'))
+sys.path.insert(0, os.path.join(ROOT, 'bench', 'mitsuba'))
+from bench_mitsuba import luminance, read_pfm  # noqa: E402 (mitsuba itself is imported lazily)
 CASES = [
     ('quad_light_floor', 320, 240, ['light_solid_angle', 'mis_power', 'ris']),
     ('cornell_box', 128, 128, ['light_solid_angle', 'mis_power', 'ris']),
     ('veach_mis', 320, 180, ['light_solid_angle', 'mis_power', 'ris']),
     ('cornell_box_path', 128, 128, ['path']),
 ]
-
-
-def read_pfm(path):
-    with open(path, 'rb') as f:
-        assert f.readline().strip() == b'PF'
-        w, h = map(int, f.readline().split())
-        scale = float(f.readline())
-        data = np.frombuffer(f.read(), '<f4' if scale < 0 else '>f4').astype(np.float64)
-    return data.reshape(h, w, 3)[::-1]
 
 
 def estimator(strategy, allocation):
@@ -64,10 +59,6 @@ def render(exe, scene, est, spp, seed, w, h, threads, folder):
     pilots = sum(e[k]['seconds'] for k in ('split_pilot', 'candidate_pilot', 'emission_pilot')
                  if k in e)
     return read_pfm(out), r['seconds'] + pilots
-
-
-def luminance(img):
-    return 0.2126 * img[..., 0] + 0.7152 * img[..., 1] + 0.0722 * img[..., 2]
 
 
 def main():
