@@ -131,16 +131,21 @@ std::vector<uint32_t> allocate_pixel_samples(const ImageBand& first, uint64_t sp
         if (members.empty()) continue;
         const std::vector<uint32_t> n =
             allocate_nets(score, first.spp, hi, double(spp) * double(members.size()), spp);
+        double uniform = 0.0, spread = 0.0;
         for (size_t i = 0; i < members.size(); ++i) {
-            counts[members[i]] = n[i];
-            gain_uniform += relative[i] / double(spp);
-            gain_adaptive += relative[i] / double(n[i]);
+            uniform += relative[i] / double(spp);
+            spread += relative[i] / double(n[i]);
         }
+        // Where the pixels' errors hardly differ, moving samples gains less than the rounding
+        // to nets and the first pass's noise cost: every pixel of the colour takes spp. Decided
+        // per colour, from the other colour's first pass like the counts themselves.
+        const bool spread_pays = spread > 0.0 && uniform >= kAdaptiveMinGain * spread;
+        for (size_t i = 0; i < members.size(); ++i)
+            counts[members[i]] = spread_pays ? n[i] : uint32_t(spp);
+        gain_uniform += uniform;
+        gain_adaptive += spread_pays ? spread : uniform;
     }
     *predicted_gain = gain_adaptive > 0.0 ? gain_uniform / gain_adaptive : 1.0;
-    // Where the pixels' errors hardly differ, moving samples gains less than the rounding to
-    // nets and the first pass's noise cost: every pixel takes spp.
-    if (*predicted_gain < kAdaptiveMinGain) std::fill(counts.begin(), counts.end(), uint32_t(spp));
     return counts;
 }
 

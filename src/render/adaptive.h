@@ -9,7 +9,7 @@
 //
 // Unbiased by construction: a pixel's count depends only on the first pass of the pixels of
 // the other colour of a checkerboard (its four edge neighbours' error, that colour's mean
-// luminance), never on its own samples; its mean of n_i samples is then unbiased given n_i.
+// luminance, whether the spread pays for its colour at all), never on its own samples; its mean of n_i samples is then unbiased given n_i.
 // A count taken from the pixel's own first pass would tie how many samples it gets to what
 // they showed (a pixel whose first samples happened to be quiet would stop early).
 //
@@ -29,7 +29,8 @@ constexpr uint64_t kAdaptiveMinSpp = 8;
 /// A pixel takes at most this many times the image's spp.
 constexpr uint64_t kAdaptiveMaxFactor = 64;
 
-/// Below this predicted gain (allocate_pixel_samples) every pixel takes the image's spp.
+/// Below this predicted gain a checkerboard colour's pixels take the image's spp
+/// (allocate_pixel_samples).
 constexpr double kAdaptiveMinGain = 1.1;
 
 /// The first pass's samples per pixel for an adaptive image of `spp`: half, at least 4 (a
@@ -40,9 +41,10 @@ uint64_t adaptive_first_pass_spp(uint64_t spp);
 /// average, from `first`, a first pass over the whole image (first.spp samples per pixel,
 /// fewer than spp). Each colour of the checkerboard spends at most spp x its pixels (what the
 /// rounding to nets leaves over is not rendered). `kind`: the pixel sampler (how fast its
-/// error falls sets how far the counts spread). *predicted_gain: the relative MSE of spp
-/// everywhere over these counts', each pixel's error as its neighbours show it and falling as
-/// 1 / n; below kAdaptiveMinGain every count is spp.
+/// error falls sets how far the counts spread). A colour whose counts promise less than
+/// kAdaptiveMinGain x lower relative MSE (each pixel's error as its neighbours show it, falling
+/// as 1 / n) keeps spp everywhere. *predicted_gain: the relative MSE of spp everywhere over the
+/// counts', the same way.
 std::vector<uint32_t> allocate_pixel_samples(const ImageBand& first, uint64_t spp,
                                              PixelSamplerKind kind, double* predicted_gain);
 
