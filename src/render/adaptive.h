@@ -9,9 +9,10 @@
 //
 // Unbiased by construction: a pixel's count depends only on the first pass of the pixels of
 // the other colour of a checkerboard (its four edge neighbours' error, that colour's mean
-// luminance, whether the spread pays for its colour at all), never on its own samples; its mean of n_i samples is then unbiased given n_i.
-// A count taken from the pixel's own first pass would tie how many samples it gets to what
-// they showed (a pixel whose first samples happened to be quiet would stop early).
+// luminance, whether the spread pays for its colour at all), never on its own samples; its mean of
+// n_i samples is then unbiased given n_i. A count taken from the pixel's own first pass would tie
+// how many samples it gets to what they showed (a pixel whose first samples happened to be quiet
+// would stop early).
 //
 // The pixel sampler must extend a pixel's samples (independent, padded_sobol: sampler_extends).
 #pragma once
